@@ -1,0 +1,1 @@
+"""Tournaments, benchmarks, reports and plots, and the ``surveil`` command line."""

@@ -1,0 +1,49 @@
+"""Project exceptions.
+
+Every error a user can trigger with bad input is a :class:`SurveilValueError`, which
+subclasses :class:`ValueError`, so ``except ValueError`` keeps working. Messages name
+the offending value and say what was expected.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "InfeasibleError",
+    "InvalidActionError",
+    "InvalidConfigError",
+    "InvalidMapError",
+    "InvalidPlacementError",
+    "SurveilValueError",
+    "UnknownNameError",
+]
+
+
+class SurveilValueError(ValueError):
+    """Base class of every project exception caused by bad input."""
+
+
+class InvalidMapError(SurveilValueError):
+    """A map polygon is not simple, degenerate, outside the boundary or overlapping."""
+
+
+class InvalidConfigError(SurveilValueError):
+    """An environment, policy or tournament configuration value is out of range."""
+
+
+class InvalidPlacementError(SurveilValueError):
+    """Requested start positions do not form a valid surveillance configuration."""
+
+
+class InvalidActionError(SurveilValueError):
+    """An action is not finite or has the wrong shape."""
+
+
+class InfeasibleError(SurveilValueError):
+    """A requested computation has no solution for the given parameters."""
+
+
+class UnknownNameError(SurveilValueError, KeyError):
+    """A name (map, policy, observation kind...) is not registered."""
+
+    def __str__(self) -> str:  # KeyError would repr() the message
+        return str(self.args[0]) if self.args else ""

@@ -1,0 +1,389 @@
+"""The :class:`Map`: a bounded polygonal world, validated once, with precomputed arrays.
+
+Representation
+--------------
+A world is given as an outer boundary polygon and obstacle polygons. On construction it
+is normalised into its *free region*: one polygon with holes. Its boundary is stored as
+**walls**, closed rings oriented so that free space lies on the **left** of every edge
+(outer ring counter-clockwise, holes clockwise). With that single orientation:
+
+* the unit normal into free space of edge ``a -> b`` is the left normal ``(-dy, dx)``;
+* a vertex where the walls turn right is a **convex obstacle vertex** (the paper's
+  "reflex vertex", an angle bigger than pi measured in free space: a corner the rod can
+  wrap around); one where they turn left is a concave obstacle vertex (a room corner).
+
+A room given as a non-convex outer boundary and the same room given as a rectangle with
+obstacle blocks produce the same walls, so nothing downstream depends on which.
+
+Validation rule for touching polygons (see :data:`envs.tolerances.REL_GAP_TOL`): two
+obstacles closer than the gap tolerance, or an obstacle that comes that close to the
+boundary, are rejected with an :class:`~envs.errors.InvalidMapError` naming both, unless
+the map is built with ``merge=True``, in which case the free region is
+``boundary - union(obstacles)`` and must still be one connected polygon.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import shapely
+from shapely.geometry import Polygon
+
+from envs.errors import InvalidMapError
+from envs.tolerances import COLLINEAR_TOL, REL_GAP_TOL, REL_LENGTH_TOL
+
+__all__ = ["Feature", "Map"]
+
+
+@dataclass(frozen=True)
+class Feature:
+    """A wall feature of a map: a vertex or an edge, by its index in the map's arrays.
+
+    Attributes:
+        kind: ``"vertex"`` or ``"edge"``.
+        index: index into ``Map.vertices`` or ``Map.edge_start``.
+    """
+
+    kind: str
+    index: int
+
+    def __str__(self) -> str:
+        return f"{self.kind} {self.index}"
+
+
+def _as_ring(points: object, what: str) -> np.ndarray:
+    """Return ``points`` as an (n, 2) float array without a repeated closing vertex."""
+    try:
+        arr = np.asarray(points, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidMapError(f"{what}: expected a sequence of (x, y) pairs, got {points!r}") from exc
+    if arr.ndim != 2 or arr.shape[1] != 2:
+        raise InvalidMapError(f"{what}: expected an (n, 2) array of vertices, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise InvalidMapError(f"{what}: vertices must be finite, got {arr.tolist()}")
+    if len(arr) >= 2 and np.array_equal(arr[0], arr[-1]):
+        arr = arr[:-1]
+    if len(arr) < 3:
+        raise InvalidMapError(f"{what}: a polygon needs at least 3 distinct vertices, got {len(arr)}")
+    return arr
+
+
+def _clean_ring(ring: np.ndarray, scale: float, what: str) -> np.ndarray:
+    """Drop repeated and straight (collinear) vertices; reject degenerate rings."""
+    keep = np.linalg.norm(ring - np.roll(ring, 1, axis=0), axis=1) > REL_LENGTH_TOL * scale
+    ring = ring[keep]
+    changed = True
+    while changed and len(ring) >= 3:
+        prev_d = ring - np.roll(ring, 1, axis=0)
+        next_d = np.roll(ring, -1, axis=0) - ring
+        cross = prev_d[:, 0] * next_d[:, 1] - prev_d[:, 1] * next_d[:, 0]
+        dot = np.einsum("ij,ij->i", prev_d, next_d)
+        norms = np.linalg.norm(prev_d, axis=1) * np.linalg.norm(next_d, axis=1)
+        straight = (np.abs(cross) <= COLLINEAR_TOL * norms) & (dot > 0)
+        changed = bool(straight.any())
+        if changed:
+            ring = ring[~straight]
+    if len(ring) < 3:
+        raise InvalidMapError(f"{what}: degenerate polygon (fewer than 3 non-collinear vertices)")
+    return ring
+
+
+def _signed_area(ring: np.ndarray) -> float:
+    x, y = ring[:, 0], ring[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+
+
+class Map:
+    """A bounded polygonal world with precomputed wall arrays.
+
+    Args:
+        boundary: outer boundary polygon, (n, 2) vertices in either orientation.
+        obstacles: obstacle polygons, each (m, 2), strictly inside the boundary.
+        name: a label used in reports and error messages.
+        merge: merge touching or overlapping obstacles (and obstacles touching the
+            boundary) instead of rejecting them.
+
+    Raises:
+        InvalidMapError: naming the offending polygon and why it is invalid.
+
+    Attributes:
+        vertices: (V, 2) all wall vertices, ring after ring.
+        vertex_ring: (V,) index of the ring of each vertex (0 = outer boundary).
+        vertex_convex: (V,) True at convex obstacle vertices (free-space reflex).
+        vertex_prev_edge, vertex_next_edge: (V,) the two wall edges at each vertex.
+        edge_start, edge_end: (E,) endpoints of each wall edge (E = V; free on the left).
+        edge_dir, edge_normal, edge_length: unit direction, unit normal into free space,
+            length of each edge.
+        rings: tuple of (n_i, 2) arrays, the walls ring by ring.
+
+    Examples:
+        >>> m = Map([(0, 0), (4, 0), (4, 4), (0, 4)], [[(1, 1), (2, 1), (2, 2), (1, 2)]])
+        >>> m.n_vertices, int(m.vertex_convex.sum())
+        (8, 4)
+        >>> bool(m.contains([[0.5, 0.5]])[0]), bool(m.contains([[1.5, 1.5]])[0])
+        (True, False)
+    """
+
+    def __init__(
+        self,
+        boundary: Sequence[Sequence[float]] | np.ndarray,
+        obstacles: Sequence[Sequence[Sequence[float]] | np.ndarray] = (),
+        *,
+        name: str = "custom",
+        merge: bool = False,
+    ) -> None:
+        self.name = str(name)
+        b = _as_ring(boundary, "boundary")
+        span = float(np.linalg.norm(b.max(axis=0) - b.min(axis=0)))
+        if span <= 0:
+            raise InvalidMapError("boundary: degenerate polygon (zero extent)")
+        self.scale = span
+        b = _clean_ring(b, span, "boundary")
+        obs = [
+            _clean_ring(_as_ring(o, f"obstacle {i}"), span, f"obstacle {i}")
+            for i, o in enumerate(obstacles)
+        ]
+        self.merged = bool(merge)
+        self.boundary = b
+        self.obstacles = tuple(obs)
+        self._free = self._build_free_region(b, obs, merge)
+        self._build_arrays()
+
+    # ------------------------------------------------------------------ validation
+    def _polygon(self, ring: np.ndarray, what: str) -> Polygon:
+        poly = Polygon(ring)
+        if not poly.is_valid or not poly.exterior.is_simple:
+            reason = shapely.is_valid_reason(poly)
+            raise InvalidMapError(f"{what}: polygon is not simple ({reason})")
+        if poly.area <= (REL_LENGTH_TOL * self.scale) ** 2 * 1e3:
+            raise InvalidMapError(f"{what}: degenerate polygon (area {poly.area:g})")
+        return poly
+
+    def _build_free_region(
+        self, b: np.ndarray, obs: list[np.ndarray], merge: bool
+    ) -> Polygon:
+        outer = self._polygon(b, "boundary")
+        gap = REL_GAP_TOL * self.scale
+        polys = [self._polygon(o, f"obstacle {i}") for i, o in enumerate(obs)]
+        for i, p in enumerate(polys):
+            if not outer.buffer(gap * 0.5).contains(p):
+                raise InvalidMapError(
+                    f"obstacle {i}: not inside the boundary (bounds {p.bounds}, "
+                    f"boundary bounds {outer.bounds})"
+                )
+        if not merge:
+            for i, p in enumerate(polys):
+                if outer.exterior.distance(p) <= gap:
+                    raise InvalidMapError(
+                        f"obstacle {i}: touches the boundary (distance "
+                        f"{outer.exterior.distance(p):g} <= gap tolerance {gap:g}); "
+                        "merge it into the boundary or build the map with merge=True"
+                    )
+            tree = shapely.STRtree(polys)
+            for i, p in enumerate(polys):
+                for j in tree.query(p.buffer(gap)):
+                    j = int(j)
+                    if j > i and p.distance(polys[j]) <= gap:
+                        what = "overlaps" if p.intersects(polys[j]) else "touches"
+                        raise InvalidMapError(
+                            f"obstacle {i} {what} obstacle {j} (distance "
+                            f"{p.distance(polys[j]):g} <= gap tolerance {gap:g}); "
+                            "build the map with merge=True to replace them by their union"
+                        )
+            return Polygon(outer.exterior.coords, [q.exterior.coords for q in polys])
+        # merge: subtract the exact union, then an opening (erode, dilate by half the
+        # gap tolerance, mitred so corners come back) removes slits thinner than the gap
+        if not polys:
+            return outer
+        free = outer.difference(shapely.union_all(polys))
+        free = free.buffer(-0.5 * gap, join_style="mitre").buffer(0.5 * gap, join_style="mitre")
+        # snap to a power-of-ten grid about 10x the gap, so that (10 +- 1e-8) -> 10
+        grid = 10.0 ** np.floor(np.log10(REL_GAP_TOL * self.scale * 10))
+        free = shapely.set_precision(free, grid)
+        if free.geom_type != "Polygon":
+            parts = getattr(free, "geoms", [free])
+            raise InvalidMapError(
+                f"merged map: free space splits into {len(parts)} disconnected parts; "
+                "the pursuer and evader need one connected free region"
+            )
+        return free
+
+    def _build_arrays(self) -> None:
+        free = shapely.orient_polygons(self._free, exterior_cw=False)
+        rings = [np.asarray(free.exterior.coords)[:-1]]
+        rings += [np.asarray(r.coords)[:-1] for r in free.interiors]
+        rings = [_clean_ring(r, self.scale, f"ring {k}") for k, r in enumerate(rings)]
+        # free space on the left: outer ring CCW, holes CW
+        for k, r in enumerate(rings):
+            area = _signed_area(r)
+            if (k == 0) != (area > 0):
+                rings[k] = r[::-1].copy()
+        self.rings: tuple[np.ndarray, ...] = tuple(rings)
+        self._free = Polygon(rings[0], rings[1:])
+        verts, vring, prev_e, next_e = [], [], [], []
+        offset = 0
+        for k, r in enumerate(rings):
+            n = len(r)
+            verts.append(r)
+            vring.append(np.full(n, k))
+            idx = np.arange(n)
+            next_e.append(offset + idx)
+            prev_e.append(offset + (idx - 1) % n)
+            offset += n
+        self.vertices = np.concatenate(verts)
+        self.vertex_ring = np.concatenate(vring)
+        self.vertex_next_edge = np.concatenate(next_e)
+        self.vertex_prev_edge = np.concatenate(prev_e)
+        nxt = np.concatenate([offset_i + (np.arange(len(r)) + 1) % len(r)
+                              for offset_i, r in zip(np.cumsum([0] + [len(r) for r in rings[:-1]]), rings)])
+        self.edge_start = self.vertices.copy()
+        self.edge_end = self.vertices[nxt]
+        self.edge_vertices = np.stack([np.arange(len(self.vertices)), nxt], axis=1)
+        d = self.edge_end - self.edge_start
+        self.edge_length = np.linalg.norm(d, axis=1)
+        self.edge_dir = d / self.edge_length[:, None]
+        self.edge_normal = np.stack([-self.edge_dir[:, 1], self.edge_dir[:, 0]], axis=1)
+        self.edge_ring = self.vertex_ring.copy()
+        din = self.edge_dir[self.vertex_prev_edge]
+        dout = self.edge_dir[self.vertex_next_edge]
+        turn = din[:, 0] * dout[:, 1] - din[:, 1] * dout[:, 0]
+        self.vertex_convex = turn < 0
+        for arr in (
+            self.vertices, self.vertex_ring, self.vertex_next_edge, self.vertex_prev_edge,
+            self.edge_start, self.edge_end, self.edge_vertices, self.edge_length,
+            self.edge_dir, self.edge_normal, self.edge_ring, self.vertex_convex,
+        ):
+            arr.setflags(write=False)
+        for r in self.rings:
+            r.setflags(write=False)
+
+    # ------------------------------------------------------------------ queries
+    @property
+    def n_vertices(self) -> int:
+        """Number of wall vertices (= number of wall edges)."""
+        return len(self.vertices)
+
+    @property
+    def n_edges(self) -> int:
+        """Number of wall edges."""
+        return len(self.edge_start)
+
+    @property
+    def bounds(self) -> tuple[float, float, float, float]:
+        """``(xmin, ymin, xmax, ymax)`` of the boundary."""
+        lo = self.rings[0].min(axis=0)
+        hi = self.rings[0].max(axis=0)
+        return (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
+
+    @property
+    def free_region(self) -> Polygon:
+        """The free region as a shapely polygon (for set-up code, not the hot path)."""
+        return self._free
+
+    @functools.cached_property
+    def prepared_free_region(self) -> Polygon:
+        """The free region, prepared for fast repeated shapely predicates."""
+        poly = Polygon(self._free.exterior.coords, [r.coords for r in self._free.interiors])
+        shapely.prepare(poly)
+        return poly
+
+    @property
+    def convex_vertices(self) -> np.ndarray:
+        """Indices of the convex obstacle vertices (corners the rod can wrap around)."""
+        return np.flatnonzero(self.vertex_convex)
+
+    def contains(self, points: np.ndarray | Sequence[Sequence[float]]) -> np.ndarray:
+        """Return which points lie in the closed free region (even-odd rule over walls).
+
+        Args:
+            points: (k, 2) array of points.
+
+        Returns:
+            (k,) bool array.
+        """
+        p = np.atleast_2d(np.asarray(points, dtype=float))
+        a = self.edge_start[None, :, :]
+        b = self.edge_end[None, :, :]
+        px = p[:, None, 0]
+        py = p[:, None, 1]
+        cond = (a[..., 1] > py) != (b[..., 1] > py)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            xint = a[..., 0] + (py - a[..., 1]) * (b[..., 0] - a[..., 0]) / (b[..., 1] - a[..., 1])
+        inside = np.count_nonzero(cond & (px < xint), axis=1) % 2 == 1
+        return inside | (self.distance_to_walls(p) <= REL_LENGTH_TOL * self.scale)
+
+    def distance_to_walls(self, points: np.ndarray | Sequence[Sequence[float]]) -> np.ndarray:
+        """Euclidean distance from each point to the nearest wall edge."""
+        p = np.atleast_2d(np.asarray(points, dtype=float))
+        rel = p[:, None, :] - self.edge_start[None, :, :]
+        t = np.clip(np.einsum("kej,ej->ke", rel, self.edge_dir), 0.0, self.edge_length)
+        closest = self.edge_start[None] + t[..., None] * self.edge_dir[None]
+        return np.linalg.norm(p[:, None, :] - closest, axis=2).min(axis=1)
+
+    def describe(self, feature: Feature) -> str:
+        """Human-readable description of a wall feature, e.g. ``"convex vertex 3 (1, 2)"``."""
+        if feature.kind == "vertex":
+            v = self.vertices[feature.index]
+            kind = "convex" if self.vertex_convex[feature.index] else "concave"
+            return f"{kind} vertex {feature.index} ({v[0]:.6g}, {v[1]:.6g})"
+        a, b = self.edge_start[feature.index], self.edge_end[feature.index]
+        return (
+            f"edge {feature.index} ({a[0]:.6g}, {a[1]:.6g})-({b[0]:.6g}, {b[1]:.6g})"
+        )
+
+    # ------------------------------------------------------------------ identity
+    def to_dict(self) -> dict:
+        """Our JSON schema (``envs.maps.io``): name, boundary, obstacles, merge."""
+        return {
+            "name": self.name,
+            "boundary": self.boundary.tolist(),
+            "obstacles": [o.tolist() for o in self.obstacles],
+            "merge": self.merged,
+        }
+
+    @functools.cached_property
+    def digest(self) -> str:
+        """SHA-256 of the wall geometry; equal maps have equal digests (cache keys)."""
+        h = hashlib.sha256()
+        for r in self.rings:
+            h.update(np.ascontiguousarray(r, dtype="<f8").tobytes())
+            h.update(b"|")
+        return h.hexdigest()
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Map) and self.digest == other.digest
+
+    def __hash__(self) -> int:
+        return hash(self.digest)
+
+    def __repr__(self) -> str:
+        return (
+            f"Map(name={self.name!r}, rings={len(self.rings)}, vertices={self.n_vertices}, "
+            f"bounds={tuple(round(v, 6) for v in self.bounds)})"
+        )
+
+    def __reduce__(self):  # pickles by value, so maps cross process boundaries
+        return (_rebuild, (json.dumps(self.to_dict()),))
+
+    # ------------------------------------------------------------------ transforms
+    def transformed(self, matrix: np.ndarray | Sequence[Sequence[float]], offset=(0.0, 0.0)) -> Map:
+        """Return the map under ``x -> matrix @ x + offset`` (a similarity, for tests).
+
+        Args:
+            matrix: 2x2 linear part (rotation times uniform scale; a reflection is allowed).
+            offset: translation.
+        """
+        m = np.asarray(matrix, dtype=float)
+        o = np.asarray(offset, dtype=float)
+        f = lambda r: r @ m.T + o  # noqa: E731
+        return Map(f(self.boundary), [f(q) for q in self.obstacles], name=self.name, merge=self.merged)
+
+
+def _rebuild(payload: str) -> Map:
+    d = json.loads(payload)
+    return Map(d["boundary"], d["obstacles"], name=d["name"], merge=d.get("merge", False))

@@ -1,0 +1,1 @@
+"""Every policy (analytic, baseline, learned-policy loader) and the theory they stand on."""

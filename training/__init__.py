@@ -1,0 +1,1 @@
+"""Learned policies: single-agent wrappers, SB3 training, self-play and the model zoo."""

@@ -1,0 +1,175 @@
+"""The ``surveil`` command line.
+
+``surveil play`` is the main job: one episode on a built-in world between two registered
+policies, its outcome printed and its replay written to a GIF. The other subcommands list
+maps, draw the configuration-space decomposition of a world, draw the optimal-control
+figures of the paper, and evaluate policies against each other.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+__all__ = ["build_parser", "main"]
+
+DEFAULT_OUT = Path("out")
+
+
+def _cmd_maps(args: argparse.Namespace) -> int:
+    from envs.maps import builtin_info, builtin_names
+
+    for name in builtin_names():
+        info = builtin_info(name)
+        m = info.map
+        print(
+            f"{name:<12} {m.n_vertices:>4} vertices  L_min={info.l_min:g} L_max={info.l_max:g} "
+            f"v_p={info.v_pursuer:g} v_e={info.v_evader:g}  {info.description}"
+        )
+        if args.plot:
+            from envs.maps.plot import plot_map
+
+            out = Path(args.plot)
+            out.mkdir(parents=True, exist_ok=True)
+            plot_map(m, path=out / f"{name}.png")
+    if args.plot:
+        print(f"wrote map pictures to {args.plot}/")
+    return 0
+
+
+def _cmd_play(args: argparse.Namespace) -> int:
+    from analysis.evaluate import play_episode
+    from analysis.replay import write_replay
+
+    overrides = json.loads(args.config) if args.config else {}
+    result = play_episode(
+        args.map,
+        args.pursuer,
+        args.evader,
+        seed=args.seed,
+        max_cycles=args.max_cycles,
+        overrides=overrides,
+        record=not args.no_gif,
+    )
+    print(result.summary())
+    if not args.no_gif:
+        out = Path(args.out)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        write_replay(result, out, decomposition=args.overlay, fps=args.fps)
+        print(f"replay written to {out}")
+    return 0
+
+
+def _cmd_analyze(args: argparse.Namespace) -> int:
+    from envs.maps import load_map
+    from strategies.cspace import decompose, draw_decomposition
+
+    world = load_map(args.map)
+    length = args.length if args.length is not None else _default_length(args.map)
+    dec = decompose(world, length)
+    out = Path(args.out or DEFAULT_OUT / f"decomposition_{world.name}_L{length:g}.png")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    draw_decomposition(dec, out, show_graph=not args.no_graph)
+    print(dec.summary() if hasattr(dec, "summary") else repr(dec))
+    print(f"picture written to {out}")
+    return 0
+
+
+def _default_length(map_name: str) -> float:
+    from envs.maps import builtin_info, builtin_names
+
+    if map_name in builtin_names():
+        return builtin_info(map_name).l_min
+    raise SystemExit(f"surveil: --length is required for map {map_name!r} (not a built-in)")
+
+
+def _cmd_figure(args: argparse.Namespace) -> int:
+    from strategies.control.figures import draw_figure
+
+    params = json.loads(args.params) if args.params else {}
+    out = Path(args.out or DEFAULT_OUT / f"figure_{args.name}.png")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    draw_figure(args.name, out, **params)
+    print(f"figure written to {out}")
+    return 0
+
+
+def _cmd_evaluate(args: argparse.Namespace) -> int:
+    from analysis.evaluate import evaluate, format_table
+
+    table = evaluate(
+        maps=args.maps,
+        pursuers=args.pursuers,
+        evaders=args.evaders,
+        seeds=range(args.seeds),
+        max_cycles=args.max_cycles,
+        results_path=Path(args.results) if args.results else None,
+    )
+    print(format_table(table))
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """Return the argument parser of the ``surveil`` command."""
+    parser = argparse.ArgumentParser(
+        prog="surveil",
+        description="Visibility-based surveillance with a finite sensor range.",
+    )
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("maps", help="list the built-in maps")
+    p.add_argument("--plot", metavar="DIR", help="also draw each map to DIR/NAME.png")
+    p.set_defaults(func=_cmd_maps)
+
+    p = sub.add_parser("play", help="play one episode and write its replay (the main job)")
+    p.add_argument("--map", default="corridor", help="built-in name or map file (default: corridor)")
+    p.add_argument("--pursuer", default="pursuer/decomposition", help="registered pursuer policy")
+    p.add_argument("--evader", default="evader/shooting", help="registered evader policy")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--max-cycles", type=int, default=None, help="episode horizon in steps")
+    p.add_argument("--config", help='env overrides as JSON, e.g. \'{"v_evader": 0.8}\'')
+    p.add_argument("--out", default=str(DEFAULT_OUT / "play.gif"), help="GIF path")
+    p.add_argument("--fps", type=int, default=20)
+    p.add_argument("--overlay", action="store_true", help="draw the decomposition under the replay")
+    p.add_argument("--no-gif", action="store_true", help="only print the outcome")
+    p.set_defaults(func=_cmd_play)
+
+    p = sub.add_parser("analyze", help="draw the critical curves, regions and graph G_L")
+    p.add_argument("map", help="built-in name or map file")
+    p.add_argument("--length", type=float, default=None, help="rod length L (default: L_min)")
+    p.add_argument("--out", help="PNG path")
+    p.add_argument("--no-graph", action="store_true", help="omit the connectivity graph panel")
+    p.set_defaults(func=_cmd_analyze)
+
+    p = sub.add_parser("figure", help="draw the paper's optimal-control figures")
+    p.add_argument("name", choices=["shooting", "greedy", "tractrix"])
+    p.add_argument("--params", help='parameters as JSON, e.g. \'{"rho": 0.5}\'')
+    p.add_argument("--out", help="PNG path")
+    p.set_defaults(func=_cmd_figure)
+
+    p = sub.add_parser("evaluate", help="play every pursuer against every evader")
+    p.add_argument("--maps", nargs="+", default=["corridor", "two_rooms"])
+    p.add_argument("--pursuers", nargs="+", default=["pursuer/decomposition", "pursuer/greedy"])
+    p.add_argument("--evaders", nargs="+", default=["evader/shooting", "evader/straight"])
+    p.add_argument("--seeds", type=int, default=10, help="number of seeded starts per match")
+    p.add_argument("--max-cycles", type=int, default=None)
+    p.add_argument("--results", help="JSONL file written as matches finish (resumable)")
+    p.set_defaults(func=_cmd_evaluate)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``surveil`` console script."""
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except ValueError as exc:  # project errors subclass ValueError and name the bad value
+        print(f"surveil: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -61,15 +61,21 @@ def _as_ring(points: object, what: str) -> np.ndarray:
     try:
         arr = np.asarray(points, dtype=float)
     except (TypeError, ValueError) as exc:
-        raise InvalidMapError(f"{what}: expected a sequence of (x, y) pairs, got {points!r}") from exc
+        raise InvalidMapError(
+            f"{what}: expected a sequence of (x, y) pairs, got {points!r}"
+        ) from exc
     if arr.ndim != 2 or arr.shape[1] != 2:
-        raise InvalidMapError(f"{what}: expected an (n, 2) array of vertices, got shape {arr.shape}")
+        raise InvalidMapError(
+            f"{what}: expected an (n, 2) array of vertices, got shape {arr.shape}"
+        )
     if not np.all(np.isfinite(arr)):
         raise InvalidMapError(f"{what}: vertices must be finite, got {arr.tolist()}")
     if len(arr) >= 2 and np.array_equal(arr[0], arr[-1]):
         arr = arr[:-1]
     if len(arr) < 3:
-        raise InvalidMapError(f"{what}: a polygon needs at least 3 distinct vertices, got {len(arr)}")
+        raise InvalidMapError(
+            f"{what}: a polygon needs at least 3 distinct vertices, got {len(arr)}"
+        )
     return arr
 
 
@@ -164,16 +170,15 @@ class Map:
             raise InvalidMapError(f"{what}: degenerate polygon (area {poly.area:g})")
         return poly
 
-    def _build_free_region(
-        self, b: np.ndarray, obs: list[np.ndarray], merge: bool
-    ) -> Polygon:
+    def _build_free_region(self, b: np.ndarray, obs: list[np.ndarray], merge: bool) -> Polygon:
         outer = self._polygon(b, "boundary")
         gap = REL_GAP_TOL * self.scale
         polys = [self._polygon(o, f"obstacle {i}") for i, o in enumerate(obs)]
         for i, p in enumerate(polys):
             if not outer.buffer(gap * 0.5).contains(p):
+                where = "crosses it" if p.intersects(outer) else "lies outside it"
                 raise InvalidMapError(
-                    f"obstacle {i}: not inside the boundary (bounds {p.bounds}, "
+                    f"obstacle {i}: not inside the boundary ({where}; bounds {p.bounds}, "
                     f"boundary bounds {outer.bounds})"
                 )
         if not merge:
@@ -189,7 +194,9 @@ class Map:
                 for j in tree.query(p.buffer(gap)):
                     j = int(j)
                     if j > i and p.distance(polys[j]) <= gap:
-                        what = "overlaps" if p.intersects(polys[j]) else "touches"
+                        # interiors meet: overlap; only boundaries (or a sub-tolerance gap): touch
+                        overlap = p.relate_pattern(polys[j], "T********")
+                        what = "overlaps" if overlap else "touches"
                         raise InvalidMapError(
                             f"obstacle {i} {what} obstacle {j} (distance "
                             f"{p.distance(polys[j]):g} <= gap tolerance {gap:g}); "
@@ -201,6 +208,10 @@ class Map:
         if not polys:
             return outer
         free = outer.difference(shapely.union_all(polys))
+        if free.is_empty or free.area <= (REL_LENGTH_TOL * self.scale) ** 2 * 1e3:
+            raise InvalidMapError(
+                "merged map: the obstacles cover the whole boundary (no free space)"
+            )
         free = free.buffer(-0.5 * gap, join_style="mitre").buffer(0.5 * gap, join_style="mitre")
         # snap to a power-of-ten grid about 10x the gap, so that (10 +- 1e-8) -> 10
         grid = 10.0 ** np.floor(np.log10(REL_GAP_TOL * self.scale * 10))
@@ -239,8 +250,14 @@ class Map:
         self.vertex_ring = np.concatenate(vring)
         self.vertex_next_edge = np.concatenate(next_e)
         self.vertex_prev_edge = np.concatenate(prev_e)
-        nxt = np.concatenate([offset_i + (np.arange(len(r)) + 1) % len(r)
-                              for offset_i, r in zip(np.cumsum([0] + [len(r) for r in rings[:-1]]), rings)])
+        nxt = np.concatenate(
+            [
+                offset_i + (np.arange(len(r)) + 1) % len(r)
+                for offset_i, r in zip(
+                    np.cumsum([0] + [len(r) for r in rings[:-1]]), rings, strict=True
+                )
+            ]
+        )
         self.edge_start = self.vertices.copy()
         self.edge_end = self.vertices[nxt]
         self.edge_vertices = np.stack([np.arange(len(self.vertices)), nxt], axis=1)
@@ -254,9 +271,18 @@ class Map:
         turn = din[:, 0] * dout[:, 1] - din[:, 1] * dout[:, 0]
         self.vertex_convex = turn < 0
         for arr in (
-            self.vertices, self.vertex_ring, self.vertex_next_edge, self.vertex_prev_edge,
-            self.edge_start, self.edge_end, self.edge_vertices, self.edge_length,
-            self.edge_dir, self.edge_normal, self.edge_ring, self.vertex_convex,
+            self.vertices,
+            self.vertex_ring,
+            self.vertex_next_edge,
+            self.vertex_prev_edge,
+            self.edge_start,
+            self.edge_end,
+            self.edge_vertices,
+            self.edge_length,
+            self.edge_dir,
+            self.edge_normal,
+            self.edge_ring,
+            self.vertex_convex,
         ):
             arr.setflags(write=False)
         for r in self.rings:
@@ -332,9 +358,7 @@ class Map:
             kind = "convex" if self.vertex_convex[feature.index] else "concave"
             return f"{kind} vertex {feature.index} ({v[0]:.6g}, {v[1]:.6g})"
         a, b = self.edge_start[feature.index], self.edge_end[feature.index]
-        return (
-            f"edge {feature.index} ({a[0]:.6g}, {a[1]:.6g})-({b[0]:.6g}, {b[1]:.6g})"
-        )
+        return f"edge {feature.index} ({a[0]:.6g}, {a[1]:.6g})-({b[0]:.6g}, {b[1]:.6g})"
 
     # ------------------------------------------------------------------ identity
     def to_dict(self) -> dict:
@@ -348,10 +372,21 @@ class Map:
 
     @functools.cached_property
     def digest(self) -> str:
-        """SHA-256 of the wall geometry; equal maps have equal digests (cache keys)."""
+        """SHA-256 of the wall geometry; equal maps have equal digests (cache keys).
+
+        Independent of where each ring starts and of the order of the holes, so the same
+        world given with its polygons listed differently has the same digest.
+        """
+
+        def canonical(r: np.ndarray) -> bytes:
+            r = np.ascontiguousarray(r, dtype="<f8") + 0.0  # + 0.0 turns -0.0 into 0.0
+            first = int(np.lexsort((r[:, 1], r[:, 0]))[0])  # lowest x, then lowest y
+            return np.roll(r, -first, axis=0).tobytes()
+
+        keys = [canonical(r) for r in self.rings]
         h = hashlib.sha256()
-        for r in self.rings:
-            h.update(np.ascontiguousarray(r, dtype="<f8").tobytes())
+        for key in [keys[0], *sorted(keys[1:])]:
+            h.update(key)
             h.update(b"|")
         return h.hexdigest()
 
@@ -380,8 +415,10 @@ class Map:
         """
         m = np.asarray(matrix, dtype=float)
         o = np.asarray(offset, dtype=float)
-        f = lambda r: r @ m.T + o  # noqa: E731
-        return Map(f(self.boundary), [f(q) for q in self.obstacles], name=self.name, merge=self.merged)
+        f = lambda r: r @ m.T + o
+        return Map(
+            f(self.boundary), [f(q) for q in self.obstacles], name=self.name, merge=self.merged
+        )
 
 
 def _rebuild(payload: str) -> Map:

@@ -1,0 +1,446 @@
+"""Tests of the :class:`Map` world model against shapely as the independent oracle."""
+
+from __future__ import annotations
+
+import math
+import pickle
+
+import numpy as np
+import pytest
+import shapely
+from shapely.geometry import Point, Polygon
+
+from envs.errors import InvalidMapError
+from envs.maps import Map
+from envs.tolerances import REL_GAP_TOL
+
+ROOM = [(0.0, 0.0), (10.0, 0.0), (10.0, 10.0), (0.0, 10.0)]
+
+
+def box(x0: float, y0: float, x1: float, y1: float) -> list[tuple[float, float]]:
+    return [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
+
+
+def regular(cx: float, cy: float, r: float, n: int, phase: float = 0.0) -> np.ndarray:
+    a = phase + 2 * np.pi * np.arange(n) / n
+    return np.stack([cx + r * np.cos(a), cy + r * np.sin(a)], axis=1)
+
+
+def rings_equal_up_to_rotation(a: np.ndarray, b: np.ndarray, tol: float = 1e-9) -> bool:
+    if a.shape != b.shape:
+        return False
+    return any(np.allclose(np.roll(a, k, axis=0), b, atol=tol) for k in range(len(a)))
+
+
+def walls_equal(m1: Map, m2: Map, tol: float = 1e-9) -> bool:
+    """Same outer ring and the same set of holes, each up to where the ring starts."""
+    if len(m1.rings) != len(m2.rings):
+        return False
+    if not rings_equal_up_to_rotation(m1.rings[0], m2.rings[0], tol):
+        return False
+    unmatched = list(m2.rings[1:])
+    for r in m1.rings[1:]:
+        hit = next(
+            (k for k, s in enumerate(unmatched) if rings_equal_up_to_rotation(r, s, tol)), None
+        )
+        if hit is None:
+            return False
+        unmatched.pop(hit)
+    return True
+
+
+# A set of valid worlds reused by the property tests below.
+WORLDS = {
+    "room_square": Map(ROOM, [box(4, 4, 6, 6)]),
+    "pillars": Map(
+        box(0, 0, 20, 12),
+        [
+            box(2, 2, 4, 4),
+            [(8, 2), (11, 2), (9.5, 5)],
+            regular(15, 6, 2, 6),
+            regular(6, 9, 1.5, 5, 0.3),
+        ],
+    ),
+    "corridor": Map(
+        [(0, -5), (10, -5), (10, 5), (0, 5), (0, 0.5), (-6, 0.5), (-6, -0.5), (0, -0.5)]
+    ),
+    "star_hole": Map(
+        box(-5, -5, 5, 5),
+        [[(0, 3), (0.8, 0.8), (3, 0), (0.8, -0.8), (0, -3), (-0.8, -0.8), (-3, 0), (-0.8, 0.8)]],
+    ),
+    "merged": Map(ROOM, [box(2, 2, 5, 4), box(4, 3, 6, 7), box(0, 8, 3, 9)], merge=True),
+}
+
+
+# ---------------------------------------------------------------------- validation
+@pytest.mark.parametrize(
+    ("boundary", "obstacles", "pattern"),
+    [
+        pytest.param(
+            [(0, 0), (10, 10), (10, 0), (0, 10)],
+            [],
+            r"boundary: .*not simple",
+            id="bowtie-boundary",
+        ),
+        pytest.param(
+            ROOM,
+            [[(1, 1), (3, 3), (3, 1), (1, 3)]],
+            r"obstacle 0: .*not simple",
+            id="bowtie-obstacle",
+        ),
+        pytest.param(ROOM, [[(1, 1), (2, 1), (3, 1)]], r"obstacle 0: degenerate", id="collinear"),
+        pytest.param(
+            ROOM, [[(1, 1), (2, 2), (3, 3), (4, 4)]], r"obstacle 0: degenerate", id="collinear-4"
+        ),
+        pytest.param(ROOM, [[(1, 1), (2, 1)]], r"obstacle 0: .*at least 3", id="two-vertices"),
+        pytest.param(
+            ROOM,
+            [[(1, 1), (1, 1), (1, 1)]],
+            r"obstacle 0: .*(at least 3|degenerate)",
+            id="one-point",
+        ),
+        pytest.param(
+            ROOM, [[(1, 1), (2, float("nan")), (3, 3)]], r"obstacle 0: .*finite", id="nan"
+        ),
+        pytest.param(
+            ROOM, [[(1, 1), (2, float("inf")), (3, 3)]], r"obstacle 0: .*finite", id="inf"
+        ),
+        pytest.param(
+            [(0, 0), (1, 0), (2, 0)], [], r"boundary: degenerate", id="collinear-boundary"
+        ),
+        pytest.param(
+            [(0, 0), (1, 1), (float("nan"), 0)], [], r"boundary: .*finite", id="nan-boundary"
+        ),
+        pytest.param(ROOM, [[1, 2, 3]], r"obstacle 0: .*\(n, 2\)", id="bad-shape"),
+        pytest.param(
+            ROOM,
+            [box(11, 11, 12, 12)],
+            r"obstacle 0: not inside the boundary \(lies outside",
+            id="outside",
+        ),
+        pytest.param(
+            ROOM,
+            [box(9, 1, 11, 2)],
+            r"obstacle 0: not inside the boundary \(crosses",
+            id="crossing",
+        ),
+        pytest.param(
+            ROOM,
+            [box(1, 1, 2, 2), box(-1, 4, 1, 5)],
+            r"obstacle 1: not inside",
+            id="second-crossing",
+        ),
+        pytest.param(
+            ROOM,
+            [box(1, 1, 3, 3), box(2, 2, 4, 4)],
+            r"obstacle 0 overlaps obstacle 1",
+            id="overlap",
+        ),
+        pytest.param(
+            ROOM, [box(1, 1, 5, 5), box(2, 2, 3, 3)], r"obstacle 0 overlaps obstacle 1", id="nested"
+        ),
+        pytest.param(
+            ROOM,
+            [box(1, 1, 3, 3), box(3, 1, 5, 3)],
+            r"obstacle 0 touches obstacle 1",
+            id="shared-edge",
+        ),
+        pytest.param(
+            ROOM,
+            [box(1, 1, 3, 3), box(3, 3, 5, 5)],
+            r"obstacle 0 touches obstacle 1",
+            id="shared-vertex",
+        ),
+        pytest.param(
+            ROOM,
+            [box(6, 6, 7, 7), box(1, 1, 3, 3), box(3 + 1e-8, 1, 5, 3)],
+            r"obstacle 1 touches obstacle 2",
+            id="tiny-gap",
+        ),
+        pytest.param(
+            ROOM, [box(0, 1, 2, 2)], r"obstacle 0: touches the boundary", id="touch-boundary-edge"
+        ),
+        pytest.param(
+            ROOM,
+            [[(5, 0), (6, 1), (5, 2), (4, 1)]],
+            r"obstacle 0: touches the boundary",
+            id="touch-boundary-vertex",
+        ),
+        pytest.param(
+            ROOM, [box(1e-8, 1, 2, 2)], r"obstacle 0: touches the boundary", id="near-boundary"
+        ),
+    ],
+)
+def test_invalid_maps_raise_naming_polygon_and_reason(boundary, obstacles, pattern):
+    with pytest.raises(InvalidMapError, match=pattern):
+        Map(boundary, obstacles)
+
+
+def test_errors_are_value_errors():
+    with pytest.raises(ValueError):
+        Map(ROOM, [box(1, 1, 3, 3), box(2, 2, 4, 4)])
+
+
+def test_gap_just_above_tolerance_is_accepted():
+    scale = math.hypot(10, 10)
+    gap = 10 * REL_GAP_TOL * scale
+    m = Map(ROOM, [box(1, 1, 3, 3), box(3 + gap, 1, 5, 3)])
+    assert len(m.rings) == 3
+
+
+def test_closing_vertex_and_straight_vertices_are_dropped():
+    m = Map([(0, 0), (5, 0), (10, 0), (10, 10), (0, 10), (0, 0)])
+    assert m.n_vertices == 4
+
+
+def test_merge_disconnecting_obstacles_raise():
+    with pytest.raises(InvalidMapError, match="disconnected"):
+        Map(ROOM, [box(4, 0, 6, 10)], merge=True)
+
+
+def test_merge_covering_everything_raises():
+    with pytest.raises(InvalidMapError, match="no free space"):
+        Map(ROOM, [ROOM], merge=True)
+
+
+# ---------------------------------------------------------------------- merge
+MERGE_CASES = {
+    "overlap": [box(1, 1, 3, 3), box(2, 2, 4, 4)],
+    "nested": [box(1, 1, 5, 5), box(2, 2, 3, 3)],
+    "shared-edge": [box(1, 1, 3, 3), box(3, 1, 5, 3)],
+    "partial-edge": [box(1, 1, 3, 3), box(3, 2, 5, 6)],
+    "shared-vertex": [box(1, 1, 3, 3), box(3, 3, 5, 5)],
+    "tiny-gap": [box(1, 1, 3, 3), box(3 + 1e-8, 1, 5, 3)],
+    "touch-boundary": [box(0, 1, 2, 2), box(7, 7, 8, 8)],
+    "triangle-chain": [
+        [(1, 1), (4, 1), (2.5, 3)],
+        [(2.5, 3), (4, 5), (1, 5)],
+        [(3, 1.5), (6, 1.5), (6, 2.5)],
+    ],
+}
+
+
+@pytest.mark.parametrize("name", sorted(MERGE_CASES))
+def test_merge_matches_shapely_union(name):
+    obstacles = MERGE_CASES[name]
+    m = Map(ROOM, obstacles, merge=True)
+    ref = Polygon(ROOM).difference(shapely.union_all([Polygon(o) for o in obstacles]))
+    # merging closes slits below the gap tolerance (the 1e-8 one of "tiny-gap") and snaps
+    # the walls to a decimal grid about ten times that tolerance (see Map): compare on it
+    grid = 10.0 ** np.floor(np.log10(REL_GAP_TOL * m.scale * 10))
+    tol = grid
+    assert m.free_region.symmetric_difference(ref).area < tol * ref.boundary.length
+    # every wall vertex lies on the reference boundary and every reference vertex on a wall
+    ref_vertices = np.concatenate(
+        [np.asarray(ref.exterior.coords)] + [np.asarray(r.coords) for r in ref.interiors]
+    )
+    assert shapely.distance(shapely.points(m.vertices), ref.boundary).max() < tol
+    assert m.distance_to_walls(ref_vertices).max() < tol
+    # walls are exactly the reference rings (straight vertices dropped by both)
+    ref_map = Map(
+        np.asarray(ref.exterior.coords),
+        [np.asarray(r.coords) for r in ref.interiors],
+        merge=True,
+    )
+    assert walls_equal(m, ref_map, tol)
+
+
+def test_merge_of_separate_obstacles_changes_nothing():
+    obstacles = [box(1, 1, 3, 3), regular(7, 7, 1.5, 6)]
+    assert walls_equal(Map(ROOM, obstacles), Map(ROOM, obstacles, merge=True), tol=1e-4)
+
+
+# ---------------------------------------------------------------------- orientation
+@pytest.mark.parametrize("name", sorted(WORLDS))
+def test_orientation_outer_ccw_holes_cw(name):
+    m = WORLDS[name]
+    areas = [shapely.geometry.LinearRing(r).is_ccw for r in m.rings]
+    assert areas[0] is True
+    assert not any(areas[1:])
+
+
+@pytest.mark.parametrize("name", sorted(WORLDS))
+def test_normals_point_into_free_space(name):
+    m = WORLDS[name]
+    eps = 1e-4 * m.scale
+    mid = 0.5 * (m.edge_start + m.edge_end)
+    inside = shapely.points(mid + eps * m.edge_normal)
+    outside = shapely.points(mid - eps * m.edge_normal)
+    assert shapely.contains(m.free_region, inside).all()
+    assert not shapely.intersects(m.free_region, outside).any()
+    np.testing.assert_allclose(np.linalg.norm(m.edge_normal, axis=1), 1.0)
+    np.testing.assert_allclose(np.einsum("ij,ij->i", m.edge_normal, m.edge_dir), 0.0, atol=1e-15)
+    np.testing.assert_allclose(
+        m.edge_start + m.edge_length[:, None] * m.edge_dir, m.edge_end, atol=1e-12 * m.scale
+    )
+
+
+@pytest.mark.parametrize("name", sorted(WORLDS))
+def test_edge_vertex_incidence(name):
+    m = WORLDS[name]
+    idx = np.arange(m.n_vertices)
+    np.testing.assert_array_equal(m.edge_start[m.vertex_next_edge], m.vertices)
+    np.testing.assert_array_equal(m.edge_end[m.vertex_prev_edge], m.vertices)
+    np.testing.assert_array_equal(m.edge_vertices[:, 0], idx)
+    np.testing.assert_array_equal(m.vertices[m.edge_vertices[:, 1]], m.edge_end)
+
+
+@pytest.mark.parametrize("name", sorted(WORLDS))
+def test_vertex_convex_matches_disk_oracle(name):
+    """A convex obstacle vertex is one where a tiny disk around it is MORE than half free.
+
+    Its angle measured in free space exceeds pi (the paper's "reflex vertex"): the obstacle
+    fills less than half of the disk. A room corner (concave obstacle vertex) is less
+    than half free.
+    """
+    m = WORLDS[name]
+    eps = 1e-3 * m.edge_length.min()
+    free = m.free_region
+    for i, v in enumerate(m.vertices):
+        disk = Point(v).buffer(eps, quad_segs=64)
+        fraction = disk.intersection(free).area / disk.area
+        assert abs(fraction - 0.5) > 1e-3  # no straight vertices survive cleaning
+        assert bool(m.vertex_convex[i]) == (fraction > 0.5), (name, i, v, fraction)
+    np.testing.assert_array_equal(m.convex_vertices, np.flatnonzero(m.vertex_convex))
+
+
+def test_convex_vertex_counts():
+    assert WORLDS["corridor"].convex_vertices.size == 2  # the two corridor mouth corners
+    assert int(WORLDS["room_square"].vertex_convex.sum()) == 4
+    assert int(WORLDS["star_hole"].vertex_convex.sum()) == 4  # the four star tips
+
+
+# ---------------------------------------------------------------------- queries
+@pytest.mark.parametrize("name", sorted(WORLDS))
+def test_contains_matches_shapely(name):
+    m = WORLDS[name]
+    rng = np.random.default_rng(1234)
+    x0, y0, x1, y1 = m.bounds
+    pts = rng.uniform([x0 - 1, y0 - 1], [x1 + 1, y1 + 1], size=(3000, 2))
+    # points on the walls are in the closed free region: add vertices and edge points
+    t = rng.uniform(size=(m.n_edges, 1))
+    on_walls = np.concatenate([m.vertices, m.edge_start + t * (m.edge_end - m.edge_start)])
+    expect = shapely.covers(m.free_region, shapely.points(pts))
+    far = m.distance_to_walls(pts) > 1e-9 * m.scale
+    np.testing.assert_array_equal(m.contains(pts)[far], expect[far])
+    assert m.contains(on_walls).all()
+
+
+@pytest.mark.parametrize("name", sorted(WORLDS))
+def test_distance_to_walls_matches_shapely(name):
+    m = WORLDS[name]
+    rng = np.random.default_rng(7)
+    x0, y0, x1, y1 = m.bounds
+    pts = rng.uniform([x0 - 1, y0 - 1], [x1 + 1, y1 + 1], size=(500, 2))
+    expect = shapely.distance(shapely.points(pts), m.free_region.boundary)
+    np.testing.assert_allclose(m.distance_to_walls(pts), expect, atol=1e-12)
+
+
+def test_describe_names_features():
+    from envs.maps import Feature
+
+    m = WORLDS["room_square"]
+    i = int(m.convex_vertices[0])
+    assert m.describe(Feature("vertex", i)).startswith(f"convex vertex {i} (")
+    assert m.describe(Feature("vertex", 0)).startswith("concave vertex 0 (")
+    assert m.describe(Feature("edge", 2)).startswith("edge 2 (")
+
+
+# ---------------------------------------------------------------------- equivalent worlds
+def test_non_convex_boundary_equals_rectangle_with_blocks():
+    """An L-shaped room equals a rectangle minus a corner block merged into the boundary."""
+    l_room = Map([(0, 0), (8, 0), (8, 3), (3, 3), (3, 8), (0, 8)])
+    blocks = Map(box(0, 0, 8, 8), [box(3, 3, 8, 8)], merge=True)
+    assert walls_equal(l_room, blocks)
+    assert l_room == blocks
+
+
+def test_corridor_room_equals_rectangle_with_blocks():
+    corridor = WORLDS["corridor"]
+    blocks = Map(box(-6, -5, 10, 5), [box(-6, -5, 0, -0.5), box(-6, 0.5, 0, 5)], merge=True)
+    assert walls_equal(corridor, blocks)
+    assert corridor.digest == blocks.digest
+    np.testing.assert_array_equal(
+        np.sort(corridor.vertices[corridor.vertex_convex], axis=0),
+        np.sort(blocks.vertices[blocks.vertex_convex], axis=0),
+    )
+
+
+# ---------------------------------------------------------------------- identity
+@pytest.mark.parametrize("name", sorted(WORLDS))
+def test_pickle_round_trip(name):
+    m = WORLDS[name]
+    m2 = pickle.loads(pickle.dumps(m))
+    assert m2 == m and m2.name == m.name and m2.merged == m.merged
+    for attr in ("vertices", "vertex_convex", "edge_normal", "edge_vertices"):
+        np.testing.assert_array_equal(getattr(m2, attr), getattr(m, attr))
+
+
+@pytest.mark.parametrize("name", sorted(WORLDS))
+@pytest.mark.parametrize("reflect", [False, True])
+def test_transformed_is_a_similarity(name, reflect):
+    m = WORLDS[name]
+    rng = np.random.default_rng(5)
+    angle, s = rng.uniform(0, 2 * np.pi), rng.uniform(0.3, 3.0)
+    rot = s * np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
+    if reflect:
+        rot = rot @ np.diag([1.0, -1.0])
+    offset = rng.uniform(-50, 50, size=2)
+    t = m.transformed(rot, offset)
+    # merged walls are snapped to a decimal grid (see test_merge_matches_shapely_union)
+    tol = 1e-9 * t.scale if not m.merged else 10.0 ** np.floor(np.log10(REL_GAP_TOL * t.scale * 10))
+    image = m.vertices @ rot.T + offset
+    # vertex i maps to a vertex of t with the same convexity
+    d = np.linalg.norm(image[:, None, :] - t.vertices[None, :, :], axis=2)
+    match = d.argmin(axis=1)
+    assert d.min(axis=1).max() < tol
+    assert len(set(match.tolist())) == m.n_vertices == t.n_vertices
+    np.testing.assert_array_equal(t.vertex_convex[match], m.vertex_convex)
+    assert t.free_region.area == pytest.approx(s * s * m.free_region.area, rel=1e-6)
+    # the two wall edges at each vertex keep their lengths times s (a reflection swaps them)
+    pair = lambda mp, idx: np.sort(
+        np.stack(
+            [mp.edge_length[mp.vertex_prev_edge[idx]], mp.edge_length[mp.vertex_next_edge[idx]]], 1
+        ),
+        1,
+    )
+    np.testing.assert_allclose(pair(t, match), s * pair(m, np.arange(m.n_vertices)), atol=3 * tol)
+
+
+def test_digest_is_canonical():
+    a = Map(ROOM, [box(1, 1, 2, 2), regular(7, 7, 1, 5)])
+    rotated_start = Map(ROOM[2:] + ROOM[:2], [regular(7, 7, 1, 5), box(1, 1, 2, 2)[::-1]])
+    assert (
+        a.digest == rotated_start.digest and a == rotated_start and hash(a) == hash(rotated_start)
+    )
+    quarter = np.array([[0.0, -1.0], [1.0, 0.0]])
+    back = a.transformed(quarter).transformed(quarter.T)
+    assert back == a
+
+
+@pytest.mark.parametrize(
+    "change",
+    [
+        pytest.param(lambda: Map(ROOM, [box(1, 1, 2, 2.000001)]), id="moved-vertex"),
+        pytest.param(lambda: Map(ROOM, [box(1, 1, 2, 2), box(5, 5, 6, 6)]), id="extra-obstacle"),
+        pytest.param(lambda: Map(ROOM), id="no-obstacle"),
+        pytest.param(lambda: Map(box(0, 0, 10, 11), [box(1, 1, 2, 2)]), id="bigger-room"),
+        pytest.param(lambda: Map(ROOM, [[(1, 1), (2, 1), (2, 2)]]), id="triangle"),
+        pytest.param(
+            lambda: Map(ROOM, [box(1, 1, 2, 2)]).transformed(np.eye(2), (1e-6, 0)), id="shifted"
+        ),
+    ],
+)
+def test_digest_differs_for_changed_maps(change):
+    base = Map(ROOM, [box(1, 1, 2, 2)], name="base")
+    other = change()
+    assert other.digest != base.digest and other != base
+    assert Map(ROOM, [box(1, 1, 2, 2)], name="renamed").digest == base.digest
+
+
+def test_arrays_are_read_only():
+    m = WORLDS["room_square"]
+    with pytest.raises(ValueError):
+        m.vertices[0, 0] = 1.0
+    with pytest.raises(ValueError):
+        m.rings[0][0, 0] = 1.0

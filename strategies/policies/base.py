@@ -1,0 +1,244 @@
+"""The one Policy protocol shared by analytic, baseline and learned policies.
+
+A policy is reset once per episode with its role, the static map and the env's config,
+then maps observations to actions. Analytic policies read the env's ``"state"``
+observation by field name (``envs.surveillance.observations.decode_state``) and the static
+map; they never see the physics engine. Every policy owns one seeded
+``np.random.Generator``; the same seed gives the same actions bit for bit.
+
+Actions are the env's normalised velocity commands: a desired velocity ``v`` (world
+units per second) becomes ``v / V_max`` clipped to the unit disk, so a policy never asks
+for more than its speed bound.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Protocol, runtime_checkable
+
+import numpy as np
+
+from envs.errors import InvalidActionError, InvalidConfigError
+
+__all__ = [
+    "ROLES",
+    "BasePolicy",
+    "Policy",
+    "Snapshot",
+    "check_role",
+    "unit",
+]
+
+ROLES = ("pursuer", "evader")
+"""The two roles, in the env's agent order."""
+
+
+def check_role(role: str) -> str:
+    """Return ``role`` if it is ``"pursuer"`` or ``"evader"``, else raise.
+
+    Raises:
+        InvalidConfigError: naming the bad role.
+    """
+    if role not in ROLES:
+        raise InvalidConfigError(f"role must be one of {ROLES}, got {role!r}")
+    return role
+
+
+def unit(v: np.ndarray) -> np.ndarray:
+    """Return ``v / |v|`` (the zero vector stays zero)."""
+    n = math.hypot(float(v[0]), float(v[1]))
+    return v / n if n > 0 else np.zeros(2)
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    """What an analytic policy knows at one step, in world units.
+
+    Attributes:
+        evader: evader position E = (x, y).
+        pursuer: pursuer position P.
+        evader_velocity: estimate of the evader's current velocity.
+        pursuer_velocity: estimate of the pursuer's current velocity.
+        time: episode time in seconds (steps times dt).
+    """
+
+    evader: np.ndarray
+    pursuer: np.ndarray
+    evader_velocity: np.ndarray
+    pursuer_velocity: np.ndarray
+    time: float
+
+    @property
+    def rod(self) -> np.ndarray:
+        """The vector P - E."""
+        return self.pursuer - self.evader
+
+    @property
+    def L(self) -> float:
+        """Surveillance distance |P - E|."""
+        d = self.rod
+        return math.hypot(float(d[0]), float(d[1]))
+
+    @property
+    def theta(self) -> float:
+        """Rod orientation, the direction from evader to pursuer (eq. 1)."""
+        d = self.rod
+        return math.atan2(float(d[1]), float(d[0]))
+
+
+@runtime_checkable
+class Policy(Protocol):
+    """Anything that plays one role of the surveillance game.
+
+    ``predict`` makes every policy an SB3 ``PolicyPredictor``.
+    """
+
+    name: str
+    role: str | None
+
+    def reset(self, *, role: str, map: Any, config: Any, seed: int | None = None) -> None:
+        """Start an episode as ``role`` on ``map`` with the env's ``config``."""
+
+    def act(self, observation: np.ndarray) -> np.ndarray:
+        """Return the action (float32, shape (2,), in [-1, 1]) for one observation."""
+
+    def predict(
+        self,
+        observation: np.ndarray,
+        state: Any = None,
+        episode_start: Any = None,
+        deterministic: bool = True,
+    ) -> tuple[np.ndarray, Any]:
+        """SB3-compatible adapter around :meth:`act`."""
+
+
+class BasePolicy:
+    """Shared plumbing: role checks, seeded RNG, observation decoding, action scaling.
+
+    Subclasses set ``roles`` (the roles they can play) and implement
+    :meth:`_decide`, which receives a :class:`Snapshot` and returns the desired velocity
+    in world units; or override :meth:`act` entirely (learned policies).
+
+    Args:
+        name: registry name, for reports.
+    """
+
+    roles: tuple[str, ...] = ROLES
+    uses_state: bool = True
+
+    def __init__(self, *, name: str | None = None) -> None:
+        self.name = name or type(self).__name__
+        self.role: str | None = None
+        self.map = None
+        self.config = None
+        self.rng = np.random.default_rng()
+        self._prev: tuple[np.ndarray, np.ndarray] | None = None
+        self._steps = 0
+
+    # ----------------------------------------------------------------- protocol
+    def reset(self, *, role: str, map: Any, config: Any, seed: int | None = None) -> None:
+        """Start an episode.
+
+        Args:
+            role: ``"pursuer"`` or ``"evader"``.
+            map: the static :class:`~envs.maps.Map`.
+            config: the env's ``EnvConfig`` (speed bounds, L range, dt, observation kind).
+            seed: seeds this policy's own RNG (``None``: fresh entropy).
+
+        Raises:
+            InvalidConfigError: the role is unknown or this policy cannot play it, or the
+                env does not give the ``"state"`` observation an analytic policy needs.
+        """
+        check_role(role)
+        if role not in self.roles:
+            raise InvalidConfigError(
+                f"policy {self.name!r} plays {self.roles}, cannot play {role!r}"
+            )
+        if self.uses_state and getattr(config, "observation", "state") != "state":
+            raise InvalidConfigError(
+                f"policy {self.name!r} reads the 'state' observation, but the env gives "
+                f"{config.observation!r}; build the env with observation='state'"
+            )
+        self.role = role
+        self.map = map
+        self.config = config
+        self.rng = np.random.default_rng(seed)
+        self._prev = None
+        self._steps = 0
+        self._reset()
+
+    def act(self, observation: np.ndarray) -> np.ndarray:
+        """Return the normalised action for one observation.
+
+        Raises:
+            InvalidConfigError: called before :meth:`reset`.
+            InvalidActionError: the observation is not finite.
+        """
+        if self.role is None:
+            raise InvalidConfigError(f"policy {self.name!r}: call reset() before act()")
+        snap = self._snapshot(observation)
+        velocity = np.asarray(self._decide(snap), dtype=float)
+        self._steps += 1
+        return self.velocity_to_action(velocity)
+
+    def predict(
+        self,
+        observation: np.ndarray,
+        state: Any = None,
+        episode_start: Any = None,
+        deterministic: bool = True,
+    ) -> tuple[np.ndarray, Any]:
+        """SB3 ``PolicyPredictor`` adapter: batched (n, obs) or single observations.
+
+        Returns:
+            ``(actions, None)`` with actions of shape (2,) or (n, 2).
+        """
+        obs = np.asarray(observation)
+        if obs.ndim == 2:
+            return np.stack([self.act(o) for o in obs]), None
+        return self.act(obs), None
+
+    # ----------------------------------------------------------------- helpers
+    @property
+    def v_max(self) -> float:
+        """This role's speed bound."""
+        return float(self.config.v_pursuer if self.role == "pursuer" else self.config.v_evader)
+
+    def velocity_to_action(self, velocity: np.ndarray) -> np.ndarray:
+        """Scale a world velocity to the action box, clipped to the unit disk."""
+        a = np.asarray(velocity, dtype=float) / self.v_max
+        n = math.hypot(float(a[0]), float(a[1]))
+        if not math.isfinite(n):
+            raise InvalidActionError(f"policy {self.name!r} produced velocity {velocity!r}")
+        if n > 1.0:
+            a = a / n
+        return a.astype(np.float32)
+
+    def _snapshot(self, observation: np.ndarray) -> Snapshot:
+        from strategies.policies.observe import read_state
+
+        e, p, ve, vp = read_state(observation, self.config)
+        dt = float(self.config.dt)
+        if ve is None or vp is None:
+            # no velocities in the observation: finite differences of the last two steps
+            if self._prev is None:
+                est_e, est_p = np.zeros(2), np.zeros(2)
+            else:
+                est_e = (e - self._prev[0]) / dt
+                est_p = (p - self._prev[1]) / dt
+            ve = est_e if ve is None else ve
+            vp = est_p if vp is None else vp
+        self._prev = (e, p)
+        return Snapshot(e, p, ve, vp, self._steps * dt)
+
+    # ----------------------------------------------------------------- subclass hooks
+    def _reset(self) -> None:
+        """Per-episode set-up after the common reset (precompute from the map here)."""
+
+    def _decide(self, snap: Snapshot) -> np.ndarray:
+        """Return the desired velocity in world units."""
+        raise NotImplementedError(f"{type(self).__name__} must implement _decide()")
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}(name={self.name!r}, role={self.role!r})"

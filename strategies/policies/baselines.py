@@ -1,0 +1,181 @@
+"""Baseline policies: random, greedy follower, straight-line, toward/away and wall-hugging.
+
+None of these uses the configuration-space theory; they are the yardsticks the analytic
+policies are measured against. The greedy pursuer knows nothing of the map; the
+straight-line and wall-hugging evaders use the map only to notice walls.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from envs.errors import InvalidConfigError
+from strategies.policies.base import BasePolicy, Snapshot, unit
+
+__all__ = [
+    "GreedyPursuer",
+    "RandomPolicy",
+    "StraightLineEvader",
+    "TowardAwayEvader",
+    "WallHuggingEvader",
+    "nearest_wall_point",
+]
+
+
+def _positive(name: str, value: float) -> float:
+    v = float(value)
+    if not (math.isfinite(v) and v > 0):
+        raise InvalidConfigError(f"{name} must be a positive number, got {value!r}")
+    return v
+
+
+def nearest_wall_point(world_map, point: np.ndarray) -> tuple[np.ndarray, int]:
+    """Closest point on the map's walls to ``point`` and the index of its edge."""
+    rel = point[None, :] - world_map.edge_start
+    t = np.clip(np.einsum("ej,ej->e", rel, world_map.edge_dir), 0.0, world_map.edge_length)
+    closest = world_map.edge_start + t[:, None] * world_map.edge_dir
+    d = np.einsum("ej,ej->e", point - closest, point - closest)
+    k = int(np.argmin(d))
+    return closest[k], k
+
+
+class RandomPolicy(BasePolicy):
+    """Uniform random velocity in the speed disk, redrawn every ``hold`` steps.
+
+    Args:
+        hold: number of steps a drawn velocity is kept (1 = white noise).
+    """
+
+    def __init__(self, *, hold: int = 1, name: str | None = None) -> None:
+        super().__init__(name=name)
+        if not (isinstance(hold, int | np.integer) and hold >= 1):
+            raise InvalidConfigError(f"hold must be an integer >= 1, got {hold!r}")
+        self.hold = int(hold)
+        self._current = np.zeros(2)
+
+    def _decide(self, snap: Snapshot) -> np.ndarray:
+        if self._steps % self.hold == 0:
+            # uniform in the disk: radius ~ sqrt(U)
+            r = math.sqrt(self.rng.random())
+            a = self.rng.uniform(-math.pi, math.pi)
+            self._current = self.v_max * r * np.array([math.cos(a), math.sin(a)])
+        return self._current
+
+
+class GreedyPursuer(BasePolicy):
+    """Keep the evader at ``L_min`` by moving along the line of sight; no map knowledge.
+
+    The pursuer's velocity is radial: it matches the evader's velocity component along
+    the rod (so L holds) and adds a proportional correction of L toward the target
+    distance, ``gain`` per second. The rod is never turned on purpose.
+
+    Args:
+        gain: rate (1/s) at which the distance error is corrected.
+        target: target distance as a fraction of the way from L_min to L_max (0 = L_min).
+    """
+
+    def __init__(self, *, gain: float = 4.0, target: float = 0.0, name: str | None = None) -> None:
+        super().__init__(name=name)
+        self.gain = _positive("gain", gain)
+        if not 0.0 <= float(target) < 1.0:
+            raise InvalidConfigError(f"target must be in [0, 1), got {target!r}")
+        self.target = float(target)
+
+    def _decide(self, snap: Snapshot) -> np.ndarray:
+        c = self.config
+        want = c.l_min + self.target * (c.l_max - c.l_min)
+        u = unit(snap.rod)  # from evader to pursuer
+        radial = float(np.dot(snap.evader_velocity, u)) - self.gain * (snap.L - want)
+        return radial * u
+
+
+class StraightLineEvader(BasePolicy):
+    """Run at full speed on a straight line; pick a new random heading when blocked.
+
+    Args:
+        heading: initial heading in radians (``None``: drawn from the policy's RNG).
+    """
+
+    def __init__(self, *, heading: float | None = None, name: str | None = None) -> None:
+        super().__init__(name=name)
+        if heading is not None and not math.isfinite(float(heading)):
+            raise InvalidConfigError(f"heading must be finite or None, got {heading!r}")
+        self.heading = heading
+
+    def _reset(self) -> None:
+        self._alpha = (
+            float(self.heading) if self.heading is not None else self.rng.uniform(-math.pi, math.pi)
+        )
+
+    def _decide(self, snap: Snapshot) -> np.ndarray:
+        d = np.array([math.cos(self._alpha), math.sin(self._alpha)])
+        if self._steps > 0 and float(np.dot(snap.evader_velocity, d)) < 0.25 * self.v_max:
+            # blocked by a wall (the physics slides us along it): turn into free space
+            _, k = nearest_wall_point(self.map, snap.evader)
+            n = self.map.edge_normal[k]
+            a = self.rng.uniform(-0.5 * math.pi, 0.5 * math.pi)
+            base = math.atan2(n[1], n[0])
+            self._alpha = base + a
+            d = np.array([math.cos(self._alpha), math.sin(self._alpha)])
+        return self.v_max * d
+
+
+class TowardAwayEvader(BasePolicy):
+    """Move straight toward or away from the pursuer (Sec. 6.1).
+
+    Moving along the rod minimises the largest rate ``max |theta_dot|`` the pursuer can
+    impose (THEORY 4.1: the minimum of ``g(phi)`` is at ``phi = k pi``).
+
+    Args:
+        mode: ``"toward"``, ``"away"``, or ``"alternate"`` (switch every ``period`` s).
+        period: switching period in seconds for ``"alternate"``.
+    """
+
+    MODES = ("toward", "away", "alternate")
+
+    def __init__(
+        self, *, mode: str = "toward", period: float = 4.0, name: str | None = None
+    ) -> None:
+        super().__init__(name=name)
+        if mode not in self.MODES:
+            raise InvalidConfigError(f"mode must be one of {self.MODES}, got {mode!r}")
+        self.mode = mode
+        self.period = _positive("period", period)
+
+    def _decide(self, snap: Snapshot) -> np.ndarray:
+        u = unit(snap.rod)
+        toward = self.mode == "toward"
+        if self.mode == "alternate":
+            toward = int(snap.time // self.period) % 2 == 0
+        return self.v_max * (u if toward else -u)
+
+
+class WallHuggingEvader(BasePolicy):
+    """Go to the nearest wall and follow it at distance ``offset``, wall on the right.
+
+    Walls are rings with free space on their left, so walking along an edge's direction
+    keeps the wall on the right; around convex corners the nearest wall point is the
+    vertex and the same rule wraps the evader round it.
+
+    Args:
+        offset: distance kept from the walls.
+        gain: rate (1/s) of the correction toward that distance.
+    """
+
+    def __init__(self, *, offset: float = 0.2, gain: float = 4.0, name: str | None = None) -> None:
+        super().__init__(name=name)
+        self.offset = _positive("offset", offset)
+        self.gain = _positive("gain", gain)
+
+    def _decide(self, snap: Snapshot) -> np.ndarray:
+        c, k = nearest_wall_point(self.map, snap.evader)
+        away = snap.evader - c
+        dist = math.hypot(float(away[0]), float(away[1]))
+        n = away / dist if dist > 1e-12 else self.map.edge_normal[k]
+        tangent = np.array([n[1], -n[0]])  # n rotated by -90 degrees: wall on the right
+        err = self.offset - dist
+        radial = np.clip(self.gain * err / self.v_max, -1.0, 1.0)
+        v = radial * n + math.sqrt(max(0.0, 1.0 - radial * radial)) * tangent
+        return self.v_max * v

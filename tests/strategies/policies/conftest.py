@@ -1,0 +1,43 @@
+"""Shared fixtures: a small world, its config, and state observations along a path."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from envs.maps import Map
+from envs.surveillance.config import EnvConfig
+from envs.surveillance.observations import StateEncoder
+
+
+@pytest.fixture(scope="session")
+def box_world() -> Map:
+    """A 12 x 8 room with one square pillar (convex corners for the corner policies)."""
+    return Map(
+        [(0, 0), (12, 0), (12, 8), (0, 8)],
+        [[(8, 5), (10, 5), (10, 7), (8, 7)]],
+        name="pillar_box",
+    )
+
+
+@pytest.fixture(scope="session")
+def box_config(box_world: Map) -> EnvConfig:
+    return EnvConfig(map=box_world, l_min=2.0, l_max=4.0, v_pursuer=1.0, v_evader=0.5)
+
+
+def state_observations(config: EnvConfig, n: int = 12, seed: int = 0) -> list[np.ndarray]:
+    """Observations of an evader walking a circle with the pursuer 2.5 away, in free space."""
+    enc = StateEncoder(config)
+    rng = np.random.default_rng(seed)
+    out = []
+    for k in range(n):
+        a = 0.3 * k
+        e = (3.0 + 1.0 * math.cos(a), 2.0 + 0.8 * math.sin(a))
+        th = 0.5 + 0.1 * k
+        p = (e[0] + 2.5 * math.cos(th), e[1] + 2.5 * math.sin(th))
+        ve = tuple(rng.uniform(-0.5, 0.5, 2))
+        vp = tuple(rng.uniform(-1, 1, 2))
+        out.append(enc.encode(p, vp, e, ve, True, k))
+    return out

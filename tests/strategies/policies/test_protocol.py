@@ -1,0 +1,102 @@
+"""Every registered policy honours the protocol: shapes, bounds, seeding, predict()."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from envs.errors import InvalidConfigError, UnknownNameError
+from strategies.policies import Policy, describe_policy, make_policy, policy_names
+from tests.strategies.policies.conftest import state_observations
+
+ALL = policy_names()
+
+
+def _run(name: str, config, seed: int, observations) -> np.ndarray:
+    pol = make_policy(name)
+    role = name.split("/")[0]
+    pol.reset(role=role, map=config.map, config=config, seed=seed)
+    return np.stack([pol.act(o) for o in observations])
+
+
+@pytest.mark.parametrize("name", ALL)
+def test_actions_have_the_right_shape_dtype_and_bounds(name, box_config):
+    obs = state_observations(box_config)
+    acts = _run(name, box_config, 3, obs)
+    assert acts.shape == (len(obs), 2)
+    assert acts.dtype == np.float32
+    assert np.all(np.isfinite(acts))
+    assert np.all(np.abs(acts) <= 1.0)
+    assert np.all(np.linalg.norm(acts, axis=1) <= 1.0 + 1e-6)  # never above the speed bound
+
+
+@pytest.mark.parametrize("name", ALL)
+def test_same_seed_same_actions_bit_for_bit(name, box_config):
+    obs = state_observations(box_config, seed=5)
+    a = _run(name, box_config, 11, obs)
+    b = _run(name, box_config, 11, obs)
+    assert a.tobytes() == b.tobytes()
+
+
+@pytest.mark.parametrize("name", ALL)
+def test_predict_matches_act_single_and_batched(name, box_config):
+    obs = state_observations(box_config, seed=2)
+    role = name.split("/")[0]
+    acting, predicting, batched = make_policy(name), make_policy(name), make_policy(name)
+    for p in (acting, predicting, batched):
+        p.reset(role=role, map=box_config.map, config=box_config, seed=7)
+        assert isinstance(p, Policy)
+    for o in obs:
+        a = acting.act(o)
+        b, state = predicting.predict(o, state=None, episode_start=None, deterministic=True)
+        assert state is None
+        assert a.tobytes() == np.asarray(b).tobytes()
+    c, _ = batched.predict(np.stack(obs))
+    assert c.shape == (len(obs), 2)
+    ref = _run(name, box_config, 7, obs)
+    assert c.tobytes() == ref.tobytes()
+
+
+def test_random_policy_seeds_differ(box_config):
+    obs = state_observations(box_config)
+    assert (
+        _run("evader/random", box_config, 1, obs).tobytes()
+        != _run("evader/random", box_config, 2, obs).tobytes()
+    )
+
+
+def test_unknown_name_lists_the_known_ones():
+    with pytest.raises(UnknownNameError, match="pursuer/greedy"):
+        make_policy("pursuer/no_such_policy")
+    with pytest.raises(UnknownNameError):
+        make_policy("nonsense")
+
+
+def test_bad_parameters_and_roles_raise(box_config):
+    with pytest.raises(InvalidConfigError, match="no parameter"):
+        make_policy("pursuer/greedy", speed=3)
+    with pytest.raises(InvalidConfigError, match="mode"):
+        make_policy("evader/toward_away", mode="sideways")
+    pol = make_policy("pursuer/greedy")
+    with pytest.raises(InvalidConfigError, match="cannot play"):
+        pol.reset(role="evader", map=box_config.map, config=box_config, seed=0)
+    with pytest.raises(InvalidConfigError, match="role"):
+        pol.reset(role="referee", map=box_config.map, config=box_config, seed=0)
+    with pytest.raises(InvalidConfigError, match="reset"):
+        make_policy("pursuer/greedy").act(state_observations(box_config)[0])
+
+
+def test_policy_names_by_role_and_descriptions():
+    assert set(policy_names("pursuer")) | set(policy_names("evader")) == set(ALL)
+    assert all(n.startswith("pursuer/") for n in policy_names("pursuer"))
+    for n in ALL:
+        assert describe_policy(n)
+    with pytest.raises(InvalidConfigError):
+        policy_names("referee")
+
+
+def test_sb3_name_form_is_lazy_and_checks_the_file(box_config, tmp_path):
+    pol = make_policy(f"pursuer/sb3:{tmp_path / 'missing.zip'}")
+    assert pol.role is None and pol.model is None
+    with pytest.raises(InvalidConfigError, match="no model file"):
+        pol.reset(role="pursuer", map=box_config.map, config=box_config, seed=0)

@@ -1,0 +1,167 @@
+"""RK4 integrators of the Sec. 6 extremals (scalar math; the hot path of the shooting).
+
+See :mod:`strategies.control.evasion` for the equations. Two integrators:
+
+* :func:`integrate_reduced` runs in the evader's arclength σ on the state
+  ``(x, y, θ, α, ln μ)``. All right-hand sides are bounded, so headings near ±π/2 cost
+  nothing; the x-formulation of the paper is only needed to *interpret* the arc, which
+  stops being admissible (H unbounded, THEORY §4.3) when α reaches ±π/2.
+* :func:`integrate_pmp` is the paper's Fig. 10 in x with RK4: state ``(y, θ, λ2)`` and α
+  the minimiser of H at every stage.
+"""
+
+from __future__ import annotations
+
+import math
+
+from scipy.optimize import brentq
+
+from strategies.control.hamiltonian import _kappa_scalar, minimise_hamiltonian, solve_stationary
+
+__all__ = ["first_return", "integrate_pmp", "integrate_reduced"]
+
+_HALF_PI = 0.5 * math.pi
+REACHED, TOO_LONG = 0, 2
+"""Status codes of :func:`integrate_reduced`; ±1 means α reached ±π/2 (turned back)."""
+
+
+def _rhs(th: float, a: float, s: int, L: float, rho: float, q: float):
+    """d/dσ of (x, y, θ, α, ln μ); ``q = 1 / (1 - rho²)``."""
+    phi = a - th
+    c, sp = math.cos(phi), math.sin(phi)
+    h = math.sqrt(1.0 - rho * rho * c * c)
+    n = h - s * rho * sp  # L θ̇ˢ / (s V_p) >= 0
+    return (math.cos(a), math.sin(a), s * n / (L * rho),
+            n * n * sp * q / L,  # reduced extremal: dα/dσ (see evasion module docstring)
+            -s * c * n / (h * L))  # d ln μ / dσ = -∂g_s/∂θ (E3b)
+
+
+def _step(state, d: float, s: int, L: float, rho: float, q: float):
+    x, y, th, a, lm = state
+    k1 = _rhs(th, a, s, L, rho, q)
+    h2 = 0.5 * d
+    k2 = _rhs(th + h2 * k1[2], a + h2 * k1[3], s, L, rho, q)
+    k3 = _rhs(th + h2 * k2[2], a + h2 * k2[3], s, L, rho, q)
+    k4 = _rhs(th + d * k3[2], a + d * k3[3], s, L, rho, q)
+    w = d / 6.0
+    return (x + w * (k1[0] + 2.0 * (k2[0] + k3[0]) + k4[0]),
+            y + w * (k1[1] + 2.0 * (k2[1] + k3[1]) + k4[1]),
+            th + w * (k1[2] + 2.0 * (k2[2] + k3[2]) + k4[2]),
+            a + w * (k1[3] + 2.0 * (k2[3] + k3[3]) + k4[3]),
+            lm + w * (k1[4] + 2.0 * (k2[4] + k3[4]) + k4[4]))
+
+
+def integrate_reduced(theta0: float, alpha0: float, s: int, L: float, rho: float,
+                      step: float, x_target: float, store: bool, max_steps: int):
+    """Integrate until ``x = x_target`` exactly (last step shortened by Newton on its length).
+
+    Returns ``(rows, status)``: rows are ``(σ, x, y, θ, α, ln(μ/μ0))``; only the last row is
+    kept when ``store`` is False. ``status`` is 0 (reached), +1/-1 (α reached ±π/2 going
+    up/down: the arc turned back in x) or 2 (``max_steps`` exhausted).
+    """
+    q = 1.0 / (1.0 - rho * rho)
+    state = (0.0, 0.0, theta0, alpha0, 0.0)
+    sig = 0.0
+    rows = [(sig, *state)]
+    for _ in range(max_steps):
+        new = _step(state, step, s, L, rho, q)
+        if not abs(new[3]) < _HALF_PI:  # also catches NaN
+            return rows, (1 if new[3] > 0 else -1)
+        if new[0] >= x_target:
+            # shorten the step: solve x(δ) = x_target, dx/dσ = cos α (Newton, 3 passes)
+            d = step * (x_target - state[0]) / (new[0] - state[0])
+            for _ in range(3):
+                new = _step(state, d, s, L, rho, q)
+                d += (x_target - new[0]) / math.cos(new[3])
+            new = _step(state, d, s, L, rho, q)
+            row = (sig + d, x_target, *new[1:])
+            if store:
+                rows.append(row)
+            else:
+                rows[0] = row
+            return rows, REACHED
+        state = new
+        sig += step
+        if store:
+            rows.append((sig, *state))
+        else:
+            rows[0] = (sig, *state)
+    return rows, TOO_LONG
+
+
+def integrate_pmp(theta0: float, lambda1: float, lambda2_0: float, s: int, L: float,
+                  rho: float, dx: float, n_steps: int):
+    """Fig. 10 with RK4 in x: state (y, θ, λ2), α = argmin H at every stage.
+
+    Returns ``(rows, unbounded)`` with rows ``(x, y, θ, α, λ2)``.
+    """
+
+    def rhs(th: float, l2: float, guess: float):
+        mu = 1.0 + s * l2
+        lo_k = _kappa_scalar(_HALF_PI, th, L, rho, s)[0]
+        hi_k = _kappa_scalar(-_HALF_PI, th, L, rho, s)[0]
+        if mu <= 0.0 or not lo_k < lambda1 / mu < hi_k:  # THEORY §4.3
+            return None
+        a, it = solve_stationary(lambda1 / mu, th, L, rho, s, guess)
+        if it >= 60:  # pragma: no cover - the bracketed iteration always converges
+            a = minimise_hamiltonian(th, lambda1, l2, L=L, rho=rho, branch=s).alpha
+        phi = a - th
+        c, sp = math.cos(phi), math.sin(phi)
+        ca = math.cos(a)
+        hh = math.sqrt(1.0 - rho * rho * c * c)
+        n = hh - s * rho * sp
+        return math.tan(a), s * n / (L * rho * ca), -(s + l2) * c * n / (hh * L * ca), a
+
+    y, th, l2 = 0.0, theta0, lambda2_0
+    k1 = rhs(th, l2, 0.0)
+    if k1 is None:
+        return [], True
+    rows = [(0.0, y, th, k1[3], l2)]
+    h2 = 0.5 * dx
+    for i in range(1, n_steps + 1):
+        k2 = rhs(th + h2 * k1[1], l2 + h2 * k1[2], k1[3])
+        k3 = k2 and rhs(th + h2 * k2[1], l2 + h2 * k2[2], k2[3])
+        k4 = k3 and rhs(th + dx * k3[1], l2 + dx * k3[2], k3[3])
+        if k4 is None:
+            return rows, True
+        w = dx / 6.0
+        y += w * (k1[0] + 2.0 * (k2[0] + k3[0]) + k4[0])
+        th += w * (k1[1] + 2.0 * (k2[1] + k3[1]) + k4[1])
+        l2 += w * (k1[2] + 2.0 * (k2[2] + k3[2]) + k4[2])
+        k1 = rhs(th, l2, k4[3])
+        if k1 is None:
+            return rows, True
+        rows.append((i * dx, y, th, k1[3], l2))
+    return rows, False
+
+
+def _hermite(t, t0, t1, v0, v1, m0, m1) -> float:
+    d = t1 - t0
+    u = (t - t0) / d
+    u2, u3 = u * u, u * u * u
+    return ((2 * u3 - 3 * u2 + 1) * v0 + (u3 - 2 * u2 + u) * d * m0
+            + (-2 * u3 + 3 * u2) * v1 + (u3 - u2) * d * m1)
+
+
+def first_return(t, x, y, th, dx, dy, dth, tol: float):
+    """First sign change of y after it leaves 0, by cubic Hermite interpolation in the
+    integration variable ``t`` (O(step⁴), like RK4). ``dx, dy, dth`` are derivatives in t.
+
+    Returns ``(x_c, θ(x_c))`` or ``(None, None)``. ``|y| <= tol`` counts as zero.
+    """
+    n = len(t)
+    i0 = next((i for i in range(1, n) if abs(y[i]) > tol), None)
+    if i0 is None:
+        return None, None
+    sgn = 1.0 if y[i0] > 0 else -1.0
+    j = next((j for j in range(i0 + 1, n) if sgn * y[j] <= tol), None)
+    if j is None:
+        return None, None
+    if abs(y[j]) <= tol:
+        tc = t[j]
+    else:
+        tc = brentq(lambda u: _hermite(u, t[j - 1], t[j], y[j - 1], y[j], dy[j - 1], dy[j]),
+                    t[j - 1], t[j], xtol=1e-15)
+    xc = _hermite(tc, t[j - 1], t[j], x[j - 1], x[j], dx[j - 1], dx[j])
+    thc = _hermite(tc, t[j - 1], t[j], th[j - 1], th[j], dth[j - 1], dth[j])
+    return float(xc), float(thc)

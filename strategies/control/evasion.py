@@ -1,0 +1,363 @@
+"""Optimal escape trajectories (paper Sec. 6.2, Figs. 10-12): shooting on the PMP extremals.
+
+The model (state equations, H, adjoints, minimiser of H) is in
+:mod:`strategies.control.hamiltonian`; read its docstring first. Two integrators:
+
+* ``method="pmp"`` is the paper's algorithm of Fig. 10 with RK4 instead of Euler
+  (THEORY §4.3): state ``(y, θ, λ2)``, and at every RK4 stage α is the minimiser of H,
+  found by safeguarded Newton on the stationarity condition. It is the reference.
+* ``method="reduced"`` (default, about 10x faster) integrates the heading itself. Along
+  an extremal ``κ = λ1/μ = K_s(α, θ)`` and ``κ' = κ ∂g_s/∂θ``; differentiating gives, after
+  the terms in κ cancel (derived here, checked with sympy, not in the paper),
+
+      dα/dx = n_s(φ)² sin φ / ((1 - rho²) L cos α),     φ = α - θ,
+
+  an explicit ODE for the state ``(y, θ, α, ln μ)``. Because ``K_s`` is strictly
+  decreasing in α, α(0) and the pair ``(λ1, μ(0))`` determine each other one to one, so the
+  shooting runs directly on α(0) ∈ (-π/2, π/2).
+
+An arc is *unbounded* (THEORY §4.3) when H has no minimiser at some x, which on the
+reduced ODE shows as α reaching ±π/2 (the evader would have to turn back in x).
+
+Scale invariance (THEORY §4.2, fact 1): ``(λ1, 1 + s λ2(0)) -> c (λ1, 1 + s λ2(0))``,
+``c > 0``, gives the same trajectory; only ``k = λ1 / (1 + s λ2(0))`` matters.
+:func:`solve_escape` reports multipliers normalised by transversality ``λ2(x_e) = 0``
+(the paper never imposes it, E3c).
+
+Greedy mode (Fig. 12, λ1 = 0): ``∂H/∂α = 0`` reduces to ``sin α = s rho cos(α - θ)``, so
+``α* = atan2(s rho cos θ, 1 - s rho sin θ)``; at θ = π this is ``-arctan rho`` and at θ = 0
+``+arctan rho`` with ``f2 = (1 - rho²)/(L rho)`` (THEORY §4.2 fact 4, §7).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+from scipy.optimize import brentq
+
+from envs.errors import SurveilValueError
+from strategies.control._integrators import (
+    REACHED,
+    first_return,
+    integrate_pmp,
+    integrate_reduced,
+)
+from strategies.control._validate import (
+    as_finite_array,
+    branch_sign,
+    check_evasion_rho,
+    finite,
+    positive,
+)
+from strategies.control.hamiltonian import _kappa_scalar, is_unbounded, solve_stationary
+
+__all__ = [
+    "EscapeSolution",
+    "GreedyHeading",
+    "ShootResult",
+    "default_step",
+    "greedy_heading",
+    "shoot",
+    "solve_escape",
+]
+
+_HALF_PI = 0.5 * math.pi
+_STEPS_PER_UNIT = 48
+"""Default RK4 steps per length ``L rho`` (dθ/dσ scales as ``1/(L rho)``). The crossing x and
+J then agree with a 4x finer grid to about 1e-8 on the cases in the tests."""
+
+
+def default_step(x_max: float, L: float, rho: float) -> float:
+    """Default RK4 step (arclength for ``"reduced"``, x for ``"pmp"``)."""
+    return min(L * rho / _STEPS_PER_UNIT, x_max / 32.0)
+
+
+@dataclass(frozen=True)
+class ShootResult:
+    """One extremal from :func:`shoot`, sampled at the RK4 nodes (evader frame).
+
+    The evader starts at the origin heading for the positive x-axis; ``theta`` is the rod
+    orientation (evader -> pursuer). Arrays share one length (shorter when ``unbounded``).
+    """
+
+    x: np.ndarray
+    y: np.ndarray
+    theta: np.ndarray
+    alpha: np.ndarray
+    lambda2: np.ndarray
+    """Adjoint of θ (``μ = 1 + s λ2``)."""
+    H: np.ndarray
+    """Hamiltonian at each node; constant along an exact extremal."""
+    x_c: float | None
+    """First return to y = 0 after leaving it (Fig. 10, step 7), or None."""
+    J: float | None
+    """``θ(x_c) - θ0`` (signed: >= 0 for branch '+', <= 0 for '-'), or None."""
+    unbounded: bool
+    """H lost its minimiser (THEORY §4.3) before ``x_max``; arrays stop there."""
+    theta0: float
+    lambda1: float
+    lambda2_0: float
+    L: float
+    rho: float
+    branch: int = 1
+    arclength: np.ndarray | None = None
+    """Evader path length at each node (integration variable of ``"reduced"``)."""
+
+    def evader_path(self) -> np.ndarray:
+        """Evader positions, shape (N, 2)."""
+        return np.column_stack([self.x, self.y])
+
+    def pursuer_path(self) -> np.ndarray:
+        """Pursuer positions ``E + L (cos θ, sin θ)`` (eq. 1), shape (N, 2)."""
+        return self.evader_path() + self.L * np.column_stack(
+            [np.cos(self.theta), np.sin(self.theta)])
+
+
+@dataclass(frozen=True)
+class EscapeSolution:
+    """Result of :func:`solve_escape`."""
+
+    success: bool
+    reason: str
+    """Empty on success, otherwise why no extremal reaches ``(x_e, 0)``."""
+    J: float | None = None
+    """``θ(x_e) - θ0`` on the optimal arc (signed like ``ShootResult.J``)."""
+    k: float | None = None
+    """``λ1 / (1 + s λ2(0))``, the one shooting unknown (THEORY §4.2 fact 1)."""
+    lambda1: float | None = None
+    """λ1 normalised so that ``λ2(x_e) = 0`` (transversality, E3c)."""
+    lambda2_0: float | None = None
+    """λ2(0) with the same normalisation."""
+    alpha0: float | None = None
+    """Initial heading."""
+    arc: ShootResult | None = None
+    """The extremal on ``[0, x_e]``."""
+    candidates: int = 0
+    """Number of extremals through ``(x_e, 0)`` found (the one with least ``|J|`` is kept)."""
+
+
+# ------------------------------------------------------------------------------- shoot
+
+
+def _build_result(rows, status, theta0, lambda1, lambda2_0, s, L, rho, reduced: bool,
+                  stop_at_crossing: bool) -> ShootResult:
+    """Assemble a :class:`ShootResult` from integrator rows (see ``_integrators``)."""
+    if reduced:
+        arr = np.asarray(rows, dtype=float).reshape(-1, 6)
+        sig, x, y, th, a, lm = arr.T
+        mu = (1.0 + s * lambda2_0) * np.exp(lm)
+        lam2 = s * (mu - 1.0)
+    else:
+        arr = np.asarray(rows, dtype=float).reshape(-1, 5)
+        x, y, th, a, lam2 = arr.T
+        sig = None
+        mu = 1.0 + s * lam2
+    phi = a - th
+    n = np.sqrt(1.0 - (rho * np.cos(phi)) ** 2) - s * rho * np.sin(phi)
+    ca = np.cos(a)
+    H = lambda1 * np.tan(a) + mu * n / (L * rho * ca)
+    xc = J = None
+    if len(x) > 1:
+        if reduced:
+            t, dx, dy, dth = sig, ca, np.sin(a), s * n / (L * rho)
+        else:
+            t, dx, dy, dth = x, np.ones_like(x), np.tan(a), s * n / (L * rho * ca)
+        tol = 1e-11 * max(float(np.max(np.abs(x))), L)
+        xc, thc = first_return(t, x, y, th, dx, dy, dth, tol)
+        J = None if thc is None else thc - theta0
+    if stop_at_crossing and xc is not None:
+        last = int(np.searchsorted(x, xc)) + 1
+        x, y, th, a, lam2, H = (v[:last] for v in (x, y, th, a, lam2, H))
+        sig = None if sig is None else sig[:last]
+    return ShootResult(x=x, y=y, theta=th, alpha=a, lambda2=lam2, H=H, x_c=xc, J=J,
+                       unbounded=status in (1, -1), theta0=theta0, lambda1=lambda1,
+                       lambda2_0=lambda2_0, L=L, rho=rho, branch=s, arclength=sig)
+
+
+def shoot(theta0: float, lambda1: float, lambda2_0: float, *, L: float, rho: float,
+          branch="+", x_max: float, step: float | None = None, method: str = "reduced",
+          stop_at_crossing: bool = False) -> ShootResult:
+    """Integrate one extremal from the origin (Fig. 10 without the outer λ loop).
+
+    Args:
+        theta0: initial rod orientation θ(0).
+        lambda1: adjoint of y (constant, ``K`` in the paper).
+        lambda2_0: adjoint of θ at x = 0; ``μ0 = 1 + s lambda2_0`` must be > 0.
+        L: surveillance distance ``L_min``, > 0.
+        rho: speed ratio, 0 < rho < 1 (InfeasibleError for rho >= 1).
+        branch: ``"+"`` (θ̇⁺, the paper's figures) or ``"-"`` (θ̇⁻).
+        x_max: integrate until ``x = x_max``.
+        step: RK4 step, arclength for ``"reduced"`` and x for ``"pmp"``
+            (default :func:`default_step`).
+        method: ``"reduced"`` (explicit heading ODE) or ``"pmp"`` (argmin of H per stage).
+        stop_at_crossing: truncate the arrays after the first return to y = 0.
+
+    Returns:
+        A :class:`ShootResult`; ``unbounded`` is set (and the arrays stop) where H lost its
+        minimiser (THEORY §4.3), e.g. Fig. 11(b)'s multipliers at rho = 0.9.
+
+    Raises:
+        SurveilValueError: non-finite input, ``L <= 0``, ``x_max <= 0``, ``step <= 0``,
+            ``1 + s lambda2_0 <= 0`` (μ keeps its sign along the arc, so transversality
+            ``λ2(x_e) = 0`` would be impossible), unknown branch or method.
+        InfeasibleError: ``rho >= 1``.
+    """
+    th0 = finite("theta0", theta0)
+    l1 = finite("lambda1", lambda1)
+    l20 = finite("lambda2_0", lambda2_0)
+    L = positive("L", L)
+    rho = check_evasion_rho(rho)
+    s = branch_sign(branch)
+    x_max = positive("x_max", x_max)
+    h = default_step(x_max, L, rho) if step is None else positive("step", step)
+    if method not in ("reduced", "pmp"):
+        raise SurveilValueError(f"method = {method!r}: expected 'reduced' or 'pmp'")
+    mu0 = 1.0 + s * l20
+    if mu0 <= 0.0:
+        raise SurveilValueError(
+            f"lambda2_0 = {lambda2_0!r} gives 1 + s*lambda2_0 = {mu0!r} for branch "
+            f"{'+' if s > 0 else '-'}: expected > 0 (μ keeps its sign along the arc and "
+            "transversality needs μ(x_e) = 1, E3c)")
+    if method == "pmp":
+        n = max(1, math.ceil(x_max / h))
+        rows, unb = integrate_pmp(th0, l1, l20, s, L, rho, x_max / n, n)
+        if not rows:
+            rows = [(0.0, 0.0, th0, math.nan, l20)]
+        return _build_result(rows, 1 if unb else 0, th0, l1, l20, s, L, rho, False,
+                             stop_at_crossing)
+    if is_unbounded(th0, l1, l20, L=L, rho=rho, branch=s):
+        return _build_result([(0.0, 0.0, 0.0, th0, math.nan, 0.0)], 1, th0, l1, l20, s, L,
+                             rho, True, stop_at_crossing)
+    a0, _ = solve_stationary(l1 / mu0, th0, L, rho, s, 0.0)
+    rows, status = integrate_reduced(th0, a0, s, L, rho, h, x_max, True,
+                                     _max_steps(x_max, L, h))
+    return _build_result(rows, status, th0, l1, l20, s, L, rho, True, stop_at_crossing)
+
+
+def _max_steps(x_max: float, L: float, h: float) -> int:
+    """Arclength budget: 10 (x_max + L); longer arcs creep toward α = ±π/2."""
+    return math.ceil(10.0 * (x_max + L) / h)
+
+
+# ------------------------------------------------------------------------- solve_escape
+
+_ALPHA_GRID = (-1.5707, -1.3, -0.9, -0.45, 0.0, 0.45, 0.9, 1.3, 1.5707)
+"""Initial headings probed for sign changes of y(x_e) before Brent refines them."""
+
+
+def solve_escape(theta0: float, x_e: float, *, L: float, rho: float, branch="+",
+                 step: float | None = None) -> EscapeSolution:
+    """The extremal from the origin to ``(x_e, 0)`` with least rotation ``|θ(x_e) - θ0|``.
+
+    Solves ``y(x_e) = 0`` for the single shooting unknown (THEORY §4.2 fact 1), run on the
+    initial heading α(0) (one to one with ``k = λ1/(1 + s λ2(0))`` because ``K_s`` is
+    strictly decreasing): a fixed grid of α(0) brackets the sign changes,
+    ``scipy.optimize.brentq`` refines each, and the extremal with the least ``|J|`` wins.
+
+    Unlike the paper's step 8, an extremal may touch y = 0 before ``x_e``; ``arc.x_c``
+    reports the first return.
+
+    Args:
+        theta0: initial rod orientation in the evader frame (target on the +x axis).
+        x_e: distance to the escape point, > 0.
+        L: surveillance distance ``L_min``, > 0.
+        rho: speed ratio ``V_e / V_p``, > 0.
+        branch: ``"+"`` if the pursuer turns the rod counter-clockwise, ``"-"`` clockwise.
+        step: RK4 arclength step (default :func:`default_step`).
+
+    Returns:
+        An :class:`EscapeSolution`; ``success`` is False with a ``reason`` when no bounded
+        extremal reaches ``(x_e, 0)`` or when ``rho >= 1`` (trivial escape, footnote 4).
+
+    Raises:
+        SurveilValueError: non-finite input, ``x_e <= 0``, ``L <= 0``, ``rho <= 0``.
+    """
+    th0 = finite("theta0", theta0)
+    x_e = positive("x_e", x_e)
+    L = positive("L", L)
+    rho_v = positive("rho", rho)
+    s = branch_sign(branch)
+    if rho_v >= 1.0:
+        return EscapeSolution(
+            success=False,
+            reason=f"rho = {rho_v!r} >= 1: the evader escapes trivially by moving away "
+                   "from the pursuer (footnote 4); at rho = 1, θ̇⁺ can vanish (E1)")
+    h = default_step(x_e, L, rho_v) if step is None else positive("step", step)
+    budget = _max_steps(x_e, L, h)
+
+    def residual(a0: float) -> float:
+        rows, status = integrate_reduced(th0, a0, s, L, rho_v, h, x_e, False, budget)
+        if status != REACHED:  # turned back going up (+1) / down (-1), or wandered (2)
+            return 10.0 * (status if status != 2 else math.copysign(1.0, rows[0][2]))
+        return rows[0][2] / x_e
+
+    grid = [(a, residual(a)) for a in _ALPHA_GRID]
+    roots = []
+    for (a_lo, r_lo), (a_hi, r_hi) in itertools.pairwise(grid):
+        if r_lo == 0.0:
+            roots.append(a_lo)
+        elif r_lo * r_hi < 0.0:
+            root = brentq(residual, a_lo, a_hi, xtol=1e-14, rtol=1e-14)
+            if abs(residual(root)) < 1e-9:  # a root, not a jump to a turned-back arc
+                roots.append(root)
+    best = None
+    for a0 in roots:
+        rows, status = integrate_reduced(th0, a0, s, L, rho_v, h, x_e, True, budget)
+        J = rows[-1][3] - th0
+        if status == REACHED and (best is None or abs(J) < abs(best[1])):
+            best = (a0, J, rows)
+    if best is None:
+        return EscapeSolution(
+            success=False,
+            reason=f"no bounded extremal from theta0 = {th0!r} reaches (x_e, 0) = "
+                   f"({x_e!r}, 0) with L = {L!r}, rho = {rho_v!r}, branch "
+                   f"{'+' if s > 0 else '-'} (the arcs turn back before x_e, THEORY §4.3)")
+    a0, J, rows = best
+    mu0 = math.exp(-rows[-1][5])  # transversality: μ(x_e) = 1, i.e. λ2(x_e) = 0 (E3c)
+    k = _kappa_scalar(a0, th0, L, rho_v, s)[0]
+    lambda1 = k * mu0
+    lambda2_0 = s * (mu0 - 1.0)
+    arc = _build_result(rows, REACHED, th0, lambda1, lambda2_0, s, L, rho_v, True, False)
+    return EscapeSolution(success=True, reason="", J=float(J), k=float(k),
+                          lambda1=float(lambda1), lambda2_0=float(lambda2_0),
+                          alpha0=float(a0), arc=arc, candidates=len(roots))
+
+
+# ------------------------------------------------------------------------------ greedy
+
+
+class GreedyHeading(NamedTuple):
+    """Result of :func:`greedy_heading`."""
+
+    alpha: float | np.ndarray
+    """``argmin_α |f2(α, θ)|``."""
+    f2: float | np.ndarray
+    """``f2`` at that heading (signed: >= 0 for '+', <= 0 for '-')."""
+
+
+def greedy_heading(theta, *, L: float, rho: float, branch="+") -> GreedyHeading:
+    """Fig. 12 mode (final y free, so λ1 = 0): the heading minimising the rotation rate.
+
+    Closed form: ``α* = atan2(s rho cos θ, 1 - s rho sin θ)`` (from ``sin α* = s rho
+    cos(α* - θ)``, the stationarity condition with λ1 = 0; unique because H is unimodal).
+
+    Examples:
+        >>> g = greedy_heading(np.pi, L=1.0, rho=0.5)
+        >>> round(g.alpha + np.arctan(0.5), 12), round(g.f2, 12)
+        (0.0, 1.5)
+    """
+    t = as_finite_array("theta", theta)
+    L = positive("L", L)
+    rho = check_evasion_rho(rho)
+    s = branch_sign(branch)
+    a = np.arctan2(s * rho * np.cos(t), 1.0 - s * rho * np.sin(t))
+    phi = a - t
+    n = np.sqrt(1.0 - (rho * np.cos(phi)) ** 2) - s * rho * np.sin(phi)
+    val = s * n / (L * rho * np.cos(a))
+    if a.ndim == 0:
+        return GreedyHeading(float(a), float(val))
+    return GreedyHeading(a, val)

@@ -1,0 +1,1 @@
+"""Configuration space of the surveillance problem (Secs. 3-4)."""

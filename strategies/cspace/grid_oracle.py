@@ -1,0 +1,509 @@
+"""A grid oracle for the Section 4 verdict: slow, approximate, independent of the exact cells.
+
+The exact decomposition (THEORY.md 1.3) partitions the evader's plane into noncritical
+regions bounded by critical curves and links the cells above neighbouring regions whose
+free arcs overlap. This module computes the same verdict a second way, with no critical
+curve at all:
+
+* **nodes**: a grid of evader positions P with spacing ``resolution``, and at each the exact
+  free arcs of the rod of length L (from the geometry kernel); a node is a pair
+  (point, arc), the grid analogue of a cell kappa = (R, [s-, s+]);
+* **edges**: between nodes of 8- (or 4-) neighbouring grid points whose arcs overlap with
+  positive length (the paper's footnote 3), and only when the evader can walk the segment
+  between the two points (it lies in free space);
+* **escapable nodes**: the least fixed point of the paper's recursive definition (Sec. 4):
+  node (p, a) is escapable if for some neighbour p' of p (a) no arc at p' overlaps a, or
+  (b) every arc at p' that overlaps a is escapable;
+* **verdict**: the evader wins if some grid point carries only escapable nodes (Prop. 2),
+  which includes a point with no free orientation at all (Prop. 5, empty admissible set).
+
+Discretisation: the grid samples each noncritical region only if the region is wider than
+about ``resolution``, and an evader step of length ``resolution`` near a convex vertex at
+distance d < resolution can turn an arc by up to ``atan(resolution / d)``. Both errors
+vanish as the resolution goes to zero; the verdict on a given map is trusted only where it
+is stable under halving the resolution. Use it as a test oracle, not as the product.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from envs.errors import InvalidConfigError, InvalidPlacementError
+from envs.geometry import kernel_for
+from envs.geometry.types import Arc
+from envs.maps.map import Map
+from envs.tolerances import REL_LENGTH_TOL
+
+__all__ = [
+    "OVERLAP_TOL",
+    "GridGraph",
+    "GridVerdict",
+    "grid_escapable",
+    "grid_graph",
+    "grid_safe_arcs",
+    "grid_verdict",
+]
+
+OVERLAP_TOL = 1e-9
+"""Arcs overlapping by at most this many radians only touch: no edge (footnote 3)."""
+
+MAX_GRID_POINTS = 4_000_000
+"""Refuse grids with more candidate points than this (memory and hours of run time)."""
+
+_TWO_PI = 2.0 * math.pi
+_HALF_OFFSETS = {4: ((1, 0), (0, 1)), 8: ((1, 0), (0, 1), (1, 1), (1, -1))}
+_CHUNK = 16_384
+
+
+# --------------------------------------------------------------------------- validation
+def _check(map_: Map, L: float, resolution: float, neighbourhood: int) -> tuple[float, float]:
+    if not isinstance(map_, Map):
+        raise InvalidConfigError(f"map: expected an envs.maps.Map, got {type(map_).__name__}")
+    L = float(L)
+    if not math.isfinite(L) or L <= 0:
+        raise InvalidConfigError(f"L: expected a finite rod length > 0, got {L!r}")
+    resolution = float(resolution)
+    if not math.isfinite(resolution) or resolution <= 0:
+        raise InvalidConfigError(f"resolution: expected a finite spacing > 0, got {resolution!r}")
+    if neighbourhood not in _HALF_OFFSETS:
+        raise InvalidConfigError(f"neighbourhood: expected 4 or 8, got {neighbourhood!r}")
+    xmin, ymin, xmax, ymax = map_.bounds
+    n = (math.floor((xmax - xmin) / resolution) + 1) * (math.floor((ymax - ymin) / resolution) + 1)
+    if n > MAX_GRID_POINTS:
+        raise InvalidConfigError(
+            f"resolution: {resolution:g} gives {n} grid points on a map of bounds "
+            f"{map_.bounds}, more than {MAX_GRID_POINTS}; use a coarser resolution"
+        )
+    return L, resolution
+
+
+def _as_point(point: Sequence[float] | np.ndarray) -> np.ndarray:
+    p = np.asarray(point, dtype=float)
+    if p.shape != (2,) or not np.all(np.isfinite(p)):
+        raise InvalidPlacementError(f"point: expected finite (x, y), got {point!r}")
+    return p
+
+
+# --------------------------------------------------------------------------- geometry
+def _axis(lo: float, hi: float, resolution: float) -> np.ndarray:
+    """Grid abscissae with spacing ``resolution``, centred in ``[lo, hi]``."""
+    n = max(1, math.floor((hi - lo) / resolution))
+    start = lo + 0.5 * ((hi - lo) - (n - 1) * resolution)
+    return start + resolution * np.arange(n)
+
+
+def _clearance(map_: Map, points: np.ndarray) -> np.ndarray:
+    """Distance from each point to the walls (chunked to bound memory)."""
+    out = np.empty(len(points))
+    for s in range(0, len(points), _CHUNK):
+        out[s : s + _CHUNK] = map_.distance_to_walls(points[s : s + _CHUNK])
+    return out
+
+
+def _steps_clear(map_: Map, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Which segments ``a[k] -> b[k]`` (both ends in free space) stay in the closed free region.
+
+    A segment leaves the free region iff it properly crosses a wall edge, or it passes
+    through obstacle interior between two wall contacts (entering and leaving through
+    vertices or along edges). The second case is caught by testing the midpoints between
+    consecutive contact parameters; we test the midpoints of the pieces cut by every
+    contact with a wall vertex, which covers it.
+    """
+    clear = np.ones(len(a), dtype=bool)
+    s0, s1 = map_.edge_start, map_.edge_end
+    vtx = map_.vertices
+    eps = REL_LENGTH_TOL * map_.scale
+    for s in range(0, len(a), _CHUNK):
+        pa, pb = a[s : s + _CHUNK], b[s : s + _CHUNK]
+        d = pb - pa  # (k, 2)
+        e = s1 - s0  # (E, 2)
+        cross = lambda u, v: u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
+        # orientation of wall endpoints w.r.t. the step, and of step endpoints w.r.t. walls
+        o1 = cross(d[:, None, :], s0[None] - pa[:, None])
+        o2 = cross(d[:, None, :], s1[None] - pa[:, None])
+        o3 = cross(e[None], pa[:, None] - s0[None])
+        o4 = cross(e[None], pb[:, None] - s0[None])
+        len_d = np.linalg.norm(d, axis=1)[:, None]
+        len_e = np.linalg.norm(e, axis=1)[None]
+        tol1, tol3 = eps * len_d, eps * len_e
+        proper = (((o1 > tol1) & (o2 < -tol1)) | ((o1 < -tol1) & (o2 > tol1))) & (
+            ((o3 > tol3) & (o4 < -tol3)) | ((o3 < -tol3) & (o4 > tol3))
+        )
+        blocked = proper.any(axis=1)
+        # contacts with wall vertices cut the step into pieces; each piece must be free
+        rel = vtx[None] - pa[:, None]  # (k, V, 2)
+        t = np.einsum("kvj,kj->kv", rel, d) / np.maximum(len_d**2, eps**2)
+        dist = np.abs(cross(d[:, None, :], rel)) / np.maximum(len_d, eps)
+        touch = (dist <= eps) & (t > 0) & (t < 1)
+        rows = np.flatnonzero(touch.any(axis=1) & ~blocked)
+        for r in rows:
+            ts = np.concatenate(([0.0], np.sort(t[r, touch[r]]), [1.0]))
+            mids = pa[r] + 0.5 * (ts[:-1] + ts[1:])[:, None] * d[r]
+            if not np.all(map_.contains(mids)):
+                blocked[r] = True
+        clear[s : s + _CHUNK] = ~blocked
+    return clear
+
+
+def _arcs_overlap(lo1, hi1, lo2, hi2, tol: float = OVERLAP_TOL) -> np.ndarray:
+    """Whether closed arcs ``[lo1, hi1]`` and ``[lo2, hi2]`` share a positive length.
+
+    Arcs are ``lo`` in ``[-pi, pi)``, ``lo <= hi <= lo + 2 pi``; trying the shifts
+    ``{-2 pi, 0, 2 pi}`` of the second arc covers every wrap-around at +-pi.
+    """
+    best = np.full(np.shape(lo1), -np.inf)
+    for shift in (-_TWO_PI, 0.0, _TWO_PI):
+        best = np.maximum(best, np.minimum(hi1, hi2 + shift) - np.maximum(lo1, lo2 + shift))
+    return best > tol
+
+
+def _concat_ranges(starts: np.ndarray, stops: np.ndarray) -> np.ndarray:
+    """``concatenate([arange(a, b) for a, b in zip(starts, stops)])`` without a loop."""
+    lens = stops - starts
+    total = int(lens.sum())
+    if total == 0:
+        return np.zeros(0, dtype=np.int64)
+    offsets = np.cumsum(lens) - lens
+    return np.repeat(starts - offsets, lens) + np.arange(total)
+
+
+# --------------------------------------------------------------------------- the graph
+@dataclass(frozen=True, eq=False)
+class GridGraph:
+    """The grid analogue of G_L (Sec. 3): nodes (point, free arc), edges by overlap.
+
+    Attributes:
+        map: the world.
+        L: rod length.
+        resolution: grid spacing.
+        neighbourhood: 4 or 8 (grid neighbours an evader step may reach).
+        points: (n, 2) grid points in the open free region.
+        point_arcs: the kernel's free arcs at each point.
+        node_point: (N,) grid point of each node; nodes of a point are consecutive.
+        node_ptr: (n + 1,) nodes of point i are ``node_ptr[i]:node_ptr[i + 1]``.
+        node_lo, node_hi: (N,) the node's arc ``[lo, hi]``.
+        point_edges: (M, 2) neighbouring grid points joined by a free segment.
+        overlap: (K, 3) rows ``(a, b, e)``: node a at ``point_edges[e, 0]`` and node b at
+            ``point_edges[e, 1]`` overlap with positive length (an edge of the graph).
+    """
+
+    map: Map
+    L: float
+    resolution: float
+    neighbourhood: int
+    points: np.ndarray
+    point_arcs: tuple[tuple[Arc, ...], ...]
+    node_point: np.ndarray
+    node_ptr: np.ndarray
+    node_lo: np.ndarray
+    node_hi: np.ndarray
+    point_edges: np.ndarray
+    overlap: np.ndarray
+
+    @property
+    def n_points(self) -> int:
+        """Number of grid points in free space."""
+        return len(self.points)
+
+    @property
+    def n_nodes(self) -> int:
+        """Number of nodes (point, arc)."""
+        return len(self.node_point)
+
+    @functools.cached_property
+    def escapable(self) -> np.ndarray:
+        """(N,) bool: the least fixed point of the escapable-cell definition (Sec. 4)."""
+        return _least_fixed_point(self)
+
+    @functools.cached_property
+    def point_escapable(self) -> np.ndarray:
+        """(n,) bool: every node at the point is escapable (vacuously true with no arc)."""
+        safe = np.bincount(self.node_point[~self.escapable], minlength=self.n_points)
+        return safe == 0
+
+
+def grid_graph(map: Map, L: float, *, resolution: float, neighbourhood: int = 8) -> GridGraph:
+    """Build the grid graph of a map for a rod of length L.
+
+    Args:
+        map: the world.
+        L: rod length (the surveillance distance, > 0).
+        resolution: grid spacing (> 0), in map units.
+        neighbourhood: 8 (default) or 4 grid neighbours per point.
+
+    Returns:
+        The :class:`GridGraph`; its ``escapable`` property runs the fixed point.
+
+    Raises:
+        InvalidConfigError: L or resolution not positive and finite, a grid too large, or
+            a neighbourhood other than 4 or 8.
+    """
+    map_ = map
+    L, resolution = _check(map_, L, resolution, neighbourhood)
+    xmin, ymin, xmax, ymax = map_.bounds
+    xs, ys = _axis(xmin, xmax, resolution), _axis(ymin, ymax, resolution)
+    gi, gj = np.meshgrid(np.arange(len(xs)), np.arange(len(ys)), indexing="ij")
+    cand = np.stack([xs[gi.ravel()], ys[gj.ravel()]], axis=1)
+    # the open free region: in free space and not on a wall (a type-0 point, THEORY 1.2)
+    keep = np.zeros(len(cand), dtype=bool)
+    for s in range(0, len(cand), _CHUNK):
+        keep[s : s + _CHUNK] = map_.contains(cand[s : s + _CHUNK])
+    idx = np.flatnonzero(keep)
+    idx = idx[_clearance(map_, cand[idx]) > REL_LENGTH_TOL * map_.scale]
+    points = cand[idx]
+    index = np.full(gi.size, -1, dtype=np.int64)
+    index[idx] = np.arange(len(idx))
+    index = index.reshape(gi.shape)
+
+    kernel = kernel_for(map_)
+    point_arcs = (
+        tuple(tuple(fa.arcs) for fa in kernel.free_arcs_many(points, L)) if len(points) else ()
+    )
+    counts = np.fromiter((len(a) for a in point_arcs), dtype=np.int64, count=len(points))
+    node_ptr = np.concatenate(([0], np.cumsum(counts)))
+    node_point = np.repeat(np.arange(len(points)), counts)
+    node_lo = np.fromiter((a.lo for arcs in point_arcs for a in arcs), dtype=float)
+    node_hi = np.fromiter((a.hi for arcs in point_arcs for a in arcs), dtype=float)
+
+    # neighbouring grid points (each unordered pair once) joined by a free segment
+    pairs = []
+    nx, ny = index.shape
+    for di, dj in _HALF_OFFSETS[neighbourhood]:  # di >= 0 always
+        j0, j1 = max(0, -dj), ny - max(0, dj)
+        a = index[: nx - di, j0:j1]
+        b = index[di:, j0 + dj : j1 + dj]
+        ok = (a >= 0) & (b >= 0)
+        pairs.append(np.stack([a[ok], b[ok]], axis=1))
+    edges = np.concatenate(pairs) if pairs else np.zeros((0, 2), dtype=np.int64)
+    edges = edges[_steps_clear(map_, points[edges[:, 0]], points[edges[:, 1]])]
+
+    # every pair of arcs across every edge, kept when they overlap (footnote 3)
+    ci, cj = counts[edges[:, 0]], counts[edges[:, 1]]
+    tot = ci * cj
+    e_rep = np.repeat(np.arange(len(edges)), tot)
+    k = np.arange(int(tot.sum())) - np.repeat(np.cumsum(tot) - tot, tot)
+    na = node_ptr[edges[e_rep, 0]] + k // np.maximum(cj[e_rep], 1)
+    nb = node_ptr[edges[e_rep, 1]] + k % np.maximum(cj[e_rep], 1)
+    hit = _arcs_overlap(node_lo[na], node_hi[na], node_lo[nb], node_hi[nb])
+    overlap = np.stack([na[hit], nb[hit], e_rep[hit]], axis=1).astype(np.int64)
+
+    for arr in (points, node_point, node_ptr, node_lo, node_hi, edges, overlap):
+        arr.setflags(write=False)
+    return GridGraph(
+        map=map_,
+        L=L,
+        resolution=resolution,
+        neighbourhood=neighbourhood,
+        points=points,
+        point_arcs=point_arcs,
+        node_point=node_point,
+        node_ptr=node_ptr,
+        node_lo=node_lo,
+        node_hi=node_hi,
+        point_edges=edges,
+        overlap=overlap,
+    )
+
+
+def _least_fixed_point(g: GridGraph) -> np.ndarray:
+    """Escapable nodes: least fixed point of conditions (a)/(b) of Sec. 4, by worklist.
+
+    One *group* per (node a at p, neighbour p'), holding the count of not-yet-escapable
+    nodes at p' that overlap a. A group at zero means (a) (it started at zero) or (b)
+    (it reached zero): its node is escapable. Each overlap pair is processed once, when
+    its far node becomes escapable, so the whole run is linear in the graph size.
+    """
+    edges, ptr = g.point_edges, g.node_ptr
+    m = len(edges)
+    src = np.concatenate([edges[:, 0], edges[:, 1]])  # directed steps p -> p'
+    cnt = ptr[src + 1] - ptr[src]
+    gstart = np.cumsum(cnt) - cnt
+    group_node = _concat_ranges(ptr[src], ptr[src + 1])
+    n_groups = len(group_node)
+    a, b, e = g.overlap[:, 0], g.overlap[:, 1], g.overlap[:, 2]
+    # directed overlap pairs (near node, far node, step): a->b on step e, b->a on e + m
+    near = np.concatenate([a, b])
+    far = np.concatenate([b, a])
+    step = np.concatenate([e, e + m])
+    pair_group = gstart[step] + (near - ptr[src[step]])
+    count = np.bincount(pair_group, minlength=n_groups)
+
+    esc = np.zeros(g.n_nodes, dtype=bool)
+    esc[group_node[count == 0]] = True
+    order = np.argsort(far, kind="stable")
+    far_ptr = np.searchsorted(far[order], np.arange(g.n_nodes + 1))
+    sorted_group = pair_group[order]
+    frontier = np.flatnonzero(esc)
+    while frontier.size:
+        groups = sorted_group[_concat_ranges(far_ptr[frontier], far_ptr[frontier + 1])]
+        np.subtract.at(count, groups, 1)
+        done = np.unique(groups[count[groups] == 0])
+        new = np.unique(group_node[done])
+        frontier = new[~esc[new]]
+        esc[frontier] = True
+    return esc
+
+
+@functools.lru_cache(maxsize=8)
+def _cached_graph(map_: Map, L: float, resolution: float, neighbourhood: int) -> GridGraph:
+    return grid_graph(map_, L, resolution=resolution, neighbourhood=neighbourhood)
+
+
+# --------------------------------------------------------------------------- verdicts
+@dataclass(frozen=True)
+class GridVerdict:
+    """The grid oracle's answer to Props. 2 and 5 at one rod length.
+
+    Attributes:
+        evader_wins: some grid point carries only escapable nodes (or no free arc).
+        witness_point: such a point (the one farthest from the walls), else ``None``.
+        n_points: grid points in free space.
+        n_nodes: nodes (point, arc).
+        n_escapable: escapable nodes.
+        n_edges: graph edges (overlapping arcs of neighbouring points).
+        resolution: grid spacing.
+        L: rod length.
+    """
+
+    evader_wins: bool
+    witness_point: tuple[float, float] | None
+    n_points: int
+    n_nodes: int
+    n_escapable: int
+    n_edges: int
+    resolution: float
+    L: float
+
+
+def grid_verdict(map: Map, L: float, *, resolution: float, neighbourhood: int = 8) -> GridVerdict:
+    """Decide, approximately, whether the evader wins at rod length L (Props. 2 and 5).
+
+    Args:
+        map: the world.
+        L: rod length (> 0).
+        resolution: grid spacing (> 0).
+        neighbourhood: 8 (default) or 4.
+
+    Returns:
+        A :class:`GridVerdict`.
+
+    Raises:
+        InvalidConfigError: as :func:`grid_graph`.
+    """
+    L, resolution = _check(map, L, resolution, neighbourhood)
+    g = _cached_graph(map, L, resolution, neighbourhood)
+    winners = np.flatnonzero(g.point_escapable)
+    witness = None
+    if winners.size:
+        best = winners[np.argmax(_clearance(map, g.points[winners]))]
+        witness = (float(g.points[best, 0]), float(g.points[best, 1]))
+    return GridVerdict(
+        evader_wins=bool(winners.size),
+        witness_point=witness,
+        n_points=g.n_points,
+        n_nodes=g.n_nodes,
+        n_escapable=int(g.escapable.sum()),
+        n_edges=len(g.overlap),
+        resolution=resolution,
+        L=L,
+    )
+
+
+def _probe(
+    map_: Map, L: float, point: np.ndarray, resolution: float, neighbourhood: int
+) -> tuple[tuple[Arc, ...], np.ndarray]:
+    """Free arcs at an off-grid point and which are escapable, by one evader step.
+
+    The point joins the grid as a node source only: arc a at the point is escapable if for
+    some grid point p' within 1.5 resolution and in sight, (a) no arc at p' overlaps a or
+    (b) every arc at p' overlapping a is escapable in the grid's fixed point.
+    """
+    if not map_.contains(point[None])[0]:
+        raise InvalidPlacementError(f"point: {tuple(point.tolist())} is not in free space")
+    g = _cached_graph(map_, L, resolution, neighbourhood)
+    arcs = tuple(kernel_for(map_).free_arcs(point, L).arcs)
+    near = np.flatnonzero(np.linalg.norm(g.points - point, axis=1) <= 1.5 * resolution)
+    near = near[_steps_clear(map_, np.repeat(point[None], len(near), axis=0), g.points[near])]
+    esc = np.zeros(len(arcs), dtype=bool)
+    if not arcs or not near.size:
+        return arcs, esc
+    lo = np.array([a.lo for a in arcs])
+    hi = np.array([a.hi for a in arcs])
+    for p in near:
+        nodes = np.arange(g.node_ptr[p], g.node_ptr[p + 1])
+        ov = _arcs_overlap(lo[:, None], hi[:, None], g.node_lo[nodes][None], g.node_hi[nodes][None])
+        esc |= ~np.any(ov & ~g.escapable[nodes][None], axis=1)
+    return arcs, esc
+
+
+def grid_safe_arcs(
+    map: Map,
+    L: float,
+    point: Sequence[float] | np.ndarray,
+    *,
+    resolution: float,
+    neighbourhood: int = 8,
+) -> tuple[Arc, ...]:
+    """The free arcs at ``point`` that are not escapable in the grid's fixed point.
+
+    Args:
+        map: the world.
+        L: rod length (> 0).
+        point: the evader position (x, y), in free space; it need not be a grid point.
+        resolution: grid spacing (> 0).
+        neighbourhood: 8 (default) or 4.
+
+    Returns:
+        The safe arcs (a subset of the kernel's free arcs at ``point``), sorted by ``lo``.
+
+    Raises:
+        InvalidConfigError: as :func:`grid_graph`.
+        InvalidPlacementError: ``point`` not finite or not in free space.
+    """
+    L, resolution = _check(map, L, resolution, neighbourhood)
+    arcs, esc = _probe(map, L, _as_point(point), resolution, neighbourhood)
+    return tuple(a for a, e in zip(arcs, esc, strict=True) if not e)
+
+
+def grid_escapable(
+    map: Map,
+    L: float,
+    point: Sequence[float] | np.ndarray,
+    theta: float,
+    *,
+    resolution: float,
+    neighbourhood: int = 8,
+) -> bool:
+    """Whether the configuration (point, theta) lies in an escapable node (Sec. 4).
+
+    Args:
+        map: the world.
+        L: rod length (> 0).
+        point: the evader position (x, y), in free space.
+        theta: direction from evader to pursuer (radians, eq. 1); must be free.
+        resolution: grid spacing (> 0).
+        neighbourhood: 8 (default) or 4.
+
+    Returns:
+        True if every free arc containing theta is escapable.
+
+    Raises:
+        InvalidConfigError: as :func:`grid_graph`.
+        InvalidPlacementError: ``point`` not in free space, or theta not finite or blocked.
+    """
+    L, resolution = _check(map, L, resolution, neighbourhood)
+    if not math.isfinite(float(theta)):
+        raise InvalidPlacementError(f"theta: expected a finite angle, got {theta!r}")
+    arcs, esc = _probe(map, L, _as_point(point), resolution, neighbourhood)
+    inside = [e for a, e in zip(arcs, esc, strict=True) if a.contains(theta)]
+    if not inside:
+        raise InvalidPlacementError(
+            f"theta: {theta!r} is blocked at point {tuple(np.asarray(point).tolist())} for "
+            f"L={L:g}; free arcs are {[(round(a.lo, 6), round(a.hi, 6)) for a in arcs]}"
+        )
+    return all(inside)

@@ -12,6 +12,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 from typing import NamedTuple
 
@@ -113,7 +114,7 @@ def tractrix_numeric(t, *, L: float = 1.0, v_e: float = 1.0, theta0: float = 0.5
 
     p = start + ev * tt[0] + L * np.array([math.cos(theta0), math.sin(theta0)])
     out = [p]
-    for t0, t1 in zip(tt[:-1], tt[1:], strict=True):
+    for t0, t1 in itertools.pairwise(tt):
         h = (t1 - t0) / substeps
         for i in range(substeps):
             ti = t0 + i * h

@@ -1,0 +1,470 @@
+"""The PettingZoo adapter: ``parallel_env`` (native), ``raw_env`` and ``env`` (AEC).
+
+The env card (agents, spaces, arguments, version history) is the docstring of
+:mod:`envs.surveillance_v0`; this module holds the implementation.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from typing import Any, ClassVar
+
+import numpy as np
+from gymnasium.spaces import Box
+from gymnasium.utils import EzPickle, seeding
+from pettingzoo import AECEnv, ParallelEnv
+from pettingzoo.utils.conversions import parallel_to_aec
+
+from envs.errors import InvalidActionError
+from envs.geometry import Kernel, kernel_for
+from envs.maps import Map
+from envs.surveillance import rules
+from envs.surveillance.config import RENDER_MODES, EnvConfig
+from envs.surveillance.observations import (
+    LidarEncoder,
+    StateEncoder,
+    lidar_space,
+    state_space,
+)
+from envs.surveillance.physics import World
+from envs.surveillance.placement import random_start, validate_placement
+
+__all__ = ["AGENTS", "EVADER", "PURSUER", "env", "parallel_env", "raw_env"]
+
+PURSUER = "pursuer_0"
+EVADER = "evader_0"
+AGENTS = (PURSUER, EVADER)
+TRAIL_LENGTH = 200
+"""Past positions kept per agent for the renderer's trails."""
+
+
+def _kernel(world: Map) -> Kernel:
+    """The cached kernel of ``world``, provided its wall indices match ``world``'s.
+
+    ``kernel_for`` caches by digest, and equal digests do not imply equal vertex
+    numbering (the digest ignores where each ring starts), while the features the
+    kernel reports index the arrays of the map it was built from.
+    """
+    k = kernel_for(world)
+    if k.map is world or np.array_equal(k.map.vertices, world.vertices):
+        return k
+    return Kernel(world)
+
+
+class parallel_env(ParallelEnv, EzPickle):
+    """Visibility-based surveillance with a finite sensor range, as a ParallelEnv.
+
+    See :mod:`envs.surveillance_v0` for the env card; every argument is a field of
+    :class:`~envs.surveillance.config.EnvConfig`.
+    """
+
+    metadata: ClassVar[dict[str, Any]] = {
+        "name": "surveillance_v0",
+        "render_modes": list(RENDER_MODES),
+        "is_parallelizable": True,
+        "render_fps": 10,
+    }
+
+    def __init__(
+        self,
+        map: Map | str | os.PathLike[str] = "corridor",
+        l_min: float = 2.0,
+        l_max: float = 4.0,
+        v_pursuer: float = 1.0,
+        v_evader: float = 0.5,
+        dt: float = 0.1,
+        max_cycles: int = 500,
+        observation: str = "state",
+        n_rays: int = 32,
+        lidar_range: float | None = None,
+        reward: str = "zero_sum",
+        body_radius: float = 0.1,
+        spawn_margin_steps: int = 3,
+        render_mode: str | None = None,
+    ) -> None:
+        EzPickle.__init__(
+            self,
+            map=map,
+            l_min=l_min,
+            l_max=l_max,
+            v_pursuer=v_pursuer,
+            v_evader=v_evader,
+            dt=dt,
+            max_cycles=max_cycles,
+            observation=observation,
+            n_rays=n_rays,
+            lidar_range=lidar_range,
+            reward=reward,
+            body_radius=body_radius,
+            spawn_margin_steps=spawn_margin_steps,
+            render_mode=render_mode,
+        )
+        cfg = EnvConfig(
+            map=map,
+            l_min=l_min,
+            l_max=l_max,
+            v_pursuer=v_pursuer,
+            v_evader=v_evader,
+            dt=dt,
+            max_cycles=max_cycles,
+            observation=observation,
+            n_rays=n_rays,
+            lidar_range=lidar_range,
+            reward=reward,
+            body_radius=body_radius,
+            spawn_margin_steps=spawn_margin_steps,
+            render_mode=render_mode,
+        )
+        self.config = cfg
+        self.render_mode = cfg.render_mode
+        self.metadata = {**type(self).metadata, "render_fps": 1.0 / cfg.dt}
+        self.possible_agents = list(AGENTS)
+        self.agents: list[str] = []
+        self.map = cfg.map
+        self.kernel = _kernel(cfg.map)
+        self.world = World(cfg.map, cfg.body_radius, cfg.dt, max(cfg.v_pursuer, cfg.v_evader))
+        self._state_encoder = StateEncoder(cfg)
+        self.state_space = state_space(cfg)
+        if cfg.observation == "state":
+            self._observation_spaces = {a: state_space(cfg) for a in AGENTS}
+            self._lidar = None
+        else:
+            self._observation_spaces = {a: lidar_space(cfg) for a in AGENTS}
+            self._lidar = {
+                PURSUER: LidarEncoder(cfg, "pursuer", self.kernel),
+                EVADER: LidarEncoder(cfg, "evader", self.kernel),
+            }
+        self._action_spaces = {a: Box(-1.0, 1.0, (2,), dtype=np.float32) for a in AGENTS}
+        self._speed = {PURSUER: cfg.v_pursuer, EVADER: cfg.v_evader}
+        self._inv_dt = 1.0 / cfg.dt
+        self._surveillance_reward = rules.reward_components(
+            cfg.reward, escaped=False, truncated=False, max_cycles=cfg.max_cycles
+        )
+        self.np_random, self._np_random_seed = seeding.np_random(None)
+        self._step = 0
+        self._pursuer = (0.0, 0.0)
+        self._evader = (0.0, 0.0)
+        self._vp = (0.0, 0.0)
+        self._ve = (0.0, 0.0)
+        self._visible = False
+        self._last_event = None
+        self._trail: tuple[list, list] = ([], [])
+        self._renderer = None
+
+    # ------------------------------------------------------------------ spaces
+    def observation_space(self, agent: str) -> Box:
+        """The observation Box of ``agent`` (the same object on every call)."""
+        return self._observation_spaces[agent]
+
+    def action_space(self, agent: str) -> Box:
+        """The action Box(-1, 1, (2,)) of ``agent`` (the same object on every call)."""
+        return self._action_spaces[agent]
+
+    # ------------------------------------------------------------------ episode
+    def reset(
+        self, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[dict[str, np.ndarray], dict[str, dict[str, Any]]]:
+        """Start an episode.
+
+        Args:
+            seed: reseeds ``self.np_random`` when not ``None``.
+            options: ``{"pursuer": (x, y), "evader": (x, y)}`` places the agents exactly
+                (validated: both in free space with body clearance, within range, with
+                line of sight); without them the start is drawn at random (see
+                :func:`envs.surveillance.placement.random_start`). Other keys are ignored,
+                as wrappers pass their own options through.
+
+        Returns:
+            Observations and infos of both agents.
+
+        Raises:
+            InvalidPlacementError: the requested placement is not a valid surveillance
+                configuration; the message names the positions and the reason.
+        """
+        if seed is not None:
+            self.np_random, self._np_random_seed = seeding.np_random(seed)
+        cfg = self.config
+        if options and ("pursuer" in options or "evader" in options):
+            p, e = validate_placement(
+                cfg, self.kernel, options.get("pursuer"), options.get("evader")
+            )
+        else:
+            p, e = random_start(cfg, self.kernel, self.np_random)
+        self.world.reset(p, e)
+        self._pursuer = (float(p[0]), float(p[1]))
+        self._evader = (float(e[0]), float(e[1]))
+        self._vp = (0.0, 0.0)
+        self._ve = (0.0, 0.0)
+        self._step = 0
+        self._last_event = None
+        self._trail = ([self._pursuer], [self._evader])
+        self.agents = list(AGENTS)
+        status = rules.surveillance_status(
+            self.kernel, self._pursuer, self._evader, cfg.l_min, cfg.l_max
+        )
+        self._visible = status.holds
+        info = self._base_info(status.holds, status.distance)
+        observations = self._observations()
+        if self.render_mode == "human":
+            self.render()
+        return observations, {PURSUER: info, EVADER: dict(info)}
+
+    def _command(self, agent: str, action: Any) -> tuple[float, float]:
+        """Validate, clip and scale one action into a velocity (see the env card)."""
+        try:
+            a = np.asarray(action, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise InvalidActionError(
+                f"{agent}: expected an action of shape (2,) with finite values, got {action!r}"
+            ) from exc
+        if a.shape != (2,):
+            raise InvalidActionError(
+                f"{agent}: expected an action of shape (2,), got shape {a.shape}"
+            )
+        x = float(a[0])
+        y = float(a[1])
+        if not (math.isfinite(x) and math.isfinite(y)):
+            raise InvalidActionError(f"{agent}: action must be finite, got {a.tolist()}")
+        # clip to the Box, then onto the unit disc: the speed bound is on |v|, and the
+        # Box corners would otherwise allow sqrt(2) times the bound
+        x = -1.0 if x < -1.0 else (1.0 if x > 1.0 else x)
+        y = -1.0 if y < -1.0 else (1.0 if y > 1.0 else y)
+        n2 = x * x + y * y
+        scale = self._speed[agent]
+        if n2 > 1.0:
+            scale /= math.sqrt(n2)
+        return (x * scale, y * scale)
+
+    def step(self, actions: dict[str, Any]) -> tuple[dict, dict, dict, dict, dict]:
+        """Advance both agents by ``dt`` and check surveillance continuously over the step.
+
+        Args:
+            actions: one action per live agent, each a (2,) velocity in units of the
+                agent's speed bound. Finite values outside [-1, 1] are clipped to the Box
+                and then onto the unit disc; NaN or inf raise.
+
+        Returns:
+            ``(observations, rewards, terminations, truncations, infos)`` for the agents
+            live at the start of the step. After the episode ends ``agents`` is empty.
+
+        Raises:
+            InvalidActionError: an action is missing, of the wrong shape, or not finite.
+        """
+        if not self.agents:
+            return {}, {}, {}, {}, {}
+        if PURSUER not in actions or EVADER not in actions:
+            missing = [a for a in AGENTS if a not in actions]
+            raise InvalidActionError(
+                f"step: missing actions for {missing}; got keys {sorted(actions)}"
+            )
+        cfg = self.config
+        vp = self._command(PURSUER, actions[PURSUER])
+        ve = self._command(EVADER, actions[EVADER])
+        p0, e0 = self._pursuer, self._evader
+        p1, e1 = self.world.step(vp, ve)
+        event = self.kernel.sweep(p0, e0, p1, e1, cfg.l_min, cfg.l_max)
+        self._step += 1
+        inv_dt = self._inv_dt
+        self._vp = ((p1[0] - p0[0]) * inv_dt, (p1[1] - p0[1]) * inv_dt)
+        self._ve = ((e1[0] - e0[0]) * inv_dt, (e1[1] - e0[1]) * inv_dt)
+        self._pursuer, self._evader = p1, e1
+        escaped = event is not None
+        trunc = (not escaped) and self._step >= cfg.max_cycles
+        if escaped or trunc:
+            comp = rules.reward_components(
+                cfg.reward, escaped=escaped, truncated=trunc, max_cycles=cfg.max_cycles
+            )
+        else:
+            comp = self._surveillance_reward
+        distance = math.hypot(p1[0] - e1[0], p1[1] - e1[1])
+        if escaped:
+            # the rod may clear the obstacle again by the end of the step
+            self._visible = rules.surveillance_status(
+                self.kernel, p1, e1, cfg.l_min, cfg.l_max
+            ).holds
+        else:
+            self._visible = True
+        self._last_event = event
+        trail_p, trail_e = self._trail
+        trail_p.append(p1)
+        trail_e.append(e1)
+        if len(trail_p) > TRAIL_LENGTH:
+            del trail_p[0], trail_e[0]
+
+        info_p = self._base_info(not escaped, distance)
+        if escaped:
+            info_p["cause"] = event.cause
+            info_p["feature"] = None if event.feature is None else self.map.describe(event.feature)
+            info_p["break_time"] = float(event.time)
+            info_p["break_at"] = (self._step - 1 + float(event.time)) * cfg.dt
+        info_e = dict(info_p)
+        r = comp.total
+        info_p["reward_surveillance"] = comp.surveillance
+        info_p["reward_escape"] = comp.escape
+        info_p["reward_horizon"] = comp.horizon
+        info_e["reward_surveillance"] = -comp.surveillance
+        info_e["reward_escape"] = -comp.escape
+        info_e["reward_horizon"] = -comp.horizon
+
+        observations = self._observations()
+        rewards = {PURSUER: r, EVADER: -r}
+        terminations = {PURSUER: escaped, EVADER: escaped}
+        truncations = {PURSUER: trunc, EVADER: trunc}
+        infos = {PURSUER: info_p, EVADER: info_e}
+        if escaped or trunc:
+            self.agents = []
+        if self.render_mode == "human":
+            self.render()
+        return observations, rewards, terminations, truncations, infos
+
+    def _base_info(self, surveillance: bool, distance: float) -> dict[str, Any]:
+        p, e = self._pursuer, self._evader
+        return {
+            "surveillance": surveillance,
+            "distance": distance,
+            "theta": math.atan2(p[1] - e[1], p[0] - e[0]),
+            "step": self._step,
+            "time": self._step * self.config.dt,
+        }
+
+    def _observations(self) -> dict[str, np.ndarray]:
+        if self._lidar is None:
+            obs = self._state_encoder.encode(
+                self._pursuer, self._vp, self._evader, self._ve, self._visible, self._step
+            )
+            return {PURSUER: obs, EVADER: obs.copy()}
+        return {
+            PURSUER: self._lidar[PURSUER].encode(
+                self._pursuer, self._vp, self._evader, self._visible, self._step
+            ),
+            EVADER: self._lidar[EVADER].encode(
+                self._evader, self._ve, self._pursuer, self._visible, self._step
+            ),
+        }
+
+    def state(self) -> np.ndarray:
+        """The global state (the ``"state"`` observation vector) for centralised critics."""
+        return self._state_encoder.encode(
+            self._pursuer, self._vp, self._evader, self._ve, self._visible, self._step
+        )
+
+    # ------------------------------------------------------------------ rendering
+    def snapshot(self):
+        """A read-only snapshot of the world for renderers (no observation is read back)."""
+        from envs.surveillance.render import Snapshot
+
+        event = self._last_event
+        return Snapshot(
+            map=self.map,
+            pursuer=self._pursuer,
+            evader=self._evader,
+            l_min=self.config.l_min,
+            l_max=self.config.l_max,
+            body_radius=self.config.body_radius,
+            surveillance=event is None,
+            cause=None if event is None else event.cause,
+            feature=None if event is None else event.feature,
+            step=self._step,
+            time=self._step * self.config.dt,
+            trail_pursuer=tuple(self._trail[0]),
+            trail_evader=tuple(self._trail[1]),
+        )
+
+    def render(self) -> np.ndarray | None:
+        """``"rgb_array"``: an HxWx3 uint8 frame; ``"human"``: draw to a window."""
+        if self.render_mode is None:
+            return None
+        if self._renderer is None:
+            from envs.surveillance.render import Renderer
+
+            self._renderer = Renderer(
+                self.map, human=self.render_mode == "human", fps=self.metadata["render_fps"]
+            )
+        return self._renderer.draw(self.snapshot())
+
+    def close(self) -> None:
+        """Release the window, if any (idempotent)."""
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+
+def raw_env(
+    map: Map | str | os.PathLike[str] = "corridor",
+    l_min: float = 2.0,
+    l_max: float = 4.0,
+    v_pursuer: float = 1.0,
+    v_evader: float = 0.5,
+    dt: float = 0.1,
+    max_cycles: int = 500,
+    observation: str = "state",
+    n_rays: int = 32,
+    lidar_range: float | None = None,
+    reward: str = "zero_sum",
+    body_radius: float = 0.1,
+    spawn_margin_steps: int = 3,
+    render_mode: str | None = None,
+) -> AECEnv:
+    """The AEC version, by conversion of :class:`parallel_env` (same arguments)."""
+    return parallel_to_aec(
+        parallel_env(
+            map=map,
+            l_min=l_min,
+            l_max=l_max,
+            v_pursuer=v_pursuer,
+            v_evader=v_evader,
+            dt=dt,
+            max_cycles=max_cycles,
+            observation=observation,
+            n_rays=n_rays,
+            lidar_range=lidar_range,
+            reward=reward,
+            body_radius=body_radius,
+            spawn_margin_steps=spawn_margin_steps,
+            render_mode=render_mode,
+        )
+    )
+
+
+def env(
+    map: Map | str | os.PathLike[str] = "corridor",
+    l_min: float = 2.0,
+    l_max: float = 4.0,
+    v_pursuer: float = 1.0,
+    v_evader: float = 0.5,
+    dt: float = 0.1,
+    max_cycles: int = 500,
+    observation: str = "state",
+    n_rays: int = 32,
+    lidar_range: float | None = None,
+    reward: str = "zero_sum",
+    body_radius: float = 0.1,
+    spawn_margin_steps: int = 3,
+    render_mode: str | None = None,
+) -> AECEnv:
+    """The AEC env with PettingZoo's standard wrappers for Box actions.
+
+    ``parallel_to_aec`` already applies ``OrderEnforcingWrapper`` (reset before step,
+    no render before reset). ``ClipOutOfBoundsWrapper`` and ``AssertOutOfBoundsWrapper``
+    are deliberately left out: the env clips finite out-of-Box actions itself and
+    raises :class:`~envs.errors.InvalidActionError` on NaN or inf, whereas the former
+    would log a warning per clipped action and turn NaN into a logger error, and the
+    latter would reject the overshoot that analytic policies produce by rounding.
+    """
+    return raw_env(
+        map=map,
+        l_min=l_min,
+        l_max=l_max,
+        v_pursuer=v_pursuer,
+        v_evader=v_evader,
+        dt=dt,
+        max_cycles=max_cycles,
+        observation=observation,
+        n_rays=n_rays,
+        lidar_range=lidar_range,
+        reward=reward,
+        body_radius=body_radius,
+        spawn_margin_steps=spawn_margin_steps,
+        render_mode=render_mode,
+    )

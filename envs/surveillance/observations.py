@@ -1,0 +1,278 @@
+"""Observation layouts, spaces, encoders and the decoder analytic policies use.
+
+Two kinds (``EnvConfig.observation``):
+
+``"state"`` -- the full state, the same vector for both agents (the agent knows its
+name, so no role bit), laid out as :data:`STATE_LAYOUT`:
+
+=============== ========= ===============================================================
+field           slice     normalisation
+=============== ========= ===============================================================
+pursuer_pos     0:2       map bounds onto [-1, 1]: ``2 (x - x_min) / (x_max - x_min) - 1``
+pursuer_vel     2:4       realised mean velocity of the last step / V_p, clipped to [-1, 1]
+evader_pos      4:6       as pursuer_pos
+evader_vel      6:8       realised mean velocity of the last step / V_e, clipped to [-1, 1]
+theta           8:10      (cos theta, sin theta), theta the direction from evader to pursuer
+distance        10:11     |P - E| / L_max, in [0, diagonal / L_max]
+visible         11:12     1.0 when surveillance holds at this instant, else 0.0
+time            12:13     steps taken / max_cycles, in [0, 1]
+=============== ========= ===============================================================
+
+The realised velocity is (displacement over the last step) / dt: the commanded
+velocity in open space, its tangential part along a wall. Contact correction can add a
+displacement of the order of the collision slop, hence the clip. At reset both are 0.
+
+``"lidar"`` -- egocentric and partial, :func:`lidar_layout`: ``n_rays`` ray distances
+from the agent's centre at angles ``2 pi k / n_rays`` (world-aligned axes: a disc has no
+heading) divided by the lidar range and saturating at 1; the other agent's position
+relative to this one divided by L_max (zeros when not visible); the agent's own
+realised velocity divided by its speed bound; the visibility bit (surveillance holds);
+the time fraction. The relative vector is zero padded *and* masked by the explicit bit,
+since a zero vector alone would be ambiguous.
+
+``state()`` (for centralised critics) is the ``"state"`` vector whatever the agents see.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from gymnasium.spaces import Box
+
+from envs.surveillance.config import EnvConfig
+
+__all__ = [
+    "STATE_LAYOUT",
+    "STATE_SIZE",
+    "LidarEncoder",
+    "StateEncoder",
+    "StateView",
+    "decode_state",
+    "lidar_layout",
+    "lidar_space",
+    "state_space",
+]
+
+STATE_LAYOUT: dict[str, slice] = {
+    "pursuer_pos": slice(0, 2),
+    "pursuer_vel": slice(2, 4),
+    "evader_pos": slice(4, 6),
+    "evader_vel": slice(6, 8),
+    "theta": slice(8, 10),
+    "distance": slice(10, 11),
+    "visible": slice(11, 12),
+    "time": slice(12, 13),
+}
+"""Where each field lives in a ``"state"`` observation (and in ``state()``)."""
+
+STATE_SIZE = 13
+
+
+def lidar_layout(n_rays: int) -> dict[str, slice]:
+    """Where each field lives in a ``"lidar"`` observation with ``n_rays`` rays.
+
+    Examples:
+        >>> lidar_layout(4)["other_rel"]
+        slice(4, 6, None)
+    """
+    n = int(n_rays)
+    return {
+        "rays": slice(0, n),
+        "other_rel": slice(n, n + 2),
+        "self_vel": slice(n + 2, n + 4),
+        "visible": slice(n + 4, n + 5),
+        "time": slice(n + 5, n + 6),
+    }
+
+
+def _max_distance_ratio(config: EnvConfig) -> float:
+    xmin, ymin, xmax, ymax = config.map.bounds
+    return math.hypot(xmax - xmin, ymax - ymin) / config.l_max
+
+
+def state_space(config: EnvConfig) -> Box:
+    """The Box of ``"state"`` observations (a new object each call: store it)."""
+    low = np.full(STATE_SIZE, -1.0, dtype=np.float32)
+    high = np.full(STATE_SIZE, 1.0, dtype=np.float32)
+    for name in ("distance", "visible", "time"):
+        low[STATE_LAYOUT[name]] = 0.0
+    high[STATE_LAYOUT["distance"]] = np.float32(_max_distance_ratio(config)) * np.float32(
+        1.0 + 1e-6
+    )
+    return Box(low=low, high=high, dtype=np.float32)
+
+
+def lidar_space(config: EnvConfig) -> Box:
+    """The Box of ``"lidar"`` observations (a new object each call: store it)."""
+    layout = lidar_layout(config.n_rays)
+    size = layout["time"].stop
+    low = np.full(size, -1.0, dtype=np.float32)
+    high = np.full(size, 1.0, dtype=np.float32)
+    for name in ("rays", "visible", "time"):
+        low[layout[name]] = 0.0
+    return Box(low=low, high=high, dtype=np.float32)
+
+
+def _clip1(x: float) -> float:
+    return -1.0 if x < -1.0 else (1.0 if x > 1.0 else x)
+
+
+@dataclass(frozen=True)
+class StateView:
+    """A ``"state"`` observation decoded into named, de-normalised fields.
+
+    Attributes:
+        pursuer_pos, evader_pos: positions in map coordinates, shape (2,).
+        pursuer_vel, evader_vel: realised velocities over the last step, shape (2,).
+        theta: direction from evader to pursuer (radians, in [-pi, pi]).
+        distance: |P - E|.
+        visible: surveillance holds at this instant.
+        step: steps taken so far.
+        time: ``step * dt``.
+    """
+
+    pursuer_pos: np.ndarray
+    pursuer_vel: np.ndarray
+    evader_pos: np.ndarray
+    evader_vel: np.ndarray
+    theta: float
+    distance: float
+    visible: bool
+    step: int
+    time: float
+
+
+class StateEncoder:
+    """Builds ``"state"`` vectors; normalisation constants are computed once.
+
+    Args:
+        config: the env configuration.
+    """
+
+    def __init__(self, config: EnvConfig) -> None:
+        xmin, ymin, xmax, ymax = config.map.bounds
+        self.cx = 0.5 * (xmin + xmax)
+        self.cy = 0.5 * (ymin + ymax)
+        self.sx = 2.0 / (xmax - xmin)
+        self.sy = 2.0 / (ymax - ymin)
+        self.inv_vp = 1.0 / config.v_pursuer
+        self.inv_ve = 1.0 / config.v_evader
+        self.inv_lmax = 1.0 / config.l_max
+        self.inv_cycles = 1.0 / config.max_cycles
+
+    def encode(
+        self,
+        p: tuple[float, float],
+        vp: tuple[float, float],
+        e: tuple[float, float],
+        ve: tuple[float, float],
+        visible: bool,
+        step: int,
+    ) -> np.ndarray:
+        """The ``"state"`` vector for positions, realised velocities, visibility and step."""
+        dx = p[0] - e[0]
+        dy = p[1] - e[1]
+        d = math.hypot(dx, dy)
+        if d > 0.0:
+            c, s = dx / d, dy / d
+        else:  # the bodies do not collide with each other, so they may coincide
+            c, s = 1.0, 0.0
+        return np.array(
+            (
+                (p[0] - self.cx) * self.sx,
+                (p[1] - self.cy) * self.sy,
+                _clip1(vp[0] * self.inv_vp),
+                _clip1(vp[1] * self.inv_vp),
+                (e[0] - self.cx) * self.sx,
+                (e[1] - self.cy) * self.sy,
+                _clip1(ve[0] * self.inv_ve),
+                _clip1(ve[1] * self.inv_ve),
+                c,
+                s,
+                d * self.inv_lmax,
+                1.0 if visible else 0.0,
+                step * self.inv_cycles,
+            ),
+            dtype=np.float32,
+        )
+
+
+def decode_state(obs: np.ndarray, config: EnvConfig) -> StateView:
+    """Decode a ``"state"`` observation (or ``state()``) into a :class:`StateView`.
+
+    Args:
+        obs: a vector laid out as :data:`STATE_LAYOUT`.
+        config: the configuration of the env that produced it.
+
+    Returns:
+        The de-normalised fields (exact up to float32 rounding of the observation).
+    """
+    o = np.asarray(obs, dtype=np.float64)
+    if o.shape != (STATE_SIZE,):
+        raise ValueError(
+            f"decode_state: expected a state vector of shape ({STATE_SIZE},), got {o.shape}"
+        )
+    xmin, ymin, xmax, ymax = config.map.bounds
+    lo = np.array([xmin, ymin])
+    half = 0.5 * np.array([xmax - xmin, ymax - ymin])
+    pos = lambda name: lo + (o[STATE_LAYOUT[name]] + 1.0) * half
+    c, s = o[STATE_LAYOUT["theta"]]
+    step = round(float(o[STATE_LAYOUT["time"]][0]) * config.max_cycles)
+    return StateView(
+        pursuer_pos=pos("pursuer_pos"),
+        pursuer_vel=o[STATE_LAYOUT["pursuer_vel"]] * config.v_pursuer,
+        evader_pos=pos("evader_pos"),
+        evader_vel=o[STATE_LAYOUT["evader_vel"]] * config.v_evader,
+        theta=math.atan2(s, c),
+        distance=float(o[STATE_LAYOUT["distance"]][0]) * config.l_max,
+        visible=bool(o[STATE_LAYOUT["visible"]][0] >= 0.5),
+        step=step,
+        time=step * config.dt,
+    )
+
+
+class LidarEncoder:
+    """Builds ``"lidar"`` vectors for one agent.
+
+    Args:
+        config: the env configuration.
+        role: ``"pursuer"`` or ``"evader"`` (whose velocity bound normalises ``self_vel``).
+        kernel: the geometry kernel, for ``ray_distances``.
+    """
+
+    def __init__(self, config: EnvConfig, role: str, kernel: object) -> None:
+        self.kernel = kernel
+        self.n = config.n_rays
+        self.angles = 2.0 * np.pi * np.arange(self.n) / self.n
+        self.angles.setflags(write=False)
+        self.max_range = config.lidar_max_range
+        self.inv_range = 1.0 / self.max_range
+        self.inv_speed = 1.0 / config.speed(role)
+        self.inv_lmax = 1.0 / config.l_max
+        self.inv_cycles = 1.0 / config.max_cycles
+
+    def encode(
+        self,
+        me: tuple[float, float],
+        my_vel: tuple[float, float],
+        other: tuple[float, float],
+        visible: bool,
+        step: int,
+    ) -> np.ndarray:
+        """The ``"lidar"`` vector of the agent at ``me`` looking for ``other``."""
+        out = np.empty(self.n + 6, dtype=np.float32)
+        rays = self.kernel.ray_distances(np.array(me), self.angles, self.max_range)
+        np.minimum(np.asarray(rays) * self.inv_range, 1.0, out=out[: self.n], casting="unsafe")
+        if visible:
+            out[self.n] = _clip1((other[0] - me[0]) * self.inv_lmax)
+            out[self.n + 1] = _clip1((other[1] - me[1]) * self.inv_lmax)
+        else:
+            out[self.n] = 0.0
+            out[self.n + 1] = 0.0
+        out[self.n + 2] = _clip1(my_vel[0] * self.inv_speed)
+        out[self.n + 3] = _clip1(my_vel[1] * self.inv_speed)
+        out[self.n + 4] = 1.0 if visible else 0.0
+        out[self.n + 5] = step * self.inv_cycles
+        return out

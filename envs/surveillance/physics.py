@@ -1,0 +1,164 @@
+"""The pymunk world: static walls and two velocity-driven disc bodies.
+
+Each agent is a small disc (radius ``body_radius``) whose centre is the point the
+surveillance rules talk about. Walls are zero-radius static segments, one per wall
+edge of the :class:`~envs.maps.Map`. Every step the commanded velocities (already
+clipped to the speed bounds by the env) are imposed at the start of the step, so
+
+* in open space a body moves exactly ``v * dt`` per step (no damping, no gravity, no
+  acceleration limit: the commanded velocity *is* the velocity);
+* against a wall the contact solver removes the normal component, so bodies slide
+  (friction and elasticity are zero) for the rest of the step; the next step imposes
+  the command afresh;
+* the substep count is chosen so that a body moves at most
+  :data:`MAX_SUBSTEP_TRAVEL` body radii per substep, which keeps a disc from
+  tunnelling through a zero-thickness wall and keeps its centre in free space.
+
+The two bodies share a non-zero collision group, so they pass through each other: the
+game has no capture and the rod length may go to zero only through a rule violation,
+which the rules report as ``"too_close"``.
+
+The space is rebuilt by :meth:`World.reset`, so an episode replays bit-identically
+from its seed and actions (Chipmunk caches contacts between steps; a fresh space
+forgets them).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pymunk
+
+from envs.maps import Map
+
+__all__ = ["MAX_SUBSTEP_TRAVEL", "World", "substeps_for"]
+
+MAX_SUBSTEP_TRAVEL = 0.25
+"""Largest distance a body may travel in one substep, as a fraction of its radius.
+
+A disc whose centre moves less than its radius per substep is detected touching a
+wall before its centre can cross it; a quarter radius leaves room for the contact
+solver's residual overlap (:data:`COLLISION_SLOP_FRACTION`).
+"""
+
+COLLISION_SLOP_FRACTION = 0.01
+"""Overlap Chipmunk tolerates before pushing back, as a fraction of the body radius."""
+
+_AGENT_GROUP = 1  # shapes in one non-zero group never collide with each other
+
+
+def substeps_for(max_speed: float, dt: float, body_radius: float) -> int:
+    """Number of physics substeps per env step so no body outruns its radius.
+
+    Args:
+        max_speed: the larger of the two speed bounds.
+        dt: env step duration.
+        body_radius: disc radius of both agents.
+
+    Returns:
+        The smallest n >= 1 with ``max_speed * dt / n <= MAX_SUBSTEP_TRAVEL * body_radius``.
+
+    Examples:
+        >>> substeps_for(1.0, 0.1, 0.1)
+        4
+    """
+    travel = max_speed * dt / (MAX_SUBSTEP_TRAVEL * body_radius)
+    # the small relative slack keeps 4.000000000000001 from becoming 5
+    return max(1, math.ceil(travel * (1.0 - 1e-12)))
+
+
+class World:
+    """A pymunk space holding the map's walls and the pursuer and evader discs.
+
+    Args:
+        world_map: the map whose wall edges become static segments.
+        body_radius: disc radius of both agents.
+        dt: env step duration.
+        max_speed: the larger speed bound, which fixes the substep count.
+    """
+
+    def __init__(self, world_map: Map, body_radius: float, dt: float, max_speed: float) -> None:
+        self.map = world_map
+        self.body_radius = float(body_radius)
+        self.dt = float(dt)
+        self.n_substeps = substeps_for(max_speed, dt, body_radius)
+        self.substep_dt = self.dt / self.n_substeps
+        # plain Python tuples: pymunk's constructors are faster on them than on arrays
+        self._walls = [
+            (tuple(map(float, a)), tuple(map(float, b)))
+            for a, b in zip(world_map.edge_start, world_map.edge_end, strict=True)
+        ]
+        self.space: pymunk.Space | None = None
+        self._pursuer: pymunk.Body | None = None
+        self._evader: pymunk.Body | None = None
+
+    def reset(self, pursuer: np.ndarray, evader: np.ndarray) -> None:
+        """Build a fresh space with both bodies at rest at the given centres."""
+        space = pymunk.Space(threaded=False)
+        space.gravity = (0.0, 0.0)
+        space.damping = 1.0  # fraction of velocity kept per second: no damping
+        space.collision_slop = COLLISION_SLOP_FRACTION * self.body_radius
+        # Chipmunk removes the fraction 1 - collision_bias**h of an overlap per substep
+        # of length h; remove half of it each substep (the default is ~15% at h = 0.025)
+        space.collision_bias = 0.5 ** (1.0 / self.substep_dt)
+        static = space.static_body
+        segments = []
+        for a, b in self._walls:
+            seg = pymunk.Segment(static, a, b, 0.0)
+            seg.elasticity = 0.0
+            seg.friction = 0.0
+            segments.append(seg)
+        space.add(*segments)
+        self._pursuer = self._make_body(space, pursuer)
+        self._evader = self._make_body(space, evader)
+        self.space = space
+
+    def _make_body(self, space: pymunk.Space, centre: np.ndarray) -> pymunk.Body:
+        body = pymunk.Body(1.0, math.inf)  # infinite moment: discs never spin
+        body.position = (float(centre[0]), float(centre[1]))
+        shape = pymunk.Circle(body, self.body_radius)
+        shape.elasticity = 0.0
+        shape.friction = 0.0
+        shape.filter = pymunk.ShapeFilter(group=_AGENT_GROUP)
+        space.add(body, shape)
+        return body
+
+    def step(
+        self, pursuer_velocity: tuple[float, float], evader_velocity: tuple[float, float]
+    ) -> tuple[tuple[float, float], tuple[float, float]]:
+        """Advance one env step with constant commanded velocities.
+
+        Args:
+            pursuer_velocity: commanded pursuer velocity (already within its bound).
+            evader_velocity: commanded evader velocity (already within its bound).
+
+        Returns:
+            The new pursuer and evader centres as ``(x, y)`` tuples.
+        """
+        space, pb, eb = self.space, self._pursuer, self._evader
+        if space is None or pb is None or eb is None:
+            raise RuntimeError("World.step called before World.reset")
+        # The command is set once per step. Chipmunk integrates positions before it
+        # solves contacts, so a body pressed into a wall overlaps it by at most one
+        # substep's travel before the solver removes the normal velocity; the rest of
+        # the step it slides with the tangential part. Re-imposing the command every
+        # substep would need a Python velocity callback per body and substep (it
+        # doubled the step cost) or would discard the solver's correction and push
+        # bodies through walls.
+        pb.velocity = pursuer_velocity
+        eb.velocity = evader_velocity
+        h = self.substep_dt
+        for _ in range(self.n_substeps):
+            space.step(h)
+        p = pb.position
+        e = eb.position
+        return (p.x, p.y), (e.x, e.y)
+
+    def positions(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        """Current pursuer and evader centres."""
+        if self._pursuer is None or self._evader is None:
+            raise RuntimeError("World.positions called before World.reset")
+        p = self._pursuer.position
+        e = self._evader.position
+        return (p.x, p.y), (e.x, e.y)

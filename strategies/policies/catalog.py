@@ -18,6 +18,7 @@ from strategies.policies.cooperative import (
     TractrixFollower,
     WallFollowingPursuer,
 )
+from strategies.policies.decomposition import DecompositionPursuer
 from strategies.policies.registry import register_policy
 
 register_policy("pursuer/random", RandomPolicy, "uniform random velocity (baseline)")
@@ -56,4 +57,9 @@ register_policy(
     "pursuer/corner_rounding",
     CornerRoundingPursuer,
     "pivots the rod about nearby convex corners (Sec. 7.4), else tractrix",
+)
+register_policy(
+    "pursuer/decomposition",
+    DecompositionPursuer,
+    "keeps the rod in admissible safe cells at L_min (Secs. 4-5): table lookup per step",
 )

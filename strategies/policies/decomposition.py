@@ -1,0 +1,196 @@
+"""The decomposition-based pursuer (Secs. 4-5): keep the rod in admissible safe cells at L_min.
+
+Per step (a table lookup plus a little arithmetic, no geometry kernel call):
+
+1. From the :class:`~strategies.policies.safety.SafetyTable` (safe = free and not in an
+   escapable cell at L_min, Sec. 4), the rotation each orientation bin needs to reach a
+   safe orientation at every probe point the evader can reach soon: probes lie on rays
+   from the evader, up to ``V_e T`` with ``T = pi / omega`` (the time to turn the rod half
+   way round), and a ray stops at the first wall it meets.
+2. The value of each orientation (eqs. 2-3 with a straight-line evader and the pursuer
+   turning at ``omega = (V_p / L_min) sqrt(1 - rho^2)``, the least rate the evader can
+   impose, Sec. 6.1)::
+
+       V(theta) = min over probes p of  t_e(p) - turn(theta -> safe(p)) / omega
+
+   ``V = 0`` means admissible: the rod reaches a safe orientation at every probe before
+   the evader does. The pursuer targets the bin maximising V within the *free arc* it is
+   in (the rod can only rotate through free orientations), minus a small penalty for the
+   rotation needed, and turns the shorter way round inside that arc.
+3. The velocity is the evader's velocity plus the perpendicular component that realises the
+   commanded rotation rate (eq. 5), plus a radial correction of L toward L_min, all within
+   V_p (:func:`strategies.control.kinematics.pursuer_velocity_holding_range`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from envs.errors import InvalidConfigError
+from strategies.control.kinematics import pursuer_velocity_holding_range, theta_dot
+from strategies.policies.base import BasePolicy, Snapshot
+from strategies.policies.safety import NO_PATH, safety_table
+
+__all__ = ["DecompositionPursuer"]
+
+
+def _check_positive(name: str, value: float) -> float:
+    v = float(value)
+    if not (math.isfinite(v) and v > 0):
+        raise InvalidConfigError(f"{name} must be a positive number, got {value!r}")
+    return v
+
+
+class DecompositionPursuer(BasePolicy):
+    """Pursuer that keeps the configuration in admissible, non-escapable cells at L_min.
+
+    Args:
+        resolution: grid spacing of the safety table (map units).
+        n_bins: orientation bins of the table.
+        rays: probe rays around the evader.
+        probe_every: use every k-th grid sample along a ray as a probe.
+        hysteresis: weight of the rotation needed to reach a target, in units of V.
+        distance_gain: rate (1/s) of the correction of L toward L_min.
+    """
+
+    roles = ("pursuer",)
+
+    def __init__(
+        self,
+        *,
+        resolution: float = 0.1,
+        n_bins: int = 144,
+        rays: int = 16,
+        probe_every: int = 3,
+        hysteresis: float = 0.25,
+        distance_gain: float = 3.0,
+        name: str | None = None,
+    ) -> None:
+        super().__init__(name=name)
+        self.resolution = _check_positive("resolution", resolution)
+        self.n_bins = int(n_bins)
+        if not (isinstance(rays, int) and rays >= 4):
+            raise InvalidConfigError(f"rays must be an integer >= 4, got {rays!r}")
+        if not (isinstance(probe_every, int) and probe_every >= 1):
+            raise InvalidConfigError(f"probe_every must be an integer >= 1, got {probe_every!r}")
+        self.rays = rays
+        self.probe_every = probe_every
+        self.hysteresis = float(hysteresis)
+        if not (math.isfinite(self.hysteresis) and self.hysteresis >= 0):
+            raise InvalidConfigError(f"hysteresis must be >= 0, got {hysteresis!r}")
+        self.distance_gain = _check_positive("distance_gain", distance_gain)
+
+    def _reset(self) -> None:
+        c = self.config
+        # keep L a little above L_min: one step of lag lets the evader close V_e dt
+        self.L_target = c.l_min + 2.0 * c.v_evader * c.dt + 0.01 * c.l_min
+        # the pursuer's disc keeps its centre body_radius off the walls, so the rod tip
+        # meets a wall as if the rod were that much longer (Prop. 3: fewer free arcs)
+        self.table_length = round(self.L_target + c.body_radius, 6)
+        self.table = safety_table(c.map, self.table_length, self.resolution, self.n_bins)
+        rho = c.rho
+        # Sec. 6.1: the evader can hold the pursuer's best rate down to (V_p/L) sqrt(1 - rho^2)
+        self.omega = c.v_pursuer * math.sqrt(max(1.0 - rho * rho, 0.05)) / c.l_min
+        self.horizon = horizon = math.pi / self.omega
+        h = self.table.resolution
+        n_r = max(2, math.ceil(c.v_evader * horizon / h))
+        radii = h * np.arange(1, n_r + 1)
+        ang = 2.0 * math.pi * np.arange(self.rays) / self.rays
+        dirs = np.stack([np.cos(ang), np.sin(ang)], axis=1)
+        self._offsets = (dirs[:, None, :] * radii[None, :, None]).reshape(-1, 2)
+        self._n_r = n_r
+        self._probe_cols = np.arange(self.probe_every - 1, n_r, self.probe_every)
+        self._t_e = (radii[self._probe_cols] / c.v_evader).astype(np.float32)
+        self._bw = self.table.bin_width
+        lut = np.arange(NO_PATH + 1) * self._bw / self.omega
+        lut[NO_PATH] = math.pi / self.omega  # no safe orientation: half a turn
+        lut[0] = -1e9
+        self._turn_lut = lut.astype(np.float32)
+        self.last_target: int | None = None
+
+    # ------------------------------------------------------------------ decision
+    def orientation_values(self, evader: np.ndarray) -> np.ndarray:
+        """V(theta) for every orientation bin at evader position ``evader`` (seconds).
+
+        The least time margin ``t_e(p) - turn(theta -> safe(p)) / omega`` over the probes
+        ``p`` where ``theta`` is not safe; the horizon where no probe threatens ``theta``,
+        and ``-turn / omega`` (negative) where ``theta`` is not safe at ``evader`` itself.
+        """
+        tab = self.table
+        row = tab.row(evader)
+        if row < 0:
+            return np.zeros(tab.n_bins)
+        value = np.full(tab.n_bins, self.horizon)
+        rows = tab.rows(evader + self._offsets).reshape(self.rays, self._n_r)
+        reach = np.cumsum(rows < 0, axis=1) == 0  # a ray stops at the first wall
+        sub_rows = rows[:, self._probe_cols]
+        sub_ok = reach[:, self._probe_cols]
+        r = sub_rows[sub_ok]
+        if r.size:
+            t_e = np.broadcast_to(self._t_e, sub_rows.shape)[sub_ok]
+            # lut: seconds to turn by a number of bins; a safe bin (0) never threatens
+            v = t_e[:, None] - self._turn_lut[tab.need[r]]
+            value = np.minimum(value, v.min(axis=0))
+        need0 = tab.need[row]
+        return np.where(need0 > 0, -self._turn_lut[need0], value)
+
+    def _target(self, snap: Snapshot) -> tuple[float, int]:
+        """Signed rotation (radians) toward the best reachable orientation, and its bin."""
+        tab = self.table
+        row = tab.row(snap.evader)
+        b0 = tab.bin_of(snap.theta)
+        if row < 0:
+            return 0.0, b0
+        value = self.orientation_values(snap.evader)
+        free = tab.free[row]
+        nb = tab.n_bins
+        # bins reachable by turning through free orientations, each way round
+        ccw_run = np.roll(free, -b0)
+        cw_run = np.roll(free[::-1], b0 + 1)
+        ccw_run[0] = cw_run[0] = True  # the current bin (the rod is free right now)
+        n_ccw = int(np.argmin(ccw_run)) if not ccw_run.all() else nb
+        n_cw = int(np.argmin(cw_run)) if not cw_run.all() else nb
+        steps = np.arange(nb)
+        cand_bins = np.concatenate([(b0 + steps[:n_ccw]) % nb, (b0 - steps[1:n_cw]) % nb])
+        cand_rot = np.concatenate([steps[:n_ccw], -steps[1:n_cw]]).astype(float)
+        score = value[cand_bins] - self.hysteresis * np.abs(cand_rot) * self._bw / self.omega
+        if self.last_target is not None:  # prefer keeping the previous goal on ties
+            score = score + 1e-9 * (cand_bins == self.last_target)
+        k = int(np.argmax(score))
+        target = int(cand_bins[k])
+        self.last_target = target
+        if target == b0:
+            return 0.0, target
+        rot = cand_rot[k] * self._bw
+        # aim at the bin centre, measured from the current angle
+        centre = float(tab.bin_centre(target))
+        offset = math.remainder(centre - snap.theta, 2.0 * math.pi)
+        if rot > 0 and offset < 0:
+            offset += 2.0 * math.pi
+        elif rot < 0 and offset > 0:
+            offset -= 2.0 * math.pi
+        return offset, target
+
+    def _decide(self, snap: Snapshot) -> np.ndarray:
+        c = self.config
+        L = max(snap.L, 1e-9)
+        ve = snap.evader_velocity
+        speed = math.hypot(float(ve[0]), float(ve[1]))
+        rot, _ = self._target(snap)
+        alpha = math.atan2(float(ve[1]), float(ve[0])) if speed > 0 else snap.theta
+        rate = min(speed / c.v_pursuer, 1.0)
+        hi, lo = theta_dot(alpha, snap.theta, L=L, v_p=c.v_pursuer, rho=rate)  # eq. (6)
+        want = rot / (2.0 * c.dt)
+        cmd_rate = min(max(want, lo), hi)
+        cmd = pursuer_velocity_holding_range(
+            ve,
+            snap.theta,
+            cmd_rate,
+            L=L,
+            L_target=self.L_target,
+            v_p=c.v_pursuer,
+            gain=self.distance_gain,
+        )
+        return cmd.velocity

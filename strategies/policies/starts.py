@@ -1,0 +1,102 @@
+"""Seeded start configurations for evaluations: valid ones, or safe ones at L_min.
+
+``kind="valid"``: the env's own rejection sampler (:func:`envs.surveillance.placement.random_start`)
+driven by the caller's generator: both bodies in free space, L inside [L_min, L_max] with
+a margin, the rod clear of convex corners, line of sight.
+
+``kind="safe"``: a valid start with L just above L_min whose orientation lies in a safe
+(non-escapable) cell at L_min, at least ``angle_margin`` inside it, and is admissible in
+the bounded-speed sense of Sec. 5 as the decomposition pursuer estimates it (value
+``V(theta) >= 0``: from there the rod reaches a safe orientation at every point before
+the evader does). On maps where no safe cell exists (Prop. 2 holds) it falls back to a
+valid start at L_min, since no safe start exists to draw.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from envs.errors import InfeasibleError, InvalidConfigError
+from envs.geometry import kernel_for
+from envs.surveillance.placement import random_start, spawn_margins
+
+__all__ = ["START_KINDS", "sample_start"]
+
+START_KINDS = ("valid", "safe")
+BATCH = 256
+MAX_BATCHES = 400
+
+
+def sample_start(
+    config, rng: np.random.Generator, *, kind: str = "safe", angle_margin: float = 0.15
+) -> dict[str, tuple[float, float]]:
+    """Draw a start ``{"pursuer": (x, y), "evader": (x, y)}`` for ``reset(options=...)``.
+
+    Args:
+        config: the env's ``EnvConfig``.
+        rng: the generator to draw from (the only source of randomness).
+        kind: ``"valid"`` or ``"safe"`` (see the module docstring).
+        angle_margin: for ``"safe"``, radians the orientation keeps from the safe set's edge.
+
+    Raises:
+        InvalidConfigError: unknown kind.
+        InfeasibleError: no start found (the message names the map).
+    """
+    if kind not in START_KINDS:
+        raise InvalidConfigError(f"kind must be one of {START_KINDS}, got {kind!r}")
+    kernel = kernel_for(config.map)
+    if kind == "valid":
+        p, e = random_start(config, kernel, rng)
+        return {"pursuer": (float(p[0]), float(p[1])), "evader": (float(e[0]), float(e[1]))}
+    from strategies.policies.decomposition import DecompositionPursuer
+
+    judge = DecompositionPursuer()
+    judge.reset(role="pursuer", map=config.map, config=config, seed=0)
+    tab = judge.table
+    if not tab.guaranteed.any():  # Prop. 2: nothing is safe anywhere
+        return _near_l_min(config, kernel, rng, judge, tab, None)
+    return _near_l_min(config, kernel, rng, judge, tab, angle_margin)
+
+
+def _near_l_min(config, kernel, rng, judge, tab, angle_margin):
+    m = config.map
+    range_margin, rod_clearance = spawn_margins(config)
+    length = max(judge.L_target, config.l_min + range_margin)
+    xmin, ymin, xmax, ymax = m.bounds
+    r = config.body_radius
+    convex = m.vertices[m.vertex_convex]
+    margin_bins = 0 if angle_margin is None else math.ceil(angle_margin / tab.bin_width)
+    for _ in range(MAX_BATCHES):
+        e = rng.uniform((xmin, ymin), (xmax, ymax), size=(BATCH, 2))
+        theta = rng.uniform(-math.pi, math.pi, size=BATCH)
+        p = e + length * np.stack([np.cos(theta), np.sin(theta)], axis=1)
+        ok = m.contains(e) & m.contains(p)
+        ok &= (m.distance_to_walls(e) >= r) & (m.distance_to_walls(p) >= r)
+        for i in np.flatnonzero(ok):
+            if len(convex):
+                d = p[i] - e[i]
+                t = np.clip((convex - e[i]) @ d / (d @ d), 0.0, 1.0)
+                if np.min(np.linalg.norm(convex - (e[i] + t[:, None] * d), axis=1)) < rod_clearance:
+                    continue
+            if not kernel.line_of_sight(p[i], e[i]):
+                continue
+            if angle_margin is not None:
+                row = tab.row(e[i])
+                if row < 0 or not tab.guaranteed[row]:
+                    continue
+                b = tab.bin_of(float(theta[i]))
+                bins = (b + np.arange(-margin_bins, margin_bins + 1)) % tab.n_bins
+                if not tab.safe[row, bins].all():
+                    continue
+                if judge.orientation_values(e[i])[b] < 0.0:
+                    continue
+            return {
+                "pursuer": (float(p[i, 0]), float(p[i, 1])),
+                "evader": (float(e[i, 0]), float(e[i, 1])),
+            }
+    raise InfeasibleError(
+        f"no {'safe' if angle_margin is not None else 'valid'} start at L = {length:.4g} found "
+        f"on map {m.name!r} in {MAX_BATCHES * BATCH} proposals"
+    )

@@ -33,7 +33,7 @@ def _rhs(th: float, a: float, s: int, L: float, rho: float, q: float):
     n = h - s * rho * sp  # L θ̇ˢ / (s V_p) >= 0
     return (math.cos(a), math.sin(a), s * n / (L * rho),
             n * n * sp * q / L,  # reduced extremal: dα/dσ (see evasion module docstring)
-            -s * c * n / (h * L))  # d ln μ / dσ = -∂g_s/∂θ (E3b)
+            -c * n / (h * L))  # d ln μ/dσ = cos α · (-∂f2/∂θ), μ = 1 + s λ2 (E3b)
 
 
 def _step(state, d: float, s: int, L: float, rho: float, q: float):

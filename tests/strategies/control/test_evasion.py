@@ -1,0 +1,268 @@
+"""Optimal evasion (Sec. 6.2): shooting invariants, solve_escape optimality, greedy mode."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.interpolate import CubicSpline
+from scipy.optimize import minimize, minimize_scalar
+
+from envs.errors import InfeasibleError, SurveilValueError
+from strategies.control.evasion import greedy_heading, shoot, solve_escape
+from strategies.control.hamiltonian import f2
+
+FIG11A = {"theta0": math.pi, "lambda1": -1.0, "lambda2_0": 0.41}
+
+
+# ----------------------------------------------------------------------------- greedy
+
+
+@pytest.mark.parametrize(
+    ("theta", "alpha", "value"),
+    [(math.pi, -math.atan(0.5), 1.5), (0.0, math.atan(0.5), 1.5), (math.pi / 2, 0.0, 3.0)],
+)
+def test_greedy_reference(theta, alpha, value):
+    g = greedy_heading(theta, L=1.0, rho=0.5)
+    assert g.alpha == pytest.approx(alpha, abs=1e-9)
+    assert g.f2 == pytest.approx(value, abs=1e-9)
+    assert g.f2 == pytest.approx(f2(g.alpha, theta, L=1.0, rho=0.5), abs=1e-12)
+
+
+@settings(max_examples=40, deadline=None)
+@given(theta=st.floats(-4, 4), rho=st.floats(0.05, 0.95), L=st.floats(0.3, 3),
+       branch=st.sampled_from(["+", "-"]))
+def test_greedy_is_the_numerical_minimiser(theta, rho, L, branch):
+    res = minimize_scalar(lambda a: abs(f2(a, theta, L=L, rho=rho, branch=branch)),
+                          bounds=(-1.5707, 1.5707), method="bounded",
+                          options={"xatol": 1e-12})
+    g = greedy_heading(theta, L=L, rho=rho, branch=branch)
+    assert abs(g.f2) <= res.fun + 1e-9
+    assert g.alpha == pytest.approx(res.x, abs=1e-5)
+
+
+def test_greedy_arc_follows_greedy_heading():
+    # λ1 = 0 keeps κ = 0, so the reduced ODE must stay on α = argmin f2 (Fig. 12 mode).
+    for branch in ("+", "-"):
+        arc = shoot(2.0, 0.0, 0.0, L=1.0, rho=0.6, branch=branch, x_max=3.0)
+        g = greedy_heading(arc.theta, L=1.0, rho=0.6, branch=branch)
+        np.testing.assert_allclose(arc.alpha, g.alpha, atol=1e-7)
+
+
+# ----------------------------------------------------------------------------- shoot
+
+SHOTS = [
+    ({**FIG11A}, 0.5, "+"),
+    ({"theta0": math.pi / 6, "lambda1": 1.0, "lambda2_0": 0.608}, 0.5, "+"),
+    ({"theta0": 1.0, "lambda1": 0.3, "lambda2_0": -0.2}, 0.3, "-"),
+    ({"theta0": -0.5, "lambda1": -0.3, "lambda2_0": 0.2}, 0.8, "-"),
+]
+
+
+@pytest.mark.parametrize(("kw", "rho", "branch"), SHOTS)
+def test_H_constant_and_integrators_agree(kw, rho, branch):
+    red = shoot(**kw, L=1.0, rho=rho, branch=branch, x_max=1.5)
+    pmp = shoot(**kw, L=1.0, rho=rho, branch=branch, x_max=1.5, method="pmp", step=1 / 800)
+    for arc in (red, pmp):
+        assert not arc.unbounded
+        assert np.ptp(arc.H) <= 1e-6 * max(1.0, abs(arc.H[0]))
+    assert red.H[0] == pytest.approx(pmp.H[0], rel=1e-12)
+    # compare the two at the pmp grid: θ(x), y(x) by interpolation of the reduced arc
+    th = CubicSpline(red.x, red.theta)(pmp.x)
+    y = CubicSpline(red.x, red.y)(pmp.x)
+    np.testing.assert_allclose(th, pmp.theta, atol=1e-6)
+    np.testing.assert_allclose(y, pmp.y, atol=1e-6)
+    assert (red.x_c is None) == (pmp.x_c is None)
+    if red.x_c is not None:
+        assert red.x_c == pytest.approx(pmp.x_c, abs=1e-6)
+        assert red.J == pytest.approx(pmp.J, abs=1e-6)
+        assert branch == "+" and red.J > 0 or branch == "-" and red.J < 0
+
+
+def test_fig11a_crossing_near_paper_goal():
+    # Fig. 11(a) states x_e = 1 for these multipliers; with L = 1, rho = 0.5 the arc
+    # returns to y = 0 at x_c ≈ 0.983 (the paper's L and rho are not given).
+    arc = shoot(**FIG11A, L=1.0, rho=0.5, x_max=2.0)
+    assert arc.x_c == pytest.approx(0.98338593, abs=1e-6)
+    assert arc.J == pytest.approx(1.23407449, abs=1e-6)
+    fine = shoot(**FIG11A, L=1.0, rho=0.5, x_max=2.0, step=arc.arclength[1] / 4)
+    assert fine.J == pytest.approx(arc.J, abs=1e-7)
+
+
+@pytest.mark.parametrize("c", [0.1, 2.0, 37.0])
+@pytest.mark.parametrize("branch", ["+", "-"])
+def test_scale_invariance(c, branch):
+    s = 1 if branch == "+" else -1
+    l1, l20, th0 = -0.7, 0.3 * s, 2.2
+    base = shoot(th0, l1, l20, L=1.2, rho=0.45, branch=branch, x_max=1.0)
+    mu0 = 1 + s * l20
+    scaled = shoot(th0, c * l1, s * (c * mu0 - 1), L=1.2, rho=0.45, branch=branch, x_max=1.0)
+    for name in ("x", "y", "theta", "alpha"):
+        np.testing.assert_allclose(getattr(scaled, name), getattr(base, name), atol=1e-12)
+    np.testing.assert_allclose(scaled.H, c * base.H, rtol=1e-10)
+    np.testing.assert_allclose(1 + s * scaled.lambda2, c * (1 + s * base.lambda2), rtol=1e-10)
+
+
+def test_branch_minus_is_the_mirror_of_plus():
+    minus = shoot(0.8, 0.4, -0.3, L=1.0, rho=0.6, branch="-", x_max=1.2)
+    plus = shoot(-0.8, -0.4, 0.3, L=1.0, rho=0.6, branch="+", x_max=1.2)
+    np.testing.assert_allclose(minus.y, -plus.y, atol=1e-12)
+    np.testing.assert_allclose(minus.theta, -plus.theta, atol=1e-12)
+    np.testing.assert_allclose(minus.alpha, -plus.alpha, atol=1e-12)
+    np.testing.assert_allclose(minus.lambda2, -plus.lambda2, atol=1e-12)
+
+
+def test_unbounded_cases():
+    # THEORY §4.3: Fig. 11(b)'s multipliers at L = 1, rho = 0.9 lose the minimiser.
+    for method in ("reduced", "pmp"):
+        arc = shoot(math.pi / 6, 1.0, 0.608, L=1.0, rho=0.9, x_max=2.0, method=method)
+        assert arc.unbounded and arc.x[-1] < 2.0 and arc.x_c is None
+    # at x = 0 already: λ1/μ above K(-π/2, θ0)
+    arc = shoot(0.0, 50.0, 0.0, L=1.0, rho=0.5, x_max=1.0)
+    assert arc.unbounded and len(arc.x) == 1
+
+
+def test_stop_at_crossing_truncates():
+    arc = shoot(**FIG11A, L=1.0, rho=0.5, x_max=3.0, stop_at_crossing=True)
+    assert arc.x[-2] <= arc.x_c <= arc.x[-1]
+    assert arc.pursuer_path().shape == (len(arc.x), 2)
+    np.testing.assert_allclose(np.linalg.norm(arc.pursuer_path() - arc.evader_path(), axis=1),
+                               1.0, atol=1e-12)
+
+
+# ----------------------------------------------------------------------- solve_escape
+
+
+def _theta_along(alpha_of_x, x_e, theta0, L, rho, branch, n=800):
+    """θ(x_e) for a given heading profile, RK4 with α evaluated at stage abscissae."""
+    h = x_e / n
+    th = theta0
+    for i in range(n):
+        x = i * h
+        k1 = f2(alpha_of_x(x), th, L=L, rho=rho, branch=branch)
+        k2 = f2(alpha_of_x(x + h / 2), th + h / 2 * k1, L=L, rho=rho, branch=branch)
+        k3 = f2(alpha_of_x(x + h / 2), th + h / 2 * k2, L=L, rho=rho, branch=branch)
+        k4 = f2(alpha_of_x(x + h), th + h * k3, L=L, rho=rho, branch=branch)
+        th += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return th - theta0
+
+
+def _direct_transcription(theta0, x_e, L, rho, branch, n=24, sub=6):
+    """Independent optimum: piecewise-constant α on n cells, SLSQP with y(x_e) = 0."""
+    s = 1 if branch == "+" else -1
+    h = x_e / (n * sub)
+
+    def g(a, th):  # s f2, vectorised over a batch of profiles
+        phi = a - th
+        return (np.sqrt(1 - (rho * np.cos(phi)) ** 2) - s * rho * np.sin(phi)) / (
+            L * rho * np.cos(a))
+
+    def cost_batch(A):
+        th = np.full(A.shape[0], theta0)
+        for j in range(n):
+            a = A[:, j]
+            for _ in range(sub):
+                k1 = g(a, th)
+                k2 = g(a, th + s * h / 2 * k1)
+                k3 = g(a, th + s * h / 2 * k2)
+                k4 = g(a, th + s * h * k3)
+                th = th + s * h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        return s * (th - theta0)
+
+    def fun(a):
+        return float(cost_batch(a[None])[0])
+
+    def jac(a):
+        eps = 1e-7
+        batch = np.vstack([a, a + eps * np.eye(n)])
+        v = cost_batch(batch)
+        return (v[1:] - v[0]) / eps
+
+    cons = {"type": "eq", "fun": lambda a: np.sum(np.tan(a)) * x_e / n,
+            "jac": lambda a: x_e / n / np.cos(a) ** 2}
+    best = None
+    for start in (0.0, 0.3, -0.3):
+        a0 = np.full(n, start)
+        a0 -= np.mean(a0)  # feasible start: straight line
+        res = minimize(fun, a0, jac=jac, constraints=[cons], method="SLSQP",
+                       bounds=[(-1.45, 1.45)] * n, options={"maxiter": 300, "ftol": 1e-12})
+        if abs(cons["fun"](res.x)) < 1e-8 and (best is None or res.fun < best):
+            best = res.fun
+    return best
+
+
+CASES = [  # (theta0, x_e, L, rho, branch): seeded, solutions exist
+    (math.pi, 1.0, 1.0, 0.5, "+"),
+    (2.3, 0.8, 1.3, 0.6, "+"),
+    (-0.9, 1.2, 1.0, 0.4, "-"),
+    (0.4, 0.6, 0.7, 0.7, "-"),
+    (-2.0, 1.5, 1.5, 0.55, "+"),
+]
+
+
+@pytest.mark.parametrize(("theta0", "x_e", "L", "rho", "branch"), CASES)
+def test_solve_escape_is_optimal(theta0, x_e, L, rho, branch):
+    sol = solve_escape(theta0, x_e, L=L, rho=rho, branch=branch)
+    assert sol.success, sol.reason
+    arc = sol.arc
+    assert arc.x[-1] == x_e and abs(arc.y[-1]) < 1e-11
+    assert sol.J == pytest.approx(arc.theta[-1] - theta0, abs=1e-14)
+    assert arc.lambda2[-1] == pytest.approx(0.0, abs=1e-12)  # transversality (E3c)
+    assert np.ptp(arc.H) <= 1e-6 * max(1.0, abs(arc.H[0]))
+    s = 1 if branch == "+" else -1
+    assert sol.k == pytest.approx(sol.lambda1 / (1 + s * sol.lambda2_0), rel=1e-12)
+    # the returned multipliers reproduce the arc with the paper's algorithm
+    again = shoot(theta0, sol.lambda1, sol.lambda2_0, L=L, rho=rho, branch=branch,
+                  x_max=x_e, method="pmp", step=x_e / 1000)
+    assert again.theta[-1] == pytest.approx(arc.theta[-1], abs=1e-6)
+    assert again.y[-1] == pytest.approx(0.0, abs=1e-6)
+    # optimality: no worse than an independent direct transcription ...
+    direct = _direct_transcription(theta0, x_e, L, rho, branch)
+    assert direct is not None
+    assert abs(sol.J) <= direct + 1e-7
+    assert direct - abs(sol.J) < 2e-2 * max(1.0, abs(sol.J))  # ... and close to it
+    # ... and than the straight path and perturbations with the same end points
+    straight = abs(_theta_along(lambda x: 0.0, x_e, theta0, L, rho, branch))
+    assert abs(sol.J) <= straight + 1e-9
+    a_star = CubicSpline(arc.x, arc.alpha)
+    same = abs(_theta_along(a_star, x_e, theta0, L, rho, branch))
+    assert same == pytest.approx(abs(sol.J), abs=1e-6)
+    for k, eps in ((1, 0.03), (2, -0.02), (3, 0.01)):
+        def pert(x, k=k, eps=eps):
+            bump = eps * k * math.pi / x_e * math.cos(k * math.pi * x / x_e)
+            return math.atan(math.tan(float(a_star(x))) + bump)  # y += eps sin(kπx/x_e)
+        assert abs(_theta_along(pert, x_e, theta0, L, rho, branch)) > same + 1e-7
+
+
+def test_solve_escape_failures_are_reported():
+    sol = solve_escape(-1.4694468369271578, 1.7090163413421233, L=1.1641292434617974,
+                       rho=0.8913647185839817, branch="-")
+    assert not sol.success and "no bounded extremal" in sol.reason and sol.arc is None
+    triv = solve_escape(0.3, 1.0, L=1.0, rho=1.3)
+    assert not triv.success and "trivially" in triv.reason
+
+
+@pytest.mark.parametrize(
+    ("call", "exc", "match"),
+    [
+        (lambda: solve_escape(0.0, 0.0, L=1.0, rho=0.5), SurveilValueError, "x_e = 0.0"),
+        (lambda: solve_escape(math.nan, 1.0, L=1.0, rho=0.5), SurveilValueError, "theta0"),
+        (lambda: solve_escape(0.0, 1.0, L=-1.0, rho=0.5), SurveilValueError, "L = -1.0"),
+        (lambda: solve_escape(0.0, 1.0, L=1.0, rho=0.0), SurveilValueError, "rho = 0.0"),
+        (lambda: solve_escape(0.0, 1.0, L=1.0, rho=0.5, branch=2), SurveilValueError,
+         "branch"),
+        (lambda: shoot(0.0, 1.0, -1.0, L=1.0, rho=0.5, x_max=1.0), SurveilValueError,
+         "lambda2_0"),
+        (lambda: shoot(0.0, 1.0, 0.0, L=1.0, rho=1.0, x_max=1.0), InfeasibleError,
+         "rho = 1.0"),
+        (lambda: shoot(0.0, 1.0, 0.0, L=1.0, rho=0.5, x_max=1.0, method="euler"),
+         SurveilValueError, "method"),
+        (lambda: greedy_heading(0.0, L=1.0, rho=2.0), InfeasibleError, "rho = 2.0"),
+    ],
+)
+def test_bad_input(call, exc, match):
+    with pytest.raises(exc, match=match):
+        call()

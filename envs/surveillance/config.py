@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from envs.errors import InvalidConfigError
-from envs.maps import Map
+from envs.maps import Map, load_map
 
 __all__ = [
     "OBSERVATION_KINDS",
@@ -45,8 +45,6 @@ def resolve_map(value: Map | str | os.PathLike[str]) -> Map:
     if isinstance(value, Map):
         return value
     if isinstance(value, (str, os.PathLike)):
-        from envs.maps.io import load_map  # file formats and built-ins: import lazily
-
         return load_map(value)
     raise InvalidConfigError(
         f"map: expected a Map, a built-in map name or a path to a map file, "

@@ -34,12 +34,14 @@ from envs.maps import Map
 
 __all__ = ["MAX_SUBSTEP_TRAVEL", "World", "substeps_for"]
 
-MAX_SUBSTEP_TRAVEL = 0.25
+MAX_SUBSTEP_TRAVEL = 0.5
 """Largest distance a body may travel in one substep, as a fraction of its radius.
 
 A disc whose centre moves less than its radius per substep is detected touching a
-wall before its centre can cross it; a quarter radius leaves room for the contact
-solver's residual overlap (:data:`COLLISION_SLOP_FRACTION`).
+wall before its centre can cross it. Positions are integrated before contacts are
+solved, so a disc driven into a wall overlaps it by up to one substep's travel: half a
+radius keeps the centre at least half a radius inside free space, with the fewest
+substeps (each costs a ``Space.step``).
 """
 
 COLLISION_SLOP_FRACTION = 0.01
@@ -61,7 +63,7 @@ def substeps_for(max_speed: float, dt: float, body_radius: float) -> int:
 
     Examples:
         >>> substeps_for(1.0, 0.1, 0.1)
-        4
+        2
     """
     travel = max_speed * dt / (MAX_SUBSTEP_TRAVEL * body_radius)
     # the small relative slack keeps 4.000000000000001 from becoming 5

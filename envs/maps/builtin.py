@@ -61,6 +61,16 @@ class MapInfo:
     map: Map = field(repr=False, compare=False)
 
     @property
+    def L_min(self) -> float:
+        """Alias of :attr:`l_min` in the paper's notation."""
+        return self.l_min
+
+    @property
+    def L_max(self) -> float:
+        """Alias of :attr:`l_max` in the paper's notation."""
+        return self.l_max
+
+    @property
     def rho(self) -> float:
         """Speed ratio rho = V_e / V_p (Sec. 6)."""
         return self.v_evader / self.v_pursuer

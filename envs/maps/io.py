@@ -520,16 +520,16 @@ def load_map(path_or_name: str | os.PathLike[str], *, merge: bool | None = None)
 
 
 def save_map(
-    m: Map,
+    map: Map,
     path: str | os.PathLike[str],
     *,
     description: str = "",
     metadata: Mapping[str, Any] | None = None,
 ) -> Path:
-    """Write ``m`` to ``path`` in the format its suffix names (see the module docstring).
+    """Write ``map`` to ``path`` in the format its suffix names (see the module docstring).
 
     Args:
-        m: the map.
+        map: the map.
         path: a ``.json``, ``.geojson`` or ``.wkt`` file (parent directories must exist).
         description: one line stored with JSON and GeoJSON (WKT has no room for it).
         metadata: a JSON-serialisable mapping stored with JSON and GeoJSON.
@@ -550,13 +550,13 @@ def save_map(
                 f"metadata {metadata!r:.80} is not JSON-serialisable ({exc})"
             ) from exc
     if fmt == "wkt":
-        text = map_to_wkt(m)
+        text = map_to_wkt(map)
     elif fmt == "geojson":
         text = (
-            json.dumps(map_to_geojson(m, description=description, metadata=metadata), indent=1)
+            json.dumps(map_to_geojson(map, description=description, metadata=metadata), indent=1)
             + "\n"
         )
     else:
-        text = _dump_json(map_to_dict(m, description=description, metadata=metadata))
+        text = _dump_json(map_to_dict(map, description=description, metadata=metadata))
     p.write_text(text, encoding="utf-8")
     return p

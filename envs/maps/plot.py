@@ -43,7 +43,7 @@ def _ring_path(rings: tuple[np.ndarray, ...], path_cls: Any) -> Any:
 
 
 def plot_map(
-    m: Map,
+    map: Map,
     ax: Any = None,
     *,
     path: str | os.PathLike[str] | None = None,
@@ -59,16 +59,16 @@ def plot_map(
     figsize: tuple[float, float] = (6.0, 6.0),
     dpi: int = 120,
 ) -> Any:
-    """Draw ``m``: free space, walls, and (optionally) convex obstacle vertices.
+    """Draw ``map``: free space, walls, and (optionally) convex obstacle vertices.
 
     Args:
-        m: the map.
+        map: the map.
         ax: a matplotlib ``Axes`` to draw into; by default a new ``Figure`` is made
             (without pyplot, so no global state and no display is needed).
         path: also save the figure to this file (PNG, SVG, PDF... by suffix).
         title: the axes title (default: the map's name and size).
         show_convex: mark the convex obstacle vertices.
-        show_indices: label every wall vertex with its index in ``m.vertices``.
+        show_indices: label every wall vertex with its index in ``map.vertices``.
         free_color, obstacle_color, wall_color, wall_width, convex_color, convex_size:
             the style.
         figsize, dpi: of the new figure when ``ax`` is None.
@@ -82,30 +82,30 @@ def plot_map(
     figure_cls, patch_cls, path_cls = _matplotlib()
     if ax is None:
         ax = figure_cls(figsize=figsize, dpi=dpi).add_subplot()
-    xmin, ymin, xmax, ymax = m.bounds
+    xmin, ymin, xmax, ymax = map.bounds
     pad = 0.04 * max(xmax - xmin, ymax - ymin)
     ax.set_facecolor(obstacle_color)
     ax.add_patch(
-        patch_cls(_ring_path(m.rings, path_cls), facecolor=free_color, edgecolor="none", zorder=1)
+        patch_cls(_ring_path(map.rings, path_cls), facecolor=free_color, edgecolor="none", zorder=1)
     )
-    for r in m.rings:
+    for r in map.rings:
         closed = np.vstack([r, r[:1]])
         ax.plot(closed[:, 0], closed[:, 1], color=wall_color, lw=wall_width, zorder=2)
-    if show_convex and m.vertex_convex.any():
-        v = m.vertices[m.vertex_convex]
+    if show_convex and map.vertex_convex.any():
+        v = map.vertices[map.vertex_convex]
         ax.scatter(
             v[:, 0], v[:, 1], s=convex_size, color=convex_color, zorder=3, label="convex vertex"
         )
     if show_indices:
-        for i, (x, y) in enumerate(m.vertices):
+        for i, (x, y) in enumerate(map.vertices):
             ax.annotate(str(i), (x, y), fontsize=7, xytext=(3, 3), textcoords="offset points")
     ax.set_xlim(xmin - pad, xmax + pad)
     ax.set_ylim(ymin - pad, ymax + pad)
     ax.set_aspect("equal")
     if title is None:
-        n_obs, n_convex = len(m.rings) - 1, int(m.vertex_convex.sum())
+        n_obs, n_convex = len(map.rings) - 1, int(map.vertex_convex.sum())
         title = (
-            f"{m.name}: {m.n_vertices} walls, {n_obs} obstacle{'s' * (n_obs != 1)}, "
+            f"{map.name}: {map.n_vertices} walls, {n_obs} obstacle{'s' * (n_obs != 1)}, "
             f"{n_convex} convex {'vertex' if n_convex == 1 else 'vertices'}"
         )
     ax.set_title(title)

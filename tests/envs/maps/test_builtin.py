@@ -46,6 +46,7 @@ def test_builtin_is_valid_with_description_and_parameters(name):
     assert info.description and "\n" not in info.description
     assert 0 < info.l_min <= info.l_max and info.v_pursuer > 0 and info.v_evader > 0
     assert info.rho == info.v_evader / info.v_pursuer
+    assert (info.L_min, info.L_max) == (info.l_min, info.l_max)
     assert info.params() == {
         "l_min": info.l_min,
         "l_max": info.l_max,

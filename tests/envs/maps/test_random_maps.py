@@ -211,3 +211,6 @@ def test_generated_maps_are_valid_against_shapely():
     union = shapely.union_all(obstacle_polygons(m))
     assert union.geom_type == "MultiPolygon" and len(union.geoms) == len(m.rings) - 1
     assert m.free_region.symmetric_difference(Polygon(m.rings[0]).difference(union)).area < 1e-9
+    pts = np.random.default_rng(0).uniform(-1, m.bounds[2] + 1, size=(2000, 2))
+    expect = shapely.covers(m.free_region, shapely.points(pts))
+    np.testing.assert_array_equal(m.contains(pts), expect)

@@ -12,8 +12,8 @@ from hypothesis import strategies as st
 from envs.errors import InfeasibleError, SurveilValueError
 from strategies.control.hamiltonian import (
     adjoint_lambda2,
-    dH_dalpha,
     df2_dtheta,
+    dH_dalpha,
     f2,
     hamiltonian,
     is_unbounded,
@@ -98,7 +98,7 @@ def test_unbounded_when_mu_not_positive_and_mirror_symmetry():
 
 
 def test_bad_input():
-    with pytest.raises(InfeasibleError, match="rho = 1.0"):
+    with pytest.raises(InfeasibleError, match=r"rho = 1\.0"):
         f2(0.1, 0.2, L=1.0, rho=1.0)
     with pytest.raises(SurveilValueError, match="rho = 0"):
         f2(0.1, 0.2, L=1.0, rho=0)

@@ -6,15 +6,17 @@ The model (state equations, H, adjoints, minimiser of H) is in
 * ``method="pmp"`` is the paper's algorithm of Fig. 10 with RK4 instead of Euler
   (THEORY §4.3): state ``(y, θ, λ2)``, and at every RK4 stage α is the minimiser of H,
   found by safeguarded Newton on the stationarity condition. It is the reference.
-* ``method="reduced"`` (default, about 10x faster) integrates the heading itself. Along
-  an extremal ``κ = λ1/μ = K_s(α, θ)`` and ``κ' = κ ∂g_s/∂θ``; differentiating gives, after
-  the terms in κ cancel (derived here, checked with sympy, not in the paper),
+* ``method="reduced"`` (default, much faster) integrates the heading itself, in the
+  evader's arclength σ so that headings near ±π/2 are harmless. Along an extremal
+  ``κ = λ1/μ = K_s(α, θ)`` and ``κ' = κ ∂f2/∂θ`` (from ``μ' = -μ ∂f2/∂θ``);
+  differentiating, the terms in κ cancel (derived here, checked with sympy; not in the
+  paper) and
 
       dα/dx = n_s(φ)² sin φ / ((1 - rho²) L cos α),     φ = α - θ,
 
-  an explicit ODE for the state ``(y, θ, α, ln μ)``. Because ``K_s`` is strictly
-  decreasing in α, α(0) and the pair ``(λ1, μ(0))`` determine each other one to one, so the
-  shooting runs directly on α(0) ∈ (-π/2, π/2).
+  an explicit ODE for the state ``(x, y, θ, α, ln μ)``. Because ``K_s`` is strictly
+  decreasing in α, α(0) and the ratio ``λ1/μ(0)`` determine each other one to one, so
+  the shooting runs directly on α(0) ∈ (-π/2, π/2).
 
 An arc is *unbounded* (THEORY §4.3) when H has no minimiser at some x, which on the
 reduced ODE shows as α reaching ±π/2 (the evader would have to turn back in x).

@@ -231,7 +231,7 @@ def test_solve_escape_is_optimal(theta0, x_e, L, rho, branch):
     direct = _direct_transcription(theta0, x_e, L, rho, branch)
     assert direct is not None
     assert abs(sol.J) <= direct + 1e-7
-    assert direct - abs(sol.J) < 2e-2 * max(1.0, abs(sol.J))  # ... and close to it
+    assert direct - abs(sol.J) < 1e-3 * max(1.0, abs(sol.J))  # ... and close (gap ~1e-5)
     # ... and than the straight path and perturbations with the same end points
     xs = np.linspace(0.0, x_e, 801)
     straight = abs(_theta_along(np.zeros_like(xs), x_e, theta0, L, rho, branch))

@@ -31,7 +31,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from envs.geometry.types import TWO_PI, Arc, FreeArcs, Stop, wrap_angle
-from envs.maps.map import Feature
 from envs.tolerances import ANGLE_TOL
 
 if TYPE_CHECKING:
@@ -44,166 +43,251 @@ def _angle(v: np.ndarray) -> np.ndarray:
     return np.arctan2(v[..., 1], v[..., 0])
 
 
-def free_arcs_at(kernel: Kernel, point: np.ndarray, L: float) -> FreeArcs:
-    """Free orientations of a rod of length ``L`` whose evader end is at ``point``.
+def free_arcs_at(kernel: Kernel, px: float, py: float, L: float) -> FreeArcs:
+    """Free orientations of a rod of length ``L`` whose evader end is at P = (px, py).
 
     Args:
         kernel: the map's geometry kernel.
-        point: P, shape (2,).
+        px: x of P.
+        py: y of P.
         L: rod length, > 0.
 
     Returns:
         The :class:`FreeArcs` at P.
     """
+    P = np.array([px, py])
+    eps = kernel.eps
+    r = L + eps
+    cand = kernel.grid.query_box(px - r, py - r, px + r, py + r)
+    if len(cand) > kernel.numpy_threshold:
+        blocks = _blocked_numpy(kernel, np.fromiter(cand, dtype=np.intp), px, py, L)
+    else:
+        blocks = _blocked_scalar(kernel, cand, px, py, L)
+    if blocks is None:  # P outside the closed free region
+        return FreeArcs(P, float(L), ())
+    lo, wid, lab_lo, lab_hi = blocks
+    if not lo:
+        return FreeArcs(P, float(L), (Arc(-math.pi, math.pi, None, None),))
+    return FreeArcs(P, float(L), _complement(lo, wid, lab_lo, lab_hi))
+
+
+Blocks = tuple[list[float], list[float], list[Stop], list[Stop]]
+
+
+def _label(
+    kernel: Kernel, at_vertex: bool, v: int, e: int, dist_v: float, L: float, eps: float
+) -> Stop:
+    """Stop label of a clipped edge end (THEORY.md 1.3 step 4)."""
+    if not at_vertex:
+        return kernel.tip_edge[e]
+    if abs(dist_v - L) <= eps:
+        return kernel.tip_vertex[v]
+    return kernel.body_vertex[v]
+
+
+def _on_wall_blocks(
+    kernel: Kernel, px: float, py: float, on_edges: list[int]
+) -> tuple[Blocks, set[int]]:
+    """Blocked arcs for P on a wall (type 0), and the edges through P they replace."""
     m = kernel.map
     eps = kernel.eps
-    P = point
-    px, py = float(P[0]), float(P[1])
-    # ---- candidates: edges within L (+eps) of P (bounding-box prefilter, then exact)
-    r = L + eps
-    idx = kernel.edges_in_box(px - r, py - r, px + r, py + r)
+    lo: list[float] = []
+    wid: list[float] = []
+    lab_lo: list[Stop] = []
+    lab_hi: list[Stop] = []
+    skip: set[int] = set()
+    ev = m.edge_vertices
+    for e in on_edges:  # P at a vertex of an edge through it: the obstacle's wedge there
+        for v in (int(ev[e, 0]), int(ev[e, 1])):
+            vx, vy = kernel._vxy[v]
+            e_in = int(m.vertex_prev_edge[v])
+            e_out = int(m.vertex_next_edge[v])
+            if e_in in skip or math.hypot(vx - px, vy - py) > eps:
+                continue
+            skip.update((e_in, e_out))
+            a = math.atan2(-kernel._dirs[e_in][1], -kernel._dirs[e_in][0])
+            b = math.atan2(kernel._dirs[e_out][1], kernel._dirs[e_out][0])
+            lo.append(a)
+            wid.append((b - a) % TWO_PI)
+            lab_lo.append(kernel.body_edge[e_in])
+            lab_hi.append(kernel.body_edge[e_out])
+    for e in on_edges:  # P inside an edge: the closed half circle behind it
+        if e in skip:
+            continue
+        skip.add(e)
+        ux, uy, _ = kernel._dirs[e]
+        lo.append(math.atan2(uy, ux) + math.pi)
+        wid.append(math.pi)
+        lab_lo.append(kernel.body_edge[e])
+        lab_hi.append(kernel.body_edge[e])
+    return (lo, wid, lab_lo, lab_hi), skip
+
+
+def _blocked_scalar(kernel: Kernel, cand, px: float, py: float, L: float) -> Blocks | None:
+    """Blocked arcs of the candidate edges, one edge at a time (few candidates)."""
+    eps = kernel.eps
+    recs, dirs, vxy = kernel._recs, kernel._dirs, kernel._vxy
+    r2 = (L + eps) ** 2
+    near: list[tuple[int, float, float, float, float, float]] = []
+    on_edges: list[int] = []
+    for e in cand:
+        ax, ay = recs[e][0], recs[e][1]
+        ux, uy, length = dirs[e]
+        wx, wy = ax - px, ay - py
+        s = -(wx * ux + wy * uy)  # projection of P on the edge's line
+        sc = 0.0 if s < 0.0 else (length if s > length else s)
+        cx, cy = wx + sc * ux, wy + sc * uy
+        d2 = cx * cx + cy * cy
+        if d2 > r2:
+            continue
+        if d2 <= eps * eps:
+            on_edges.append(e)
+        else:
+            near.append((e, wx, wy, ux, uy, s))
+    if on_edges:
+        (lo, wid, lab_lo, lab_hi), skip = _on_wall_blocks(kernel, px, py, on_edges)
+    else:
+        if not kernel.contains_point(px, py):
+            return None
+        lo, wid, lab_lo, lab_hi, skip = [], [], [], [], set()
+    ev = kernel.map.edge_vertices
+    LL = L * L
+    for e, wx, wy, ux, uy, s in near:
+        if e in skip:
+            continue
+        length = dirs[e][2]
+        ww = wx * wx + wy * wy
+        disc = s * s - (ww - LL)  # |w + t u|^2 = L^2, t in [0, length]
+        if disc < 0.0:
+            continue
+        sq = math.sqrt(disc)
+        t0 = s - sq
+        t1 = s + sq
+        t0 = 0.0 if t0 < 0.0 else t0
+        t1 = length if t1 > length else t1
+        if t0 > t1:
+            continue
+        ang_a = math.atan2(wy + t0 * uy, wx + t0 * ux)
+        ang_b = math.atan2(wy + t1 * uy, wx + t1 * ux)
+        w = (ang_b - ang_a) % TWO_PI
+        flip = w > math.pi  # P behind the edge's line: the short arc runs b' -> a'
+        if flip:
+            w = TWO_PI - w
+        if w <= ANGLE_TOL:  # zero width: a contact (tangency), not a block
+            continue
+        la = _label(kernel, t0 <= eps, e, e, math.sqrt(ww), L, eps)
+        if t1 >= length - eps:
+            vb = int(ev[e, 1])
+            lb = _label(kernel, True, vb, e, math.hypot(vxy[vb][0] - px, vxy[vb][1] - py), L, eps)
+        else:
+            lb = kernel.tip_edge[e]
+        if flip:
+            lo.append(ang_b)
+            lab_lo.append(lb)
+            lab_hi.append(la)
+        else:
+            lo.append(ang_a)
+            lab_lo.append(la)
+            lab_hi.append(lb)
+        wid.append(w)
+    return lo, wid, lab_lo, lab_hi
+
+
+def _blocked_numpy(
+    kernel: Kernel, idx: np.ndarray, px: float, py: float, L: float
+) -> Blocks | None:
+    """Blocked arcs of the candidate edges, vectorised (many candidates)."""
+    m = kernel.map
+    eps = kernel.eps
     a = m.edge_start[idx]
     u = m.edge_dir[idx]
     length = m.edge_length[idx]
-    w = a - P
-    s = -(w[:, 0] * u[:, 0] + w[:, 1] * u[:, 1])  # projection of P on the edge line
+    wx = a[:, 0] - px
+    wy = a[:, 1] - py
+    s = -(wx * u[:, 0] + wy * u[:, 1])
     sc = np.clip(s, 0.0, length)
-    cx = w[:, 0] + sc * u[:, 0]
-    cy = w[:, 1] + sc * u[:, 1]
-    dist = np.hypot(cx, cy)
-    keep = dist <= r
-    idx, a, u, length, w, s, dist = (
-        idx[keep],
-        a[keep],
-        u[keep],
-        length[keep],
-        w[keep],
-        s[keep],
-        dist[keep],
-    )
-
-    lo_list: list[np.ndarray] = []
-    wid_list: list[np.ndarray] = []
-    lab_lo: list[Stop] = []
-    lab_hi: list[Stop] = []
-
-    # ---- P on a wall (type 0): block the obstacle side, drop the edges through P
-    on = dist <= eps
+    dist = np.hypot(wx + sc * u[:, 0], wy + sc * u[:, 1])
+    keep = dist <= L + eps
+    on = keep & (dist <= eps)
     if on.any():
-        vd = np.hypot(m.vertices[:, 0] - px, m.vertices[:, 1] - py)
-        at_vertex = np.flatnonzero(vd <= eps)
-        skip: set[int] = set()
-        for v in at_vertex.tolist():
-            e_in = int(m.vertex_prev_edge[v])
-            e_out = int(m.vertex_next_edge[v])
-            skip.update((e_in, e_out))
-            lo = math.atan2(-m.edge_dir[e_in, 1], -m.edge_dir[e_in, 0])
-            hi = math.atan2(m.edge_dir[e_out, 1], m.edge_dir[e_out, 0])
-            lo_list.append(np.array([lo]))
-            wid_list.append(np.array([(hi - lo) % TWO_PI]))
-            lab_lo.append(Stop("body", Feature("edge", e_in)))
-            lab_hi.append(Stop("body", Feature("edge", e_out)))
-        for j in np.flatnonzero(on).tolist():
-            e = int(idx[j])
-            if e in skip:
-                continue
-            alpha = math.atan2(u[j, 1], u[j, 0])
-            lo_list.append(np.array([alpha + math.pi]))
-            wid_list.append(np.array([math.pi]))
-            lab_lo.append(Stop("body", Feature("edge", e)))
-            lab_hi.append(Stop("body", Feature("edge", e)))
-        off = ~on
-        idx, a, u, length, w, s = idx[off], a[off], u[off], length[off], w[off], s[off]
-    elif not kernel.contains_point(px, py):
-        return FreeArcs(np.array(P, dtype=float), float(L), ())
-
-    # ---- clip each edge to the closed disk: |w + t u|^2 = L^2, t in [0, length]
-    ww = w[:, 0] * w[:, 0] + w[:, 1] * w[:, 1]
+        (lo, wid, lab_lo, lab_hi), skip = _on_wall_blocks(kernel, px, py, idx[on].tolist())
+        keep &= ~on & ~np.isin(idx, list(skip))
+    else:
+        if not kernel.contains_point(px, py):
+            return None
+        lo, wid, lab_lo, lab_hi = [], [], [], []
+    idx, wx, wy, u, length, s = idx[keep], wx[keep], wy[keep], u[keep], length[keep], s[keep]
+    ww = wx * wx + wy * wy
     disc = s * s - (ww - L * L)
     ok = disc >= 0.0
     sq = np.sqrt(np.where(ok, disc, 0.0))
     t0 = np.maximum(s - sq, 0.0)
     t1 = np.minimum(s + sq, length)
     ok &= t0 <= t1
-    idx, a, u, length, t0, t1, ww = idx[ok], a[ok], u[ok], length[ok], t0[ok], t1[ok], ww[ok]
-    pa = a + t0[:, None] * u - P
-    pb = a + t1[:, None] * u - P
-    ang_a = _angle(pa)
-    ang_b = _angle(pb)
-    wid = (ang_b - ang_a) % TWO_PI
-    flip = wid > math.pi  # P behind the edge's line: the short arc runs b' -> a'
-    lo = np.where(flip, ang_b, ang_a)
-    wid = np.where(flip, TWO_PI - wid, wid)
-    real = wid > ANGLE_TOL  # zero-width arcs are contacts (tangency), not blocks
-    if real.any():
-        sel = np.flatnonzero(real)
-        lo_list.append(lo[sel])
-        wid_list.append(wid[sel])
-        ev = m.edge_vertices
-        da = math.sqrt  # local alias
-        for j in sel.tolist():
-            e = int(idx[j])
-            lab_a = _label(t0[j] <= eps, int(ev[e, 0]), e, da(float(ww[j])), L, eps)
-            if t1[j] >= length[j] - eps:
-                vb = int(ev[e, 1])
-                db = math.hypot(m.vertices[vb, 0] - px, m.vertices[vb, 1] - py)
-                lab_b = _label(True, vb, e, db, L, eps)
-            else:
-                lab_b = Stop("tip", Feature("edge", e))
-            if flip[j]:
-                lab_a, lab_b = lab_b, lab_a
-            lab_lo.append(lab_a)
-            lab_hi.append(lab_b)
-    if not lo_list:
-        full = Arc(-math.pi, math.pi, None, None)
-        return FreeArcs(np.array(P, dtype=float), float(L), (full,))
-    return FreeArcs(
-        np.array(P, dtype=float),
-        float(L),
-        _complement(np.concatenate(lo_list), np.concatenate(wid_list), lab_lo, lab_hi),
-    )
-
-
-def _label(at_vertex: bool, v: int, e: int, dist_v: float, L: float, eps: float) -> Stop:
-    """Stop label of a clipped edge end (THEORY.md 1.3 step 4)."""
-    if not at_vertex:
-        return Stop("tip", Feature("edge", e))
-    if abs(dist_v - L) <= eps:
-        return Stop("tip", Feature("vertex", v))
-    return Stop("body", Feature("vertex", v))
+    ang_a = np.arctan2(wy + t0 * u[:, 1], wx + t0 * u[:, 0])
+    ang_b = np.arctan2(wy + t1 * u[:, 1], wx + t1 * u[:, 0])
+    w = (ang_b - ang_a) % TWO_PI
+    flip = w > math.pi
+    w = np.where(flip, TWO_PI - w, w)
+    start = np.where(flip, ang_b, ang_a)
+    sel = np.flatnonzero(ok & (w > ANGLE_TOL))
+    if len(sel) == 0:
+        return lo, wid, lab_lo, lab_hi
+    ev = m.edge_vertices
+    vb = ev[idx[sel], 1]
+    db = np.hypot(m.vertices[vb, 0] - px, m.vertices[vb, 1] - py)
+    for k, j in enumerate(sel.tolist()):
+        e = int(idx[j])
+        la = _label(kernel, bool(t0[j] <= eps), e, e, math.sqrt(ww[j]), L, eps)
+        if t1[j] >= length[j] - eps:
+            lb = _label(kernel, True, int(vb[k]), e, float(db[k]), L, eps)
+        else:
+            lb = kernel.tip_edge[e]
+        if flip[j]:
+            la, lb = lb, la
+        lab_lo.append(la)
+        lab_hi.append(lb)
+    lo.extend(start[sel].tolist())
+    wid.extend(w[sel].tolist())
+    return lo, wid, lab_lo, lab_hi
 
 
 def _complement(
-    lo: np.ndarray, wid: np.ndarray, lab_lo: list[Stop], lab_hi: list[Stop]
+    lo: list[float], wid: list[float], lab_lo: list[Stop], lab_hi: list[Stop]
 ) -> tuple[Arc, ...]:
-    """Complement a union of closed blocked arcs ``[lo, lo + wid]`` on the circle."""
-    if np.any(wid >= TWO_PI - ANGLE_TOL):
+    """Complement a union of closed blocked arcs ``[lo, lo + wid]`` on the circle.
+
+    The circle is cut at the start ``c`` of a blocked arc; arcs that wrap past the cut
+    also cover ``[0, hi - 2 pi]`` after it. A sweep in order of start angle then finds
+    the gaps, each free arc taking its stops from the arcs that bound it.
+    """
+    if max(wid) >= TWO_PI - ANGLE_TOL:
         return ()
-    c = float(lo[np.argmin(lo)])  # a blocked angle: cut the circle there
-    rel = (lo - c) % TWO_PI
-    hi = rel + wid
-    n = len(rel)
-    ids = np.arange(n)
-    wrap = hi > TWO_PI
-    if wrap.any():  # arcs that wrap past the cut also cover [0, hi - 2 pi]
-        rel = np.concatenate([rel, rel[wrap] - TWO_PI])
-        hi = np.concatenate([hi, hi[wrap] - TWO_PI])
-        ids = np.concatenate([ids, ids[wrap]])
-    order = np.argsort(rel, kind="stable")
-    rel, hi, ids = rel[order], hi[order], ids[order]
-    cmax = np.maximum.accumulate(hi)
-    pos = np.arange(len(hi))
-    arg = np.maximum.accumulate(np.where(hi >= cmax, pos, -1))
-    nxt = np.append(rel[1:], TWO_PI)
-    nxt_id = np.append(ids[1:], int(np.argmin(lo)))  # the gap before 2 pi ends at the cut
-    gaps = np.flatnonzero(nxt - cmax > ANGLE_TOL)
+    first = min(range(len(lo)), key=lo.__getitem__)
+    c = lo[first]
+    items = []
+    for i, (a, w) in enumerate(zip(lo, wid, strict=True)):
+        rel = (a - c) % TWO_PI
+        if i == first:
+            rel = 0.0
+        items.append((rel, rel + w, i))
+        if rel + w > TWO_PI:
+            items.append((rel - TWO_PI, rel + w - TWO_PI, i))
+    items.sort()
     arcs = []
-    for g in gaps.tolist():
-        start = c + float(cmax[g])
-        end = c + float(nxt[g])
-        lo_w = wrap_angle(start)
-        arcs.append(
-            Arc(lo_w, lo_w + (end - start), lab_hi[int(ids[arg[g]])], lab_lo[int(nxt_id[g])])
-        )
+    cmax = -math.inf
+    cmax_id = -1
+    for rel, hi, i in items:
+        if cmax_id >= 0 and rel - cmax > ANGLE_TOL:
+            arcs.append(_arc(c, cmax, rel, lab_hi[cmax_id], lab_lo[i]))
+        if hi >= cmax:
+            cmax, cmax_id = hi, i
+    if TWO_PI - cmax > ANGLE_TOL:  # the last gap ends at the cut
+        arcs.append(_arc(c, cmax, TWO_PI, lab_hi[cmax_id], lab_lo[first]))
     arcs.sort(key=lambda arc: arc.lo)
     return tuple(arcs)
+
+
+def _arc(c: float, start: float, end: float, stop_lo: Stop, stop_hi: Stop) -> Arc:
+    lo = wrap_angle(c + start)
+    return Arc(lo, lo + (end - start), stop_lo, stop_hi)

@@ -15,15 +15,31 @@ import numpy as np
 
 from envs.errors import InvalidConfigError
 from envs.geometry.arcs import free_arcs_at
-from envs.geometry.segments import endpoint_on_edge, point_in_walls, segment_contacts
+from envs.geometry.grid import Grid
+from envs.geometry.segments import point_in_walls, scan_segment, segment_contacts
 from envs.geometry.sweep import sweep_step
-from envs.geometry.types import FreeArcs, SweepEvent
+from envs.geometry.types import FreeArcs, Stop, SweepEvent
 from envs.maps.map import Feature, Map
 from envs.tolerances import REL_LENGTH_TOL
 
 __all__ = ["Kernel", "kernel_for"]
 
 ArrayLike = np.ndarray | Sequence[float]
+
+
+def _xy(p: ArrayLike, what: str) -> tuple[float, float]:
+    """``p`` as two finite floats (fast path for the per-step predicates)."""
+    try:
+        x, y = p
+        if isinstance(x, np.ndarray) or isinstance(y, np.ndarray):
+            raise TypeError
+        x = float(x)
+        y = float(y)
+    except (TypeError, ValueError) as exc:
+        raise InvalidConfigError(f"{what}: expected a finite (x, y) point, got {p!r}") from exc
+    if not (math.isfinite(x) and math.isfinite(y)):
+        raise InvalidConfigError(f"{what}: expected a finite (x, y) point, got {p!r}")
+    return x, y
 
 
 def _point(x: ArrayLike, what: str) -> np.ndarray:
@@ -58,83 +74,174 @@ def _length(x: float, what: str, *, positive: bool = True) -> float:
 class Kernel:
     """Exact polygon geometry for one map: visibility, sweeps, free arcs, lidar.
 
+    Built once per map (use :func:`kernel_for`); immutable afterwards and safe to share
+    between threads. Queries look up nearby walls in a uniform bucket grid and test them
+    in plain Python when there are few (the common case: per-call numpy overhead would
+    dominate), with numpy when there are many.
+
     Args:
         world: the map.
 
     Attributes:
         map: the map.
-        eps: absolute length tolerance, ``REL_LENGTH_TOL * map.scale``.
+        eps: absolute length tolerance, ``REL_LENGTH_TOL * map.scale``. A wall vertex
+            closer than ``eps`` to a segment touches it; a point closer than ``eps`` to a
+            wall lies on it.
     """
+
+    #: candidate counts above which a query switches from Python loops to numpy
+    numpy_threshold: int = 48
 
     def __init__(self, world: Map) -> None:
         if not isinstance(world, Map):
             raise InvalidConfigError(f"Kernel: expected a Map, got {type(world).__name__}")
         self.map = world
-        self.eps = REL_LENGTH_TOL * world.scale
+        self.eps = eps = REL_LENGTH_TOL * world.scale
         a, b = world.edge_start, world.edge_end
         self._a = a
         self._b = b
         self._n = world.edge_normal
-        self._exmin = np.minimum(a[:, 0], b[:, 0])
-        self._exmax = np.maximum(a[:, 0], b[:, 0])
-        self._eymin = np.minimum(a[:, 1], b[:, 1])
-        self._eymax = np.maximum(a[:, 1], b[:, 1])
-        self._all_edges = np.arange(world.n_edges)
+        self._recs = [
+            (float(r[0]), float(r[1]), float(r[2]), float(r[3]), float(r[4]), float(r[5]))
+            for r in np.concatenate([a, b, world.edge_normal], axis=1)
+        ]
+        self._dirs = [
+            (float(u[0]), float(u[1]), float(n))
+            for u, n in zip(world.edge_dir, world.edge_length, strict=True)
+        ]
+        self._vxy = [(float(v[0]), float(v[1])) for v in world.vertices]
+        # stop labels are immutable: build each one once and share it
+        n = world.n_vertices
+        self.tip_edge = [Stop("tip", Feature("edge", e)) for e in range(n)]
+        self.body_edge = [Stop("body", Feature("edge", e)) for e in range(n)]
+        self.tip_vertex = [Stop("tip", Feature("vertex", v)) for v in range(n)]
+        self.body_vertex = [Stop("body", Feature("vertex", v)) for v in range(n)]
         self._convex = world.convex_vertices
-        self._cv = world.vertices[self._convex]
+        x0, y0, x1, y1 = world.bounds
+        self._bounds = (x0 - eps, y0 - eps, x1 + eps, y1 + eps)
+        self.grid = Grid((x0, y0), (x1, y1), world.n_edges, eps)
+        for e in range(world.n_edges):
+            ax, ay, bx, by = self._recs[e][:4]
+            self.grid.insert_box(e, min(ax, bx), min(ay, by), max(ax, bx), max(ay, by))
+        self.grid.freeze()
+        self.vgrid = Grid((x0, y0), (x1, y1), world.n_edges, eps)
+        for v in self._convex.tolist():
+            vx, vy = self._vxy[v]
+            self.vgrid.insert_box(v, vx, vy, vx, vy)
+        self.vgrid.freeze()
+        self._build_cell_status()
+
+    def _build_cell_status(self) -> None:
+        """Pick a reference point per grid cell away from the walls and classify it."""
+        g = self.grid
+        h = g.h
+        refs = g.cell_centers()
+        # nudge reference points that lie near a wall of their cell (deterministic offsets)
+        offsets = [(0.0, 0.0)] + [
+            (0.31 * math.cos(2.4 * k) * h, 0.31 * math.sin(2.4 * k) * h) for k in range(1, 24)
+        ]
+        for c, cell in enumerate(g.cells):
+            if not cell:
+                continue
+            cx, cy = refs[c]
+            for ox, oy in offsets:
+                x, y = cx + ox, cy + oy
+                if self._near_wall(x, y, cell, 1e-6 * h) is None:
+                    refs[c] = (x, y)
+                    break
+        self._refs = [(float(x), float(y)) for x, y in refs]
+        self._ref_free = point_in_walls(refs, self._a, self._b).tolist()
 
     # ------------------------------------------------------------------ prefilters
-    def edges_in_box(self, xmin: float, ymin: float, xmax: float, ymax: float) -> np.ndarray:
-        """Indices of the edges whose bounding boxes meet the given box."""
-        m = (
-            (self._exmin <= xmax)
-            & (self._exmax >= xmin)
-            & (self._eymin <= ymax)
-            & (self._eymax >= ymin)
-        )
-        return np.flatnonzero(m)
+    def edges_near_box(self, xmin: float, ymin: float, xmax: float, ymax: float) -> np.ndarray:
+        """Indices of edges in the grid cells the box overlaps (a superset of those within)."""
+        return np.fromiter(self.grid.query_box(xmin, ymin, xmax, ymax), dtype=np.intp)
 
-    def convex_in_box(self, xmin: float, ymin: float, xmax: float, ymax: float) -> np.ndarray:
-        """Indices (into ``map.vertices``) of the convex obstacle vertices in the box."""
-        v = self._cv
-        m = (v[:, 0] >= xmin) & (v[:, 0] <= xmax) & (v[:, 1] >= ymin) & (v[:, 1] <= ymax)
-        return self._convex[m]
+    def _near_wall(self, x: float, y: float, cand, tol: float) -> int | None:
+        """An edge among ``cand`` within ``tol`` of (x, y), or None."""
+        recs, dirs = self._recs, self._dirs
+        for e in cand:
+            ax, ay = recs[e][0], recs[e][1]
+            ux, uy, length = dirs[e]
+            wx, wy = x - ax, y - ay
+            s = wx * ux + wy * uy
+            s = 0.0 if s < 0.0 else (length if s > length else s)
+            dx, dy = wx - s * ux, wy - s * uy
+            if dx * dx + dy * dy <= tol * tol:
+                return e
+        return None
+
+    def on_wall(self, x: float, y: float) -> int | None:
+        """An edge within ``eps`` of (x, y), or None."""
+        return self._near_wall(x, y, self.grid.cells[self.grid.cell_of(x, y)], self.eps)
 
     def contains_point(self, x: float, y: float) -> bool:
-        """Whether ``(x, y)`` lies in the closed free region (walls count as free)."""
-        p = np.array([[x, y]])
-        if float(self.map.distance_to_walls(p)[0]) <= self.eps:
+        """Whether (x, y) lies in the closed free region (points on walls count as free).
+
+        The parity of wall crossings on the segment from the cell's reference point,
+        whose status was computed at construction, decides; only the cell's walls count.
+        """
+        x0, y0, x1, y1 = self._bounds
+        if not (x0 <= x <= x1 and y0 <= y <= y1):
+            return False
+        c = self.grid.cell_of(x, y)
+        cell = self.grid.cells[c]
+        if not cell:
+            return self._ref_free[c]
+        if self._near_wall(x, y, cell, self.eps) is not None:
             return True
-        return bool(point_in_walls(p, self._a, self._b)[0])
+        rx, ry = self._refs[c]
+        dx, dy = x - rx, y - ry
+        inside = self._ref_free[c]
+        recs = self._recs
+        for e in cell:
+            ax, ay, bx, by, nx, ny = recs[e]
+            # half-open rule at the edge's ends: a vertex on the line counts as "left"
+            sa = dx * (ay - ry) - dy * (ax - rx) >= 0.0
+            sb = dx * (by - ry) - dy * (bx - rx) >= 0.0
+            if sa == sb:
+                continue
+            hr = nx * (rx - ax) + ny * (ry - ay)
+            hx = nx * (x - ax) + ny * (y - ay)
+            if (hr > 0.0) != (hx > 0.0):
+                inside = not inside
+        return inside
 
     # ------------------------------------------------------------------ visibility
-    def _contacts(self, p: np.ndarray, q: np.ndarray):
-        eps = self.eps
-        lo = np.minimum(p, q) - eps
-        hi = np.maximum(p, q) + eps
-        idx = self.edges_in_box(lo[0], lo[1], hi[0], hi[1])
-        a, b, n = self._a[idx], self._b[idx], self._n[idx]
-        return idx, segment_contacts(p, q, a, b, n, eps)
+    def _scan(self, px: float, py: float, qx: float, qy: float, nearest: bool):
+        cand = self.grid.query_segment(px, py, qx, qy)
+        if len(cand) > self.numpy_threshold:
+            return self._scan_numpy(np.fromiter(cand, dtype=np.intp), px, py, qx, qy)
+        return scan_segment(self._recs, cand, px, py, qx, qy, self.eps, nearest)
 
-    def _through_obstacle(self, p: np.ndarray, q: np.ndarray) -> bool:
+    def _scan_numpy(self, idx: np.ndarray, px: float, py: float, qx: float, qy: float):
+        """Nearest contact over many candidate edges, vectorised."""
+        p = np.array([px, py])
+        q = np.array([qx, qy])
+        cross, t_cross, vhit, t_vertex, along = segment_contacts(
+            p, q, self._a[idx], self._b[idx], self._n[idx], self.eps
+        )
+        best = None
+        for mask, t, kind in (
+            (vhit, t_vertex, "vertex"),
+            (cross, t_cross, "edge"),
+            (along & ~vhit, t_vertex, "edge"),
+        ):
+            if mask.any():
+                j = np.flatnonzero(mask)
+                k = j[np.argmin(t[j])]
+                if best is None or float(t[k]) < best[0]:
+                    best = (float(t[k]), kind, int(idx[k]))
+        return best
+
+    def _through_obstacle(self, px: float, py: float, qx: float, qy: float) -> bool:
         """For a segment whose open part touches no wall: does it lie outside free space?
 
         Only possible when both ends rest on walls; decided by the midpoint.
         """
-        m = self.map
-        ends = np.stack([p, q])
-        on = endpoint_on_edge(
-            ends[:, None, :],
-            self._a[None],
-            m.edge_dir[None],
-            self._n[None],
-            m.edge_length[None],
-            self.eps,
-        ).any(axis=1)
-        if not on.all():
+        if self.on_wall(px, py) is None or self.on_wall(qx, qy) is None:
             return False
-        mid = 0.5 * (p + q)
-        return not bool(point_in_walls(mid[None], self._a, self._b)[0])
+        return not self.contains_point(0.5 * (px + qx), 0.5 * (py + qy))
 
     def line_of_sight(self, p: ArrayLike, q: ArrayLike) -> bool:
         """Whether the segment p-q touches no wall.
@@ -150,14 +257,17 @@ class Kernel:
         Returns:
             True when the line of sight is clear.
         """
-        p = _point(p, "line_of_sight p")
-        q = _point(q, "line_of_sight q")
-        if float(np.hypot(*(q - p))) <= self.eps:
+        px, py = _xy(p, "line_of_sight p")
+        qx, qy = _xy(q, "line_of_sight q")
+        return self._los(px, py, qx, qy)
+
+    def _los(self, px: float, py: float, qx: float, qy: float) -> bool:
+        """:meth:`line_of_sight` on validated floats."""
+        if math.hypot(qx - px, qy - py) <= self.eps:
             return True
-        _, (cross, _, vhit, _, along) = self._contacts(p, q)
-        if cross.any() or vhit.any() or along.any():
+        if self._scan(px, py, qx, qy, False) is not None:
             return False
-        return not self._through_obstacle(p, q)
+        return not self._through_obstacle(px, py, qx, qy)
 
     def line_of_sight_many(self, P: ArrayLike, Q: ArrayLike) -> np.ndarray:
         """Vectorised :meth:`line_of_sight`: (k, 2), (k, 2) -> (k,) bool."""
@@ -168,32 +278,33 @@ class Kernel:
                 f"line_of_sight_many: P and Q must have the same shape, got {P.shape} and {Q.shape}"
             )
         k = len(P)
+        if k == 0:
+            return np.ones(0, dtype=bool)
+        eps = self.eps
+        if self.map.n_edges > self.numpy_threshold:
+            # a big map: each segment meets few walls, the grid finds them faster than
+            # a (k, n_edges) broadcast
+            los = self._los
+            return np.fromiter(
+                (los(p[0], p[1], q[0], q[1]) for p, q in zip(P.tolist(), Q.tolist(), strict=True)),
+                dtype=bool,
+                count=k,
+            )
         out = np.ones(k, dtype=bool)
-        chunk = max(1, 200_000 // max(1, self.map.n_edges))
         a, b, n = self._a[None], self._b[None], self._n[None]
+        chunk = max(1, 200_000 // self.map.n_edges)
         for s in range(0, k, chunk):
             p = P[s : s + chunk, None, :]
             q = Q[s : s + chunk, None, :]
-            cross, _, vhit, _, along = segment_contacts(p, q, a, b, n, self.eps)
+            cross, _, vhit, _, along = segment_contacts(p, q, a, b, n, eps)
             out[s : s + chunk] = ~(cross | vhit | along).any(axis=1)
-        short = np.hypot(*(Q - P).T) <= self.eps
+        short = np.hypot(*(Q - P).T) <= eps
         out[short] = True
-        for i in np.flatnonzero(out & ~short):
-            # both ends on walls and nothing touched: rare, check through the obstacle
-            if self._ends_on_walls(P[i], Q[i]) and self._through_obstacle(P[i], Q[i]):
+        for i in np.flatnonzero(out & ~short).tolist():
+            # nothing touched: blocked only if both ends rest on walls across an obstacle
+            if self._through_obstacle(P[i, 0], P[i, 1], Q[i, 0], Q[i, 1]):
                 out[i] = False
         return out
-
-    def _edge_distances(self, p: np.ndarray) -> np.ndarray:
-        """Distance from point ``p`` to every wall edge."""
-        m = self.map
-        rel = p - self._a
-        t = np.clip(np.einsum("ej,ej->e", rel, m.edge_dir), 0.0, m.edge_length)
-        return np.hypot(*(rel - t[:, None] * m.edge_dir).T)
-
-    def _ends_on_walls(self, p: np.ndarray, q: np.ndarray) -> bool:
-        d = self.map.distance_to_walls(np.stack([p, q]))
-        return bool((d <= self.eps).all())
 
     def blocking_feature(self, p: ArrayLike, q: ArrayLike) -> Feature | None:
         """The wall feature nearest to ``p`` that blocks the segment p-q, or None if clear.
@@ -202,31 +313,16 @@ class Kernel:
         edge as the edge. When only the through-an-obstacle test blocks (both ends on
         walls), the edge under ``p`` is reported.
         """
-        p = _point(p, "blocking_feature p")
-        q = _point(q, "blocking_feature q")
-        if float(np.hypot(*(q - p))) <= self.eps:
+        px, py = _xy(p, "blocking_feature p")
+        qx, qy = _xy(q, "blocking_feature q")
+        if math.hypot(qx - px, qy - py) <= self.eps:
             return None
-        idx, (cross, t_cross, vhit, t_vertex, along) = self._contacts(p, q)
-        best_t = math.inf
-        best: Feature | None = None
-        if vhit.any():
-            j = np.flatnonzero(vhit)
-            k = j[np.argmin(t_vertex[j])]
-            best_t, best = float(t_vertex[k]), Feature("vertex", int(idx[k]))
-        if cross.any():
-            j = np.flatnonzero(cross)
-            k = j[np.argmin(t_cross[j])]
-            if float(t_cross[k]) < best_t:
-                best_t, best = float(t_cross[k]), Feature("edge", int(idx[k]))
-        along_only = along & ~vhit
-        if along_only.any():
-            j = np.flatnonzero(along_only)
-            k = j[np.argmin(t_vertex[j])]
-            if float(t_vertex[k]) < best_t:
-                best_t, best = float(t_vertex[k]), Feature("edge", int(idx[k]))
-        if best is None and self._through_obstacle(p, q):
-            best = Feature("edge", int(np.argmin(self._edge_distances(p))))
-        return best
+        hit = self._scan(px, py, qx, qy, True)
+        if hit is not None:
+            return Feature(hit[1], hit[2])
+        if self._through_obstacle(px, py, qx, qy):
+            return Feature("edge", self.on_wall(px, py))
+        return None
 
     # ------------------------------------------------------------------ sweep
     def sweep(
@@ -255,10 +351,10 @@ class Kernel:
         Returns:
             The earliest :class:`SweepEvent`, or None.
         """
-        p0 = _point(p0, "sweep p0")
-        e0 = _point(e0, "sweep e0")
-        p1 = _point(p1, "sweep p1")
-        e1 = _point(e1, "sweep e1")
+        p0 = _xy(p0, "sweep p0")
+        e0 = _xy(e0, "sweep e0")
+        p1 = _xy(p1, "sweep p1")
+        e1 = _xy(e1, "sweep e1")
         l_min = _length(l_min, "sweep l_min", positive=False)
         l_max = _length(l_max, "sweep l_max")
         if l_max < l_min:
@@ -272,13 +368,14 @@ class Kernel:
         See :mod:`envs.geometry.arcs` for the method (THEORY.md 1.3) and the degenerate
         cases.
         """
-        return free_arcs_at(self, _point(point, "free_arcs point"), _length(L, "free_arcs L"))
+        px, py = _xy(point, "free_arcs point")
+        return free_arcs_at(self, px, py, _length(L, "free_arcs L"))
 
     def free_arcs_many(self, points: ArrayLike, L: float) -> list[FreeArcs]:
         """:meth:`free_arcs` at each of (k, 2) points."""
         pts = _points(points, "free_arcs_many points")
         L = _length(L, "free_arcs_many L")
-        return [free_arcs_at(self, p, L) for p in pts]
+        return [free_arcs_at(self, x, y, L) for x, y in pts.tolist()]
 
     # ------------------------------------------------------------------ lidar
     def ray_distances(self, origin: ArrayLike, angles: ArrayLike, max_range: float) -> np.ndarray:
@@ -303,7 +400,7 @@ class Kernel:
         rmax = _length(max_range, "ray_distances max_range")
         eps = self.eps
         r = rmax + eps
-        idx = self.edges_in_box(o[0] - r, o[1] - r, o[0] + r, o[1] + r)
+        idx = self.edges_near_box(o[0] - r, o[1] - r, o[0] + r, o[1] + r)
         out = np.full(len(ang), rmax)
         if len(idx) == 0 or len(ang) == 0:
             return out

@@ -10,9 +10,11 @@ tolerance ``eps`` (``REL_LENGTH_TOL`` times the map scale), so a vertex closer t
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-__all__ = ["endpoint_on_edge", "point_in_walls", "segment_contacts"]
+__all__ = ["endpoint_on_edge", "point_in_walls", "scan_segment", "segment_contacts"]
 
 
 def segment_contacts(
@@ -102,3 +104,76 @@ def point_in_walls(x: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         xint = ax + (py - ay) * (bx - ax) / (by - ay)
     return np.count_nonzero(cond & (px < xint), axis=1) % 2 == 1
+
+
+def scan_segment(
+    recs: list[tuple[float, float, float, float, float, float]],
+    cand,
+    px: float,
+    py: float,
+    qx: float,
+    qy: float,
+    eps: float,
+    nearest: bool,
+) -> tuple[float, str, int] | None:
+    """Scalar version of :func:`segment_contacts` over candidate edges ``cand``.
+
+    Args:
+        recs: per edge ``(ax, ay, bx, by, nx, ny)`` (start, end, unit normal into free space).
+        cand: iterable of edge indices to test.
+        px, py, qx, qy: the segment (length > eps).
+        eps: absolute length tolerance.
+        nearest: find the contact nearest to p; otherwise return the first one found.
+
+    Returns:
+        ``(t, kind, index)`` of a contact of the open segment (``kind`` ``"vertex"`` with
+        the vertex index, which is also the edge it starts, or ``"edge"``), or None.
+    """
+    dx = qx - px
+    dy = qy - py
+    ell2 = dx * dx + dy * dy
+    ell = math.sqrt(ell2)
+    inv = 1.0 / ell2
+    tol = eps * ell
+    t_lo = eps / ell
+    t_hi = 1.0 - t_lo
+    best: tuple[float, str, int] | None = None
+    for e in cand:
+        ax, ay, bx, by, nx, ny = recs[e]
+        apx = ax - px
+        apy = ay - py
+        oa = dx * apy - dy * apx
+        bpx = bx - px
+        bpy = by - py
+        ob = dx * bpy - dy * bpx
+        if -tol <= oa <= tol:
+            ta = (dx * apx + dy * apy) * inv
+            if t_lo < ta < t_hi:
+                if not nearest:
+                    return (ta, "vertex", e)
+                if best is None or ta < best[0]:
+                    best = (ta, "vertex", e)
+            if -tol <= ob <= tol:  # collinear: does the open segment run along the edge?
+                tb = (dx * bpx + dy * bpy) * inv
+                lo = max(min(ta, tb), 0.0)
+                hi = min(max(ta, tb), 1.0)
+                if lo < t_hi and hi > t_lo:
+                    if not nearest:
+                        return (lo, "edge", e)
+                    if best is None or lo < best[0]:
+                        best = (lo, "edge", e)
+            continue
+        if oa > tol:
+            if ob >= -tol:
+                continue
+        elif ob <= tol:
+            continue
+        op = -(nx * apx + ny * apy)
+        oq = nx * (qx - ax) + ny * (qy - ay)
+        if (op > eps and oq < -eps) or (op < -eps and oq > eps):
+            t = op / (op - oq)
+            if not nearest:
+                return (t, "edge", e)
+            if best is None or t < best[0]:
+                best = (t, "edge", e)
+    return best

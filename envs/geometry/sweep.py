@@ -53,50 +53,140 @@ def _quad_roots(c2: float, c1: np.ndarray, c0: np.ndarray) -> tuple[np.ndarray, 
 
 
 def _first_distance_event(
-    R: np.ndarray, S: np.ndarray, l_min: float, l_max: float, eps: float
+    rx: float, ry: float, sx: float, sy: float, l_min: float, l_max: float, eps: float
 ) -> tuple[float, str] | None:
-    """Earliest ``t`` in [0, 1] where ``|R + t S|`` leaves ``[l_min, l_max]`` (by > eps)."""
-    A = float(S @ S)
-    B = 2.0 * float(R @ S)
-    C = float(R @ R)
+    """Earliest ``t`` in [0, 1] where ``|R + t S|`` leaves ``[l_min, l_max]`` (by > eps).
+
+    ``f(t) = |R + t S|^2 = A t^2 + B t + C`` is convex: with ``f(0)`` in range, it leaves
+    through ``l_max`` only if ``f(1)`` is out (at the larger root of ``f = l_max^2``), and
+    through ``l_min`` only if its minimum on [0, 1] is (at the smaller root of
+    ``f = l_min^2``).
+    """
+    A = sx * sx + sy * sy
+    B = 2.0 * (rx * sx + ry * sy)
+    C = rx * rx + ry * ry
     d0 = math.sqrt(C)
-    best: tuple[float, str] | None = None
     if d0 > l_max + eps:
         return (0.0, "too_far")
     if d0 < l_min - eps:
         return (0.0, "too_close")
     if A == 0.0:
         return None
-    f1 = A + B + C
-    if math.sqrt(max(f1, 0.0)) > l_max + eps:
-        # convex f, f(0) <= l_max^2 < f(1): the larger root of f = l_max^2 is the exit
-        r1, r2 = _quad_roots(A, np.array([B]), np.array([C - l_max * l_max]))
-        t = float(np.nanmax([r1[0], r2[0]]))
+    best: tuple[float, str] | None = None
+    if math.sqrt(max(A + B + C, 0.0)) > l_max + eps:
+        t = max(_roots(A, B, C - l_max * l_max), default=1.0)
         best = (min(max(t, 0.0), 1.0), "too_far")
     if l_min > 0.0:
         tm = min(max(-B / (2.0 * A), 0.0), 1.0)
-        fm = (A * tm + B) * tm + C
-        if math.sqrt(max(fm, 0.0)) < l_min - eps:
-            r1, r2 = _quad_roots(A, np.array([B]), np.array([C - l_min * l_min]))
-            t = float(np.nanmin([r1[0], r2[0]]))
+        if math.sqrt(max((A * tm + B) * tm + C, 0.0)) < l_min - eps:
+            t = min(_roots(A, B, C - l_min * l_min), default=tm)
             t = min(max(t, 0.0), 1.0)
             if best is None or t < best[0]:
                 best = (t, "too_close")
     return best
 
 
+def _roots(c2: float, c1: float, c0: float) -> list[float]:
+    """Real roots of ``c2 t^2 + c1 t + c0`` (stable formula; a discriminant negative
+    only by rounding, a tangency, counts as zero)."""
+    disc = c1 * c1 - 4.0 * c2 * c0
+    if disc < 0.0:
+        if disc < -1e-12 * (c1 * c1 + abs(4.0 * c2 * c0)):
+            return []
+        disc = 0.0
+    sq = math.sqrt(disc)
+    qq = -0.5 * (c1 + (sq if c1 >= 0.0 else -sq))
+    out = []
+    if qq != 0.0:
+        out.append(c0 / qq)
+        if c2 != 0.0:
+            out.append(qq / c2)
+    elif c0 == 0.0:
+        out.append(0.0)
+    return out
+
+
 def _vertex_event(
-    kernel: Kernel, p0: np.ndarray, e0: np.ndarray, dp: np.ndarray, de: np.ndarray
+    kernel: Kernel,
+    p0x: float,
+    p0y: float,
+    e0x: float,
+    e0y: float,
+    dpx: float,
+    dpy: float,
+    dex: float,
+    dey: float,
 ) -> tuple[float, int] | None:
     """Earliest ``t`` in [0, 1] where a convex vertex lies on the open rod."""
     eps = kernel.eps
+    xs = (p0x, p0x + dpx, e0x, e0x + dex)
+    ys = (p0y, p0y + dpy, e0y, e0y + dey)
+    cand = kernel.vgrid.query_box(min(xs) - eps, min(ys) - eps, max(xs) + eps, max(ys) + eps)
+    if len(cand) > kernel.numpy_threshold:
+        return _vertex_event_numpy(
+            kernel,
+            np.fromiter(cand, dtype=np.intp),
+            np.array([p0x, p0y]),
+            np.array([e0x, e0y]),
+            np.array([dpx, dpy]),
+            np.array([dex, dey]),
+        )
+    lo = (min(xs) - eps, min(ys) - eps)
+    hi = (max(xs) + eps, max(ys) + eps)
+    c2 = dpx * dey - dpy * dex
+    best_t = math.inf
+    best_v = -1
+    vxy = kernel._vxy
+    for v in cand:
+        vx, vy = vxy[v]
+        if not (lo[0] <= vx <= hi[0] and lo[1] <= vy <= hi[1]):
+            continue
+        ax, ay = p0x - vx, p0y - vy  # P(t) - v = A + t dp
+        cx, cy = e0x - vx, e0y - vy  # E(t) - v = C + t de
+        c1 = ax * dey - ay * dex + dpx * cy - dpy * cx
+        c0 = ax * cy - ay * cx
+        if abs(c2) + abs(c1) + abs(c0) <= eps * (math.hypot(ax, ay) + math.hypot(cx, cy)):
+            # v stays on the rod's line: test the start, end and dot-product roots
+            ts = [0.0, 1.0, 0.5]
+            for r in _roots(
+                dpx * dex + dpy * dey, ax * dex + ay * dey + cx * dpx + cy * dpy, ax * cx + ay * cy
+            ):
+                ts += [r, r + 1e-9]
+        else:
+            ts = _roots(c2, c1, c0)
+        for t in ts:
+            if not (-1e-12 <= t <= 1.0 + 1e-12) or t >= best_t:
+                continue
+            t = min(max(t, 0.0), 1.0)
+            ex, ey = e0x + t * dex, e0y + t * dey
+            rx, ry = p0x + t * dpx - ex, p0y + t * dpy - ey
+            ell2 = rx * rx + ry * ry
+            if ell2 <= eps * eps:
+                continue
+            ell = math.sqrt(ell2)
+            sv = ((vx - ex) * rx + (vy - ey) * ry) / ell2
+            margin = eps / ell
+            if margin < sv < 1.0 - margin:
+                best_t, best_v = t, v
+    return None if best_v < 0 else (best_t, best_v)
+
+
+def _vertex_event_numpy(
+    kernel: Kernel,
+    vid: np.ndarray,
+    p0: np.ndarray,
+    e0: np.ndarray,
+    dp: np.ndarray,
+    de: np.ndarray,
+) -> tuple[float, int] | None:
+    """:func:`_vertex_event` vectorised over many candidate vertices."""
+    eps = kernel.eps
+    v = kernel.map.vertices[vid]
     pts = np.stack([p0, p0 + dp, e0, e0 + de])
-    lo = pts.min(axis=0) - eps
-    hi = pts.max(axis=0) + eps
-    vid = kernel.convex_in_box(lo[0], lo[1], hi[0], hi[1])
+    box = np.all((v >= pts.min(axis=0) - eps) & (v <= pts.max(axis=0) + eps), axis=1)
+    vid, v = vid[box], v[box]
     if len(vid) == 0:
         return None
-    v = kernel.map.vertices[vid]
     A = p0 - v  # P(t) - v = A + t dp
     C = e0 - v  # E(t) - v = C + t de
     c2 = float(dp[0] * de[1] - dp[1] * de[0])
@@ -152,28 +242,33 @@ def _on_line_candidates(
 
 def sweep_step(
     kernel: Kernel,
-    p0: np.ndarray,
-    e0: np.ndarray,
-    p1: np.ndarray,
-    e1: np.ndarray,
+    p0: tuple[float, float],
+    e0: tuple[float, float],
+    p1: tuple[float, float],
+    e1: tuple[float, float],
     l_min: float,
     l_max: float,
 ) -> SweepEvent | None:
-    """See :meth:`Kernel.sweep`."""
-    dp = p1 - p0
-    de = e1 - e0
+    """See :meth:`Kernel.sweep` (arguments already validated, as float pairs)."""
+    p0x, p0y = p0
+    e0x, e0y = e0
+    dpx, dpy = p1[0] - p0x, p1[1] - p0y
+    dex, dey = e1[0] - e0x, e1[1] - e0y
     cands: list[tuple[float, str, Feature | None]] = []
-    dist = _first_distance_event(p0 - e0, dp - de, l_min, l_max, kernel.eps)
+    dist = _first_distance_event(
+        p0x - e0x, p0y - e0y, dpx - dex, dpy - dey, l_min, l_max, kernel.eps
+    )
     if dist is not None:
         cands.append((dist[0], dist[1], None))
-    if not kernel.line_of_sight(e0, p0):
-        cands.append((0.0, "occluded", kernel.blocking_feature(e0, p0)))
-    else:
-        hit = _vertex_event(kernel, p0, e0, dp, de)
-        if hit is not None:
-            cands.append((hit[0], "occluded", Feature("vertex", hit[1])))
-        elif not kernel.line_of_sight(e1, p1):
-            cands.append((1.0, "occluded", kernel.blocking_feature(e1, p1)))
+    if dist is None or dist[0] > 0.0:
+        if not kernel._los(e0x, e0y, p0x, p0y):
+            cands.append((0.0, "occluded", kernel.blocking_feature(e0, p0)))
+        else:
+            hit = _vertex_event(kernel, p0x, p0y, e0x, e0y, dpx, dpy, dex, dey)
+            if hit is not None:
+                cands.append((hit[0], "occluded", Feature("vertex", hit[1])))
+            elif not kernel._los(e1[0], e1[1], p1[0], p1[1]):
+                cands.append((1.0, "occluded", kernel.blocking_feature(e1, p1)))
     if not cands:
         return None
     t, cause, feature = min(cands, key=lambda c: (c[0], _CAUSE_ORDER[c[1]]))
@@ -181,6 +276,6 @@ def sweep_step(
         time=t,
         cause=cause,
         feature=feature,
-        pursuer=p0 + t * dp,
-        evader=e0 + t * de,
+        pursuer=np.array([p0x + t * dpx, p0y + t * dpy]),
+        evader=np.array([e0x + t * dex, e0y + t * dey]),
     )

@@ -212,20 +212,23 @@ class parallel_env(ParallelEnv, EzPickle):
 
     def _command(self, agent: str, action: Any) -> tuple[float, float]:
         """Validate, clip and scale one action into a velocity (see the env card)."""
-        try:
-            a = np.asarray(action, dtype=np.float64)
-        except (TypeError, ValueError) as exc:
-            raise InvalidActionError(
-                f"{agent}: expected an action of shape (2,) with finite values, got {action!r}"
-            ) from exc
-        if a.shape != (2,):
-            raise InvalidActionError(
-                f"{agent}: expected an action of shape (2,), got shape {a.shape}"
-            )
-        x = float(a[0])
-        y = float(a[1])
+        if type(action) is np.ndarray and action.shape == (2,) and action.dtype.kind == "f":
+            x, y = action.tolist()  # the common case, without a conversion to float64
+        else:
+            try:
+                a = np.asarray(action, dtype=np.float64)
+            except (TypeError, ValueError) as exc:
+                raise InvalidActionError(
+                    f"{agent}: expected an action of shape (2,) with finite values, "
+                    f"got {action!r}"
+                ) from exc
+            if a.shape != (2,):
+                raise InvalidActionError(
+                    f"{agent}: expected an action of shape (2,), got shape {a.shape}"
+                )
+            x, y = a.tolist()
         if not (math.isfinite(x) and math.isfinite(y)):
-            raise InvalidActionError(f"{agent}: action must be finite, got {a.tolist()}")
+            raise InvalidActionError(f"{agent}: action must be finite, got {[x, y]}")
         # clip to the Box, then onto the unit disc: the speed bound is on |v|, and the
         # Box corners would otherwise allow sqrt(2) times the bound
         x = -1.0 if x < -1.0 else (1.0 if x > 1.0 else x)

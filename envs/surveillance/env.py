@@ -219,8 +219,7 @@ class parallel_env(ParallelEnv, EzPickle):
                 a = np.asarray(action, dtype=np.float64)
             except (TypeError, ValueError) as exc:
                 raise InvalidActionError(
-                    f"{agent}: expected an action of shape (2,) with finite values, "
-                    f"got {action!r}"
+                    f"{agent}: expected an action of shape (2,) with finite values, got {action!r}"
                 ) from exc
             if a.shape != (2,):
                 raise InvalidActionError(

@@ -71,7 +71,7 @@ class Snapshot:
 def _pygame() -> Any:
     try:
         import pygame
-    except ImportError as exc:  # pragma: no cover - exercised only without pygame
+    except ImportError as exc:
         raise ImportError(
             "rendering needs pygame (pygame-ce): install it with `pip install surveil[render]`"
         ) from exc

@@ -9,12 +9,13 @@ Measured in one run, so the ratios do not depend on the machine:
 
 Actions are pre-sampled (uniform in each agent's Box) so the loop times only
 ``env.step``. Episodes of surveillance_v0 end when the evader escapes; the env is then
-reset outside the timed region. Goals: ours >= 6x simple_tag, and the large map no more
-than 1.5x slower than the small one.
+reset outside the timed region. The three envs run in interleaved chunks, so that load
+from other processes affects them alike. Goals: ours >= 6x simple_tag, and the large map
+no more than 1.5x slower than the small one.
 
-A breakdown per step follows: physics (``World.step``), the kernel's continuous-time
-``sweep`` and the rest of ``step`` (actions, observations, infos), each timed on its own
-over recorded positions.
+A breakdown per step follows: physics (``World.step``) and the kernel's continuous-time
+``sweep``, each replayed on its own over the first 2000 recorded steps, and the rest of
+``step`` (actions, observations, infos) as the difference (so it absorbs timing noise).
 
 Usage::
 

@@ -1,0 +1,130 @@
+"""Semi-free rod test: does a rod lie in the *closed* free region (touching allowed)?
+
+The critical curves of THEORY.md 1.2 are loci of *contact* configurations: the rod
+touches walls (at its tip, or with its body at convex vertices, or lying along an edge)
+but crosses no obstacle. The kernel's line of sight is stricter (any touch blocks), so
+this module adds the predicate the clip needs, vectorised over many rods:
+
+* the evader end P lies in the closed free region;
+* the open rod properly crosses no wall edge;
+* at every wall vertex the open rod passes through, neither direction of the rod enters
+  the obstacle wedge there (a tangent rod passes, a rod cutting the corner does not);
+* when P rests on a wall, the rod leaves it into free space.
+
+Together these say the rod lies in the closed free region: a straight segment starting in
+free space can leave it only through an edge interior (a proper crossing) or through a
+vertex (the wedge test).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from envs.geometry.segments import segment_contacts
+from envs.maps.map import Map
+from envs.tolerances import REL_LENGTH_TOL
+
+__all__ = ["WEDGE_TOL", "rods_semifree", "wedge_interior"]
+
+WEDGE_TOL = 1e-9
+"""Angle (radians) by which a rod must enter an obstacle wedge to count as entering it.
+
+Contact configurations put the rod exactly along a wedge side (type 4) or tangent to a
+corner (types 3, 5); rounding errors of order 1e-15 must not make them penetrate.
+"""
+
+_CHUNK_CELLS = 400_000  # rods x edges per vectorised block
+
+
+def _obstacle_wedge(world: Map) -> tuple[np.ndarray, np.ndarray]:
+    """Per vertex: the angle where its obstacle wedge starts and the wedge's span.
+
+    With free space on the left of every edge, the obstacle at vertex v occupies the
+    directions counter-clockwise from ``-d_in`` (back along the incoming edge) to
+    ``d_out`` (along the outgoing edge).
+    """
+    d_in = world.edge_dir[world.vertex_prev_edge]
+    d_out = world.edge_dir[world.vertex_next_edge]
+    start = np.arctan2(-d_in[:, 1], -d_in[:, 0])
+    span = (np.arctan2(d_out[:, 1], d_out[:, 0]) - start) % (2.0 * math.pi)
+    return start, span
+
+
+def wedge_interior(world: Map, vertex: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """Whether each direction points strictly into the obstacle at the given vertex.
+
+    Args:
+        world: the map.
+        vertex: (k,) vertex indices.
+        direction: (k, 2) directions (need not be unit).
+
+    Returns:
+        (k,) bool: the direction lies inside the obstacle wedge by more than
+        :data:`WEDGE_TOL`.
+    """
+    start, span = _obstacle_wedge(world)
+    ang = (np.arctan2(direction[:, 1], direction[:, 0]) - start[vertex]) % (2.0 * math.pi)
+    return (ang > WEDGE_TOL) & (ang < span[vertex] - WEDGE_TOL)
+
+
+def rods_semifree(world: Map, P: np.ndarray, Q: np.ndarray) -> np.ndarray:
+    """Which rods P[k]-Q[k] lie in the closed free region (contacts allowed).
+
+    Args:
+        world: the map.
+        P: (k, 2) evader ends.
+        Q: (k, 2) pursuer ends.
+
+    Returns:
+        (k,) bool.
+    """
+    P = np.asarray(P, dtype=float).reshape(-1, 2)
+    Q = np.asarray(Q, dtype=float).reshape(-1, 2)
+    k = len(P)
+    out = np.zeros(k, dtype=bool)
+    if k == 0:
+        return out
+    eps = REL_LENGTH_TOL * world.scale
+    inside = world.contains(P)
+    idx = np.flatnonzero(inside)
+    if len(idx) == 0:
+        return out
+    a = world.edge_start[None]
+    b = world.edge_end[None]
+    n = world.edge_normal[None]
+    chunk = max(1, _CHUNK_CELLS // max(1, world.n_edges))
+    ok = np.ones(len(idx), dtype=bool)
+    for s in range(0, len(idx), chunk):
+        rows = idx[s : s + chunk]
+        p = P[rows, None, :]
+        q = Q[rows, None, :]
+        crossing, _, vertex_hit, _, _ = segment_contacts(p, q, a, b, n, eps)
+        bad = crossing.any(axis=1)
+        r, v = np.nonzero(vertex_hit & ~bad[:, None])
+        if len(r):
+            d = Q[rows[r]] - P[rows[r]]
+            enters = wedge_interior(world, v, d) | wedge_interior(world, v, -d)
+            bad[r[enters]] = True
+        ok[s : s + chunk] = ~bad
+    out[idx] = ok
+    # P resting on a wall: the rod must leave it into free space
+    near = np.flatnonzero(out & (world.distance_to_walls(P) <= eps))
+    for i in near.tolist():
+        out[i] = _leaves_wall(world, P[i], Q[i] - P[i], eps)
+    return out
+
+
+def _leaves_wall(world: Map, p: np.ndarray, d: np.ndarray, eps: float) -> bool:
+    """For P on a wall: does direction ``d`` leave P into free space?"""
+    vd = np.hypot(*(world.vertices - p).T)
+    at = np.flatnonzero(vd <= eps)
+    if len(at):
+        return not bool(wedge_interior(world, at, np.repeat(d[None], len(at), axis=0)).any())
+    rel = p - world.edge_start
+    s = np.einsum("ej,ej->e", rel, world.edge_dir)
+    h = np.einsum("ej,ej->e", rel, world.edge_normal)
+    on = (np.abs(h) <= eps) & (s >= 0) & (s <= world.edge_length)
+    dn = world.edge_normal[on] @ d
+    return bool(np.all(dn >= -WEDGE_TOL * float(np.hypot(*d))))

@@ -1,0 +1,548 @@
+"""The cylindrical decomposition of Q_L, its connectivity graph G_L and escapable cells.
+
+Sections 3-4 of the paper, THEORY.md 1.3:
+
+* **regions**: faces of the arrangement of the semi-free critical curves
+  (:mod:`strategies.cspace.arrangement`);
+* **cells**: above each region, one cell per free arc at a sample point of the region,
+  keyed by its stop pair ``(s-, s+)`` (constant over the region);
+* **adjacency** across a boundary piece shared by regions R and R': at a point p of the
+  piece's exact curve, the free arcs at ``p +- eps n`` are matched to the cells of R and R'
+  by their stop pairs; two cells are adjacent iff their arcs overlap with positive length
+  (the paper's footnote 3);
+* **escapable cells**: the least fixed point of Sec. 4's recursive definition: kappa
+  above R is escapable if across some boundary piece of R (not a wall: the evader cannot
+  cross walls) (a) no cell is adjacent to kappa, or (b) every adjacent cell is escapable;
+* **Prop. 2**: the evader wins if some region carries only escapable cells (a region
+  with no free orientation at all counts: the rod cannot exist there).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import networkx as nx
+import numpy as np
+import shapely
+import shapely.ops
+from shapely.geometry import Polygon
+
+from envs.geometry import kernel_for
+from envs.geometry.types import Arc, FreeArcs
+from envs.maps.map import Map
+from strategies.cspace._arcs import OVERLAP_TOL, StopPair, overlap, pairs
+from strategies.cspace.arrangement import SNAP_REL, Arrangement, Piece, arrange
+from strategies.cspace.curves import CriticalCurve, _check_map, check_length, critical_curves
+
+__all__ = ["Boundary", "Cell", "CellArc", "Decomposition", "Region", "decompose"]
+
+ADJ_EPS_REL = 1e-6
+"""Offset (relative to the map scale) of the two probe points across a boundary piece."""
+
+_PROBE_SEGMENTS = 4  # segments of a piece tried before falling back to overlap matching
+
+
+@dataclass(frozen=True)
+class Cell:
+    """A free cell kappa = (R, [s-, s+]) above a region (Sec. 3).
+
+    Attributes:
+        id: index into ``Decomposition.cells`` (a node of ``graph``).
+        region: the region R below it.
+        stops: ``(s-, s+)``, the stops of its free arc (``(None, None)``: full circle).
+        arc: its free arc at the region's sample point.
+        escapable: whether it is an escapable cell (Sec. 4).
+        reason: ``"a"`` (no adjacent cell across ``via``), ``"b"`` (every adjacent
+            cell across ``via`` is escapable) or ``None``.
+        via: the boundary piece across which the evader escapes, or ``None``.
+    """
+
+    id: int
+    region: int
+    stops: StopPair
+    arc: Arc
+    escapable: bool = False
+    reason: str | None = None
+    via: int | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class Region:
+    """A noncritical region R.
+
+    Attributes:
+        id: index into ``Decomposition.regions``.
+        polygon: its polygon (arcs and conchoids as polylines).
+        point: a sample point well inside it.
+        cells: ids of the cells above it.
+        boundaries: ids of its boundary pieces shared with other regions.
+    """
+
+    id: int
+    polygon: Polygon = field(repr=False)
+    point: np.ndarray = field(repr=False)
+    cells: tuple[int, ...]
+    boundaries: tuple[int, ...]
+
+    @property
+    def area(self) -> float:
+        """Area of the region's polygon."""
+        return float(self.polygon.area)
+
+
+@dataclass(frozen=True, eq=False)
+class Boundary:
+    """A boundary piece between two regions, on one or more critical curves.
+
+    Attributes:
+        id: index into ``Decomposition.boundaries``.
+        regions: ``(A, B)``; ``normal`` points from B into A.
+        curves: indices into ``Decomposition.curves``.
+        segments: (m, 2, 2) its noded segments.
+        point: the probe point on the exact curve.
+        normal: unit normal at ``point`` pointing into A.
+        adjacent: pairs ``(cell of A, cell of B)`` whose arcs overlap across it.
+        resolved: False if the probe arcs could not be matched to the regions' cells
+            by their stops (then matched by overlap; see ``Decomposition.unresolved``).
+    """
+
+    id: int
+    regions: tuple[int, int]
+    curves: tuple[int, ...]
+    segments: np.ndarray = field(repr=False)
+    point: np.ndarray = field(repr=False)
+    normal: np.ndarray = field(repr=False)
+    adjacent: tuple[tuple[int, int], ...]
+    resolved: bool = True
+
+
+@dataclass(frozen=True)
+class CellArc:
+    """A free arc at a query point with the cell it belongs to.
+
+    Attributes:
+        arc: the free arc at the point.
+        cell: the cell's id, or ``None`` if it could not be identified.
+        escapable: whether that cell is escapable (``None`` if unidentified).
+    """
+
+    arc: Arc
+    cell: int | None
+    escapable: bool | None
+
+
+class Decomposition:
+    """The decomposition K_L of the configuration space slice Q_L (Secs. 3-4).
+
+    Build it with :func:`decompose`. Answers point queries (which cell holds a
+    configuration, the free and the safe arcs at a point) and the Prop. 2 verdict.
+
+    Attributes:
+        map: the world.
+        L: rod length.
+        curves: the semi-free critical curves (walls included).
+        regions: the noncritical regions.
+        cells: the free cells, ``cells[i].id == i``.
+        boundaries: boundary pieces between regions.
+        graph: the connectivity graph G_L (networkx) over cell ids; node attributes
+            ``region``, ``stops``, ``escapable``; edge attribute ``boundaries``.
+        chord_tol: polyline tolerance of arcs and conchoids.
+        unresolved: number of boundary pieces matched by overlap, not stops.
+    """
+
+    def __init__(
+        self,
+        world: Map,
+        L: float,
+        curves: tuple[CriticalCurve, ...],
+        regions: tuple[Region, ...],
+        cells: tuple[Cell, ...],
+        boundaries: tuple[Boundary, ...],
+        chord_tol: float,
+    ) -> None:
+        self.map = world
+        self.L = L
+        self.curves = curves
+        self.regions = regions
+        self.cells = cells
+        self.boundaries = boundaries
+        self.chord_tol = chord_tol
+        self.unresolved = sum(not b.resolved for b in boundaries)
+        g = nx.Graph()
+        for c in cells:
+            g.add_node(c.id, region=c.region, stops=c.stops, escapable=c.escapable)
+        for b in boundaries:
+            for i, j in b.adjacent:
+                if g.has_edge(i, j):
+                    g.edges[i, j]["boundaries"].append(b.id)
+                else:
+                    g.add_edge(i, j, boundaries=[b.id])
+        self.graph = g
+        self._index()
+
+    # ------------------------------------------------------------------ indexing
+    def _index(self) -> None:
+        self._tree = shapely.STRtree([r.polygon for r in self.regions])
+        self._cell_of: list[dict[StopPair, int]] = [
+            {self.cells[c].stops: c for c in r.cells} for r in self.regions
+        ]
+        nb: list[set[int]] = [set() for _ in self.regions]
+        for b in self.boundaries:
+            a, c = b.regions
+            nb[a].add(c)
+            nb[c].add(a)
+        self._neighbours = [tuple(sorted(s)) for s in nb]
+        self._kernel = kernel_for(self.map)
+
+    def __getstate__(self) -> dict:
+        state = self.__dict__.copy()
+        for k in ("_tree", "_cell_of", "_neighbours", "_kernel"):
+            state.pop(k, None)
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._index()
+
+    # ------------------------------------------------------------------ verdict
+    @property
+    def escapable(self) -> frozenset[int]:
+        """Ids of the escapable cells."""
+        return frozenset(c.id for c in self.cells if c.escapable)
+
+    @property
+    def witness_regions(self) -> tuple[int, ...]:
+        """Regions whose cylinder holds only escapable cells (Prop. 2), largest first."""
+        w = [r for r in self.regions if all(self.cells[c].escapable for c in r.cells)]
+        return tuple(r.id for r in sorted(w, key=lambda r: -r.area))
+
+    @property
+    def evader_wins(self) -> bool:
+        """Prop. 2: some region carries only escapable cells (an infinitely fast pursuer
+        with this fixed L cannot keep surveillance)."""
+        return bool(self.witness_regions)
+
+    @property
+    def witness_region(self) -> Region | None:
+        """The largest region with only escapable cells, or ``None`` if the pursuer wins."""
+        w = self.witness_regions
+        return self.regions[w[0]] if w else None
+
+    # ------------------------------------------------------------------ queries
+    def locate(self, point) -> int | None:
+        """The region containing ``point`` (nearest region within the polyline tolerance),
+        or ``None`` outside the free region."""
+        p = np.asarray(point, dtype=float)
+        pt = shapely.Point(p)
+        hits = self._tree.query(pt, predicate="intersects")
+        if len(hits):
+            return int(hits[0])
+        if not self._kernel.contains_point(float(p[0]), float(p[1])):
+            return None
+        near = self._tree.nearest(pt)
+        return None if near is None else int(near)
+
+    def _match(self, region: int | None, fa: FreeArcs) -> list[int | None]:
+        """Cells of the arcs at a point located in ``region`` (neighbours as fallback)."""
+        if region is None:
+            return [None] * len(fa.arcs)
+        keys = pairs(fa)
+        cands = (region, *self._neighbours[region])
+        for r in cands:
+            table = self._cell_of[r]
+            if len(table) == len(keys) and all(k in table for k in keys):
+                return [table[k] for k in keys]
+        out: list[int | None] = []
+        for k in keys:
+            out.append(next((self._cell_of[r][k] for r in cands if k in self._cell_of[r]), None))
+        return out
+
+    def free_arcs(self, point) -> tuple[CellArc, ...]:
+        """The free arcs at ``point`` with their cells and escapability."""
+        p = np.asarray(point, dtype=float)
+        fa = self._kernel.free_arcs(p, self.L)
+        ids = self._match(self.locate(p), fa)
+        return tuple(
+            CellArc(a, i, None if i is None else self.cells[i].escapable)
+            for a, i in zip(fa.arcs, ids, strict=True)
+        )
+
+    def safe_arcs(self, point) -> tuple[Arc, ...]:
+        """The free arcs at ``point`` whose cells are not escapable (where the pursuer
+        must keep the rod)."""
+        return tuple(ca.arc for ca in self.free_arcs(point) if ca.escapable is False)
+
+    def cell_at(self, x: float, y: float, theta: float) -> Cell | None:
+        """The cell holding configuration ``(x, y, theta)``, or ``None`` if not free."""
+        fa = self._kernel.free_arcs(np.array([x, y], dtype=float), self.L)
+        k = fa.arc_index(theta)
+        if k is None:
+            return None
+        i = self._match(self.locate((x, y)), fa)[k]
+        return None if i is None else self.cells[i]
+
+    def region_cells(self, region: int) -> tuple[Cell, ...]:
+        """The cells above a region."""
+        return tuple(self.cells[c] for c in self.regions[region].cells)
+
+    def summary(self) -> str:
+        """A few lines describing the decomposition and its verdict."""
+        types = np.bincount([c.type for c in self.curves], minlength=6)
+        n_esc = sum(c.escapable for c in self.cells)
+        lines = [
+            f"decomposition of {self.map.name!r} at L = {self.L:g}",
+            "  critical curves by type 0-5: " + ", ".join(str(int(t)) for t in types),
+            f"  {len(self.regions)} regions, {len(self.cells)} cells, "
+            f"{self.graph.number_of_edges()} adjacencies, {n_esc} escapable cells",
+        ]
+        if self.unresolved:
+            lines.append(f"  {self.unresolved} boundary pieces matched by overlap only")
+        w = self.witness_region
+        if w is None:
+            lines.append("  verdict: every region has a non-escapable cell: the pursuer can hold")
+        else:
+            x, y = w.point
+            lines.append(
+                f"  verdict: the evader wins (Prop. 2); witness region {w.id} "
+                f"near ({x:.3g}, {y:.3g})"
+            )
+        return "\n".join(lines)
+
+    def __repr__(self) -> str:
+        return (
+            f"Decomposition(map={self.map.name!r}, L={self.L:g}, regions={len(self.regions)}, "
+            f"cells={len(self.cells)}, evader_wins={self.evader_wins})"
+        )
+
+
+# ---------------------------------------------------------------------- building
+def _sample_point(poly: Polygon) -> np.ndarray:
+    """A point far from the boundary of ``poly`` (pole of inaccessibility, coarse)."""
+    scale = math.sqrt(poly.area)
+    p = shapely.ops.polylabel(poly, tolerance=max(scale * 0.02, 1e-12))
+    if not poly.contains(p):
+        p = shapely.point_on_surface(poly)
+    return np.array([p.x, p.y])
+
+
+def _probe(dec_cells, table_a, table_b, arcs_a, arcs_b, fa_plus, fa_minus, strict: bool):
+    """Match probe arcs to cells; return adjacency pairs or None if stops disagree."""
+
+    def assign(fa: FreeArcs, table, rep) -> list[int | None] | None:
+        keys = pairs(fa)
+        if set(keys) == set(table):
+            return [table[k] for k in keys]
+        if strict:
+            return None
+        out = []
+        for k, arc in zip(keys, fa.arcs, strict=True):
+            if k in table:
+                out.append(table[k])
+                continue
+            best = max(rep, key=lambda c: overlap(arc, rep[c]), default=None)
+            out.append(best if best is not None and overlap(arc, rep[best]) > OVERLAP_TOL else None)
+        return out
+
+    ia = assign(fa_plus, table_a, arcs_a)
+    ib = assign(fa_minus, table_b, arcs_b)
+    if ia is None or ib is None:
+        return None
+    adj = set()
+    for x, ca in zip(fa_plus.arcs, ia, strict=True):
+        for y, cb in zip(fa_minus.arcs, ib, strict=True):
+            if ca is not None and cb is not None and overlap(x, y) > OVERLAP_TOL:
+                adj.add((ca, cb))
+    return tuple(sorted(adj))
+
+
+def _boundary(bid, piece: Piece, curves, kernel, L, regions_cells, eps0) -> Boundary:
+    a, b = piece.faces
+    table_a, arcs_a = regions_cells[a]
+    table_b, arcs_b = regions_cells[b]
+    seg = piece.segments
+    lens = np.hypot(*(seg[:, 1] - seg[:, 0]).T)
+    order = np.argsort(-lens)[:_PROBE_SEGMENTS]
+    first = None
+    for k in order.tolist():
+        p0, p1 = seg[k]
+        d = (p1 - p0) / lens[k]
+        n = np.array([-d[1], d[0]])
+        mid = 0.5 * (p0 + p1)
+        if piece.curves:
+            c = curves[piece.curves[0]]
+            if c.shape != "segment":
+                P, _ = c.evaluate(c.project(mid[None]))
+                mid = P[0]
+        for eps in (min(eps0, 1e-3 * lens[k]), min(eps0, 1e-3 * lens[k]) * 1e-2):
+            fp = kernel.free_arcs(mid + eps * n, L)
+            fm = kernel.free_arcs(mid - eps * n, L)
+            if first is None:
+                first = (mid, n, fp, fm)
+            adj = _probe(None, table_a, table_b, arcs_a, arcs_b, fp, fm, strict=True)
+            if adj is not None:
+                return Boundary(bid, (a, b), piece.curves, seg, mid, n, adj, True)
+    mid, n, fp, fm = first
+    adj = _probe(None, table_a, table_b, arcs_a, arcs_b, fp, fm, strict=False)
+    return Boundary(bid, (a, b), piece.curves, seg, mid, n, adj, False)
+
+
+def _escapable(n_cells: int, boundaries: tuple[Boundary, ...], cell_region: list[int]):
+    """Least fixed point of Sec. 4's definition; returns (flags, reason, via)."""
+    # for each (cell, boundary of its region): the set of adjacent cells across it
+    adj: dict[tuple[int, int], set[int]] = {}
+    region_bounds: dict[int, list[int]] = {}
+    for b in boundaries:
+        for r in b.regions:
+            region_bounds.setdefault(r, []).append(b.id)
+    for c in range(n_cells):
+        for bid in region_bounds.get(cell_region[c], ()):
+            adj[(c, bid)] = set()
+    for b in boundaries:
+        for i, j in b.adjacent:
+            adj[(i, b.id)].add(j)
+            adj[(j, b.id)].add(i)
+    esc = [False] * n_cells
+    reason: list[str | None] = [None] * n_cells
+    via: list[int | None] = [None] * n_cells
+    count = {k: len(v) for k, v in adj.items()}
+    watchers: dict[int, list[tuple[int, int]]] = {}
+    for (c, bid), nbrs in adj.items():
+        for x in nbrs:
+            watchers.setdefault(x, []).append((c, bid))
+    stack = []
+    for (c, bid), n in sorted(count.items()):
+        if n == 0 and not esc[c]:
+            esc[c], reason[c], via[c] = True, "a", bid
+            stack.append(c)
+    while stack:
+        x = stack.pop()
+        for c, bid in watchers.get(x, ()):
+            count[(c, bid)] -= 1
+            if count[(c, bid)] == 0 and not esc[c]:
+                esc[c], reason[c], via[c] = True, "b", bid
+                stack.append(c)
+    return esc, reason, via
+
+
+def _merge_equal(arr: Arrangement, sigs: list[frozenset]) -> list[int]:
+    """Group faces joined by a piece whose two sides have the same stop pairs.
+
+    Crossing a semi-free critical curve always changes the stop pairs (THEORY.md 1.4),
+    so two neighbouring faces with equal stop pairs are one noncritical region cut by an
+    artefact of the polylines (a sliver where two curves are tangent).
+    """
+    parent = list(range(len(arr.faces)))
+
+    def find(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for piece in arr.pieces:
+        a, b = piece.faces
+        if sigs[a] == sigs[b]:
+            ra, rb = find(a), find(b)
+            if ra != rb:
+                parent[max(ra, rb)] = min(ra, rb)
+    roots = sorted({find(i) for i in range(len(parent))})
+    index = {r: k for k, r in enumerate(roots)}
+    return [index[find(i)] for i in range(len(parent))]
+
+
+def build_decomposition(world: Map, L: float, chord_tol: float | None = None) -> Decomposition:
+    """Compute the decomposition without touching any cache (see :func:`decompose`)."""
+    curves = critical_curves(world, L, chord_tol=chord_tol)
+    tol = next((c.tolerance for c in curves if c.tolerance > 0), chord_tol or 0.0)
+    arr: Arrangement = arrange(world, curves)
+    kernel = kernel_for(world)
+    points = [_sample_point(f) for f in arr.faces]
+    face_arcs = [kernel.free_arcs(p, L) for p in points]
+    group = _merge_equal(arr, [frozenset(pairs(fa)) for fa in face_arcs])
+    n_regions = max(group, default=-1) + 1
+    members: list[list[int]] = [[] for _ in range(n_regions)]
+    for f, g in enumerate(group):
+        members[g].append(f)
+    rep_face = [max(m, key=lambda f: arr.faces[f].area) for m in members]
+    cells_tmp: list[tuple[int, StopPair, Arc]] = []
+    region_cells: list[tuple[dict[StopPair, int], dict[int, Arc]]] = []
+    region_ids: list[list[int]] = []
+    for r in range(n_regions):
+        fa = face_arcs[rep_face[r]]
+        table, rep, ids = {}, {}, []
+        for key, arc in zip(pairs(fa), fa.arcs, strict=True):
+            cid = len(cells_tmp)
+            cells_tmp.append((r, key, arc))
+            table[key] = cid
+            rep[cid] = arc
+            ids.append(cid)
+        region_cells.append((table, rep))
+        region_ids.append(ids)
+    pieces = [
+        Piece((group[p.faces[0]], group[p.faces[1]]), p.curves, p.segments)
+        for p in arr.pieces
+        if group[p.faces[0]] != group[p.faces[1]]
+    ]
+    eps0 = ADJ_EPS_REL * world.scale
+    boundaries = tuple(
+        _boundary(i, piece, curves, kernel, L, region_cells, eps0) for i, piece in enumerate(pieces)
+    )
+    cell_region = [c[0] for c in cells_tmp]
+    esc, reason, via = _escapable(len(cells_tmp), boundaries, cell_region)
+    cells = tuple(
+        Cell(i, r, key, arc, esc[i], reason[i], via[i]) for i, (r, key, arc) in enumerate(cells_tmp)
+    )
+    bounds_of: list[list[int]] = [[] for _ in range(n_regions)]
+    for b in boundaries:
+        for r in b.regions:
+            bounds_of[r].append(b.id)
+    grid = SNAP_REL * world.scale
+    regions = tuple(
+        Region(
+            r,
+            arr.faces[members[r][0]]
+            if len(members[r]) == 1
+            else shapely.union_all([arr.faces[f] for f in members[r]], grid_size=grid),
+            points[rep_face[r]],
+            tuple(region_ids[r]),
+            tuple(bounds_of[r]),
+        )
+        for r in range(n_regions)
+    )
+    return Decomposition(world, L, curves, regions, cells, boundaries, tol)
+
+
+def decompose(
+    map: Map,
+    L: float,
+    *,
+    chord_tol: float | None = None,
+    cache: bool = False,
+    cache_dir=None,
+) -> Decomposition:
+    """The decomposition K_L of the slice Q_L for rod length ``L`` (Secs. 3-4).
+
+    Args:
+        map: the world.
+        L: rod length (the surveillance distance), > 0.
+        chord_tol: polyline tolerance of arcs and conchoids (default
+            ``CHORD_TOL_REL * L``).
+        cache: read and write the on-disk cache (:mod:`strategies.cspace.cache`).
+        cache_dir: cache directory (default ``$SURVEIL_CACHE_DIR`` or ``~/.cache/surveil``).
+
+    Returns:
+        The :class:`Decomposition`.
+
+    Raises:
+        InvalidConfigError: for a non-map or a bad ``L`` / ``chord_tol``.
+    """
+    world = _check_map(map)
+    L = check_length(L)
+    if chord_tol is not None:
+        chord_tol = check_length(chord_tol, "chord_tol")
+    if cache:
+        from strategies.cspace.cache import cached_decomposition
+
+        return cached_decomposition(world, L, chord_tol=chord_tol, cache_dir=cache_dir)
+    return build_decomposition(world, L, chord_tol)

@@ -252,6 +252,20 @@ def _blocked_numpy(
     return lo, wid, lab_lo, lab_hi
 
 
+_PRIORITY = {("body", "edge"): 0, ("body", "vertex"): 1, ("tip", "vertex"): 2, ("tip", "edge"): 3}
+
+
+def _best(labels: list[Stop]) -> Stop:
+    """The label to report when several blocked arcs end at the same angle.
+
+    Ties are structural (the rod touches two features at once, e.g. P exactly on a type-5
+    curve, or on a wall next to a vertex), so the choice must not depend on rounding:
+    the rod along the wall under P, then a body contact, then a tip contact, then the
+    lowest feature index.
+    """
+    return min(labels, key=lambda st: (_PRIORITY[st.kind, st.feature.kind], st.feature.index))
+
+
 def _complement(
     lo: list[float], wid: list[float], lab_lo: list[Stop], lab_hi: list[Stop]
 ) -> tuple[Arc, ...]:
@@ -259,7 +273,8 @@ def _complement(
 
     The circle is cut at the start ``c`` of a blocked arc; arcs that wrap past the cut
     also cover ``[0, hi - 2 pi]`` after it. A sweep in order of start angle then finds
-    the gaps, each free arc taking its stops from the arcs that bound it.
+    the gaps; each free arc takes its stops from the blocked arcs that end (start) within
+    ``ANGLE_TOL`` of its start (end).
     """
     if max(wid) >= TWO_PI - ANGLE_TOL:
         return ()
@@ -267,23 +282,23 @@ def _complement(
     c = lo[first]
     items = []
     for i, (a, w) in enumerate(zip(lo, wid, strict=True)):
-        rel = (a - c) % TWO_PI
-        if i == first:
-            rel = 0.0
+        rel = 0.0 if i == first else (a - c) % TWO_PI
         items.append((rel, rel + w, i))
         if rel + w > TWO_PI:
             items.append((rel - TWO_PI, rel + w - TWO_PI, i))
+    items.append((TWO_PI, TWO_PI + wid[first], first))  # the cut arc again, one turn on
     items.sort()
-    arcs = []
+    gaps = []
     cmax = -math.inf
-    cmax_id = -1
-    for rel, hi, i in items:
-        if cmax_id >= 0 and rel - cmax > ANGLE_TOL:
-            arcs.append(_arc(c, cmax, rel, lab_hi[cmax_id], lab_lo[i]))
-        if hi >= cmax:
-            cmax, cmax_id = hi, i
-    if TWO_PI - cmax > ANGLE_TOL:  # the last gap ends at the cut
-        arcs.append(_arc(c, cmax, TWO_PI, lab_hi[cmax_id], lab_lo[first]))
+    for rel, hi, _ in items:
+        if cmax > -math.inf and rel - cmax > ANGLE_TOL:
+            gaps.append((cmax, rel))
+        cmax = max(cmax, hi)
+    arcs = []
+    for start, end in gaps:
+        stop_lo = _best([lab_hi[i] for _, h, i in items if abs(h - start) <= ANGLE_TOL])
+        stop_hi = _best([lab_lo[i] for r, _, i in items if abs(r - end) <= ANGLE_TOL])
+        arcs.append(_arc(c, start, end, stop_lo, stop_hi))
     arcs.sort(key=lambda arc: arc.lo)
     return tuple(arcs)
 

@@ -6,6 +6,7 @@ caches by the map's digest). Nothing here calls shapely.
 
 from __future__ import annotations
 
+import hashlib
 import math
 import threading
 from collections import OrderedDict
@@ -424,16 +425,23 @@ class Kernel:
         return np.minimum(s.min(axis=1), rmax)
 
 
-_CACHE: OrderedDict[str, Kernel] = OrderedDict()
+_CACHE: OrderedDict[tuple[str, bytes], Kernel] = OrderedDict()
 _CACHE_SIZE = 64
 _LOCK = threading.Lock()
 
 
 def kernel_for(world: Map) -> Kernel:
-    """The kernel of ``world``, built once and cached by the map's digest (LRU of 64)."""
+    """The kernel of ``world``, built once and cached (LRU of 64 maps).
+
+    The key is the map's digest *and* its vertex numbering: equal digests do not imply
+    equal numbering (the digest ignores where each ring starts), and the features a
+    kernel reports index the arrays of the map it was built from. So the returned
+    kernel's ``map`` may be another :class:`Map` object, but one whose ``vertices`` (and
+    hence every feature index) equal ``world``'s.
+    """
     if not isinstance(world, Map):
         raise InvalidConfigError(f"kernel_for: expected a Map, got {type(world).__name__}")
-    key = world.digest
+    key = (world.digest, hashlib.blake2b(world.vertices.tobytes(), digest_size=16).digest())
     with _LOCK:
         k = _CACHE.get(key)
         if k is not None:
@@ -441,7 +449,7 @@ def kernel_for(world: Map) -> Kernel:
             return k
     k = Kernel(world)
     with _LOCK:
-        _CACHE[key] = k
+        k = _CACHE.setdefault(key, k)
         _CACHE.move_to_end(key)
         while len(_CACHE) > _CACHE_SIZE:
             _CACHE.popitem(last=False)

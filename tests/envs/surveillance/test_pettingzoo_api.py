@@ -8,15 +8,19 @@ import warnings
 
 import numpy as np
 import pytest
-from pettingzoo.test import (
-    api_test,
-    max_cycles_test,
-    parallel_api_test,
-    parallel_seed_test,
-    render_test,
-    seed_test,
-)
-from pettingzoo.test.state_test import state_test
+
+with warnings.catch_warnings():
+    # pettingzoo.test imports PettingZoo's own deprecated env modules, which warn
+    warnings.filterwarnings("ignore", "The old environment creation API", DeprecationWarning)
+    from pettingzoo.test import (
+        api_test,
+        max_cycles_test,
+        parallel_api_test,
+        parallel_seed_test,
+        render_test,
+        seed_test,
+    )
+    from pettingzoo.test.state_test import state_test
 
 from envs import surveillance_v0
 from tests.envs.surveillance._worlds import l_room, pillar_room

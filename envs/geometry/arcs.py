@@ -79,10 +79,10 @@ def _label(
 ) -> Stop:
     """Stop label of a clipped edge end (THEORY.md 1.3 step 4)."""
     if not at_vertex:
-        return kernel.tip_edge[e]
+        return kernel._tip_edge[e]
     if abs(dist_v - L) <= eps:
-        return kernel.tip_vertex[v]
-    return kernel.body_vertex[v]
+        return kernel._tip_vertex[v]
+    return kernel._body_vertex[v]
 
 
 def _on_wall_blocks(
@@ -109,8 +109,8 @@ def _on_wall_blocks(
             b = math.atan2(kernel._dirs[e_out][1], kernel._dirs[e_out][0])
             lo.append(a)
             wid.append((b - a) % TWO_PI)
-            lab_lo.append(kernel.body_edge[e_in])
-            lab_hi.append(kernel.body_edge[e_out])
+            lab_lo.append(kernel._body_edge[e_in])
+            lab_hi.append(kernel._body_edge[e_out])
     for e in on_edges:  # P inside an edge: the closed half circle behind it
         if e in skip:
             continue
@@ -118,8 +118,8 @@ def _on_wall_blocks(
         ux, uy, _ = kernel._dirs[e]
         lo.append(math.atan2(uy, ux) + math.pi)
         wid.append(math.pi)
-        lab_lo.append(kernel.body_edge[e])
-        lab_hi.append(kernel.body_edge[e])
+        lab_lo.append(kernel._body_edge[e])
+        lab_hi.append(kernel._body_edge[e])
     return (lo, wid, lab_lo, lab_hi), skip
 
 
@@ -180,7 +180,7 @@ def _blocked_scalar(kernel: Kernel, cand, px: float, py: float, L: float) -> Blo
             vb = int(ev[e, 1])
             lb = _label(kernel, True, vb, e, math.hypot(vxy[vb][0] - px, vxy[vb][1] - py), L, eps)
         else:
-            lb = kernel.tip_edge[e]
+            lb = kernel._tip_edge[e]
         if flip:
             lo.append(ang_b)
             lab_lo.append(lb)
@@ -242,7 +242,7 @@ def _blocked_numpy(
         if t1[j] >= length[j] - eps:
             lb = _label(kernel, True, int(vb[k]), e, float(db[k]), L, eps)
         else:
-            lb = kernel.tip_edge[e]
+            lb = kernel._tip_edge[e]
         if flip[j]:
             la, lb = lb, la
         lab_lo.append(la)

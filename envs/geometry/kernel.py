@@ -113,10 +113,10 @@ class Kernel:
         self._vxy = [(float(v[0]), float(v[1])) for v in world.vertices]
         # stop labels are immutable: build each one once and share it
         n = world.n_vertices
-        self.tip_edge = [Stop("tip", Feature("edge", e)) for e in range(n)]
-        self.body_edge = [Stop("body", Feature("edge", e)) for e in range(n)]
-        self.tip_vertex = [Stop("tip", Feature("vertex", v)) for v in range(n)]
-        self.body_vertex = [Stop("body", Feature("vertex", v)) for v in range(n)]
+        self._tip_edge = [Stop("tip", Feature("edge", e)) for e in range(n)]
+        self._body_edge = [Stop("body", Feature("edge", e)) for e in range(n)]
+        self._tip_vertex = [Stop("tip", Feature("vertex", v)) for v in range(n)]
+        self._body_vertex = [Stop("body", Feature("vertex", v)) for v in range(n)]
         self._convex = world.convex_vertices
         x0, y0, x1, y1 = world.bounds
         self._bounds = (x0 - eps, y0 - eps, x1 + eps, y1 + eps)

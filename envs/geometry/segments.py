@@ -1,4 +1,4 @@
-"""Vectorised segment-versus-wall predicates (numpy, no shapely).
+"""Segment-versus-wall contacts, vectorised (numpy) and scalar (plain Python).
 
 Line of sight is the predicate "the *open* segment p-q touches no wall": crossing an
 edge, touching any wall vertex, or running along an edge blocks it. Contact at the
@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-__all__ = ["endpoint_on_edge", "point_in_walls", "scan_segment", "segment_contacts"]
+__all__ = ["point_in_walls", "scan_segment", "segment_contacts"]
 
 
 def segment_contacts(
@@ -44,7 +44,6 @@ def segment_contacts(
         ``t_cross``; ``vertex_hit`` edge start ``a`` within ``eps`` of the open segment at
         parameter ``t_vertex``; ``along`` the open segment overlaps the edge collinearly
         (grazing), the first contact being at parameter ``t_vertex`` clipped to 0.
-        Also ``p_on`` / ``q_on`` are not returned here; see :func:`endpoint_on_edge`.
     """
     d = q - p
     ell2 = d[..., 0] * d[..., 0] + d[..., 1] * d[..., 1]
@@ -77,17 +76,6 @@ def segment_contacts(
     along = near_a & near_b & (lo < t_hi) & (hi > t_lo)
     t_vertex = np.where(along & ~vertex_hit, lo, ta)
     return crossing, t_cross, vertex_hit, t_vertex, along
-
-
-def endpoint_on_edge(
-    x: np.ndarray, a: np.ndarray, u: np.ndarray, n: np.ndarray, length: np.ndarray, eps: float
-) -> np.ndarray:
-    """Return which points ``x`` lie within ``eps`` of which closed edges (broadcast)."""
-    rel0 = x[..., 0] - a[..., 0]
-    rel1 = x[..., 1] - a[..., 1]
-    s = u[..., 0] * rel0 + u[..., 1] * rel1
-    h = n[..., 0] * rel0 + n[..., 1] * rel1
-    return (np.abs(h) <= eps) & (s >= -eps) & (s <= length + eps)
 
 
 def point_in_walls(x: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:

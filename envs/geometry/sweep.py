@@ -154,6 +154,8 @@ def _vertex_event(
                 ts += [r, r + 1e-9]
         else:
             ts = _roots(c2, c1, c0)
+            if not ts and c2 != 0.0:  # no crossing: a near miss may still touch
+                ts = [-c1 / (2.0 * c2)]
         for t in ts:
             if not (-1e-12 <= t <= 1.0 + 1e-12) or t >= best_t:
                 continue
@@ -164,6 +166,8 @@ def _vertex_event(
             if ell2 <= eps * eps:
                 continue
             ell = math.sqrt(ell2)
+            if abs((vx - ex) * ry - (vy - ey) * rx) > eps * ell:
+                continue  # v not on the rod's line (within eps) at this time
             sv = ((vx - ex) * rx + (vy - ey) * ry) / ell2
             margin = eps / ell
             if margin < sv < 1.0 - margin:
@@ -193,8 +197,10 @@ def _vertex_event_numpy(
     c1 = (A[:, 0] * de[1] - A[:, 1] * de[0]) + (dp[0] * C[:, 1] - dp[1] * C[:, 0])
     c0 = A[:, 0] * C[:, 1] - A[:, 1] * C[:, 0]
     r1, r2 = _quad_roots(c2, c1, c0)
-    ts = np.concatenate([r1, r2])
-    ids = np.concatenate([np.arange(len(vid)), np.arange(len(vid))])
+    # no crossing: the extremum of the cross product, where a near miss may still touch
+    ext = np.where(np.isnan(r1) & (c2 != 0.0), -c1 / (2.0 * c2) if c2 != 0.0 else np.nan, np.nan)
+    ts = np.concatenate([r1, r2, ext])
+    ids = np.tile(np.arange(len(vid)), 3)
     # a vertex on the rod's line for the whole step (cross identically zero): test the
     # start, the end and the roots of the dot product instead
     scale_c = np.abs(c1) + np.abs(c0) + abs(c2)
@@ -214,10 +220,12 @@ def _vertex_event_numpy(
     rod = Pt - Et
     ell2 = np.einsum("ij,ij->i", rod, rod)
     ell = np.sqrt(ell2)
+    rel = v[ids] - Et
+    on_line = np.abs(rel[:, 0] * rod[:, 1] - rel[:, 1] * rod[:, 0]) <= eps * ell
     with np.errstate(divide="ignore", invalid="ignore"):
-        sv = np.einsum("ij,ij->i", v[ids] - Et, rod) / ell2
+        sv = np.einsum("ij,ij->i", rel, rod) / ell2
         margin = eps / ell
-    inside = (ell > eps) & (sv > margin) & (sv < 1.0 - margin)
+    inside = (ell > eps) & on_line & (sv > margin) & (sv < 1.0 - margin)
     if not inside.any():
         return None
     k = np.flatnonzero(inside)

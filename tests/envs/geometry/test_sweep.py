@@ -11,7 +11,7 @@ import shapely
 from shapely.geometry import LineString, Point
 
 from envs.errors import InvalidConfigError
-from envs.geometry import kernel_for
+from envs.geometry import Kernel, kernel_for
 from envs.maps import Feature, Map
 from tests.envs.geometry._maps import all_maps, sample_free_points, square_obstacle_map
 
@@ -187,3 +187,25 @@ def test_sweep_rejects_bad_input():
         k.sweep((1, 1), (2, 2), (1, np.nan), (2, 2), 0.0, 1.0)
     with pytest.raises(InvalidConfigError, match="sweep l_max"):
         k.sweep((1, 1), (2, 2), (1, 1), (2, 2), 0.0, -1.0)
+
+
+@pytest.mark.parametrize("numpy_path", [False, True])
+@pytest.mark.parametrize(
+    ("dx", "touches"), [(0.0, True), (1e-12, True), (-1e-12, True), (1e-6, False)]
+)
+def test_rod_grazing_a_corner_is_a_touch(dx, touches, numpy_path):
+    """cross(P(t) - v, E(t) - v) = 2 (t - 1/2)^2 for dx = 0: the rod's line touches the
+    corner (0, 0) at t = 1/2 and backs off; touching blocks (within eps), missing not."""
+    world = square_obstacle_map()
+    k = Kernel(world)
+    k.numpy_threshold = 0 if numpy_path else 10**9
+    p0, p1 = np.array([0.5 + dx, 0.0]), np.array([0.5 + dx, -2.0])
+    e0, e1 = np.array([-1.0, 1.0]), np.array([0.0, 1.0])
+    assert k.line_of_sight(e0, p0) and k.line_of_sight(e1, p1)
+    ev = k.sweep(p0, e0, p1, e1, 0.0, 10.0)
+    if not touches:
+        assert ev is None
+        return
+    assert ev is not None and ev.cause == "occluded"
+    assert ev.time == pytest.approx(0.5, abs=1e-5)
+    assert ev.feature == Feature("vertex", _vertex(world, (0, 0)))

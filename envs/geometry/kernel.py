@@ -1,7 +1,7 @@
 """The geometry kernel: precomputed per-map numpy arrays and the hot-path predicates.
 
 One :class:`Kernel` per :class:`~envs.maps.Map` (get it with :func:`kernel_for`, which
-caches by the map's digest). Nothing here calls shapely.
+caches it). Nothing here calls shapely.
 """
 
 from __future__ import annotations
@@ -143,13 +143,19 @@ class Kernel:
         ]
         for c, cell in enumerate(g.cells):
             if not cell:
-                continue
+                continue  # no wall crosses the cell: its centre speaks for all of it
             cx, cy = refs[c]
+            # the first offset point clear of the cell's walls, else the clearest one
+            best, best_d = (cx, cy), -1.0
             for ox, oy in offsets:
                 x, y = cx + ox, cy + oy
-                if self._near_wall(x, y, cell, 1e-6 * h) is None:
-                    refs[c] = (x, y)
+                d = min(self._distance(x, y, e) for e in cell)
+                if d > 1e-6 * h:
+                    best = (x, y)
                     break
+                if d > best_d:
+                    best, best_d = (x, y), d
+            refs[c] = best
         self._refs = [(float(x), float(y)) for x, y in refs]
         self._ref_free = point_in_walls(refs, self._a, self._b).tolist()
 
@@ -157,6 +163,14 @@ class Kernel:
     def edges_near_box(self, xmin: float, ymin: float, xmax: float, ymax: float) -> np.ndarray:
         """Indices of edges in the grid cells the box overlaps (a superset of those within)."""
         return np.fromiter(self.grid.query_box(xmin, ymin, xmax, ymax), dtype=np.intp)
+
+    def _distance(self, x: float, y: float, e: int) -> float:
+        """Distance from (x, y) to edge ``e``."""
+        ax, ay = self._recs[e][0], self._recs[e][1]
+        ux, uy, length = self._dirs[e]
+        wx, wy = x - ax, y - ay
+        s = min(max(wx * ux + wy * uy, 0.0), length)
+        return math.hypot(wx - s * ux, wy - s * uy)
 
     def _near_wall(self, x: float, y: float, cand, tol: float) -> int | None:
         """An edge among ``cand`` within ``tol`` of (x, y), or None."""

@@ -39,10 +39,6 @@ if TYPE_CHECKING:
 __all__ = ["free_arcs_at"]
 
 
-def _angle(v: np.ndarray) -> np.ndarray:
-    return np.arctan2(v[..., 1], v[..., 0])
-
-
 def free_arcs_at(kernel: Kernel, px: float, py: float, L: float) -> FreeArcs:
     """Free orientations of a rod of length ``L`` whose evader end is at P = (px, py).
 

@@ -1,0 +1,128 @@
+"""Variable L: Prop. 1's critical lengths, Sec. 3's stratified graph G, Prop. 4's verdict."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import shapely
+
+from envs.errors import InvalidConfigError
+from envs.maps import Map
+from strategies.cspace import (
+    candidate_lengths,
+    critical_lengths,
+    decompose,
+    graph_signature,
+    stratified_graph,
+    surveillance_verdict,
+)
+from strategies.cspace._rod import rods_semifree
+from tests.strategies.cspace._oracle import corridor, open_room, two_rooms
+
+
+def two_pillars(gap: float = 2.0) -> Map:
+    """Two 2 x 2 pillars side by side, ``gap`` apart, in a 12 x 8 room."""
+    x = 5.0 + gap
+    return Map(
+        [(0, 0), (12, 0), (12, 8), (0, 8)],
+        [[(3, 3), (5, 3), (5, 5), (3, 5)], [(x, 3), (x + 2, 3), (x + 2, 5), (x, 5)]],
+        name="two_pillars",
+    )
+
+
+def test_candidates_are_distances_and_their_halves():
+    world = two_pillars(2.0)
+    cands = candidate_lengths(world, 0.5, 6.0)
+    assert list(cands) == sorted(set(cands))
+    assert all(0.5 < c < 6.0 for c in cands)
+    for want in (2.0, 1.0, 3.0, 1.5, math.hypot(2, 2), math.hypot(2, 2) / 2):
+        assert any(abs(c - want) < 1e-9 for c in cands), want
+
+
+def test_signature_ignores_geometry_but_sees_structure():
+    world = two_pillars(2.0)
+    a = graph_signature(decompose(world, 1.62))
+    assert graph_signature(decompose(world, 1.64)) == a  # no candidate in between
+    moved = world.transformed([[1.0, 0.0], [0.0, 1.0]], (4.0, -2.0))
+    assert moved.n_vertices == world.n_vertices
+    assert graph_signature(decompose(moved, 1.62)) == a
+    assert graph_signature(decompose(world, 2.5)) != a
+
+
+def test_critical_lengths_find_the_type3_birth():
+    """A type-3 curve appears at L = d (Prop. 1 (a)): G_L changes there."""
+    world = two_pillars(2.0)
+    crit = critical_lengths(world, 1.9, 2.1, samples=1)
+    assert any(abs(c - 2.0) < 1e-9 for c in crit), crit
+    below = graph_signature(decompose(world, 1.95))
+    above = graph_signature(decompose(world, 2.05))
+    assert below != above
+
+
+def test_critical_lengths_locate_events_prop1_misses_by_bisection():
+    """On the corridor world an event lies between two candidates (erratum E10)."""
+    world = corridor()
+    cands = candidate_lengths(world, 1.0, 2.2)
+    crit = critical_lengths(world, 1.0, 2.2, samples=2, tol=1e-3)
+    extra = [c for c in crit if all(abs(c - d) > 1e-6 for d in cands)]
+    assert extra, (cands, crit)
+    for c in extra:  # the hash really differs on the two sides of the event
+        lo = graph_signature(decompose(world, c - 5e-3))
+        hi = graph_signature(decompose(world, c + 5e-3))
+        assert lo != hi, c
+
+
+def test_stratified_graph_links_every_cell_to_the_shorter_rod():
+    """Theta_f(P; L') is inside Theta_f(P; L) for L' > L: every cell of G_{i+1} links to G_i."""
+    world = two_pillars(2.0)
+    sg = stratified_graph(world, 1.7, 2.3, critical=(2.0,))
+    assert sg.samples == pytest.approx((1.85, 2.15))
+    assert sg.graph.number_of_nodes() == sum(len(d.cells) for d in sg.strata)
+    lower, upper = sg.strata
+    for c in upper.cells:
+        nbrs = [n for n in sg.graph.neighbors((1, c.id)) if n[0] == 0]
+        assert nbrs, c
+        for _, k in nbrs:  # linked regions overlap
+            ra, rb = lower.regions[lower.cells[k].region], upper.regions[c.region]
+            assert ra.polygon.intersection(rb.polygon).area > 0
+    kinds = {d["kind"] for *_, d in sg.graph.edges(data=True)}
+    assert kinds == {"cell", "length"}
+
+
+def test_verdict_on_the_papers_worlds():
+    assert surveillance_verdict(corridor(), 2.0, 4.0).pursuer_can_hold
+    assert surveillance_verdict(open_room(), 2.0, 4.0).pursuer_can_hold
+    v = surveillance_verdict(two_rooms(), 2.0, 4.0, start=(5.0, 0.0))
+    assert v.evader_wins and v.witness_region is not None
+    assert all(v.decomposition.cells[c].escapable for c in v.witness_region.cells)
+    path = v.evader_path
+    assert np.allclose(path[0], (5.0, 0.0)) and np.allclose(path[-1], v.witness_point)
+    assert rods_semifree(v.decomposition.map, path[:-1], path[1:]).all()
+    assert v.witness_region.polygon.covers(shapely.Point(v.witness_point))
+
+
+def test_verdict_is_monotone_in_l_min():
+    """Prop. 3 + 4: an escape at l_min remains one for every larger l_min."""
+    world = two_pillars(1.0)
+    wins = [surveillance_verdict(world, lm, 6.0).evader_wins for lm in (0.6, 1.2, 2.0, 3.5)]
+    assert wins == sorted(wins)
+
+
+def test_first_sample_length_avoids_a_critical_l_min():
+    world = two_pillars(2.0)
+    v = surveillance_verdict(world, 2.0, 3.0)  # 2.0 is a candidate: sample just above
+    assert 2.0 < v.L < 2.01
+    assert surveillance_verdict(world, 2.2, 3.0).L == 2.2
+
+
+@pytest.mark.parametrize(("lo", "hi"), [(2.0, 1.0), (0.0, 1.0), (1.0, math.inf)])
+def test_bad_ranges_are_rejected(lo, hi):
+    with pytest.raises(InvalidConfigError):
+        surveillance_verdict(corridor(), lo, hi)
+
+
+def test_bad_start_is_rejected():
+    with pytest.raises(InvalidConfigError, match="start"):
+        surveillance_verdict(two_rooms(), 2.0, 4.0, start=(-3.0, 3.0))  # inside a wall

@@ -99,6 +99,13 @@ def _clean_ring(ring: np.ndarray, scale: float, what: str) -> np.ndarray:
     return ring
 
 
+def _canonical_start(ring: np.ndarray) -> np.ndarray:
+    """Rotate a ring to start at its vertex with the lowest x (then lowest y)."""
+    r = ring + 0.0
+    first = int(np.lexsort((r[:, 1], r[:, 0]))[0])
+    return np.roll(r, -first, axis=0)
+
+
 def _signed_area(ring: np.ndarray) -> float:
     x, y = ring[:, 0], ring[:, 1]
     return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
@@ -234,6 +241,11 @@ class Map:
             area = _signed_area(r)
             if (k == 0) != (area > 0):
                 rings[k] = r[::-1].copy()
+        # canonical numbering: each ring starts at its lowest (x, y) vertex and the holes
+        # are sorted, so the same world listed differently gets identical arrays (feature
+        # indices in caches and kernels keyed by ``digest`` stay valid)
+        rings = [_canonical_start(r) for r in rings]
+        rings = [rings[0], *sorted(rings[1:], key=lambda r: tuple(r.ravel()))]
         self.rings: tuple[np.ndarray, ...] = tuple(rings)
         self._free = Polygon(rings[0], rings[1:])
         verts, vring, prev_e, next_e = [], [], [], []
@@ -374,19 +386,14 @@ class Map:
     def digest(self) -> str:
         """SHA-256 of the wall geometry; equal maps have equal digests (cache keys).
 
-        Independent of where each ring starts and of the order of the holes, so the same
-        world given with its polygons listed differently has the same digest.
+        Independent of where each ring starts and of the order of the holes (the numbering
+        is canonical), so the same world given with its polygons listed differently has the
+        same digest and the same vertex and edge indices.
         """
 
-        def canonical(r: np.ndarray) -> bytes:
-            r = np.ascontiguousarray(r, dtype="<f8") + 0.0  # + 0.0 turns -0.0 into 0.0
-            first = int(np.lexsort((r[:, 1], r[:, 0]))[0])  # lowest x, then lowest y
-            return np.roll(r, -first, axis=0).tobytes()
-
-        keys = [canonical(r) for r in self.rings]
         h = hashlib.sha256()
-        for key in [keys[0], *sorted(keys[1:])]:
-            h.update(key)
+        for r in self.rings:  # rings are canonically numbered in _build_arrays
+            h.update((np.ascontiguousarray(r, dtype="<f8") + 0.0).tobytes())  # -0.0 -> 0.0
             h.update(b"|")
         return h.hexdigest()
 

@@ -61,6 +61,9 @@ def wilson_interval(successes: int, n: int, confidence: float = 0.95) -> tuple[f
     if n == 0:
         return (0.0, 1.0)
     z = float(stats.norm.ppf(0.5 + c / 2))
+    if successes in (0, n):  # exact ends: 0 (resp. 1) without rounding residue
+        edge = z * z / (n + z * z)
+        return (0.0, edge) if successes == 0 else (1.0 - edge, 1.0)
     p = successes / n
     denom = 1 + z * z / n
     centre = (p + z * z / (2 * n)) / denom
@@ -407,6 +410,8 @@ def evaluate(
     if path is not None:
         path.parent.mkdir(parents=True, exist_ok=True)
     out = path.open("a", encoding="utf-8") if path is not None else None
+    if out is not None and path.stat().st_size and not path.read_bytes().endswith(b"\n"):
+        out.write("\n")  # an interrupted write left half a line: start a fresh one
     try:
         bar = tqdm(
             total=len(jobs), initial=len(jobs) - len(todo), disable=not progress, desc="episodes"

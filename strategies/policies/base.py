@@ -27,6 +27,7 @@ __all__ = [
     "Policy",
     "Snapshot",
     "check_role",
+    "distance_target",
     "unit",
 ]
 
@@ -43,6 +44,16 @@ def check_role(role: str) -> str:
     if role not in ROLES:
         raise InvalidConfigError(f"role must be one of {ROLES}, got {role!r}")
     return role
+
+
+def distance_target(config: Any) -> float:
+    """The distance a pursuer holds: L_min plus a buffer against one step of reaction lag.
+
+    Policies see the evader's velocity of the *previous* step, so a sudden dash toward
+    the pursuer closes up to ``V_e dt`` before it reacts; twice that, plus 1 % of L_min,
+    keeps L above L_min (the env's ``"too_close"``).
+    """
+    return config.l_min + 2.0 * config.v_evader * config.dt + 0.01 * config.l_min
 
 
 def unit(v: np.ndarray) -> np.ndarray:

@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from envs.errors import InvalidConfigError
-from strategies.policies.base import BasePolicy, Snapshot, unit
+from strategies.policies.base import BasePolicy, Snapshot, distance_target, unit
 
 __all__ = [
     "GreedyPursuer",
@@ -73,7 +73,8 @@ class GreedyPursuer(BasePolicy):
 
     Args:
         gain: rate (1/s) at which the distance error is corrected.
-        target: target distance as a fraction of the way from L_min to L_max (0 = L_min).
+        target: target distance as a fraction of the way from L_min (plus the lag buffer
+            of :func:`~strategies.policies.base.distance_target`) to L_max.
     """
 
     def __init__(self, *, gain: float = 4.0, target: float = 0.0, name: str | None = None) -> None:
@@ -85,7 +86,8 @@ class GreedyPursuer(BasePolicy):
 
     def _decide(self, snap: Snapshot) -> np.ndarray:
         c = self.config
-        want = c.l_min + self.target * (c.l_max - c.l_min)
+        low = distance_target(c)
+        want = low + self.target * (c.l_max - low)
         u = unit(snap.rod)  # from evader to pursuer
         radial = float(np.dot(snap.evader_velocity, u)) - self.gain * (snap.L - want)
         return radial * u

@@ -20,6 +20,7 @@ from strategies.policies.cooperative import (
 )
 from strategies.policies.decomposition import DecompositionPursuer
 from strategies.policies.registry import register_policy
+from strategies.policies.shooting import ShootingEvader
 
 register_policy("pursuer/random", RandomPolicy, "uniform random velocity (baseline)")
 register_policy("evader/random", RandomPolicy, "uniform random velocity (baseline)")
@@ -62,4 +63,9 @@ register_policy(
     "pursuer/decomposition",
     DecompositionPursuer,
     "keeps the rod in admissible safe cells at L_min (Secs. 4-5): table lookup per step",
+)
+register_policy(
+    "evader/shooting",
+    ShootingEvader,
+    "escape plans through escapable cells, optimal escape arcs (Sec. 6), else pressure",
 )

@@ -22,7 +22,7 @@ import math
 import numpy as np
 
 from envs.errors import InvalidConfigError
-from strategies.policies.base import BasePolicy, Snapshot, unit
+from strategies.policies.base import BasePolicy, Snapshot, distance_target, unit
 from strategies.policies.baselines import nearest_wall_point
 
 __all__ = ["CornerRoundingPursuer", "TractrixFollower", "WallFollowingPursuer"]
@@ -52,7 +52,9 @@ class TractrixFollower(BasePolicy):
 
     def _decide(self, snap: Snapshot) -> np.ndarray:
         u = -unit(snap.rod)  # pursuer -> evader
-        pull = float(np.dot(snap.evader_velocity, u)) + self.gain * (snap.L - self.config.l_min)
+        pull = float(np.dot(snap.evader_velocity, u)) + self.gain * (
+            snap.L - distance_target(self.config)
+        )
         return max(0.0, pull) * u
 
 
@@ -83,7 +85,7 @@ class WallFollowingPursuer(BasePolicy):
         d = snap.rod
         along = float(np.dot(d, tau))
         rhs = float(np.dot(d, snap.evader_velocity)) - self.gain * snap.L * (
-            snap.L - self.config.l_min
+            snap.L - distance_target(self.config)
         )
         if abs(along) < 1e-9:  # rod perpendicular to the wall: no tangential motion helps
             return np.zeros(2)
@@ -147,6 +149,6 @@ class CornerRoundingPursuer(BasePolicy):
                     n = np.array([math.sin(th), -math.cos(th)])
                     L = snap.L
                     v = snap.evader_velocity - (L / l) * n * float(n @ snap.evader_velocity)
-                    target = e + self.config.l_min * (c - e) / l
+                    target = e + distance_target(self.config) * (c - e) / l
                     return v + self.gain * (target - snap.pursuer)
         return self._tractrix._decide(snap)

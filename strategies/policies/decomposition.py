@@ -30,7 +30,7 @@ import numpy as np
 
 from envs.errors import InvalidConfigError
 from strategies.control.kinematics import pursuer_velocity_holding_range, theta_dot
-from strategies.policies.base import BasePolicy, Snapshot
+from strategies.policies.base import BasePolicy, Snapshot, distance_target
 from strategies.policies.safety import NO_PATH, safety_table
 
 __all__ = ["DecompositionPursuer"]
@@ -84,8 +84,7 @@ class DecompositionPursuer(BasePolicy):
 
     def _reset(self) -> None:
         c = self.config
-        # keep L a little above L_min: one step of lag lets the evader close V_e dt
-        self.L_target = c.l_min + 2.0 * c.v_evader * c.dt + 0.01 * c.l_min
+        self.L_target = distance_target(c)
         # the pursuer's disc keeps its centre body_radius off the walls, so the rod tip
         # meets a wall as if the rod were that much longer (Prop. 3: fewer free arcs)
         self.table_length = round(self.L_target + c.body_radius, 6)

@@ -29,7 +29,7 @@ import numpy as np
 from envs.errors import InvalidConfigError
 from envs.maps import Map
 
-__all__ = ["NO_PATH", "SafetyTable", "safety_table"]
+__all__ = ["NO_PATH", "SafetyTable", "cspace_graph", "safety_table"]
 
 NO_PATH = 255
 """Entry of the rotation tables meaning "no safe orientation at this point"."""
@@ -128,14 +128,21 @@ def _circular_distance(safe: np.ndarray, step: int) -> np.ndarray:
     return np.minimum(dist, NO_PATH).astype(np.uint8)
 
 
-def _cache_dir() -> Path:
+def cache_dir() -> Path:
+    """Directory of the on-disk table cache (``$SURVEIL_CACHE_DIR`` or ``~/.cache/surveil``)."""
     return Path(os.environ.get("SURVEIL_CACHE_DIR", Path.home() / ".cache" / "surveil"))
 
 
-def _build(world: Map, L: float, resolution: float, n_bins: int) -> SafetyTable:
+@functools.lru_cache(maxsize=4)
+def cspace_graph(world: Map, L: float, resolution: float):
+    """The cspace grid graph of ``world`` at rod length ``L`` (shared, cached in memory)."""
     from strategies.cspace.grid_oracle import grid_graph
 
-    g = grid_graph(world, L, resolution=resolution)
+    return grid_graph(world, L, resolution=resolution)
+
+
+def _build(world: Map, L: float, resolution: float, n_bins: int) -> SafetyTable:
+    g = cspace_graph(world, L, resolution)
     pts = g.points
     origin = pts.min(axis=0)
     idx = np.rint((pts - origin) / resolution).astype(np.int64)
@@ -195,7 +202,7 @@ def safety_table(
     key = hashlib.sha256(
         f"{TABLE_VERSION}|{world.digest}|{L!r}|{resolution!r}|{n_bins}".encode()
     ).hexdigest()[:24]
-    path = _cache_dir() / f"safety_{key}.npz"
+    path = cache_dir() / f"safety_{key}.npz"
     if disk_cache and path.exists():
         try:
             with np.load(path) as z:

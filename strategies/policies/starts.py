@@ -8,7 +8,8 @@ a margin, the rod clear of convex corners, line of sight.
 (non-escapable) cell at L_min, at least ``angle_margin`` inside it, and is admissible in
 the bounded-speed sense of Sec. 5 as the decomposition pursuer estimates it (value
 ``V(theta) >= 0``: from there the rod reaches a safe orientation at every point before
-the evader does). On maps where no safe cell exists (Prop. 2 holds) it falls back to a
+the evader does; for rho >= 1 nothing is admissible and only the safe cell is
+required). On maps where no safe cell exists (Prop. 2 holds) it falls back to a
 valid start at L_min, since no safe start exists to draw.
 """
 
@@ -26,7 +27,7 @@ __all__ = ["START_KINDS", "sample_start"]
 
 START_KINDS = ("valid", "safe")
 BATCH = 256
-MAX_BATCHES = 400
+MAX_BATCHES = 100
 
 
 def sample_start(
@@ -62,6 +63,7 @@ def sample_start(
 
 def _near_l_min(config, kernel, rng, judge, tab, angle_margin):
     m = config.map
+    admissible = config.rho < 1.0  # for rho >= 1 no configuration is admissible (Sec. 5)
     range_margin, rod_clearance = spawn_margins(config)
     length = max(judge.L_target, config.l_min + range_margin)
     xmin, ymin, xmax, ymax = m.bounds
@@ -90,7 +92,7 @@ def _near_l_min(config, kernel, rng, judge, tab, angle_margin):
                 bins = (b + np.arange(-margin_bins, margin_bins + 1)) % tab.n_bins
                 if not tab.safe[row, bins].all():
                     continue
-                if judge.orientation_values(e[i])[b] < 0.0:
+                if admissible and judge.orientation_values(e[i])[b] < 0.0:
                     continue
             return {
                 "pursuer": (float(p[i, 0]), float(p[i, 1])),

@@ -1,0 +1,231 @@
+"""The shooting-based evader (Secs. 4-6): a combinatorial plan says where, shooting says how.
+
+Each step, with the rod of length L_eff = L_min + body radius (the most capable pursuer,
+Sec. 5 "minimax": its tip meets walls as if the rod were that long):
+
+1. **Escapable cell** (the configuration lies in an escapable node of the cspace graph):
+   step to the node's witness (:mod:`strategies.policies.escape_plan`); the rank falls
+   every step whatever the pursuer does, until condition (a) breaks surveillance.
+2. **Shooting escape**: candidate endpoints (Fig. 13) are points the evader can reach in
+   a straight line (probes on rays, and points just past each convex obstacle vertex in
+   reach) where the current orientation is not safe. For each, the rotation the pursuer
+   must make each way round to a safe orientation there (the safety table) is compared
+   with the rotation it can make while the evader travels (eq. 6 integrated along the
+   straight path). The best candidate with a positive margin is re-solved with the
+   optimal escape arc of Sec. 6 (:func:`strategies.control.evasion.solve_escape`, for the
+   branch the pursuer would turn) and the evader follows that arc, replanning every
+   ``replan`` steps.
+3. **Witness region** (Prop. 2 holds on the map): walk a shortest grid path to it.
+4. Otherwise **pressure**: move straight toward or away from the pursuer (Sec. 6.1, the
+   headings minimising max |theta_dot|), whichever points more toward the most
+   promising candidate.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from envs.errors import InvalidConfigError
+from envs.geometry import kernel_for
+from strategies.control.evasion import solve_escape
+from strategies.policies.base import BasePolicy, Snapshot, unit
+from strategies.policies.escape_plan import escape_plan
+from strategies.policies.safety import NO_PATH, safety_table
+
+__all__ = ["ShootingEvader"]
+
+_EULER = 8  # sub-steps of the straight-path rotation estimate
+
+
+class ShootingEvader(BasePolicy):
+    """Evader that follows guaranteed escape plans and optimal escape arcs.
+
+    Args:
+        resolution: grid spacing of the cspace tables.
+        rays: candidate directions around the evader.
+        probe_every: every k-th grid sample along a ray is a candidate.
+        replan: steps between shooting re-plans.
+        shoot: refine the chosen straight path with the optimal arc of Sec. 6.
+    """
+
+    roles = ("evader",)
+
+    def __init__(
+        self,
+        *,
+        resolution: float = 0.1,
+        rays: int = 24,
+        probe_every: int = 3,
+        replan: int = 5,
+        shoot: bool = True,
+        name: str | None = None,
+    ) -> None:
+        super().__init__(name=name)
+        self.resolution = float(resolution)
+        if not (math.isfinite(self.resolution) and self.resolution > 0):
+            raise InvalidConfigError(f"resolution must be > 0, got {resolution!r}")
+        for k, v, lo in (("rays", rays, 4), ("probe_every", probe_every, 1), ("replan", replan, 1)):
+            if not (isinstance(v, int) and v >= lo):
+                raise InvalidConfigError(f"{k} must be an integer >= {lo}, got {v!r}")
+        self.rays, self.probe_every, self.replan, self.shoot = (
+            rays,
+            probe_every,
+            replan,
+            bool(shoot),
+        )
+
+    def _reset(self) -> None:
+        c = self.config
+        self.L_eff = round(c.l_min + c.body_radius, 6)
+        self.table = safety_table(c.map, self.L_eff, self.resolution)
+        self.plan = escape_plan(c.map, self.L_eff, self.resolution)
+        self.kernel = kernel_for(c.map)
+        self.rho = c.rho
+        omega_max = c.v_pursuer * (1.0 + min(self.rho, 1.0)) / c.l_min  # Sec. 6.1 maximum
+        reach = c.v_evader * math.pi / omega_max + 2.0 * c.l_min
+        h = self.table.resolution
+        n_r = max(2, math.ceil(reach / h))
+        radii = h * np.arange(1, n_r + 1)
+        ang = 2.0 * math.pi * np.arange(self.rays) / self.rays
+        dirs = np.stack([np.cos(ang), np.sin(ang)], axis=1)
+        self._offsets = (dirs[:, None, :] * radii[None, :, None]).reshape(-1, 2)
+        self._n_r = n_r
+        self._cols = np.arange(self.probe_every - 1, n_r, self.probe_every)
+        m = c.map
+        idx = m.convex_vertices
+        bis = m.edge_normal[m.vertex_prev_edge[idx]] + m.edge_normal[m.vertex_next_edge[idx]]
+        bis = bis / np.maximum(np.linalg.norm(bis, axis=1, keepdims=True), 1e-12)
+        self._corner_points = m.vertices[idx] + (c.body_radius + 2.0 * h) * bis
+        self._arc: tuple[np.ndarray, float, np.ndarray] | None = None  # (start, frame, path)
+        self._arc_age = 0
+        self.mode = "start"
+
+    # ------------------------------------------------------------------ candidates
+    def _candidates(self, e: np.ndarray) -> np.ndarray:
+        tab = self.table
+        pts = e + self._offsets
+        rows = tab.rows(pts).reshape(self.rays, self._n_r)
+        reach = np.cumsum(rows < 0, axis=1) == 0
+        cand = pts.reshape(self.rays, self._n_r, 2)[:, self._cols][reach[:, self._cols]]
+        near = np.linalg.norm(self._corner_points - e, axis=1) <= self._n_r * tab.resolution
+        corners = [q for q in self._corner_points[near] if self.kernel.line_of_sight(e, q)]
+        return np.concatenate([cand, np.asarray(corners).reshape(-1, 2)])
+
+    def _margins(self, e: np.ndarray, theta: float, cand: np.ndarray):
+        """Escape margin (radians) per candidate, and which way the pursuer would turn."""
+        c, tab = self.config, self.table
+        rows = tab.rows(cand)
+        ok = rows >= 0
+        b = tab.bin_of(theta)
+        need_ccw = np.where(ok, tab.ccw[np.maximum(rows, 0), b], 0).astype(float)
+        need_cw = np.where(ok, tab.cw[np.maximum(rows, 0), b], 0).astype(float)
+        need_ccw = np.where(need_ccw >= NO_PATH, 2 * math.pi, need_ccw * tab.bin_width)
+        need_cw = np.where(need_cw >= NO_PATH, 2 * math.pi, need_cw * tab.bin_width)
+        d = cand - e
+        dist = np.linalg.norm(d, axis=1)
+        alpha = np.arctan2(d[:, 1], d[:, 0])
+        dt = dist / c.v_evader / _EULER
+        rho = min(self.rho, 1.0)
+        k = c.v_pursuer / c.l_min
+        turned = []
+        for s in (1.0, -1.0):  # eq. (6): the pursuer turns at its best rate each way
+            th = np.full(len(cand), theta)
+            for _ in range(_EULER):
+                phi = alpha - th
+                rate = k * (
+                    -rho * np.sin(phi) + s * np.sqrt(np.maximum(1 - (rho * np.cos(phi)) ** 2, 0))
+                )
+                th = th + rate * dt
+            turned.append(np.abs(th - theta))
+        margin = np.minimum(need_ccw - turned[0], need_cw - turned[1])
+        margin = np.where(ok & ((need_ccw > 0) | (need_cw > 0)), margin, -np.inf)
+        branch = np.where(need_ccw - turned[0] < need_cw - turned[1], "+", "-")
+        return margin, branch
+
+    # ------------------------------------------------------------------ decision
+    def _decide(self, snap: Snapshot) -> np.ndarray:
+        c = self.config
+        e, theta = snap.evader, snap.theta
+        if c.rho > 1.0:  # footnote 4: the trivial escape, away from the pursuer
+            self.mode = "away"
+            return c.v_evader * self._away_heading(snap)
+        row = self.table.row(e)
+        if row >= 0:
+            node = self.plan.node_at(row, theta)
+            if node >= 0 and self.plan.rank[node] >= 0:
+                self.mode = "plan"
+                self._arc = None
+                target = self.plan.points[self.plan.witness[node]]
+                return c.v_evader * unit(target - e)
+        if self._arc is not None and self._arc_age < self.replan:
+            self._arc_age += 1
+            return c.v_evader * self._arc_heading(e)
+        cand = self._candidates(e)
+        if len(cand):
+            margin, branch = self._margins(e, theta, cand)
+            best = int(np.argmax(margin))
+            if margin[best] > 0:
+                self.mode = "shoot"
+                return c.v_evader * self._start_arc(e, theta, cand[best], branch[best])
+        if row >= 0 and self.plan.region.any() and not self.plan.region[row]:
+            nxt = self.plan.region_next[row]
+            if nxt >= 0:
+                self.mode = "region"
+                return c.v_evader * unit(self.plan.points[nxt] - e)
+        self.mode = "pressure"
+        u = unit(snap.rod)
+        if len(cand) and np.isfinite(margin[best]):
+            toward = float(np.dot(cand[best] - e, u)) >= 0.0
+        else:
+            toward = True
+        return c.v_evader * (u if toward else -u)
+
+    def _away_heading(self, snap: Snapshot) -> np.ndarray:
+        """Footnote 4 in a bounded world: away from the pursuer, where there is room.
+
+        L grows whenever the heading is within ``acos(1 / rho)`` of straight away from the
+        pursuer (even if it runs at V_p straight after the evader); among such headings
+        take the one with the longest free run before a wall.
+        """
+        away = math.atan2(-snap.rod[1], -snap.rod[0])
+        half = 0.9 * math.acos(1.0 / self.rho)
+        angles = away + np.linspace(-half, half, 15)
+        runs = self.kernel.ray_distances(snap.evader, angles, 2.0 * self.config.l_max)
+        best = angles[int(np.argmax(runs))]
+        return np.array([math.cos(best), math.sin(best)])
+
+    def _start_arc(
+        self, e: np.ndarray, theta: float, target: np.ndarray, branch: str
+    ) -> np.ndarray:
+        """Solve the optimal escape arc to ``target`` (Sec. 6) and return its first heading."""
+        d = target - e
+        frame = math.atan2(d[1], d[0])
+        dist = math.hypot(d[0], d[1])
+        self._arc, self._arc_age = None, 0
+        if self.shoot and 0.0 < self.rho < 1.0:
+            sol = solve_escape(
+                theta - frame, dist, L=self.config.l_min, rho=self.rho, branch=branch
+            )
+            if sol.success and sol.arc is not None:
+                path = sol.arc.evader_path()
+                rot = np.array(
+                    [[math.cos(frame), -math.sin(frame)], [math.sin(frame), math.cos(frame)]]
+                )
+                self._arc = (e.copy(), frame, path @ rot.T + e)
+                self._arc_age = 1
+                return self._arc_heading(e)
+        return unit(d)
+
+    def _arc_heading(self, e: np.ndarray) -> np.ndarray:
+        """Heading toward the stored arc's point one step ahead of the evader's progress."""
+        _, _, path = self._arc
+        k = int(np.argmin(np.linalg.norm(path - e, axis=1)))
+        ahead = self.config.v_evader * self.config.dt
+        s = np.cumsum(np.r_[0.0, np.linalg.norm(np.diff(path, axis=0), axis=1)])
+        j = int(np.searchsorted(s, s[k] + ahead))
+        if j >= len(path):
+            self._arc = None
+            return unit(path[-1] - e)
+        return unit(path[j] - e)

@@ -34,6 +34,7 @@ TYPE_COLOURS = {
 """Colour of each critical-curve type (0 = walls)."""
 
 _ESC = "#e4572e"
+_ESC_DARK = "#9c2a10"
 _SAFE = "#3a7ca5"
 _OBSTACLE = "#b9b4ab"
 
@@ -65,14 +66,27 @@ def _fill_polygon(ax, poly, **kw) -> None:
         ax.add_patch(PathPatch(MPath(np.concatenate(verts), codes), **kw))
 
 
+def _frame(ax, world) -> None:
+    xmin, ymin, xmax, ymax = world.bounds
+    pad = 0.03 * max(xmax - xmin, ymax - ymin)
+    ax.set_xlim(xmin - pad, xmax + pad)
+    ax.set_ylim(ymin - pad, ymax + pad)
+    ax.set_aspect("equal")
+    ax.set_xticks([])
+    ax.set_yticks([])
+    for s in ax.spines.values():
+        s.set_visible(False)
+
+
 def _draw_world(ax, dec: Decomposition, label_regions: bool) -> None:
     from matplotlib.colors import to_rgba
+    from matplotlib.patches import Rectangle
 
     world = dec.map
     xmin, ymin, xmax, ymax = world.bounds
-    pad = 0.04 * max(xmax - xmin, ymax - ymin)
+    pad = 0.03 * max(xmax - xmin, ymax - ymin)
     ax.add_patch(
-        __import__("matplotlib.patches", fromlist=["Rectangle"]).Rectangle(
+        Rectangle(
             (xmin - pad, ymin - pad),
             xmax - xmin + 2 * pad,
             ymax - ymin + 2 * pad,
@@ -82,26 +96,35 @@ def _draw_world(ax, dec: Decomposition, label_regions: bool) -> None:
         )
     )
     _fill_polygon(ax, world.free_region, facecolor="white", edgecolor="none", zorder=1)
+    witnesses = set(dec.witness_regions)
     for r in dec.regions:
         cells = [dec.cells[c] for c in r.cells]
         share = (sum(c.escapable for c in cells) / len(cells)) if cells else 1.0
-        if share > 0:
-            all_esc = share >= 1.0
-            _fill_polygon(
-                ax,
-                r.polygon,
-                facecolor=to_rgba(_ESC, 0.18 + 0.42 * share),
-                edgecolor="none",
-                hatch="////" if all_esc else None,
-                zorder=2,
-            )
+        if share <= 0:
+            continue
+        _fill_polygon(
+            ax,
+            r.polygon,
+            facecolor=to_rgba(_ESC, 0.12 + 0.30 * share),
+            edgecolor=to_rgba(_ESC_DARK, 0.55) if r.id in witnesses else "none",
+            linewidth=0.0,
+            hatch="////" if r.id in witnesses else None,
+            zorder=2,
+        )
     for c in sorted(dec.curves, key=lambda c: c.type):
         if c.type == 0:
             continue
-        ax.plot(*c.points.T, color=TYPE_COLOURS[c.type], lw=1.1, solid_capstyle="round", zorder=3)
+        ax.plot(
+            *c.points.T,
+            color=TYPE_COLOURS[c.type],
+            lw=1.15,
+            solid_capstyle="round",
+            solid_joinstyle="round",
+            zorder=3,
+        )
     for ring in world.rings:
         closed = np.vstack([ring, ring[:1]])
-        ax.plot(*closed.T, color=TYPE_COLOURS[0], lw=1.6, zorder=4)
+        ax.plot(*closed.T, color=TYPE_COLOURS[0], lw=1.8, solid_joinstyle="miter", zorder=4)
     if label_regions:
         for r in dec.regions:
             ax.annotate(
@@ -110,16 +133,13 @@ def _draw_world(ax, dec: Decomposition, label_regions: bool) -> None:
                 fontsize=5.5,
                 ha="center",
                 va="center",
-                color="#333333",
+                color="#444444",
                 zorder=5,
             )
-    ax.set_xlim(xmin - pad, xmax + pad)
-    ax.set_ylim(ymin - pad, ymax + pad)
-    ax.set_aspect("equal")
-    ax.set_xticks([])
-    ax.set_yticks([])
-    for s in ax.spines.values():
-        s.set_visible(False)
+    w = dec.witness_region
+    if w is not None:
+        ax.plot(*w.point, marker="*", ms=13, color="#ffd23f", mec="#3d3d3d", mew=0.8, zorder=6)
+    _frame(ax, world)
 
 
 def _cell_positions(dec: Decomposition) -> dict[int, np.ndarray]:
@@ -138,9 +158,13 @@ def _cell_positions(dec: Decomposition) -> dict[int, np.ndarray]:
 
 def _draw_graph(ax, dec: Decomposition) -> None:
     world = dec.map
+    _fill_polygon(ax, world.free_region, facecolor="#f7f7f5", edgecolor="none", zorder=0)
+    for c in dec.curves:
+        if c.type != 0:
+            ax.plot(*c.points.T, color=TYPE_COLOURS[c.type], lw=0.6, alpha=0.18, zorder=0)
     for ring in world.rings:
         closed = np.vstack([ring, ring[:1]])
-        ax.plot(*closed.T, color="#cccccc", lw=1.0, zorder=0)
+        ax.plot(*closed.T, color="#9a9a9a", lw=1.0, zorder=0)
     pos = _cell_positions(dec)
     for i, j in dec.graph.edges:
         a, b = pos[i], pos[j]
@@ -157,16 +181,9 @@ def _draw_graph(ax, dec: Decomposition) -> None:
         ids = sorted(pos)
         xy = np.array([pos[i] for i in ids])
         col = [_ESC if dec.cells[i].escapable else _SAFE for i in ids]
-        ax.scatter(xy[:, 0], xy[:, 1], s=9, c=col, edgecolors="white", linewidths=0.3, zorder=2)
-    xmin, ymin, xmax, ymax = world.bounds
-    pad = 0.04 * max(xmax - xmin, ymax - ymin)
-    ax.set_xlim(xmin - pad, xmax + pad)
-    ax.set_ylim(ymin - pad, ymax + pad)
-    ax.set_aspect("equal")
-    ax.set_xticks([])
-    ax.set_yticks([])
-    for s in ax.spines.values():
-        s.set_visible(False)
+        size = 14 if len(ids) < 150 else 7
+        ax.scatter(xy[:, 0], xy[:, 1], s=size, c=col, edgecolors="white", linewidths=0.4, zorder=2)
+    _frame(ax, world)
 
 
 def draw_decomposition(
@@ -189,6 +206,7 @@ def draw_decomposition(
     Returns:
         The path written.
     """
+    from matplotlib.colors import to_rgb
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
@@ -202,41 +220,63 @@ def draw_decomposition(
     xmin, ymin, xmax, ymax = dec.map.bounds
     aspect = (ymax - ymin) / max(xmax - xmin, 1e-12)
     ncol = 2 if show_graph else 1
-    width = 6.2 * ncol
-    fig, axes = plt.subplots(
-        1,
-        ncol,
-        figsize=(width, min(9.0, 6.2 * aspect + 1.6)),
-        squeeze=False,
-        layout="constrained",
-    )
-    _draw_world(axes[0, 0], dec, label_regions)
-    verdict = "evader wins (Prop. 2)" if dec.evader_wins else "pursuer holds"
-    axes[0, 0].set_title(f"{dec.map.name}: critical curves and regions, L = {dec.L:g}", fontsize=10)
-    present = sorted({c.type for c in dec.curves})
-    handles = [
-        Line2D([], [], color=TYPE_COLOURS[t], lw=1.8, label=f"type {t}: {TYPE_NAMES[t]}")
-        for t in present
-    ]
-    handles.append(Patch(facecolor=_ESC, alpha=0.45, label="region with escapable cells"))
-    handles.append(Patch(facecolor=_ESC, alpha=0.6, hatch="////", label="only escapable cells"))
-    if show_graph:
-        _draw_graph(axes[0, 1], dec)
-        axes[0, 1].set_title(
-            f"connectivity graph $G_L$: {len(dec.cells)} cells, "
-            f"{dec.graph.number_of_edges()} adjacencies — {verdict}",
-            fontsize=10,
+    panel = 6.0
+    height = min(9.0, max(2.6, panel * aspect) + 1.3)
+    rc = {"hatch.linewidth": 0.5, "font.family": "DejaVu Sans", "axes.titlesize": 10}
+    with plt.rc_context(rc):
+        fig, axes = plt.subplots(
+            1, ncol, figsize=(panel * ncol, height), squeeze=False, layout="constrained"
         )
-        handles.append(Line2D([], [], marker="o", ls="", color=_SAFE, label="cell"))
-        handles.append(Line2D([], [], marker="o", ls="", color=_ESC, label="escapable cell"))
-    fig.legend(
-        handles=handles,
-        loc="outside lower center",
-        ncol=min(4, len(handles)),
-        fontsize=7.5,
-        frameon=False,
-    )
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=dpi)
-    plt.close(fig)
+        _draw_world(axes[0, 0], dec, label_regions)
+        n_esc = sum(c.escapable for c in dec.cells)
+        axes[0, 0].set_title(
+            f"{dec.map.name}: critical curves and {len(dec.regions)} regions, L = {dec.L:g}"
+        )
+        present = sorted({c.type for c in dec.curves})
+        handles = [
+            Line2D([], [], color=TYPE_COLOURS[t], lw=1.8, label=f"type {t}: {TYPE_NAMES[t]}")
+            for t in present
+        ]
+        handles.append(Patch(facecolor=_ESC, alpha=0.35, label="region with escapable cells"))
+        handles.append(
+            Patch(
+                facecolor=(*to_rgb(_ESC), 0.42),
+                edgecolor=(*to_rgb(_ESC_DARK), 0.55),
+                lw=0.0,
+                hatch="////",
+                label="only escapable cells (Prop. 2)",
+            )
+        )
+        if dec.evader_wins:
+            handles.append(
+                Line2D(
+                    [],
+                    [],
+                    marker="*",
+                    ls="",
+                    ms=10,
+                    color="#ffd23f",
+                    mec="#3d3d3d",
+                    label="witness region",
+                )
+            )
+        if show_graph:
+            _draw_graph(axes[0, 1], dec)
+            verdict = "the evader wins" if dec.evader_wins else "the pursuer holds"
+            axes[0, 1].set_title(
+                f"$G_L$: {len(dec.cells)} cells ({n_esc} escapable), "
+                f"{dec.graph.number_of_edges()} adjacencies: {verdict}"
+            )
+            handles.append(Line2D([], [], marker="o", ls="", color=_SAFE, label="cell"))
+            handles.append(Line2D([], [], marker="o", ls="", color=_ESC, label="escapable cell"))
+        fig.legend(
+            handles=handles,
+            loc="outside lower center",
+            ncol=min(4 if show_graph else 2, len(handles)),
+            fontsize=7.5,
+            frameon=False,
+        )
+        out.parent.mkdir(parents=True, exist_ok=True)
+        fig.savefig(out, dpi=dpi)
+        plt.close(fig)
     return out

@@ -32,9 +32,9 @@ def test_rays_through_vertices_and_from_walls():
     # into the concave room corner (5, 5) and onto the convex corner (0, 0)
     assert k.ray_distances((4, 4), [math.pi / 4], 10)[0] == pytest.approx(math.sqrt(2))
     assert k.ray_distances((1, 1), [-3 * math.pi / 4], 10)[0] == pytest.approx(math.sqrt(2))
-    # from a point on the bottom wall: up sees the far wall... over the free side
-    d = k.ray_distances((3, -5), [math.pi / 2, -math.pi / 2, 0.0], 20)
-    np.testing.assert_allclose(d, [10.0, 0.0, 2.0])
+    # from a point on the bottom wall: rays into free space see past the wall it rests on
+    d = k.ray_distances((3, -5), [math.pi / 2, -math.pi / 2, 0.0, math.pi / 4], 20)
+    np.testing.assert_allclose(d, [10.0, 0.0, 2.0, 2 * math.sqrt(2)])
     # from the top edge of the obstacle, straight up and straight down into it
     d = k.ray_distances((-1, 0), [math.pi / 2, -math.pi / 2], 20)
     np.testing.assert_allclose(d, [5.0, 0.0])

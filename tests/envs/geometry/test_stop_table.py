@@ -191,3 +191,17 @@ def test_control_pair_crossing_no_curve_has_identical_stops():
     b = k.free_arcs((-1.0 + OFF, 0.5 + OFF), L)
     assert _stops(a) == _stops(b)
     assert np.allclose([x.width for x in a.arcs], [x.width for x in b.arcs], atol=0.1)
+
+
+def test_vertex_on_the_circle_is_a_tip_stop_and_just_inside_a_body_stop():
+    world = square_obstacle_map()
+    k = kernel_for(world)
+    v = _vertex(world, (0, 0))
+    top = _edge(world, (-2, 0), (0, 0))
+    d = np.array([-0.6, 0.8])  # |d| = 1 = L: the top edge's clip ends exactly at v
+    on = k.free_arcs(d, L)
+    inside = k.free_arcs(d * (1 - 1e-6), L)
+    outside = k.free_arcs(d * (1 + 1e-6), L)
+    assert _stops(on) == [(Stop("tip", v), Stop("tip", top))]
+    assert _stops(inside) == [(Stop("body", v), Stop("tip", top))]
+    assert _stops(outside) == [(Stop("tip", top), Stop("tip", top))]

@@ -8,10 +8,17 @@ Surveillance breaks at the earliest ``t`` where
 * the rod touches a wall. While both ends stay in free space the rod can first touch a
   wall only at a convex obstacle vertex v (THEORY.md section 0), when v lies on the rod:
   ``cross(P(t) - v, E(t) - v) = 0`` (a quadratic in ``t``) with v strictly between the ends.
+  A graze (the rod's line reaching v and backing off, no real root) counts when the
+  closest approach, at the quadratic's extremum, is within ``eps``, as in line of sight.
+
+Candidate vertices come from the kernel's grid over the bounding box of the four points
+(the rod stays in their convex hull during the step). The earliest event wins; at equal
+times "occluded" comes before "too_far" before "too_close".
 
 Frames are checked too: a rod already blocked at ``t = 0`` is reported at time 0, and one
 found blocked at ``t = 1`` with no earlier vertex contact (an end pushed into a wall, or
-a contact lost to rounding) at time 1. Contacts of an end with a wall are not breaks,
+a contact lost to rounding) at time 1; their feature is the blocking feature nearest the
+evader. Contacts of an end with a wall are not breaks,
 as in :meth:`Kernel.line_of_sight`; two ends resting on the same wall edge *between*
 frames (the rod lying along the wall) are not detected.
 """

@@ -275,15 +275,14 @@ def sweep_step(
     )
     if dist is not None:
         cands.append((dist[0], dist[1], None))
-    if dist is None or dist[0] > 0.0:
-        if not kernel._los(e0x, e0y, p0x, p0y):
-            cands.append((0.0, "occluded", kernel.blocking_feature(e0, p0)))
-        else:
-            hit = _vertex_event(kernel, p0x, p0y, e0x, e0y, dpx, dpy, dex, dey)
-            if hit is not None:
-                cands.append((hit[0], "occluded", Feature("vertex", hit[1])))
-            elif not kernel._los(e1[0], e1[1], p1[0], p1[1]):
-                cands.append((1.0, "occluded", kernel.blocking_feature(e1, p1)))
+    if not kernel._los(e0x, e0y, p0x, p0y):
+        cands.append((0.0, "occluded", kernel.blocking_feature(e0, p0)))
+    elif dist is None or dist[0] > 0.0:
+        hit = _vertex_event(kernel, p0x, p0y, e0x, e0y, dpx, dpy, dex, dey)
+        if hit is not None:
+            cands.append((hit[0], "occluded", Feature("vertex", hit[1])))
+        elif not kernel._los(e1[0], e1[1], p1[0], p1[1]):
+            cands.append((1.0, "occluded", kernel.blocking_feature(e1, p1)))
     if not cands:
         return None
     t, cause, feature = min(cands, key=lambda c: (c[0], _CAUSE_ORDER[c[1]]))

@@ -209,3 +209,11 @@ def test_rod_grazing_a_corner_is_a_touch(dx, touches, numpy_path):
     assert ev is not None and ev.cause == "occluded"
     assert ev.time == pytest.approx(0.5, abs=1e-5)
     assert ev.feature == Feature("vertex", _vertex(world, (0, 0)))
+
+
+def test_occlusion_wins_a_tie_at_time_zero():
+    k = kernel_for(square_obstacle_map())
+    ev = k.sweep((1, -1), (-1, 1), (1, -1), (-1, 1), 0.0, 1.0)  # too far and occluded
+    assert (ev.time, ev.cause) == (0.0, "occluded")
+    ev = k.sweep((1, 1), (-1, 1), (1, 1), (-1, 1), 0.0, 1.0)  # too far only
+    assert (ev.time, ev.cause) == (0.0, "too_far")

@@ -100,3 +100,25 @@ def test_sb3_name_form_is_lazy_and_checks_the_file(box_config, tmp_path):
     assert pol.role is None and pol.model is None
     with pytest.raises(InvalidConfigError, match="no model file"):
         pol.reset(role="pursuer", map=box_config.map, config=box_config, seed=0)
+
+
+def test_every_policy_class_is_registered_and_exercised():
+    # completeness: a policy class added to the package but not to the registry (and so
+    # to the parametrised tests above and the theory matchups) fails here
+    import inspect
+
+    import strategies.policies.baselines as b
+    import strategies.policies.cooperative as c
+    import strategies.policies.decomposition as d
+    import strategies.policies.shooting as s
+    from strategies.policies import BasePolicy, policy_spec
+
+    classes = {
+        obj
+        for mod in (b, c, d, s)
+        for _, obj in inspect.getmembers(mod, inspect.isclass)
+        if issubclass(obj, BasePolicy) and obj is not BasePolicy and obj.__module__ == mod.__name__
+    }
+    registered = {policy_spec(n).factory for n in ALL}
+    assert classes <= registered, classes - registered
+    assert {n.split("/")[0] for n in ALL} == {"pursuer", "evader"}

@@ -1,8 +1,8 @@
 """A uniform bucket grid over a map: which wall edges / vertices lie near a query.
 
-Built once per kernel. Each edge is registered in every cell its bounding box, grown by
-the kernel's tolerance ``pad``, overlaps; so any point within ``pad`` of an edge lies in
-a cell that lists it. A segment query visits, row by row, exactly the cells that the
+Built once per kernel. Each edge is registered in every cell that it, grown by the
+kernel's tolerance ``pad``, overlaps; so any point within ``pad`` of an edge lies in a
+cell that lists it. A segment query visits, row by row, exactly the cells that the
 segment (grown by ``pad``) overlaps, so a query costs the number of nearby edges, not the
 size of the map. Pure Python on purpose: per-call numpy overhead dominates at this size.
 """
@@ -58,6 +58,11 @@ class Grid:
         j = math.floor((y - self.y0) * self.inv_h)
         return 0 if j < 0 else (self.ny - 1 if j >= self.ny else j)
 
+    def insert_segment(self, item: int, px: float, py: float, qx: float, qy: float) -> None:
+        """Register ``item`` in every cell the segment p-q (grown by ``pad``) overlaps."""
+        for c in self.segment_cells(px, py, qx, qy):
+            self._cells[c].append(item)
+
     def insert_box(self, item: int, xmin: float, ymin: float, xmax: float, ymax: float) -> None:
         """Register ``item`` in every cell its box (grown by ``pad``) overlaps."""
         p = self.pad
@@ -97,27 +102,16 @@ class Grid:
                 out.update(cells[row + i])
         return out
 
-    def query_segment(self, px: float, py: float, qx: float, qy: float):
-        """Items in the cells that segment p-q, grown by ``pad``, overlaps."""
+    def segment_cells(self, px: float, py: float, qx: float, qy: float) -> list[int]:
+        """Indices of the cells that segment p-q, grown by ``pad``, overlaps (row by row)."""
         p = self.pad
-        cells = self.cells
         nx = self.nx
         j0 = self._iy(min(py, qy) - p)
         j1 = self._iy(max(py, qy) + p)
-        if j0 == j1:
-            i0 = self._ix(min(px, qx) - p)
-            i1 = self._ix(max(px, qx) + p)
-            if i0 == i1:
-                return cells[j0 * nx + i0]
-            out: set[int] = set()
-            row = j0 * nx
-            for i in range(i0, i1 + 1):
-                out.update(cells[row + i])
-            return out
-        out = set()
         dy = qy - py
         dx = qx - px
         inv = 1.0 / dy if abs(dy) > p else 0.0
+        out: list[int] = []
         for j in range(j0, j1 + 1):
             if inv == 0.0:
                 xa, xb = (px, qx) if px <= qx else (qx, px)
@@ -136,6 +130,19 @@ class Grid:
                 if xa > xb:
                     xa, xb = xb, xa
             row = j * nx
-            for i in range(self._ix(xa - p), self._ix(xb + p) + 1):
-                out.update(cells[row + i])
+            out.extend(range(row + self._ix(xa - p), row + self._ix(xb + p) + 1))
+        return out
+
+    def query_segment(self, px: float, py: float, qx: float, qy: float):
+        """Items in the cells that segment p-q, grown by ``pad``, overlaps."""
+        p = self.pad
+        cells = self.cells
+        j0 = self._iy(min(py, qy) - p)
+        if j0 == self._iy(max(py, qy) + p):
+            i0 = self._ix(min(px, qx) - p)
+            if i0 == self._ix(max(px, qx) + p):
+                return cells[j0 * self.nx + i0]
+        out: set[int] = set()
+        for c in self.segment_cells(px, py, qx, qy):
+            out.update(cells[c])
         return out

@@ -123,7 +123,7 @@ class Kernel:
         self.grid = Grid((x0, y0), (x1, y1), world.n_edges, eps)
         for e in range(world.n_edges):
             ax, ay, bx, by = self._recs[e][:4]
-            self.grid.insert_box(e, min(ax, bx), min(ay, by), max(ax, bx), max(ay, by))
+            self.grid.insert_segment(e, ax, ay, bx, by)
         self.grid.freeze()
         self.vgrid = Grid((x0, y0), (x1, y1), world.n_edges, eps)
         for v in self._convex.tolist():

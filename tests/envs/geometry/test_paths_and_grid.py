@@ -100,7 +100,7 @@ def test_grid_segment_query_finds_every_nearby_edge(world):
         got = set(k.grid.query_segment(p[0], p[1], q[0], q[1]))
         assert near <= got
         box = set(k.grid.query_box(*np.minimum(p, q), *np.maximum(p, q)))
-        assert set(tree.query(seg.envelope).tolist()) <= box
+        assert set(tree.query(seg.envelope, predicate="intersects").tolist()) <= box
 
 
 @pytest.mark.parametrize(

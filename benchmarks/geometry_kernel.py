@@ -104,9 +104,9 @@ def bench(world: Map, n: int, repeat: int) -> dict[str, float]:
         "free_arcs (L=2)": per_call(kern.free_arcs, arc_args, repeat),
         "ray_distances (32 rays)": per_call(kern.ray_distances, ray_args, repeat),
     }
-    t0 = time.perf_counter()
-    kern.line_of_sight_many(E, P)
-    out["line_of_sight_many (per segment)"] = (time.perf_counter() - t0) / len(E)
+    out["line_of_sight_many (per segment)"] = per_call(
+        kern.line_of_sight_many, [(E, P)], repeat
+    ) / len(E)
     return out
 
 

@@ -54,11 +54,15 @@ def free_arcs_at(kernel: Kernel, px: float, py: float, L: float) -> FreeArcs:
     P = np.array([px, py])
     eps = kernel.eps
     r = L + eps
-    cand = kernel.grid.query_box(px - r, py - r, px + r, py + r)
+    cand = kernel.edges_near_box(px - r, py - r, px + r, py + r)
     if len(cand) > kernel.numpy_threshold:
-        blocks = _blocked_numpy(kernel, np.fromiter(cand, dtype=np.intp), px, py, L)
+        if not isinstance(cand, np.ndarray):
+            cand = np.fromiter(cand, dtype=np.intp, count=len(cand))
+        blocks = _blocked_numpy(kernel, cand, px, py, L)
     else:
-        blocks = _blocked_scalar(kernel, cand, px, py, L)
+        blocks = _blocked_scalar(
+            kernel, cand.tolist() if isinstance(cand, np.ndarray) else cand, px, py, L
+        )
     if blocks is None:  # P outside the closed free region
         return FreeArcs(P, float(L), ())
     lo, wid, lab_lo, lab_hi = blocks

@@ -50,11 +50,13 @@ class Grid:
         self.cells: list[tuple[int, ...]] = []
 
     # ------------------------------------------------------------------ building
-    def _ix(self, x: float) -> int:
+    def ix(self, x: float) -> int:
+        """Column of the cell containing x (clamped to the grid)."""
         i = math.floor((x - self.x0) * self.inv_h)
         return 0 if i < 0 else (self.nx - 1 if i >= self.nx else i)
 
-    def _iy(self, y: float) -> int:
+    def iy(self, y: float) -> int:
+        """Row of the cell containing y (clamped to the grid)."""
         j = math.floor((y - self.y0) * self.inv_h)
         return 0 if j < 0 else (self.ny - 1 if j >= self.ny else j)
 
@@ -66,9 +68,9 @@ class Grid:
     def insert_box(self, item: int, xmin: float, ymin: float, xmax: float, ymax: float) -> None:
         """Register ``item`` in every cell its box (grown by ``pad``) overlaps."""
         p = self.pad
-        for j in range(self._iy(ymin - p), self._iy(ymax + p) + 1):
+        for j in range(self.iy(ymin - p), self.iy(ymax + p) + 1):
             row = j * self.nx
-            for i in range(self._ix(xmin - p), self._ix(xmax + p) + 1):
+            for i in range(self.ix(xmin - p), self.ix(xmax + p) + 1):
                 self._cells[row + i].append(item)
 
     def freeze(self) -> None:
@@ -86,12 +88,12 @@ class Grid:
     # ------------------------------------------------------------------ queries
     def cell_of(self, x: float, y: float) -> int:
         """Index of the cell containing (x, y) (clamped to the grid)."""
-        return self._iy(y) * self.nx + self._ix(x)
+        return self.iy(y) * self.nx + self.ix(x)
 
     def query_box(self, xmin: float, ymin: float, xmax: float, ymax: float):
         """Items registered in the cells the box overlaps (a tuple or a set)."""
-        j0, j1 = self._iy(ymin), self._iy(ymax)
-        i0, i1 = self._ix(xmin), self._ix(xmax)
+        j0, j1 = self.iy(ymin), self.iy(ymax)
+        i0, i1 = self.ix(xmin), self.ix(xmax)
         cells = self.cells
         if j0 == j1 and i0 == i1:
             return cells[j0 * self.nx + i0]
@@ -106,8 +108,8 @@ class Grid:
         """Indices of the cells that segment p-q, grown by ``pad``, overlaps (row by row)."""
         p = self.pad
         nx = self.nx
-        j0 = self._iy(min(py, qy) - p)
-        j1 = self._iy(max(py, qy) + p)
+        j0 = self.iy(min(py, qy) - p)
+        j1 = self.iy(max(py, qy) + p)
         dy = qy - py
         dx = qx - px
         inv = 1.0 / dy if abs(dy) > p else 0.0
@@ -130,17 +132,17 @@ class Grid:
                 if xa > xb:
                     xa, xb = xb, xa
             row = j * nx
-            out.extend(range(row + self._ix(xa - p), row + self._ix(xb + p) + 1))
+            out.extend(range(row + self.ix(xa - p), row + self.ix(xb + p) + 1))
         return out
 
     def query_segment(self, px: float, py: float, qx: float, qy: float):
         """Items in the cells that segment p-q, grown by ``pad``, overlaps."""
         p = self.pad
         cells = self.cells
-        j0 = self._iy(min(py, qy) - p)
-        if j0 == self._iy(max(py, qy) + p):
-            i0 = self._ix(min(px, qx) - p)
-            if i0 == self._ix(max(px, qx) + p):
+        j0 = self.iy(min(py, qy) - p)
+        if j0 == self.iy(max(py, qy) + p):
+            i0 = self.ix(min(px, qx) - p)
+            if i0 == self.ix(max(px, qx) + p):
                 return cells[j0 * self.nx + i0]
         out: set[int] = set()
         for c in self.segment_cells(px, py, qx, qy):

@@ -118,6 +118,10 @@ class Kernel:
         self._tip_vertex = [Stop("tip", Feature("vertex", v)) for v in range(n)]
         self._body_vertex = [Stop("body", Feature("vertex", v)) for v in range(n)]
         self._convex = world.convex_vertices
+        self._exmin = np.minimum(a[:, 0], b[:, 0]) - eps
+        self._exmax = np.maximum(a[:, 0], b[:, 0]) + eps
+        self._eymin = np.minimum(a[:, 1], b[:, 1]) - eps
+        self._eymax = np.maximum(a[:, 1], b[:, 1]) + eps
         x0, y0, x1, y1 = world.bounds
         self._bounds = (x0 - eps, y0 - eps, x1 + eps, y1 + eps)
         self.grid = Grid((x0, y0), (x1, y1), world.n_edges, eps)
@@ -160,9 +164,20 @@ class Kernel:
         self._ref_free = point_in_walls(refs, self._a, self._b).tolist()
 
     # ------------------------------------------------------------------ prefilters
-    def edges_near_box(self, xmin: float, ymin: float, xmax: float, ymax: float) -> np.ndarray:
-        """Indices of edges in the grid cells the box overlaps (a superset of those within)."""
-        return np.fromiter(self.grid.query_box(xmin, ymin, xmax, ymax), dtype=np.intp)
+    def edges_near_box(self, xmin: float, ymin: float, xmax: float, ymax: float):
+        """Edges that may meet the box: a superset of those within ``eps`` of it.
+
+        A small box reads the grid cells it overlaps (a tuple or set of indices); a box
+        spanning many cells filters precomputed edge bounding boxes with numpy (an index
+        array), which is cheaper than merging many cells.
+        """
+        g = self.grid
+        ncells = (g.ix(xmax) - g.ix(xmin) + 1) * (g.iy(ymax) - g.iy(ymin) + 1)
+        if ncells <= 16:
+            return g.query_box(xmin, ymin, xmax, ymax)
+        m = (self._exmin <= xmax) & (self._exmax >= xmin)
+        m &= (self._eymin <= ymax) & (self._eymax >= ymin)
+        return np.flatnonzero(m)
 
     def _distance(self, x: float, y: float, e: int) -> float:
         """Distance from (x, y) to edge ``e``."""
@@ -416,6 +431,8 @@ class Kernel:
         eps = self.eps
         r = rmax + eps
         idx = self.edges_near_box(o[0] - r, o[1] - r, o[0] + r, o[1] + r)
+        if not isinstance(idx, np.ndarray):
+            idx = np.fromiter(idx, dtype=np.intp, count=len(idx))
         out = np.full(len(ang), rmax)
         if len(idx) == 0 or len(ang) == 0:
             return out

@@ -27,7 +27,7 @@ from strategies.cspace._rod import rods_semifree
 
 __all__ = ["CHORD_TOL_REL", "TYPE_NAMES", "CriticalCurve", "check_length", "critical_curves"]
 
-CHORD_TOL_REL = 1e-3
+CHORD_TOL_REL = 1e-4
 """Default polyline tolerance of arcs and conchoids, relative to the rod length L."""
 
 TYPE_NAMES = {

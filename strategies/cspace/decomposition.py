@@ -326,45 +326,64 @@ def _sample_point(poly: Polygon) -> np.ndarray:
     return np.array([p.x, p.y])
 
 
-def _probe(dec_cells, table_a, table_b, arcs_a, arcs_b, fa_plus, fa_minus, strict: bool):
-    """Match probe arcs to cells; return adjacency pairs or None if stops disagree."""
+def _assign(fa: FreeArcs, table: dict, rep: dict, strict: bool) -> list[int | None] | None:
+    """Cells of the arcs ``fa`` in a region (``table``: stop pair -> cell).
 
-    def assign(fa: FreeArcs, table, rep) -> list[int | None] | None:
-        keys = pairs(fa)
-        if set(keys) == set(table):
-            return [table[k] for k in keys]
-        if strict:
-            return None
-        out = []
-        for k, arc in zip(keys, fa.arcs, strict=True):
-            if k in table:
-                out.append(table[k])
-                continue
-            best = max(rep, key=lambda c: overlap(arc, rep[c]), default=None)
-            out.append(best if best is not None and overlap(arc, rep[best]) > OVERLAP_TOL else None)
-        return out
-
-    ia = assign(fa_plus, table_a, arcs_a)
-    ib = assign(fa_minus, table_b, arcs_b)
-    if ia is None or ib is None:
+    Strict: the stop pairs must be exactly the region's, else ``None``. Otherwise an arc
+    with unknown stops goes to the region's cell whose sample arc overlaps it most.
+    """
+    keys = pairs(fa)
+    if set(keys) == set(table):
+        return [table[k] for k in keys]
+    if strict:
         return None
+    out = []
+    for k, arc in zip(keys, fa.arcs, strict=True):
+        if k in table:
+            out.append(table[k])
+            continue
+        best = max(rep, key=lambda c: overlap(arc, rep[c]), default=None)
+        out.append(best if best is not None and overlap(arc, rep[best]) > OVERLAP_TOL else None)
+    return out
+
+
+def _adjacent(fa_a, ia, fa_b, ib) -> tuple[tuple[int, int], ...]:
+    """Pairs of cells whose arcs overlap with positive length (footnote 3)."""
     adj = set()
-    for x, ca in zip(fa_plus.arcs, ia, strict=True):
-        for y, cb in zip(fa_minus.arcs, ib, strict=True):
+    for x, ca in zip(fa_a.arcs, ia, strict=True):
+        for y, cb in zip(fa_b.arcs, ib, strict=True):
             if ca is not None and cb is not None and overlap(x, y) > OVERLAP_TOL:
                 adj.add((ca, cb))
     return tuple(sorted(adj))
 
 
-def _boundary(bid, piece: Piece, curves, kernel, L, regions_cells, eps0) -> Boundary:
+def _walk(kernel, L, p, n, table, eps, reach) -> FreeArcs | None:
+    """Free arcs at the first point ``p + s n`` (s = eps, 3 eps, ...) with the region's stops."""
+    s = eps
+    while s <= reach:
+        fa = kernel.free_arcs(p + s * n, L)
+        if set(pairs(fa)) == set(table):
+            return fa
+        s *= 3.0
+    return None
+
+
+def _boundary(bid, piece: Piece, curves, kernel, L, regions_cells, eps0, reach) -> Boundary:
+    """Adjacency across a boundary piece from the free arcs at two probe points.
+
+    The probes sit at ``+- eps`` along the normal of the piece's longest segments, at the
+    exact curve point. When the stops there are not exactly the two regions' (a thin
+    region the polylines do not resolve, within the chord tolerance), the probes walk
+    out along the normal (up to ``reach``) to the first points with the regions' stops;
+    failing that, arcs are matched to cells by overlap (``resolved=False`` either way).
+    """
     a, b = piece.faces
     table_a, arcs_a = regions_cells[a]
     table_b, arcs_b = regions_cells[b]
     seg = piece.segments
     lens = np.hypot(*(seg[:, 1] - seg[:, 0]).T)
-    order = np.argsort(-lens)[:_PROBE_SEGMENTS]
-    first = None
-    for k in order.tolist():
+    probes = []
+    for k in np.argsort(-lens)[:_PROBE_SEGMENTS].tolist():
         p0, p1 = seg[k]
         d = (p1 - p0) / lens[k]
         n = np.array([-d[1], d[0]])
@@ -372,19 +391,26 @@ def _boundary(bid, piece: Piece, curves, kernel, L, regions_cells, eps0) -> Boun
         if piece.curves:
             c = curves[piece.curves[0]]
             if c.shape != "segment":
-                P, _ = c.evaluate(c.project(mid[None]))
-                mid = P[0]
-        for eps in (min(eps0, 1e-3 * lens[k]), min(eps0, 1e-3 * lens[k]) * 1e-2):
-            fp = kernel.free_arcs(mid + eps * n, L)
-            fm = kernel.free_arcs(mid - eps * n, L)
-            if first is None:
-                first = (mid, n, fp, fm)
-            adj = _probe(None, table_a, table_b, arcs_a, arcs_b, fp, fm, strict=True)
-            if adj is not None:
-                return Boundary(bid, (a, b), piece.curves, seg, mid, n, adj, True)
-    mid, n, fp, fm = first
-    adj = _probe(None, table_a, table_b, arcs_a, arcs_b, fp, fm, strict=False)
-    return Boundary(bid, (a, b), piece.curves, seg, mid, n, adj, False)
+                mid = c.evaluate(c.project(mid[None]))[0][0]
+        eps = min(eps0, 1e-3 * lens[k])
+        probes.append((mid, n, eps))
+        for e in (eps, 1e-2 * eps):
+            fp = kernel.free_arcs(mid + e * n, L)
+            fm = kernel.free_arcs(mid - e * n, L)
+            ia = _assign(fp, table_a, arcs_a, strict=True)
+            ib = _assign(fm, table_b, arcs_b, strict=True)
+            if ia is not None and ib is not None:
+                return Boundary(bid, (a, b), piece.curves, seg, mid, n, _adjacent(fp, ia, fm, ib))
+    mid, n, eps = probes[0]
+    fp = _walk(kernel, L, mid, n, table_a, eps, reach)
+    fm = _walk(kernel, L, mid, -n, table_b, eps, reach)
+    if fp is None:
+        fp = kernel.free_arcs(mid + eps * n, L)
+    if fm is None:
+        fm = kernel.free_arcs(mid - eps * n, L)
+    ia = _assign(fp, table_a, arcs_a, strict=False)
+    ib = _assign(fm, table_b, arcs_b, strict=False)
+    return Boundary(bid, (a, b), piece.curves, seg, mid, n, _adjacent(fp, ia, fm, ib), False)
 
 
 def _escapable(n_cells: int, boundaries: tuple[Boundary, ...], cell_region: list[int]):
@@ -485,8 +511,10 @@ def build_decomposition(world: Map, L: float, chord_tol: float | None = None) ->
         if group[p.faces[0]] != group[p.faces[1]]
     ]
     eps0 = ADJ_EPS_REL * world.scale
+    reach = max(30.0 * tol, 1e-4 * world.scale)
     boundaries = tuple(
-        _boundary(i, piece, curves, kernel, L, region_cells, eps0) for i, piece in enumerate(pieces)
+        _boundary(i, piece, curves, kernel, L, region_cells, eps0, reach)
+        for i, piece in enumerate(pieces)
     )
     cell_region = [c[0] for c in cells_tmp]
     esc, reason, via = _escapable(len(cells_tmp), boundaries, cell_region)

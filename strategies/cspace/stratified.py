@@ -121,7 +121,9 @@ def critical_lengths(
         l_min: smallest rod length.
         l_max: largest rod length.
         samples: sample lengths per interval between consecutive candidates (>= 1); an
-            event between two samples whose hashes differ is located by bisection.
+            event between two samples whose hashes differ is located by bisection, so
+            events off the candidates are found only with ``samples >= 2`` (and only
+            when they change the hash between two samples).
         tol: bisection tolerance in L (default ``1e-4 * (l_max - l_min)``).
         chord_tol: passed to :func:`decompose`.
 

@@ -76,3 +76,12 @@ def stops(fa: FreeArcs) -> Counter:
 def stop_pairs(fa: FreeArcs) -> frozenset:
     """The set of stop pairs at a point."""
     return frozenset((a.stop_lo, a.stop_hi) for a in fa.arcs)
+
+
+def resolvable(arcs, step: float) -> bool:
+    """Whether every free arc and every blocked gap between them is wider than ``step``."""
+    arcs = list(arcs)
+    if not arcs or (len(arcs) == 1 and arcs[0].is_full):
+        return True
+    gaps = [(arcs[(k + 1) % len(arcs)].lo - a.hi) % (2 * math.pi) for k, a in enumerate(arcs)]
+    return min(a.width for a in arcs) > step and min(gaps) > step

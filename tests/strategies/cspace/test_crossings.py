@@ -18,6 +18,7 @@ from tests.strategies.cspace._oracle import (
     circular_runs,
     corridor,
     pillar_room,
+    resolvable,
     stop_pairs,
     stops,
     two_rooms,
@@ -43,13 +44,6 @@ def _involved(world, curve) -> set[Feature]:
             for v in world.edge_vertices[f.index]:
                 out.add(Feature("vertex", int(v)))
     return out
-
-
-def _resolvable(fa, step: float) -> bool:
-    """Whether every free arc and every blocked gap is wider than ``step``."""
-    arcs = fa.arcs
-    gaps = [(arcs[(k + 1) % len(arcs)].lo - a.hi) % (2 * math.pi) for k, a in enumerate(arcs)]
-    return min(a.width for a in arcs) > step and min(gaps) > step
 
 
 def _crossing_samples(world, L, rng, per_curve=4, delta=2e-4):
@@ -105,7 +99,7 @@ def test_every_crossing_changes_the_stops_of_the_curves_features(name, L):
             mask = brute_free(world, p, L, n=2048)
             if fa_.is_full:
                 assert mask.all()
-            elif _resolvable(fa_, 4 * 2 * math.pi / 2048):
+            elif resolvable(fa_.arcs, 4 * 2 * math.pi / 2048):
                 assert circular_runs(mask) == len(fa_.arcs), (c.name, p)
     assert {1, 2} <= checked
 

@@ -61,17 +61,24 @@ def test_critical_lengths_find_the_type3_birth():
     assert below != above
 
 
+@pytest.mark.slow
 def test_critical_lengths_locate_events_prop1_misses_by_bisection():
-    """On the corridor world an event lies between two candidates (erratum E10)."""
-    world = corridor()
-    cands = candidate_lengths(world, 1.0, 2.2)
-    crit = critical_lengths(world, 1.0, 2.2, samples=2, tol=1e-3)
-    extra = [c for c in crit if all(abs(c - d) > 1e-6 for d in cands)]
-    assert extra, (cands, crit)
-    for c in extra:  # the hash really differs on the two sides of the event
-        lo = graph_signature(decompose(world, c - 5e-3))
-        hi = graph_signature(decompose(world, c + 5e-3))
-        assert lo != hi, c
+    """Erratum E10: the end a + L n of edge [(-1, 0), (1, 0)]'s type-1 segment crosses the
+    type-2 circle of radius L about v = (3, 1.2) at L* = |w|^2 / (2 w.n), w = v - a,
+    which is no vertex-vertex or vertex-edge distance nor half of one."""
+    world = Map(
+        [(-8, -8), (12, -8), (12, 10), (-8, 10)],
+        [[(-1, -2), (1, -2), (1, 0), (-1, 0)], [(3, 1.2), (3.8, 2.0), (3.0, 2.6)]],
+    )
+    w = np.array([3.0, 1.2]) - np.array([1.0, 0.0])
+    star = float(w @ w / (2 * w[1]))
+    lo, hi = star - 0.01, star + 0.01
+    assert candidate_lengths(world, lo, hi) == ()
+    assert graph_signature(decompose(world, lo)) != graph_signature(decompose(world, hi))
+    crit = critical_lengths(world, lo, hi, samples=2, tol=2e-4)
+    assert crit and min(abs(c - star) for c in crit) < 1e-3, (star, crit)
+    for c in crit:  # each reported event separates different structures
+        assert lo < c < hi
 
 
 def test_stratified_graph_links_every_cell_to_the_shorter_rod():

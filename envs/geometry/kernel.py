@@ -363,6 +363,8 @@ class Kernel:
         e1: ArrayLike,
         l_min: float,
         l_max: float,
+        *,
+        start_clear: bool = False,
     ) -> SweepEvent | None:
         """First moment in a step where surveillance breaks, or None if it holds.
 
@@ -377,6 +379,9 @@ class Kernel:
             e1: evader at the end of the step.
             l_min: minimum distance (>= 0).
             l_max: maximum distance (>= l_min).
+            start_clear: the caller knows the rod e0-p0 is clear (the env does: the step
+                starts where the previous one ended with surveillance held), which skips
+                the line-of-sight test of the first frame.
 
         Returns:
             The earliest :class:`SweepEvent`, or None.
@@ -389,7 +394,7 @@ class Kernel:
         l_max = _length(l_max, "sweep l_max")
         if l_max < l_min:
             raise InvalidConfigError(f"sweep: expected l_min <= l_max, got {l_min} > {l_max}")
-        return sweep_step(self, p0, e0, p1, e1, l_min, l_max)
+        return sweep_step(self, p0, e0, p1, e1, l_min, l_max, start_clear)
 
     # ------------------------------------------------------------------ free arcs
     def free_arcs(self, point: ArrayLike, L: float) -> FreeArcs:

@@ -39,6 +39,8 @@ if TYPE_CHECKING:
 __all__ = ["sweep_step"]
 
 _CAUSE_ORDER = {"occluded": 0, "too_far": 1, "too_close": 2}
+_NO_CANDIDATE = (math.inf, -1)
+"""Returned by :func:`_vertex_event` when no convex vertex lies near the swept rod."""
 
 
 def _quad_roots(c2: float, c1: np.ndarray, c0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -129,6 +131,8 @@ def _vertex_event(
     xs = (p0x, p0x + dpx, e0x, e0x + dex)
     ys = (p0y, p0y + dpy, e0y, e0y + dey)
     cand = kernel.vgrid.query_box(min(xs) - eps, min(ys) - eps, max(xs) + eps, max(ys) + eps)
+    if not cand:
+        return _NO_CANDIDATE
     if len(cand) > kernel.numpy_threshold:
         return _vertex_event_numpy(
             kernel,
@@ -263,6 +267,7 @@ def sweep_step(
     e1: tuple[float, float],
     l_min: float,
     l_max: float,
+    start_clear: bool = False,
 ) -> SweepEvent | None:
     """See :meth:`Kernel.sweep` (arguments already validated, as float pairs)."""
     p0x, p0y = p0
@@ -275,11 +280,15 @@ def sweep_step(
     )
     if dist is not None:
         cands.append((dist[0], dist[1], None))
-    if not kernel._los(e0x, e0y, p0x, p0y):
+    if not start_clear and not kernel._los(e0x, e0y, p0x, p0y):
         cands.append((0.0, "occluded", kernel.blocking_feature(e0, p0)))
     elif dist is None or dist[0] > 0.0:
         hit = _vertex_event(kernel, p0x, p0y, e0x, e0y, dpx, dpy, dex, dey)
-        if hit is not None:
+        if hit is _NO_CANDIDATE:
+            # no convex vertex near the swept rod: clear at t = 0 with both ends free, it
+            # cannot become blocked by t = 1 (it would have to sweep over a vertex first)
+            pass
+        elif hit is not None:
             cands.append((hit[0], "occluded", Feature("vertex", hit[1])))
         elif not kernel._los(e1[0], e1[1], p1[0], p1[1]):
             cands.append((1.0, "occluded", kernel.blocking_feature(e1, p1)))

@@ -265,7 +265,8 @@ class parallel_env(ParallelEnv, EzPickle):
         ve = self._command(EVADER, actions[EVADER])
         p0, e0 = self._pursuer, self._evader
         p1, e1 = self.world.step(vp, ve)
-        event = self.kernel.sweep(p0, e0, p1, e1, cfg.l_min, cfg.l_max)
+        # the step starts clear: reset validated it, and a broken step ends the episode
+        event = self.kernel.sweep(p0, e0, p1, e1, cfg.l_min, cfg.l_max, start_clear=True)
         self._step += 1
         inv_dt = self._inv_dt
         self._vp = ((p1[0] - p0[0]) * inv_dt, (p1[1] - p0[1]) * inv_dt)

@@ -158,6 +158,11 @@ def test_sweep_matches_dense_sampling(world):
     events = 0
     for p0, e0, p1, e1 in _random_steps(world, rng, 40, l_min, l_max, reach=1.5):
         ev = k.sweep(p0, e0, p1, e1, l_min, l_max)
+        # the env's shortcut (start known clear) must not change any answer
+        fast = k.sweep(p0, e0, p1, e1, l_min, l_max, start_clear=True)
+        assert (ev is None) == (fast is None)
+        if ev is not None:
+            assert (fast.time, fast.cause, fast.feature) == (ev.time, ev.cause, ev.feature)
         t, fail = _dense_failures(world, p0, e0, p1, e1, l_min, l_max)
         if ev is None:
             assert not fail.any(), (p0, e0, p1, e1)

@@ -20,9 +20,10 @@ import tempfile
 from pathlib import Path
 
 from envs.maps.map import Map
+from strategies.cspace._build import build_decomposition
 from strategies.cspace.arrangement import SNAP_REL
 from strategies.cspace.curves import CHORD_TOL_REL
-from strategies.cspace.decomposition import ADJ_EPS_REL, Decomposition, build_decomposition
+from strategies.cspace.decomposition import ADJ_EPS_REL, Decomposition
 
 __all__ = ["FORMAT_VERSION", "cache_path", "cached_decomposition", "resolve_cache_dir"]
 

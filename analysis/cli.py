@@ -125,12 +125,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_maps)
 
     p = sub.add_parser("play", help="play one episode and write its replay (the main job)")
-    p.add_argument("--map", default="corridor", help="built-in name or map file (default: corridor)")
+    p.add_argument(
+        "--map", default="corridor", help="built-in name or map file (default: corridor)"
+    )
     p.add_argument("--pursuer", default="pursuer/decomposition", help="registered pursuer policy")
     p.add_argument("--evader", default="evader/shooting", help="registered evader policy")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--max-cycles", type=int, default=None, help="episode horizon in steps")
-    p.add_argument("--config", help='env overrides as JSON, e.g. \'{"v_evader": 0.8}\'')
+    p.add_argument("--config", help="env overrides as JSON, e.g. '{\"v_evader\": 0.8}'")
     p.add_argument("--out", default=str(DEFAULT_OUT / "play.gif"), help="GIF path")
     p.add_argument("--fps", type=int, default=20)
     p.add_argument("--overlay", action="store_true", help="draw the decomposition under the replay")
@@ -146,7 +148,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("figure", help="draw the paper's optimal-control figures")
     p.add_argument("name", choices=["shooting", "greedy", "tractrix"])
-    p.add_argument("--params", help='parameters as JSON, e.g. \'{"rho": 0.5}\'')
+    p.add_argument("--params", help="parameters as JSON, e.g. '{\"rho\": 0.5}'")
     p.add_argument("--out", help="PNG path")
     p.set_defaults(func=_cmd_figure)
 

@@ -121,6 +121,7 @@ class EpisodeResult:
         trajectory: (steps + 1, 2, 2) positions ``[pursuer, evader]`` per step.
         frames: rendered RGB frames when recorded, else ``None``.
         map_obj: the :class:`Map` (for replays; not serialised).
+        config: the env's ``EnvConfig`` (for replays; not serialised).
     """
 
     map: str
@@ -138,6 +139,7 @@ class EpisodeResult:
     trajectory: np.ndarray | None = field(default=None, repr=False)
     frames: list[np.ndarray] | None = field(default=None, repr=False)
     map_obj: Any = field(default=None, repr=False)
+    config: Any = field(default=None, repr=False)
 
     def summary(self) -> str:
         """One line: who won, why and when."""
@@ -149,7 +151,7 @@ class EpisodeResult:
     def to_record(self) -> dict[str, Any]:
         """JSON-ready dict without trajectory and frames."""
         d = asdict(self)
-        for k in ("trajectory", "frames", "map_obj"):
+        for k in ("trajectory", "frames", "map_obj", "config"):
             d.pop(k)
         return d
 
@@ -282,6 +284,7 @@ def play_episode(
         trajectory=np.asarray(traj),
         frames=frames,
         map_obj=config.map,
+        config=config,
     )
 
 

@@ -18,20 +18,22 @@ from envs.errors import InvalidConfigError
 __all__ = ["frames_from_trajectory", "write_replay", "write_strip"]
 
 
-def frames_from_trajectory(result: Any, *, size: int = 480, trail: int = 60) -> list[np.ndarray]:
+def frames_from_trajectory(
+    result: Any, *, size: int = 600, trail: int = 60, shading: tuple = ()
+) -> list[np.ndarray]:
     """Redraw every step of a played episode from its recorded positions.
 
     Args:
-        result: an :class:`analysis.evaluate.EpisodeResult` with ``trajectory`` and ``map_obj``.
+        result: an :class:`analysis.evaluate.EpisodeResult` with ``trajectory``,
+            ``map_obj`` and ``config``.
         size: pixels along the map's longer side.
         trail: how many past positions to draw behind each agent.
+        shading: ``Snapshot.shading`` polygons drawn under the agents.
     """
     from envs.surveillance.render import Snapshot, render_frame
 
     traj = np.asarray(result.trajectory)
-    config = result.config if hasattr(result, "config") else None
-    l_min = getattr(config, "l_min", None) or result.overrides.get("l_min", 0.0)
-    l_max = getattr(config, "l_max", None) or result.overrides.get("l_max", 0.0)
+    config = result.config
     frames = []
     for k, (p, e) in enumerate(traj):
         last = k == len(traj) - 1
@@ -43,15 +45,16 @@ def frames_from_trajectory(result: Any, *, size: int = 480, trail: int = 60) -> 
                     map=result.map_obj,
                     pursuer=(float(p[0]), float(p[1])),
                     evader=(float(e[0]), float(e[1])),
-                    l_min=float(l_min),
-                    l_max=float(l_max),
-                    body_radius=0.1,
+                    l_min=config.l_min,
+                    l_max=config.l_max,
+                    body_radius=config.body_radius,
                     surveillance=not broken,
                     cause=result.cause if broken else None,
                     step=k,
                     time=k * result.dt,
                     trail_pursuer=tuple(map(tuple, traj[lo : k + 1, 0])),
                     trail_evader=tuple(map(tuple, traj[lo : k + 1, 1])),
+                    shading=shading,
                 ),
                 size=size,
             )
@@ -64,14 +67,6 @@ def _frames(result: Any) -> list[np.ndarray]:
     if not frames:
         raise InvalidConfigError("the episode has no frames and no trajectory to draw")
     return list(frames)
-
-
-def _overlay(result: Any, frames: list[np.ndarray]) -> list[np.ndarray]:
-    """Tint the free space of each frame by the decomposition at L_min (safe/escapable)."""
-    from analysis.overlay import decomposition_tint
-
-    tint = decomposition_tint(result, frames[0].shape)
-    return [np.where(tint[..., 3:4] > 0, tint[..., :3], f).astype(np.uint8) for f in frames]
 
 
 def write_replay(
@@ -93,9 +88,13 @@ def write_replay(
     path = Path(path)
     if fps <= 0:
         raise InvalidConfigError(f"fps must be a positive integer, got {fps!r}")
-    frames = _frames(result)
     if decomposition:
-        frames = _overlay(result, frames)
+        from analysis.overlay import decomposition_shading
+
+        shading = decomposition_shading(result.map_obj, result.config.l_min)
+        frames = frames_from_trajectory(result, shading=shading)
+    else:
+        frames = _frames(result)
     if path.suffix.lower() == ".png":
         return write_strip(frames, path)
     if path.suffix.lower() != ".gif":

@@ -51,6 +51,8 @@ class Snapshot:
         feature: the occluding wall feature, if any.
         step, time: steps taken and simulated time.
         trail_pursuer, trail_evader: recent centres, oldest first (may be empty).
+        shading: ``(polygon, rgb)`` pairs filled over free space under everything else
+            (a caller's overlay, e.g. regions of a decomposition; the env sets none).
     """
 
     map: Map
@@ -66,6 +68,7 @@ class Snapshot:
     time: float = 0.0
     trail_pursuer: tuple[tuple[float, float], ...] = ()
     trail_evader: tuple[tuple[float, float], ...] = ()
+    shading: tuple[tuple[np.ndarray, tuple[int, int, int]], ...] = ()
 
 
 def _pygame() -> Any:
@@ -105,6 +108,9 @@ def _draw(pygame: Any, surface: Any, frame: _Frame, snap: Snapshot) -> None:
     m = snap.map
     surface.fill(_BACKGROUND)
     pygame.draw.polygon(surface, _FREE, [frame.px(v) for v in m.rings[0]])
+    for polygon, colour in snap.shading:
+        if len(polygon) >= 3:
+            pygame.draw.polygon(surface, colour, [frame.px(v) for v in polygon])
     for ring in m.rings[1:]:
         pygame.draw.polygon(surface, _WALL, [frame.px(v) for v in ring])
     for ring in m.rings:

@@ -1,0 +1,97 @@
+"""The ``surveil`` command line, run in-process as a user would."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from analysis.cli import main
+
+
+def test_maps_lists_every_builtin(capsys):
+    from envs.maps import builtin_names
+
+    assert main(["maps"]) == 0
+    out = capsys.readouterr().out
+    for name in builtin_names():
+        assert name in out
+
+
+def test_play_prints_the_outcome_and_writes_a_gif(tmp_path, capsys):
+    out = tmp_path / "replay.gif"
+    code = main(
+        [
+            "play",
+            "--map",
+            "open_room",
+            "--pursuer",
+            "pursuer/greedy",
+            "--evader",
+            "evader/straight",
+            "--seed",
+            "1",
+            "--max-cycles",
+            "15",
+            "--out",
+            str(out),
+        ]
+    )
+    assert code == 0
+    text = capsys.readouterr().out
+    assert "open_room" in text and ("kept surveillance" in text or "escaped" in text)
+    with Image.open(out) as gif:
+        assert gif.n_frames >= 2
+        first = np.asarray(gif.convert("RGB"))
+        gif.seek(gif.n_frames - 1)
+        last = np.asarray(gif.convert("RGB"))
+    assert first.shape == last.shape and not np.array_equal(first, last)
+
+
+def test_play_png_strip_with_decomposition_overlay(tmp_path):
+    out = tmp_path / "strip.png"
+    code = main(
+        [
+            "play",
+            "--map",
+            "corridor",
+            "--pursuer",
+            "pursuer/greedy",
+            "--evader",
+            "evader/random",
+            "--max-cycles",
+            "8",
+            "--overlay",
+            "--out",
+            str(out),
+        ]
+    )
+    assert code == 0
+    img = np.asarray(Image.open(out).convert("RGB"))
+    # the overlay paints regions with escapable cells in its two tints
+    from analysis.overlay import ONLY_ESCAPABLE, SOME_ESCAPABLE
+
+    colours = {tuple(c) for c in img.reshape(-1, 3)[::7]}
+    assert SOME_ESCAPABLE in colours or ONLY_ESCAPABLE in colours
+
+
+def test_analyze_writes_the_decomposition_picture(tmp_path, capsys):
+    out = tmp_path / "dec.png"
+    assert main(["analyze", "corridor", "--length", "2", "--out", str(out)]) == 0
+    assert "pursuer can hold" in capsys.readouterr().out
+    with Image.open(out) as img:
+        assert img.size[0] > 400 and img.size[1] > 200
+
+
+def test_figure_tractrix(tmp_path):
+    out = tmp_path / "tractrix.png"
+    assert main(["figure", "tractrix", "--out", str(out)]) == 0
+    assert out.stat().st_size > 1000
+
+
+def test_bad_input_is_a_clear_error(capsys):
+    assert main(["play", "--map", "no_such_map", "--no-gif"]) == 2
+    err = capsys.readouterr().err
+    assert "no_such_map" in err
+    with pytest.raises(SystemExit):
+        main(["play", "--seed", "not-a-number"])

@@ -58,6 +58,8 @@ MAX_GRID_POINTS = 4_000_000
 _TWO_PI = 2.0 * math.pi
 _HALF_OFFSETS = {4: ((1, 0), (0, 1)), 8: ((1, 0), (0, 1), (1, 1), (1, -1))}
 _CHUNK = 16_384
+_MAX_TURN = 0.3  # rad: a step on which some stop turns farther than this is resampled
+_MAX_DEPTH = 5  # bisections of a grid step: the finest sample spacing is resolution / 32
 
 
 # --------------------------------------------------------------------------- validation
@@ -172,6 +174,93 @@ def _concat_ranges(starts: np.ndarray, stops: np.ndarray) -> np.ndarray:
     return np.repeat(starts - offsets, lens) + np.arange(total)
 
 
+def _arrays(arcs) -> tuple[np.ndarray, np.ndarray]:
+    return np.array([a.lo for a in arcs], dtype=float), np.array([a.hi for a in arcs], dtype=float)
+
+
+def _gaps_after(lo: np.ndarray, hi: np.ndarray, ptr: np.ndarray) -> np.ndarray:
+    """Width of the blocked gap after each arc, up to the next arc of the same point."""
+    nxt = np.arange(len(lo)) + 1
+    last = ptr[1:][ptr[1:] > ptr[:-1]] - 1  # the last arc of each point with arcs
+    nxt[last] = ptr[:-1][ptr[1:] > ptr[:-1]]
+    return (lo[nxt] - hi) % _TWO_PI
+
+
+def _plain_steps(
+    lo_s, hi_s, lo_t, hi_t, gap_s, gap_t, hit, slot_s, slot_t, step, n_s, n_t
+) -> np.ndarray:
+    """Which steps the plain overlap rule (footnote 3) settles, vectorised over steps.
+
+    Inputs describe every (arc at s, arc at t) pair of every step: the arcs' ends and the
+    blocked gaps after them, whether they overlap (``hit``), the pair's slot among the
+    step's arcs at s and at t, the step index, and the arc counts at both ends of each
+    step. A step is settled when
+
+    * an end has no arc (nothing can connect), or an end is the full circle (it meets
+      every arc across; an arc born inside the step could only be over-connected), or
+    * both ends have equally many arcs and the overlaps pair them one to one; with two
+      arcs or more, also no stop of a pair turns by more than ``_MAX_TURN`` or than half
+      the narrowest gap between arcs: each arc can only have become its partner, and no
+      two arcs can have merged (letting the pursuer switch) and split again. With one arc
+      a side, overlapping arcs are connected unless the arc died and another was born
+      within the step, which only over-connects.
+
+    Otherwise an arc may have turned past its own width (the pursuer follows it, yet the
+    arcs at the two ends do not overlap) or arcs were born, died, split or merged on the
+    way, and the step is resampled (:func:`_step_relation`).
+    """
+    n_steps = len(n_s)
+    full = lambda lo, hi: hi - lo >= _TWO_PI - OVERLAP_TOL
+    full_s = np.bincount(step, weights=full(lo_s, hi_s), minlength=n_steps) > 0
+    full_t = np.bincount(step, weights=full(lo_t, hi_t), minlength=n_steps) > 0
+    deg_s = np.bincount(slot_s[hit], minlength=int(n_s.sum()))
+    deg_t = np.bincount(slot_t[hit], minlength=int(n_t.sum()))
+    bad = np.zeros(n_steps, dtype=bool)
+    bad[np.repeat(np.arange(n_steps), n_s)[deg_s != 1]] = True
+    bad[np.repeat(np.arange(n_steps), n_t)[deg_t != 1]] = True
+    wrap = lambda x: np.abs((x + math.pi) % _TWO_PI - math.pi)
+    turn = np.maximum(wrap(lo_t - lo_s), wrap(hi_t - hi_s))
+    # with two arcs or more a side, no stop may turn farther than half the narrowest gap
+    gap = np.full(n_steps, 2.0 * _MAX_TURN)
+    np.minimum.at(gap, step, np.minimum(gap_s, gap_t))
+    multi = (n_s[step] > 1) | (n_t[step] > 1)  # one arc a side: overlapping is enough
+    bad[step[hit & multi & (turn > 0.5 * gap[step])]] = True
+    return (n_s == 0) | (n_t == 0) | full_s | full_t | ((n_s == n_t) & ~bad)
+
+
+def _relation_once(s: tuple, t: tuple) -> tuple[np.ndarray, bool]:
+    """The overlap relation of one step and whether :func:`_plain_steps` settles it."""
+    ns, nt = len(s[1]), len(t[1])
+    i, j = np.divmod(np.arange(ns * nt), max(nt, 1))
+    hit = _arcs_overlap(s[1][i], s[2][i], t[1][j], t[2][j])
+    gap_s = _gaps_after(s[1], s[2], np.array([0, ns]))
+    gap_t = _gaps_after(t[1], t[2], np.array([0, nt]))
+    zero = np.zeros(ns * nt, dtype=np.int64)
+    n_s, n_t = np.array([ns]), np.array([nt])
+    args = (s[1][i], s[2][i], t[1][j], t[2][j], gap_s[i], gap_t[j], hit, i, j, zero, n_s, n_t)
+    settled = _plain_steps(*args)[0]
+    return hit.reshape(ns, nt), bool(settled)
+
+
+def _step_relation(kernel, L: float, s: tuple, t: tuple, depth: int) -> np.ndarray:
+    """Which arcs at sample s connect to which at sample t along the segment s-t.
+
+    ``s`` and ``t`` are ``(point, lo, hi)``. A step the overlap rule settles is its
+    overlap relation; otherwise it is bisected (free arcs at the midpoint from the kernel)
+    and the halves' relations are composed: a chain of arcs along the step. After
+    ``depth`` bisections the overlap rule decides anyway: a critical curve lies in this
+    sliver, and an arc that vanishes on it overlaps nothing across (THEORY 1.3).
+    """
+    rel, settled = _relation_once(s, t)
+    if settled or depth == 0:
+        return rel
+    mid_point = 0.5 * (s[0] + t[0])
+    mid = (mid_point, *_arrays(kernel.free_arcs(mid_point, L).arcs))
+    first = _step_relation(kernel, L, s, mid, depth - 1).astype(np.int64)
+    second = _step_relation(kernel, L, mid, t, depth - 1).astype(np.int64)
+    return (first @ second) > 0
+
+
 # --------------------------------------------------------------------------- the graph
 @dataclass(frozen=True, eq=False)
 class GridGraph:
@@ -282,15 +371,33 @@ def grid_graph(map: Map, L: float, *, resolution: float, neighbourhood: int = 8)
     edges = np.concatenate(pairs) if pairs else np.zeros((0, 2), dtype=np.int64)
     edges = edges[_steps_clear(map_, points[edges[:, 0]], points[edges[:, 1]])]
 
-    # every pair of arcs across every edge, kept when they overlap (footnote 3)
+    # which arcs at one end the pursuer can keep the rod in while the evader walks the step:
+    # every pair of arcs across every step, overlap-tested at once; the steps the plain
+    # overlap rule does not settle are resampled one by one
     ci, cj = counts[edges[:, 0]], counts[edges[:, 1]]
     tot = ci * cj
     e_rep = np.repeat(np.arange(len(edges)), tot)
     k = np.arange(int(tot.sum())) - np.repeat(np.cumsum(tot) - tot, tot)
-    na = node_ptr[edges[e_rep, 0]] + k // np.maximum(cj[e_rep], 1)
-    nb = node_ptr[edges[e_rep, 1]] + k % np.maximum(cj[e_rep], 1)
-    hit = _arcs_overlap(node_lo[na], node_hi[na], node_lo[nb], node_hi[nb])
-    overlap = np.stack([na[hit], nb[hit], e_rep[hit]], axis=1).astype(np.int64)
+    ka, kb = np.divmod(k, np.maximum(cj[e_rep], 1))
+    na, nb = node_ptr[edges[e_rep, 0]] + ka, node_ptr[edges[e_rep, 1]] + kb
+    lo_a, hi_a, lo_b, hi_b = node_lo[na], node_hi[na], node_lo[nb], node_hi[nb]
+    hit = _arcs_overlap(lo_a, hi_a, lo_b, hi_b)
+    slot_a = np.repeat(np.cumsum(ci) - ci, tot) + ka
+    slot_b = np.repeat(np.cumsum(cj) - cj, tot) + kb
+    gaps = _gaps_after(node_lo, node_hi, node_ptr)
+    settled = _plain_steps(
+        lo_a, hi_a, lo_b, hi_b, gaps[na], gaps[nb], hit, slot_a, slot_b, e_rep, ci, cj
+    )
+    keep = hit & settled[e_rep]
+    rows = [np.stack([na[keep], nb[keep], e_rep[keep]], axis=1)]
+    for e in np.flatnonzero(~settled).tolist():
+        i, j = edges[e]
+        si, sj = slice(node_ptr[i], node_ptr[i + 1]), slice(node_ptr[j], node_ptr[j + 1])
+        s_end = (points[i], node_lo[si], node_hi[si])
+        t_end = (points[j], node_lo[sj], node_hi[sj])
+        a, b = np.nonzero(_step_relation(kernel, L, s_end, t_end, _MAX_DEPTH))
+        rows.append(np.stack([a + node_ptr[i], b + node_ptr[j], np.full(len(a), e)], axis=1))
+    overlap = np.concatenate(rows).astype(np.int64)
 
     for arr in (points, node_point, node_ptr, node_lo, node_hi, edges, overlap):
         arr.setflags(write=False)

@@ -186,9 +186,7 @@ def _type2(world: Map, L: float, eps: float) -> list[_Cand]:
     return out
 
 
-def _sliding(
-    world: Map, L: float, o: np.ndarray, e: np.ndarray, T: float, eps: float
-) -> np.ndarray:
+def _sliding(world: Map, L: float, o: np.ndarray, e: np.ndarray, eps: float) -> np.ndarray:
     """Breakpoints of a rod sliding along its line: ``P(t) = o - t e``, tip at ``L - t``."""
     lam = _line_wall_params(world, o, e, eps)
     return np.concatenate([-lam, L - lam])
@@ -212,7 +210,7 @@ def _type4(world: Map, L: float, eps: float) -> list[_Cand]:
                     (*o, *(-e), theta),
                     0.0,
                     L,
-                    _sliding(world, L, o, e, L, eps),
+                    _sliding(world, L, o, e, eps),
                 )
             )
     return out
@@ -241,7 +239,7 @@ def _type3(world: Map, L: float, eps: float) -> list[_Cand]:
                     (*o, *(-e), math.atan2(e[1], e[0])),
                     0.0,
                     T,
-                    _sliding(world, L, o, e, T, eps),
+                    _sliding(world, L, o, e, eps),
                 )
             )
     return out

@@ -8,20 +8,39 @@ curve at all:
 * **nodes**: a grid of evader positions P with spacing ``resolution``, and at each the exact
   free arcs of the rod of length L (from the geometry kernel); a node is a pair
   (point, arc), the grid analogue of a cell kappa = (R, [s-, s+]);
-* **edges**: between nodes of 8- (or 4-) neighbouring grid points whose arcs overlap with
-  positive length (the paper's footnote 3), and only when the evader can walk the segment
-  between the two points (it lies in free space);
+* **edges**: between nodes of 8- (or 4-) neighbouring grid points, when the evader can
+  walk the segment between the two points (it stays in the closed free region) and the
+  pursuer can keep the rod in one arc at the start and end in the other: the arcs are
+  followed along the step, bisecting it (exact free arcs at the midpoints) until every
+  sub-step is settled by the overlap rule of the paper's footnote 3;
 * **escapable nodes**: the least fixed point of the paper's recursive definition (Sec. 4):
-  node (p, a) is escapable if for some neighbour p' of p (a) no arc at p' overlaps a, or
-  (b) every arc at p' that overlaps a is escapable;
+  node (p, a) is escapable if for some neighbour p' of p (a) no arc at p' is connected to
+  a or (b) every arc at p' connected to a is escapable;
 * **verdict**: the evader wins if some grid point carries only escapable nodes (Prop. 2),
   which includes a point with no free orientation at all (Prop. 5, empty admissible set).
 
-Discretisation: the grid samples each noncritical region only if the region is wider than
-about ``resolution``, and an evader step of length ``resolution`` near a convex vertex at
-distance d < resolution can turn an arc by up to ``atan(resolution / d)``. Both errors
-vanish as the resolution goes to zero; the verdict on a given map is trusted only where it
-is stable under halving the resolution. Use it as a test oracle, not as the product.
+Discretisation, and which way the errors go:
+
+1. *Near walls the arcs change fast.* At distance d from a convex vertex a body-contact
+   stop turns by about ``resolution / d`` per grid step, so a narrow arc can turn past its
+   own width between two grid points: plain overlap would call that an escape although
+   the pursuer just follows the arc. Following the arcs along the step (bisection down to
+   ``resolution / 2**_MAX_DEPTH``) removes that false escape.
+2. *A thin critical feature between neighbours* (a sliver region, two arcs merging and
+   splitting again): sub-steps with two or more arcs are resampled until no stop turns
+   farther than half the narrowest gap between arcs, so a closing gap is seen.
+3. *An arc that vanishes between two grid points* shrinks to zero width inside the step;
+   the bisection closes in on the critical curve, and at the finest sub-step the overlap
+   rule decides: a vanished arc overlaps nothing across (THEORY 1.3), which is an escape.
+
+What remains is one-sided. A grid-escapable node is a real escape (the evader walks grid
+steps, the pursuer's whole arc is tracked along each), up to the finest sub-step. But the
+evader only walks grid steps, so an escape that needs a region narrower than the grid
+spacing (a sliver next to a convex vertex, where an arc is pinched to nothing) can be
+missed: an evader-wins verdict is trustworthy, a pursuer-wins verdict is a lower bound
+that improves, not monotonically, as the resolution shrinks. Use it as a test oracle
+("the grid's escapes are escapes"; "on maps without slivers, the verdicts agree"), not
+as the product.
 """
 
 from __future__ import annotations
@@ -264,7 +283,7 @@ def _step_relation(kernel, L: float, s: tuple, t: tuple, depth: int) -> np.ndarr
 # --------------------------------------------------------------------------- the graph
 @dataclass(frozen=True, eq=False)
 class GridGraph:
-    """The grid analogue of G_L (Sec. 3): nodes (point, free arc), edges by overlap.
+    """The grid analogue of G_L (Sec. 3): nodes (point, free arc), edges along steps.
 
     Attributes:
         map: the world.
@@ -278,7 +297,7 @@ class GridGraph:
         node_lo, node_hi: (N,) the node's arc ``[lo, hi]``.
         point_edges: (M, 2) neighbouring grid points joined by a free segment.
         overlap: (K, 3) rows ``(a, b, e)``: node a at ``point_edges[e, 0]`` and node b at
-            ``point_edges[e, 1]`` overlap with positive length (an edge of the graph).
+            ``point_edges[e, 1]`` are connected along the step (the graph's edges).
     """
 
     map: Map
@@ -526,25 +545,25 @@ def _probe(
 ) -> tuple[tuple[Arc, ...], np.ndarray]:
     """Free arcs at an off-grid point and which are escapable, by one evader step.
 
-    The point joins the grid as a node source only: arc a at the point is escapable if for
-    some grid point p' within 1.5 resolution and in sight, (a) no arc at p' overlaps a or
-    (b) every arc at p' overlapping a is escapable in the grid's fixed point.
+    The point joins the grid as a source of steps only: arc a at the point is escapable
+    if for some grid point p' within 1.5 resolution and in reach, (a) no arc at p' is
+    connected to a along the step or (b) every connected arc is escapable in the grid's
+    fixed point.
     """
     if not map_.contains(point[None])[0]:
         raise InvalidPlacementError(f"point: {tuple(point.tolist())} is not in free space")
     g = _cached_graph(map_, L, resolution, neighbourhood)
-    arcs = tuple(kernel_for(map_).free_arcs(point, L).arcs)
+    kernel = kernel_for(map_)
+    arcs = tuple(kernel.free_arcs(point, L).arcs)
     near = np.flatnonzero(np.linalg.norm(g.points - point, axis=1) <= 1.5 * resolution)
     near = near[_steps_clear(map_, np.repeat(point[None], len(near), axis=0), g.points[near])]
     esc = np.zeros(len(arcs), dtype=bool)
-    if not arcs or not near.size:
-        return arcs, esc
-    lo = np.array([a.lo for a in arcs])
-    hi = np.array([a.hi for a in arcs])
-    for p in near:
+    here = (point, *_arrays(arcs))
+    for p in near.tolist():
         nodes = np.arange(g.node_ptr[p], g.node_ptr[p + 1])
-        ov = _arcs_overlap(lo[:, None], hi[:, None], g.node_lo[nodes][None], g.node_hi[nodes][None])
-        esc |= ~np.any(ov & ~g.escapable[nodes][None], axis=1)
+        there = (g.points[p], g.node_lo[nodes], g.node_hi[nodes])
+        rel = _step_relation(kernel, L, here, there, _MAX_DEPTH)
+        esc |= ~np.any(rel & ~g.escapable[nodes][None], axis=1)
     return arcs, esc
 
 

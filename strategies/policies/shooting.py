@@ -16,6 +16,8 @@ Sec. 5 "minimax": its tip meets walls as if the rod were that long):
    branch the pursuer would turn) and the evader follows that arc, replanning every
    ``replan`` steps.
 3. **Witness region** (Prop. 2 holds on the map): walk a shortest grid path to it.
+For rho > 1 it runs straight at the pursuer (footnote 4; see :meth:`ShootingEvader._decide`).
+
 4. Otherwise **pressure**: move straight toward or away from the pursuer (Sec. 6.1, the
    headings minimising max |theta_dot|), whichever points more toward the most
    promising candidate.
@@ -148,9 +150,13 @@ class ShootingEvader(BasePolicy):
     def _decide(self, snap: Snapshot) -> np.ndarray:
         c = self.config
         e, theta = snap.evader, snap.theta
-        if c.rho > 1.0:  # footnote 4: the trivial escape, away from the pursuer
-            self.mode = "away"
-            return c.v_evader * self._away_heading(snap)
+        if c.rho > 1.0:
+            # footnote 4's trivial escape, in a bounded world: straight at the pursuer. The
+            # rod is free (surveillance holds), so nothing blocks the way, and whatever
+            # the pursuer does, dL/dt <= V_p - V_e < 0 until L < L_min ("too_close").
+            # (Straight away, as the paper says, can end in a room corner.)
+            self.mode = "toward"
+            return c.v_evader * unit(snap.rod)
         row = self.table.row(e)
         if row >= 0:
             node = self.plan.node_at(row, theta)
@@ -181,20 +187,6 @@ class ShootingEvader(BasePolicy):
         else:
             toward = True
         return c.v_evader * (u if toward else -u)
-
-    def _away_heading(self, snap: Snapshot) -> np.ndarray:
-        """Footnote 4 in a bounded world: away from the pursuer, where there is room.
-
-        L grows whenever the heading is within ``acos(1 / rho)`` of straight away from the
-        pursuer (even if it runs at V_p straight after the evader); among such headings
-        take the one with the longest free run before a wall.
-        """
-        away = math.atan2(-snap.rod[1], -snap.rod[0])
-        half = 0.9 * math.acos(1.0 / self.rho)
-        angles = away + np.linspace(-half, half, 15)
-        runs = self.kernel.ray_distances(snap.evader, angles, 2.0 * self.config.l_max)
-        best = angles[int(np.argmax(runs))]
-        return np.array([math.cos(best), math.sin(best)])
 
     def _start_arc(
         self, e: np.ndarray, theta: float, target: np.ndarray, branch: str

@@ -34,7 +34,7 @@ def test_two_rooms_shooting_evader_escapes_from_every_pursuer(pursuer):
         assert r.cause in ("occluded", "too_far", "too_close")
 
 
-@pytest.mark.parametrize("map_name", ["corridor", "open_room", "two_rooms"])
+@pytest.mark.parametrize("map_name", ["corridor", "open_room", "pillars", "two_rooms"])
 @pytest.mark.parametrize("pursuer", ["pursuer/decomposition", "pursuer/greedy"])
 def test_faster_evader_escapes_everywhere(map_name, pursuer):
     r = play_episode(

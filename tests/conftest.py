@@ -9,3 +9,12 @@ import os
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
+
+# decompositions and safety tables are cached on disk; tests keep theirs inside the
+# checkout (git-ignored) instead of the user's ~/.cache/surveil
+os.environ.setdefault(
+    "SURVEIL_CACHE_DIR",
+    os.path.join(
+        os.path.dirname(os.path.dirname(os.path.abspath(__file__))), ".pytest_cache", "surveil"
+    ),
+)

@@ -100,15 +100,25 @@ def _cmd_figure(args: argparse.Namespace) -> int:
 def _cmd_evaluate(args: argparse.Namespace) -> int:
     from analysis.evaluate import evaluate, format_table
 
+    overrides = json.loads(args.config) if args.config else None
     table = evaluate(
         maps=args.maps,
         pursuers=args.pursuers,
         evaders=args.evaders,
         seeds=range(args.seeds),
         max_cycles=args.max_cycles,
+        overrides=overrides,
+        start=args.start,
         results_path=Path(args.results) if args.results else None,
+        workers=args.workers,
     )
     print(format_table(table))
+    if args.plot:
+        from analysis.plots import plot_matchups
+
+        Path(args.plot).parent.mkdir(parents=True, exist_ok=True)
+        plot_matchups(table, args.plot)
+        print(f"table picture written to {args.plot}")
     return 0
 
 
@@ -158,7 +168,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--evaders", nargs="+", default=["evader/shooting", "evader/straight"])
     p.add_argument("--seeds", type=int, default=10, help="number of seeded starts per match")
     p.add_argument("--max-cycles", type=int, default=None)
+    p.add_argument("--config", help="env overrides as JSON, e.g. '{\"v_evader\": 0.8}'")
+    p.add_argument(
+        "--start",
+        choices=["safe", "valid"],
+        default="safe",
+        help="starts in a non-escapable cell at L_min (safe) or any valid configuration",
+    )
+    p.add_argument("--workers", type=int, default=1, help="processes to play in")
     p.add_argument("--results", help="JSONL file written as matches finish (resumable)")
+    p.add_argument("--plot", help="also draw the table as heat maps to this PNG")
     p.set_defaults(func=_cmd_evaluate)
     return parser
 

@@ -95,3 +95,34 @@ def test_bad_input_is_a_clear_error(capsys):
     assert "no_such_map" in err
     with pytest.raises(SystemExit):
         main(["play", "--seed", "not-a-number"])
+
+
+def test_evaluate_prints_the_table_resumes_and_plots(tmp_path, capsys):
+    results, picture = tmp_path / "runs.jsonl", tmp_path / "table.png"
+    argv = [
+        "evaluate",
+        "--maps",
+        "open_room",
+        "--pursuers",
+        "pursuer/greedy",
+        "--evaders",
+        "evader/straight",
+        "evader/random",
+        "--seeds",
+        "2",
+        "--max-cycles",
+        "20",
+        "--results",
+        str(results),
+        "--plot",
+        str(picture),
+    ]
+    assert main(argv) == 0
+    first = capsys.readouterr().out
+    assert "pursuer/greedy" in first and "evader/random" in first
+    assert len(results.read_text().splitlines()) == 4  # 2 evaders x 2 seeds, as they finish
+    assert picture.stat().st_size > 1000
+    # a second run replays nothing: every episode is already in the results file
+    assert main(argv) == 0
+    assert len(results.read_text().splitlines()) == 4
+    assert capsys.readouterr().out.splitlines()[-4:] == first.splitlines()[-4:]

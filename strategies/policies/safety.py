@@ -1,18 +1,23 @@
-"""A lookup table of safe rod orientations at L_min, built once per map from the cspace graph.
+"""A lookup table of safe rod orientations at L_min, built once per map from the exact cells.
 
 The analytic policies decide in microseconds by looking up, at the grid point nearest to
 an evader position, which orientation bins are *free* (the rod of length L_min touches
 no wall) and which are *safe* (free and in a non-escapable cell, Sec. 4), and how far
 the rod must turn, counter-clockwise or clockwise, to reach a safe orientation.
 
-The source is the configuration-space graph of :mod:`strategies.cspace.grid_oracle`
-(grid points, the exact free arcs at each, overlap edges, and the least fixed point of
-the escapable-cell definition). Where a grid point carries no safe arc at all (Prop. 2:
-every cell above it escapable) the table falls back to its free bins, so a pursuer still
-keeps the rod clear of walls where no guarantee exists.
+The source is the exact decomposition K_L (:func:`strategies.cspace.decompose`, cached on
+disk): at each grid point the free bins are the bin centres inside the kernel's exact
+free arcs and the safe bins those inside ``Decomposition.safe_arcs`` (the arcs of
+non-escapable cells). Where a grid point sits on a critical curve and its arcs cannot be
+matched to cells, the classification is borrowed from a point nudged off the curve (a
+quarter grid step at most); if that fails too, no guarantee is claimed there. Where a
+grid point carries no safe arc at all (Prop. 2: every cell above it escapable, or
+unclassified) the table falls back to its free bins, so a pursuer still keeps the rod
+clear of walls where no guarantee exists; ``guaranteed`` marks the other points.
 
 Tables are cached in memory and on disk (``$SURVEIL_CACHE_DIR``, default
-``~/.cache/surveil``), keyed by the map digest and the parameters.
+``~/.cache/surveil``), keyed by the version, the source, the map digest and the
+parameters.
 """
 
 from __future__ import annotations
@@ -28,13 +33,19 @@ import numpy as np
 
 from envs.errors import InvalidConfigError
 from envs.maps import Map
+from envs.tolerances import REL_LENGTH_TOL
 
-__all__ = ["NO_PATH", "SafetyTable", "cspace_graph", "safety_table"]
+__all__ = ["NO_PATH", "SOURCE", "SafetyTable", "cspace_graph", "safety_table"]
 
 NO_PATH = 255
 """Entry of the rotation tables meaning "no safe orientation at this point"."""
 
-TABLE_VERSION = 1
+TABLE_VERSION = 2
+
+SOURCE = "decomposition"
+"""What the table is built from (part of the cache key): the exact cells of K_L."""
+
+_CHUNK = 65536
 
 
 @dataclass(frozen=True, eq=False)
@@ -135,38 +146,94 @@ def cache_dir() -> Path:
 
 @functools.lru_cache(maxsize=4)
 def cspace_graph(world: Map, L: float, resolution: float):
-    """The cspace grid graph of ``world`` at rod length ``L`` (shared, cached in memory)."""
+    """The grid oracle's cspace graph of ``world`` at ``L`` (cached in memory).
+
+    Not the safety table's source (that is the exact decomposition); kept for
+    :mod:`strategies.policies.escape_plan`, which ranks grid nodes.
+    """
     from strategies.cspace.grid_oracle import grid_graph
 
     return grid_graph(world, L, resolution=resolution)
 
 
+def _axis(lo: float, hi: float, resolution: float) -> np.ndarray:
+    """Grid abscissae with spacing ``resolution``, centred in ``[lo, hi]``."""
+    n = max(1, math.floor((hi - lo) / resolution))
+    return lo + 0.5 * ((hi - lo) - (n - 1) * resolution) + resolution * np.arange(n)
+
+
+def _grid(world: Map, resolution: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Grid points strictly inside the free region: (origin, cell index array, points)."""
+    xmin, ymin, xmax, ymax = world.bounds
+    xs, ys = _axis(xmin, xmax, resolution), _axis(ymin, ymax, resolution)
+    gi, gj = np.meshgrid(np.arange(len(xs)), np.arange(len(ys)), indexing="ij")
+    cand = np.stack([xs[gi.ravel()], ys[gj.ravel()]], axis=1)
+    keep = np.zeros(len(cand), dtype=bool)
+    for s in range(0, len(cand), _CHUNK):
+        c = cand[s : s + _CHUNK]
+        ok = world.contains(c)
+        ok[ok] = world.distance_to_walls(c[ok]) > REL_LENGTH_TOL * world.scale
+        keep[s : s + _CHUNK] = ok
+    idx = np.flatnonzero(keep)
+    cell = np.full(gi.size, -1, dtype=np.int32)
+    cell[idx] = np.arange(len(idx), dtype=np.int32)
+    origin = np.array([xs[0], ys[0]], dtype=float)
+    return origin, cell.reshape(gi.shape), cand[idx]
+
+
+def _arc_bins(arcs, centres: np.ndarray) -> np.ndarray:
+    """Which bin centres lie in the union of closed arcs."""
+    out = np.zeros(len(centres), dtype=bool)
+    for a in arcs:
+        out |= ((centres - a.lo) % (2.0 * math.pi)) <= (a.hi - a.lo)
+    return out
+
+
+def _classified(dec, p: np.ndarray, step: float):
+    """The free arcs at ``p`` and the safe ones (``None`` if they cannot be classified).
+
+    ``Decomposition.free_arcs`` leaves an arc unclassified (``escapable is None``) when
+    ``p`` cannot be matched to a region's cells by its stops, which happens on (or within
+    the polyline tolerance of) a critical curve. The classification is then borrowed
+    from a point nudged off the curve by at most ``step / 4`` (it is constant inside a
+    region, and the arcs move by a negligible angle); ``None`` if no nudge resolves every
+    arc, and the caller claims no guarantee there.
+    """
+    cas = dec.free_arcs(p)
+    arcs = [ca.arc for ca in cas]
+    if all(ca.escapable is not None for ca in cas):
+        return arcs, [ca.arc for ca in cas if not ca.escapable]
+    for r in (1e-3, 1e-2, 0.1, 0.25):
+        for k in range(8):
+            q = p + r * step * np.array([math.cos(k * math.pi / 4), math.sin(k * math.pi / 4)])
+            if not dec.map.contains(q[None])[0]:
+                continue
+            near = dec.free_arcs(q)
+            if all(ca.escapable is not None for ca in near):
+                return arcs, [ca.arc for ca in near if not ca.escapable]
+    return arcs, None
+
+
 def _build(world: Map, L: float, resolution: float, n_bins: int) -> SafetyTable:
-    g = cspace_graph(world, L, resolution)
-    pts = g.points
-    origin = pts.min(axis=0)
-    idx = np.rint((pts - origin) / resolution).astype(np.int64)
-    shape = (int(idx[:, 0].max()) + 1, int(idx[:, 1].max()) + 1)
-    cell = np.full(shape, -1, dtype=np.int32)
-    cell[idx[:, 0], idx[:, 1]] = np.arange(len(pts), dtype=np.int32)
+    from strategies.cspace import decompose
+
+    dec = decompose(world, L, cache=True)
+    origin, cell, pts = _grid(world, resolution)
     centres = -math.pi + (np.arange(n_bins) + 0.5) * (2.0 * math.pi / n_bins)
     free = np.zeros((len(pts), n_bins), dtype=bool)
     safe = np.zeros_like(free)
-    esc = g.escapable
-    for node in range(g.n_nodes):
-        p = g.node_point[node]
-        lo, hi = g.node_lo[node], g.node_hi[node]
-        inside = ((centres - lo) % (2.0 * math.pi)) <= (hi - lo)
-        free[p] |= inside
-        if not esc[node]:
-            safe[p] |= inside
+    for i, p in enumerate(pts):
+        arcs, safe_arcs = _classified(dec, p, resolution)
+        free[i] = _arc_bins(arcs, centres)
+        if safe_arcs is not None:  # unresolved: no guarantee claimed, the free bins stand in
+            safe[i] = free[i] & _arc_bins(safe_arcs, centres)
     guaranteed = safe.any(axis=1)
-    safe = np.where(guaranteed[:, None], safe, free)
+    safe = np.where(guaranteed[:, None], safe, free)  # Prop. 2: nothing safe, keep it free
     return SafetyTable(
         L=float(L),
         resolution=float(resolution),
         origin=origin,
-        shape=shape,
+        shape=(int(cell.shape[0]), int(cell.shape[1])),
         n_bins=n_bins,
         cell=cell,
         free=free,
@@ -200,7 +267,7 @@ def safety_table(
     if not 8 <= int(n_bins) < NO_PATH:
         raise InvalidConfigError(f"n_bins must be in [8, {NO_PATH}), got {n_bins!r}")
     key = hashlib.sha256(
-        f"{TABLE_VERSION}|{world.digest}|{L!r}|{resolution!r}|{n_bins}".encode()
+        f"{TABLE_VERSION}|{SOURCE}|{world.digest}|{L!r}|{resolution!r}|{n_bins}".encode()
     ).hexdigest()[:24]
     path = cache_dir() / f"safety_{key}.npz"
     if disk_cache and path.exists():

@@ -121,7 +121,8 @@ class DecompositionPursuer(BasePolicy):
         radii_room = h * np.arange(1, math.ceil(reach / h) + 1)
         ang = self.table.bin_centre(np.arange(n_room) * self._room_step)
         dirs = np.stack([np.cos(ang), np.sin(ang)], axis=1)
-        self._room_offsets = (dirs[:, None, :] * radii_room[None, :, None]).reshape(-1, 2)
+        offs = (dirs[:, None, :] * radii_room[None, :, None]).reshape(-1, 2)
+        self._room_di = np.rint(offs / h).astype(np.int64)  # grid steps from the evader's point
         self._room_radii = radii_room
         self._n_room = n_room
         # an evader charging along the rod while it turns by phi at omega has moved
@@ -165,8 +166,13 @@ class DecompositionPursuer(BasePolicy):
         """
         tab = self.table
         c = self.config
-        rows = tab.rows(evader + self._room_offsets).reshape(self._n_room, -1)
-        inside = np.cumsum(rows < 0, axis=1) == 0
+        i0 = np.rint((np.asarray(evader, dtype=float) - tab.origin) / tab.resolution)
+        ij = self._room_di + i0.astype(np.int64)
+        nx, ny = tab.shape
+        ok = (ij[:, 0] >= 0) & (ij[:, 0] < nx) & (ij[:, 1] >= 0) & (ij[:, 1] < ny)
+        flat = np.where(ok, ij[:, 0] * ny + ij[:, 1], 0)
+        wall = (~ok | (tab.cell.ravel()[flat] < 0)).reshape(self._n_room, -1)
+        inside = np.cumsum(wall, axis=1) == 0
         n_in = inside.sum(axis=1)  # samples before the first wall
         d = np.where(n_in > 0, self._room_radii[np.maximum(n_in - 1, 0)], 0.0)
         d = np.where(n_in == len(self._room_radii), np.inf, d)

@@ -1,6 +1,6 @@
 """The decomposition-based pursuer (Secs. 4-5): keep the rod in admissible safe cells at L_min.
 
-Per step (table lookups plus a little arithmetic, no geometry kernel call):
+Per step (a table lookup plus a little arithmetic, no geometry kernel call):
 
 1. From the :class:`~strategies.policies.safety.SafetyTable` (safe = free and not in an
    escapable cell at L_min, Sec. 4), the rotation each orientation bin needs to reach a
@@ -17,12 +17,6 @@ Per step (table lookups plus a little arithmetic, no geometry kernel call):
    the evader does. The pursuer targets the bin maximising V within the *free arc* it is
    in (the rod can only rotate through free orientations), minus a small penalty for the
    rotation needed, and turns the shorter way round inside that arc.
-   The pursuer's own clearance enters as *retreat room*: per bin, the seconds before an
-   evader charging along the rod pins the pursuer (body radius included) to the first wall
-   on that ray (rays marched on the table's grid). A candidate's score is also bounded by
-   the room of every bin passed on the way there, less the evader's drift toward it while
-   the rod turns (``(V_e/omega) sin(phi)``), and a target with less room than the horizon
-   is charged its shortfall (the turn away from it would come later, with less room).
 3. The velocity is the evader's velocity plus the perpendicular component that realises the
    commanded rotation rate (eq. 5), plus a radial correction of L toward L_min, all within
    V_p (:func:`strategies.control.kinematics.pursuer_velocity_holding_range`).
@@ -113,22 +107,6 @@ class DecompositionPursuer(BasePolicy):
         lut[NO_PATH] = math.pi / self.omega  # no safe orientation: half a turn
         lut[0] = -1e9
         self._turn_lut = lut.astype(np.float32)
-        # retreat room along each orientation (Sec. 5 with the pursuer's own clearance):
-        # rays from the evader on the table's grid, one per ``_room_step`` bins
-        self._room_step = max(1, self.n_bins // 72)
-        n_room = math.ceil(self.n_bins / self._room_step)
-        reach = self.L_target + c.body_radius + c.v_evader * horizon + 2.0 * h
-        radii_room = h * np.arange(1, math.ceil(reach / h) + 1)
-        ang = self.table.bin_centre(np.arange(n_room) * self._room_step)
-        dirs = np.stack([np.cos(ang), np.sin(ang)], axis=1)
-        offs = (dirs[:, None, :] * radii_room[None, :, None]).reshape(-1, 2)
-        self._room_di = np.rint(offs / h).astype(np.int64)  # grid steps from the evader's point
-        self._room_radii = radii_room
-        self._n_room = n_room
-        # an evader charging along the rod while it turns by phi at omega has moved
-        # (V_e / omega) sin(phi) toward the orientation reached (phi <= pi/2); in seconds:
-        phi = np.minimum(np.arange(self.n_bins) * self._bw, 0.5 * math.pi)
-        self._drift = np.sin(phi) / self.omega
         self.last_target: int | None = None
 
     # ------------------------------------------------------------------ decision
@@ -157,44 +135,14 @@ class DecompositionPursuer(BasePolicy):
         need0 = tab.need[row]
         return np.where(need0 > 0, -self._turn_lut[need0], value)
 
-    def retreat_times(self, evader: np.ndarray) -> np.ndarray:
-        """Per bin, the seconds before a pursuer at ``L_target`` along it meets a wall while
-        the evader charges straight at it (the rod's tip, plus the body radius, reaches the
-        first wall the ray from the evader meets; the pair drifts along the rod at V_e).
-
-        Capped at the horizon; negative where the pursuer cannot stand at ``L_target``.
-        """
-        tab = self.table
-        c = self.config
-        i0 = np.rint((np.asarray(evader, dtype=float) - tab.origin) / tab.resolution)
-        ij = self._room_di + i0.astype(np.int64)
-        nx, ny = tab.shape
-        ok = (ij[:, 0] >= 0) & (ij[:, 0] < nx) & (ij[:, 1] >= 0) & (ij[:, 1] < ny)
-        flat = np.where(ok, ij[:, 0] * ny + ij[:, 1], 0)
-        wall = (~ok | (tab.cell.ravel()[flat] < 0)).reshape(self._n_room, -1)
-        inside = np.cumsum(wall, axis=1) == 0
-        n_in = inside.sum(axis=1)  # samples before the first wall
-        d = np.where(n_in > 0, self._room_radii[np.maximum(n_in - 1, 0)], 0.0)
-        d = np.where(n_in == len(self._room_radii), np.inf, d)
-        t = (d - c.body_radius - self.L_target) / c.v_evader
-        t = np.minimum(t, self.horizon)
-        return np.repeat(t, self._room_step)[: tab.n_bins]
-
     def _target(self, snap: Snapshot) -> tuple[float, int]:
-        """Signed rotation (radians) toward the best reachable orientation, and its bin.
-
-        A candidate's score is the least of its value ``V`` (eqs. 2-3) and, along the way
-        there, the retreat time of every bin passed minus the time to reach it: turning
-        through orientations where a charging evader would pin the pursuer to a wall first
-        is as bad as an unsafe target.
-        """
+        """Signed rotation (radians) toward the best reachable orientation, and its bin."""
         tab = self.table
         row = tab.row(snap.evader)
         b0 = tab.bin_of(snap.theta)
         if row < 0:
             return 0.0, b0
         value = self.orientation_values(snap.evader)
-        room = self.retreat_times(snap.evader)
         free = tab.free[row]
         nb = tab.n_bins
         # bins reachable by turning through free orientations, each way round
@@ -204,19 +152,9 @@ class DecompositionPursuer(BasePolicy):
         n_ccw = int(np.argmin(ccw_run)) if not ccw_run.all() else nb
         n_cw = int(np.argmin(cw_run)) if not cw_run.all() else nb
         steps = np.arange(nb)
-        ccw_bins = (b0 + steps[:n_ccw]) % nb
-        cw_bins = (b0 - steps[:n_cw]) % nb
-        drift = self._drift
-        ccw_path = np.minimum.accumulate(room[ccw_bins] - drift[:n_ccw])
-        cw_path = np.minimum.accumulate(room[cw_bins] - drift[:n_cw])
-        cand_bins = np.concatenate([ccw_bins, cw_bins[1:]])
+        cand_bins = np.concatenate([(b0 + steps[:n_ccw]) % nb, (b0 - steps[1:n_cw]) % nb])
         cand_rot = np.concatenate([steps[:n_ccw], -steps[1:n_cw]]).astype(float)
-        path = np.concatenate([ccw_path, cw_path[1:]])
-        # a target the evader can still pin to a wall within the horizon is only a halt:
-        # the turn from there comes later with less room, so its shortfall is charged now
-        short = self.horizon - np.maximum(room[cand_bins], 0.0)
-        score = np.minimum(value[cand_bins], path) - short
-        score = score - self.hysteresis * np.abs(cand_rot) * self._bw / self.omega
+        score = value[cand_bins] - self.hysteresis * np.abs(cand_rot) * self._bw / self.omega
         if self.last_target is not None:  # prefer keeping the previous goal on ties
             score = score + 1e-9 * (cand_bins == self.last_target)
         k = int(np.argmax(score))

@@ -1,0 +1,98 @@
+"""TrainConfig: TOML loading, round trips, and errors that name the bad field."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from envs.errors import InvalidConfigError
+from training.config import TrainConfig, load_config
+
+CONFIGS = sorted((Path(__file__).resolve().parents[2] / "training" / "configs").glob("*.toml"))
+
+
+def test_example_configs_exist():
+    names = {p.stem for p in CONFIGS}
+    assert {"ppo_pursuer_vs_straight_corridor", "ppo_evader_vs_greedy_open_room"} <= names
+
+
+@pytest.mark.parametrize("path", CONFIGS, ids=lambda p: p.stem)
+def test_example_configs_load_and_round_trip(path, tmp_path):
+    config = load_config(path)
+    out = tmp_path / "again.toml"
+    out.write_text(config.to_toml())
+    assert load_config(out) == config
+    assert TrainConfig.from_dict(config.to_dict()) == config
+
+
+def test_overrides_and_defaults(tmp_path):
+    p = tmp_path / "c.toml"
+    p.write_text('role = "evader"\nopponent = "pursuer/greedy"\n[env]\nmax_cycles = 77\n')
+    config = load_config(p, seed=5, total_timesteps=1000)
+    assert (config.seed, config.total_timesteps, config.env) == (5, 1000, {"max_cycles": 77})
+    assert config.net_arch == (64, 64) and config.algo == "ppo"
+    assert config.env_kwargs() == {"map": "open_room", "start": "env", "max_cycles": 77}
+
+
+BASE = {"role": "pursuer", "opponent": "evader/straight"}
+
+
+@pytest.mark.parametrize(
+    ("changes", "field"),
+    [
+        ({"role": "bishop"}, "role"),
+        ({"opponent": "pursuer/greedy"}, "opponent"),
+        ({"algo": "dqn"}, "algo"),
+        ({"total_timesteps": 0}, "total_timesteps"),
+        ({"total_timesteps": 1.5}, "total_timesteps"),
+        ({"seed": -1}, "seed"),
+        ({"n_envs": True}, "n_envs"),
+        ({"learning_rate": -1e-3}, "learning_rate"),
+        ({"gamma": 1.5}, "gamma"),
+        ({"net_arch": [64, 0]}, r"net_arch\[1\]"),
+        ({"net_arch": "64"}, "net_arch"),
+        ({"env": {"max_cycles": 0}}, "env.max_cycles"),
+        ({"env": {"l_min": 5.0}}, "env.l_max"),
+        ({"env": {"map": "corridor"}}, "env"),
+        ({"env": {"speed": 2}}, "speed"),
+        ({"algo_kwargs": {"n_epoch": 3}}, "n_epoch"),
+        ({"algo_kwargs": {"seed": 3}}, "seed"),
+        ({"algo": "sac", "algo_kwargs": {"n_epochs": 3}}, "n_epochs"),
+        ({"start": "far"}, "start"),
+        ({"eval_episodes": -2}, "eval_episodes"),
+        ({"map": "atlantis"}, "map"),
+        ({"map": ""}, "map"),
+    ],
+)
+def test_bad_values_name_the_field(changes, field):
+    with pytest.raises(InvalidConfigError, match=field):
+        TrainConfig(**{**BASE, **changes})
+
+
+def test_bad_files(tmp_path):
+    with pytest.raises(InvalidConfigError, match="no such file"):
+        load_config(tmp_path / "missing.toml")
+    bad = tmp_path / "bad.toml"
+    bad.write_text("role = \n")
+    with pytest.raises(InvalidConfigError, match="not valid TOML"):
+        load_config(bad)
+    unknown = tmp_path / "unknown.toml"
+    unknown.write_text('role = "pursuer"\nopponent = "evader/straight"\ntimesteps = 5\n')
+    with pytest.raises(InvalidConfigError, match="timesteps"):
+        load_config(unknown)
+    missing = tmp_path / "missing_role.toml"
+    missing.write_text('opponent = "evader/straight"\n')
+    with pytest.raises(InvalidConfigError, match="role"):
+        load_config(missing)
+
+
+def test_every_field_has_a_docstring():
+    import inspect
+
+    import training.config as module
+
+    src = inspect.getsource(module.TrainConfig)
+    for name in TrainConfig.__dataclass_fields__:
+        after = src.split(f"\n    {name}:", 1)[1].split("\n", 2)[1].strip()
+        assert after.startswith('"""'), name

@@ -1,0 +1,91 @@
+"""The ``train`` command: argument parsing for ``surveil train`` and ``python -m training``.
+
+``analysis.cli`` wires its ``train`` subcommand to :func:`add_train_arguments` and
+:func:`run_train`, or simply calls :func:`cli_train` with the remaining arguments.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from collections.abc import Sequence
+
+from training.config import load_config
+from training.selfplay import self_play
+from training.train import TrainResult, train
+
+__all__ = ["add_train_arguments", "cli_train", "run_train"]
+
+
+def add_train_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
+    """Add the ``train`` options to ``parser`` (a subparser of ``surveil``)."""
+    parser.add_argument("config", help="TOML training config (see training/configs/)")
+    parser.add_argument("--output-dir", default=None, help="override output_dir")
+    parser.add_argument("--timesteps", type=int, default=None, help="override total_timesteps")
+    parser.add_argument("--seed", type=int, default=None, help="override seed")
+    parser.add_argument(
+        "--self-play",
+        type=int,
+        default=0,
+        metavar="ROUNDS",
+        help="alternate ROUNDS rounds of pursuer/evader training instead of one run",
+    )
+    parser.add_argument("--progress", action="store_true", help="show SB3's progress bar")
+    return parser
+
+
+def run_train(args: argparse.Namespace) -> int:
+    """Run a parsed ``train`` command; prints one line per trained model. Returns 0.
+
+    Raises:
+        InvalidConfigError: a bad config file or override (naming the field).
+    """
+    overrides = {}
+    if args.output_dir is not None:
+        overrides["output_dir"] = args.output_dir
+    if args.timesteps is not None:
+        overrides["total_timesteps"] = args.timesteps
+    if args.seed is not None:
+        overrides["seed"] = args.seed
+    config = load_config(args.config, **overrides)
+    if args.self_play:
+        results = self_play(config, args.self_play, progress_bar=args.progress).stages
+    else:
+        results = (train(config, progress_bar=args.progress),)
+    for r in results:
+        print(summary(r))
+    return 0
+
+
+def cli_train(argv: Sequence[str] | None = None) -> int:
+    """``surveil train CONFIG [--output-dir D] [--timesteps N] [--seed S] [--self-play R]``.
+
+    Args:
+        argv: the arguments after ``train`` (``None``: ``sys.argv[1:]``).
+
+    Returns:
+        The exit code (0).
+    """
+    parser = add_train_arguments(
+        argparse.ArgumentParser(prog="surveil train", description="Train a policy with SB3.")
+    )
+    return run_train(parser.parse_args(None if argv is None else list(argv)))
+
+
+def summary(result: TrainResult) -> str:
+    """One line: what was trained, for how long, where, and how it did."""
+    c = result.config
+    head = (
+        f"{c.algo.upper()} {c.role} vs {c.opponent} on {c.map}: {result.timesteps} timesteps"
+        f" in {result.wall_time:.1f} s"
+        + (f" (resumed from {result.resumed_from.name})" if result.resumed_from else "")
+        + f" -> {result.model_path}"
+    )
+    ev = result.evaluation
+    if ev is None:
+        return head
+    t = "-" if math.isnan(ev.mean_escape_time) else f"{ev.mean_escape_time:.2f} s"
+    return head + (
+        f"; eval: success {ev.successes}/{ev.episodes} ({ev.success_rate:.0%}), "
+        f"mean escape time {t}"
+    )

@@ -1,0 +1,344 @@
+"""The frozen, validated configuration of one training run, loaded from TOML.
+
+A config file holds the flat fields of :class:`TrainConfig` plus three tables,
+``[env]`` (arguments of ``surveillance_v0.parallel_env``), ``[policy_kwargs]`` (extra
+SB3 policy arguments) and ``[algo_kwargs]`` (extra SB3 algorithm arguments)::
+
+    role = "pursuer"
+    opponent = "evader/straight"
+    map = "open_room"
+    algo = "ppo"
+    total_timesteps = 100_000
+    seed = 0
+    output_dir = "out/training/ppo_pursuer_vs_straight_open_room"
+
+    [env]
+    max_cycles = 200
+
+    [algo_kwargs]
+    n_steps = 512
+
+Every bad value raises :class:`~envs.errors.InvalidConfigError` naming the field, the
+value and what was expected.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import inspect
+import math
+import os
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10 reads TOML with the tomli backport
+    import tomli as tomllib
+
+from envs.errors import InvalidConfigError
+from envs.surveillance.config import EnvConfig
+from strategies.policies.base import check_role
+from training.single_agent import START_CHOICES
+
+__all__ = ["ALGORITHMS", "TrainConfig", "load_config"]
+
+ALGORITHMS = ("ppo", "sac")
+"""The SB3 algorithms :func:`training.train` runs (continuous actions)."""
+
+_ENV_KEYS = (
+    "l_min",
+    "l_max",
+    "v_pursuer",
+    "v_evader",
+    "dt",
+    "max_cycles",
+    "observation",
+    "n_rays",
+    "lidar_range",
+    "reward",
+    "body_radius",
+    "spawn_margin_steps",
+)
+"""Keys allowed in ``[env]`` (``map`` and ``render_mode`` are not: see the fields)."""
+
+_ALGO_MANAGED = {
+    "policy",
+    "env",
+    "learning_rate",
+    "gamma",
+    "batch_size",
+    "n_steps",
+    "policy_kwargs",
+    "seed",
+    "device",
+    "verbose",
+    "tensorboard_log",
+    "_init_setup_model",
+}
+"""SB3 constructor arguments set from dedicated fields, so not allowed in ``algo_kwargs``."""
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """One SB3 training run of one role against a fixed opponent."""
+
+    role: str
+    """The learner's role: ``"pursuer"`` or ``"evader"``."""
+    opponent: str
+    """The other role's policy name (``"evader/straight"``, ``"pursuer/sb3:PATH"``...)."""
+    map: str = "open_room"
+    """Built-in map name or map file path."""
+    env: dict[str, Any] = field(default_factory=dict)
+    """Overrides of ``surveillance_v0.parallel_env`` arguments (``max_cycles``, ...)."""
+    start: str = "env"
+    """Training starts: ``"env"`` (env sampler), ``"valid"`` or ``"safe"`` (sample_start)."""
+    algo: str = "ppo"
+    """``"ppo"`` or ``"sac"``."""
+    total_timesteps: int = 100_000
+    """Environment steps to train for, summed over the ``n_envs`` copies."""
+    seed: int = 0
+    """Seeds the model, the vector env and (through it) starts and opponents."""
+    n_envs: int = 1
+    """Copies of the env in the ``DummyVecEnv``."""
+    net_arch: tuple[int, ...] = (64, 64)
+    """Hidden layer sizes of the actor and the critic MLPs."""
+    policy_kwargs: dict[str, Any] = field(default_factory=dict)
+    """Other policy constructor arguments (``log_std_init``, ``ortho_init``...)."""
+    learning_rate: float = 3e-4
+    """Adam learning rate."""
+    gamma: float = 0.99
+    """Discount factor."""
+    batch_size: int = 64
+    """Minibatch size (PPO) or replay sample size (SAC)."""
+    n_steps: int = 512
+    """PPO rollout length per env (ignored by SAC)."""
+    algo_kwargs: dict[str, Any] = field(default_factory=dict)
+    """Other keyword arguments of the SB3 algorithm (``ent_coef``, ``n_epochs``...)."""
+    checkpoint_freq: int = 10_000
+    """Write a checkpoint every this many timesteps (resume point after interruption)."""
+    eval_episodes: int = 20
+    """Episodes of the final evaluation against ``opponent`` (0: skip)."""
+    eval_start: str = "safe"
+    """Starts of the final evaluation (``"env"``, ``"valid"``, ``"safe"``)."""
+    output_dir: str = "out/training/run"
+    """Directory for checkpoints, ``model.zip`` and ``provenance.json``."""
+
+    def __post_init__(self) -> None:
+        put = lambda name, value: object.__setattr__(self, name, value)
+        check = _Checker()
+        check.role(self.role)
+        put("opponent", check.string("opponent", self.opponent))
+        other = "evader" if self.role == "pursuer" else "pursuer"
+        if self.opponent.partition("/")[0] != other:
+            raise InvalidConfigError(
+                f"opponent: a {self.role} learner needs an '{other}/KIND' policy, "
+                f"got {self.opponent!r}"
+            )
+        put("map", check.string("map", self.map))
+        put("env", check.table("env", self.env, allowed=_ENV_KEYS))
+        try:  # the env's own validation, so a bad [env] value fails here, not mid-run
+            EnvConfig(map=self.map, **self.env)
+        except InvalidConfigError as exc:
+            if str(exc).startswith("map:"):
+                raise
+            raise InvalidConfigError(f"env.{exc}") from None
+        except ValueError as exc:  # an unknown map name or an invalid map file
+            raise InvalidConfigError(f"map: {exc}") from None
+        put("start", check.choice("start", self.start, START_CHOICES))
+        put("algo", check.choice("algo", str(self.algo).lower(), ALGORITHMS))
+        put("total_timesteps", check.integer("total_timesteps", self.total_timesteps, 1))
+        put("seed", check.integer("seed", self.seed, 0))
+        put("n_envs", check.integer("n_envs", self.n_envs, 1))
+        if isinstance(self.net_arch, (str, bytes)) or not hasattr(self.net_arch, "__iter__"):
+            raise InvalidConfigError(
+                f"net_arch: expected a list of layer sizes, got {self.net_arch!r}"
+            )
+        put(
+            "net_arch",
+            tuple(check.integer(f"net_arch[{i}]", n, 1) for i, n in enumerate(self.net_arch)),
+        )
+        put("policy_kwargs", check.table("policy_kwargs", self.policy_kwargs))
+        put("learning_rate", check.positive("learning_rate", self.learning_rate))
+        gamma = check.positive("gamma", self.gamma)
+        if gamma > 1.0:
+            raise InvalidConfigError(f"gamma: expected a value in (0, 1], got {self.gamma!r}")
+        put("gamma", gamma)
+        put("batch_size", check.integer("batch_size", self.batch_size, 1))
+        put("n_steps", check.integer("n_steps", self.n_steps, 2))
+        put("algo_kwargs", check.table("algo_kwargs", self.algo_kwargs))
+        self._check_algo_kwargs()
+        self._check_policy_kwargs()
+        put("checkpoint_freq", check.integer("checkpoint_freq", self.checkpoint_freq, 1))
+        put("eval_episodes", check.integer("eval_episodes", self.eval_episodes, 0))
+        put("eval_start", check.choice("eval_start", self.eval_start, START_CHOICES))
+        put("output_dir", check.string("output_dir", os.fspath(self.output_dir)))
+
+    def _check_policy_kwargs(self) -> None:
+        if "net_arch" in self.policy_kwargs:
+            raise InvalidConfigError("policy_kwargs: set net_arch with the net_arch field")
+        if self.algo == "ppo":
+            from stable_baselines3.common.policies import ActorCriticPolicy as cls
+        else:
+            from stable_baselines3.sac.policies import SACPolicy as cls
+        known = set(inspect.signature(cls.__init__).parameters) - {
+            "self",
+            "observation_space",
+            "action_space",
+            "lr_schedule",
+            "net_arch",
+        }
+        unknown = sorted(set(self.policy_kwargs) - known)
+        if unknown:
+            raise InvalidConfigError(
+                f"policy_kwargs: {unknown} are not arguments of {cls.__name__}; "
+                f"known: {sorted(known)}"
+            )
+
+    def _check_algo_kwargs(self) -> None:
+        managed = sorted(set(self.algo_kwargs) & _ALGO_MANAGED)
+        if managed:
+            raise InvalidConfigError(
+                f"algo_kwargs: {managed} are set by their own fields or by train(); "
+                f"remove them from algo_kwargs"
+            )
+        import stable_baselines3
+
+        cls = getattr(stable_baselines3, self.algo.upper())
+        known = set(inspect.signature(cls.__init__).parameters) - {"self"}
+        unknown = sorted(set(self.algo_kwargs) - known)
+        if unknown:
+            raise InvalidConfigError(
+                f"algo_kwargs: {unknown} are not arguments of stable_baselines3."
+                f"{self.algo.upper()}; known: {sorted(known - _ALGO_MANAGED)}"
+            )
+
+    # ----------------------------------------------------------------- conversions
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> TrainConfig:
+        """Build a config from a mapping (a parsed TOML file).
+
+        Raises:
+            InvalidConfigError: an unknown or missing key, or a bad value (named).
+        """
+        if not isinstance(data, dict):
+            raise InvalidConfigError(f"config: expected a table, got {type(data).__name__}")
+        names = [f.name for f in dataclasses.fields(cls)]
+        unknown = sorted(set(data) - set(names))
+        if unknown:
+            raise InvalidConfigError(f"config: unknown field(s) {unknown}; fields are {names}")
+        missing = [n for n in ("role", "opponent") if n not in data]
+        if missing:
+            raise InvalidConfigError(f"config: missing required field(s) {missing}")
+        return cls(**data)
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON/TOML-ready dict that :meth:`from_dict` turns back into this config."""
+        d = dataclasses.asdict(self)
+        d["net_arch"] = list(self.net_arch)
+        d["env"] = dict(self.env)
+        d["algo_kwargs"] = dict(self.algo_kwargs)
+        d["policy_kwargs"] = dict(self.policy_kwargs)
+        return d
+
+    def to_toml(self) -> str:
+        """This config as TOML text (loadable by :func:`load_config`)."""
+        flat = {k: v for k, v in self.to_dict().items() if not isinstance(v, dict)}
+        lines = [f"{k} = {_toml_value(v)}" for k, v in flat.items()]
+        for table in ("env", "policy_kwargs", "algo_kwargs"):
+            items = getattr(self, table)
+            if items:
+                lines += ["", f"[{table}]"] + [f"{k} = {_toml_value(v)}" for k, v in items.items()]
+        return "\n".join(lines) + "\n"
+
+    def env_kwargs(self) -> dict[str, Any]:
+        """Keyword arguments of :class:`~training.single_agent.SingleAgentEnv` (no opponent)."""
+        return {"map": self.map, "start": self.start, **self.env}
+
+    def replace(self, **changes: Any) -> TrainConfig:
+        """A copy with some fields changed (validated again)."""
+        return dataclasses.replace(self, **changes)
+
+
+def load_config(path: str | os.PathLike[str], **overrides: Any) -> TrainConfig:
+    """Load a :class:`TrainConfig` from a TOML file, with optional field overrides.
+
+    Raises:
+        InvalidConfigError: the file is missing or not valid TOML, or a field is bad.
+    """
+    p = Path(path)
+    try:
+        with p.open("rb") as fh:
+            data = tomllib.load(fh)
+    except FileNotFoundError:
+        raise InvalidConfigError(f"config: no such file {str(p)!r}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise InvalidConfigError(f"config: {str(p)!r} is not valid TOML ({exc})") from exc
+    data.update(overrides)
+    return TrainConfig.from_dict(data)
+
+
+def _toml_value(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, float)):
+        return repr(v) if math.isfinite(v) else ("nan" if v != v else ("inf" if v > 0 else "-inf"))
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    if v is None:
+        raise InvalidConfigError("config: TOML has no null; drop the key instead of None")
+    raise InvalidConfigError(f"config: cannot write {type(v).__name__} {v!r} as TOML")
+
+
+class _Checker:
+    """Validators that raise InvalidConfigError naming the field."""
+
+    @staticmethod
+    def role(value: Any) -> str:
+        try:
+            return check_role(value)
+        except InvalidConfigError:
+            raise InvalidConfigError(
+                f"role: expected 'pursuer' or 'evader', got {value!r}"
+            ) from None
+
+    @staticmethod
+    def string(name: str, value: Any) -> str:
+        if not isinstance(value, str) or not value:
+            raise InvalidConfigError(f"{name}: expected a non-empty string, got {value!r}")
+        return value
+
+    @staticmethod
+    def choice(name: str, value: Any, options: tuple[str, ...]) -> str:
+        if value not in options:
+            raise InvalidConfigError(f"{name}: expected one of {list(options)}, got {value!r}")
+        return value
+
+    @staticmethod
+    def integer(name: str, value: Any, minimum: int) -> int:
+        if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
+            raise InvalidConfigError(f"{name}: expected an integer >= {minimum}, got {value!r}")
+        return int(value)
+
+    @staticmethod
+    def positive(name: str, value: Any) -> float:
+        ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+        if not ok or not math.isfinite(value) or value <= 0:
+            raise InvalidConfigError(f"{name}: expected a finite number > 0, got {value!r}")
+        return float(value)
+
+    @staticmethod
+    def table(name: str, value: Any, allowed: tuple[str, ...] | None = None) -> dict[str, Any]:
+        if not isinstance(value, dict):
+            raise InvalidConfigError(f"{name}: expected a table (dict), got {value!r}")
+        if allowed is not None:
+            unknown = sorted(set(value) - set(allowed))
+            if unknown:
+                raise InvalidConfigError(
+                    f"{name}: unknown key(s) {unknown}; allowed: {list(allowed)}"
+                )
+        return dict(value)

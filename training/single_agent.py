@@ -1,0 +1,244 @@
+"""One role of ``surveillance_v0`` as a Gymnasium env, the other played by a fixed Policy.
+
+:class:`SingleAgentEnv` wraps :func:`envs.surveillance_v0.parallel_env` so that SB3 (or
+any single-agent learner) trains the pursuer or the evader against a fixed opponent: a
+registered policy name (``"evader/straight"``), a ``ROLE/sb3:PATH`` model zip, or any
+object with the Policy protocol. SuperSuit's vector envs would need both agents to share
+spaces; here only the learner's spaces are exposed.
+
+Seeding: ``reset(seed=s)`` reseeds ``self.np_random`` (Gymnasium's generator, built from
+``SeedSequence(s)``); every episode then draws from it, in a fixed order, one seed for the
+env, one for the start sampler and one for the opponent. The same seed therefore gives
+the same episodes, and later resets without a seed continue the same stream.
+
+Opponents that read the ``"state"`` observation (every analytic policy) still play when
+the learner sees ``"lidar"``: they receive ``env.state()`` (the ``"state"`` vector) and a
+copy of the config with ``observation="state"``, so they are as strong as in a
+``"state"`` env. Learned opponents (``uses_state = False``) get their own observation.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+from pathlib import Path
+from typing import Any, ClassVar
+
+import gymnasium as gym
+import numpy as np
+
+from envs import surveillance_v0
+from envs.errors import InvalidConfigError
+from envs.maps import Map
+from envs.surveillance.env import EVADER, PURSUER
+from strategies.policies import Policy, make_policy
+from strategies.policies.base import check_role
+from strategies.policies.starts import START_KINDS, sample_start
+
+__all__ = ["AGENT_OF_ROLE", "START_CHOICES", "SingleAgentEnv", "make_opponent", "sb3_params"]
+
+AGENT_OF_ROLE = {"pursuer": PURSUER, "evader": EVADER}
+"""The env's agent name of each role."""
+
+START_CHOICES = ("env", *START_KINDS)
+"""``"env"``: the env's own random start; ``"valid"``/``"safe"``: ``sample_start``."""
+
+_SEED_BOUND = 2**31 - 1
+
+
+def _other(role: str) -> str:
+    return "evader" if role == "pursuer" else "pursuer"
+
+
+def sb3_params(name: str) -> dict[str, Any]:
+    """Extra ``make_policy`` parameters for a ``ROLE/sb3:PATH`` name: the algorithm.
+
+    ``SB3Policy`` reads the algorithm from the zip, which cannot tell PPO from A2C (both
+    save ``common.policies.ActorCriticPolicy``); the ``provenance.json`` that
+    :func:`training.train` writes beside every model names it. Other names: ``{}``.
+    """
+    kind = name.partition("/")[2]
+    if not kind.startswith("sb3:"):
+        return {}
+    prov = Path(kind[len("sb3:") :]).parent / "provenance.json"
+    try:
+        algo = json.loads(prov.read_text()).get("algo")
+    except (OSError, ValueError):
+        return {}
+    return {"algo": str(algo).upper()} if algo else {}
+
+
+def make_opponent(opponent: str | Policy, role: str) -> Policy:
+    """Build the opponent of a learner playing ``role``.
+
+    Args:
+        opponent: a policy name (``"evader/straight"``, ``"evader/sb3:PATH"``) or a Policy.
+        role: the learner's role; the opponent must play the other one.
+
+    Raises:
+        InvalidConfigError: the opponent is of the wrong type or plays the learner's role.
+        UnknownNameError: the name is not registered.
+    """
+    check_role(role)
+    want = _other(role)
+    if isinstance(opponent, str):
+        if opponent.partition("/")[0] != want:
+            raise InvalidConfigError(
+                f"opponent: a {role} learner needs a {want!r} policy ('{want}/KIND'), "
+                f"got {opponent!r}"
+            )
+        return make_policy(opponent, **sb3_params(opponent))
+    if isinstance(opponent, Policy):
+        roles = getattr(opponent, "roles", (want,))
+        if want not in roles:
+            raise InvalidConfigError(
+                f"opponent: policy {opponent.name!r} plays {tuple(roles)}, not {want!r}"
+            )
+        return opponent
+    raise InvalidConfigError(
+        f"opponent: expected a policy name or a Policy, got {type(opponent).__name__} {opponent!r}"
+    )
+
+
+class SingleAgentEnv(gym.Env):
+    """The surveillance game seen by one role; a fixed Policy plays the other.
+
+    Args:
+        role: ``"pursuer"`` or ``"evader"``, the role the learner plays.
+        opponent: the other role's policy: a name for
+            :func:`strategies.policies.make_policy` or a Policy object.
+        map: the world (a :class:`Map`, a built-in name or a map file path).
+        start: ``"env"`` (the env's random start), ``"valid"`` or ``"safe"``
+            (:func:`strategies.policies.starts.sample_start`).
+        render_mode: ``None``, ``"human"`` or ``"rgb_array"``.
+        **env_kwargs: the other arguments of :func:`envs.surveillance_v0.parallel_env`
+            (``max_cycles``, ``observation``, ``v_evader``...).
+
+    Rewards are the learner's env rewards, ``terminated`` means surveillance broke and
+    ``truncated`` that the horizon was reached. ``info`` is the env's info of the
+    learner's agent (surveillance, distance, theta, step, time; cause, feature and
+    break time on escape; reward components).
+
+    Raises:
+        InvalidConfigError: bad role, opponent, start or env argument (naming it).
+    """
+
+    metadata: ClassVar[dict[str, Any]] = {
+        "render_modes": ["human", "rgb_array"],
+        "render_fps": 10,
+    }
+
+    def __init__(
+        self,
+        role: str,
+        opponent: str | Policy,
+        map: Map | str | os.PathLike[str] = "corridor",
+        *,
+        start: str = "env",
+        render_mode: str | None = None,
+        **env_kwargs: Any,
+    ) -> None:
+        self.role = check_role(role)
+        if start not in START_CHOICES:
+            raise InvalidConfigError(f"start: expected one of {START_CHOICES}, got {start!r}")
+        self.start = start
+        self.opponent = make_opponent(opponent, role)
+        self.opponent_role = _other(role)
+        self.agent = AGENT_OF_ROLE[role]
+        self.opponent_agent = AGENT_OF_ROLE[self.opponent_role]
+        try:
+            self.env = surveillance_v0.parallel_env(map=map, render_mode=render_mode, **env_kwargs)
+        except TypeError as exc:  # a misspelt env argument
+            raise InvalidConfigError(f"env: {exc}") from exc
+        self.config = self.env.config
+        self.render_mode = self.env.render_mode
+        self.metadata = {**type(self).metadata, "render_fps": 1.0 / self.config.dt}
+        self.observation_space = self.env.observation_space(self.agent)
+        self.action_space = self.env.action_space(self.agent)
+        # analytic opponents read the "state" vector even when the learner sees lidar
+        self._opponent_reads_state = bool(getattr(self.opponent, "uses_state", True))
+        self._opponent_config = self.config
+        if self._opponent_reads_state and self.config.observation != "state":
+            self._opponent_config = dataclasses.replace(self.config, observation="state")
+        self._opponent_obs: np.ndarray | None = None
+
+    # ------------------------------------------------------------------ episode
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        """Start an episode.
+
+        Args:
+            seed: reseeds this env's generator (and through it the env, the start
+                sampler and the opponent); ``None`` continues the current stream.
+            options: ``{"pursuer": (x, y), "evader": (x, y)}`` places the agents exactly,
+                bypassing the start sampler.
+
+        Returns:
+            The learner's observation and info.
+        """
+        super().reset(seed=seed)
+        env_seed, start_seed, opp_seed = (
+            int(s) for s in self.np_random.integers(_SEED_BOUND, size=3)
+        )
+        if options and ("pursuer" in options or "evader" in options):
+            placement = dict(options)
+        elif self.start == "env":
+            placement = None
+        else:
+            placement = sample_start(
+                self.config, np.random.default_rng(start_seed), kind=self.start
+            )
+        self.opponent.reset(
+            role=self.opponent_role,
+            map=self.config.map,
+            config=self._opponent_config,
+            seed=opp_seed,
+        )
+        obs, infos = self.env.reset(seed=env_seed, options=placement)
+        self._opponent_obs = self._opponent_view(obs)
+        return obs[self.agent], dict(infos[self.agent])
+
+    def _opponent_view(self, obs: dict[str, np.ndarray]) -> np.ndarray:
+        if self._opponent_config is not self.config:
+            return self.env.state()
+        return obs[self.opponent_agent]
+
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        """Play the learner's ``action`` and the opponent's reply for one step.
+
+        Args:
+            action: the learner's (2,) action (finite values outside [-1, 1] are clipped
+                by the env; NaN or inf raise ``InvalidActionError``).
+
+        Returns:
+            ``(observation, reward, terminated, truncated, info)`` of the learner.
+
+        Raises:
+            InvalidConfigError: called before ``reset`` or after the episode ended.
+        """
+        if self._opponent_obs is None or not self.env.agents:
+            raise InvalidConfigError("step: call reset() first; the episode is over")
+        reply = self.opponent.act(self._opponent_obs)
+        obs, rewards, terms, truncs, infos = self.env.step(
+            {self.agent: action, self.opponent_agent: reply}
+        )
+        terminated = bool(terms[self.agent])
+        truncated = bool(truncs[self.agent])
+        self._opponent_obs = None if terminated or truncated else self._opponent_view(obs)
+        return (
+            obs[self.agent],
+            float(rewards[self.agent]),
+            terminated,
+            truncated,
+            dict(infos[self.agent]),
+        )
+
+    def render(self) -> np.ndarray | None:
+        """The env's frame (``"rgb_array"``) or window (``"human"``)."""
+        return self.env.render()
+
+    def close(self) -> None:
+        """Close the env's renderer (idempotent)."""
+        self.env.close()

@@ -1,0 +1,546 @@
+"""SB3 training (PPO, SAC) of one role from a :class:`TrainConfig`, with resume and provenance.
+
+:func:`train` builds a ``DummyVecEnv`` of :class:`~training.single_agent.SingleAgentEnv`,
+trains on the CPU with one torch thread, and writes into ``config.output_dir``:
+
+* ``config.toml`` -- the config of the run (a resumed run must match it);
+* ``checkpoints/ckpt_<timesteps>.zip`` -- written as it goes (atomically, the last two
+  kept); a rerun of an interrupted run continues from the newest one with the
+  remaining timesteps;
+* ``model.zip`` -- the final model, loadable as ``make_policy("ROLE/sb3:.../model.zip")``;
+* ``provenance.json`` -- config, git SHA, versioned env id, package versions,
+  timesteps, wall time, evaluation.
+
+A resumed run continues from the checkpoint's weights and counters with the env and
+model reseeded from ``seed + timesteps``: deterministic given the checkpoint, but not bit
+for bit the run that was never interrupted (the rollout in progress is lost).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+import time
+from dataclasses import asdict, dataclass, field
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from envs.errors import InvalidConfigError
+from envs.surveillance_v0 import ENV_ID
+from strategies.policies import Policy, make_policy
+from training.config import TrainConfig, load_config
+from training.single_agent import SingleAgentEnv, sb3_params
+
+__all__ = [
+    "ENV_NAME",
+    "EVAL_SEED_OFFSET",
+    "EvalResult",
+    "TrainResult",
+    "evaluate_model",
+    "latest_checkpoint",
+    "load_policy",
+    "read_provenance",
+    "train",
+    "train_from_config",
+]
+
+ENV_NAME = "surveillance_v0"
+"""The versioned env every model here is trained on (recorded in provenance)."""
+
+EVAL_SEED_OFFSET = 1_000_003
+"""The final evaluation uses ``seed + EVAL_SEED_OFFSET``: starts the training never drew."""
+
+KEEP_CHECKPOINTS = 2
+_CKPT = re.compile(r"^ckpt_(\d+)\.zip$")
+_PACKAGES = (
+    "numpy",
+    "torch",
+    "stable-baselines3",
+    "gymnasium",
+    "pettingzoo",
+    "pymunk",
+    "shapely",
+    "scipy",
+)
+
+
+# --------------------------------------------------------------------------- results
+@dataclass(frozen=True)
+class EvalResult:
+    """A model's record against one opponent.
+
+    Attributes:
+        role: the model's role.
+        opponent: the opponent's name.
+        episodes: episodes played.
+        successes: episodes the model won (pursuer: surveillance held to the horizon;
+            evader: surveillance broke).
+        success_rate: ``successes / episodes``.
+        mean_escape_time: mean time (s) at which surveillance broke, over the episodes
+            where it did (NaN if it never did).
+        escape_times: those times, in episode order.
+        causes: escape causes and their counts.
+    """
+
+    role: str
+    opponent: str
+    episodes: int
+    successes: int
+    success_rate: float
+    mean_escape_time: float
+    escape_times: tuple[float, ...] = ()
+    causes: dict[str, int] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict (NaN written as ``None``)."""
+        d = asdict(self)
+        d["escape_times"] = list(self.escape_times)
+        if math.isnan(self.mean_escape_time):
+            d["mean_escape_time"] = None
+        return d
+
+
+@dataclass(frozen=True)
+class TrainResult:
+    """What :func:`train` produced.
+
+    Attributes:
+        config: the run's config.
+        output_dir: where everything was written.
+        model_path: the final ``model.zip``.
+        provenance_path: ``provenance.json``.
+        timesteps: timesteps the final model has been trained for.
+        wall_time: seconds spent in this call (training and evaluation).
+        resumed_from: the checkpoint this call continued from, if any.
+        evaluation: the final evaluation against the opponent (``None`` if skipped).
+    """
+
+    config: TrainConfig
+    output_dir: Path
+    model_path: Path
+    provenance_path: Path
+    timesteps: int
+    wall_time: float
+    resumed_from: Path | None
+    evaluation: EvalResult | None
+
+    @property
+    def policy_name(self) -> str:
+        """The registry name that loads this model: ``"ROLE/sb3:PATH"``."""
+        return f"{self.config.role}/sb3:{self.model_path}"
+
+
+# --------------------------------------------------------------------------- helpers
+def _algo_class(algo: str):
+    import stable_baselines3
+
+    return getattr(stable_baselines3, algo.upper())
+
+
+def latest_checkpoint(output_dir: str | os.PathLike[str]) -> tuple[int, Path] | None:
+    """The newest ``checkpoints/ckpt_<timesteps>.zip`` in ``output_dir``, if any."""
+    found = []
+    ckdir = Path(output_dir) / "checkpoints"
+    if ckdir.is_dir():
+        for p in ckdir.iterdir():
+            m = _CKPT.match(p.name)
+            if m:
+                found.append((int(m.group(1)), p))
+    return max(found) if found else None
+
+
+def read_provenance(path: str | os.PathLike[str]) -> dict[str, Any]:
+    """The ``provenance.json`` of a model zip (or of a run directory).
+
+    Raises:
+        InvalidConfigError: there is no readable ``provenance.json`` next to it.
+    """
+    p = Path(path)
+    prov = (p if p.is_dir() else p.parent) / "provenance.json"
+    try:
+        return json.loads(prov.read_text())
+    except (OSError, json.JSONDecodeError) as exc:
+        raise InvalidConfigError(f"{str(prov)!r}: no readable provenance ({exc})") from exc
+
+
+def _provenance_or_none(path: str | os.PathLike[str]) -> dict[str, Any] | None:
+    try:
+        return read_provenance(path)
+    except InvalidConfigError:
+        return None
+
+
+def load_policy(
+    path: str | os.PathLike[str], *, role: str | None = None, deterministic: bool = True
+) -> Policy:
+    """A trained model zip as a Policy: ``make_policy("ROLE/sb3:PATH")``.
+
+    The role and the algorithm come from the ``provenance.json`` beside the zip when
+    there is one (the algorithm is passed explicitly: ``SB3Policy`` cannot tell PPO
+    from A2C by the zip alone, as both save ``common.policies.ActorCriticPolicy``).
+
+    Raises:
+        InvalidConfigError: no role given and no provenance to read it from.
+    """
+    prov = _provenance_or_none(path)
+    if role is None:
+        if prov is None:
+            raise InvalidConfigError(f"{os.fspath(path)!r}: pass role=, no provenance.json")
+        role = prov["role"]
+    name = f"{role}/sb3:{os.fspath(path)}"
+    return make_policy(name, deterministic=deterministic, **sb3_params(name))
+
+
+def _atomic_write(path: Path, text: str) -> None:
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def _save_model(model, path: Path) -> None:
+    tmp = path.with_name(path.name + ".tmp")  # has a suffix, so SB3 adds no ".zip"
+    model.save(str(tmp))
+    os.replace(tmp, path)
+
+
+def _git_sha() -> str | None:
+    root = Path(__file__).resolve().parents[1]
+    try:
+        out = subprocess.run(
+            ["git", "rev-parse", "HEAD"], cwd=root, capture_output=True, text=True, timeout=10
+        )
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return out.stdout.strip() or None if out.returncode == 0 else None
+
+
+def _versions() -> dict[str, str | None]:
+    out: dict[str, str | None] = {"python": sys.version.split()[0]}
+    for name in _PACKAGES:
+        try:
+            out[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            out[name] = None
+    return out
+
+
+_RESUME_FREE = {"total_timesteps", "eval_episodes", "eval_start", "checkpoint_freq", "output_dir"}
+"""Fields a resumed run may change: they do not alter what has been learned so far."""
+
+
+def _check_resumable(config: TrainConfig, out: Path) -> None:
+    stored = out / "config.toml"
+    if not stored.is_file():
+        return
+    before = load_config(stored).to_dict()
+    now = config.to_dict()
+    diff = sorted(k for k in now if k not in _RESUME_FREE and before.get(k) != now[k])
+    if diff:
+        raise InvalidConfigError(
+            f"output_dir {str(out)!r} holds a run with a different config (fields {diff}: "
+            f"{[before.get(k) for k in diff]} there, {[now[k] for k in diff]} now); "
+            f"use another output_dir or delete that one"
+        )
+
+
+def _make_vec_env(config: TrainConfig):
+    from stable_baselines3.common.monitor import Monitor
+    from stable_baselines3.common.vec_env import DummyVecEnv
+
+    def factory():
+        return Monitor(SingleAgentEnv(config.role, config.opponent, **config.env_kwargs()))
+
+    return DummyVecEnv([factory] * config.n_envs)
+
+
+def _new_model(config: TrainConfig, vec_env):
+    cls = _algo_class(config.algo)
+    kwargs: dict[str, Any] = {
+        "learning_rate": config.learning_rate,
+        "gamma": config.gamma,
+        "batch_size": config.batch_size,
+        "policy_kwargs": {**config.policy_kwargs, "net_arch": list(config.net_arch)},
+        "seed": config.seed,
+        "device": "cpu",
+        "verbose": 0,
+    }
+    if config.algo == "ppo":
+        kwargs["n_steps"] = config.n_steps
+    kwargs.update(config.algo_kwargs)
+    return cls("MlpPolicy", vec_env, **kwargs)
+
+
+def _checkpoint_callback(config: TrainConfig, out: Path, start: int):
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    class Checkpoint(BaseCallback):
+        """Saves at the start of a rollout, when the previous one has been trained on."""
+
+        def __init__(self) -> None:
+            super().__init__()
+            self.last = start
+
+        def _on_step(self) -> bool:
+            return True
+
+        def _on_rollout_start(self) -> None:
+            n = self.model.num_timesteps
+            if n - self.last >= config.checkpoint_freq:
+                self.last = n
+                ckdir = out / "checkpoints"
+                ckdir.mkdir(parents=True, exist_ok=True)
+                _save_model(self.model, ckdir / f"ckpt_{n}.zip")
+                if config.algo == "sac":
+                    self.model.save_replay_buffer(str(ckdir / "replay_buffer.pkl"))
+                old = sorted(
+                    (int(m.group(1)), p) for p in ckdir.iterdir() if (m := _CKPT.match(p.name))
+                )
+                for _, p in old[:-KEEP_CHECKPOINTS]:
+                    p.unlink(missing_ok=True)
+
+    return Checkpoint()
+
+
+# --------------------------------------------------------------------------- training
+def train(
+    config: TrainConfig,
+    *,
+    init_model: str | os.PathLike[str] | None = None,
+    callbacks: list[Any] | None = None,
+    progress_bar: bool = False,
+) -> TrainResult:
+    """Train ``config.role`` against ``config.opponent``, resuming if interrupted.
+
+    Args:
+        config: the run.
+        init_model: a model zip to start from instead of fresh weights (self-play warm
+            start; ignored when resuming from a checkpoint).
+        callbacks: extra SB3 callbacks (run after the checkpoint callback).
+        progress_bar: show SB3's progress bar (needs ``tqdm`` and ``rich``).
+
+    Returns:
+        The :class:`TrainResult`. If ``output_dir`` already holds a finished run with at
+        least ``total_timesteps``, it is returned as is, without training.
+
+    Raises:
+        InvalidConfigError: ``output_dir`` holds a run with another config.
+    """
+    import torch
+
+    t0 = time.perf_counter()
+    torch.set_num_threads(1)
+    out = Path(config.output_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    _check_resumable(config, out)
+    _atomic_write(out / "config.toml", config.to_toml())
+    model_path, prov_path = out / "model.zip", out / "provenance.json"
+    if model_path.is_file() and prov_path.is_file():
+        prov = read_provenance(out)
+        if prov.get("timesteps", -1) >= config.total_timesteps:
+            return _result_from_provenance(config, out, prov)
+
+    vec_env = _make_vec_env(config)
+    cls = _algo_class(config.algo)
+    ckpt = latest_checkpoint(out)
+    resumed_from = None
+    if ckpt is not None:
+        done, path = ckpt
+        model = cls.load(str(path), env=vec_env, device="cpu")
+        buf = out / "checkpoints" / "replay_buffer.pkl"
+        if config.algo == "sac" and buf.is_file():
+            model.load_replay_buffer(str(buf))
+        model.set_random_seed(config.seed + done)
+        model._last_obs = None  # start fresh episodes in the new env copies
+        resumed_from = path
+    elif init_model is not None:
+        model = cls.load(str(init_model), env=vec_env, device="cpu")
+        model.set_random_seed(config.seed)
+        model._last_obs = None
+        done = 0
+    else:
+        model = _new_model(config, vec_env)
+        done = 0
+    remaining = config.total_timesteps - model.num_timesteps
+    if remaining > 0:
+        cbs = [_checkpoint_callback(config, out, model.num_timesteps), *(callbacks or [])]
+        model.learn(
+            total_timesteps=remaining,
+            callback=cbs,
+            reset_num_timesteps=resumed_from is None,
+            progress_bar=progress_bar,
+        )
+    _save_model(model, model_path)
+    timesteps = int(model.num_timesteps)
+    vec_env.close()
+    train_time = time.perf_counter() - t0
+
+    evaluation = None
+    if config.eval_episodes > 0:
+        learner = make_policy(f"{config.role}/sb3:{model_path}", algo=config.algo.upper())
+        evaluation = evaluate_model(
+            learner,
+            config.opponent,
+            episodes=config.eval_episodes,
+            seed=config.seed + EVAL_SEED_OFFSET,
+            role=config.role,
+            map=config.map,
+            start=config.eval_start,
+            env=config.env,
+        )
+    wall = time.perf_counter() - t0
+    provenance = {
+        "env_id": ENV_NAME,
+        "registry_id": ENV_ID,
+        "role": config.role,
+        "opponent": config.opponent,
+        "algo": config.algo,
+        "config": config.to_dict(),
+        "env_config": SingleAgentEnv(
+            config.role, config.opponent, **config.env_kwargs()
+        ).config.to_dict(),
+        "git_sha": _git_sha(),
+        "packages": _versions(),
+        "timesteps": timesteps,
+        "resumed_from": None if resumed_from is None else resumed_from.name,
+        "resumed_at": done if resumed_from is not None else None,
+        "init_model": None if init_model is None else str(init_model),
+        "train_seconds": round(train_time, 3),
+        "wall_seconds": round(wall, 3),
+        "evaluation": None if evaluation is None else evaluation.to_dict(),
+        "created": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
+    }
+    _atomic_write(prov_path, json.dumps(provenance, indent=2) + "\n")
+    return TrainResult(
+        config, out, model_path, prov_path, timesteps, wall, resumed_from, evaluation
+    )
+
+
+def _result_from_provenance(config: TrainConfig, out: Path, prov: dict[str, Any]) -> TrainResult:
+    ev = prov.get("evaluation")
+    evaluation = None
+    if ev is not None:
+        ev = dict(ev)
+        ev["escape_times"] = tuple(ev.get("escape_times", ()))
+        if ev.get("mean_escape_time") is None:
+            ev["mean_escape_time"] = math.nan
+        evaluation = EvalResult(**ev)
+    return TrainResult(
+        config,
+        out,
+        out / "model.zip",
+        out / "provenance.json",
+        int(prov["timesteps"]),
+        0.0,
+        None,
+        evaluation,
+    )
+
+
+def train_from_config(
+    path: str | os.PathLike[str],
+    *,
+    output_dir: str | os.PathLike[str] | None = None,
+    total_timesteps: int | None = None,
+    seed: int | None = None,
+    progress_bar: bool = False,
+) -> TrainResult:
+    """Load a TOML config (optionally overriding some fields) and :func:`train` it.
+
+    Raises:
+        InvalidConfigError: the file or a field is bad.
+    """
+    overrides: dict[str, Any] = {}
+    if output_dir is not None:
+        overrides["output_dir"] = os.fspath(output_dir)
+    if total_timesteps is not None:
+        overrides["total_timesteps"] = total_timesteps
+    if seed is not None:
+        overrides["seed"] = seed
+    return train(load_config(path, **overrides), progress_bar=progress_bar)
+
+
+# --------------------------------------------------------------------------- evaluation
+def evaluate_model(
+    path: str | os.PathLike[str] | Policy,
+    opponent: str | Policy,
+    episodes: int = 20,
+    seed: int = 0,
+    *,
+    role: str | None = None,
+    map: str | None = None,
+    start: str | None = None,
+    env: dict[str, Any] | None = None,
+    deterministic: bool = True,
+) -> EvalResult:
+    """Play a trained model against ``opponent`` and count its wins.
+
+    ``role``, ``map`` and ``env`` default to those in the ``provenance.json`` beside the
+    model (the settings it was trained with, which matter: the observation holds the
+    time as a fraction of ``max_cycles``); ``start`` defaults to ``"safe"``.
+
+    Args:
+        path: the model zip (or an already built Policy, with ``role`` and ``map`` given).
+        opponent: the other role's policy name or Policy.
+        episodes: episodes to play (>= 1).
+        seed: seeds the episode stream (starts, env, opponent, model).
+        role, map, start, env: see above.
+        deterministic: use the model's deterministic action.
+
+    Returns:
+        The :class:`EvalResult`.
+
+    Raises:
+        InvalidConfigError: bad arguments, or settings missing with no provenance.
+    """
+    if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
+        raise InvalidConfigError(f"episodes: expected an integer >= 1, got {episodes!r}")
+    if isinstance(path, Policy):
+        learner = path
+        if role is None or map is None:
+            raise InvalidConfigError("evaluate_model: pass role= and map= with a Policy")
+    else:
+        prov = _provenance_or_none(path)
+        if role is None or map is None or env is None:
+            if prov is None:
+                read_provenance(path)  # raises, naming the missing file
+            role = role or prov["role"]
+            map = map or prov["config"]["map"]
+            env = prov["config"]["env"] if env is None else env
+        learner = load_policy(path, role=role, deterministic=deterministic)
+    game = SingleAgentEnv(role, opponent, map=map, start=start or "safe", **(env or {}))
+    rng = np.random.default_rng(np.random.SeedSequence(int(seed)).spawn(1)[0])
+    successes, times, causes = 0, [], {}
+    obs, _ = game.reset(seed=int(seed))
+    for k in range(episodes):
+        if k:
+            obs, _ = game.reset()
+        learner.reset(
+            role=role, map=game.config.map, config=game.config, seed=int(rng.integers(2**31 - 1))
+        )
+        while True:
+            obs, _, terminated, truncated, info = game.step(learner.act(obs))
+            if terminated or truncated:
+                break
+        if terminated:
+            times.append(float(info["break_at"]))
+            cause = str(info.get("cause"))
+            causes[cause] = causes.get(cause, 0) + 1
+        successes += int(terminated) if role == "evader" else int(not terminated)
+    game.close()
+    return EvalResult(
+        role=role,
+        opponent=opponent if isinstance(opponent, str) else opponent.name,
+        episodes=episodes,
+        successes=successes,
+        success_rate=successes / episodes,
+        mean_escape_time=float(np.mean(times)) if times else math.nan,
+        escape_times=tuple(times),
+        causes=causes,
+    )

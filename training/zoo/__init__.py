@@ -1,0 +1,135 @@
+"""The model zoo: small trained policies shipped in the repo, each reproducible by one command.
+
+Each model lives in ``training/zoo/models/<name>/`` as ``model.zip`` (an SB3 model, a
+[64, 64] MLP), ``config.toml`` (the :class:`~training.config.TrainConfig` it was trained
+from) and ``provenance.json`` (git SHA, package versions, timesteps, wall time, the
+evaluation against its training opponent).
+
+Examples:
+    >>> from training import zoo
+    >>> "ppo_pursuer_vs_straight_open_room" in zoo.list_models()
+    True
+
+Command line::
+
+    python -m training.zoo list
+    python -m training.zoo info NAME
+    python -m training.zoo reproduce NAME [--output-dir DIR] [--install]
+    python -m training.zoo evaluate NAME --opponent evader/shooting [--episodes 50]
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+from typing import Any
+
+from envs.errors import UnknownNameError
+from strategies.policies import Policy
+from training.config import TrainConfig, load_config
+from training.train import TrainResult, load_policy, read_provenance, train
+
+__all__ = [
+    "MODELS_DIR",
+    "config",
+    "info",
+    "install",
+    "list_models",
+    "load",
+    "model_path",
+    "policy_name",
+    "reproduce",
+]
+
+MODELS_DIR = Path(__file__).resolve().parent / "models"
+"""Where the shipped models live."""
+
+_FILES = ("model.zip", "config.toml", "provenance.json")
+
+
+def list_models() -> list[str]:
+    """Names of the shipped models, sorted."""
+    if not MODELS_DIR.is_dir():
+        return []
+    return sorted(p.name for p in MODELS_DIR.iterdir() if all((p / f).is_file() for f in _FILES))
+
+
+def _dir(name: str) -> Path:
+    if name not in list_models():
+        raise UnknownNameError(
+            f"unknown zoo model {name!r}; known models: {', '.join(list_models()) or 'none'}"
+        )
+    return MODELS_DIR / name
+
+
+def model_path(name: str) -> Path:
+    """The ``model.zip`` of ``name``.
+
+    Raises:
+        UnknownNameError: listing the known models.
+    """
+    return _dir(name) / "model.zip"
+
+
+def info(name: str) -> dict[str, Any]:
+    """The provenance record of ``name`` (config, versions, timesteps, evaluation)."""
+    return read_provenance(_dir(name))
+
+
+def config(name: str) -> TrainConfig:
+    """The training config of ``name``."""
+    return load_config(_dir(name) / "config.toml")
+
+
+def policy_name(name: str) -> str:
+    """The registry name that plays ``name``: ``"ROLE/sb3:PATH"``."""
+    return f"{info(name)['role']}/sb3:{model_path(name)}"
+
+
+def load(name: str, *, deterministic: bool = True) -> Policy:
+    """The model ``name`` as a Policy (reset it with its role before ``act``).
+
+    Raises:
+        UnknownNameError: listing the known models.
+    """
+    return load_policy(model_path(name), deterministic=deterministic)
+
+
+def reproduce(
+    name: str,
+    output_dir: str | os.PathLike[str] | None = None,
+    *,
+    install_result: bool = False,
+    progress_bar: bool = False,
+) -> TrainResult:
+    """Retrain ``name`` from its stored config (same seed, same hyperparameters).
+
+    Args:
+        name: a zoo model.
+        output_dir: where to train (default ``out/zoo/<name>``); resumes if interrupted.
+        install_result: replace the shipped model with the retrained one.
+        progress_bar: show SB3's progress bar.
+    """
+    cfg = config(name).replace(output_dir=os.fspath(output_dir or Path("out/zoo") / name))
+    result = train(cfg, progress_bar=progress_bar)
+    if install_result:
+        install(name, result.output_dir)
+    return result
+
+
+def install(name: str, run_dir: str | os.PathLike[str]) -> Path:
+    """Copy a finished run's model, config and provenance into the zoo as ``name``.
+
+    Raises:
+        UnknownNameError: the run directory lacks one of the files.
+    """
+    src = Path(run_dir)
+    missing = [f for f in _FILES if not (src / f).is_file()]
+    if missing:
+        raise UnknownNameError(f"{str(src)!r} is not a finished run: missing {missing}")
+    dst = MODELS_DIR / name
+    dst.mkdir(parents=True, exist_ok=True)
+    for f in _FILES:
+        shutil.copyfile(src / f, dst / f)
+    return dst

@@ -1,0 +1,67 @@
+"""``python -m training.zoo {list,info,reproduce,evaluate}``: see :mod:`training.zoo`."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+
+from training import zoo
+from training.train import evaluate_model
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the zoo command line; returns the exit code."""
+    parser = argparse.ArgumentParser(prog="python -m training.zoo", description=__doc__)
+    sub = parser.add_subparsers(dest="command", required=True)
+    sub.add_parser("list", help="names of the shipped models")
+    p_info = sub.add_parser("info", help="provenance of one model")
+    p_info.add_argument("name")
+    p_rep = sub.add_parser("reproduce", help="retrain a model from its stored config")
+    p_rep.add_argument("name")
+    p_rep.add_argument("--output-dir", default=None, help="default: out/zoo/NAME")
+    p_rep.add_argument("--install", action="store_true", help="replace the shipped model")
+    p_rep.add_argument("--progress", action="store_true", help="SB3 progress bar")
+    p_ev = sub.add_parser("evaluate", help="play a model against an opponent")
+    p_ev.add_argument("name")
+    p_ev.add_argument("--opponent", required=True, help="e.g. evader/shooting")
+    p_ev.add_argument("--episodes", type=int, default=50)
+    p_ev.add_argument("--seed", type=int, default=0)
+    p_ev.add_argument("--start", default="safe", choices=["env", "valid", "safe"])
+    args = parser.parse_args(argv)
+    if args.command == "list":
+        for name in zoo.list_models():
+            prov = zoo.info(name)
+            print(f"{name}\t{prov['role']} vs {prov['opponent']} on {prov['config']['map']}")
+    elif args.command == "info":
+        print(json.dumps(zoo.info(args.name), indent=2))
+    elif args.command == "reproduce":
+        r = zoo.reproduce(
+            args.name, args.output_dir, install_result=args.install, progress_bar=args.progress
+        )
+        print(f"trained {r.timesteps} timesteps in {r.wall_time:.1f} s -> {r.model_path}")
+        if r.evaluation is not None:
+            print(_line(r.evaluation))
+    else:
+        ev = evaluate_model(
+            zoo.model_path(args.name),
+            args.opponent,
+            episodes=args.episodes,
+            seed=args.seed,
+            start=args.start,
+        )
+        print(_line(ev))
+    return 0
+
+
+def _line(ev) -> str:
+    t = "-" if math.isnan(ev.mean_escape_time) else f"{ev.mean_escape_time:.2f} s"
+    return (
+        f"{ev.role} vs {ev.opponent}: success {ev.successes}/{ev.episodes} "
+        f"({ev.success_rate:.0%}), mean escape time {t}, causes {ev.causes}"
+    )
+
+
+if __name__ == "__main__":
+    sys.exit(main())

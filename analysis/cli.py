@@ -40,15 +40,27 @@ def _cmd_maps(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_policies(args: argparse.Namespace) -> int:
+    from strategies.policies import describe_policy, policy_names
+
+    for name in policy_names(args.role):
+        print(f"{name:<26} {describe_policy(name)}")
+    print("learned policies: ROLE/sb3:PATH (a stable-baselines3 model zip)")
+    return 0
+
+
 def _cmd_play(args: argparse.Namespace) -> int:
     from analysis.evaluate import play_episode
     from analysis.replay import write_replay
+    from strategies.policies import make_policy
 
     overrides = json.loads(args.config) if args.config else {}
+    pursuer = make_policy(args.pursuer, **json.loads(args.pursuer_params or "{}"))
+    evader = make_policy(args.evader, **json.loads(args.evader_params or "{}"))
     result = play_episode(
         args.map,
-        args.pursuer,
-        args.evader,
+        pursuer,
+        evader,
         seed=args.seed,
         max_cycles=args.max_cycles,
         overrides=overrides,
@@ -134,12 +146,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plot", metavar="DIR", help="also draw each map to DIR/NAME.png")
     p.set_defaults(func=_cmd_maps)
 
+    p = sub.add_parser("policies", help="list the registered policies")
+    p.add_argument("--role", choices=["pursuer", "evader"], default=None)
+    p.set_defaults(func=_cmd_policies)
+
     p = sub.add_parser("play", help="play one episode and write its replay (the main job)")
     p.add_argument(
         "--map", default="corridor", help="built-in name or map file (default: corridor)"
     )
     p.add_argument("--pursuer", default="pursuer/decomposition", help="registered pursuer policy")
     p.add_argument("--evader", default="evader/shooting", help="registered evader policy")
+    p.add_argument("--pursuer-params", help="pursuer parameters as JSON (see surveil policies)")
+    p.add_argument("--evader-params", help='evader parameters as JSON, e.g. \'{"mode": "away"}\'')
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--max-cycles", type=int, default=None, help="episode horizon in steps")
     p.add_argument("--config", help="env overrides as JSON, e.g. '{\"v_evader\": 0.8}'")

@@ -126,3 +126,28 @@ def test_evaluate_prints_the_table_resumes_and_plots(tmp_path, capsys):
     assert main(argv) == 0
     assert len(results.read_text().splitlines()) == 4
     assert capsys.readouterr().out.splitlines()[-4:] == first.splitlines()[-4:]
+
+
+def test_policies_lists_the_registry_and_play_takes_parameters(tmp_path, capsys):
+    from strategies.policies import policy_names
+
+    assert main(["policies", "--role", "evader"]) == 0
+    out = capsys.readouterr().out
+    assert all(name in out for name in policy_names("evader"))
+    assert "pursuer/greedy" not in out
+    argv = [
+        "play",
+        "--map",
+        "open_room",
+        "--pursuer",
+        "pursuer/greedy",
+        "--evader",
+        "evader/toward_away",
+        "--evader-params",
+        '{"mode": "away"}',
+        "--max-cycles",
+        "5",
+        "--no-gif",
+    ]
+    assert main(argv) == 0
+    assert main([*argv[:-3], "--evader-params", '{"no_such_param": 1}', "--no-gif"]) != 0

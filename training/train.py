@@ -294,18 +294,23 @@ def _checkpoint_callback(config: TrainConfig, out: Path, start: int):
             n = self.model.num_timesteps
             if n - self.last >= config.checkpoint_freq:
                 self.last = n
-                ckdir = out / "checkpoints"
-                ckdir.mkdir(parents=True, exist_ok=True)
-                _save_model(self.model, ckdir / f"ckpt_{n}.zip")
-                if config.algo == "sac":
-                    self.model.save_replay_buffer(str(ckdir / "replay_buffer.pkl"))
-                old = sorted(
-                    (int(m.group(1)), p) for p in ckdir.iterdir() if (m := _CKPT.match(p.name))
-                )
-                for _, p in old[:-KEEP_CHECKPOINTS]:
-                    p.unlink(missing_ok=True)
+                _checkpoint(self.model, config, out)
 
     return Checkpoint()
+
+
+def _checkpoint(model, config: TrainConfig, out: Path) -> None:
+    """Write ``checkpoints/ckpt_<timesteps>.zip`` (and SAC's replay buffer), keep the last two."""
+    ckdir = out / "checkpoints"
+    ckdir.mkdir(parents=True, exist_ok=True)
+    if config.algo == "sac":  # the buffer first: a checkpoint never lacks its buffer
+        tmp = ckdir / "replay_buffer.pkl.tmp"
+        model.save_replay_buffer(str(tmp))
+        os.replace(tmp, ckdir / "replay_buffer.pkl")
+    _save_model(model, ckdir / f"ckpt_{model.num_timesteps}.zip")
+    old = sorted((int(m.group(1)), p) for p in ckdir.iterdir() if (m := _CKPT.match(p.name)))
+    for _, p in old[:-KEEP_CHECKPOINTS]:
+        p.unlink(missing_ok=True)
 
 
 # --------------------------------------------------------------------------- training
@@ -378,6 +383,8 @@ def train(
         )
     _save_model(model, model_path)
     timesteps = int(model.num_timesteps)
+    if remaining > 0:  # the final state is a checkpoint too: a longer rerun continues it
+        _checkpoint(model, config, out)
     vec_env.close()
     train_time = time.perf_counter() - t0
 

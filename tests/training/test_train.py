@@ -124,6 +124,7 @@ def test_same_seed_same_model_and_resume_guard(tiny, tmp_path):
     # more timesteps in the same directory continue the finished run
     longer = train(tiny(eval_episodes=0, total_timesteps=192, output_dir=str(tmp_path / "a")))
     assert longer.timesteps == 192
+    assert longer.resumed_from.name == "ckpt_128.zip"  # the finished run's final state
 
 
 def test_tiny_sac_and_resume(tiny):

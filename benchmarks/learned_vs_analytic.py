@@ -84,7 +84,7 @@ def fmt_row(label_p, label_e, row, learner_role):
     own = row["rate"] if learner_role == "pursuer" else 1.0 - row["rate"]
     causes = ", ".join(f"{k}:{v}" for k, v in sorted(row["causes"].items())) or "-"
     return (
-        f"{label_p:<34} {label_e:<34} {row['held']:>3}/{row['n']:<3} "
+        f"{label_p:<38} {label_e:<36} {row['held']:>3}/{row['n']:<3} "
         f"{row['rate']:5.2f} [{row['lo']:.2f}, {row['hi']:.2f}]  {own:5.2f}  "
         f"{esc:<22} {causes}"
     )
@@ -99,7 +99,7 @@ def main() -> None:
     names = args.models or zoo.list_models()
     seeds = list(range(args.seed, args.seed + args.episodes))
     header = (
-        f"{'pursuer':<34} {'evader':<34} {'held':>7} {'rate [Wilson 95%]':<18}  "
+        f"{'pursuer':<38} {'evader':<36} {'held':>7} {'rate [Wilson 95%]':<18}  "
         f"{'learner':>5}  {'escape time s [t 95%]':<22} causes"
     )
     timing = []

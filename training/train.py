@@ -210,15 +210,20 @@ def _save_model(model, path: Path) -> None:
     os.replace(tmp, path)
 
 
-def _git_sha() -> str | None:
+def _git(*args: str) -> str | None:
     root = Path(__file__).resolve().parents[1]
     try:
-        out = subprocess.run(
-            ["git", "rev-parse", "HEAD"], cwd=root, capture_output=True, text=True, timeout=10
-        )
+        out = subprocess.run(["git", *args], cwd=root, capture_output=True, text=True, timeout=10)
     except (OSError, subprocess.SubprocessError):
         return None
-    return out.stdout.strip() or None if out.returncode == 0 else None
+    return out.stdout.strip() if out.returncode == 0 else None
+
+
+def _git_state() -> dict[str, Any]:
+    """HEAD's SHA and whether the code this package runs differs from it (``None``: no git)."""
+    sha = _git("rev-parse", "HEAD")
+    status = _git("status", "--porcelain", "--", "envs", "strategies", "training")
+    return {"git_sha": sha or None, "git_dirty": None if status is None else bool(status)}
 
 
 def _versions() -> dict[str, str | None]:
@@ -412,7 +417,7 @@ def train(
         "env_config": SingleAgentEnv(
             config.role, config.opponent, **config.env_kwargs()
         ).config.to_dict(),
-        "git_sha": _git_sha(),
+        **_git_state(),
         "packages": _versions(),
         "timesteps": timesteps,
         "resumed_from": None if resumed_from is None else resumed_from.name,

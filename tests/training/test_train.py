@@ -46,7 +46,7 @@ def test_tiny_ppo_writes_model_and_provenance(tiny):
     assert prov["config"]["role"] == "pursuer" and prov["algo"] == "ppo"
     assert prov["env_config"]["max_cycles"] == 40
     assert {"torch", "stable-baselines3", "gymnasium", "python"} <= set(prov["packages"])
-    assert "git_sha" in prov and prov["wall_seconds"] > 0
+    assert "git_sha" in prov and "git_dirty" in prov and prov["wall_seconds"] > 0
     ev = prov["evaluation"]
     assert ev["episodes"] == 2 and 0 <= ev["successes"] <= 2
     assert len(ev["escape_times"]) == sum(ev["causes"].values())

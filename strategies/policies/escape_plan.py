@@ -1,173 +1,277 @@
-"""Guaranteed escape plans from the escapable-cell fixed point (Sec. 4, conditions (a)/(b)).
+"""Guaranteed escape plans from the exact decomposition K_L (Sec. 4, conditions (a)/(b)).
 
-Every escapable cell (here a node of the cspace grid graph: a grid point and one free arc
-at L) became escapable at some round of the least fixed point: round 0 by condition (a)
-(some neighbouring point has no free arc overlapping it), round r by condition (b) (at
-some neighbouring point every overlapping arc became escapable before round r). The
-neighbouring point responsible is the node's *witness*. An evader in an escapable node
-steps to its witness; whatever orientation the pursuer then picks among the overlapping
-arcs, the new node has a smaller rank, and at rank 0 the step leaves no free
-continuation: surveillance breaks (Sec. 4: "a guaranteed escape path").
+Every escapable cell kappa of K_L (:func:`strategies.cspace.decompose`) became escapable
+at some round of the least fixed point of Sec. 4's definition, through some boundary
+piece of its region R: round 0 by condition (a) (across the piece no cell is adjacent to
+kappa), round r by condition (b) (across the piece every adjacent cell has a rank < r).
+The pieces that qualify at the cell's own round are its *vias*. An evader whose
+configuration lies in kappa walks, inside R, to the nearest point of a via and steps
+across it; whatever orientation the pursuer then holds, the new cell has a smaller rank,
+and at rank 0 the rod has no continuation: surveillance breaks (Sec. 4: "a guaranteed
+escape path"). The cell keeps its identity while the evader stays in R (the rod cannot
+jump across a wall), so the rank only falls.
 
-Where some point carries only escapable nodes (Prop. 2, the *witness region*), an evader
-in a safe node first walks there; :attr:`EscapePlan.region_next` gives the next grid
-point on a shortest walk.
+Where some region carries only escapable cells (Prop. 2, ``Decomposition.witness_regions``)
+an evader in a non-escapable cell first walks there: :attr:`EscapePlan.region_next` gives
+the next grid point on a shortest grid walk.
 """
 
 from __future__ import annotations
 
 import functools
-import hashlib
 import math
-import os
-from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
+import shapely
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import breadth_first_order
 
 from envs.maps import Map
-from strategies.policies.safety import cache_dir, cspace_graph
+from strategies.cspace import Decomposition, decompose
+from strategies.policies.safety import _grid
 
-__all__ = ["EscapePlan", "escape_plan"]
+__all__ = ["CROSS_REL", "EscapePlan", "Witness", "escape_plan", "escape_ranks"]
 
-PLAN_VERSION = 1
+CROSS_REL = 1e-3
+"""How far past a boundary piece (relative to L) a witness point lies."""
+
+_SAMPLES = 64  # fallback crossing points per boundary piece
+
+
+def escape_ranks(dec: Decomposition) -> tuple[np.ndarray, tuple[tuple[int, ...], ...]]:
+    """Rank and vias of every cell: the least fixed point of Sec. 4, by rounds.
+
+    A pair (cell kappa, boundary piece b of kappa's region) is *satisfied* at round 0 if
+    no cell is adjacent to kappa across b (condition (a)), at round r + 1 if every cell
+    adjacent across b has rank <= r (condition (b)). A cell's rank is the first round at
+    which one of its pairs is satisfied; its vias are the pieces satisfied then.
+
+    Returns:
+        ``(rank, vias)``: (n_cells,) int64 ranks (-1 for a non-escapable cell) and, per
+        cell, the ids of its via pieces (empty if not escapable).
+    """
+    n = len(dec.cells)
+    across: dict[tuple[int, int], set[int]] = {}
+    for c in dec.cells:
+        for b in dec.regions[c.region].boundaries:
+            across[(c.id, b)] = set()
+    for b in dec.boundaries:
+        for i, j in b.adjacent:
+            across[(i, b.id)].add(j)
+            across[(j, b.id)].add(i)
+    count = {k: len(v) for k, v in across.items()}
+    watchers: dict[int, list[tuple[int, int]]] = {}
+    for key, nbrs in across.items():
+        for x in nbrs:
+            watchers.setdefault(x, []).append(key)
+    rank = np.full(n, -1, dtype=np.int64)
+    vias: list[list[int]] = [[] for _ in range(n)]
+    ready = sorted(k for k, m in count.items() if m == 0)  # condition (a)
+    r = 0
+    while ready:
+        fresh = []
+        for c, b in ready:
+            if rank[c] < 0 or rank[c] == r:
+                if rank[c] < 0:
+                    rank[c] = r
+                    fresh.append(c)
+                vias[c].append(b)
+        ready = []
+        for x in fresh:  # condition (b): pairs whose last adjacent cell just became escapable
+            for key in watchers.get(x, ()):
+                count[key] -= 1
+                if count[key] == 0 and rank[key[0]] < 0:
+                    ready.append(key)
+        ready.sort()
+        r += 1
+    return rank, tuple(tuple(v) for v in vias)
+
+
+@dataclass(frozen=True)
+class Witness:
+    """Where an evader in an escapable cell goes next.
+
+    Attributes:
+        boundary: the via piece crossed.
+        cross: (2,) the point of the piece the evader walks to.
+        normal: (2,) unit normal there, pointing out of the cell's region.
+        target: (2,) ``cross + CROSS_REL * L * normal``, just across the piece.
+    """
+
+    boundary: int
+    cross: np.ndarray
+    normal: np.ndarray
+    target: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)
 class EscapePlan:
-    """Ranks and witnesses of the escapable nodes of a cspace grid graph.
+    """Ranks and vias of the escapable cells of K_L, and the walk to a witness region.
 
     Attributes:
+        dec: the decomposition.
+        rank: (n_cells,) round of the fixed point at which the cell became escapable, -1
+            if not escapable.
+        vias: per cell, the boundary pieces that make it escapable at its rank.
         points: (n, 2) grid points (the rows of the matching ``SafetyTable``).
-        node_ptr: (n + 1,) nodes of point i are ``node_ptr[i]:node_ptr[i + 1]``.
-        node_lo, node_hi: (N,) each node's free arc ``[lo, hi]``.
-        rank: (N,) round of the fixed point at which the node became escapable, -1 if safe.
-        witness: (N,) neighbouring grid point to step to, -1 if safe.
-        region_next: (n,) next grid point toward the nearest all-escapable point (-1 where
-            none is reachable or the point is in the region).
-        region: (n,) bool, every node at the point is escapable (Prop. 2).
+        region: (n,) bool, the grid point lies in a witness region (Prop. 2).
+        region_next: (n,) next grid point toward the nearest witness-region point (-1
+            where none is reachable or the point is in a witness region).
     """
 
-    points: np.ndarray
-    node_ptr: np.ndarray
-    node_lo: np.ndarray
-    node_hi: np.ndarray
+    dec: Decomposition
     rank: np.ndarray
-    witness: np.ndarray
-    region_next: np.ndarray
+    vias: tuple[tuple[int, ...], ...]
+    points: np.ndarray
     region: np.ndarray
+    region_next: np.ndarray
 
-    def node_at(self, row: int, theta: float) -> int:
-        """The node of grid point ``row`` whose arc contains ``theta`` (else the nearest)."""
-        lo = self.node_lo[self.node_ptr[row] : self.node_ptr[row + 1]]
-        hi = self.node_hi[self.node_ptr[row] : self.node_ptr[row + 1]]
-        if lo.size == 0:
-            return -1
-        d = (theta - lo) % (2.0 * math.pi)
-        inside = d <= hi - lo
-        if inside.any():
-            return int(self.node_ptr[row] + np.argmax(inside))
-        gap = np.minimum(d - (hi - lo), 2.0 * math.pi - d)
-        return int(self.node_ptr[row] + np.argmin(gap))
+    @functools.cached_property
+    def _pieces(self) -> list[tuple[np.ndarray, ...]]:
+        """Per boundary: segment starts, directions, lengths, left normals (into A), and
+        fallback samples along the piece with their segment and wall clearance."""
+        out = []
+        step_min = self.dec.chord_tol
+        for b in self.dec.boundaries:
+            p0, p1 = b.segments[:, 0], b.segments[:, 1]
+            d = p1 - p0
+            ln = np.hypot(d[:, 0], d[:, 1])
+            keep = ln > 0
+            p0, d, ln = p0[keep], d[keep], ln[keep]
+            u = d / ln[:, None]
+            step = max(step_min, float(ln.sum()) / _SAMPLES)
+            m = np.maximum(1, np.ceil(ln / step).astype(int))
+            seg = np.repeat(np.arange(len(ln)), m)
+            frac = (np.arange(int(m.sum())) - np.repeat(np.cumsum(m) - m, m) + 0.5) / m[seg]
+            s = p0[seg] + frac[:, None] * d[seg]
+            clear = self.dec.map.distance_to_walls(s) if len(s) else np.zeros(0)
+            out.append((p0, d, ln, np.stack([-u[:, 1], u[:, 0]], axis=1), s, seg, clear))
+        return out
+
+    @functools.cached_property
+    def _inside(self) -> list:
+        """Region polygons grown by a few polyline tolerances, prepared for line tests."""
+        tol = 4.0 * self.dec.chord_tol + CROSS_REL * self.dec.L
+        polys = [r.polygon.buffer(tol) for r in self.dec.regions]
+        shapely.prepare(polys)
+        return polys
+
+    def well_inside(self, region: int, point: np.ndarray) -> bool:
+        """Whether ``point`` lies in ``region`` farther than a few polyline tolerances from
+        its boundary (then the configuration's cell cannot have changed since it was
+        identified in that region: the rod cannot cross a wall)."""
+        poly = self._shrunk.get(region)
+        if poly is None:
+            poly = self.dec.regions[region].polygon.buffer(-4.0 * self.dec.chord_tol)
+            shapely.prepare(poly)
+            self._shrunk[region] = poly
+        return bool(shapely.contains_xy(poly, float(point[0]), float(point[1])))
+
+    @functools.cached_property
+    def _shrunk(self) -> dict:
+        return {}
+
+    def cell_at(self, point: np.ndarray, theta: float) -> int:
+        """The cell holding configuration ``(point, theta)``, -1 if none is identified."""
+        c = self.dec.cell_at(float(point[0]), float(point[1]), float(theta))
+        return -1 if c is None else c.id
+
+    def witness(self, cell: int, point: np.ndarray, clearance: float = 0.0) -> Witness | None:
+        """The crossing of one of ``cell``'s vias nearest to ``point`` (None if not escapable).
+
+        The point of each via piece nearest to ``point`` (projection onto the piece's
+        polyline) is preferred; it must keep ``clearance`` from the walls (the evader's
+        disc) and be reachable in a straight line inside the cell's region. Failing
+        that, the nearest such point among samples of the pieces; failing that too, the
+        nearest projection.
+        """
+        if self.rank[cell] < 0:
+            return None
+        dec = self.dec
+        reg = dec.cells[cell].region
+        p = np.asarray(point, dtype=float)
+        best = None  # (distance, boundary, point, normal out of the region)
+        fallback = []  # (distance, boundary, point, normal), clear of the walls
+        for b in self.vias[cell]:
+            p0, d, ln, nrm, s, seg, clear = self._pieces[b]
+            if not len(ln):
+                continue
+            sign = 1.0 if dec.boundaries[b].regions[1] == reg else -1.0  # left normal -> A
+            t = np.clip(np.einsum("ij,ij->i", p - p0, d) / ln**2, 0.0, 1.0)
+            q = p0 + t[:, None] * d
+            dist = np.hypot(q[:, 0] - p[0], q[:, 1] - p[1])
+            k = int(np.argmin(dist))
+            cand = (float(dist[k]), b, q[k], sign * nrm[k])
+            if best is None or cand[0] < best[0]:
+                best = cand
+            ds = np.hypot(s[:, 0] - p[0], s[:, 1] - p[1])
+            ok = np.flatnonzero(clear >= clearance)
+            fallback.append(cand)
+            fallback.extend(
+                (float(ds[i]), b, s[i], sign * nrm[seg[i]]) for i in ok[np.argsort(ds[ok])[:8]]
+            )
+        if best is None:
+            return None
+        fallback.sort(key=lambda c: c[0])
+        poly = self._inside[reg]
+        choice = best
+        for c in fallback:
+            if dec.map.distance_to_walls(c[2][None])[0] < clearance:
+                continue
+            if c[0] == 0.0 or shapely.covers(poly, shapely.LineString([p, c[2]])):
+                choice = c
+                break
+        _, b, q, n = choice
+        return Witness(int(b), q, n, q + CROSS_REL * dec.L * n)
 
 
-def _ranks(g) -> tuple[np.ndarray, np.ndarray]:
-    """Least fixed point of (a)/(b) by rounds, recording each node's rank and witness."""
-    edges, ptr = g.point_edges, g.node_ptr
-    m = len(edges)
-    src = np.concatenate([edges[:, 0], edges[:, 1]])
-    dst = np.concatenate([edges[:, 1], edges[:, 0]])
-    # one group per (node a at src, directed step): counts non-escapable overlaps at dst
-    cnt = ptr[src + 1] - ptr[src]
-    gstart = np.cumsum(cnt) - cnt
-    total = int(cnt.sum())
-    group_dst = np.repeat(dst, cnt)
-    group_node = np.arange(total) - np.repeat(gstart, cnt) + np.repeat(ptr[src], cnt)
-    a, b, e = g.overlap[:, 0], g.overlap[:, 1], g.overlap[:, 2]
-    near = np.concatenate([a, b])
-    far = np.concatenate([b, a])
-    step = np.concatenate([e, e + m])
-    pair_group = gstart[step] + (near - ptr[src[step]])
-    count = np.bincount(pair_group, minlength=total)
-    rank = np.full(g.n_nodes, -1, dtype=np.int64)
-    witness = np.full(g.n_nodes, -1, dtype=np.int64)
-    order = np.argsort(far, kind="stable")
-    far_ptr = np.searchsorted(far[order], np.arange(g.n_nodes + 1))
-    sorted_group = pair_group[order]
-    done = np.flatnonzero(count == 0)
-    r = 0
-    while done.size:
-        nodes = group_node[done]
-        fresh = rank[nodes] < 0
-        nodes, groups = nodes[fresh], done[fresh]
-        nodes, first = np.unique(nodes, return_index=True)
-        rank[nodes] = r
-        witness[nodes] = group_dst[groups[first]]
-        if not nodes.size:
-            break
-        lens = far_ptr[nodes + 1] - far_ptr[nodes]
-        idx = np.arange(int(lens.sum())) - np.repeat(np.cumsum(lens) - lens, lens)
-        idx += np.repeat(far_ptr[nodes], lens)
-        hit = sorted_group[idx]
-        np.subtract.at(count, hit, 1)
-        done = np.unique(hit[count[hit] == 0])
-        r += 1
-    return rank, witness
+def _region_next(world: Map, cell: np.ndarray, pts: np.ndarray, h: float, region: np.ndarray):
+    """Next hop on a shortest 8-neighbour grid walk to the region (breadth first).
 
-
-def _region_next(g, region: np.ndarray) -> np.ndarray:
-    """Next hop on a shortest grid walk to the region (breadth first from the region)."""
-    n = g.n_points
-    adj: list[list[int]] = [[] for _ in range(n)]
-    for p, q in g.point_edges:
-        adj[int(p)].append(int(q))
-        adj[int(q)].append(int(p))
-    nxt = np.full(n, -1, dtype=np.int64)
-    seen = region.copy()
-    queue = deque(int(i) for i in np.flatnonzero(region))
-    while queue:
-        u = queue.popleft()
-        for v in adj[u]:
-            if not seen[v]:
-                seen[v] = True
-                nxt[v] = u
-                queue.append(v)
+    Two neighbouring grid points are joined when both keep more than half the step from
+    the walls: the two discs of that radius are free and cover the segment between them.
+    """
+    n = len(pts)
+    clear = np.zeros(n)
+    for s in range(0, n, 65536):
+        clear[s : s + 65536] = world.distance_to_walls(pts[s : s + 65536])
+    rows, cols = [], []
+    nx, ny = cell.shape
+    for di, dj in ((1, 0), (0, 1), (1, 1), (1, -1)):
+        a = cell[max(0, -di) : nx - max(0, di), max(0, -dj) : ny - max(0, dj)]
+        b = cell[max(0, di) : nx - max(0, -di), max(0, dj) : ny - max(0, -dj)]
+        ok = (a >= 0) & (b >= 0)
+        a, b = a[ok], b[ok]
+        half = 0.5 * h * math.hypot(di, dj)
+        ok = (clear[a] > half) & (clear[b] > half)
+        rows.append(a[ok])
+        cols.append(b[ok])
+    src = np.concatenate([*rows, np.flatnonzero(region)])  # node n: the region's source
+    dst = np.concatenate([*cols, np.full(int(region.sum()), n)])
+    g = coo_matrix((np.ones(len(src)), (src, dst)), shape=(n + 1, n + 1)).tocsr()
+    _, pred = breadth_first_order(g, n, directed=False, return_predecessors=True)
+    nxt = pred[:n].astype(np.int64)
+    nxt[(nxt == n) | (nxt < 0)] = -1
+    nxt[region] = -1
     return nxt
-
-
-_FIELDS = ("points", "node_ptr", "node_lo", "node_hi", "rank", "witness", "region_next", "region")
 
 
 @functools.lru_cache(maxsize=8)
 def escape_plan(world: Map, L: float, resolution: float = 0.1) -> EscapePlan:
-    """The :class:`EscapePlan` of ``world`` for a rod of length ``L`` (cached, also on disk)."""
-    key = hashlib.sha256(f"{PLAN_VERSION}|{world.digest}|{L!r}|{resolution!r}".encode())
-    path = cache_dir() / f"plan_{key.hexdigest()[:24]}.npz"
-    if path.exists():
-        try:
-            with np.load(path) as z:
-                return EscapePlan(**{k: z[k] for k in _FIELDS})
-        except (OSError, KeyError, ValueError):
-            pass  # a damaged cache file: rebuild it
-    g = cspace_graph(world, L, resolution)
-    rank, witness = _ranks(g)
-    escapable = rank >= 0
-    region = np.bincount(g.node_point[~escapable], minlength=g.n_points) == 0
-    plan = EscapePlan(
-        points=g.points,
-        node_ptr=g.node_ptr,
-        node_lo=g.node_lo,
-        node_hi=g.node_hi,
-        rank=rank,
-        witness=witness,
-        region_next=_region_next(g, region),
-        region=region,
-    )
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_suffix(f".{os.getpid()}.tmp.npz")
-        np.savez_compressed(tmp, **{k: getattr(plan, k) for k in _FIELDS})
-        os.replace(tmp, path)
-    except OSError:
-        pass  # read-only cache directory: keep the plan in memory only
-    return plan
+    """The :class:`EscapePlan` of ``world`` for a rod of length ``L`` (cached in memory).
+
+    The decomposition comes from :func:`strategies.cspace.decompose` (cached on disk);
+    the grid is the safety table's at the same ``resolution``.
+    """
+    dec = decompose(world, L, cache=True)
+    rank, vias = escape_ranks(dec)
+    _origin, cell, pts = _grid(world, resolution)
+    region = np.zeros(len(pts), dtype=bool)
+    for r in dec.witness_regions:
+        region |= shapely.contains_xy(dec.regions[r].polygon, pts[:, 0], pts[:, 1])
+    if region.any():
+        nxt = _region_next(world, cell, pts, resolution, region)
+    else:
+        nxt = np.full(len(pts), -1, dtype=np.int64)
+    return EscapePlan(dec, rank, vias, pts, region, nxt)

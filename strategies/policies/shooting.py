@@ -3,9 +3,10 @@
 Each step, with the rod of length L_eff = L_min + body radius (the most capable pursuer,
 Sec. 5 "minimax": its tip meets walls as if the rod were that long):
 
-1. **Escapable cell** (the configuration lies in an escapable node of the cspace graph):
-   step to the node's witness (:mod:`strategies.policies.escape_plan`); the rank falls
-   every step whatever the pursuer does, until condition (a) breaks surveillance.
+1. **Escapable cell** (the configuration lies in an escapable cell of the exact
+   decomposition K_L): walk to the nearest crossing of one of the cell's via pieces and
+   step across (:mod:`strategies.policies.escape_plan`); the rank falls at every
+   crossing whatever the pursuer does, until condition (a) breaks surveillance.
 2. **Shooting escape**: candidate endpoints (Fig. 13) are points the evader can reach in
    a straight line (probes on rays, and points just past each convex obstacle vertex in
    reach) where the current orientation is not safe. For each, the rotation the pursuer
@@ -15,7 +16,8 @@ Sec. 5 "minimax": its tip meets walls as if the rod were that long):
    optimal escape arc of Sec. 6 (:func:`strategies.control.evasion.solve_escape`, for the
    branch the pursuer would turn) and the evader follows that arc, replanning every
    ``replan`` steps.
-3. **Witness region** (Prop. 2 holds on the map): walk a shortest grid path to it.
+3. **Witness region** (Prop. 2 holds on the map): walk a shortest grid path to a
+   region whose cells are all escapable (``Decomposition.witness_regions``).
 For rho > 1 it runs straight at the pursuer (footnote 4; see :meth:`ShootingEvader._decide`).
 
 4. Otherwise **pressure**: move straight toward or away from the pursuer (Sec. 6.1, the
@@ -102,6 +104,7 @@ class ShootingEvader(BasePolicy):
         self._corner_points = m.vertices[idx] + (c.body_radius + 2.0 * h) * bis
         self._arc: tuple[np.ndarray, float, np.ndarray] | None = None  # (start, frame, path)
         self._arc_age = 0
+        self._plan_cell, self._plan_lost, self._witness = -1, False, None
         self.mode = "start"
 
     # ------------------------------------------------------------------ candidates
@@ -158,13 +161,11 @@ class ShootingEvader(BasePolicy):
             self.mode = "toward"
             return c.v_evader * unit(snap.rod)
         row = self.table.row(e)
-        if row >= 0:
-            node = self.plan.node_at(row, theta)
-            if node >= 0 and self.plan.rank[node] >= 0:
-                self.mode = "plan"
-                self._arc = None
-                target = self.plan.points[self.plan.witness[node]]
-                return c.v_evader * unit(target - e)
+        heading = self._plan_heading(e, theta)
+        if heading is not None:
+            self.mode = "plan"
+            self._arc = None
+            return c.v_evader * heading
         if self._arc is not None and self._arc_age < self.replan:
             self._arc_age += 1
             return c.v_evader * self._arc_heading(e)
@@ -187,6 +188,41 @@ class ShootingEvader(BasePolicy):
         else:
             toward = True
         return c.v_evader * (u if toward else -u)
+
+    def _plan_heading(self, e: np.ndarray, theta: float) -> np.ndarray | None:
+        """Heading of the guaranteed escape plan, or ``None`` if the cell is not escapable.
+
+        The configuration's cell in K_L (exact; ``None`` on a critical curve, where the
+        last plan, if any, is kept for one step) and, if escapable, the crossing of one
+        of its vias nearest to the evader (kept while the cell stays the same). Within
+        one step of the crossing the evader heads straight across the piece.
+        """
+        plan = self.plan
+        last = self._plan_cell
+        if last >= 0 and not self._plan_lost and plan.well_inside(plan.dec.cells[last].region, e):
+            cell = last  # same region, same cell (it changes only across a boundary piece)
+        else:
+            cell = plan.cell_at(e, theta)
+        if cell < 0:
+            cell = self._plan_cell
+            if cell < 0 or self._plan_lost:
+                return None
+            self._plan_lost = True
+        else:
+            self._plan_lost = False
+        if plan.rank[cell] < 0:
+            self._plan_cell, self._witness = cell, None
+            return None
+        if cell != last or self._witness is None:
+            self._witness = plan.witness(cell, e, self.config.body_radius)
+            self._plan_cell = cell
+        w = self._witness
+        if w is None:
+            return None
+        step = self.config.v_evader * self.config.dt
+        if np.linalg.norm(w.cross - e) <= step:
+            return w.normal.copy()
+        return unit(w.target - e)
 
     def _start_arc(
         self, e: np.ndarray, theta: float, target: np.ndarray, branch: str

@@ -1,4 +1,7 @@
-"""The policies' lookup tables against independent oracles: shapely, brute force, cspace."""
+"""The safety table against independent oracles: shapely and brute force.
+
+The escape plan is tested in ``test_escape_plan.py``.
+"""
 
 from __future__ import annotations
 
@@ -9,8 +12,7 @@ import pytest
 from shapely.geometry import LineString
 
 from envs.maps import builtin_map
-from strategies.policies.escape_plan import escape_plan
-from strategies.policies.safety import NO_PATH, cspace_graph, safety_table
+from strategies.policies.safety import NO_PATH, safety_table
 
 RES = 0.25  # coarse grids keep these tests fast
 
@@ -58,30 +60,3 @@ def test_safe_cells_exist_in_the_corridor_but_not_between_two_rooms(corridor):
     two = safety_table(builtin_map("two_rooms"), 2.0, RES, 72, disk_cache=False)
     assert not two.guaranteed.any()  # Prop. 2: every cell escapable
     assert np.array_equal(two.safe, two.free)  # falls back to keeping the rod free
-
-
-def test_escape_plan_ranks_and_witnesses(corridor, tmp_path, monkeypatch):
-    monkeypatch.setenv("SURVEIL_CACHE_DIR", str(tmp_path))
-    plan = escape_plan(corridor, 2.0, RES)
-    g = cspace_graph(corridor, 2.0, RES)
-    assert np.array_equal(plan.rank >= 0, g.escapable)
-    assert not plan.region.any()
-    lo, hi = plan.node_lo, plan.node_hi
-
-    def overlaps(a, b):
-        for k in (-1, 0, 1):
-            s = 2 * math.pi * k
-            if min(hi[a], hi[b] + s) - max(lo[a], lo[b] + s) > 1e-9:
-                return True
-        return False
-
-    for node in np.flatnonzero(plan.rank >= 0):
-        p = g.node_point[node]
-        w = plan.witness[node]
-        assert np.linalg.norm(plan.points[w] - plan.points[p]) <= 1.5 * RES
-        there = range(plan.node_ptr[w], plan.node_ptr[w + 1])
-        ranks = [plan.rank[b] for b in there if overlaps(node, b)]
-        if plan.rank[node] == 0:
-            assert ranks == []  # condition (a)
-        else:
-            assert ranks and all(0 <= r < plan.rank[node] for r in ranks)  # condition (b)

@@ -1,0 +1,190 @@
+"""The escape plan (ranks, vias, witness crossings) against the exact decomposition.
+
+* Ranks: an independent naive iteration of Sec. 4's definition over ``dec.graph`` (round
+  r: the cells with a boundary piece of their region across which every graph neighbour
+  has rank < r) gives the same ranks, and the escapable set is exactly
+  ``dec.escapable``.
+* Witnesses: from a point of an escapable cell's region, the crossing lies on a via piece,
+  the target just across it lies outside the region, and at the target the configuration
+  has no continuation in a cell adjacent to the cell (condition (a)) or only in cells of
+  lower rank (condition (b)), checked with ``dec.free_arcs`` and the kernel's arcs.
+* The witness-region walk: every hop is a grid neighbour joined by a wall-free segment
+  (shapely) and the walk is a shortest one (networkx breadth first search).
+"""
+
+from __future__ import annotations
+
+import math
+
+import networkx as nx
+import numpy as np
+import pytest
+from shapely.geometry import LineString, Point
+
+from envs.maps import builtin_map
+from strategies.cspace._arcs import overlap
+from strategies.policies.escape_plan import (
+    CROSS_REL,
+    _region_next,
+    escape_plan,
+    escape_ranks,
+)
+from strategies.policies.safety import _grid, safety_table
+
+L = 2.1
+MAPS = ["corridor", "two_rooms", "maze", "l_hall", "pillars", "corner"]
+
+
+def _naive_ranks(dec) -> tuple[np.ndarray, list[set[int]]]:
+    """Sec. 4 by rounds, from the graph's edges and the regions' boundary lists."""
+    n = len(dec.cells)
+    rank = np.full(n, -1)
+    vias: list[set[int]] = [set() for _ in range(n)]
+    r = 0
+    while True:
+        new = {}
+        for c in dec.cells:
+            if rank[c.id] >= 0:
+                continue
+            for b in dec.regions[c.region].boundaries:
+                nbrs = [
+                    x
+                    for x in dec.graph.neighbors(c.id)
+                    if b in dec.graph.edges[c.id, x]["boundaries"]
+                ]
+                if all(0 <= rank[x] < r for x in nbrs) and (r > 0 or not nbrs):
+                    new.setdefault(c.id, set()).add(b)
+        if not new:
+            return rank, vias
+        for c, bs in new.items():
+            rank[c], vias[c] = r, bs
+        r += 1
+
+
+@pytest.mark.parametrize("name", MAPS)
+def test_ranks_reproduce_the_decomposition(name):
+    plan = escape_plan(builtin_map(name), L)
+    dec = plan.dec
+    assert {int(c) for c in np.flatnonzero(plan.rank >= 0)} == set(dec.escapable)
+    rank, vias = _naive_ranks(dec)
+    assert np.array_equal(plan.rank, rank)
+    assert [set(v) for v in plan.vias] == vias
+    for c in dec.cells:  # the decomposition's own reasons: round 0 is condition (a)
+        assert (c.reason == "a") == (plan.rank[c.id] == 0), c
+        if c.reason == "a":
+            assert c.via in plan.vias[c.id], c
+
+
+def test_rank_one_cells_escape_into_rank_zero_cells():
+    """Condition (b) at round 1: across a via every adjacent cell has rank 0."""
+    dec = escape_plan(builtin_map("corridor"), L).dec
+    rank, vias = escape_ranks(dec)
+    one = [c for c in range(len(rank)) if rank[c] == 1]
+    assert one  # the corridor has a rank-1 cell
+    for c in one:
+        for b in vias[c]:
+            nbrs = [x for x in dec.graph.neighbors(c) if b in dec.graph.edges[c, x]["boundaries"]]
+            assert nbrs and all(rank[x] == 0 for x in nbrs)
+
+
+def _cell_arc(dec, point, cell):
+    return next((ca.arc for ca in dec.free_arcs(point) if ca.cell == cell), None)
+
+
+@pytest.mark.parametrize("name", ["corridor", "two_rooms", "maze", "pillars"])
+def test_witness_crossings_leave_the_cell(name):
+    world = builtin_map(name)
+    plan = escape_plan(world, L)
+    dec = plan.dec
+    eps = CROSS_REL * L
+    rng = np.random.default_rng(0)
+    cells = np.flatnonzero(plan.rank >= 0)
+    cells = rng.choice(cells, size=min(60, len(cells)), replace=False)
+    checked = reached = 0
+    for c in cells.tolist():
+        reg = dec.regions[dec.cells[c].region]
+        start = reg.point
+        w = plan.witness(c, start)
+        assert w is not None and w.boundary in plan.vias[c]
+        seg = dec.boundaries[w.boundary].segments
+        on = min(LineString(s).distance(Point(w.cross)) for s in seg if np.ptp(s, axis=0).any())
+        assert on < 1e-9 * world.scale + 1e-12
+        assert math.isclose(float(np.linalg.norm(w.normal)), 1.0)
+        assert np.allclose(w.target, w.cross + eps * w.normal)
+        inner = w.cross - eps * w.normal
+        assert (
+            not reg.polygon.contains(Point(w.target))
+            or reg.polygon.exterior.distance(Point(w.target)) < 2 * dec.chord_tol
+        )
+        reached += reg.polygon.buffer(4 * dec.chord_tol + eps).covers(LineString([start, w.cross]))
+        arc = _cell_arc(dec, inner, c)
+        there = dec.free_arcs(w.target)
+        if arc is None or any(ca.cell is None for ca in there):
+            continue  # on a critical curve's polyline tolerance: not identifiable
+        checked += 1
+        nbrs = set(dec.graph.neighbors(c))
+        if plan.rank[c] == 0:  # condition (a): no continuation
+            assert not any(ca.cell in nbrs for ca in there), (c, w)
+            assert all(overlap(arc, ca.arc) < 0.05 for ca in there), (c, w)
+        else:  # condition (b): every continuation has a lower rank
+            for ca in there:
+                if overlap(arc, ca.arc) > 0.05:
+                    assert 0 <= plan.rank[ca.cell] < plan.rank[c], (c, ca, w)
+    assert checked >= 0.8 * len(cells), (checked, len(cells))
+    assert reached >= 0.8 * len(cells), (reached, len(cells))
+
+
+def test_witness_of_a_safe_cell_is_none():
+    plan = escape_plan(builtin_map("corridor"), L)
+    safe = int(np.flatnonzero(plan.rank < 0)[0])
+    assert plan.witness(safe, plan.dec.regions[plan.dec.cells[safe].region].point) is None
+
+
+def test_witness_keeps_clearance_from_walls():
+    world = builtin_map("maze")
+    plan = escape_plan(world, L)
+    dec = plan.dec
+    for c in np.flatnonzero(plan.rank >= 0)[:40].tolist():
+        w = plan.witness(c, dec.regions[dec.cells[c].region].point, clearance=0.1)
+        p0 = plan._pieces[w.boundary]
+        if (p0[6] >= 0.1).any():  # the piece has a crossing clear of the walls
+            assert world.free_region.boundary.distance(Point(w.cross)) >= 0.1 - 1e-9, (c, w)
+
+
+def test_plan_grid_is_the_safety_tables():
+    world = builtin_map("corridor")
+    plan = escape_plan(world, L, 0.25)
+    tab = safety_table(world, L, 0.25, 36, disk_cache=False)
+    assert np.array_equal(tab.rows(plan.points), np.arange(len(plan.points)))
+
+
+def test_region_walk_is_a_shortest_wall_free_grid_walk():
+    world = builtin_map("pillars")
+    h = 0.25
+    _origin, cell, pts = _grid(world, h)
+    region = np.hypot(pts[:, 0] - pts[0, 0], pts[:, 1] - pts[0, 1]) < 1.0  # a patch
+    nxt = _region_next(world, cell, pts, h, region)
+    free = world.free_region
+    clear = np.array([free.exterior.distance(Point(p)) for p in pts])
+    for ring in free.interiors:
+        clear = np.minimum(clear, [ring.distance(Point(p)) for p in pts])
+    g = nx.Graph()
+    g.add_nodes_from(range(len(pts)))
+    index = {tuple(ij): int(cell[tuple(ij)]) for ij in np.argwhere(cell >= 0)}
+    for (i, j), a in index.items():
+        for di, dj in ((1, 0), (0, 1), (1, 1), (1, -1)):
+            b = index.get((i + di, j + dj))
+            half = 0.5 * h * math.hypot(di, dj)
+            if b is not None and clear[a] > half and clear[b] > half:
+                g.add_edge(a, b)
+    g.add_edges_from(("R", int(i)) for i in np.flatnonzero(region))
+    dist = nx.single_source_shortest_path_length(g, "R")
+    for i in range(len(pts)):
+        if region[i]:
+            assert nxt[i] == -1
+        elif i not in dist:
+            assert nxt[i] == -1
+        else:
+            j = int(nxt[i])
+            assert j >= 0 and dist[j] == dist[i] - 1
+            assert free.covers(LineString([pts[i], pts[j]]))

@@ -134,6 +134,21 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_train(args: argparse.Namespace) -> int:
+    # DESIGN.md: analysis calls training only from the command line
+    from training.cli import run_train
+
+    return run_train(args)
+
+
+def _add_train_parser(sub: argparse._SubParsersAction) -> None:
+    from training.cli import add_train_arguments
+
+    p = sub.add_parser("train", help="train a learned policy (SB3) against a fixed opponent")
+    add_train_arguments(p)
+    p.set_defaults(func=_cmd_train)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the argument parser of the ``surveil`` command."""
     parser = argparse.ArgumentParser(
@@ -197,6 +212,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--results", help="JSONL file written as matches finish (resumable)")
     p.add_argument("--plot", help="also draw the table as heat maps to this PNG")
     p.set_defaults(func=_cmd_evaluate)
+
+    _add_train_parser(sub)
     return parser
 
 

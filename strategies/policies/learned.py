@@ -34,6 +34,9 @@ def _algo_from_zip(path: Path) -> str:
     for algo in SB3_ALGORITHMS:
         if f"stable_baselines3.{algo.lower()}." in text:
             return algo
+    if "stable_baselines3.common.policies" in text:
+        # PPO and A2C both save the shared ActorCriticPolicy; only PPO stores clip_range
+        return "PPO" if "clip_range" in data else "A2C"
     raise InvalidConfigError(
         f"{path}: cannot tell the algorithm from the zip; pass algo= one of {SB3_ALGORITHMS}"
     )

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from PIL import Image
@@ -151,3 +153,17 @@ def test_policies_lists_the_registry_and_play_takes_parameters(tmp_path, capsys)
     ]
     assert main(argv) == 0
     assert main([*argv[:-3], "--evader-params", '{"no_such_param": 1}', "--no-gif"]) != 0
+
+
+def test_train_runs_a_tiny_config_through_the_cli(tmp_path, capsys):
+    import training
+    from training.config import load_config
+
+    configs = Path(training.__file__).parent / "configs"
+    config = load_config(configs / "ppo_pursuer_vs_straight_open_room.toml")
+    small = tmp_path / "tiny.toml"
+    tiny = config.replace(total_timesteps=64, n_steps=32, batch_size=32, eval_episodes=0)
+    small.write_text(tiny.to_toml())
+    assert main(["train", str(small), "--output-dir", str(tmp_path / "run")]) == 0
+    assert (tmp_path / "run" / "model.zip").exists()
+    assert (tmp_path / "run" / "provenance.json").exists()

@@ -80,11 +80,6 @@ def test_model_plays_as_a_registered_policy(tiny):
     assert np.array_equal(loaded.predict(o)[0], policy.act(o))
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="SB3Policy reads the algorithm from the zip's policy class, and PPO saves "
-    "stable_baselines3.common.policies.ActorCriticPolicy (shared with A2C)",
-)
 def test_sb3_name_without_algo_loads_ppo(tiny):
     result = train(tiny(eval_episodes=0, total_timesteps=64))
     policy = make_policy("pursuer/sb3:" + str(result.model_path))

@@ -36,7 +36,7 @@ __all__ = ["CROSS_REL", "EscapePlan", "Witness", "escape_plan", "escape_ranks"]
 CROSS_REL = 1e-3
 """How far past a boundary piece (relative to L) a witness point lies."""
 
-_SAMPLES = 64  # fallback crossing points per boundary piece
+_SAMPLES = 64  # cands crossing points per boundary piece
 
 
 def escape_ranks(dec: Decomposition) -> tuple[np.ndarray, tuple[tuple[int, ...], ...]]:
@@ -130,7 +130,7 @@ class EscapePlan:
     @functools.cached_property
     def _pieces(self) -> list[tuple[np.ndarray, ...]]:
         """Per boundary: segment starts, directions, lengths, left normals (into A), and
-        fallback samples along the piece with their segment and wall clearance."""
+        cands samples along the piece with their segment and wall clearance."""
         out = []
         step_min = self.dec.chord_tol
         for b in self.dec.boundaries:
@@ -178,21 +178,24 @@ class EscapePlan:
         return -1 if c is None else c.id
 
     def witness(self, cell: int, point: np.ndarray, clearance: float = 0.0) -> Witness | None:
-        """The crossing of one of ``cell``'s vias nearest to ``point`` (None if not escapable).
+        """The crossing of one of ``cell``'s vias nearest to ``point``.
 
-        The point of each via piece nearest to ``point`` (projection onto the piece's
-        polyline) is preferred; it must keep ``clearance`` from the walls (the evader's
-        disc) and be reachable in a straight line inside the cell's region. Failing
-        that, the nearest such point among samples of the pieces; failing that too, the
-        nearest projection.
+        Candidates are the point of each via piece nearest to ``point`` (projection onto
+        the piece's polyline) and samples along the pieces, nearest first; a crossing
+        must keep ``clearance`` from the walls (the evader's disc). The first candidate
+        reachable in a straight line inside the cell's region is taken, else the
+        nearest one.
+
+        Returns:
+            The :class:`Witness`, or ``None`` if the cell is not escapable or no crossing
+            of its vias keeps ``clearance`` (the evader cannot carry the plan out).
         """
         if self.rank[cell] < 0:
             return None
         dec = self.dec
         reg = dec.cells[cell].region
         p = np.asarray(point, dtype=float)
-        best = None  # (distance, boundary, point, normal out of the region)
-        fallback = []  # (distance, boundary, point, normal), clear of the walls
+        cands = []  # (distance, boundary, point, normal out of the region)
         for b in self.vias[cell]:
             p0, d, ln, nrm, s, seg, clear = self._pieces[b]
             if not len(ln):
@@ -203,25 +206,28 @@ class EscapePlan:
             dist = np.hypot(q[:, 0] - p[0], q[:, 1] - p[1])
             k = int(np.argmin(dist))
             cand = (float(dist[k]), b, q[k], sign * nrm[k])
-            if best is None or cand[0] < best[0]:
-                best = cand
             ds = np.hypot(s[:, 0] - p[0], s[:, 1] - p[1])
             ok = np.flatnonzero(clear >= clearance)
-            fallback.append(cand)
-            fallback.extend(
+            cands.append(cand)
+            cands.extend(
                 (float(ds[i]), b, s[i], sign * nrm[seg[i]]) for i in ok[np.argsort(ds[ok])[:8]]
             )
-        if best is None:
+        if not cands:
             return None
-        fallback.sort(key=lambda c: c[0])
+        cands.sort(key=lambda c: c[0])
+        clear = dec.map.distance_to_walls(np.array([c[2] for c in cands]))
+        cands = [c for c, cl in zip(cands, clear, strict=True) if cl >= clearance]
+        if not cands:
+            return None  # every crossing is closer to a wall than the evader's disc allows
         poly = self._inside[reg]
-        choice = best
-        for c in fallback:
-            if dec.map.distance_to_walls(c[2][None])[0] < clearance:
-                continue
-            if c[0] == 0.0 or shapely.covers(poly, shapely.LineString([p, c[2]])):
-                choice = c
-                break
+        choice = next(
+            (
+                c
+                for c in cands
+                if c[0] == 0.0 or shapely.covers(poly, shapely.LineString([p, c[2]]))
+            ),
+            cands[0],
+        )
         _, b, q, n = choice
         return Witness(int(b), q, n, q + CROSS_REL * dec.L * n)
 

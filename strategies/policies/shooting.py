@@ -190,7 +190,8 @@ class ShootingEvader(BasePolicy):
         return c.v_evader * (u if toward else -u)
 
     def _plan_heading(self, e: np.ndarray, theta: float) -> np.ndarray | None:
-        """Heading of the guaranteed escape plan, or ``None`` if the cell is not escapable.
+        """Heading of the guaranteed escape plan, or ``None`` if the cell is not escapable
+        (or its vias cannot be crossed by the evader's disc).
 
         The configuration's cell in K_L (exact; ``None`` on a critical curve, where the
         last plan, if any, is kept for one step) and, if escapable, the crossing of one
@@ -210,12 +211,9 @@ class ShootingEvader(BasePolicy):
             self._plan_lost = True
         else:
             self._plan_lost = False
-        if plan.rank[cell] < 0:
-            self._plan_cell, self._witness = cell, None
-            return None
-        if cell != last or self._witness is None:
-            self._witness = plan.witness(cell, e, self.config.body_radius)
+        if cell != last:
             self._plan_cell = cell
+            self._witness = plan.witness(cell, e, self.config.body_radius)  # None if safe
         w = self._witness
         if w is None:
             return None

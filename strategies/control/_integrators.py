@@ -31,9 +31,13 @@ def _rhs(th: float, a: float, s: int, L: float, rho: float, q: float):
     c, sp = math.cos(phi), math.sin(phi)
     h = math.sqrt(1.0 - rho * rho * c * c)
     n = h - s * rho * sp  # L θ̇ˢ / (s V_p) >= 0
-    return (math.cos(a), math.sin(a), s * n / (L * rho),
-            n * n * sp * q / L,  # reduced extremal: dα/dσ (see evasion module docstring)
-            -c * n / (h * L))  # d ln μ/dσ = cos α · (-∂f2/∂θ), μ = 1 + s λ2 (E3b)
+    return (
+        math.cos(a),
+        math.sin(a),
+        s * n / (L * rho),
+        n * n * sp * q / L,  # reduced extremal: dα/dσ (see evasion module docstring)
+        -c * n / (h * L),
+    )  # d ln μ/dσ = cos α · (-∂f2/∂θ), μ = 1 + s λ2 (E3b)
 
 
 def _step(state, d: float, s: int, L: float, rho: float, q: float):
@@ -44,15 +48,26 @@ def _step(state, d: float, s: int, L: float, rho: float, q: float):
     k3 = _rhs(th + h2 * k2[2], a + h2 * k2[3], s, L, rho, q)
     k4 = _rhs(th + d * k3[2], a + d * k3[3], s, L, rho, q)
     w = d / 6.0
-    return (x + w * (k1[0] + 2.0 * (k2[0] + k3[0]) + k4[0]),
-            y + w * (k1[1] + 2.0 * (k2[1] + k3[1]) + k4[1]),
-            th + w * (k1[2] + 2.0 * (k2[2] + k3[2]) + k4[2]),
-            a + w * (k1[3] + 2.0 * (k2[3] + k3[3]) + k4[3]),
-            lm + w * (k1[4] + 2.0 * (k2[4] + k3[4]) + k4[4]))
+    return (
+        x + w * (k1[0] + 2.0 * (k2[0] + k3[0]) + k4[0]),
+        y + w * (k1[1] + 2.0 * (k2[1] + k3[1]) + k4[1]),
+        th + w * (k1[2] + 2.0 * (k2[2] + k3[2]) + k4[2]),
+        a + w * (k1[3] + 2.0 * (k2[3] + k3[3]) + k4[3]),
+        lm + w * (k1[4] + 2.0 * (k2[4] + k3[4]) + k4[4]),
+    )
 
 
-def integrate_reduced(theta0: float, alpha0: float, s: int, L: float, rho: float,
-                      step: float, x_target: float, store: bool, max_steps: int):
+def integrate_reduced(
+    theta0: float,
+    alpha0: float,
+    s: int,
+    L: float,
+    rho: float,
+    step: float,
+    x_target: float,
+    store: bool,
+    max_steps: int,
+):
     """Integrate until ``x = x_target`` exactly (last step shortened by Newton on its length).
 
     Returns ``(rows, status)``: rows are ``(σ, x, y, θ, α, ln(μ/μ0))``; only the last row is
@@ -89,8 +104,16 @@ def integrate_reduced(theta0: float, alpha0: float, s: int, L: float, rho: float
     return rows, TOO_LONG
 
 
-def integrate_pmp(theta0: float, lambda1: float, lambda2_0: float, s: int, L: float,
-                  rho: float, dx: float, n_steps: int):
+def integrate_pmp(
+    theta0: float,
+    lambda1: float,
+    lambda2_0: float,
+    s: int,
+    L: float,
+    rho: float,
+    dx: float,
+    n_steps: int,
+):
     """Fig. 10 with RK4 in x: state (y, θ, λ2), α = argmin H at every stage.
 
     Returns ``(rows, unbounded)`` with rows ``(x, y, θ, α, λ2)``.
@@ -139,8 +162,12 @@ def _hermite(t, t0, t1, v0, v1, m0, m1) -> float:
     d = t1 - t0
     u = (t - t0) / d
     u2, u3 = u * u, u * u * u
-    return ((2 * u3 - 3 * u2 + 1) * v0 + (u3 - 2 * u2 + u) * d * m0
-            + (-2 * u3 + 3 * u2) * v1 + (u3 - u2) * d * m1)
+    return (
+        (2 * u3 - 3 * u2 + 1) * v0
+        + (u3 - 2 * u2 + u) * d * m0
+        + (-2 * u3 + 3 * u2) * v1
+        + (u3 - u2) * d * m1
+    )
 
 
 def first_return(t, x, y, th, dx, dy, dth, tol: float):
@@ -160,8 +187,12 @@ def first_return(t, x, y, th, dx, dy, dth, tol: float):
     if abs(y[j]) <= tol:
         tc = t[j]
     else:
-        tc = brentq(lambda u: _hermite(u, t[j - 1], t[j], y[j - 1], y[j], dy[j - 1], dy[j]),
-                    t[j - 1], t[j], xtol=1e-15)
+        tc = brentq(
+            lambda u: _hermite(u, t[j - 1], t[j], y[j - 1], y[j], dy[j - 1], dy[j]),
+            t[j - 1],
+            t[j],
+            xtol=1e-15,
+        )
     xc = _hermite(tc, t[j - 1], t[j], x[j - 1], x[j], dx[j - 1], dx[j])
     thc = _hermite(tc, t[j - 1], t[j], th[j - 1], th[j], dth[j - 1], dth[j])
     return float(xc), float(thc)

@@ -63,16 +63,29 @@ def _tractrix_args(t, L, v_e, theta0, alpha, leader_start):
     tt = np.atleast_1d(as_finite_array("t", t))
     if tt.ndim != 1:
         raise SurveilValueError(f"t has shape {tt.shape}: expected a 1-D array of times")
-    return (tt, positive("L", L), nonnegative("v_e", v_e), finite("theta0", theta0),
-            finite("alpha", alpha), vector2("leader_start", leader_start))
+    return (
+        tt,
+        positive("L", L),
+        nonnegative("v_e", v_e),
+        finite("theta0", theta0),
+        finite("alpha", alpha),
+        vector2("leader_start", leader_start),
+    )
 
 
 def _leader(tt, v_e, alpha, start):
     return start + (v_e * tt)[:, None] * np.array([math.cos(alpha), math.sin(alpha)])
 
 
-def tractrix(t, *, L: float = 1.0, v_e: float = 1.0, theta0: float = 0.5 * math.pi,
-             alpha: float = 0.0, leader_start=(0.0, 0.0)) -> Tractrix:
+def tractrix(
+    t,
+    *,
+    L: float = 1.0,
+    v_e: float = 1.0,
+    theta0: float = 0.5 * math.pi,
+    alpha: float = 0.0,
+    leader_start=(0.0, 0.0),
+) -> Tractrix:
     """Closed-form tractrix (Sec. 7.1, generalised; THEORY §5.1).
 
     The leader moves from ``leader_start`` in direction α at speed ``v_e``. The dragged
@@ -94,9 +107,16 @@ def tractrix(t, *, L: float = 1.0, v_e: float = 1.0, theta0: float = 0.5 * math.
     return Tractrix(tt, leader, follower, theta, v_e * np.abs(np.cos(psi)))
 
 
-def tractrix_numeric(t, *, L: float = 1.0, v_e: float = 1.0, theta0: float = 0.5 * math.pi,
-                     alpha: float = 0.0, leader_start=(0.0, 0.0),
-                     substeps: int = 200) -> Tractrix:
+def tractrix_numeric(
+    t,
+    *,
+    L: float = 1.0,
+    v_e: float = 1.0,
+    theta0: float = 0.5 * math.pi,
+    alpha: float = 0.0,
+    leader_start=(0.0, 0.0),
+    substeps: int = 200,
+) -> Tractrix:
     """The same motion by RK4 on the follower position: ``ṗ = (ė·u) u``, ``u = (p - e)/|p - e|``.
 
     An independent check of :func:`tractrix` (a different ODE: positions, not θ).
@@ -132,8 +152,9 @@ def tractrix_numeric(t, *, L: float = 1.0, v_e: float = 1.0, theta0: float = 0.5
     return Tractrix(tt, leader, follower, theta, v_e * np.abs(np.cos(theta - alpha)))
 
 
-def straight_leader_time(theta0: float, theta1: float, *, alpha: float, L: float,
-                         v_p: float, rho: float) -> float:
+def straight_leader_time(
+    theta0: float, theta1: float, *, alpha: float, L: float, v_p: float, rho: float
+) -> float:
     """Minimum time for the follower to turn the rod from θ0 to θ1 while the leader goes
     straight in direction α at full speed (Sec. 7.2), the follower rotating at its extreme
     rate θ̇⁺ (θ1 > θ0, counter-clockwise) or θ̇⁻ (θ1 < θ0, clockwise).
@@ -167,7 +188,8 @@ def straight_leader_time(theta0: float, theta1: float, *, alpha: float, L: float
     if rho >= 1.0:
         raise InfeasibleError(
             f"rho = {rho!r}: the straight-leader time needs rho < 1 (the closed form divides "
-            "by 1 - rho^2; at rho >= 1 the follower may never complete the turn, E1, E5b)")
+            "by 1 - rho^2; at rho >= 1 the follower may never complete the turn, E1, E5b)"
+        )
     sign = 1.0 if th1 >= th0 else -1.0
     m = rho * rho
     phi0, phi1 = 0.5 * math.pi - alpha + th0, 0.5 * math.pi - alpha + th1
@@ -230,7 +252,8 @@ def _corner_geometry(evader, vertex, L):
     if np.any(ell <= 0.0) or np.any(ell > L * (1.0 + 1e-12)):
         raise SurveilValueError(
             f"distance from evader to vertex = {ell!r}: expected 0 < l <= L = {L!r} "
-            "(the vertex must lie on the rod)")
+            "(the vertex must lie on the rod)"
+        )
     return e, v, L, d, ell
 
 
@@ -274,7 +297,8 @@ def corner_min_distance(*, L: float, rho: float) -> float:
     L, rho = positive("L", L), nonnegative("rho", rho)
     if rho > 1.0:
         raise InfeasibleError(
-            f"rho = {rho!r} > 1: the follower cannot even match the leader's speed")
+            f"rho = {rho!r} > 1: the follower cannot even match the leader's speed"
+        )
     return rho * L / (1.0 + rho)
 
 

@@ -122,7 +122,8 @@ class ShootResult:
     def pursuer_path(self) -> np.ndarray:
         """Pursuer positions ``E + L (cos θ, sin θ)`` (eq. 1), shape (N, 2)."""
         return self.evader_path() + self.L * np.column_stack(
-            [np.cos(self.theta), np.sin(self.theta)])
+            [np.cos(self.theta), np.sin(self.theta)]
+        )
 
 
 @dataclass(frozen=True)
@@ -151,8 +152,9 @@ class EscapeSolution:
 # ------------------------------------------------------------------------------- shoot
 
 
-def _build_result(rows, status, theta0, lambda1, lambda2_0, s, L, rho, reduced: bool,
-                  stop_at_crossing: bool) -> ShootResult:
+def _build_result(
+    rows, status, theta0, lambda1, lambda2_0, s, L, rho, reduced: bool, stop_at_crossing: bool
+) -> ShootResult:
     """Assemble a :class:`ShootResult` from integrator rows (see ``_integrators``)."""
     if reduced:
         arr = np.asarray(rows, dtype=float).reshape(-1, 6)
@@ -181,14 +183,39 @@ def _build_result(rows, status, theta0, lambda1, lambda2_0, s, L, rho, reduced: 
         last = int(np.searchsorted(x, xc)) + 1
         x, y, th, a, lam2, H = (v[:last] for v in (x, y, th, a, lam2, H))
         sig = None if sig is None else sig[:last]
-    return ShootResult(x=x, y=y, theta=th, alpha=a, lambda2=lam2, H=H, x_c=xc, J=J,
-                       unbounded=status in (1, -1), theta0=theta0, lambda1=lambda1,
-                       lambda2_0=lambda2_0, L=L, rho=rho, branch=s, arclength=sig)
+    return ShootResult(
+        x=x,
+        y=y,
+        theta=th,
+        alpha=a,
+        lambda2=lam2,
+        H=H,
+        x_c=xc,
+        J=J,
+        unbounded=status in (1, -1),
+        theta0=theta0,
+        lambda1=lambda1,
+        lambda2_0=lambda2_0,
+        L=L,
+        rho=rho,
+        branch=s,
+        arclength=sig,
+    )
 
 
-def shoot(theta0: float, lambda1: float, lambda2_0: float, *, L: float, rho: float,
-          branch="+", x_max: float, step: float | None = None, method: str = "reduced",
-          stop_at_crossing: bool = False) -> ShootResult:
+def shoot(
+    theta0: float,
+    lambda1: float,
+    lambda2_0: float,
+    *,
+    L: float,
+    rho: float,
+    branch="+",
+    x_max: float,
+    step: float | None = None,
+    method: str = "reduced",
+    stop_at_crossing: bool = False,
+) -> ShootResult:
     """Integrate one extremal from the origin (Fig. 10 without the outer λ loop).
 
     Args:
@@ -229,20 +256,31 @@ def shoot(theta0: float, lambda1: float, lambda2_0: float, *, L: float, rho: flo
         raise SurveilValueError(
             f"lambda2_0 = {lambda2_0!r} gives 1 + s*lambda2_0 = {mu0!r} for branch "
             f"{'+' if s > 0 else '-'}: expected > 0 (μ keeps its sign along the arc and "
-            "transversality needs μ(x_e) = 1, E3c)")
+            "transversality needs μ(x_e) = 1, E3c)"
+        )
     if method == "pmp":
         n = max(1, math.ceil(x_max / h))
         rows, unb = integrate_pmp(th0, l1, l20, s, L, rho, x_max / n, n)
         if not rows:
             rows = [(0.0, 0.0, th0, math.nan, l20)]
-        return _build_result(rows, 1 if unb else 0, th0, l1, l20, s, L, rho, False,
-                             stop_at_crossing)
+        return _build_result(
+            rows, 1 if unb else 0, th0, l1, l20, s, L, rho, False, stop_at_crossing
+        )
     if is_unbounded(th0, l1, l20, L=L, rho=rho, branch=s):
-        return _build_result([(0.0, 0.0, 0.0, th0, math.nan, 0.0)], 1, th0, l1, l20, s, L,
-                             rho, True, stop_at_crossing)
+        return _build_result(
+            [(0.0, 0.0, 0.0, th0, math.nan, 0.0)],
+            1,
+            th0,
+            l1,
+            l20,
+            s,
+            L,
+            rho,
+            True,
+            stop_at_crossing,
+        )
     a0, _ = solve_stationary(l1 / mu0, th0, L, rho, s, 0.0)
-    rows, status = integrate_reduced(th0, a0, s, L, rho, h, x_max, True,
-                                     _max_steps(x_max, L, h))
+    rows, status = integrate_reduced(th0, a0, s, L, rho, h, x_max, True, _max_steps(x_max, L, h))
     return _build_result(rows, status, th0, l1, l20, s, L, rho, True, stop_at_crossing)
 
 
@@ -257,8 +295,9 @@ _ALPHA_GRID = (-1.5707, -1.3, -0.9, -0.45, 0.0, 0.45, 0.9, 1.3, 1.5707)
 """Initial headings probed for sign changes of y(x_e) before Brent refines them."""
 
 
-def solve_escape(theta0: float, x_e: float, *, L: float, rho: float, branch="+",
-                 step: float | None = None) -> EscapeSolution:
+def solve_escape(
+    theta0: float, x_e: float, *, L: float, rho: float, branch="+", step: float | None = None
+) -> EscapeSolution:
     """The extremal from the origin to ``(x_e, 0)`` with least rotation ``|θ(x_e) - θ0|``.
 
     Solves ``y(x_e) = 0`` for the single shooting unknown (THEORY §4.2 fact 1), run on the
@@ -293,13 +332,15 @@ def solve_escape(theta0: float, x_e: float, *, L: float, rho: float, branch="+",
         return EscapeSolution(
             success=False,
             reason=f"rho = {rho_v!r} >= 1: the evader escapes trivially by moving away "
-                   "from the pursuer (footnote 4); at rho = 1, θ̇⁺ can vanish (E1)")
+            "from the pursuer (footnote 4); at rho = 1, θ̇⁺ can vanish (E1)",
+        )
     h = default_step(x_e, L, rho_v) if step is None else positive("step", step)
     coarse = 8.0 * h  # bracket and first root on an 8x coarser grid, then polish
 
     def residual(a0: float, hh: float = h) -> float:
-        rows, status = integrate_reduced(th0, a0, s, L, rho_v, hh, x_e, False,
-                                         _max_steps(x_e, L, hh))
+        rows, status = integrate_reduced(
+            th0, a0, s, L, rho_v, hh, x_e, False, _max_steps(x_e, L, hh)
+        )
         if status != REACHED:  # turned back going up (+1) / down (-1), or wandered (2)
             return 10.0 * (status if status != 2 else math.copysign(1.0, rows[0][2]))
         return rows[0][2] / x_e
@@ -313,8 +354,7 @@ def solve_escape(theta0: float, x_e: float, *, L: float, rho: float, branch="+",
                 roots.append(root)
     best = None
     for a0 in roots:
-        rows, status = integrate_reduced(th0, a0, s, L, rho_v, h, x_e, True,
-                                         _max_steps(x_e, L, h))
+        rows, status = integrate_reduced(th0, a0, s, L, rho_v, h, x_e, True, _max_steps(x_e, L, h))
         J = rows[-1][3] - th0
         if status == REACHED and (best is None or abs(J) < abs(best[1])):
             best = (a0, J, rows)
@@ -322,17 +362,26 @@ def solve_escape(theta0: float, x_e: float, *, L: float, rho: float, branch="+",
         return EscapeSolution(
             success=False,
             reason=f"no bounded extremal from theta0 = {th0!r} reaches (x_e, 0) = "
-                   f"({x_e!r}, 0) with L = {L!r}, rho = {rho_v!r}, branch "
-                   f"{'+' if s > 0 else '-'} (the arcs turn back before x_e, THEORY §4.3)")
+            f"({x_e!r}, 0) with L = {L!r}, rho = {rho_v!r}, branch "
+            f"{'+' if s > 0 else '-'} (the arcs turn back before x_e, THEORY §4.3)",
+        )
     a0, J, rows = best
     mu0 = math.exp(-rows[-1][5])  # transversality: μ(x_e) = 1, i.e. λ2(x_e) = 0 (E3c)
     k = _kappa_scalar(a0, th0, L, rho_v, s)[0]
     lambda1 = k * mu0
     lambda2_0 = s * (mu0 - 1.0)
     arc = _build_result(rows, REACHED, th0, lambda1, lambda2_0, s, L, rho_v, True, False)
-    return EscapeSolution(success=True, reason="", J=float(J), k=float(k),
-                          lambda1=float(lambda1), lambda2_0=float(lambda2_0),
-                          alpha0=float(a0), arc=arc, candidates=len(roots))
+    return EscapeSolution(
+        success=True,
+        reason="",
+        J=float(J),
+        k=float(k),
+        lambda1=float(lambda1),
+        lambda2_0=float(lambda2_0),
+        alpha0=float(a0),
+        arc=arc,
+        candidates=len(roots),
+    )
 
 
 def _polished_root(residual, a_lo: float, a_hi: float, coarse: float) -> float | None:

@@ -30,7 +30,8 @@ def _pyplot():
         import matplotlib.pyplot as plt
     except ImportError as exc:  # pragma: no cover - matplotlib is in the analysis extra
         raise ImportError(
-            "drawing figures needs matplotlib: pip install 'surveil[analysis]'") from exc
+            "drawing figures needs matplotlib: pip install 'surveil[analysis]'"
+        ) from exc
     return plt
 
 
@@ -48,22 +49,34 @@ def _draw_arc(ax, arc: ShootResult, title: str, rods: int = 6) -> None:
     ax.legend(fontsize=8, loc="best")
 
 
-def _shooting(ax, theta0=math.pi, x_e=1.0, L=1.0, rho=0.5, branch="+",
-              lambda1=None, lambda2_0=None) -> None:
+def _shooting(
+    ax, theta0=math.pi, x_e=1.0, L=1.0, rho=0.5, branch="+", lambda1=None, lambda2_0=None
+) -> None:
     """Fig. 11: an optimal escape to (x_e, 0); with multipliers given, the plain shot."""
     if lambda1 is not None or lambda2_0 is not None:
-        arc = shoot(theta0, 0.0 if lambda1 is None else lambda1,
-                    0.0 if lambda2_0 is None else lambda2_0, L=L, rho=rho, branch=branch,
-                    x_max=x_e, stop_at_crossing=True)
-        title = (f"shot: θ0={theta0:.3f}, λ1={arc.lambda1:.3f}, λ2(0)={arc.lambda2_0:.3f}, "
-                 f"L={L}, ρ={rho}, x_c={arc.x_c}")
+        arc = shoot(
+            theta0,
+            0.0 if lambda1 is None else lambda1,
+            0.0 if lambda2_0 is None else lambda2_0,
+            L=L,
+            rho=rho,
+            branch=branch,
+            x_max=x_e,
+            stop_at_crossing=True,
+        )
+        title = (
+            f"shot: θ0={theta0:.3f}, λ1={arc.lambda1:.3f}, λ2(0)={arc.lambda2_0:.3f}, "
+            f"L={L}, ρ={rho}, x_c={arc.x_c}"
+        )
     else:
         sol = solve_escape(theta0, x_e, L=L, rho=rho, branch=branch)
         if not sol.success:
             raise SurveilValueError(f"no optimal escape to draw: {sol.reason}")
         arc = sol.arc
-        title = (f"optimal escape: θ0={theta0:.3f}, x_e={x_e}, L={L}, ρ={rho}\n"
-                 f"λ1={sol.lambda1:.4f}, λ2(0)={sol.lambda2_0:.4f}, J={sol.J:.4f}")
+        title = (
+            f"optimal escape: θ0={theta0:.3f}, x_e={x_e}, L={L}, ρ={rho}\n"
+            f"λ1={sol.lambda1:.4f}, λ2(0)={sol.lambda2_0:.4f}, J={sol.J:.4f}"
+        )
     _draw_arc(ax, arc, title)
 
 
@@ -79,8 +92,12 @@ def _tractrix(ax, t_max=4.0, L=1.0, v_e=1.0, theta0=0.5 * math.pi) -> None:
     ax.plot(tr.leader[:, 0], tr.leader[:, 1], "b-", lw=2, label="leader (evader)")
     ax.plot(tr.follower[:, 0], tr.follower[:, 1], "r-", lw=2, label="follower (tractrix)")
     for i in np.linspace(0, len(tr.t) - 1, 7).astype(int):
-        ax.plot([tr.leader[i, 0], tr.follower[i, 0]], [tr.leader[i, 1], tr.follower[i, 1]],
-                color="0.6", lw=0.8)
+        ax.plot(
+            [tr.leader[i, 0], tr.follower[i, 0]],
+            [tr.leader[i, 1], tr.follower[i, 1]],
+            color="0.6",
+            lw=0.8,
+        )
     ax.set_aspect("equal")
     ax.set_title(f"tractrix: L={L}, V_e={v_e}, θ0={theta0:.3f}", fontsize=9)
     ax.legend(fontsize=8, loc="best")

@@ -189,9 +189,16 @@ def _kappa_scalar(a: float, t: float, L: float, rho: float, s: int) -> tuple[flo
     return k, dk
 
 
-def solve_stationary(kappa: float, theta: float, L: float, rho: float, s: int,
-                     alpha_guess: float = 0.0, tol: float = 1e-14,
-                     max_iter: int = 60) -> tuple[float, int]:
+def solve_stationary(
+    kappa: float,
+    theta: float,
+    L: float,
+    rho: float,
+    s: int,
+    alpha_guess: float = 0.0,
+    tol: float = 1e-14,
+    max_iter: int = 60,
+) -> tuple[float, int]:
     """Root of ``K_s(α, θ) = kappa`` on (-π/2, π/2): Newton safeguarded by bisection.
 
     Assumes ``kappa`` lies strictly inside :func:`kappa_bounds` (the caller checks); since
@@ -217,9 +224,16 @@ def solve_stationary(kappa: float, theta: float, L: float, rho: float, s: int,
     return a, max_iter
 
 
-def minimise_hamiltonian(theta: float, lambda1: float, lambda2: float, *, L: float,
-                         rho: float, branch="+",
-                         alpha_guess: float | None = None) -> HamiltonianMinimum:
+def minimise_hamiltonian(
+    theta: float,
+    lambda1: float,
+    lambda2: float,
+    *,
+    L: float,
+    rho: float,
+    branch="+",
+    alpha_guess: float | None = None,
+) -> HamiltonianMinimum:
     """``argmin_α H(θ, α)`` over (-π/2, π/2) (Fig. 10, step 3).
 
     Newton on the stationarity condition ``λ1/μ = K_s(α, θ)`` of THEORY §4.2, safeguarded
@@ -251,8 +265,10 @@ def minimise_hamiltonian(theta: float, lambda1: float, lambda2: float, *, L: flo
 
     def h_of(al: float) -> float:  # pragma: no cover - fallback, not reached in tests
         return l1 * math.tan(al) + mu * float(_n_h(np.asarray(al - t), rho, s)[0]) / (
-            L * rho * math.cos(al))
+            L * rho * math.cos(al)
+        )
 
-    res = minimize_scalar(h_of, bounds=(-_HALF_PI + 1e-9, _HALF_PI - 1e-9),
-                          method="bounded", options={"xatol": 1e-12})
+    res = minimize_scalar(
+        h_of, bounds=(-_HALF_PI + 1e-9, _HALF_PI - 1e-9), method="bounded", options={"xatol": 1e-12}
+    )
     return HamiltonianMinimum(float(res.x), False, it, True)  # pragma: no cover

@@ -113,15 +113,23 @@ def _make(kind, position, theta_i, theta_f, evader, pursuer, L) -> EscapeTarget:
     beta = math.atan2(d[1], d[0]) if x_e > 0.0 else 0.0
     inside = _ccw(theta_i, theta) <= _ccw(theta_i, theta_f)
     return EscapeTarget(
-        kind=kind, position=position.copy(), theta_i=_wrap(theta_i), theta_f=_wrap(theta_f),
-        beta=beta, x_e=x_e, theta0=_wrap(theta - beta), theta_i_frame=_wrap(theta_i - beta),
+        kind=kind,
+        position=position.copy(),
+        theta_i=_wrap(theta_i),
+        theta_f=_wrap(theta_f),
+        beta=beta,
+        x_e=x_e,
+        theta0=_wrap(theta - beta),
+        theta_i_frame=_wrap(theta_i - beta),
         theta_f_frame=_wrap(theta_f - beta),
         rotation_ccw=0.0 if inside else _ccw(theta, theta_i),
-        rotation_cw=0.0 if inside else _ccw(theta_f, theta))
+        rotation_cw=0.0 if inside else _ccw(theta_f, theta),
+    )
 
 
-def vertex_escape_target(evader, pursuer, vertex, prev_vertex, next_vertex, *, L: float,
-                         obstacle_ccw: bool | None = None) -> EscapeTarget:
+def vertex_escape_target(
+    evader, pursuer, vertex, prev_vertex, next_vertex, *, L: float, obstacle_ccw: bool | None = None
+) -> EscapeTarget:
     """Escape endpoint at a convex obstacle vertex (Fig. 13, left).
 
     Args:
@@ -147,20 +155,23 @@ def vertex_escape_target(evader, pursuer, vertex, prev_vertex, next_vertex, *, L
     cross = float(d1[0] * d2[1] - d1[1] * d2[0])
     if abs(cross) <= 1e-12 * float(np.hypot(*d1) * np.hypot(*d2)):
         raise SurveilValueError(
-            f"vertex {v.tolist()} has collinear edges: no corner, no type-4 curves")
+            f"vertex {v.tolist()} has collinear edges: no corner, no type-4 curves"
+        )
     if obstacle_ccw is not None:
         turn = float((v - a)[0] * (b - v)[1] - (v - a)[1] * (b - v)[0])
         if (turn > 0) != bool(obstacle_ccw):
             raise SurveilValueError(
                 f"vertex {v.tolist()} is a concave obstacle vertex (free-space convex): "
-                "no type-4 critical curves leave it")
+                "no type-4 critical curves leave it"
+            )
     t1, t2 = math.atan2(d1[1], d1[0]), math.atan2(d2[1], d2[0])
     theta_i, theta_f = (t1, t2) if _ccw(t1, t2) < math.pi else (t2, t1)  # narrow wedge
     return _make("vertex", v, theta_i, theta_f, e, p, L)
 
 
-def critical_curve_escape_target(evader, pursuer, curve, escapable_from: float,
-                                 escapable_to: float, *, L: float) -> EscapeTarget:
+def critical_curve_escape_target(
+    evader, pursuer, curve, escapable_from: float, escapable_to: float, *, L: float
+) -> EscapeTarget:
     """Escape endpoint on a critical curve bounding an escapable cell (Fig. 13, right).
 
     Args:

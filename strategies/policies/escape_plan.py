@@ -29,7 +29,7 @@ from scipy.sparse.csgraph import breadth_first_order
 
 from envs.maps import Map
 from strategies.cspace import Decomposition, decompose
-from strategies.policies.safety import _grid
+from strategies.policies.safety import grid_points
 
 __all__ = ["CROSS_REL", "EscapePlan", "Witness", "escape_plan", "escape_ranks"]
 
@@ -272,7 +272,7 @@ def escape_plan(world: Map, L: float, resolution: float = 0.1) -> EscapePlan:
     """
     dec = decompose(world, L, cache=True)
     rank, vias = escape_ranks(dec)
-    _origin, cell, pts = _grid(world, resolution)
+    _origin, cell, pts = grid_points(world, resolution)
     region = np.zeros(len(pts), dtype=bool)
     for r in dec.witness_regions:
         region |= shapely.contains_xy(dec.regions[r].polygon, pts[:, 0], pts[:, 1])

@@ -35,7 +35,7 @@ from envs.errors import InvalidConfigError
 from envs.maps import Map
 from envs.tolerances import REL_LENGTH_TOL
 
-__all__ = ["NO_PATH", "SOURCE", "SafetyTable", "cspace_graph", "safety_table"]
+__all__ = ["NO_PATH", "SOURCE", "SafetyTable", "grid_points", "safety_table"]
 
 NO_PATH = 255
 """Entry of the rotation tables meaning "no safe orientation at this point"."""
@@ -145,24 +145,13 @@ def cache_dir() -> Path:
 
 
 @functools.lru_cache(maxsize=4)
-def cspace_graph(world: Map, L: float, resolution: float):
-    """The grid oracle's cspace graph of ``world`` at ``L`` (cached in memory).
-
-    Not the safety table's source (that is the exact decomposition); kept for
-    :mod:`strategies.policies.escape_plan`, which ranks grid nodes.
-    """
-    from strategies.cspace.grid_oracle import grid_graph
-
-    return grid_graph(world, L, resolution=resolution)
-
-
 def _axis(lo: float, hi: float, resolution: float) -> np.ndarray:
     """Grid abscissae with spacing ``resolution``, centred in ``[lo, hi]``."""
     n = max(1, math.floor((hi - lo) / resolution))
     return lo + 0.5 * ((hi - lo) - (n - 1) * resolution) + resolution * np.arange(n)
 
 
-def _grid(world: Map, resolution: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def grid_points(world: Map, resolution: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Grid points strictly inside the free region: (origin, cell index array, points)."""
     xmin, ymin, xmax, ymax = world.bounds
     xs, ys = _axis(xmin, xmax, resolution), _axis(ymin, ymax, resolution)
@@ -218,7 +207,7 @@ def _build(world: Map, L: float, resolution: float, n_bins: int) -> SafetyTable:
     from strategies.cspace import decompose
 
     dec = decompose(world, L, cache=True)
-    origin, cell, pts = _grid(world, resolution)
+    origin, cell, pts = grid_points(world, resolution)
     centres = -math.pi + (np.arange(n_bins) + 0.5) * (2.0 * math.pi / n_bins)
     free = np.zeros((len(pts), n_bins), dtype=bool)
     safe = np.zeros_like(free)

@@ -38,16 +38,14 @@ def test_tractrix_reference_and_printed_form():
     np.testing.assert_allclose(tr.follower[:, 1], 1.0 / np.cosh(t), atol=1e-12)
     np.testing.assert_allclose(tr.theta, 2 * np.arctan(np.exp(t)), atol=1e-12)
     np.testing.assert_allclose(tr.speed, np.tanh(t), atol=1e-12)
-    np.testing.assert_allclose(np.linalg.norm(tr.follower - tr.leader, axis=1), 1.0,
-                               atol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(tr.follower - tr.leader, axis=1), 1.0, atol=1e-12)
     one = tractrix([1.0])
     np.testing.assert_allclose(one.follower[0], [0.2384058440, 0.6480542737], atol=1e-9)
     assert one.theta[0] == pytest.approx(2.4365658100, abs=1e-9)
 
 
 @settings(max_examples=10, deadline=None)
-@given(L=st.floats(0.3, 3), v_e=st.floats(0.2, 2), theta0=st.floats(-6, 6),
-       alpha=st.floats(-3, 3))
+@given(L=st.floats(0.3, 3), v_e=st.floats(0.2, 2), theta0=st.floats(-6, 6), alpha=st.floats(-3, 3))
 def test_tractrix_closed_form_matches_position_ode(L, v_e, theta0, alpha):
     t = np.linspace(0.0, 2.0, 5)
     kw = {"L": L, "v_e": v_e, "theta0": theta0, "alpha": alpha, "leader_start": (1.0, -2.0)}
@@ -69,16 +67,19 @@ def test_tractrix_speed_is_follower_speed():
 
 def test_straight_leader_reference():
     kw = {"alpha": 0.0, "L": 1.0, "v_p": 1.0, "rho": 0.5}
-    assert straight_leader_time(math.pi / 2, math.pi, **kw) == pytest.approx(1.2899496125,
-                                                                             abs=1e-9)
-    assert straight_leader_time(math.pi / 2, 0.0, **kw) == pytest.approx(2.6232829458,
-                                                                         abs=1e-9)
+    assert straight_leader_time(math.pi / 2, math.pi, **kw) == pytest.approx(1.2899496125, abs=1e-9)
+    assert straight_leader_time(math.pi / 2, 0.0, **kw) == pytest.approx(2.6232829458, abs=1e-9)
 
 
 @settings(max_examples=40, deadline=None)
-@given(th0=st.floats(-4, 4), dth=st.floats(-5, 5).filter(lambda d: abs(d) > 1e-3),
-       alpha=st.floats(-4, 4), rho=st.floats(0.0, 0.95), L=st.floats(0.2, 3),
-       v_p=st.floats(0.3, 3))
+@given(
+    th0=st.floats(-4, 4),
+    dth=st.floats(-5, 5).filter(lambda d: abs(d) > 1e-3),
+    alpha=st.floats(-4, 4),
+    rho=st.floats(0.0, 0.95),
+    L=st.floats(0.2, 3),
+    v_p=st.floats(0.3, 3),
+)
 def test_straight_leader_matches_quadrature(th0, dth, alpha, rho, L, v_p):
     def dt_dtheta(th):
         tp, tm = theta_dot(alpha, th, L=L, v_p=v_p, rho=rho)
@@ -102,7 +103,8 @@ def test_straight_leader_simulated_and_refusals():
     ev.terminal = True
     sol = solve_ivp(f, (0, 50), [0.3], events=ev, rtol=1e-12, atol=1e-12)
     assert sol.t_events[0][0] == pytest.approx(
-        straight_leader_time(0.3, 2.5, alpha=0.7, **kw), rel=1e-8)
+        straight_leader_time(0.3, 2.5, alpha=0.7, **kw), rel=1e-8
+    )
     for rho in (1.0, 1.5):
         with pytest.raises(InfeasibleError, match=re.escape(f"rho = {rho}")):
             straight_leader_time(0.0, 1.0, alpha=0.0, L=1.0, v_p=1.0, rho=rho)
@@ -113,8 +115,13 @@ def test_straight_leader_simulated_and_refusals():
 
 
 @settings(max_examples=30, deadline=None)
-@given(alpha=st.floats(-4, 4), theta=st.floats(-1.4, 1.4).map(lambda t: t + math.pi * 0),
-       flip=st.booleans(), L=st.floats(0.3, 3), v_e=st.floats(0.2, 2))
+@given(
+    alpha=st.floats(-4, 4),
+    theta=st.floats(-1.4, 1.4).map(lambda t: t + math.pi * 0),
+    flip=st.booleans(),
+    L=st.floats(0.3, 3),
+    v_e=st.floats(0.2, 2),
+)
 def test_wall_following_matches_finite_differences(alpha, theta, flip, L, v_e):
     if flip:
         theta += math.pi  # cos θ < 0: the case the printed bound gets wrong (E6)
@@ -131,11 +138,13 @@ def test_wall_following_matches_finite_differences(alpha, theta, flip, L, v_e):
 
     h = 1e-6
     (xp1, th1), (xp0, th0_) = state(h), state(-h)
-    assert (xp1 - xp0) / (2 * h) == pytest.approx(wall_follow_speed(alpha, theta, v_e=v_e),
-                                                  rel=1e-6, abs=1e-6)
+    assert (xp1 - xp0) / (2 * h) == pytest.approx(
+        wall_follow_speed(alpha, theta, v_e=v_e), rel=1e-6, abs=1e-6
+    )
     dth = math.remainder(th1 - th0_, 2 * math.pi) / (2 * h)
-    assert dth == pytest.approx(wall_follow_theta_dot(alpha, theta, L=L, v_e=v_e),
-                                rel=1e-6, abs=1e-6)
+    assert dth == pytest.approx(
+        wall_follow_theta_dot(alpha, theta, L=L, v_e=v_e), rel=1e-6, abs=1e-6
+    )
 
 
 def test_wall_following_worst_heading_and_feasibility():
@@ -145,22 +154,30 @@ def test_wall_following_worst_heading_and_feasibility():
         assert worst == pytest.approx(wall_follow_max_speed(theta, v_e=0.7), rel=1e-8)
         for k in (-1, 0, 1, 2):  # α = θ + kπ for every integer k (E6)
             assert abs(wall_follow_speed(theta + k * math.pi, theta, v_e=0.7)) == (
-                pytest.approx(0.7 / abs(math.cos(theta))))
+                pytest.approx(0.7 / abs(math.cos(theta)))
+            )
     # E6: |cos θ| >= rho, not cos θ >= rho
     assert wall_follow_feasible(2.8, rho=0.5)  # cos 2.8 ≈ -0.94
     assert not wall_follow_feasible(1.4, rho=0.5)
-    np.testing.assert_array_equal(wall_follow_feasible(np.array([0.0, 1.5, math.pi]),
-                                                       rho=0.5), [True, False, True])
+    np.testing.assert_array_equal(
+        wall_follow_feasible(np.array([0.0, 1.5, math.pi]), rho=0.5), [True, False, True]
+    )
     assert math.isinf(wall_follow_max_speed(math.pi / 2 + 0.0, v_e=1.0)) or (
-        wall_follow_max_speed(math.pi / 2, v_e=1.0) > 1e15)
+        wall_follow_max_speed(math.pi / 2, v_e=1.0) > 1e15
+    )
 
 
 # ---------------------------------------------------------------------- 7.4 corner
 
 
 @settings(max_examples=30, deadline=None)
-@given(ex=st.floats(-2, 2), ey=st.floats(-2, 2), heading=st.floats(-4, 4),
-       frac=st.floats(0.1, 0.95), v_e=st.floats(0.2, 2))
+@given(
+    ex=st.floats(-2, 2),
+    ey=st.floats(-2, 2),
+    heading=st.floats(-4, 4),
+    frac=st.floats(0.1, 0.95),
+    v_e=st.floats(0.2, 2),
+)
 def test_corner_velocity_matches_finite_differences(ex, ey, heading, frac, v_e):
     vertex = np.array([0.3, 0.4])
     e = np.array([ex, ey])
@@ -170,8 +187,10 @@ def test_corner_velocity_matches_finite_differences(ex, ey, heading, frac, v_e):
     L = ell / frac
     e_dot = v_e * np.array([math.cos(heading), math.sin(heading)])
     h = 1e-6
-    fd = (corner_pursuer_position(e + h * e_dot, vertex, L=L)
-          - corner_pursuer_position(e - h * e_dot, vertex, L=L)) / (2 * h)
+    fd = (
+        corner_pursuer_position(e + h * e_dot, vertex, L=L)
+        - corner_pursuer_position(e - h * e_dot, vertex, L=L)
+    ) / (2 * h)
     got = corner_pursuer_velocity(e, vertex, e_dot, L=L)
     np.testing.assert_allclose(got, fd, atol=1e-6 * max(1.0, L / ell))
     p = corner_pursuer_position(e, vertex, L=L)
@@ -188,10 +207,10 @@ def test_corner_required_speed_and_threshold():
         vertex = np.array([ell, 0.0])
         heads = np.linspace(-math.pi, math.pi, 3601)
         e_dots = v_e * np.column_stack([np.cos(heads), np.sin(heads)])
-        speeds = np.linalg.norm(corner_pursuer_velocity(np.tile(e, (len(heads), 1)),
-                                                        vertex, e_dots, L=L), axis=1)
-        assert speeds.max() == pytest.approx(corner_required_speed(ell, L=L, v_e=v_e),
-                                             rel=1e-6)
+        speeds = np.linalg.norm(
+            corner_pursuer_velocity(np.tile(e, (len(heads), 1)), vertex, e_dots, L=L), axis=1
+        )
+        assert speeds.max() == pytest.approx(corner_required_speed(ell, L=L, v_e=v_e), rel=1e-6)
     rho = 0.5
     l_min = corner_min_distance(L=L, rho=rho)
     assert l_min == pytest.approx(rho * L / (1 + rho))

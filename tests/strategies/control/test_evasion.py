@@ -33,12 +33,19 @@ def test_greedy_reference(theta, alpha, value):
 
 
 @settings(max_examples=40, deadline=None)
-@given(theta=st.floats(-4, 4), rho=st.floats(0.05, 0.95), L=st.floats(0.3, 3),
-       branch=st.sampled_from(["+", "-"]))
+@given(
+    theta=st.floats(-4, 4),
+    rho=st.floats(0.05, 0.95),
+    L=st.floats(0.3, 3),
+    branch=st.sampled_from(["+", "-"]),
+)
 def test_greedy_is_the_numerical_minimiser(theta, rho, L, branch):
-    res = minimize_scalar(lambda a: abs(f2(a, theta, L=L, rho=rho, branch=branch)),
-                          bounds=(-1.5707, 1.5707), method="bounded",
-                          options={"xatol": 1e-12})
+    res = minimize_scalar(
+        lambda a: abs(f2(a, theta, L=L, rho=rho, branch=branch)),
+        bounds=(-1.5707, 1.5707),
+        method="bounded",
+        options={"xatol": 1e-12},
+    )
     g = greedy_heading(theta, L=L, rho=rho, branch=branch)
     assert abs(g.f2) <= res.fun + 1e-9
     assert g.alpha == pytest.approx(res.x, abs=1e-5)
@@ -129,8 +136,9 @@ def test_stop_at_crossing_truncates():
     arc = shoot(**FIG11A, L=1.0, rho=0.5, x_max=3.0, stop_at_crossing=True)
     assert arc.x[-2] <= arc.x_c <= arc.x[-1]
     assert arc.pursuer_path().shape == (len(arc.x), 2)
-    np.testing.assert_allclose(np.linalg.norm(arc.pursuer_path() - arc.evader_path(), axis=1),
-                               1.0, atol=1e-12)
+    np.testing.assert_allclose(
+        np.linalg.norm(arc.pursuer_path() - arc.evader_path(), axis=1), 1.0, atol=1e-12
+    )
 
 
 # ----------------------------------------------------------------------- solve_escape
@@ -166,7 +174,8 @@ def _direct_transcription(theta0, x_e, L, rho, branch, n=20, sub=4):
     def g(a, th):  # s f2, vectorised over a batch of profiles
         phi = a - th
         return (np.sqrt(1 - (rho * np.cos(phi)) ** 2) - s * rho * np.sin(phi)) / (
-            L * rho * np.cos(a))
+            L * rho * np.cos(a)
+        )
 
     def cost_batch(A):
         th = np.full(A.shape[0], theta0)
@@ -189,14 +198,24 @@ def _direct_transcription(theta0, x_e, L, rho, branch, n=20, sub=4):
         v = cost_batch(batch)
         return (v[1:] - v[0]) / eps
 
-    cons = {"type": "eq", "fun": lambda a: np.sum(np.tan(a)) * x_e / n,
-            "jac": lambda a: x_e / n / np.cos(a) ** 2}
+    cons = {
+        "type": "eq",
+        "fun": lambda a: np.sum(np.tan(a)) * x_e / n,
+        "jac": lambda a: x_e / n / np.cos(a) ** 2,
+    }
     best = None
     for start in (0.0,):
         a0 = np.full(n, start)
         a0 -= np.mean(a0)  # feasible start: straight line
-        res = minimize(fun, a0, jac=jac, constraints=[cons], method="SLSQP",
-                       bounds=[(-1.45, 1.45)] * n, options={"maxiter": 300, "ftol": 1e-12})
+        res = minimize(
+            fun,
+            a0,
+            jac=jac,
+            constraints=[cons],
+            method="SLSQP",
+            bounds=[(-1.45, 1.45)] * n,
+            options={"maxiter": 300, "ftol": 1e-12},
+        )
         if abs(cons["fun"](res.x)) < 1e-8 and (best is None or res.fun < best):
             best = res.fun
     return best
@@ -223,8 +242,17 @@ def test_solve_escape_is_optimal(theta0, x_e, L, rho, branch):
     s = 1 if branch == "+" else -1
     assert sol.k == pytest.approx(sol.lambda1 / (1 + s * sol.lambda2_0), rel=1e-12)
     # the returned multipliers reproduce the arc with the paper's algorithm
-    again = shoot(theta0, sol.lambda1, sol.lambda2_0, L=L, rho=rho, branch=branch,
-                  x_max=x_e, method="pmp", step=x_e / 1000)
+    again = shoot(
+        theta0,
+        sol.lambda1,
+        sol.lambda2_0,
+        L=L,
+        rho=rho,
+        branch=branch,
+        x_max=x_e,
+        method="pmp",
+        step=x_e / 1000,
+    )
     assert again.theta[-1] == pytest.approx(arc.theta[-1], abs=1e-6)
     assert again.y[-1] == pytest.approx(0.0, abs=1e-6)
     # optimality: no worse than an independent direct transcription ...
@@ -246,8 +274,13 @@ def test_solve_escape_is_optimal(theta0, x_e, L, rho, branch):
 
 
 def test_solve_escape_failures_are_reported():
-    sol = solve_escape(-1.4694468369271578, 1.7090163413421233, L=1.1641292434617974,
-                       rho=0.8913647185839817, branch="-")
+    sol = solve_escape(
+        -1.4694468369271578,
+        1.7090163413421233,
+        L=1.1641292434617974,
+        rho=0.8913647185839817,
+        branch="-",
+    )
     assert not sol.success and "no bounded extremal" in sol.reason and sol.arc is None
     triv = solve_escape(0.3, 1.0, L=1.0, rho=1.3)
     assert not triv.success and "trivially" in triv.reason
@@ -260,14 +293,14 @@ def test_solve_escape_failures_are_reported():
         (lambda: solve_escape(math.nan, 1.0, L=1.0, rho=0.5), SurveilValueError, "theta0"),
         (lambda: solve_escape(0.0, 1.0, L=-1.0, rho=0.5), SurveilValueError, "L = -1.0"),
         (lambda: solve_escape(0.0, 1.0, L=1.0, rho=0.0), SurveilValueError, "rho = 0.0"),
-        (lambda: solve_escape(0.0, 1.0, L=1.0, rho=0.5, branch=2), SurveilValueError,
-         "branch"),
-        (lambda: shoot(0.0, 1.0, -1.0, L=1.0, rho=0.5, x_max=1.0), SurveilValueError,
-         "lambda2_0"),
-        (lambda: shoot(0.0, 1.0, 0.0, L=1.0, rho=1.0, x_max=1.0), InfeasibleError,
-         "rho = 1.0"),
-        (lambda: shoot(0.0, 1.0, 0.0, L=1.0, rho=0.5, x_max=1.0, method="euler"),
-         SurveilValueError, "method"),
+        (lambda: solve_escape(0.0, 1.0, L=1.0, rho=0.5, branch=2), SurveilValueError, "branch"),
+        (lambda: shoot(0.0, 1.0, -1.0, L=1.0, rho=0.5, x_max=1.0), SurveilValueError, "lambda2_0"),
+        (lambda: shoot(0.0, 1.0, 0.0, L=1.0, rho=1.0, x_max=1.0), InfeasibleError, "rho = 1.0"),
+        (
+            lambda: shoot(0.0, 1.0, 0.0, L=1.0, rho=0.5, x_max=1.0, method="euler"),
+            SurveilValueError,
+            "method",
+        ),
         (lambda: greedy_heading(0.0, L=1.0, rho=2.0), InfeasibleError, "rho = 2.0"),
     ],
 )

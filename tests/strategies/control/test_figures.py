@@ -24,6 +24,12 @@ def test_draw_figure_with_multipliers_and_errors(tmp_path):
     with pytest.raises(TypeError):
         draw_figure("tractrix", tmp_path / "x.png", colour="red")
     with pytest.raises(SurveilValueError, match="no optimal escape"):
-        draw_figure("shooting", tmp_path / "x.png", theta0=-1.4694468369271578,
-                    x_e=1.7090163413421233, L=1.1641292434617974, rho=0.8913647185839817,
-                    branch="-")
+        draw_figure(
+            "shooting",
+            tmp_path / "x.png",
+            theta0=-1.4694468369271578,
+            x_e=1.7090163413421233,
+            L=1.1641292434617974,
+            rho=0.8913647185839817,
+            branch="-",
+        )

@@ -37,8 +37,7 @@ def test_fig11a_hamiltonian_reference():
 
 
 @settings(max_examples=40, deadline=None)
-@given(alpha=st.floats(-1.4, 1.4), theta=thetas, rho=rhos, L=st.floats(0.3, 3.0),
-       branch=branches)
+@given(alpha=st.floats(-1.4, 1.4), theta=thetas, rho=rhos, L=st.floats(0.3, 3.0), branch=branches)
 def test_f2_is_theta_dot_over_x_dot(alpha, theta, rho, L, branch):
     tp, tm = theta_dot(alpha, theta, L=L, v_p=1.0, rho=rho)
     expected = (tp if branch == "+" else tm) / (rho * math.cos(alpha))
@@ -46,18 +45,28 @@ def test_f2_is_theta_dot_over_x_dot(alpha, theta, rho, L, branch):
 
 
 @settings(max_examples=40, deadline=None)
-@given(alpha=st.floats(-1.4, 1.4), theta=thetas, rho=rhos, l1=st.floats(-3, 3),
-       l2=st.floats(-0.9, 3), branch=branches)
+@given(
+    alpha=st.floats(-1.4, 1.4),
+    theta=thetas,
+    rho=rhos,
+    l1=st.floats(-3, 3),
+    l2=st.floats(-0.9, 3),
+    branch=branches,
+)
 def test_adjoint_and_partials_match_finite_differences(alpha, theta, rho, l1, l2, branch):
     kw = {"L": 1.3, "rho": rho, "branch": branch}
     eps = 1e-6
     fd_th = (f2(alpha, theta + eps, **kw) - f2(alpha, theta - eps, **kw)) / (2 * eps)
     assert df2_dtheta(alpha, theta, **kw) == pytest.approx(fd_th, rel=1e-6, abs=1e-6)
-    dH_th = (hamiltonian(alpha, theta + eps, l1, l2, **kw)
-             - hamiltonian(alpha, theta - eps, l1, l2, **kw)) / (2 * eps)
+    dH_th = (
+        hamiltonian(alpha, theta + eps, l1, l2, **kw)
+        - hamiltonian(alpha, theta - eps, l1, l2, **kw)
+    ) / (2 * eps)
     assert adjoint_lambda2(alpha, theta, l2, **kw) == pytest.approx(-dH_th, rel=1e-6, abs=1e-6)
-    dH_a = (hamiltonian(alpha + eps, theta, l1, l2, **kw)
-            - hamiltonian(alpha - eps, theta, l1, l2, **kw)) / (2 * eps)
+    dH_a = (
+        hamiltonian(alpha + eps, theta, l1, l2, **kw)
+        - hamiltonian(alpha - eps, theta, l1, l2, **kw)
+    ) / (2 * eps)
     assert dH_dalpha(alpha, theta, l1, l2, **kw) == pytest.approx(dH_a, rel=1e-5, abs=1e-5)
 
 
@@ -72,8 +81,7 @@ def test_stationary_kappa_is_strictly_decreasing(theta, rho, branch):
 
 
 @settings(max_examples=60, deadline=None)
-@given(theta=thetas, rho=rhos, l1=st.floats(-3, 3), l2=st.floats(-0.9, 3),
-       branch=branches)
+@given(theta=thetas, rho=rhos, l1=st.floats(-3, 3), l2=st.floats(-0.9, 3), branch=branches)
 def test_minimiser_matches_dense_grid(theta, rho, l1, l2, branch):
     kw = {"L": 1.0, "rho": rho, "branch": branch}
     m = minimise_hamiltonian(theta, l1, l2, **kw)
@@ -93,8 +101,9 @@ def test_unbounded_when_mu_not_positive_and_mirror_symmetry():
     assert is_unbounded(0.3, 0.2, -1.0, L=1.0, rho=0.5)  # μ = 0
     assert is_unbounded(0.3, 0.2, 1.0, L=1.0, rho=0.5, branch="-")  # μ = 1 - λ2 = 0
     a, th = np.linspace(-1.4, 1.4, 9), 0.7
-    np.testing.assert_allclose(f2(a, th, L=1.0, rho=0.4, branch="-"),
-                               -f2(-a, -th, L=1.0, rho=0.4, branch="+"), rtol=1e-13)
+    np.testing.assert_allclose(
+        f2(a, th, L=1.0, rho=0.4, branch="-"), -f2(-a, -th, L=1.0, rho=0.4, branch="+"), rtol=1e-13
+    )
 
 
 def test_bad_input():

@@ -67,8 +67,9 @@ def test_strict_signs_below_one_and_zero_rate_at_rho_one():
 
 
 def test_min_and_max_of_max_abs_theta_dot_reference():
-    vals = max_abs_theta_dot(np.array([0.0, math.pi / 2, math.pi, 1.5 * math.pi]), 0.0,
-                             L=1.0, v_p=1.0, rho=0.5)
+    vals = max_abs_theta_dot(
+        np.array([0.0, math.pi / 2, math.pi, 1.5 * math.pi]), 0.0, L=1.0, v_p=1.0, rho=0.5
+    )
     np.testing.assert_allclose(vals, [math.sqrt(0.75), 1.5, math.sqrt(0.75), 1.5], atol=1e-12)
 
 
@@ -83,7 +84,8 @@ def test_min_max_heading_is_the_grid_minimum(theta, L, v_p, rho):
     assert best.rate == pytest.approx((v_p / L) * math.sqrt(1 - rho * rho), rel=1e-12)
     for heading in (best.toward, best.away):
         assert max_abs_theta_dot(heading, theta, L=L, v_p=v_p, rho=rho) == pytest.approx(
-            best.rate, rel=1e-9)
+            best.rate, rel=1e-9
+        )
     assert math.cos(best.toward - theta) == pytest.approx(1.0)
     assert math.cos(best.away - theta) == pytest.approx(-1.0)
 
@@ -102,8 +104,7 @@ def test_rho_above_one_is_nan_free_and_flagged():
 
 
 @settings(max_examples=100, deadline=None)
-@given(alpha=angles, theta=angles, L=lengths, v_p=speeds, rho=ratios,
-       t=st.floats(0.0, 1.0))
+@given(alpha=angles, theta=angles, L=lengths, v_p=speeds, rho=ratios, t=st.floats(0.0, 1.0))
 def test_pursuer_velocity_in_rate_interval_is_within_speed(alpha, theta, L, v_p, rho, t):
     tp, tm = theta_dot(alpha, theta, L=L, v_p=v_p, rho=rho)
     td = tm + t * (tp - tm)
@@ -151,7 +152,8 @@ def test_integrated_pursuer_keeps_distance_and_orientation():
     rel = z[2:4] - z[0:2]
     assert np.linalg.norm(rel) == pytest.approx(L, abs=1e-9)
     assert math.remainder(math.atan2(rel[1], rel[0]) - z[4], 2 * math.pi) == pytest.approx(
-        0.0, abs=1e-9)
+        0.0, abs=1e-9
+    )
     assert vmax <= v_p * (1 + 1e-9)
 
 
@@ -163,12 +165,14 @@ def test_holding_range_converges_to_target_within_speed():
         L = float(np.linalg.norm(rel))
         th = math.atan2(rel[1], rel[0])
         _, tm = theta_dot(a, th, L=L, v_p=v_p, rho=rho)
-        cmd = pursuer_velocity_holding_range(e_dot, th, 0.5 * tm, L=L, L_target=target,
-                                             v_p=v_p, gain=2.0)
+        cmd = pursuer_velocity_holding_range(
+            e_dot, th, 0.5 * tm, L=L, L_target=target, v_p=v_p, gain=2.0
+        )
         assert cmd.feasible
         assert np.linalg.norm(cmd.velocity) <= v_p * (1 + 1e-12)
         assert theta_dot_from_velocities(e_dot, cmd.velocity, th, L=L) == pytest.approx(
-            0.5 * tm, abs=1e-12)
+            0.5 * tm, abs=1e-12
+        )
         return cmd.velocity, 0.0
 
     z, _ = _simulate(command, t_end=6.0, steps=1500, L=L0, v_p=v_p, rho=rho)

@@ -29,15 +29,17 @@ def _rod_hits_square(p, theta, L, n=4000):
 
 def test_square_vertex_admissible_wedge():
     # the square's CCW order is (-2,-2), (0,-2), (0,0), (-2,0)
-    t = vertex_escape_target([3.0, 1.0], [3.0, 2.5], [0.0, 0.0], [0.0, -2.0], [-2.0, 0.0],
-                             L=1.5, obstacle_ccw=True)
+    t = vertex_escape_target(
+        [3.0, 1.0], [3.0, 2.5], [0.0, 0.0], [0.0, -2.0], [-2.0, 0.0], L=1.5, obstacle_ccw=True
+    )
     assert t.kind == "vertex"
     assert t.theta_i == pytest.approx(0.0) and t.theta_f == pytest.approx(math.pi / 2)
     swapped = vertex_escape_target([3.0, 1.0], [3.0, 2.5], [0, 0], [0, -2], [-2, 0], L=1.5)
     assert (swapped.theta_i, swapped.theta_f) == (t.theta_i, t.theta_f)
     assert t.x_e == pytest.approx(math.hypot(3, 1))
-    np.testing.assert_allclose(to_evader_frame(t.position, [3.0, 1.0], t.beta), [t.x_e, 0.0],
-                               atol=1e-12)
+    np.testing.assert_allclose(
+        to_evader_frame(t.position, [3.0, 1.0], t.beta), [t.x_e, 0.0], atol=1e-12
+    )
     assert t.theta0 == pytest.approx(math.remainder(math.pi / 2 - t.beta, 2 * math.pi))
 
 
@@ -45,8 +47,10 @@ def test_admissible_wedge_matches_brute_force_rod_collisions():
     # With the evader at v, the rod survives every small evader move iff θ is in the wedge.
     t = vertex_escape_target([3.0, 1.0], [3.0, 2.5], [0, 0], [-2, 0], [0, -2], L=1.5)
     eps = 1e-3
-    moves = [eps * np.array([math.cos(a), math.sin(a)])
-             for a in np.linspace(-math.pi / 2 + 0.01, math.pi - 0.01, 400)]  # free wedge
+    moves = [
+        eps * np.array([math.cos(a), math.sin(a)])
+        for a in np.linspace(-math.pi / 2 + 0.01, math.pi - 0.01, 400)
+    ]  # free wedge
     for theta in np.linspace(-math.pi / 2 + 0.05, math.pi - 0.05, 40):
         inside = (theta - t.theta_i) % (2 * math.pi) <= (t.theta_f - t.theta_i) % (2 * math.pi)
         hit = any(_rod_hits_square(m, theta, 1.5) for m in moves)
@@ -82,15 +86,18 @@ def test_critical_curve_target():
 
 
 @settings(max_examples=50, deadline=None)
-@given(pts=st.lists(st.tuples(st.floats(-50, 50), st.floats(-50, 50)), min_size=1,
-                    max_size=5),
-       e=st.tuples(st.floats(-50, 50), st.floats(-50, 50)), beta=st.floats(-7, 7))
+@given(
+    pts=st.lists(st.tuples(st.floats(-50, 50), st.floats(-50, 50)), min_size=1, max_size=5),
+    e=st.tuples(st.floats(-50, 50), st.floats(-50, 50)),
+    beta=st.floats(-7, 7),
+)
 def test_frame_round_trip(pts, e, beta):
     p = np.array(pts)
     q = to_evader_frame(p, e, beta)
     np.testing.assert_allclose(from_evader_frame(q, e, beta), p, atol=1e-9)
-    np.testing.assert_allclose(np.linalg.norm(q, axis=1),
-                               np.linalg.norm(p - np.array(e), axis=1), atol=1e-9)
+    np.testing.assert_allclose(
+        np.linalg.norm(q, axis=1), np.linalg.norm(p - np.array(e), axis=1), atol=1e-9
+    )
 
 
 def test_bad_input():

@@ -30,7 +30,7 @@ from strategies.policies.escape_plan import (
     escape_plan,
     escape_ranks,
 )
-from strategies.policies.safety import _grid, safety_table
+from strategies.policies.safety import grid_points, safety_table
 
 L = 2.1
 MAPS = ["corridor", "two_rooms", "maze", "l_hall", "pillars", "corner"]
@@ -169,7 +169,7 @@ def test_plan_grid_is_the_safety_tables():
 def test_region_walk_is_a_shortest_wall_free_grid_walk():
     world = builtin_map("pillars")
     h = 0.25
-    _origin, cell, pts = _grid(world, h)
+    _origin, cell, pts = grid_points(world, h)
     region = np.hypot(pts[:, 0] - pts[0, 0], pts[:, 1] - pts[0, 1]) < 1.0  # a patch
     nxt = _region_next(world, cell, pts, h, region)
     free = world.free_region

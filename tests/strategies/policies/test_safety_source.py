@@ -21,7 +21,8 @@ from shapely.geometry import LineString
 from envs.geometry import kernel_for
 from envs.maps import builtin_map
 from strategies.cspace import decompose
-from strategies.policies.safety import SOURCE, TABLE_VERSION, cspace_graph, safety_table
+from strategies.cspace.grid_oracle import grid_graph
+from strategies.policies.safety import SOURCE, TABLE_VERSION, safety_table
 
 RES = 0.25
 L = 2.0
@@ -69,7 +70,7 @@ def test_safe_bins_are_the_decompositions_safe_arcs(name):
 def test_no_grid_escape_is_safe_in_the_table():
     world = builtin_map("maze")
     tab = safety_table(world, L, RES, N_BINS, disk_cache=False)
-    g = cspace_graph(world, L, RES)
+    g = grid_graph(world, L, resolution=RES)
     dec = decompose(world, L, cache=True)
     curves = shapely.STRtree([LineString(c.points) for c in dec.curves if len(c.points) > 1])
     esc = np.flatnonzero(g.escapable)

@@ -43,15 +43,23 @@ def _xy(p: ArrayLike, what: str) -> tuple[float, float]:
     return x, y
 
 
+def _as_floats(x: ArrayLike, what: str, expected: str) -> np.ndarray:
+    """``x`` as a float array; non-numeric input raises InvalidConfigError naming it."""
+    try:
+        return np.asarray(x, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidConfigError(f"{what}: expected {expected}, got {x!r}") from exc
+
+
 def _point(x: ArrayLike, what: str) -> np.ndarray:
-    arr = np.asarray(x, dtype=float)
+    arr = _as_floats(x, what, "a finite (x, y) point")
     if arr.shape != (2,) or not np.all(np.isfinite(arr)):
         raise InvalidConfigError(f"{what}: expected a finite (x, y) point, got {x!r}")
     return arr
 
 
 def _points(x: ArrayLike, what: str) -> np.ndarray:
-    arr = np.asarray(x, dtype=float)
+    arr = _as_floats(x, what, "a finite (k, 2) array of points")
     if arr.ndim == 1 and arr.shape == (2,):
         arr = arr[None, :]
     if arr.ndim != 2 or arr.shape[1] != 2 or not np.all(np.isfinite(arr)):
@@ -63,6 +71,8 @@ def _points(x: ArrayLike, what: str) -> np.ndarray:
 
 def _length(x: float, what: str, *, positive: bool = True) -> float:
     try:
+        if isinstance(x, (str, bytes, bool, np.bool_)):
+            raise TypeError  # float("2") and float(True) would succeed
         v = float(x)
     except (TypeError, ValueError) as exc:
         raise InvalidConfigError(f"{what}: expected a number, got {x!r}") from exc
@@ -429,7 +439,7 @@ class Kernel:
             (k,) float distances.
         """
         o = _point(origin, "ray_distances origin")
-        ang = np.asarray(angles, dtype=float).reshape(-1)
+        ang = _as_floats(angles, "ray_distances angles", "finite angles in radians").reshape(-1)
         if not np.all(np.isfinite(ang)):
             raise InvalidConfigError(f"ray_distances: angles must be finite, got {angles!r}")
         rmax = _length(max_range, "ray_distances max_range")

@@ -381,6 +381,8 @@ def map_from_wkt(
     Raises:
         InvalidMapError: naming ``source`` and the problem.
     """
+    if not isinstance(text, str):
+        raise _fail(source, f"expected WKT text, got {type(text).__name__} {text!r}")
     try:
         geom = shapely.from_wkt(text.strip())
     except (ShapelyError, TypeError, ValueError) as exc:
@@ -504,6 +506,11 @@ def load_map(path_or_name: str | os.PathLike[str], *, merge: bool | None = None)
     """
     from envs.maps.builtin import builtin_map, builtin_names
 
+    if not isinstance(path_or_name, (str, os.PathLike)):
+        raise UnknownNameError(
+            f"map: expected a built-in name {builtin_names()} or a map file path, got "
+            f"{type(path_or_name).__name__} {path_or_name!r}"
+        )
     if isinstance(path_or_name, str) and Path(path_or_name).suffix.lower() not in FORMATS:
         if path_or_name in builtin_names():
             if merge is not None:

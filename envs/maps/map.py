@@ -157,6 +157,11 @@ class Map:
             raise InvalidMapError("boundary: degenerate polygon (zero extent)")
         self.scale = span
         b = _clean_ring(b, span, "boundary")
+        if isinstance(obstacles, (str, bytes)) or not hasattr(obstacles, "__iter__"):
+            raise InvalidMapError(
+                f"obstacles: expected a sequence of polygons, got {type(obstacles).__name__} "
+                f"{obstacles!r}"
+            )
         obs = [
             _clean_ring(_as_ring(o, f"obstacle {i}"), span, f"obstacle {i}")
             for i, o in enumerate(obstacles)
@@ -420,8 +425,23 @@ class Map:
             matrix: 2x2 linear part (rotation times uniform scale; a reflection is allowed).
             offset: translation.
         """
-        m = np.asarray(matrix, dtype=float)
-        o = np.asarray(offset, dtype=float)
+        try:
+            m = np.asarray(matrix, dtype=float)
+            o = np.asarray(offset, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise InvalidMapError(
+                f"transformed: expected a 2x2 matrix and an (x, y) offset, got {matrix!r} "
+                f"and {offset!r}"
+            ) from exc
+        if (
+            m.shape != (2, 2)
+            or o.shape != (2,)
+            or not (np.isfinite(m).all() and np.isfinite(o).all())
+        ):
+            raise InvalidMapError(
+                f"transformed: expected a finite 2x2 matrix and a finite (x, y) offset, got "
+                f"{m.tolist()} and {o.tolist()}"
+            )
         f = lambda r: r @ m.T + o
         return Map(
             f(self.boundary), [f(q) for q in self.obstacles], name=self.name, merge=self.merged

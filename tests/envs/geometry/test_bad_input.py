@@ -1,0 +1,51 @@
+"""Hostile input to the kernel's public queries raises InvalidConfigError naming it."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from envs.errors import InvalidConfigError
+from envs.geometry import kernel_for
+from envs.maps import Map
+
+
+@pytest.fixture(scope="module")
+def kernel():
+    return kernel_for(Map([(0, 0), (10, 0), (10, 10), (0, 10)], [[(4, 4), (6, 4), (6, 6)]]))
+
+
+@pytest.mark.parametrize("length", ["1", b"1", True, np.bool_(True), None])
+def test_lengths_must_be_numbers(kernel, length):
+    with pytest.raises(InvalidConfigError, match="expected"):
+        kernel.free_arcs((1.0, 1.0), length)
+    with pytest.raises(InvalidConfigError, match="l_max"):
+        kernel.sweep((1, 1), (2, 1), (1, 1), (2, 1), 0.0, length)
+    with pytest.raises(InvalidConfigError, match="max_range"):
+        kernel.ray_distances((1.0, 1.0), [0.0], length)
+
+
+def test_numpy_lengths_are_accepted(kernel):
+    a = kernel.free_arcs((1.0, 1.0), np.float32(2.0))
+    assert a.L == 2.0
+    assert kernel.sweep((1, 1), (3, 1), (1, 1), (3, 1), np.int64(0), np.int64(5)) is None
+
+
+@pytest.mark.parametrize("origin", ["ab", ("a", "b"), {"x": 1}])
+def test_ray_origin_not_numeric(kernel, origin):
+    with pytest.raises(InvalidConfigError, match="ray_distances origin"):
+        kernel.ray_distances(origin, [0.0], 1.0)
+
+
+@pytest.mark.parametrize("angles", ["abc", [None, "x"], {"a": 1}])
+def test_ray_angles_not_numeric(kernel, angles):
+    with pytest.raises(InvalidConfigError, match="ray_distances angles"):
+        kernel.ray_distances((1.0, 1.0), angles, 1.0)
+
+
+@pytest.mark.parametrize("points", ["ab", [("a", "b")]])
+def test_point_arrays_not_numeric(kernel, points):
+    with pytest.raises(InvalidConfigError, match="free_arcs_many points"):
+        kernel.free_arcs_many(points, 1.0)
+    with pytest.raises(InvalidConfigError, match="line_of_sight_many P"):
+        kernel.line_of_sight_many(points, [(1.0, 1.0)])

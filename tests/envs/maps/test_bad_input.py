@@ -1,0 +1,55 @@
+"""Hostile input to the map API raises InvalidMapError / UnknownNameError naming it."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from envs.errors import InvalidMapError, UnknownNameError
+from envs.maps import Map, load_map
+from envs.maps.io import map_from_wkt
+
+SQUARE = [(0, 0), (4, 0), (4, 4), (0, 4)]
+
+
+@pytest.mark.parametrize("obstacles", [None, 5, "abc"])
+def test_obstacles_not_a_sequence_of_polygons(obstacles):
+    with pytest.raises(InvalidMapError, match="obstacles"):
+        Map(SQUARE, obstacles)
+
+
+@pytest.mark.parametrize(
+    ("matrix", "offset"),
+    [
+        (np.eye(3), (0, 0)),
+        ("x", (0, 0)),
+        ([[1, 0]], (0, 0)),
+        (np.eye(2), (1, 2, 3)),
+        (np.eye(2), (math.nan, 0)),
+        ([[math.inf, 0], [0, 1]], (0, 0)),
+        (np.eye(2), "ab"),
+    ],
+)
+def test_transformed_rejects_bad_matrix_or_offset(matrix, offset):
+    with pytest.raises(InvalidMapError, match="transformed"):
+        Map(SQUARE).transformed(matrix, offset)
+
+
+def test_transformed_accepts_integer_reflection():
+    m = Map(SQUARE, [[(1, 1), (2, 1), (2, 2)]]).transformed(np.array([[-1, 0], [0, 1]]), (4, 0))
+    assert m.bounds == (0.0, 0.0, 4.0, 4.0)
+    assert int(m.vertex_convex.sum()) == 3
+
+
+@pytest.mark.parametrize("text", [None, 5, {"type": "Polygon"}, b"POLYGON ((0 0, 1 0, 1 1))"])
+def test_wkt_requires_text(text):
+    with pytest.raises(InvalidMapError, match="expected WKT text"):
+        map_from_wkt(text)
+
+
+@pytest.mark.parametrize("value", [3, None, 2.5, ["corridor"]])
+def test_load_map_rejects_non_names(value):
+    with pytest.raises(UnknownNameError, match=repr(value).replace("[", r"\[")):
+        load_map(value)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Mapping
 from typing import Any, ClassVar
 
 import numpy as np
@@ -16,7 +17,7 @@ from gymnasium.utils import EzPickle, seeding
 from pettingzoo import AECEnv, ParallelEnv
 from pettingzoo.utils.conversions import parallel_to_aec
 
-from envs.errors import InvalidActionError
+from envs.errors import InvalidActionError, InvalidConfigError, InvalidPlacementError
 from envs.geometry import Kernel, kernel_for
 from envs.maps import Map
 from envs.surveillance import rules
@@ -179,11 +180,24 @@ class parallel_env(ParallelEnv, EzPickle):
             Observations and infos of both agents.
 
         Raises:
-            InvalidPlacementError: the requested placement is not a valid surveillance
-                configuration; the message names the positions and the reason.
+            InvalidConfigError: ``seed`` is not None or an integer >= 0.
+            InvalidPlacementError: ``options`` is not a dict, or the requested placement is
+                not a valid surveillance configuration; the message names the positions
+                and the reason.
+            InfeasibleError: no random start exists (see ``random_start``).
         """
         if seed is not None:
-            self.np_random, self._np_random_seed = seeding.np_random(seed)
+            if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+                raise InvalidConfigError(
+                    f"reset: seed must be None or an integer >= 0, got {type(seed).__name__} "
+                    f"{seed!r}"
+                )
+            self.np_random, self._np_random_seed = seeding.np_random(int(seed))
+        if options is not None and not isinstance(options, Mapping):
+            raise InvalidPlacementError(
+                "reset: options must be None or a dict such as {'pursuer': (x, y), "
+                f"'evader': (x, y)}}, got {type(options).__name__} {options!r}"
+            )
         cfg = self.config
         if options and ("pursuer" in options or "evader" in options):
             p, e = validate_placement(
@@ -216,7 +230,10 @@ class parallel_env(ParallelEnv, EzPickle):
             x, y = action.tolist()  # the common case, without a conversion to float64
         else:
             try:
-                a = np.asarray(action, dtype=np.float64)
+                a = np.asarray(action)
+                if a.dtype.kind not in "iuf":  # no strings, booleans, complex or objects
+                    raise TypeError(f"dtype {a.dtype}")
+                a = a.astype(np.float64)
             except (TypeError, ValueError) as exc:
                 raise InvalidActionError(
                     f"{agent}: expected an action of shape (2,) with finite values, got {action!r}"
@@ -251,10 +268,16 @@ class parallel_env(ParallelEnv, EzPickle):
             live at the start of the step. After the episode ends ``agents`` is empty.
 
         Raises:
-            InvalidActionError: an action is missing, of the wrong shape, or not finite.
+            InvalidActionError: ``actions`` is not a dict, or an action is missing, not
+                numeric, of the wrong shape, or not finite.
         """
         if not self.agents:
             return {}, {}, {}, {}, {}
+        if not isinstance(actions, Mapping):
+            raise InvalidActionError(
+                f"step: expected a dict of actions keyed by agent, got "
+                f"{type(actions).__name__} {actions!r}"
+            )
         if PURSUER not in actions or EVADER not in actions:
             missing = [a for a in AGENTS if a not in actions]
             raise InvalidActionError(

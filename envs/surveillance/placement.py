@@ -23,7 +23,10 @@ MAX_BATCHES = 64
 
 def _point(value: Any, who: str) -> np.ndarray:
     try:
-        arr = np.asarray(value, dtype=float)
+        raw = np.asarray(value)
+        if raw.dtype.kind not in "iuf":  # no strings, booleans, complex or objects
+            raise TypeError(f"dtype {raw.dtype}")
+        arr = raw.astype(float)
     except (TypeError, ValueError) as exc:
         raise InvalidPlacementError(f"{who}: expected an (x, y) position, got {value!r}") from exc
     if arr.shape != (2,) or not np.all(np.isfinite(arr)):

@@ -1,0 +1,59 @@
+"""Hostile input to reset/step raises project errors naming the value."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from envs.errors import InvalidActionError, InvalidConfigError, InvalidPlacementError
+from envs.surveillance_v0 import parallel_env
+
+
+@pytest.fixture
+def env():
+    e = parallel_env()
+    e.reset(seed=0)
+    return e
+
+
+@pytest.mark.parametrize("seed", ["x", -1, 1.5, True])
+def test_reset_rejects_bad_seeds(seed):
+    with pytest.raises(InvalidConfigError, match="seed"):
+        parallel_env().reset(seed=seed)
+
+
+def test_numpy_integer_seed_equals_python_seed():
+    a, _ = parallel_env().reset(seed=np.int64(7))
+    b, _ = parallel_env().reset(seed=7)
+    assert all(np.array_equal(a[k], b[k]) for k in a)
+
+
+@pytest.mark.parametrize("options", [[1, 2], "pursuer", (("pursuer", (1, 1)),)])
+def test_reset_rejects_options_that_are_not_a_dict(env, options):
+    with pytest.raises(InvalidPlacementError, match="options"):
+        env.reset(options=options)
+
+
+def test_reset_rejects_boolean_or_string_positions(env):
+    p, e = env._pursuer, env._evader
+    env.reset(options={"pursuer": np.array(p, dtype=np.float32).astype(float), "evader": list(e)})
+    for bad in [(True, False), ("1", "2"), np.array(["1", "2"])]:
+        with pytest.raises(InvalidPlacementError, match="pursuer"):
+            env.reset(options={"pursuer": bad, "evader": e})
+
+
+@pytest.mark.parametrize("actions", [None, [0.0, 0.0], 3])
+def test_step_rejects_actions_that_are_not_a_dict(env, actions):
+    with pytest.raises(InvalidActionError, match="dict"):
+        env.step(actions)
+
+
+@pytest.mark.parametrize("action", [np.array([True, False]), ["0.1", "0.2"], [1 + 1j, 0.0]])
+def test_step_rejects_non_real_actions(env, action):
+    with pytest.raises(InvalidActionError, match="pursuer_0"):
+        env.step({"pursuer_0": action, "evader_0": [0.0, 0.0]})
+
+
+def test_integer_and_list_actions_are_accepted(env):
+    env.step({"pursuer_0": np.array([1, 0]), "evader_0": [0, 0]})
+    assert env._step == 1

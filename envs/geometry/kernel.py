@@ -71,9 +71,12 @@ def _points(x: ArrayLike, what: str) -> np.ndarray:
 
 def _length(x: float, what: str, *, positive: bool = True) -> float:
     try:
-        if isinstance(x, (str, bytes, bool, np.bool_)):
+        if type(x) is float:  # the per-step case
+            v = x
+        elif isinstance(x, (str, bytes, bool, np.bool_)):
             raise TypeError  # float("2") and float(True) would succeed
-        v = float(x)
+        else:
+            v = float(x)
     except (TypeError, ValueError) as exc:
         raise InvalidConfigError(f"{what}: expected a number, got {x!r}") from exc
     if not math.isfinite(v) or v < 0 or (positive and v == 0):

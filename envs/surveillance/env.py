@@ -273,7 +273,7 @@ class parallel_env(ParallelEnv, EzPickle):
         """
         if not self.agents:
             return {}, {}, {}, {}, {}
-        if not isinstance(actions, Mapping):
+        if type(actions) is not dict and not isinstance(actions, Mapping):
             raise InvalidActionError(
                 f"step: expected a dict of actions keyed by agent, got "
                 f"{type(actions).__name__} {actions!r}"

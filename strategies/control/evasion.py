@@ -291,6 +291,10 @@ def _max_steps(x_max: float, L: float, h: float) -> int:
 
 # ------------------------------------------------------------------------- solve_escape
 
+_MAX_DEFAULT_STEPS = 50_000
+"""Largest ``x_e / h`` :func:`solve_escape` attempts with the default step: beyond it (``x_e``
+thousands of times ``L``, or rho within ~1e-2 of 0 or 1) one solve takes seconds to minutes."""
+
 _ALPHA_GRID = (-1.5707, -1.3, -0.9, -0.45, 0.0, 0.45, 0.9, 1.3, 1.5707)
 """Initial headings probed for sign changes of y(x_e) before Brent refines them."""
 
@@ -318,7 +322,9 @@ def solve_escape(
 
     Returns:
         An :class:`EscapeSolution`; ``success`` is False with a ``reason`` when no bounded
-        extremal reaches ``(x_e, 0)`` or when ``rho >= 1`` (trivial escape, footnote 4).
+        extremal reaches ``(x_e, 0)``, when ``rho >= 1`` (trivial escape, footnote 4), or
+        when the default step would need more than 50,000 RK4 steps to reach ``x_e``
+        (pass an explicit ``step`` to force the integration).
 
     Raises:
         SurveilValueError: non-finite input, ``x_e <= 0``, ``L <= 0``, ``rho <= 0``.
@@ -335,6 +341,13 @@ def solve_escape(
             "from the pursuer (footnote 4); at rho = 1, θ̇⁺ can vanish (E1)",
         )
     h = default_step(x_e, L, rho_v) if step is None else positive("step", step)
+    if step is None and x_e / h > _MAX_DEFAULT_STEPS:
+        return EscapeSolution(
+            success=False,
+            reason=f"x_e = {x_e!r} with L = {L!r}, rho = {rho_v!r} needs {x_e / h:.3g} RK4 "
+            f"steps of the default step {h:.3g} (budget {_MAX_DEFAULT_STEPS}); pass step= "
+            "to integrate anyway",
+        )
     coarse = 8.0 * h  # bracket and first root on an 8x coarser grid, then polish
 
     def residual(a0: float, hh: float = h) -> float:

@@ -27,6 +27,7 @@ import shapely
 import shapely.ops
 from shapely.geometry import Polygon
 
+from envs.errors import InvalidConfigError
 from envs.geometry import kernel_for
 from envs.geometry.types import Arc, FreeArcs
 from envs.maps.map import Map
@@ -228,8 +229,12 @@ class Decomposition:
     # ------------------------------------------------------------------ queries
     def locate(self, point) -> int | None:
         """The region containing ``point`` (nearest region within the polyline tolerance),
-        or ``None`` outside the free region."""
-        p = np.asarray(point, dtype=float)
+        or ``None`` outside the free region.
+
+        Raises:
+            InvalidConfigError: ``point`` is not a finite (x, y) pair.
+        """
+        p = _point(point)
         pt = shapely.Point(p)
         hits = self._tree.query(pt, predicate="intersects")
         if len(hits):
@@ -255,8 +260,12 @@ class Decomposition:
         return out
 
     def free_arcs(self, point) -> tuple[CellArc, ...]:
-        """The free arcs at ``point`` with their cells and escapability."""
-        p = np.asarray(point, dtype=float)
+        """The free arcs at ``point`` with their cells and escapability.
+
+        Raises:
+            InvalidConfigError: ``point`` is not a finite (x, y) pair.
+        """
+        p = _point(point)
         fa = self._kernel.free_arcs(p, self.L)
         ids = self._match(self.locate(p), fa)
         return tuple(
@@ -270,12 +279,18 @@ class Decomposition:
         return tuple(ca.arc for ca in self.free_arcs(point) if ca.escapable is False)
 
     def cell_at(self, x: float, y: float, theta: float) -> Cell | None:
-        """The cell holding configuration ``(x, y, theta)``, or ``None`` if not free."""
-        fa = self._kernel.free_arcs(np.array([x, y], dtype=float), self.L)
+        """The cell holding configuration ``(x, y, theta)``, or ``None`` if not free.
+
+        Raises:
+            InvalidConfigError: non-finite or non-numeric ``x``, ``y`` or ``theta``.
+        """
+        p = _point((x, y), "(x, y)")
+        theta = _angle(theta)
+        fa = self._kernel.free_arcs(p, self.L)
         k = fa.arc_index(theta)
         if k is None:
             return None
-        i = self._match(self.locate((x, y)), fa)[k]
+        i = self._match(self.locate(p), fa)[k]
         return None if i is None else self.cells[i]
 
     def region_cells(self, region: int) -> tuple[Cell, ...]:
@@ -310,6 +325,28 @@ class Decomposition:
             f"Decomposition(map={self.map.name!r}, L={self.L:g}, regions={len(self.regions)}, "
             f"cells={len(self.cells)}, evader_wins={self.evader_wins})"
         )
+
+
+def _point(point: object, what: str = "point") -> np.ndarray:
+    """``point`` as a finite float (x, y) array, or InvalidConfigError naming it."""
+    try:
+        p = np.asarray(point, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidConfigError(f"{what} = {point!r}: expected a finite (x, y) point") from exc
+    if p.shape != (2,) or not np.all(np.isfinite(p)):
+        raise InvalidConfigError(f"{what} = {point!r}: expected a finite (x, y) point")
+    return p
+
+
+def _angle(theta: object) -> float:
+    """``theta`` as a finite float, or InvalidConfigError naming it."""
+    try:
+        t = float(theta)
+    except (TypeError, ValueError) as exc:
+        raise InvalidConfigError(f"theta = {theta!r}: expected a finite angle") from exc
+    if not np.isfinite(t):
+        raise InvalidConfigError(f"theta = {theta!r}: expected a finite angle")
+    return t
 
 
 def decompose(

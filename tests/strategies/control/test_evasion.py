@@ -307,3 +307,19 @@ def test_solve_escape_failures_are_reported():
 def test_bad_input(call, exc, match):
     with pytest.raises(exc, match=match):
         call()
+
+
+@pytest.mark.parametrize(
+    ("theta0", "x_e", "L", "rho"),
+    [
+        (0.0, 1e4, 1.0, 0.5),
+        (np.pi, 10.0, 1e-3, 0.5),
+        (0.0, 10.0, 1.0, 1e-3),
+        (0.0, 10.0, 1.0, 0.9999),
+    ],
+)
+def test_solve_escape_refuses_runaway_integrations(theta0, x_e, L, rho):
+    # x_e / default_step in the millions used to run for minutes; now a prompt, explained failure
+    sol = solve_escape(theta0, x_e, L=L, rho=rho)
+    assert not sol.success
+    assert "RK4 steps" in sol.reason and repr(x_e) in sol.reason

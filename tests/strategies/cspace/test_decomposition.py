@@ -244,3 +244,23 @@ def test_prop3_escapes_persist_as_L_grows(seed):
 def test_bad_length_rejected(bad):
     with pytest.raises(InvalidConfigError, match="L"):
         decompose(corridor(), bad)
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda d: d.cell_at(5.0, 5.0, float("nan")),
+        lambda d: d.cell_at(5.0, 5.0, float("inf")),
+        lambda d: d.cell_at("a", 5.0, 0.0),
+        lambda d: d.locate("a"),
+        lambda d: d.locate(None),
+        lambda d: d.locate((0.0,)),
+        lambda d: d.locate([[1.0, 2.0], [3.0, 4.0]]),
+        lambda d: d.safe_arcs("a"),
+        lambda d: d.free_arcs((float("nan"), 1.0)),
+    ],
+)
+def test_point_queries_reject_bad_input_with_a_project_error(corridor_dec, call):
+    # cell_at(x, y, nan) used to answer None; locate("a") raised numpy's plain ValueError
+    with pytest.raises(InvalidConfigError, match="expected a finite"):
+        call(corridor_dec)

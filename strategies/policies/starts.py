@@ -65,7 +65,9 @@ def _near_l_min(config, kernel, rng, judge, tab, angle_margin):
     m = config.map
     admissible = config.rho < 1.0  # for rho >= 1 no configuration is admissible (Sec. 5)
     range_margin, rod_clearance = spawn_margins(config)
-    length = max(judge.L_target, config.l_min + range_margin)
+    # near L_min (the pursuer's target), but inside the sensor range even when it is
+    # narrower than the pursuer's distance buffer
+    length = min(max(judge.L_target, config.l_min + range_margin), config.l_max - range_margin)
     xmin, ymin, xmax, ymax = m.bounds
     r = config.body_radius
     convex = m.vertices[m.vertex_convex]

@@ -46,6 +46,22 @@ def check_role(role: str) -> str:
     return role
 
 
+def positive_param(name: str, value: float) -> float:
+    """A policy parameter as a float; raise unless it is finite and > 0."""
+    v = float(value)
+    if not (math.isfinite(v) and v > 0):
+        raise InvalidConfigError(f"{name} must be a positive number, got {value!r}")
+    return v
+
+
+def nonnegative_param(name: str, value: float) -> float:
+    """A policy parameter as a float; raise unless it is finite and >= 0."""
+    v = float(value)
+    if not (math.isfinite(v) and v >= 0):
+        raise InvalidConfigError(f"{name} must be a finite number >= 0, got {value!r}")
+    return v
+
+
 def distance_target(config: Any) -> float:
     """The distance a pursuer holds: L_min plus a buffer against one step of reaction lag.
 

@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from envs.errors import InvalidConfigError
-from strategies.policies.base import BasePolicy, Snapshot, distance_target, unit
+from strategies.policies.base import BasePolicy, Snapshot, distance_target, positive_param, unit
 
 __all__ = [
     "GreedyPursuer",
@@ -22,13 +22,6 @@ __all__ = [
     "WallHuggingEvader",
     "nearest_wall_point",
 ]
-
-
-def _positive(name: str, value: float) -> float:
-    v = float(value)
-    if not (math.isfinite(v) and v > 0):
-        raise InvalidConfigError(f"{name} must be a positive number, got {value!r}")
-    return v
 
 
 def nearest_wall_point(world_map, point: np.ndarray) -> tuple[np.ndarray, int]:
@@ -79,7 +72,7 @@ class GreedyPursuer(BasePolicy):
 
     def __init__(self, *, gain: float = 4.0, target: float = 0.0, name: str | None = None) -> None:
         super().__init__(name=name)
-        self.gain = _positive("gain", gain)
+        self.gain = positive_param("gain", gain)
         if not 0.0 <= float(target) < 1.0:
             raise InvalidConfigError(f"target must be in [0, 1), got {target!r}")
         self.target = float(target)
@@ -144,7 +137,7 @@ class TowardAwayEvader(BasePolicy):
         if mode not in self.MODES:
             raise InvalidConfigError(f"mode must be one of {self.MODES}, got {mode!r}")
         self.mode = mode
-        self.period = _positive("period", period)
+        self.period = positive_param("period", period)
 
     def _decide(self, snap: Snapshot) -> np.ndarray:
         u = unit(snap.rod)
@@ -168,8 +161,8 @@ class WallHuggingEvader(BasePolicy):
 
     def __init__(self, *, offset: float = 0.2, gain: float = 4.0, name: str | None = None) -> None:
         super().__init__(name=name)
-        self.offset = _positive("offset", offset)
-        self.gain = _positive("gain", gain)
+        self.offset = positive_param("offset", offset)
+        self.gain = positive_param("gain", gain)
 
     def _decide(self, snap: Snapshot) -> np.ndarray:
         c, k = nearest_wall_point(self.map, snap.evader)

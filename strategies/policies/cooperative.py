@@ -21,18 +21,10 @@ import math
 
 import numpy as np
 
-from envs.errors import InvalidConfigError
-from strategies.policies.base import BasePolicy, Snapshot, distance_target, unit
+from strategies.policies.base import BasePolicy, Snapshot, distance_target, nonnegative_param, unit
 from strategies.policies.baselines import nearest_wall_point
 
 __all__ = ["CornerRoundingPursuer", "TractrixFollower", "WallFollowingPursuer"]
-
-
-def _nonneg(name: str, value: float) -> float:
-    v = float(value)
-    if not (math.isfinite(v) and v >= 0):
-        raise InvalidConfigError(f"{name} must be a finite number >= 0, got {value!r}")
-    return v
 
 
 class TractrixFollower(BasePolicy):
@@ -48,7 +40,7 @@ class TractrixFollower(BasePolicy):
 
     def __init__(self, *, gain: float = 1.0, name: str | None = None) -> None:
         super().__init__(name=name)
-        self.gain = _nonneg("gain", gain)
+        self.gain = nonnegative_param("gain", gain)
 
     def _decide(self, snap: Snapshot) -> np.ndarray:
         u = -unit(snap.rod)  # pursuer -> evader
@@ -73,8 +65,8 @@ class WallFollowingPursuer(BasePolicy):
 
     def __init__(self, *, gain: float = 1.0, reach: float = 0.3, name: str | None = None) -> None:
         super().__init__(name=name)
-        self.gain = _nonneg("gain", gain)
-        self.reach = _nonneg("reach", reach)
+        self.gain = nonnegative_param("gain", gain)
+        self.reach = nonnegative_param("reach", reach)
 
     def _decide(self, snap: Snapshot) -> np.ndarray:
         c, k = nearest_wall_point(self.map, snap.pursuer)
@@ -117,9 +109,9 @@ class CornerRoundingPursuer(BasePolicy):
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
-        self.engage = _nonneg("engage", engage)
-        self.clearance = _nonneg("clearance", clearance)
-        self.gain = _nonneg("gain", gain)
+        self.engage = nonnegative_param("engage", engage)
+        self.clearance = nonnegative_param("clearance", clearance)
+        self.gain = nonnegative_param("gain", gain)
 
     def _reset(self) -> None:
         m = self.map

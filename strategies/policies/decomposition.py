@@ -30,17 +30,10 @@ import numpy as np
 
 from envs.errors import InvalidConfigError
 from strategies.control.kinematics import pursuer_velocity_holding_range, theta_dot
-from strategies.policies.base import BasePolicy, Snapshot, distance_target
+from strategies.policies.base import BasePolicy, Snapshot, distance_target, positive_param
 from strategies.policies.safety import NO_PATH, safety_table
 
 __all__ = ["DecompositionPursuer"]
-
-
-def _check_positive(name: str, value: float) -> float:
-    v = float(value)
-    if not (math.isfinite(v) and v > 0):
-        raise InvalidConfigError(f"{name} must be a positive number, got {value!r}")
-    return v
 
 
 class DecompositionPursuer(BasePolicy):
@@ -69,7 +62,7 @@ class DecompositionPursuer(BasePolicy):
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
-        self.resolution = _check_positive("resolution", resolution)
+        self.resolution = positive_param("resolution", resolution)
         self.n_bins = int(n_bins)
         if not (isinstance(rays, int) and rays >= 4):
             raise InvalidConfigError(f"rays must be an integer >= 4, got {rays!r}")
@@ -80,7 +73,7 @@ class DecompositionPursuer(BasePolicy):
         self.hysteresis = float(hysteresis)
         if not (math.isfinite(self.hysteresis) and self.hysteresis >= 0):
             raise InvalidConfigError(f"hysteresis must be >= 0, got {hysteresis!r}")
-        self.distance_gain = _check_positive("distance_gain", distance_gain)
+        self.distance_gain = positive_param("distance_gain", distance_gain)
 
     def _reset(self) -> None:
         c = self.config

@@ -34,6 +34,7 @@ import numpy as np
 from envs.errors import InvalidConfigError
 from envs.maps import Map
 from envs.tolerances import REL_LENGTH_TOL
+from strategies.cspace.cache import resolve_cache_dir
 
 __all__ = ["NO_PATH", "SOURCE", "SafetyTable", "grid_points", "safety_table"]
 
@@ -140,8 +141,8 @@ def _circular_distance(safe: np.ndarray, step: int) -> np.ndarray:
 
 
 def cache_dir() -> Path:
-    """Directory of the on-disk table cache (``$SURVEIL_CACHE_DIR`` or ``~/.cache/surveil``)."""
-    return Path(os.environ.get("SURVEIL_CACHE_DIR", Path.home() / ".cache" / "surveil"))
+    """Directory of the on-disk table cache: the decompositions' (``$SURVEIL_CACHE_DIR``)."""
+    return resolve_cache_dir()
 
 
 @functools.lru_cache(maxsize=4)

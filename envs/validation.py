@@ -1,0 +1,228 @@
+"""One module, one rule: checks of user input shared by every layer.
+
+Every check returns the value normalised (a ``float``, an ``int``, a tuple...) or raises
+:class:`~envs.errors.InvalidConfigError` (a :class:`ValueError`) with a one-line message
+that names the value, says what was expected and, when ``where`` is given, where the value
+came from (a file, a CLI flag, a config section)::
+
+    corridor.toml [env]: l_min = -1: expected a finite number > 0
+
+**What is a number.** A real number is a Python ``int`` or ``float`` or a numpy integer or
+floating scalar, finite unless stated otherwise. ``bool`` is *not* a number (``True`` would
+silently mean 1), strings are not numbers (``"1"`` must be parsed by the caller that knows
+it came from text), and neither are ``None``, complex numbers or containers. An integer is
+an ``int`` or numpy integer (not a float with an integral value, not a bool).
+
+Examples:
+    >>> positive("l_min", 2)
+    2.0
+    >>> integer("seeds", 3, minimum=1)
+    3
+    >>> positive("l_min", True)
+    Traceback (most recent call last):
+    ...
+    envs.errors.InvalidConfigError: l_min = True: expected a finite number > 0, got bool
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Mapping
+from typing import Any
+
+import numpy as np
+
+from envs.errors import InvalidConfigError
+
+__all__ = [
+    "boolean",
+    "choice",
+    "finite_array",
+    "integer",
+    "is_integer",
+    "is_real",
+    "mapping",
+    "nonnegative",
+    "point",
+    "positive",
+    "real",
+    "string",
+    "unit_interval",
+]
+
+
+def _where(name: str, where: str | None) -> str:
+    return f"{where}: {name}" if where else name
+
+
+def _fail(name: str, value: Any, expected: str, where: str | None) -> InvalidConfigError:
+    kind = type(value).__name__
+    shown = repr(value)
+    if len(shown) > 80:
+        shown = shown[:77] + "..."
+    suffix = (
+        "" if isinstance(value, (int, float)) and not isinstance(value, bool) else f", got {kind}"
+    )
+    return InvalidConfigError(f"{_where(name, where)} = {shown}: expected {expected}{suffix}")
+
+
+def is_real(value: Any) -> bool:
+    """True for a Python or numpy real scalar (int or float), False for bool and all else."""
+    if isinstance(value, (bool, np.bool_)):
+        return False
+    return isinstance(value, (int, float, np.integer, np.floating))
+
+
+def is_integer(value: Any) -> bool:
+    """True for a Python or numpy integer scalar (not bool)."""
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+
+def real(
+    name: str,
+    value: Any,
+    *,
+    where: str | None = None,
+    minimum: float | None = None,
+    maximum: float | None = None,
+    allow_inf: bool = False,
+) -> float:
+    """``value`` as a float: a real number (finite unless ``allow_inf``) in [minimum, maximum].
+
+    Raises:
+        InvalidConfigError: naming ``name`` (and ``where``), the value and the range.
+    """
+    lo = "" if minimum is None else f" >= {minimum:g}"
+    hi = "" if maximum is None else f" <= {maximum:g}"
+    expected = "a finite number" if not allow_inf else "a number"
+    expected += lo + ("," if lo and hi else "") + hi
+    if not is_real(value):
+        raise _fail(name, value, expected, where)
+    v = float(value)
+    if math.isnan(v) or (not allow_inf and math.isinf(v)):
+        raise _fail(name, value, expected, where)
+    if (minimum is not None and v < minimum) or (maximum is not None and v > maximum):
+        raise _fail(name, value, expected, where)
+    return v
+
+
+def positive(name: str, value: Any, *, where: str | None = None) -> float:
+    """``value`` as a float, finite and > 0."""
+    if not is_real(value) or not math.isfinite(float(value)) or float(value) <= 0:
+        raise _fail(name, value, "a finite number > 0", where)
+    return float(value)
+
+
+def nonnegative(name: str, value: Any, *, where: str | None = None) -> float:
+    """``value`` as a float, finite and >= 0."""
+    if not is_real(value) or not math.isfinite(float(value)) or float(value) < 0:
+        raise _fail(name, value, "a finite number >= 0", where)
+    return float(value)
+
+
+def unit_interval(name: str, value: Any, *, where: str | None = None, open: bool = True) -> float:
+    """``value`` as a float in (0, 1) (``open=True``) or [0, 1]."""
+    expected = "a number in (0, 1)" if open else "a number in [0, 1]"
+    if not is_real(value):
+        raise _fail(name, value, expected, where)
+    v = float(value)
+    ok = (0.0 < v < 1.0) if open else (0.0 <= v <= 1.0)
+    if not ok:
+        raise _fail(name, value, expected, where)
+    return v
+
+
+def integer(
+    name: str,
+    value: Any,
+    *,
+    minimum: int | None = None,
+    maximum: int | None = None,
+    where: str | None = None,
+) -> int:
+    """``value`` as an int in [minimum, maximum] (bools and floats are refused)."""
+    if minimum is not None and maximum is not None:
+        expected = f"an integer in [{minimum}, {maximum}]"
+    elif minimum is not None:
+        expected = f"an integer >= {minimum}"
+    elif maximum is not None:
+        expected = f"an integer <= {maximum}"
+    else:
+        expected = "an integer"
+    if not is_integer(value):
+        raise _fail(name, value, expected, where)
+    v = int(value)
+    if (minimum is not None and v < minimum) or (maximum is not None and v > maximum):
+        raise _fail(name, value, expected, where)
+    return v
+
+
+def boolean(name: str, value: Any, *, where: str | None = None) -> bool:
+    """``value`` as a bool: only ``True``/``False`` (numpy bools too), never ``"no"`` or 1."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise _fail(name, value, "true or false", where)
+    return bool(value)
+
+
+def string(name: str, value: Any, *, where: str | None = None, nonempty: bool = True) -> str:
+    """``value`` as a str (non-empty unless ``nonempty=False``)."""
+    if not isinstance(value, str) or (nonempty and not value):
+        raise _fail(name, value, "a non-empty string" if nonempty else "a string", where)
+    return value
+
+
+def choice(name: str, value: Any, options: Iterable[Any], *, where: str | None = None) -> Any:
+    """``value`` if it is one of ``options`` (compared with ``==``, bools never match ints)."""
+    opts = list(options)
+    for o in opts:
+        if type(o) is type(value) and o == value:
+            return value
+    raise InvalidConfigError(
+        f"{_where(name, where)} = {value!r}: expected one of {', '.join(map(repr, opts))}"
+    )
+
+
+def mapping(name: str, value: Any, *, where: str | None = None) -> dict[str, Any]:
+    """``value`` as a dict with string keys (a JSON object, a TOML table)."""
+    if not isinstance(value, Mapping) or not all(isinstance(k, str) for k in value):
+        raise _fail(name, value, "a table/object of name = value pairs", where)
+    return dict(value)
+
+
+def finite_array(
+    name: str, value: Any, *, shape: tuple[int | None, ...] | None = None, where: str | None = None
+) -> np.ndarray:
+    """``value`` as a float64 array of finite real numbers, of ``shape`` if given
+    (``None`` entries match any length)."""
+    what = "finite real numbers" if shape is None else f"an array of shape {_shape(shape)}"
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError) as exc:  # ragged nested lists
+        raise _fail(name, value, what, where) from exc
+    if arr.dtype.kind not in "iuf":
+        raise _fail(name, value, what + " (real numbers)", where)
+    arr = arr.astype(np.float64)
+    if shape is not None and (
+        arr.ndim != len(shape)
+        or any(s is not None and s != n for s, n in zip(shape, arr.shape, strict=False))
+    ):
+        raise InvalidConfigError(
+            f"{_where(name, where)}: expected shape {_shape(shape)}, got shape {arr.shape}"
+        )
+    if not np.all(np.isfinite(arr)):
+        raise _fail(name, value, what + " (no NaN or inf)", where)
+    return arr
+
+
+def point(name: str, value: Any, *, where: str | None = None) -> np.ndarray:
+    """``value`` as a finite float (x, y) array."""
+    return finite_array(name, value, shape=(2,), where=where)
+
+
+def _shape(shape: tuple[int | None, ...]) -> str:
+    return (
+        "("
+        + ", ".join("n" if s is None else str(s) for s in shape)
+        + ("," if len(shape) == 1 else "")
+        + ")"
+    )

@@ -50,14 +50,14 @@ def _cmd_policies(args: argparse.Namespace) -> int:
 
 
 def _cmd_play(args: argparse.Namespace) -> int:
-    from analysis.evaluate import play_episode
     from analysis.replay import write_replay
     from strategies.policies import make_policy
+    from strategies.runner import run_episode
 
     overrides = json.loads(args.config) if args.config else {}
     pursuer = make_policy(args.pursuer, **json.loads(args.pursuer_params or "{}"))
     evader = make_policy(args.evader, **json.loads(args.evader_params or "{}"))
-    result = play_episode(
+    result = run_episode(
         args.map,
         pursuer,
         evader,

@@ -13,9 +13,8 @@ from __future__ import annotations
 
 import json
 import math
-import time
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +22,7 @@ import numpy as np
 from scipy import stats
 
 from envs.errors import InvalidConfigError
+from strategies.runner import EpisodeResult
 
 __all__ = [
     "EpisodeResult",
@@ -101,105 +101,16 @@ def bootstrap_mean_interval(
 
 
 # --------------------------------------------------------------------------- one episode
-@dataclass
-class EpisodeResult:
-    """Outcome of one episode.
-
-    Attributes:
-        map: map name.
-        pursuer, evader: policy names.
-        seed: the episode seed (env, start sampler and both policies derive from it).
-        winner: ``"pursuer"`` (surveillance held to the horizon) or ``"evader"``.
-        cause: why surveillance broke (``"occluded"``, ``"too_far"``, ``"too_close"``),
-            ``None`` if it held.
-        escape_time: time (s) at which surveillance broke, within the step; ``None`` if held.
-        steps: env steps played.
-        dt: step duration (s).
-        start: ``{"pursuer": [x, y], "evader": [x, y]}``.
-        overrides: env config overrides used.
-        decide_seconds: mean wall-clock seconds per ``act`` call, per role.
-        trajectory: (steps + 1, 2, 2) positions ``[pursuer, evader]`` per step.
-        frames: rendered RGB frames when recorded, else ``None``.
-        map_obj: the :class:`Map` (for replays; not serialised).
-        config: the env's ``EnvConfig`` (for replays; not serialised).
-    """
-
-    map: str
-    pursuer: str
-    evader: str
-    seed: int
-    winner: str
-    cause: str | None
-    escape_time: float | None
-    steps: int
-    dt: float
-    start: dict[str, list[float]]
-    overrides: dict[str, Any] = field(default_factory=dict)
-    decide_seconds: dict[str, float] = field(default_factory=dict)
-    trajectory: np.ndarray | None = field(default=None, repr=False)
-    frames: list[np.ndarray] | None = field(default=None, repr=False)
-    map_obj: Any = field(default=None, repr=False)
-    config: Any = field(default=None, repr=False)
-
-    def summary(self) -> str:
-        """One line: who won, why and when."""
-        head = f"{self.map}: {self.pursuer} vs {self.evader} (seed {self.seed}): "
-        if self.winner == "pursuer":
-            return head + f"pursuer kept surveillance for all {self.steps} steps"
-        return head + f"evader escaped at t = {self.escape_time:.3f} s ({self.cause})"
-
-    def to_record(self) -> dict[str, Any]:
-        """JSON-ready dict without trajectory and frames."""
-        d = asdict(self)
-        for k in ("trajectory", "frames", "map_obj", "config"):
-            d.pop(k)
-        return d
-
-
-def _resolve_map(map_: Any) -> tuple[Any, dict[str, Any]]:
-    """Return the Map and the built-in recommended parameters (empty for other maps)."""
-    from envs.maps import Map, builtin_info, builtin_names
-
-    if isinstance(map_, str) and map_ in builtin_names():
-        info = builtin_info(map_)
-        rec = {
-            "l_min": info.l_min,
-            "l_max": info.l_max,
-            "v_pursuer": info.v_pursuer,
-            "v_evader": info.v_evader,
-        }
-        return info.map, rec
-    if isinstance(map_, Map):
-        return map_, {}
-    from envs.surveillance.config import resolve_map
-
-    return resolve_map(map_), {}
-
-
 def make_env(map_: Any, overrides: Mapping[str, Any] | None = None, *, record: bool = False):
-    """Build a ``surveillance_v0`` parallel env with the state observation.
+    """A ``surveillance_v0`` parallel env with the state observation (see
+    :func:`strategies.runner.build_env`)."""
+    from strategies.runner import build_env
 
-    A built-in map's recommended ``l_min``, ``l_max`` and speeds are used unless
-    ``overrides`` sets them.
-    """
-    from envs import surveillance_v0
-
-    world, kwargs = _resolve_map(map_)
-    kwargs.update(dict(overrides or {}))
-    kwargs["observation"] = "state"
-    if record:
-        kwargs["render_mode"] = "rgb_array"
-    return surveillance_v0.parallel_env(map=world, **kwargs)
-
-
-def _make(policy: Any, role: str):
-    from strategies.policies import Policy, make_policy
-
-    if isinstance(policy, str):
-        return make_policy(policy)
-    if isinstance(policy, Policy):
-        return policy
-    raise InvalidConfigError(f"{role}: expected a policy name or a Policy, got {policy!r}")
+    return build_env(
+        map_,
+        {**dict(overrides or {}), "observation": "state"},
+        render_mode="rgb_array" if record else None,
+    )
 
 
 def play_episode(
@@ -214,85 +125,23 @@ def play_episode(
     start: str = "safe",
     record: bool = False,
 ) -> EpisodeResult:
-    """Play one episode between two policies.
+    """One episode: a thin alias of :func:`strategies.runner.run_episode`.
 
-    Args:
-        map: built-in name, map file path or :class:`~envs.maps.Map`.
-        pursuer, evader: registered names (``"pursuer/decomposition"``) or policies.
-        seed: seeds the env, the start sampler and both policies (independent streams).
-        max_cycles: episode horizon in steps (``None``: the config default).
-        overrides: env config overrides, e.g. ``{"v_evader": 0.8}``.
-        options: explicit start ``{"pursuer": (x, y), "evader": (x, y)}``; ``None`` draws
-            one with :func:`strategies.policies.starts.sample_start`.
-        start: ``"safe"`` (a non-escapable cell at L_min where one exists) or
-            ``"valid"`` (any valid surveillance configuration) for drawn starts.
-        record: render RGB frames for a replay.
-
-    Returns:
-        The :class:`EpisodeResult` (positions always recorded; frames if ``record``).
+    ``options`` (an explicit start ``{"pursuer": (x, y), "evader": (x, y)}``) wins over
+    ``start``; ``record`` keeps the rendered frames in ``result.frames``.
     """
-    from strategies.policies.starts import sample_start
+    from strategies.runner import run_episode
 
-    overrides = dict(overrides or {})
-    if max_cycles is not None:
-        overrides["max_cycles"] = int(max_cycles)
-    env = make_env(map, overrides, record=record)
-    config = env.config
-    ss = np.random.SeedSequence(int(seed))
-    s_env, s_start, s_p, s_e = (int(s.generate_state(1)[0]) for s in ss.spawn(4))
-    if options is None:
-        options = sample_start(config, np.random.default_rng(s_start), kind=start)
-    p_pol, e_pol = _make(pursuer, "pursuer"), _make(evader, "evader")
-    p_pol.reset(role="pursuer", map=config.map, config=config, seed=s_p)
-    e_pol.reset(role="evader", map=config.map, config=config, seed=s_e)
-    obs, infos = env.reset(seed=s_env, options=dict(options))
-    frames = [env.render()] if record else None
-    traj = [_positions(obs[PURSUER], config)]
-    spent = {"pursuer": 0.0, "evader": 0.0}
-    steps, cause, escape = 0, None, None
-    while env.agents:
-        t0 = time.perf_counter()
-        a_p = p_pol.act(obs[PURSUER])
-        t1 = time.perf_counter()
-        a_e = e_pol.act(obs[EVADER])
-        spent["pursuer"] += t1 - t0
-        spent["evader"] += time.perf_counter() - t1
-        obs, _, _terms, _truncs, infos = env.step({PURSUER: a_p, EVADER: a_e})
-        steps += 1
-        traj.append(_positions(obs[PURSUER], config))
-        if record:
-            frames.append(env.render())
-        info = infos.get(PURSUER, {})
-        if not info.get("surveillance", True):
-            cause = info.get("cause")
-            escape = float(info["break_at"])
-            break
-    env.close()
-    return EpisodeResult(
-        map=config.map.name,
-        pursuer=p_pol.name,
-        evader=e_pol.name,
-        seed=int(seed),
-        winner="evader" if cause is not None else "pursuer",
-        cause=cause,
-        escape_time=escape,
-        steps=steps,
-        dt=config.dt,
-        start={k: [float(v) for v in options[k]] for k in ("pursuer", "evader")},
+    return run_episode(
+        map,
+        pursuer,
+        evader,
+        seed,
+        max_cycles=max_cycles,
         overrides=overrides,
-        decide_seconds={k: v / max(steps, 1) for k, v in spent.items()},
-        trajectory=np.asarray(traj),
-        frames=frames,
-        map_obj=config.map,
-        config=config,
+        start=dict(options) if options is not None else start,
+        record=record,
     )
-
-
-def _positions(observation: np.ndarray, config: Any) -> np.ndarray:
-    from envs.surveillance.observations import decode_state
-
-    view = decode_state(observation, config)
-    return np.stack([view.pursuer_pos, view.evader_pos])
 
 
 # --------------------------------------------------------------------------- many episodes

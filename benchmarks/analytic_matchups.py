@@ -29,10 +29,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import numpy as np
 
-from analysis.evaluate import evaluate, format_table, make_env
+from analysis.evaluate import evaluate, format_table
 from envs.maps import builtin_names
 from strategies.policies import make_policy, policy_names
 from strategies.policies.starts import sample_start
+from strategies.runner import build_env
 
 FAST_RHO = {"v_evader": 1.5}  # rho = 1.5 with the built-ins' V_p = 1
 
@@ -90,7 +91,7 @@ def check_theory(rows, fast_rows) -> list[str]:
 
 def decision_times(map_name: str = "corridor", steps: int = 2000, seed: int = 0) -> str:
     """Per-step decision time of the decomposition pursuer vs the greedy pursuer."""
-    env = make_env(map_name)
+    env = build_env(map_name)
     cfg = env.config
     start = sample_start(cfg, np.random.default_rng(seed))
     obs, _ = env.reset(seed=seed, options=start)

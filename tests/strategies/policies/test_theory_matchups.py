@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import pytest
 
-from analysis.evaluate import play_episode
 from strategies.policies import policy_names
+from strategies.runner import run_episode as play_episode
 
 SEEDS = (0, 1)
 

@@ -1,0 +1,564 @@
+"""The one episode loop: `surveil play`, tournaments, benchmarks and training all use it.
+
+:func:`run_episode` builds a ``surveillance_v0`` parallel env from a map and env
+overrides, draws (or takes) a start, seeds everything from one episode seed, plays two
+policies against each other and returns an :class:`EpisodeResult`.
+
+**Each policy gets the observation it was built for.** A policy says what it needs with
+an ``observation_options`` attribute (or a method of that name): a mapping of the
+observation fields of ``EnvConfig`` (:data:`OBSERVATION_OPTIONS`: ``observation``,
+``n_rays``, ``lidar_range``), e.g. ``{"observation": "lidar", "n_rays": 32}`` for a
+model trained on 32-ray lidar; ``None`` means "whatever the env gives". Without the
+attribute, a policy with ``uses_state = True`` (every analytic policy, see
+:class:`~strategies.policies.base.BasePolicy`) asks for ``{"observation": "state"}`` and
+one with ``uses_state = False`` takes the env's own observation. The ``observations``
+argument of :func:`run_episode` overrides both per role (a tournament spec may say
+what a model was trained on). The env is built with the first non-state request (so it
+encodes that one itself); a ``"state"`` request is served with ``env.state()`` (the same
+encoder, bit for bit), and a second, different lidar request with the env's own
+:class:`~envs.surveillance.observations.LidarEncoder` fed the exact positions and the
+realised velocities (displacement / dt, as the env computes them). Each policy is reset
+with the env's config carrying *its* observation settings.
+
+**Seeding.** One episode seed, split with ``numpy.random.SeedSequence(seed).spawn(4)``
+into the env's seed, the start sampler's, the pursuer's and the evader's (independent
+streams): the same seed gives the same episode, bit for bit. A policy with a
+``select(seed)`` method (a mixture, :class:`strategies.mixed.MixedPolicy`) first picks
+the concrete policy of the episode with its role's seed.
+
+**Failures.** An exception raised by a policy's ``act`` (or a non-``ValueError`` one from
+its ``reset``) becomes a :class:`PolicyFailure` naming the role, the policy and the step
+(the original exception is its ``__cause__``); a ``time_limit`` overrun is an
+:class:`EpisodeTimeout` blaming the role that spent more time deciding. Configuration
+errors (``ValueError`` subclasses, see :mod:`envs.errors`) propagate unchanged.
+
+Examples:
+    >>> r = run_episode("open_room", "pursuer/greedy", "evader/straight", seed=3, max_cycles=20)
+    >>> r.winner in ("pursuer", "evader"), r.trajectory.shape[1:]
+    (True, (2, 2))
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from envs.errors import InvalidConfigError
+
+__all__ = [
+    "OBSERVATION_OPTIONS",
+    "EpisodeResult",
+    "EpisodeTimeout",
+    "PolicyFailure",
+    "Transition",
+    "build_env",
+    "episode_seeds",
+    "map_parameters",
+    "observation_options",
+    "run_episode",
+]
+
+PURSUER, EVADER = "pursuer_0", "evader_0"
+AGENT = {"pursuer": PURSUER, "evader": EVADER}
+OBSERVATION_OPTIONS = ("observation", "n_rays", "lidar_range")
+"""The ``EnvConfig`` fields that decide what an observation looks like."""
+
+_SEED_BOUND = 2**63
+
+
+# --------------------------------------------------------------------------- failures
+class PolicyFailure(RuntimeError):
+    """A policy raised (or overran its time) during an episode: that role forfeits.
+
+    Attributes:
+        role: ``"pursuer"`` or ``"evader"``, the side at fault.
+        policy: the policy's name.
+        step: the env step at which it failed (``-1``: during reset).
+        error: ``"TypeName: message"`` of the original exception.
+    """
+
+    def __init__(self, role: str, policy: str, step: int, error: str) -> None:
+        where = "reset" if step < 0 else f"step {step}"
+        super().__init__(f"{role} {policy!r} failed at {where}: {error}")
+        self.role = role
+        self.policy = policy
+        self.step = step
+        self.error = error
+
+    def __reduce__(self):  # picklable across processes
+        return (type(self), (self.role, self.policy, self.step, self.error))
+
+
+class EpisodeTimeout(PolicyFailure):
+    """The episode exceeded its wall-clock ``time_limit``; ``role`` decided slower."""
+
+
+# --------------------------------------------------------------------------- records
+@dataclass(frozen=True)
+class Transition:
+    """One env step as the ``on_step`` callback sees it.
+
+    Attributes:
+        step: index of the step (0 for the first).
+        observations: ``{"pursuer": obs, "evader": obs}``, what each policy saw.
+        state: the env's ``state()`` vector before the step (the ``"state"`` layout).
+        actions: ``{"pursuer": action, "evader": action}`` the policies returned.
+        info: the env's info of the pursuer after the step (surveillance, distance...).
+        done: the episode ended with this step.
+    """
+
+    step: int
+    observations: dict[str, np.ndarray]
+    state: np.ndarray
+    actions: dict[str, np.ndarray]
+    info: dict[str, Any]
+    done: bool
+
+
+@dataclass
+class EpisodeResult:
+    """Outcome of one episode.
+
+    Attributes:
+        map: map name.
+        map_digest: SHA-256 of the map's geometry (:attr:`envs.maps.Map.digest`).
+        pursuer, evader: names of the policies that played (a mixture's pick).
+        seed: the episode seed (env, start sampler and both policies derive from it).
+        winner: ``"pursuer"`` (surveillance held to the horizon) or ``"evader"``.
+        cause: why surveillance broke (``"occluded"``, ``"too_far"``, ``"too_close"``),
+            ``None`` if it held.
+        feature: the wall feature that occluded, as the map describes it, or ``None``.
+        escape_time: time (s) at which surveillance broke, within the step; ``None`` if held.
+        steps: env steps played.
+        dt: step duration (s).
+        start: ``{"pursuer": [x, y], "evader": [x, y]}``.
+        start_kind: ``"safe"``, ``"valid"`` or ``"given"``.
+        overrides: env config overrides used (besides the map's recommended parameters).
+        observations: the observation settings each role was given.
+        decide_seconds: mean wall-clock seconds per ``act`` call, per role.
+        decide_max: the longest ``act`` call, per role.
+        wall_seconds: wall-clock time of the whole episode.
+        trajectory: (steps + 1, 2, 2) positions ``[pursuer, evader]`` per step, exact.
+        map_obj: the :class:`Map` (for replays; not serialised).
+        config: the env's ``EnvConfig`` (for replays; not serialised).
+        frames: frames collected by ``record=True`` (``None`` otherwise; not serialised).
+    """
+
+    map: str
+    map_digest: str
+    pursuer: str
+    evader: str
+    seed: int
+    winner: str
+    cause: str | None
+    feature: str | None
+    escape_time: float | None
+    steps: int
+    dt: float
+    start: dict[str, list[float]]
+    start_kind: str
+    overrides: dict[str, Any] = field(default_factory=dict)
+    observations: dict[str, dict[str, Any]] = field(default_factory=dict)
+    decide_seconds: dict[str, float] = field(default_factory=dict)
+    decide_max: dict[str, float] = field(default_factory=dict)
+    wall_seconds: float = 0.0
+    trajectory: np.ndarray | None = field(default=None, repr=False)
+    map_obj: Any = field(default=None, repr=False)
+    config: Any = field(default=None, repr=False)
+    frames: list[np.ndarray] | None = field(default=None, repr=False)
+
+    def summary(self) -> str:
+        """One line: who won, why and when."""
+        head = f"{self.map}: {self.pursuer} vs {self.evader} (seed {self.seed}): "
+        if self.winner == "pursuer":
+            return head + f"pursuer kept surveillance for all {self.steps} steps"
+        return head + f"evader escaped at t = {self.escape_time:.3f} s ({self.cause})"
+
+    def to_record(self) -> dict[str, Any]:
+        """JSON-ready dict without trajectory, frames, map and config objects."""
+        d = dataclasses.asdict(
+            dataclasses.replace(self, trajectory=None, map_obj=None, config=None, frames=None)
+        )
+        for k in ("trajectory", "frames", "map_obj", "config"):
+            d.pop(k)
+        return d
+
+
+# --------------------------------------------------------------------------- set-up
+def map_parameters(map_: Any) -> tuple[Any, dict[str, float]]:
+    """The :class:`Map` of ``map_`` and the recommended parameters of a built-in name.
+
+    Args:
+        map_: a built-in map name, a map file path or a :class:`~envs.maps.Map`.
+
+    Returns:
+        ``(map, params)`` with ``params`` the built-in's ``l_min``, ``l_max``,
+        ``v_pursuer`` and ``v_evader`` (``{}`` for files and Map objects: the env's
+        defaults apply).
+    """
+    from envs.maps import Map, builtin_info, builtin_names
+
+    if isinstance(map_, str) and map_ in builtin_names():
+        info = builtin_info(map_)
+        rec = {
+            "l_min": info.l_min,
+            "l_max": info.l_max,
+            "v_pursuer": info.v_pursuer,
+            "v_evader": info.v_evader,
+        }
+        return info.map, rec
+    if isinstance(map_, Map):
+        return map_, {}
+    from envs.surveillance.config import resolve_map
+
+    return resolve_map(map_), {}
+
+
+def build_env(
+    map_: Any,
+    overrides: Mapping[str, Any] | None = None,
+    *,
+    render_mode: str | None = None,
+):
+    """A ``surveillance_v0`` parallel env on ``map_``.
+
+    A built-in map's recommended ``l_min``, ``l_max`` and speeds apply unless
+    ``overrides`` sets them.
+
+    Raises:
+        InvalidConfigError: an override is not an env argument or is out of range.
+    """
+    from envs import surveillance_v0
+
+    world, kwargs = map_parameters(map_)
+    kwargs.update(dict(overrides or {}))
+    for bad in ("map", "render_mode"):
+        if bad in kwargs:
+            raise InvalidConfigError(f"env overrides: {bad!r} is set by the runner, not here")
+    try:
+        return surveillance_v0.parallel_env(map=world, render_mode=render_mode, **kwargs)
+    except TypeError as exc:  # a misspelt env argument
+        raise InvalidConfigError(f"env overrides: {exc}") from exc
+
+
+def episode_seeds(seed: int) -> tuple[int, int, int, int]:
+    """The env, start-sampler, pursuer and evader seeds of episode ``seed``."""
+    from envs.validation import integer
+
+    s = integer("seed", seed, minimum=0)
+    ss = np.random.SeedSequence(s)
+    return tuple(int(c.generate_state(1)[0]) for c in ss.spawn(4))  # type: ignore[return-value]
+
+
+def observation_options(policy: Any) -> dict[str, Any] | None:
+    """The observation settings ``policy`` needs (see the module docstring).
+
+    Returns:
+        A dict of :data:`OBSERVATION_OPTIONS` fields, or ``None`` for "the env's own".
+
+    Raises:
+        InvalidConfigError: the policy declares an unknown field or observation kind.
+    """
+    opts = getattr(policy, "observation_options", None)
+    if callable(opts):
+        opts = opts()
+    if opts is None:
+        return {"observation": "state"} if getattr(policy, "uses_state", True) else None
+    return _checked_options(opts, f"policy {getattr(policy, 'name', policy)!r}")
+
+
+def _checked_options(opts: Any, where: str) -> dict[str, Any]:
+    from envs.surveillance.config import OBSERVATION_KINDS
+
+    if not isinstance(opts, Mapping):
+        raise InvalidConfigError(
+            f"{where}: observation options must be a mapping such as "
+            f"{{'observation': 'lidar', 'n_rays': 32}}, got {opts!r}"
+        )
+    unknown = sorted(set(opts) - set(OBSERVATION_OPTIONS))
+    if unknown:
+        raise InvalidConfigError(
+            f"{where}: observation options {unknown} are not among {list(OBSERVATION_OPTIONS)}"
+        )
+    kind = opts.get("observation")
+    if kind not in OBSERVATION_KINDS:
+        raise InvalidConfigError(
+            f"{where}: observation = {kind!r}: expected one of {list(OBSERVATION_KINDS)}"
+        )
+    return dict(opts)
+
+
+def _settings(config: Any, opts: Mapping[str, Any]) -> tuple:
+    """What an observation looks like under ``config`` with ``opts`` applied."""
+    kind = opts.get("observation", config.observation)
+    if kind == "state":
+        return ("state",)
+    rays = opts.get("n_rays", config.n_rays)
+    rng = opts.get("lidar_range", config.lidar_range)
+    return (kind, int(rays), None if rng is None else float(rng))
+
+
+class _Observer:
+    """Serves one role the observation it asked for from the env of the episode."""
+
+    def __init__(self, env: Any, role: str, opts: Mapping[str, Any]) -> None:
+        cfg = env.config
+        self.env = env
+        self.agent = AGENT[role]
+        mine = _settings(cfg, opts)
+        self.config = cfg if mine == _settings(cfg, {}) else dataclasses.replace(cfg, **opts)
+        self.options = dict(zip(OBSERVATION_OPTIONS[: len(mine)], mine, strict=False))
+        if mine == _settings(cfg, {}):
+            self.mode = "env"
+        elif mine == ("state",):
+            self.mode = "state"
+        else:
+            from envs.surveillance.observations import LidarEncoder
+
+            self.mode = "lidar"
+            self.encoder = LidarEncoder(self.config, role, env.kernel)
+            self.role = role
+            self.inv_dt = 1.0 / cfg.dt
+            self.prev: tuple | None = None
+
+    def __call__(self, obs: dict[str, np.ndarray], visible: bool, step: int) -> np.ndarray:
+        if self.mode == "env":
+            return obs[self.agent]
+        if self.mode == "state":
+            return self.env.state()
+        p, e = self.env.world.positions()
+        if self.prev is None:
+            vel = (0.0, 0.0)
+        else:  # the realised velocity, as the env computes it
+            p0, e0 = self.prev
+            a0, a1 = (p0, p) if self.role == "pursuer" else (e0, e)
+            vel = ((a1[0] - a0[0]) * self.inv_dt, (a1[1] - a0[1]) * self.inv_dt)
+        self.prev = (p, e)
+        me, other = (p, e) if self.role == "pursuer" else (e, p)
+        return self.encoder.encode(me, vel, other, visible, step)
+
+
+def _make(policy: Any, role: str):
+    from strategies.policies import Policy, make_policy
+
+    if isinstance(policy, str):
+        if policy.partition("/")[0] != role:
+            raise InvalidConfigError(
+                f"{role}: expected a '{role}/KIND' policy name, got {policy!r}"
+            )
+        return make_policy(policy)
+    if isinstance(policy, Policy) or hasattr(policy, "select"):
+        return policy
+    raise InvalidConfigError(
+        f"{role}: expected a policy name or a Policy, got {type(policy).__name__} {policy!r}"
+    )
+
+
+# --------------------------------------------------------------------------- the loop
+def run_episode(
+    map: Any,
+    pursuer: Any,
+    evader: Any,
+    seed: int = 0,
+    *,
+    max_cycles: int | None = None,
+    overrides: Mapping[str, Any] | None = None,
+    start: str | Mapping[str, Any] = "safe",
+    observations: Mapping[str, Mapping[str, Any] | None] | None = None,
+    on_step: Callable[[Transition], None] | None = None,
+    on_frame: Callable[[np.ndarray], None] | None = None,
+    record: bool = False,
+    time_limit: float | None = None,
+) -> EpisodeResult:
+    """Play one episode between two policies.
+
+    Args:
+        map: built-in name, map file path or :class:`~envs.maps.Map`.
+        pursuer, evader: registered names (``"pursuer/decomposition"``), policies, or
+            mixtures (anything with ``select(seed) -> Policy``).
+        seed: the episode seed (see the module docstring).
+        max_cycles: episode horizon in steps (``None``: the overrides' or the default).
+        overrides: env config overrides, e.g. ``{"v_evader": 0.8}``; a built-in map's
+            recommended parameters apply to what they leave unset.
+        start: ``"safe"`` (a non-escapable cell at L_min where one exists), ``"valid"``
+            (any valid surveillance configuration), both drawn by
+            :func:`strategies.policies.starts.sample_start`, or an explicit
+            ``{"pursuer": (x, y), "evader": (x, y)}``.
+        observations: per role (``"pursuer"``, ``"evader"``) observation options that
+            override what the policy declares.
+        on_step: called after every env step with a :class:`Transition`.
+        on_frame: called with each rendered RGB frame (the env renders ``"rgb_array"``);
+            frames are not kept, so a writer can stream them.
+        record: also keep the frames in ``result.frames`` (memory grows with the episode).
+        time_limit: wall-clock seconds the episode may take; checked between steps.
+
+    Returns:
+        The :class:`EpisodeResult`.
+
+    Raises:
+        PolicyFailure: a policy raised while playing (its role forfeits).
+        EpisodeTimeout: ``time_limit`` was exceeded.
+        InvalidConfigError: bad arguments (names, overrides, start, observations).
+    """
+    from strategies.policies.starts import START_KINDS, sample_start
+
+    t_start = time.perf_counter()
+    overrides = dict(overrides or {})
+    if max_cycles is not None:
+        overrides["max_cycles"] = max_cycles
+    s_env, s_start, s_p, s_e = episode_seeds(seed)
+    policies = {"pursuer": _make(pursuer, "pursuer"), "evader": _make(evader, "evader")}
+    seeds = {"pursuer": s_p, "evader": s_e}
+    for role, pol in policies.items():
+        if hasattr(pol, "select"):  # a mixture: the concrete policy of this episode
+            rng = np.random.default_rng(seeds[role])
+            policies[role] = pol.select(int(rng.integers(_SEED_BOUND)))
+            seeds[role] = int(rng.integers(_SEED_BOUND))
+    requests = _requests(policies, overrides, observations)
+    env_obs = next(
+        (r for r in (requests["pursuer"], requests["evader"]) if r["observation"] != "state"),
+        {"observation": "state"},
+    )
+    render = "rgb_array" if (on_frame is not None or record) else None
+    env = build_env(map, {**overrides, **env_obs}, render_mode=render)
+    try:
+        config = env.config
+        observers = {r: _Observer(env, r, requests[r]) for r in policies}
+        if isinstance(start, Mapping):
+            placement, start_kind = dict(start), "given"
+        elif start in START_KINDS:
+            judge = config if config.observation == "state" else _state_config(config)
+            placement = sample_start(judge, np.random.default_rng(s_start), kind=start)
+            start_kind = start
+        else:
+            raise InvalidConfigError(
+                f"start: expected one of {list(START_KINDS)} or "
+                f"{{'pursuer': (x, y), 'evader': (x, y)}}, got {start!r}"
+            )
+        for role, pol in policies.items():
+            try:
+                pol.reset(
+                    role=role, map=config.map, config=observers[role].config, seed=seeds[role]
+                )
+            except ValueError:
+                raise
+            except Exception as exc:
+                raise PolicyFailure(role, _name(pol), -1, _describe(exc)) from exc
+        obs, infos = env.reset(seed=s_env, options=placement)
+        frames: list[np.ndarray] | None = [] if record else None
+        _emit_frame(env, on_frame, frames)
+        traj = [env.world.positions()]
+        spent = {"pursuer": 0.0, "evader": 0.0}
+        slowest = {"pursuer": 0.0, "evader": 0.0}
+        steps, cause, feature, escape = 0, None, None, None
+        visible = bool(infos[PURSUER].get("surveillance", True))
+        while env.agents:
+            seen = {r: observers[r](obs, visible, steps) for r in policies}
+            state = env.state() if on_step is not None else None
+            actions = {}
+            for role, pol in policies.items():
+                t0 = time.perf_counter()
+                try:
+                    actions[role] = pol.act(seen[role])
+                except Exception as exc:
+                    raise PolicyFailure(role, _name(pol), steps, _describe(exc)) from exc
+                dt = time.perf_counter() - t0
+                spent[role] += dt
+                slowest[role] = max(slowest[role], dt)
+            obs, _, _, _, infos = env.step({AGENT[r]: a for r, a in actions.items()})
+            info = infos[PURSUER]
+            steps += 1
+            traj.append(env.world.positions())
+            _emit_frame(env, on_frame, frames)
+            visible = bool(info.get("surveillance", True))
+            if not visible:
+                cause, feature = info.get("cause"), info.get("feature")
+                escape = float(info["break_at"])
+            if on_step is not None:
+                on_step(Transition(steps - 1, seen, state, actions, info, not env.agents))
+            if time_limit is not None and env.agents:
+                if time.perf_counter() - t_start > time_limit:
+                    blame = max(spent, key=spent.get)
+                    raise EpisodeTimeout(
+                        blame,
+                        _name(policies[blame]),
+                        steps,
+                        f"episode exceeded its time limit of {time_limit:g} s "
+                        f"(decision time: pursuer {spent['pursuer']:.2f} s, "
+                        f"evader {spent['evader']:.2f} s)",
+                    )
+    finally:
+        env.close()
+    return EpisodeResult(
+        map=config.map.name,
+        map_digest=config.map.digest,
+        pursuer=_name(policies["pursuer"]),
+        evader=_name(policies["evader"]),
+        seed=int(seed),
+        winner="evader" if cause is not None else "pursuer",
+        cause=cause,
+        feature=None if feature is None else str(feature),
+        escape_time=escape,
+        steps=steps,
+        dt=config.dt,
+        start={k: [float(v) for v in placement[k]] for k in ("pursuer", "evader")},
+        start_kind=start_kind,
+        overrides=overrides,
+        observations={r: dict(o.options) for r, o in observers.items()},
+        decide_seconds={k: v / max(steps, 1) for k, v in spent.items()},
+        decide_max=dict(slowest),
+        wall_seconds=time.perf_counter() - t_start,
+        trajectory=np.asarray(traj, dtype=float),
+        map_obj=config.map,
+        config=config,
+        frames=frames,
+    )
+
+
+def _requests(
+    policies: dict[str, Any],
+    overrides: Mapping[str, Any],
+    explicit: Mapping[str, Mapping[str, Any] | None] | None,
+) -> dict[str, dict[str, Any]]:
+    explicit = dict(explicit or {})
+    unknown = sorted(set(explicit) - {"pursuer", "evader"})
+    if unknown:
+        raise InvalidConfigError(f"observations: keys must be 'pursuer' or 'evader', got {unknown}")
+    default = {k: overrides[k] for k in OBSERVATION_OPTIONS if k in overrides}
+    default.setdefault("observation", "state")
+    out = {}
+    for role, pol in policies.items():
+        if explicit.get(role) is not None:
+            req = _checked_options(explicit[role], f"observations[{role!r}]")
+        else:
+            req = observation_options(pol)
+        out[role] = dict(default) if req is None else req
+    return out
+
+
+def _state_config(config: Any) -> Any:
+    return dataclasses.replace(config, observation="state")
+
+
+def _emit_frame(env: Any, sink: Callable | None, frames: list | None) -> None:
+    if sink is None and frames is None:
+        return
+    frame = env.render()
+    if sink is not None:
+        sink(frame)
+    if frames is not None:
+        frames.append(frame)
+
+
+def _name(policy: Any) -> str:
+    return str(getattr(policy, "name", type(policy).__name__))
+
+
+def _describe(exc: BaseException) -> str:
+    lines = str(exc).strip().splitlines()
+    return f"{type(exc).__name__}: {lines[0]}" if lines else type(exc).__name__

@@ -1,0 +1,172 @@
+"""The shared episode runner: seeding, per-role observations, callbacks, failures."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from envs.errors import InvalidConfigError, InvalidPlacementError
+from envs.surveillance.observations import decode_state, lidar_layout
+from strategies.mixed import MixedPolicy
+from strategies.policies.base import BasePolicy
+from strategies.runner import (
+    EpisodeTimeout,
+    PolicyFailure,
+    observation_options,
+    run_episode,
+)
+
+MAP = "open_room"
+
+
+class Probe(BasePolicy):
+    """Records what it sees; moves on a fixed, observation-independent schedule."""
+
+    def __init__(self, options=None, *, name="probe", fail_at=None, sleep=0.0, fail_reset=None):
+        super().__init__(name=name)
+        self.uses_state = options is None or options.get("observation") == "state"
+        self.observation_options = options
+        self.fail_at, self.sleep, self.fail_reset = fail_at, sleep, fail_reset
+        self.seen: list[np.ndarray] = []
+
+    def _reset(self) -> None:
+        if self.fail_reset is not None:
+            raise self.fail_reset
+        self.seen = []
+
+    def act(self, observation):
+        if self._steps == self.fail_at:
+            raise RuntimeError("probe exploded")
+        if self.sleep:
+            time.sleep(self.sleep)
+        self.seen.append(np.array(observation, copy=True))
+        k = self._steps
+        self._steps += 1
+        return np.array([np.cos(0.1 * k), np.sin(0.1 * k)], dtype=np.float32) * 0.3
+
+
+def test_same_seed_same_episode_bit_for_bit():
+    a = run_episode(MAP, "pursuer/greedy", "evader/random", seed=7, max_cycles=60)
+    b = run_episode(MAP, "pursuer/greedy", "evader/random", seed=7, max_cycles=60)
+    c = run_episode(MAP, "pursuer/greedy", "evader/random", seed=8, max_cycles=60)
+    assert np.array_equal(a.trajectory, b.trajectory)
+    assert a.to_record() | {"wall_seconds": 0, "decide_seconds": 0, "decide_max": 0} == (
+        b.to_record() | {"wall_seconds": 0, "decide_seconds": 0, "decide_max": 0}
+    )
+    assert a.start != c.start
+    assert a.trajectory.shape == (a.steps + 1, 2, 2)
+    assert np.allclose(a.trajectory[0, 0], a.start["pursuer"])
+    assert a.map_digest and a.observations == {
+        "pursuer": {"observation": "state"},
+        "evader": {"observation": "state"},
+    }
+
+
+def test_each_policy_gets_its_own_observation_bit_for_bit():
+    lidar16 = {"observation": "lidar", "n_rays": 16}
+    lidar8 = {"observation": "lidar", "n_rays": 8}
+    # the env is built with the pursuer's lidar-8; the evader's lidar-16 is encoded aside
+    p1, e1 = Probe(lidar8), Probe(lidar16)
+    r1 = run_episode(MAP, p1, e1, seed=2, max_cycles=25, start="valid")
+    # the env is built with the evader's lidar-16 (the pursuer reads state here)
+    p2, e2 = Probe(None), Probe(lidar16)
+    r2 = run_episode(MAP, p2, e2, seed=2, max_cycles=25, start="valid")
+    assert np.array_equal(r1.trajectory, r2.trajectory)  # the probes ignore what they see
+    assert len(e1.seen) == len(e2.seen) == r1.steps
+    for a, b in zip(e1.seen, e2.seen, strict=True):
+        assert np.array_equal(a, b)
+    assert e1.seen[0].shape == (lidar_layout(16)["time"].stop,)
+    assert p1.seen[0].shape == (lidar_layout(8)["time"].stop,)
+    # the state reader got env.state(): it decodes to the exact positions
+    for k, obs in enumerate(p2.seen):
+        view = decode_state(obs, r2.config)
+        assert np.allclose(view.pursuer_pos, r2.trajectory[k, 0], atol=1e-4)
+    assert r1.observations["evader"] == {"observation": "lidar", "n_rays": 16, "lidar_range": None}
+
+
+def test_analytic_policy_plays_the_same_beside_a_lidar_opponent():
+    """An analytic pursuer reads the state even when the env encodes lidar for the evader."""
+    lidar = {"observation": "lidar", "n_rays": 8}
+    a = run_episode(MAP, "pursuer/greedy", Probe(lidar), seed=4, max_cycles=40)
+    b = run_episode(MAP, "pursuer/greedy", Probe(None), seed=4, max_cycles=40)
+    assert np.array_equal(a.trajectory, b.trajectory)
+    assert observation_options(Probe(lidar)) == lidar
+    assert observation_options(Probe(None)) == {"observation": "state"}
+
+
+def test_step_callback_and_streamed_frames():
+    seen, frames = [], []
+    r = run_episode(
+        MAP,
+        "pursuer/greedy",
+        "evader/straight",
+        seed=1,
+        max_cycles=12,
+        on_step=seen.append,
+        on_frame=frames.append,
+    )
+    assert [t.step for t in seen] == list(range(r.steps))
+    assert seen[-1].done and not any(t.done for t in seen[:-1])
+    for k, t in enumerate(seen):
+        view = decode_state(t.state, r.config)
+        assert np.allclose(view.evader_pos, r.trajectory[k, 1], atol=1e-4)
+        assert set(t.actions) == {"pursuer", "evader"}
+    assert len(frames) == r.steps + 1 and frames[0].ndim == 3 and r.frames is None
+    kept = run_episode(MAP, "pursuer/greedy", "evader/straight", seed=1, max_cycles=12, record=True)
+    assert len(kept.frames) == r.steps + 1
+    assert np.array_equal(kept.frames[-1], frames[-1])
+
+
+def test_a_raising_policy_is_blamed_by_role_and_step():
+    with pytest.raises(PolicyFailure) as info:
+        run_episode(MAP, "pursuer/greedy", Probe(fail_at=5), seed=0, max_cycles=30)
+    assert info.value.role == "evader" and info.value.step == 5
+    assert "probe exploded" in str(info.value) and "RuntimeError" in info.value.error
+    with pytest.raises(PolicyFailure) as info:
+        run_episode(MAP, Probe(fail_reset=KeyError("k")), "evader/random", seed=0, max_cycles=5)
+    assert info.value.role == "pursuer" and info.value.step == -1
+    # configuration errors stay what they are
+    with pytest.raises(InvalidConfigError):
+        run_episode(MAP, Probe(fail_reset=InvalidConfigError("bad")), "evader/random", 0)
+
+
+def test_time_limit_blames_the_slow_side():
+    with pytest.raises(EpisodeTimeout) as info:
+        run_episode(
+            MAP, Probe(sleep=0.02), "evader/random", seed=0, max_cycles=200, time_limit=0.15
+        )
+    assert info.value.role == "pursuer" and 0 < info.value.step < 200
+
+
+def test_mixture_picks_one_component_per_episode_reproducibly():
+    mix = MixedPolicy(["evader/straight", "evader/random"], [0.5, 0.5])
+    picks = {
+        s: run_episode(MAP, "pursuer/greedy", mix, seed=s, max_cycles=5).evader for s in range(12)
+    }
+    assert set(picks.values()) == {"evader/straight", "evader/random"}
+    again = run_episode(MAP, "pursuer/greedy", mix, seed=3, max_cycles=5)
+    assert again.evader == picks[3]
+
+
+def test_bad_arguments_are_clear_errors():
+    with pytest.raises(InvalidConfigError, match="start"):
+        run_episode(MAP, "pursuer/greedy", "evader/random", 0, start="anywhere")
+    with pytest.raises(InvalidConfigError, match="pursuer/KIND"):
+        run_episode(MAP, "evader/random", "evader/random", 0)
+    with pytest.raises(InvalidConfigError, match="observation"):
+        run_episode(
+            MAP, "pursuer/greedy", "evader/random", 0, observations={"evader": {"observation": 3}}
+        )
+    with pytest.raises(InvalidConfigError, match="seed"):
+        run_episode(MAP, "pursuer/greedy", "evader/random", -1)
+    with pytest.raises(InvalidConfigError, match="bogus"):
+        run_episode(MAP, "pursuer/greedy", "evader/random", 0, overrides={"bogus": 1})
+    with pytest.raises(InvalidPlacementError):
+        run_episode(
+            MAP, "pursuer/greedy", "evader/random", 0, start={"pursuer": (0, 0), "evader": (0, 0)}
+        )
+    given = {"pursuer": (3.0, 5.0), "evader": (5.5, 5.0)}
+    r = run_episode(MAP, "pursuer/greedy", "evader/random", 0, start=given, max_cycles=3)
+    assert r.start_kind == "given" and r.start["pursuer"] == [3.0, 5.0]

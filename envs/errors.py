@@ -8,11 +8,14 @@ the offending value and say what was expected.
 from __future__ import annotations
 
 __all__ = [
+    "EpisodeStateError",
     "InfeasibleError",
     "InvalidActionError",
     "InvalidConfigError",
     "InvalidMapError",
+    "InvalidObservationError",
     "InvalidPlacementError",
+    "RhoAboveOneWarning",
     "SurveilValueError",
     "UnknownNameError",
 ]
@@ -38,6 +41,17 @@ class InvalidActionError(SurveilValueError):
     """An action is not finite or has the wrong shape."""
 
 
+class InvalidObservationError(SurveilValueError):
+    """An observation given to a policy has the wrong shape or is not finite."""
+
+
+class EpisodeStateError(SurveilValueError, RuntimeError):
+    """A call out of order: ``step()`` before ``reset()`` or after the episode ended.
+
+    Also a :class:`RuntimeError`, the conventional type of a call in the wrong state.
+    """
+
+
 class InfeasibleError(SurveilValueError):
     """A requested computation has no solution for the given parameters."""
 
@@ -47,3 +61,7 @@ class UnknownNameError(SurveilValueError, KeyError):
 
     def __str__(self) -> str:  # KeyError would repr() the message
         return str(self.args[0]) if self.args else ""
+
+
+class RhoAboveOneWarning(UserWarning):
+    """V_e > V_p: legal, but escape is trivial for the evader (Sec. 5 of the paper)."""

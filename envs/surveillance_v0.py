@@ -71,21 +71,34 @@ survives any actions for `spawn_margin_steps` steps.
 ### Arguments
 
 ``` python
-surveillance_v0.parallel_env(map="corridor", l_min=2.0, l_max=4.0, v_pursuer=1.0,
-    v_evader=0.5, dt=0.1, max_cycles=500, observation="state", n_rays=32,
+surveillance_v0.parallel_env(map="corridor", l_min=None, l_max=None, v_pursuer=None,
+    v_evader=None, dt=0.1, max_cycles=500, observation="state", n_rays=32,
     lidar_range=None, reward="zero_sum", body_radius=0.1, spawn_margin_steps=3,
     render_mode=None)
 ```
+
+The three factories share one signature, derived from the fields of
+`envs.surveillance.config.EnvConfig` (`inspect.signature` shows it); a misspelt option is
+a `TypeError` that suggests the closest name.
 
 `map`: a `Map`, a built-in name (`envs.maps.builtin_names()`) or a map file path.
 
 `l_min`, `l_max`: the sensor range, 0 < l_min < l_max.
 
-`v_pursuer`, `v_evader`: speed bounds (> 0); rho = v_evader / v_pursuer.
+`v_pursuer`, `v_evader`: speed bounds (> 0); rho = v_evader / v_pursuer. rho > 1 is legal
+but raises a `RhoAboveOneWarning`: escape is then trivial for the evader (Sec. 5).
+
+`None` for `l_min`, `l_max`, `v_pursuer` or `v_evader` takes the value the map recommends:
+a built-in map named by a string brings its own (`envs.maps.builtin_info(name).params()`);
+a `Map` object or a map file gets L_min = 2, L_max = 4, V_p = 1, V_e = 0.5. Explicit
+arguments always win. Every built-in map recommends these same values today (a test says
+so): changing a built-in's recommendation changes this version's behaviour and needs a
+new version.
 
 `dt`: step duration. `max_cycles`: steps before truncation.
 
-`observation`: `"state"` or `"lidar"`. `n_rays`, `lidar_range` (default `l_max`): lidar.
+`observation`: `"state"` or `"lidar"`. `n_rays` (at most 4096), `lidar_range` (default
+`l_max`): lidar.
 
 `reward`: `"zero_sum"` or `"sparse"`.
 
@@ -95,9 +108,8 @@ surveillance_v0.parallel_env(map="corridor", l_min=2.0, l_max=4.0, v_pursuer=1.0
 
 `render_mode`: `None`, `"human"` or `"rgb_array"`.
 
-The defaults equal the recommended parameters of the built-in maps (L_min = 2,
-L_max = 4, V_p = 1, V_e = 0.5), fixed here so that a change of a map's metadata never
-changes this version's behaviour.
+`step()` before `reset()` or after the episode ended raises `EpisodeStateError`; loop
+`while env.agents:`.
 
 ### Version History
 

@@ -39,7 +39,7 @@ else:  # pragma: no cover - Python 3.10 reads TOML with the tomli backport
     import tomli as tomllib
 
 from envs.errors import InvalidConfigError
-from envs.surveillance.config import EnvConfig
+from envs.surveillance.config import EnvConfig, env_parameters
 from strategies.policies.base import check_role
 from training.single_agent import START_CHOICES
 
@@ -48,20 +48,7 @@ __all__ = ["ALGORITHMS", "TrainConfig", "load_config"]
 ALGORITHMS = ("ppo", "sac")
 """The SB3 algorithms :func:`training.train` runs (continuous actions)."""
 
-_ENV_KEYS = (
-    "l_min",
-    "l_max",
-    "v_pursuer",
-    "v_evader",
-    "dt",
-    "max_cycles",
-    "observation",
-    "n_rays",
-    "lidar_range",
-    "reward",
-    "body_radius",
-    "spawn_margin_steps",
-)
+_ENV_KEYS = tuple(k for k in env_parameters() if k not in ("map", "render_mode"))
 """Keys allowed in ``[env]`` (``map`` and ``render_mode`` are not: see the fields)."""
 
 _ALGO_MANAGED = {

@@ -8,21 +8,31 @@ that object, never the raw arguments. Bad values raise
 
 from __future__ import annotations
 
-import math
+import dataclasses
+import difflib
+import inspect
 import os
+import sys
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-
-from envs.errors import InvalidConfigError
-from envs.maps import Map, load_map
+from envs import validation as v
+from envs.errors import InvalidConfigError, RhoAboveOneWarning
+from envs.maps import Map, builtin_info, builtin_names, load_map
 
 __all__ = [
+    "GLOBAL_DEFAULTS",
+    "MAP_PARAMETERS",
+    "MAX_RAYS",
     "OBSERVATION_KINDS",
     "RENDER_MODES",
     "REWARD_KINDS",
     "EnvConfig",
+    "bind_env_arguments",
+    "env_parameters",
+    "env_signature",
+    "map_recommendations",
     "resolve_map",
 ]
 
@@ -34,6 +44,9 @@ REWARD_KINDS = ("zero_sum", "sparse")
 
 RENDER_MODES = ("human", "rgb_array")
 """Render modes the env supports (``None`` renders nothing)."""
+
+MAX_RAYS = 4096
+"""Upper bound of ``n_rays`` (a lidar of 1e9 rays would exhaust memory before failing)."""
 
 
 def resolve_map(value: Map | str | os.PathLike[str]) -> Map:
@@ -52,55 +65,51 @@ def resolve_map(value: Map | str | os.PathLike[str]) -> Map:
     )
 
 
-def _real(name: str, value: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise InvalidConfigError(
-            f"{name}: expected a real number, got {type(value).__name__} {value!r}"
-        )
-    value = float(value)
-    if not math.isfinite(value):
-        raise InvalidConfigError(f"{name}: expected a finite number, got {value!r}")
-    return value
+MAP_PARAMETERS = ("l_min", "l_max", "v_pursuer", "v_evader")
+"""The parameters a built-in map recommends (``envs.maps.builtin_info(name).params()``)."""
+
+GLOBAL_DEFAULTS: dict[str, float] = {"l_min": 2.0, "l_max": 4.0, "v_pursuer": 1.0, "v_evader": 0.5}
+"""Values of :data:`MAP_PARAMETERS` for a Map object or a map file (no recommendation)."""
 
 
-def _positive(name: str, value: Any) -> float:
-    v = _real(name, value)
-    if v <= 0:
-        raise InvalidConfigError(f"{name}: expected a value > 0, got {value!r}")
-    return v
+def map_recommendations(value: Any) -> dict[str, float]:
+    """The recommended :data:`MAP_PARAMETERS` for the map argument ``value``.
 
+    A built-in map *named by a string* brings its own (``envs.maps.builtin_info``); a
+    :class:`Map` object or a map file path gets :data:`GLOBAL_DEFAULTS`.
 
-def _integer(name: str, value: Any, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise InvalidConfigError(
-            f"{name}: expected an integer >= {minimum}, got {type(value).__name__} {value!r}"
-        )
-    if int(value) < minimum:
-        raise InvalidConfigError(f"{name}: expected an integer >= {minimum}, got {value!r}")
-    return int(value)
-
-
-def _choice(name: str, value: Any, options: tuple[str, ...]) -> str:
-    if value not in options:
-        raise InvalidConfigError(f"{name}: expected one of {list(options)}, got {value!r}")
-    return str(value)
+    Examples:
+        >>> map_recommendations("corridor")
+        {'l_min': 2.0, 'l_max': 4.0, 'v_pursuer': 1.0, 'v_evader': 0.5}
+    """
+    if isinstance(value, str) and value in builtin_names():
+        return builtin_info(value).params()
+    return dict(GLOBAL_DEFAULTS)
 
 
 @dataclass(frozen=True)
 class EnvConfig:
     """Every parameter of a surveillance episode, validated once.
 
+    This dataclass is the one source of the env's arguments: the signatures of
+    ``parallel_env``, ``raw_env`` and ``env`` are derived from its fields
+    (:func:`env_parameters`), and so is the list of ``[env]`` keys a training config
+    accepts.
+
     Attributes:
         map: the world (a :class:`Map`; a built-in name or a file path is resolved with
             :func:`envs.maps.load_map`).
-        l_min: L_min, the sensor's minimum range (> 0).
+        l_min: L_min, the sensor's minimum range (> 0). ``None``: the map's
+            recommendation (see :func:`map_recommendations`); the same for ``l_max``,
+            ``v_pursuer`` and ``v_evader``.
         l_max: L_max, the sensor's maximum range (> l_min).
         v_pursuer: V_p, the pursuer's speed bound (> 0).
-        v_evader: V_e, the evader's speed bound (> 0); rho = V_e / V_p.
+        v_evader: V_e, the evader's speed bound (> 0); rho = V_e / V_p. rho > 1 is legal
+            but warned about: the evader then wins by charging (Sec. 5).
         dt: duration of one env step (> 0).
         max_cycles: steps before the episode is truncated (>= 1).
         observation: ``"state"`` or ``"lidar"`` (see :mod:`.observations`).
-        n_rays: lidar rays per agent (>= 1; used by ``"lidar"`` only).
+        n_rays: lidar rays per agent (in [1, MAX_RAYS]; used by ``"lidar"`` only).
         lidar_range: range at which lidar rays saturate (> 0); ``None`` means ``l_max``.
         reward: ``"zero_sum"`` or ``"sparse"`` (see :mod:`.rules`).
         body_radius: radius of both agents' discs, in (0, l_min / 2).
@@ -109,11 +118,11 @@ class EnvConfig:
         render_mode: ``None``, ``"human"`` or ``"rgb_array"``.
     """
 
-    map: Map
-    l_min: float = 2.0
-    l_max: float = 4.0
-    v_pursuer: float = 1.0
-    v_evader: float = 0.5
+    map: Map | str | os.PathLike[str] = "corridor"
+    l_min: float | None = None
+    l_max: float | None = None
+    v_pursuer: float | None = None
+    v_evader: float | None = None
     dt: float = 0.1
     max_cycles: int = 500
     observation: str = "state"
@@ -126,31 +135,42 @@ class EnvConfig:
 
     def __post_init__(self) -> None:
         put = lambda name, value: object.__setattr__(self, name, value)
+        recommended = map_recommendations(self.map)
         put("map", resolve_map(self.map))
-        put("l_min", _positive("l_min", self.l_min))
-        put("l_max", _positive("l_max", self.l_max))
+        for name in MAP_PARAMETERS:
+            value = getattr(self, name)
+            put(name, recommended[name] if value is None else v.positive(name, value))
         if self.l_max <= self.l_min:
             raise InvalidConfigError(
-                f"l_max: expected a value > l_min = {self.l_min!r}, got {self.l_max!r}"
+                f"l_max = {self.l_max!r}: expected a value > l_min = {self.l_min!r}"
             )
-        put("v_pursuer", _positive("v_pursuer", self.v_pursuer))
-        put("v_evader", _positive("v_evader", self.v_evader))
-        put("dt", _positive("dt", self.dt))
-        put("max_cycles", _integer("max_cycles", self.max_cycles, 1))
-        put("observation", _choice("observation", self.observation, OBSERVATION_KINDS))
-        put("n_rays", _integer("n_rays", self.n_rays, 1))
+        if self.v_evader > self.v_pursuer:
+            warnings.warn(
+                f"v_evader = {self.v_evader!r} > v_pursuer = {self.v_pursuer!r} (rho = "
+                f"{self.v_evader / self.v_pursuer:.3g} > 1): the evader can always escape by "
+                "running at the pursuer (Sec. 5 of the paper); legal, but no pursuer can win",
+                RhoAboveOneWarning,
+                stacklevel=_caller_stacklevel(),
+            )
+        put("dt", v.positive("dt", self.dt))
+        put("max_cycles", v.integer("max_cycles", self.max_cycles, minimum=1))
+        put("observation", v.choice("observation", self.observation, OBSERVATION_KINDS))
+        put("n_rays", v.integer("n_rays", self.n_rays, minimum=1, maximum=MAX_RAYS))
         if self.lidar_range is not None:
-            put("lidar_range", _positive("lidar_range", self.lidar_range))
-        put("reward", _choice("reward", self.reward, REWARD_KINDS))
-        put("body_radius", _positive("body_radius", self.body_radius))
+            put("lidar_range", v.positive("lidar_range", self.lidar_range))
+        put("reward", v.choice("reward", self.reward, REWARD_KINDS))
+        put("body_radius", v.positive("body_radius", self.body_radius))
         if self.body_radius >= 0.5 * self.l_min:
             raise InvalidConfigError(
-                f"body_radius: expected a value in (0, l_min / 2 = {0.5 * self.l_min!r}), "
-                f"got {self.body_radius!r}"
+                f"body_radius = {self.body_radius!r}: expected a value in "
+                f"(0, l_min / 2 = {0.5 * self.l_min!r})"
             )
-        put("spawn_margin_steps", _integer("spawn_margin_steps", self.spawn_margin_steps, 0))
+        put(
+            "spawn_margin_steps",
+            v.integer("spawn_margin_steps", self.spawn_margin_steps, minimum=0),
+        )
         if self.render_mode is not None:
-            put("render_mode", _choice("render_mode", self.render_mode, RENDER_MODES))
+            put("render_mode", v.choice("render_mode", self.render_mode, RENDER_MODES))
 
     # ---------------------------------------------------------------- derived values
     @property
@@ -169,20 +189,60 @@ class EnvConfig:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready record of the configuration (the map by name and digest)."""
-        return {
-            "map": self.map.name,
-            "map_digest": self.map.digest,
-            "l_min": self.l_min,
-            "l_max": self.l_max,
-            "v_pursuer": self.v_pursuer,
-            "v_evader": self.v_evader,
-            "dt": self.dt,
-            "max_cycles": self.max_cycles,
-            "observation": self.observation,
-            "n_rays": self.n_rays,
-            "lidar_range": self.lidar_range,
-            "reward": self.reward,
-            "body_radius": self.body_radius,
-            "spawn_margin_steps": self.spawn_margin_steps,
-            "render_mode": self.render_mode,
-        }
+        record: dict[str, Any] = {"map": self.map.name, "map_digest": self.map.digest}
+        for f in dataclasses.fields(self):
+            if f.name != "map":
+                record[f.name] = getattr(self, f.name)
+        return record
+
+
+def env_parameters() -> dict[str, Any]:
+    """The env's arguments in signature order, each with its default (``EnvConfig``'s fields).
+
+    ``None`` for ``l_min``, ``l_max``, ``v_pursuer`` and ``v_evader`` means the map's
+    recommendation (:func:`map_recommendations`).
+
+    Examples:
+        >>> list(env_parameters())[:3]
+        ['map', 'l_min', 'l_max']
+    """
+    return {f.name: f.default for f in dataclasses.fields(EnvConfig)}
+
+
+def env_signature(return_annotation: Any = inspect.Signature.empty) -> inspect.Signature:
+    """The keyword signature of the env factories, derived from :class:`EnvConfig`."""
+    sig = inspect.signature(EnvConfig)
+    return sig.replace(return_annotation=return_annotation)
+
+
+def bind_env_arguments(factory: str, args: tuple, kwargs: dict[str, Any]) -> dict[str, Any]:
+    """The arguments given to the env factory ``factory`` as keywords (defaults not filled).
+
+    Raises:
+        TypeError: an unknown (misspelt) or repeated argument, or too many positional
+            ones; the message names it, suggests the closest argument and lists them all.
+    """
+    try:
+        bound = env_signature().bind(*args, **kwargs)
+    except TypeError as exc:
+        names = list(env_parameters())
+        unknown = [k for k in kwargs if k not in names]
+        hint = ""
+        if unknown:
+            close = difflib.get_close_matches(unknown[0], names, n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else ""
+        raise TypeError(f"{factory}(): {exc}{hint} (arguments: {', '.join(names)})") from None
+    return dict(bound.arguments)
+
+
+def _caller_stacklevel() -> int:
+    """``stacklevel`` that points a warning at the first frame outside ``envs.surveillance``."""
+    frame = sys._getframe(1)
+    level = 1
+    while frame is not None and (
+        frame.f_code.co_filename == "<string>"  # the __init__ that dataclasses generate
+        or frame.f_globals.get("__name__", "").startswith(("envs.surveillance", "pettingzoo"))
+    ):
+        frame = frame.f_back
+        level += 1
+    return level

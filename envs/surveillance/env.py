@@ -6,8 +6,8 @@ The env card (agents, spaces, arguments, version history) is the docstring of
 
 from __future__ import annotations
 
+import inspect
 import math
-import os
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
@@ -17,11 +17,21 @@ from gymnasium.utils import EzPickle, seeding
 from pettingzoo import AECEnv, ParallelEnv
 from pettingzoo.utils.conversions import parallel_to_aec
 
-from envs.errors import InvalidActionError, InvalidConfigError, InvalidPlacementError
+from envs.errors import (
+    EpisodeStateError,
+    InvalidActionError,
+    InvalidConfigError,
+    InvalidPlacementError,
+)
 from envs.geometry import Kernel, kernel_for
 from envs.maps import Map
 from envs.surveillance import rules
-from envs.surveillance.config import RENDER_MODES, EnvConfig
+from envs.surveillance.config import (
+    RENDER_MODES,
+    EnvConfig,
+    bind_env_arguments,
+    env_signature,
+)
 from envs.surveillance.observations import (
     LidarEncoder,
     StateEncoder,
@@ -67,56 +77,11 @@ class parallel_env(ParallelEnv, EzPickle):
         "render_fps": 10,
     }
 
-    def __init__(
-        self,
-        map: Map | str | os.PathLike[str] = "corridor",
-        l_min: float = 2.0,
-        l_max: float = 4.0,
-        v_pursuer: float = 1.0,
-        v_evader: float = 0.5,
-        dt: float = 0.1,
-        max_cycles: int = 500,
-        observation: str = "state",
-        n_rays: int = 32,
-        lidar_range: float | None = None,
-        reward: str = "zero_sum",
-        body_radius: float = 0.1,
-        spawn_margin_steps: int = 3,
-        render_mode: str | None = None,
-    ) -> None:
-        EzPickle.__init__(
-            self,
-            map=map,
-            l_min=l_min,
-            l_max=l_max,
-            v_pursuer=v_pursuer,
-            v_evader=v_evader,
-            dt=dt,
-            max_cycles=max_cycles,
-            observation=observation,
-            n_rays=n_rays,
-            lidar_range=lidar_range,
-            reward=reward,
-            body_radius=body_radius,
-            spawn_margin_steps=spawn_margin_steps,
-            render_mode=render_mode,
-        )
-        cfg = EnvConfig(
-            map=map,
-            l_min=l_min,
-            l_max=l_max,
-            v_pursuer=v_pursuer,
-            v_evader=v_evader,
-            dt=dt,
-            max_cycles=max_cycles,
-            observation=observation,
-            n_rays=n_rays,
-            lidar_range=lidar_range,
-            reward=reward,
-            body_radius=body_radius,
-            spawn_margin_steps=spawn_margin_steps,
-            render_mode=render_mode,
-        )
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        # the signature is EnvConfig's (set below the class): one source for the arguments
+        given = bind_env_arguments("parallel_env", args, kwargs)
+        EzPickle.__init__(self, **given)
+        cfg = EnvConfig(**given)
         self.config = cfg
         self.render_mode = cfg.render_mode
         self.metadata = {**type(self).metadata, "render_fps": 1.0 / cfg.dt}
@@ -150,6 +115,7 @@ class parallel_env(ParallelEnv, EzPickle):
         self._ve = (0.0, 0.0)
         self._visible = False
         self._last_event = None
+        self._ended_at: str | None = None  # why the last episode ended; None before reset
         self._trail: tuple[list, list] = ([], [])
         self._renderer = None
 
@@ -212,6 +178,7 @@ class parallel_env(ParallelEnv, EzPickle):
         self._ve = (0.0, 0.0)
         self._step = 0
         self._last_event = None
+        self._ended_at = ""
         self._trail = ([self._pursuer], [self._evader])
         self.agents = list(AGENTS)
         status = rules.surveillance_status(
@@ -268,11 +235,18 @@ class parallel_env(ParallelEnv, EzPickle):
             live at the start of the step. After the episode ends ``agents`` is empty.
 
         Raises:
+            EpisodeStateError: ``step()`` before ``reset()`` or after the episode ended
+                (loop ``while env.agents:``).
             InvalidActionError: ``actions`` is not a dict, or an action is missing, not
                 numeric, of the wrong shape, or not finite.
         """
         if not self.agents:
-            return {}, {}, {}, {}, {}
+            if self._ended_at is None:
+                raise EpisodeStateError("step() before reset(): call reset(seed=...) first")
+            raise EpisodeStateError(
+                f"step() after the episode ended at step {self._step} ({self._ended_at}): "
+                "call reset() to start a new episode"
+            )
         if type(actions) is not dict and not isinstance(actions, Mapping):
             raise InvalidActionError(
                 f"step: expected a dict of actions keyed by agent, got "
@@ -340,6 +314,9 @@ class parallel_env(ParallelEnv, EzPickle):
         infos = {PURSUER: info_p, EVADER: info_e}
         if escaped or trunc:
             self.agents = []
+            self._ended_at = (
+                f"the evader escaped: {event.cause}" if escaped else "max_cycles reached"
+            )
         if self.render_mode == "human":
             self.render()
         return observations, rewards, terminations, truncations, infos
@@ -416,60 +393,34 @@ class parallel_env(ParallelEnv, EzPickle):
             self._renderer = None
 
 
-def raw_env(
-    map: Map | str | os.PathLike[str] = "corridor",
-    l_min: float = 2.0,
-    l_max: float = 4.0,
-    v_pursuer: float = 1.0,
-    v_evader: float = 0.5,
-    dt: float = 0.1,
-    max_cycles: int = 500,
-    observation: str = "state",
-    n_rays: int = 32,
-    lidar_range: float | None = None,
-    reward: str = "zero_sum",
-    body_radius: float = 0.1,
-    spawn_margin_steps: int = 3,
-    render_mode: str | None = None,
-) -> AECEnv:
+parallel_env.__init__.__signature__ = env_signature(None).replace(  # type: ignore[attr-defined]
+    parameters=[
+        inspect.Parameter("self", inspect.Parameter.POSITIONAL_OR_KEYWORD),
+        *env_signature().parameters.values(),
+    ]
+)
+
+
+def _env_factory(fn):
+    """Give a factory that forwards ``*args, **kwargs`` to ``parallel_env`` its signature.
+
+    The PettingZoo way (``aec_wrapper_fn``) with the arguments kept introspectable:
+    ``inspect.signature(raw_env)`` lists EnvConfig's fields, and a misspelt option is a
+    ``TypeError`` raised by ``parallel_env``.
+    """
+    fn.__signature__ = env_signature(AECEnv)
+    return fn
+
+
+@_env_factory
+def raw_env(*args: Any, **kwargs: Any) -> AECEnv:
     """The AEC version, by conversion of :class:`parallel_env` (same arguments)."""
-    return parallel_to_aec(
-        parallel_env(
-            map=map,
-            l_min=l_min,
-            l_max=l_max,
-            v_pursuer=v_pursuer,
-            v_evader=v_evader,
-            dt=dt,
-            max_cycles=max_cycles,
-            observation=observation,
-            n_rays=n_rays,
-            lidar_range=lidar_range,
-            reward=reward,
-            body_radius=body_radius,
-            spawn_margin_steps=spawn_margin_steps,
-            render_mode=render_mode,
-        )
-    )
+    return parallel_to_aec(parallel_env(*args, **kwargs))
 
 
-def env(
-    map: Map | str | os.PathLike[str] = "corridor",
-    l_min: float = 2.0,
-    l_max: float = 4.0,
-    v_pursuer: float = 1.0,
-    v_evader: float = 0.5,
-    dt: float = 0.1,
-    max_cycles: int = 500,
-    observation: str = "state",
-    n_rays: int = 32,
-    lidar_range: float | None = None,
-    reward: str = "zero_sum",
-    body_radius: float = 0.1,
-    spawn_margin_steps: int = 3,
-    render_mode: str | None = None,
-) -> AECEnv:
-    """The AEC env with PettingZoo's standard wrappers for Box actions.
+@_env_factory
+def env(*args: Any, **kwargs: Any) -> AECEnv:
+    """The AEC env with PettingZoo's standard wrappers for Box actions (same arguments).
 
     ``parallel_to_aec`` already applies ``OrderEnforcingWrapper`` (reset before step,
     no render before reset). ``ClipOutOfBoundsWrapper`` and ``AssertOutOfBoundsWrapper``
@@ -478,19 +429,4 @@ def env(
     would log a warning per clipped action and turn NaN into a logger error, and the
     latter would reject the overshoot that analytic policies produce by rounding.
     """
-    return raw_env(
-        map=map,
-        l_min=l_min,
-        l_max=l_max,
-        v_pursuer=v_pursuer,
-        v_evader=v_evader,
-        dt=dt,
-        max_cycles=max_cycles,
-        observation=observation,
-        n_rays=n_rays,
-        lidar_range=lidar_range,
-        reward=reward,
-        body_radius=body_radius,
-        spawn_margin_steps=spawn_margin_steps,
-        render_mode=render_mode,
-    )
+    return raw_env(*args, **kwargs)

@@ -15,7 +15,7 @@ import shapely
 from shapely.geometry import LineString, Polygon
 
 from envs import surveillance_v0
-from envs.errors import InvalidActionError, InvalidPlacementError
+from envs.errors import EpisodeStateError, InvalidActionError, InvalidPlacementError
 from envs.maps import Feature
 from envs.surveillance.observations import STATE_LAYOUT, decode_state
 from tests.envs.surveillance._worlds import l_room, open_room, pillar_room, thin_pillar_room
@@ -281,13 +281,30 @@ def test_rewards_are_zero_sum_and_components_add_up(reward: str) -> None:
         assert trunc[P] == (not escaped) and steps <= 40
 
 
-def test_agents_emptied_after_the_end_and_further_steps_are_empty() -> None:
+def test_agents_emptied_after_the_end_and_further_steps_raise() -> None:
     env = surveillance_v0.parallel_env(map=open_room(), max_cycles=3)
+    with pytest.raises(EpisodeStateError, match=r"^step\(\) before reset\(\)"):
+        env.step({P: np.zeros(2), E: np.zeros(2)})
     env.reset(seed=0)
     for _ in range(3):
         out = env.step({P: np.zeros(2), E: np.zeros(2)})
     assert out[3] == {P: True, E: True} and env.agents == []
-    assert env.step({}) == ({}, {}, {}, {}, {})
+    with pytest.raises(EpisodeStateError, match=r"ended at step 3 \(max_cycles reached\)"):
+        env.step({})
+    with pytest.raises(RuntimeError):  # also the conventional type of a call out of order
+        env.step({P: np.zeros(2), E: np.zeros(2)})
+    env.reset(seed=1)  # a new episode steps again
+    assert env.step({P: np.zeros(2), E: np.zeros(2)})[0].keys() == {P, E}
+
+
+def test_step_after_an_escape_names_the_cause() -> None:
+    env = surveillance_v0.parallel_env(map=open_room(), max_cycles=200)
+    env.reset(seed=0)
+    while env.agents:  # the evader runs straight at the pursuer: too close
+        d = np.subtract(env._pursuer, env._evader)
+        env.step({P: np.zeros(2), E: d / np.linalg.norm(d)})
+    with pytest.raises(EpisodeStateError, match=r"the evader escaped: too_close"):
+        env.step({P: np.zeros(2), E: np.zeros(2)})
 
 
 def test_registry_and_versioned_name() -> None:

@@ -1,0 +1,110 @@
+"""One source for the env's arguments (EnvConfig) and a built-in map's parameters."""
+
+from __future__ import annotations
+
+import dataclasses
+import inspect
+import pickle
+import warnings
+
+import pytest
+
+from envs import surveillance_v0
+from envs.errors import RhoAboveOneWarning
+from envs.maps import builtin_info, builtin_map, builtin_names, save_map
+from envs.surveillance.config import (
+    GLOBAL_DEFAULTS,
+    MAP_PARAMETERS,
+    EnvConfig,
+    env_parameters,
+    map_recommendations,
+)
+from tests.envs.surveillance._worlds import open_room
+
+FACTORIES = [surveillance_v0.parallel_env, surveillance_v0.raw_env, surveillance_v0.env]
+
+
+@pytest.mark.parametrize("factory", FACTORIES, ids=lambda f: f.__name__)
+def test_every_factory_has_the_signature_of_envconfig(factory) -> None:
+    params = inspect.signature(factory).parameters
+    fields = dataclasses.fields(EnvConfig)
+    assert list(params) == [f.name for f in fields]
+    assert [p.default for p in params.values()] == [f.default for f in fields]
+    assert env_parameters() == {f.name: f.default for f in fields}
+
+
+@pytest.mark.parametrize("factory", FACTORIES, ids=lambda f: f.__name__)
+def test_a_misspelt_option_is_a_type_error_with_a_suggestion(factory) -> None:
+    with pytest.raises(TypeError, match=r"unexpected keyword argument 'lmax'.*'l_max'\?"):
+        factory(map=open_room(), lmax=3.0)
+    with pytest.raises(TypeError, match="multiple values for argument 'map'"):
+        factory(open_room(), map="corridor")
+
+
+def test_positional_arguments_follow_the_field_order() -> None:
+    env = surveillance_v0.parallel_env(open_room(), 1.0, 3.0)
+    assert (env.config.l_min, env.config.l_max) == (1.0, 3.0)
+
+
+@pytest.mark.parametrize("name", builtin_names())
+def test_a_builtin_name_brings_its_recommended_parameters(name: str) -> None:
+    info = builtin_info(name)
+    cfg = surveillance_v0.parallel_env(map=name).config
+    assert {k: getattr(cfg, k) for k in MAP_PARAMETERS} == info.params()
+
+
+def test_every_builtin_recommends_the_global_defaults() -> None:
+    """Changing a built-in's recommendation changes surveillance_v0 (STYLE.md 1: bump it)."""
+    for name in builtin_names():
+        assert builtin_info(name).params() == GLOBAL_DEFAULTS, (
+            f"{name} recommends {builtin_info(name).params()}: this changes what "
+            f"surveillance_v0(map={name!r}) plays; add surveillance_v1 and update this test"
+        )
+
+
+def test_recommendations_follow_the_map_metadata(monkeypatch) -> None:
+    """The env reads the map's metadata (not a copy of the defaults), explicit values win."""
+    import envs.surveillance.config as config
+
+    info = builtin_info("two_rooms")
+    changed = dataclasses.replace(info, l_min=1.5, l_max=5.0, v_evader=0.25)
+    monkeypatch.setattr(config, "builtin_info", lambda name: changed)
+    cfg = EnvConfig(map="two_rooms")
+    assert (cfg.l_min, cfg.l_max, cfg.v_pursuer, cfg.v_evader) == (1.5, 5.0, 1.0, 0.25)
+    cfg = EnvConfig(map="two_rooms", l_max=3.0, v_evader=0.5)
+    assert (cfg.l_min, cfg.l_max, cfg.v_evader) == (1.5, 3.0, 0.5)
+    # a Map object or a file: the global defaults, whatever the map is called
+    assert EnvConfig(map=builtin_map("two_rooms")).l_min == GLOBAL_DEFAULTS["l_min"]
+    assert map_recommendations(builtin_map("two_rooms")) == GLOBAL_DEFAULTS
+
+
+def test_a_map_file_uses_the_global_defaults(tmp_path) -> None:
+    path = tmp_path / "room.json"
+    save_map(open_room(), path, metadata={"l_min": 1.0, "l_max": 2.0})
+    cfg = EnvConfig(map=str(path))
+    assert {k: getattr(cfg, k) for k in MAP_PARAMETERS} == GLOBAL_DEFAULTS
+
+
+def test_pickling_replays_the_given_arguments() -> None:
+    env = surveillance_v0.parallel_env(map="corridor", l_max=3.5, max_cycles=9)
+    clone = pickle.loads(pickle.dumps(env))
+    assert clone.config == env.config and clone.config.l_max == 3.5
+
+
+def test_rho_above_one_is_legal_with_a_warning() -> None:
+    with pytest.warns(RhoAboveOneWarning, match=r"v_evader = 1.5 > v_pursuer = 1.0") as record:
+        env = surveillance_v0.parallel_env(map="open_room", v_evader=1.5)
+    assert record[0].filename == __file__  # points at the caller, not at the env's internals
+    env.reset(seed=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        surveillance_v0.parallel_env(map="open_room", v_evader=1.0)  # rho = 1: no warning
+
+
+def test_the_env_card_shows_the_real_signature() -> None:
+    """The signature block of the env card (surveillance_v0's docstring) agrees with the code."""
+    card = surveillance_v0.__doc__
+    block = card[card.index("surveillance_v0.parallel_env(") :]
+    call = block[len("surveillance_v0.parallel_env") : block.index(")\n") + 1]
+    shown = eval(f"dict{call}")  # the card writes plain literals
+    assert shown == env_parameters()

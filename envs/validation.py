@@ -44,6 +44,7 @@ __all__ = [
     "mapping",
     "nonnegative",
     "point",
+    "points",
     "positive",
     "real",
     "string",
@@ -67,10 +68,15 @@ def _fail(name: str, value: Any, expected: str, where: str | None) -> InvalidCon
 
 
 def is_real(value: Any) -> bool:
-    """True for a Python or numpy real scalar (int or float), False for bool and all else."""
+    """True for a Python or numpy real scalar (int or float), False for bool and all else.
+
+    A 0-d numpy array of integer or float dtype counts as a numpy scalar.
+    """
     if isinstance(value, (bool, np.bool_)):
         return False
-    return isinstance(value, (int, float, np.integer, np.floating))
+    if isinstance(value, (int, float, np.integer, np.floating)):
+        return True
+    return isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf"
 
 
 def is_integer(value: Any) -> bool:
@@ -193,15 +199,17 @@ def finite_array(
     name: str, value: Any, *, shape: tuple[int | None, ...] | None = None, where: str | None = None
 ) -> np.ndarray:
     """``value`` as a float64 array of finite real numbers, of ``shape`` if given
-    (``None`` entries match any length)."""
-    what = "finite real numbers" if shape is None else f"an array of shape {_shape(shape)}"
+    (``None`` entries match any length). A float64 array is returned as is (no copy)."""
+    what = "real numbers" if shape is None else f"an array of shape {_shape(shape)}"
     try:
         arr = np.asarray(value)
     except (TypeError, ValueError) as exc:  # ragged nested lists
         raise _fail(name, value, what, where) from exc
-    if arr.dtype.kind not in "iuf":
-        raise _fail(name, value, what + " (real numbers)", where)
-    arr = arr.astype(np.float64)
+    if arr.dtype.kind not in "iuf" or (
+        isinstance(value, (list, tuple)) and _contains_bool(value)  # numpy reads True as 1
+    ):
+        raise _fail(name, value, what if shape is None else what + " of real numbers", where)
+    arr = arr.astype(np.float64, copy=False)
     if shape is not None and (
         arr.ndim != len(shape)
         or any(s is not None and s != n for s, n in zip(shape, arr.shape, strict=False))
@@ -209,14 +217,41 @@ def finite_array(
         raise InvalidConfigError(
             f"{_where(name, where)}: expected shape {_shape(shape)}, got shape {arr.shape}"
         )
-    if not np.all(np.isfinite(arr)):
-        raise _fail(name, value, what + " (no NaN or inf)", where)
+    finite = np.isfinite(arr)
+    if not finite.all():
+        bad = np.argwhere(~finite)[0]
+        at = int(bad[0]) if len(bad) == 1 else tuple(int(i) for i in bad)
+        shown = repr(value)
+        if len(shown) > 80:
+            shown = shown[:77] + "..."
+        raise InvalidConfigError(
+            f"{_where(name, where)} = {shown}: expected finite values, got {arr[tuple(bad)]} "
+            f"at index {at}"
+        )
     return arr
 
 
 def point(name: str, value: Any, *, where: str | None = None) -> np.ndarray:
     """``value`` as a finite float (x, y) array."""
     return finite_array(name, value, shape=(2,), where=where)
+
+
+def points(name: str, value: Any, *, where: str | None = None) -> np.ndarray:
+    """``value`` as a finite float array whose last axis has length 2: one (x, y) of shape
+    (2,) or many of shape (..., 2) (points, velocities)."""
+    arr = finite_array(name, value, where=where)
+    if arr.ndim == 0 or arr.shape[-1] != 2:
+        raise InvalidConfigError(
+            f"{_where(name, where)}: expected shape (2,) or (..., 2), got shape {arr.shape}"
+        )
+    return arr
+
+
+def _contains_bool(value: list | tuple) -> bool:
+    return any(
+        isinstance(v, (bool, np.bool_)) or (isinstance(v, (list, tuple)) and _contains_bool(v))
+        for v in value
+    )
 
 
 def _shape(shape: tuple[int | None, ...]) -> str:

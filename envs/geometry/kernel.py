@@ -14,6 +14,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from envs import validation
 from envs.errors import InvalidConfigError
 from envs.geometry.arcs import free_arcs_at
 from envs.geometry.grid import Grid
@@ -28,61 +29,38 @@ __all__ = ["Kernel", "kernel_for"]
 ArrayLike = np.ndarray | Sequence[float]
 
 
+# Input checks: the rule is envs.validation's (bools and strings are not numbers); the
+# fast paths only skip it for plain Python floats, the per-step case.
+
+
 def _xy(p: ArrayLike, what: str) -> tuple[float, float]:
     """``p`` as two finite floats (fast path for the per-step predicates)."""
-    try:
+    if type(p) is tuple and len(p) == 2:
         x, y = p
-        if isinstance(x, np.ndarray) or isinstance(y, np.ndarray):
-            raise TypeError
-        x = float(x)
-        y = float(y)
-    except (TypeError, ValueError) as exc:
-        raise InvalidConfigError(f"{what}: expected a finite (x, y) point, got {p!r}") from exc
-    if not (math.isfinite(x) and math.isfinite(y)):
-        raise InvalidConfigError(f"{what}: expected a finite (x, y) point, got {p!r}")
+        if type(x) is float and type(y) is float and math.isfinite(x) and math.isfinite(y):
+            return x, y
+    x, y = validation.point(what, p).tolist()
     return x, y
 
 
-def _as_floats(x: ArrayLike, what: str, expected: str) -> np.ndarray:
-    """``x`` as a float array; non-numeric input raises InvalidConfigError naming it."""
-    try:
-        return np.asarray(x, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise InvalidConfigError(f"{what}: expected {expected}, got {x!r}") from exc
-
-
 def _point(x: ArrayLike, what: str) -> np.ndarray:
-    arr = _as_floats(x, what, "a finite (x, y) point")
-    if arr.shape != (2,) or not np.all(np.isfinite(arr)):
-        raise InvalidConfigError(f"{what}: expected a finite (x, y) point, got {x!r}")
-    return arr
+    return validation.point(what, x)
 
 
 def _points(x: ArrayLike, what: str) -> np.ndarray:
-    arr = _as_floats(x, what, "a finite (k, 2) array of points")
-    if arr.ndim == 1 and arr.shape == (2,):
+    """``x`` as a finite (k, 2) float array (a single (2,) point becomes (1, 2))."""
+    arr = validation.points(what, x)
+    if arr.ndim == 1:
         arr = arr[None, :]
-    if arr.ndim != 2 or arr.shape[1] != 2 or not np.all(np.isfinite(arr)):
-        raise InvalidConfigError(
-            f"{what}: expected a finite (k, 2) array of points, got shape {arr.shape}"
-        )
+    if arr.ndim != 2:
+        raise InvalidConfigError(f"{what}: expected shape (k, 2), got shape {arr.shape}")
     return arr
 
 
 def _length(x: float, what: str, *, positive: bool = True) -> float:
-    try:
-        if type(x) is float:  # the per-step case
-            v = x
-        elif isinstance(x, (str, bytes, bool, np.bool_)):
-            raise TypeError  # float("2") and float(True) would succeed
-        else:
-            v = float(x)
-    except (TypeError, ValueError) as exc:
-        raise InvalidConfigError(f"{what}: expected a number, got {x!r}") from exc
-    if not math.isfinite(v) or v < 0 or (positive and v == 0):
-        need = "a finite number > 0" if positive else "a finite number >= 0"
-        raise InvalidConfigError(f"{what}: expected {need}, got {x!r}")
-    return v
+    if type(x) is float and (x > 0.0 if positive else x >= 0.0) and x < math.inf:
+        return x  # the per-step case
+    return validation.positive(what, x) if positive else validation.nonnegative(what, x)
 
 
 class Kernel:
@@ -442,9 +420,7 @@ class Kernel:
             (k,) float distances.
         """
         o = _point(origin, "ray_distances origin")
-        ang = _as_floats(angles, "ray_distances angles", "finite angles in radians").reshape(-1)
-        if not np.all(np.isfinite(ang)):
-            raise InvalidConfigError(f"ray_distances: angles must be finite, got {angles!r}")
+        ang = validation.finite_array("ray_distances angles", angles).reshape(-1)
         rmax = _length(max_range, "ray_distances max_range")
         eps = self.eps
         r = rmax + eps

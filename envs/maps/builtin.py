@@ -25,11 +25,11 @@ from __future__ import annotations
 
 import functools
 import json
-import math
 from dataclasses import dataclass, field
 from importlib import resources
 
-from envs.errors import InvalidMapError, UnknownNameError
+from envs import validation
+from envs.errors import InvalidConfigError, InvalidMapError, UnknownNameError
 from envs.maps.io import map_from_dict
 from envs.maps.map import Map
 
@@ -108,12 +108,11 @@ def _load(name: str) -> MapInfo:
         raise InvalidMapError(f"{source}: its name {doc.map.name!r} differs from the file name")
     values = {}
     for key in _PARAMS:
-        v = doc.metadata.get(key)
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0:
-            raise InvalidMapError(
-                f"{source}: metadata {key!r} must be a positive number, got {v!r}"
-            )
-        values[key] = float(v)
+        try:
+            value = doc.metadata.get(key)
+            values[key] = validation.positive(key, value, where=f"{source} metadata")
+        except InvalidConfigError as exc:
+            raise InvalidMapError(str(exc)) from None
     if values["l_min"] > values["l_max"]:
         raise InvalidMapError(
             f"{source}: metadata l_min {values['l_min']} > l_max {values['l_max']}"

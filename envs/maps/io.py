@@ -52,6 +52,7 @@ import shapely
 from shapely.errors import ShapelyError
 from shapely.geometry import Polygon
 
+from envs import validation
 from envs.errors import InvalidConfigError, InvalidMapError, UnknownNameError
 from envs.maps.map import Map
 
@@ -97,7 +98,7 @@ def _fail(source: str, problem: str) -> InvalidMapError:
 
 
 def _is_number(x: object) -> bool:
-    return isinstance(x, (int, float)) and not isinstance(x, bool)
+    return validation.is_real(x)
 
 
 def _ring(obj: object, source: str, what: str) -> list[list[float]]:

@@ -34,7 +34,8 @@ import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
-from envs.errors import InvalidMapError
+from envs import validation
+from envs.errors import InvalidConfigError, InvalidMapError
 from envs.tolerances import COLLINEAR_TOL, REL_GAP_TOL, REL_LENGTH_TOL
 
 __all__ = ["Feature", "Map"]
@@ -58,12 +59,10 @@ class Feature:
 
 def _as_ring(points: object, what: str) -> np.ndarray:
     """Return ``points`` as an (n, 2) float array without a repeated closing vertex."""
-    try:
-        arr = np.asarray(points, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise InvalidMapError(
-            f"{what}: expected a sequence of (x, y) pairs, got {points!r}"
-        ) from exc
+    try:  # one rule for numbers (envs.validation): "1" and True are not coordinates
+        arr = validation.finite_array(what, points)
+    except InvalidConfigError as exc:
+        raise InvalidMapError(str(exc)) from None
     if arr.ndim != 2 or arr.shape[1] != 2:
         raise InvalidMapError(
             f"{what}: expected an (n, 2) array of vertices, got shape {arr.shape}"

@@ -28,10 +28,11 @@ import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
+from envs import validation
 from envs.errors import InfeasibleError, InvalidConfigError
 from envs.maps.map import Map
 
-__all__ = ["KINDS", "random_map"]
+__all__ = ["KINDS", "MAX_OBSTACLES", "MAX_VERTICES", "random_map"]
 
 KINDS = ("polygons", "convex", "star", "rectangles")
 """Obstacle shape families accepted by :func:`random_map`."""
@@ -46,21 +47,12 @@ _SHRINK = 0.85
 _SMALLEST = 0.25  # give up once the radius falls below this fraction of the first one
 
 
-def _int(value: object, what: str, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
-        raise InvalidConfigError(f"{what}={value!r}: expected an integer >= {minimum}")
-    return int(value)
+MAX_VERTICES = 1_000_000
+"""Upper bound of ``n_vertices`` (and of the vertices drawn per map): a typo such as
+``n_vertices=1e9`` fails at once instead of exhausting memory."""
 
-
-def _positive(value: object, what: str) -> float:
-    if (
-        isinstance(value, bool)
-        or not isinstance(value, (int, float, np.integer, np.floating))
-        or not math.isfinite(value)
-        or value <= 0
-    ):
-        raise InvalidConfigError(f"{what}={value!r}: expected a finite number > 0")
-    return float(value)
+MAX_OBSTACLES = 100_000
+"""Upper bound of ``n_obstacles``."""
 
 
 def _size(size: object, n: int, min_gap: float) -> tuple[float, float]:
@@ -71,9 +63,9 @@ def _size(size: object, n: int, min_gap: float) -> tuple[float, float]:
         return side, side
     if isinstance(size, (tuple, list, np.ndarray)):
         if len(size) != 2:
-            raise InvalidConfigError(f"size={size!r}: expected a number or (width, height)")
-        return _positive(size[0], "size[0]"), _positive(size[1], "size[1]")
-    s = _positive(size, "size")
+            raise InvalidConfigError(f"size = {size!r}: expected a number or (width, height)")
+        return validation.positive("size[0]", size[0]), validation.positive("size[1]", size[1])
+    s = validation.positive("size", size)
     return s, s
 
 
@@ -85,13 +77,13 @@ def _vertex_counts(rng: np.random.Generator, kinds: list[str], n_vertices: int |
     if kinds and kinds[0] == "rectangles":
         if n_vertices != 4 * n:
             raise InvalidConfigError(
-                f"n_vertices={n_vertices}: rectangles have 4 vertices each, "
+                f"n_vertices = {n_vertices}: rectangles have 4 vertices each, "
                 f"expected 4 * n_obstacles = {4 * n}"
             )
         return [4] * n
     if n_vertices < 3 * n:
         raise InvalidConfigError(
-            f"n_vertices={n_vertices}: each of the n_obstacles={n} obstacles needs at least "
+            f"n_vertices = {n_vertices}: each of the n_obstacles = {n} obstacles needs at least "
             f"3 vertices, expected n_vertices >= {3 * n}"
         )
     counts = np.full(n, n_vertices // n)
@@ -174,11 +166,10 @@ def random_map(
         >>> m == random_map(3, n_obstacles=4, n_vertices=20)
         True
     """
-    seed = _int(seed, "seed", 0)
-    if kind not in KINDS:
-        raise InvalidConfigError(f"kind={kind!r}: expected one of {list(KINDS)}")
+    seed = validation.integer("seed", seed, minimum=0)
+    kind = validation.choice("kind", kind, KINDS)
     if n_vertices is not None:
-        n_vertices = _int(n_vertices, "n_vertices", 0)
+        n_vertices = validation.integer("n_vertices", n_vertices, minimum=0, maximum=MAX_VERTICES)
     if n_obstacles is None:
         if n_vertices is None:
             n_obstacles = _DEFAULT_N_OBSTACLES
@@ -186,10 +177,10 @@ def random_map(
             n_obstacles = n_vertices // 4
         else:
             n_obstacles = max(1, n_vertices // 6) if n_vertices >= 3 else 0
-    n = _int(n_obstacles, "n_obstacles", 0)
+    n = validation.integer("n_obstacles", n_obstacles, minimum=0, maximum=MAX_OBSTACLES)
     if n == 0 and n_vertices:
-        raise InvalidConfigError(f"n_vertices={n_vertices}: expected 0 with n_obstacles=0")
-    min_gap = _positive(min_gap, "min_gap")
+        raise InvalidConfigError(f"n_vertices = {n_vertices}: expected 0 with n_obstacles = 0")
+    min_gap = validation.positive("min_gap", min_gap)
     width, height = _size(size, n, min_gap)
     rng = np.random.default_rng(seed)
     if kind == "polygons":

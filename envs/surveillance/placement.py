@@ -7,7 +7,8 @@ from typing import Any
 
 import numpy as np
 
-from envs.errors import InfeasibleError, InvalidPlacementError
+from envs import validation
+from envs.errors import InfeasibleError, InvalidConfigError, InvalidPlacementError
 from envs.surveillance import rules
 from envs.surveillance.config import EnvConfig
 from envs.tolerances import REL_LENGTH_TOL
@@ -23,15 +24,9 @@ MAX_BATCHES = 64
 
 def _point(value: Any, who: str) -> np.ndarray:
     try:
-        raw = np.asarray(value)
-        if raw.dtype.kind not in "iuf":  # no strings, booleans, complex or objects
-            raise TypeError(f"dtype {raw.dtype}")
-        arr = raw.astype(float)
-    except (TypeError, ValueError) as exc:
-        raise InvalidPlacementError(f"{who}: expected an (x, y) position, got {value!r}") from exc
-    if arr.shape != (2,) or not np.all(np.isfinite(arr)):
-        raise InvalidPlacementError(f"{who}: expected a finite (x, y) position, got {value!r}")
-    return arr
+        return validation.point(who, value)
+    except InvalidConfigError as exc:
+        raise InvalidPlacementError(str(exc)) from None
 
 
 def _fmt(p: np.ndarray) -> str:

@@ -19,14 +19,8 @@ from typing import NamedTuple
 import numpy as np
 from scipy.special import ellipeinc
 
+from envs import validation
 from envs.errors import InfeasibleError, SurveilValueError
-from strategies.control._validate import (
-    as_finite_array,
-    finite,
-    nonnegative,
-    positive,
-    vector2,
-)
 
 __all__ = [
     "Tractrix",
@@ -60,16 +54,16 @@ class Tractrix(NamedTuple):
 
 
 def _tractrix_args(t, L, v_e, theta0, alpha, leader_start):
-    tt = np.atleast_1d(as_finite_array("t", t))
+    tt = np.atleast_1d(validation.finite_array("t", t))
     if tt.ndim != 1:
         raise SurveilValueError(f"t has shape {tt.shape}: expected a 1-D array of times")
     return (
         tt,
-        positive("L", L),
-        nonnegative("v_e", v_e),
-        finite("theta0", theta0),
-        finite("alpha", alpha),
-        vector2("leader_start", leader_start),
+        validation.positive("L", L),
+        validation.nonnegative("v_e", v_e),
+        validation.real("theta0", theta0),
+        validation.real("alpha", alpha),
+        validation.points("leader_start", leader_start),
     )
 
 
@@ -181,10 +175,10 @@ def straight_leader_time(
         InfeasibleError: rho >= 1 (the closed form divides by 1 - rho²; at rho = 1 the
             rate θ̇⁺ vanishes when sin(α - θ) >= 0, E1, and T can be infinite).
     """
-    th0, th1 = finite("theta0", theta0), finite("theta1", theta1)
-    alpha = finite("alpha", alpha)
-    L, v_p = positive("L", L), positive("v_p", v_p)
-    rho = nonnegative("rho", rho)
+    th0, th1 = validation.real("theta0", theta0), validation.real("theta1", theta1)
+    alpha = validation.real("alpha", alpha)
+    L, v_p = validation.positive("L", L), validation.positive("v_p", v_p)
+    rho = validation.nonnegative("rho", rho)
     if rho >= 1.0:
         raise InfeasibleError(
             f"rho = {rho!r}: the straight-leader time needs rho < 1 (the closed form divides "
@@ -203,8 +197,8 @@ def wall_follow_theta_dot(alpha, theta, *, L: float, v_e: float):
 
     ±inf where ``cos θ = 0`` (rod perpendicular to the wall) and ``sin α != 0``.
     """
-    a, th = as_finite_array("alpha", alpha), as_finite_array("theta", theta)
-    L, v_e = positive("L", L), nonnegative("v_e", v_e)
+    a, th = validation.finite_array("alpha", alpha), validation.finite_array("theta", theta)
+    L, v_e = validation.positive("L", L), validation.nonnegative("v_e", v_e)
     with np.errstate(divide="ignore", invalid="ignore"):
         out = -v_e * np.sin(a) / (L * np.cos(th))
     return float(out) if out.ndim == 0 else out
@@ -215,8 +209,8 @@ def wall_follow_speed(alpha, theta, *, v_e: float):
 
     Signed (negative: the follower moves toward -x). ±inf where ``cos θ = 0``.
     """
-    a, th = as_finite_array("alpha", alpha), as_finite_array("theta", theta)
-    v_e = nonnegative("v_e", v_e)
+    a, th = validation.finite_array("alpha", alpha), validation.finite_array("theta", theta)
+    v_e = validation.nonnegative("v_e", v_e)
     with np.errstate(divide="ignore", invalid="ignore"):
         out = v_e * np.cos(a - th) / np.cos(th)
     return float(out) if out.ndim == 0 else out
@@ -225,8 +219,8 @@ def wall_follow_speed(alpha, theta, *, v_e: float):
 def wall_follow_max_speed(theta, *, v_e: float):
     """Worst case over leader headings, at ``α = θ + kπ`` for every integer k (E6):
     ``v_e / |cos θ|`` (inf at ``cos θ = 0``)."""
-    th = as_finite_array("theta", theta)
-    v_e = nonnegative("v_e", v_e)
+    th = validation.finite_array("theta", theta)
+    v_e = validation.nonnegative("v_e", v_e)
     with np.errstate(divide="ignore"):
         out = v_e / np.abs(np.cos(th))
     return float(out) if out.ndim == 0 else out
@@ -237,16 +231,16 @@ def wall_follow_feasible(theta, *, rho: float):
 
     The paper prints ``cos θ >= rho``, right only when cos θ > 0 (E6).
     """
-    th = as_finite_array("theta", theta)
-    rho = nonnegative("rho", rho)
+    th = validation.finite_array("theta", theta)
+    rho = validation.nonnegative("rho", rho)
     out = np.abs(np.cos(th)) >= rho
     return bool(out) if out.ndim == 0 else out
 
 
 def _corner_geometry(evader, vertex, L):
-    e = vector2("evader", evader)
-    v = vector2("vertex", vertex)
-    L = positive("L", L)
+    e = validation.points("evader", evader)
+    v = validation.points("vertex", vertex)
+    L = validation.positive("L", L)
     d = v - e
     ell = np.hypot(d[..., 0], d[..., 1])
     if np.any(ell <= 0.0) or np.any(ell > L * (1.0 + 1e-12)):
@@ -274,7 +268,7 @@ def corner_pursuer_velocity(evader, vertex, evader_velocity, *, L: float) -> np.
     ``1 - L/l <= 0`` (a lever about the vertex, E7).
     """
     _, _, L, d, ell = _corner_geometry(evader, vertex, L)
-    ev = vector2("evader_velocity", evader_velocity)
+    ev = validation.points("evader_velocity", evader_velocity)
     u = d / ell[..., None]
     n = np.stack([u[..., 1], -u[..., 0]], axis=-1)  # (sin θ, -cos θ)
     perp = np.sum(ev * n, axis=-1)
@@ -283,8 +277,8 @@ def corner_pursuer_velocity(evader, vertex, evader_velocity, *, L: float) -> np.
 
 def corner_required_speed(ell, *, L: float, v_e: float):
     """Worst-case follower speed over leader headings: ``v_e max(1, (L - l)/l)`` (THEORY §5.4)."""
-    ell_a = as_finite_array("l", ell)
-    L, v_e = positive("L", L), nonnegative("v_e", v_e)
+    ell_a = validation.finite_array("l", ell)
+    L, v_e = validation.positive("L", L), validation.nonnegative("v_e", v_e)
     if np.any(ell_a <= 0.0) or np.any(ell_a > L):
         raise SurveilValueError(f"l = {ell!r}: expected 0 < l <= L = {L!r}")
     out = v_e * np.maximum(1.0, (L - ell_a) / ell_a)
@@ -294,7 +288,7 @@ def corner_required_speed(ell, *, L: float, v_e: float):
 def corner_min_distance(*, L: float, rho: float) -> float:
     """Smallest leader-vertex distance at which the follower can hold the contact for every
     leader heading: ``rho L / (1 + rho)`` (needs rho <= 1, otherwise nothing is feasible)."""
-    L, rho = positive("L", L), nonnegative("rho", rho)
+    L, rho = validation.positive("L", L), validation.nonnegative("rho", rho)
     if rho > 1.0:
         raise InfeasibleError(
             f"rho = {rho!r} > 1: the follower cannot even match the leader's speed"
@@ -304,8 +298,8 @@ def corner_min_distance(*, L: float, rho: float) -> float:
 
 def corner_feasible(ell, *, L: float, rho: float):
     """Whether ``corner_required_speed(l) <= v_p``, i.e. ``rho <= 1`` and ``l >= rho L/(1+rho)``."""
-    ell_a = as_finite_array("l", ell)
-    L, rho = positive("L", L), nonnegative("rho", rho)
+    ell_a = validation.finite_array("l", ell)
+    L, rho = validation.positive("L", L), validation.nonnegative("rho", rho)
     if np.any(ell_a <= 0.0) or np.any(ell_a > L):
         raise SurveilValueError(f"l = {ell!r}: expected 0 < l <= L = {L!r}")
     out = (rho <= 1.0) & (ell_a >= rho * L / (1.0 + rho))

@@ -41,6 +41,7 @@ from typing import NamedTuple
 import numpy as np
 from scipy.optimize import brentq
 
+from envs import validation
 from envs.errors import SurveilValueError
 from strategies.control._integrators import (
     REACHED,
@@ -48,13 +49,7 @@ from strategies.control._integrators import (
     integrate_pmp,
     integrate_reduced,
 )
-from strategies.control._validate import (
-    as_finite_array,
-    branch_sign,
-    check_evasion_rho,
-    finite,
-    positive,
-)
+from strategies.control._validate import branch_sign, check_evasion_rho
 from strategies.control.hamiltonian import _kappa_scalar, is_unbounded, solve_stationary
 
 __all__ = [
@@ -241,14 +236,14 @@ def shoot(
             ``λ2(x_e) = 0`` would be impossible), unknown branch or method.
         InfeasibleError: ``rho >= 1``.
     """
-    th0 = finite("theta0", theta0)
-    l1 = finite("lambda1", lambda1)
-    l20 = finite("lambda2_0", lambda2_0)
-    L = positive("L", L)
+    th0 = validation.real("theta0", theta0)
+    l1 = validation.real("lambda1", lambda1)
+    l20 = validation.real("lambda2_0", lambda2_0)
+    L = validation.positive("L", L)
     rho = check_evasion_rho(rho)
     s = branch_sign(branch)
-    x_max = positive("x_max", x_max)
-    h = default_step(x_max, L, rho) if step is None else positive("step", step)
+    x_max = validation.positive("x_max", x_max)
+    h = default_step(x_max, L, rho) if step is None else validation.positive("step", step)
     if method not in ("reduced", "pmp"):
         raise SurveilValueError(f"method = {method!r}: expected 'reduced' or 'pmp'")
     mu0 = 1.0 + s * l20
@@ -329,10 +324,10 @@ def solve_escape(
     Raises:
         SurveilValueError: non-finite input, ``x_e <= 0``, ``L <= 0``, ``rho <= 0``.
     """
-    th0 = finite("theta0", theta0)
-    x_e = positive("x_e", x_e)
-    L = positive("L", L)
-    rho_v = positive("rho", rho)
+    th0 = validation.real("theta0", theta0)
+    x_e = validation.positive("x_e", x_e)
+    L = validation.positive("L", L)
+    rho_v = validation.positive("rho", rho)
     s = branch_sign(branch)
     if rho_v >= 1.0:
         return EscapeSolution(
@@ -340,7 +335,7 @@ def solve_escape(
             reason=f"rho = {rho_v!r} >= 1: the evader escapes trivially by moving away "
             "from the pursuer (footnote 4); at rho = 1, θ̇⁺ can vanish (E1)",
         )
-    h = default_step(x_e, L, rho_v) if step is None else positive("step", step)
+    h = default_step(x_e, L, rho_v) if step is None else validation.positive("step", step)
     if step is None and x_e / h > _MAX_DEFAULT_STEPS:
         return EscapeSolution(
             success=False,
@@ -451,8 +446,8 @@ def greedy_heading(theta, *, L: float, rho: float, branch="+") -> GreedyHeading:
         >>> bool(np.isclose(g.alpha, -np.arctan(0.5))), round(g.f2, 12)
         (True, 1.5)
     """
-    t = as_finite_array("theta", theta)
-    L = positive("L", L)
+    t = validation.finite_array("theta", theta)
+    L = validation.positive("L", L)
     rho = check_evasion_rho(rho)
     s = branch_sign(branch)
     a = np.arctan2(s * rho * np.cos(t), 1.0 - s * rho * np.sin(t))

@@ -39,13 +39,8 @@ from typing import NamedTuple
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from strategies.control._validate import (
-    as_finite_array,
-    branch_sign,
-    check_evasion_rho,
-    finite,
-    positive,
-)
+from envs import validation
+from strategies.control._validate import branch_sign, check_evasion_rho
 
 __all__ = [
     "HamiltonianMinimum",
@@ -69,9 +64,9 @@ def _out(a: np.ndarray) -> float | np.ndarray:
 
 
 def _common(alpha, theta, L, rho, branch):
-    a = as_finite_array("alpha", alpha)
-    t = as_finite_array("theta", theta)
-    return a, t, positive("L", L), check_evasion_rho(rho), branch_sign(branch)
+    a = validation.finite_array("alpha", alpha)
+    t = validation.finite_array("theta", theta)
+    return a, t, validation.positive("L", L), check_evasion_rho(rho), branch_sign(branch)
 
 
 def _n_h(phi: np.ndarray, rho: float, s: int) -> tuple[np.ndarray, np.ndarray]:
@@ -81,7 +76,7 @@ def _n_h(phi: np.ndarray, rho: float, s: int) -> tuple[np.ndarray, np.ndarray]:
 
 def f1(alpha):
     """``dy/dx = tan α``."""
-    return _out(np.tan(as_finite_array("alpha", alpha)))
+    return _out(np.tan(validation.finite_array("alpha", alpha)))
 
 
 def f2(alpha, theta, *, L: float, rho: float, branch="+"):
@@ -102,24 +97,24 @@ def df2_dtheta(alpha, theta, *, L: float, rho: float, branch="+"):
 def hamiltonian(alpha, theta, lambda1, lambda2, *, L: float, rho: float, branch="+"):
     """``H = λ1 tan α + (s + λ2) f2`` (for ``s = +1`` the paper's H)."""
     a, t, L, rho, s = _common(alpha, theta, L, rho, branch)
-    l1 = as_finite_array("lambda1", lambda1)
-    l2 = as_finite_array("lambda2", lambda2)
+    l1 = validation.finite_array("lambda1", lambda1)
+    l2 = validation.finite_array("lambda2", lambda2)
     n, _ = _n_h(a - t, rho, s)
     return _out(l1 * np.tan(a) + (s + l2) * s * n / (L * rho * np.cos(a)))
 
 
 def dH_dalpha(alpha, theta, lambda1, lambda2, *, L: float, rho: float, branch="+"):
     """``∂H/∂α = (λ1 - μ K_s(α, θ)) / cos² α`` with ``μ = 1 + s λ2`` (THEORY §4.2)."""
-    a = as_finite_array("alpha", alpha)
-    mu = 1.0 + branch_sign(branch) * as_finite_array("lambda2", lambda2)
+    a = validation.finite_array("alpha", alpha)
+    mu = 1.0 + branch_sign(branch) * validation.finite_array("lambda2", lambda2)
     k = np.asarray(stationary_kappa(a, theta, L=L, rho=rho, branch=branch))
-    return _out((as_finite_array("lambda1", lambda1) - mu * k) / np.cos(a) ** 2)
+    return _out((validation.finite_array("lambda1", lambda1) - mu * k) / np.cos(a) ** 2)
 
 
 def adjoint_lambda2(alpha, theta, lambda2, *, L: float, rho: float, branch="+"):
     """``λ2' = -∂H/∂θ = -(s + λ2) ∂f2/∂θ`` (printed adjoint for θ̇⁺, E3b)."""
     s = branch_sign(branch)
-    l2 = as_finite_array("lambda2", lambda2)
+    l2 = validation.finite_array("lambda2", lambda2)
     return _out(-(s + l2) * np.asarray(df2_dtheta(alpha, theta, L=L, rho=rho, branch=branch)))
 
 
@@ -133,8 +128,8 @@ def stationary_kappa(alpha, theta, *, L: float, rho: float, branch="+"):
 
 def kappa_bounds(theta, *, L: float, rho: float, branch="+"):
     """``(K_s(π/2, θ), K_s(-π/2, θ))``: H has a minimiser iff ``λ1/μ`` lies strictly inside."""
-    t = as_finite_array("theta", theta)
-    L = positive("L", L)
+    t = validation.finite_array("theta", theta)
+    L = validation.positive("L", L)
     rho = check_evasion_rho(rho)
     s = branch_sign(branch)
     n_up, _ = _n_h(_HALF_PI - t, rho, s)
@@ -149,12 +144,12 @@ def is_unbounded(theta, lambda1, lambda2, *, L: float, rho: float, branch="+") -
     ``α = +π/2`` or ``α = -π/2`` (the numerator of ``H cos α``; ``= 0`` counts as unbounded:
     the infimum is then approached at the boundary, not attained).
     """
-    t = finite("theta", theta)
-    l1 = finite("lambda1", lambda1)
-    L = positive("L", L)
+    t = validation.real("theta", theta)
+    l1 = validation.real("lambda1", lambda1)
+    L = validation.positive("L", L)
     rho = check_evasion_rho(rho)
     s = branch_sign(branch)
-    mu = 1.0 + s * finite("lambda2", lambda2)
+    mu = 1.0 + s * validation.real("lambda2", lambda2)
     if mu <= 0.0:
         return True
     for sa in (1.0, -1.0):
@@ -249,16 +244,16 @@ def minimise_hamiltonian(
         branch: ``"+"`` (θ̇⁺) or ``"-"`` (θ̇⁻).
         alpha_guess: Newton start (e.g. the previous step's α); default 0.
     """
-    t = finite("theta", theta)
-    l1 = finite("lambda1", lambda1)
-    l2 = finite("lambda2", lambda2)
-    L = positive("L", L)
+    t = validation.real("theta", theta)
+    l1 = validation.real("lambda1", lambda1)
+    l2 = validation.real("lambda2", lambda2)
+    L = validation.positive("L", L)
     rho = check_evasion_rho(rho)
     s = branch_sign(branch)
     mu = 1.0 + s * l2
     if is_unbounded(t, l1, l2, L=L, rho=rho, branch=s):
         return HamiltonianMinimum(math.nan, True, 0, False)
-    guess = 0.0 if alpha_guess is None else finite("alpha_guess", alpha_guess)
+    guess = 0.0 if alpha_guess is None else validation.real("alpha_guess", alpha_guess)
     a, it = solve_stationary(l1 / mu, t, L, rho, s, guess)
     if it < 60:
         return HamiltonianMinimum(a, False, it, False)

@@ -22,14 +22,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from envs import validation
 from envs.errors import SurveilValueError
-from strategies.control._validate import (
-    as_finite_array,
-    finite,
-    nonnegative,
-    positive,
-    vector2,
-)
 
 __all__ = [
     "MinMaxHeading",
@@ -59,7 +53,7 @@ def escape_trivial(rho: float) -> bool:
     Args:
         rho: speed ratio ``V_e / V_p`` (finite, >= 0).
     """
-    return nonnegative("rho", rho) > 1.0
+    return validation.nonnegative("rho", rho) > 1.0
 
 
 def theta_dot_feasible(alpha, theta, *, rho: float):
@@ -67,8 +61,8 @@ def theta_dot_feasible(alpha, theta, *, rho: float):
 
     Always True for ``rho <= 1``. Vectorised over ``alpha`` and ``theta``.
     """
-    rho = nonnegative("rho", rho)
-    phi = as_finite_array("alpha", alpha) - as_finite_array("theta", theta)
+    rho = validation.nonnegative("rho", rho)
+    phi = validation.finite_array("alpha", alpha) - validation.finite_array("theta", theta)
     return _scalar_or_array(np.asarray(1.0 - (rho * np.cos(phi)) ** 2 >= 0.0))
 
 
@@ -98,10 +92,10 @@ def theta_dot(alpha, theta, *, L: float, v_p: float, rho: float):
         >>> round(tp, 12), round(tm, 12)
         (0.5, -1.5)
     """
-    L = positive("L", L)
-    v_p = positive("v_p", v_p)
-    rho = nonnegative("rho", rho)
-    phi = as_finite_array("alpha", alpha) - as_finite_array("theta", theta)
+    L = validation.positive("L", L)
+    v_p = validation.positive("v_p", v_p)
+    rho = validation.nonnegative("rho", rho)
+    phi = validation.finite_array("alpha", alpha) - validation.finite_array("theta", theta)
     root = np.sqrt(np.maximum(1.0 - (rho * np.cos(phi)) ** 2, 0.0))
     base = -rho * np.sin(phi)
     k = v_p / L
@@ -145,10 +139,10 @@ def min_max_theta_dot(theta: float, *, L: float, v_p: float, rho: float) -> MinM
     For ``rho > 1`` the clamped rate at ``φ = kπ`` is 0: the pursuer cannot even hold L
     there and the evader escapes trivially (:func:`escape_trivial`).
     """
-    theta = finite("theta", theta)
-    L = positive("L", L)
-    v_p = positive("v_p", v_p)
-    rho = nonnegative("rho", rho)
+    theta = validation.real("theta", theta)
+    L = validation.positive("L", L)
+    v_p = validation.positive("v_p", v_p)
+    rho = validation.nonnegative("rho", rho)
     rate = (v_p / L) * math.sqrt(max(1.0 - rho * rho, 0.0))
     return MinMaxHeading(toward=_wrap(theta), away=_wrap(theta + math.pi), rate=rate)
 
@@ -176,20 +170,20 @@ def pursuer_velocity(evader_velocity, theta, theta_dot, *, L: float) -> np.ndarr
     Returns:
         Array of shape ``(..., 2)`` (broadcast of the inputs).
     """
-    ev = vector2("evader_velocity", evader_velocity)
-    th = as_finite_array("theta", theta)
-    td = as_finite_array("theta_dot", theta_dot)
-    L = positive("L", L)
+    ev = validation.points("evader_velocity", evader_velocity)
+    th = validation.finite_array("theta", theta)
+    td = validation.finite_array("theta_dot", theta_dot)
+    L = validation.positive("L", L)
     _, normal = _rod_frame(th)
     return ev + (L * td)[..., None] * normal
 
 
 def theta_dot_from_velocities(evader_velocity, pursuer_velocity_, theta, *, L: float):
     """Rotation rate produced by given velocities: ``(ṗ - ė)·(-sin θ, cos θ) / L`` (E8)."""
-    ev = vector2("evader_velocity", evader_velocity)
-    pv = vector2("pursuer_velocity", pursuer_velocity_)
-    th = as_finite_array("theta", theta)
-    L = positive("L", L)
+    ev = validation.points("evader_velocity", evader_velocity)
+    pv = validation.points("pursuer_velocity", pursuer_velocity_)
+    th = validation.finite_array("theta", theta)
+    L = validation.positive("L", L)
     _, normal = _rod_frame(th)
     return _scalar_or_array(np.sum((pv - ev) * normal, axis=-1) / L)
 
@@ -235,15 +229,15 @@ def pursuer_velocity_holding_range(
         v_p: pursuer speed bound, > 0.
         gain: proportional gain of the distance correction, 1/s, >= 0.
     """
-    ev = vector2("evader_velocity", evader_velocity)
+    ev = validation.points("evader_velocity", evader_velocity)
     if ev.shape != (2,):
         raise SurveilValueError(f"evader_velocity has shape {ev.shape}: expected (2,)")
-    th = finite("theta", theta)
-    td = finite("theta_dot_", theta_dot_)
-    L = positive("L", L)
-    L_target = positive("L_target", L_target)
-    v_p = positive("v_p", v_p)
-    gain = nonnegative("gain", gain)
+    th = validation.real("theta", theta)
+    td = validation.real("theta_dot_", theta_dot_)
+    L = validation.positive("L", L)
+    L_target = validation.positive("L_target", L_target)
+    v_p = validation.positive("v_p", v_p)
+    gain = validation.nonnegative("gain", gain)
     u = np.array([math.cos(th), math.sin(th)])
     n = np.array([-math.sin(th), math.cos(th)])
     perp = float(ev @ n) + L * td  # pursuer's own perpendicular speed

@@ -23,8 +23,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from envs import validation
 from envs.errors import SurveilValueError
-from strategies.control._validate import branch_sign, finite, positive, vector2
+from strategies.control._validate import branch_sign
 
 __all__ = [
     "EscapeTarget",
@@ -82,28 +83,28 @@ class EscapeTarget:
 
 def to_evader_frame(points, evader, beta: float) -> np.ndarray:
     """World points -> evader frame: translate the evader to 0, rotate by ``-beta``."""
-    p = vector2("points", points) - vector2("evader", evader)
-    c, s = math.cos(finite("beta", beta)), math.sin(beta)
+    p = validation.points("points", points) - validation.points("evader", evader)
+    c, s = math.cos(validation.real("beta", beta)), math.sin(beta)
     return np.stack([c * p[..., 0] + s * p[..., 1], -s * p[..., 0] + c * p[..., 1]], axis=-1)
 
 
 def from_evader_frame(points, evader, beta: float) -> np.ndarray:
     """Evader-frame points -> world (inverse of :func:`to_evader_frame`)."""
-    p = vector2("points", points)
-    c, s = math.cos(finite("beta", beta)), math.sin(beta)
+    p = validation.points("points", points)
+    c, s = math.cos(validation.real("beta", beta)), math.sin(beta)
     rot = np.stack([c * p[..., 0] - s * p[..., 1], s * p[..., 0] + c * p[..., 1]], axis=-1)
-    return rot + vector2("evader", evader)
+    return rot + validation.points("evader", evader)
 
 
 def _point(name: str, value) -> np.ndarray:
-    p = vector2(name, value)
+    p = validation.points(name, value)
     if p.shape != (2,):
         raise SurveilValueError(f"{name} has shape {p.shape}: expected a point of shape (2,)")
     return p
 
 
 def _make(kind, position, theta_i, theta_f, evader, pursuer, L) -> EscapeTarget:
-    L = positive("L", L)
+    L = validation.positive("L", L)
     rod = pursuer - evader
     if np.hypot(*rod) == 0.0:
         raise SurveilValueError("pursuer coincides with evader: the rod orientation is undefined")
@@ -184,10 +185,11 @@ def critical_curve_escape_target(
         L: surveillance distance.
     """
     e, p = _point("evader", evader), _point("pursuer", pursuer)
-    pts = vector2("curve", curve)
+    pts = validation.points("curve", curve)
     if pts.ndim != 2 or pts.shape[0] < 2:
         raise SurveilValueError(f"curve has shape {pts.shape}: expected (k, 2) with k >= 2")
-    lo, hi = finite("escapable_from", escapable_from), finite("escapable_to", escapable_to)
+    lo = validation.real("escapable_from", escapable_from)
+    hi = validation.real("escapable_to", escapable_to)
     a, b = pts[:-1], pts[1:]
     ab = b - a
     len2 = np.einsum("ij,ij->i", ab, ab)

@@ -19,20 +19,29 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
+from envs import validation
 from envs.errors import InvalidActionError, InvalidConfigError
 
 __all__ = [
+    "MAX_RAYS",
     "ROLES",
     "BasePolicy",
     "Policy",
     "Snapshot",
     "check_role",
+    "count_param",
     "distance_target",
+    "flag_param",
+    "nonnegative_param",
+    "positive_param",
     "unit",
 ]
 
 ROLES = ("pursuer", "evader")
 """The two roles, in the env's agent order."""
+
+MAX_RAYS = 4096
+"""Upper bound of a policy's probe-ray count (see :func:`count_param`)."""
 
 
 def check_role(role: str) -> str:
@@ -41,25 +50,37 @@ def check_role(role: str) -> str:
     Raises:
         InvalidConfigError: naming the bad role.
     """
-    if role not in ROLES:
-        raise InvalidConfigError(f"role must be one of {ROLES}, got {role!r}")
-    return role
+    return validation.choice("role", role, ROLES)
 
 
-def positive_param(name: str, value: float) -> float:
-    """A policy parameter as a float; raise unless it is finite and > 0."""
-    v = float(value)
-    if not (math.isfinite(v) and v > 0):
-        raise InvalidConfigError(f"{name} must be a positive number, got {value!r}")
-    return v
+def positive_param(name: str, value: Any) -> float:
+    """A policy parameter as a float; raise unless it is a finite number > 0.
+
+    Bools and strings are not numbers (:mod:`envs.validation`): ``True`` does not mean 1.
+    """
+    return validation.positive(name, value)
 
 
-def nonnegative_param(name: str, value: float) -> float:
-    """A policy parameter as a float; raise unless it is finite and >= 0."""
-    v = float(value)
-    if not (math.isfinite(v) and v >= 0):
-        raise InvalidConfigError(f"{name} must be a finite number >= 0, got {value!r}")
-    return v
+def nonnegative_param(name: str, value: Any) -> float:
+    """A policy parameter as a float; raise unless it is a finite number >= 0."""
+    return validation.nonnegative(name, value)
+
+
+def count_param(name: str, value: Any, minimum: int, maximum: int) -> int:
+    """A policy parameter that sizes an array (rays, bins, samples) as an int.
+
+    Bounded above so that a typo such as ``rays: 1000000000`` fails at once with a message
+    instead of exhausting memory when the policy allocates.
+
+    Raises:
+        InvalidConfigError: not an integer (bools and floats are refused) or out of range.
+    """
+    return validation.integer(name, value, minimum=minimum, maximum=maximum)
+
+
+def flag_param(name: str, value: Any) -> bool:
+    """A policy parameter that is a switch: only ``True`` or ``False`` (never ``"no"``)."""
+    return validation.boolean(name, value)
 
 
 def distance_target(config: Any) -> float:
@@ -200,7 +221,7 @@ class BasePolicy:
 
         Raises:
             InvalidConfigError: called before :meth:`reset`.
-            InvalidActionError: the observation is not finite.
+            InvalidObservationError: the observation is not a finite ``"state"`` vector.
         """
         if self.role is None:
             raise InvalidConfigError(f"policy {self.name!r}: call reset() before act()")

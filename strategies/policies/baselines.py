@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 
+from envs import validation
 from envs.errors import InvalidConfigError
 from strategies.policies.base import BasePolicy, Snapshot, distance_target, positive_param, unit
 
@@ -43,9 +44,7 @@ class RandomPolicy(BasePolicy):
 
     def __init__(self, *, hold: int = 1, name: str | None = None) -> None:
         super().__init__(name=name)
-        if not (isinstance(hold, int | np.integer) and hold >= 1):
-            raise InvalidConfigError(f"hold must be an integer >= 1, got {hold!r}")
-        self.hold = int(hold)
+        self.hold = validation.integer("hold", hold, minimum=1)
         self._current = np.zeros(2)
 
     def _decide(self, snap: Snapshot) -> np.ndarray:
@@ -73,9 +72,9 @@ class GreedyPursuer(BasePolicy):
     def __init__(self, *, gain: float = 4.0, target: float = 0.0, name: str | None = None) -> None:
         super().__init__(name=name)
         self.gain = positive_param("gain", gain)
-        if not 0.0 <= float(target) < 1.0:
-            raise InvalidConfigError(f"target must be in [0, 1), got {target!r}")
-        self.target = float(target)
+        self.target = validation.real("target", target, minimum=0.0)
+        if self.target >= 1.0:
+            raise InvalidConfigError(f"target = {target!r}: expected a number in [0, 1)")
 
     def _decide(self, snap: Snapshot) -> np.ndarray:
         c = self.config
@@ -95,9 +94,7 @@ class StraightLineEvader(BasePolicy):
 
     def __init__(self, *, heading: float | None = None, name: str | None = None) -> None:
         super().__init__(name=name)
-        if heading is not None and not math.isfinite(float(heading)):
-            raise InvalidConfigError(f"heading must be finite or None, got {heading!r}")
-        self.heading = heading
+        self.heading = None if heading is None else validation.real("heading", heading)
 
     def _reset(self) -> None:
         self._alpha = (
@@ -134,9 +131,7 @@ class TowardAwayEvader(BasePolicy):
         self, *, mode: str = "toward", period: float = 4.0, name: str | None = None
     ) -> None:
         super().__init__(name=name)
-        if mode not in self.MODES:
-            raise InvalidConfigError(f"mode must be one of {self.MODES}, got {mode!r}")
-        self.mode = mode
+        self.mode = validation.choice("mode", mode, self.MODES)
         self.period = positive_param("period", period)
 
     def _decide(self, snap: Snapshot) -> np.ndarray:

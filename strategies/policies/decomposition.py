@@ -28,9 +28,16 @@ import math
 
 import numpy as np
 
-from envs.errors import InvalidConfigError
 from strategies.control.kinematics import pursuer_velocity_holding_range, theta_dot
-from strategies.policies.base import BasePolicy, Snapshot, distance_target, positive_param
+from strategies.policies.base import (
+    MAX_RAYS,
+    BasePolicy,
+    Snapshot,
+    count_param,
+    distance_target,
+    nonnegative_param,
+    positive_param,
+)
 from strategies.policies.safety import NO_PATH, safety_table
 
 __all__ = ["DecompositionPursuer"]
@@ -63,16 +70,10 @@ class DecompositionPursuer(BasePolicy):
     ) -> None:
         super().__init__(name=name)
         self.resolution = positive_param("resolution", resolution)
-        self.n_bins = int(n_bins)
-        if not (isinstance(rays, int) and rays >= 4):
-            raise InvalidConfigError(f"rays must be an integer >= 4, got {rays!r}")
-        if not (isinstance(probe_every, int) and probe_every >= 1):
-            raise InvalidConfigError(f"probe_every must be an integer >= 1, got {probe_every!r}")
-        self.rays = rays
-        self.probe_every = probe_every
-        self.hysteresis = float(hysteresis)
-        if not (math.isfinite(self.hysteresis) and self.hysteresis >= 0):
-            raise InvalidConfigError(f"hysteresis must be >= 0, got {hysteresis!r}")
+        self.n_bins = count_param("n_bins", n_bins, 8, NO_PATH - 1)
+        self.rays = count_param("rays", rays, 4, MAX_RAYS)
+        self.probe_every = count_param("probe_every", probe_every, 1, MAX_RAYS)
+        self.hysteresis = nonnegative_param("hysteresis", hysteresis)
         self.distance_gain = positive_param("distance_gain", distance_gain)
 
     def _reset(self) -> None:

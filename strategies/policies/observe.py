@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from envs.errors import InvalidActionError
+from envs.errors import InvalidObservationError
 from envs.surveillance.observations import decode_state
 
 __all__ = ["read_state"]
@@ -23,13 +23,24 @@ def read_state(
         ``(evader, pursuer, evader_velocity, pursuer_velocity)``.
 
     Raises:
-        InvalidActionError: the observation has the wrong shape or is not finite.
+        InvalidObservationError: the observation is not an array of real numbers, has
+            the wrong shape or is not finite.
     """
-    obs = np.asarray(observation, dtype=np.float64)
+    try:
+        obs = np.asarray(observation, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InvalidObservationError(
+            f"observation: expected a 'state' observation (an array of real numbers), got "
+            f"{type(observation).__name__} {observation!r}"[:200]
+        ) from exc
     if not np.all(np.isfinite(obs)):
-        raise InvalidActionError(f"observation is not finite: {obs!r}")
+        bad = np.flatnonzero(~np.isfinite(obs.ravel()))
+        raise InvalidObservationError(
+            f"observation: expected finite values, got {obs.ravel()[bad[0]]} at index "
+            f"{int(bad[0])} ({len(bad)} non-finite of {obs.size})"
+        )
     try:
         view = decode_state(obs, config)
     except ValueError as exc:
-        raise InvalidActionError(str(exc)) from exc
+        raise InvalidObservationError(f"observation: {exc}") from exc
     return view.evader_pos, view.pursuer_pos, view.evader_vel, view.pursuer_vel

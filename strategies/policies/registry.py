@@ -14,10 +14,13 @@ Examples:
 from __future__ import annotations
 
 import inspect
+import types
+import typing
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from envs import validation
 from envs.errors import InvalidConfigError, UnknownNameError
 from strategies.policies.base import ROLES, BasePolicy, check_role
 
@@ -42,12 +45,16 @@ class PolicySpec:
         factory: builds the policy from keyword parameters.
         description: one line for ``surveil`` listings.
         params: the factory's parameters and their defaults.
+        types: the declared type of each parameter (``float``, ``int``, ``bool``, ``str``,
+            or ``None`` when the annotation says nothing checkable), and whether ``None``
+            is allowed; :func:`make_policy` checks given values against it.
     """
 
     name: str
     factory: Callable[..., BasePolicy]
     description: str
     params: dict[str, Any] = field(default_factory=dict)
+    types: dict[str, tuple[type | None, bool]] = field(default_factory=dict, repr=False)
 
     @property
     def role(self) -> str:
@@ -71,11 +78,53 @@ def register_policy(name: str, factory: Callable[..., BasePolicy], description: 
         )
     if name in _REGISTRY:
         raise InvalidConfigError(f"policy {name!r} is already registered")
-    sig = inspect.signature(factory)
-    params = {
-        k: p.default for k, p in sig.parameters.items() if p.kind is p.KEYWORD_ONLY and k != "name"
-    }
-    _REGISTRY[name] = PolicySpec(name, factory, description, params)
+    try:
+        sig = inspect.signature(factory, eval_str=True)
+    except (NameError, TypeError):  # an annotation that cannot be evaluated here
+        sig = inspect.signature(factory)
+    keyword = [p for k, p in sig.parameters.items() if p.kind is p.KEYWORD_ONLY and k != "name"]
+    params = {p.name: p.default for p in keyword}
+    kinds = {p.name: _declared_type(p) for p in keyword}
+    _REGISTRY[name] = PolicySpec(name, factory, description, params, kinds)
+
+
+_CHECKABLE = (bool, int, float, str)
+
+
+def _declared_type(param: inspect.Parameter) -> tuple[type | None, bool]:
+    """``(type, none_allowed)`` of a factory parameter from its annotation or default."""
+    ann = param.annotation
+    none_ok = param.default is None
+    if isinstance(ann, (types.UnionType,)) or typing.get_origin(ann) is typing.Union:
+        args = typing.get_args(ann)
+        none_ok = none_ok or type(None) in args
+        rest = [a for a in args if a is not type(None)]
+        ann = rest[0] if len(rest) == 1 else None
+    if ann is inspect.Parameter.empty or isinstance(ann, str):
+        default = param.default
+        ann = type(default) if default is not None and default is not param.empty else None
+    return (ann if ann in _CHECKABLE else None), none_ok
+
+
+def _checked_param(policy: str, key: str, value: Any, declared: tuple[type | None, bool]) -> Any:
+    """``value`` checked against the declared type of parameter ``key`` (one rule for all
+    policies: :mod:`envs.validation`; bools and strings are not numbers, ``"no"`` is not a
+    bool). The policy checks its own ranges afterwards."""
+    kind, none_ok = declared
+    where = f"policy {policy!r}"
+    if value is None and none_ok:
+        return None
+    if kind is bool:
+        return validation.boolean(key, value, where=where)
+    if kind is int:
+        validation.integer(key, value, where=where)
+    elif kind is float:  # the policy converts: its range messages then show the value given
+        validation.real(key, value, where=where)
+    elif kind is str:
+        validation.string(key, value, where=where)
+    if value is None:
+        raise InvalidConfigError(f"{where}: {key} = None: expected a value")
+    return value
 
 
 def policy_names(role: str | None = None) -> list[str]:
@@ -118,8 +167,11 @@ def make_policy(name: str, **params: Any) -> BasePolicy:
 
     Raises:
         UnknownNameError: the name is not registered (the message lists the known ones).
-        InvalidConfigError: a parameter is unknown or out of range.
+        InvalidConfigError: the name is not a string, or a parameter is unknown, of the
+            wrong type (``{"shoot": "no"}``, ``{"n_bins": True}``, ``{"gain": None}``)
+            or out of range.
     """
+    name = validation.string("policy name", name)
     role, _, kind = name.partition("/")
     if kind.startswith(SB3_PREFIX) and role in ROLES:
         from strategies.policies.learned import SB3Policy
@@ -132,7 +184,13 @@ def make_policy(name: str, **params: Any) -> BasePolicy:
             f"policy {name!r} has no parameter(s) {unknown}; its parameters are "
             f"{sorted(spec.params)}"
         )
-    policy = spec.factory(name=name, **params)
+    checked = {k: _checked_param(name, k, v, spec.types[k]) for k, v in params.items()}
+    try:
+        policy = spec.factory(name=name, **checked)
+    except InvalidConfigError as exc:  # the policy's own range checks: say which policy
+        if str(exc).startswith(f"policy {name!r}"):
+            raise
+        raise InvalidConfigError(f"policy {name!r}: {exc}") from None
     policy.roles = (spec.role,)
     return policy
 

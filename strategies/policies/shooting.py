@@ -31,10 +31,18 @@ import math
 
 import numpy as np
 
-from envs.errors import InvalidConfigError
+from envs import validation
 from envs.geometry import kernel_for
 from strategies.control.evasion import solve_escape
-from strategies.policies.base import BasePolicy, Snapshot, unit
+from strategies.policies.base import (
+    MAX_RAYS,
+    BasePolicy,
+    Snapshot,
+    count_param,
+    flag_param,
+    positive_param,
+    unit,
+)
 from strategies.policies.escape_plan import escape_plan
 from strategies.policies.safety import NO_PATH, safety_table
 
@@ -67,18 +75,11 @@ class ShootingEvader(BasePolicy):
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
-        self.resolution = float(resolution)
-        if not (math.isfinite(self.resolution) and self.resolution > 0):
-            raise InvalidConfigError(f"resolution must be > 0, got {resolution!r}")
-        for k, v, lo in (("rays", rays, 4), ("probe_every", probe_every, 1), ("replan", replan, 1)):
-            if not (isinstance(v, int) and v >= lo):
-                raise InvalidConfigError(f"{k} must be an integer >= {lo}, got {v!r}")
-        self.rays, self.probe_every, self.replan, self.shoot = (
-            rays,
-            probe_every,
-            replan,
-            bool(shoot),
-        )
+        self.resolution = positive_param("resolution", resolution)
+        self.rays = count_param("rays", rays, 4, MAX_RAYS)
+        self.probe_every = count_param("probe_every", probe_every, 1, MAX_RAYS)
+        self.replan = validation.integer("replan", replan, minimum=1)
+        self.shoot = flag_param("shoot", shoot)
 
     def _reset(self) -> None:
         c = self.config

@@ -74,7 +74,7 @@ def test_arrays_and_points():
     np.testing.assert_array_equal(v.point("p", [1, 2]), [1.0, 2.0])
     with pytest.raises(InvalidConfigError, match=r"expected shape \(2,\), got shape \(3,\)"):
         v.point("p", [1, 2, 3])
-    with pytest.raises(InvalidConfigError, match="no NaN"):
+    with pytest.raises(InvalidConfigError, match="expected finite values, got nan"):
         v.point("p", [1, math.nan])
     with pytest.raises(InvalidConfigError, match="real numbers"):
         v.point("p", ["a", "b"])
@@ -87,3 +87,15 @@ def test_long_values_are_shortened_in_messages():
     with pytest.raises(InvalidConfigError) as info:
         v.positive("x", "y" * 500)
     assert len(str(info.value)) < 200
+
+
+def test_arrays_refuse_bools_hidden_in_lists_and_name_the_bad_entry():
+    with pytest.raises(InvalidConfigError, match=r"^p = \[True, 2.0\]: expected an array of shape"):
+        v.point("p", [True, 2.0])
+    with pytest.raises(InvalidConfigError, match=r"expected real numbers"):
+        v.finite_array("ring", [(0, 0), (1, (False))])
+    with pytest.raises(InvalidConfigError, match=r"got inf at index \(1, 0\)"):
+        v.points("ring", [(0.0, 0.0), (np.inf, 1.0)])
+    assert v.is_real(np.array(2.5)) and not v.is_real(np.array([2.5]))
+    arr = np.zeros((3, 2))
+    assert v.points("pts", arr) is arr  # float64 input is not copied

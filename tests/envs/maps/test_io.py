@@ -276,7 +276,11 @@ MALFORMED = [
         json.dumps({**GOOD, "obstacles": [box(1, 1, 3, 3), box(2, 2, 4, 4)]}),
         r"obstacle 0 overlaps obstacle 1",
     ),
-    ("json", '{"boundary": [[0, 0], [NaN, 0], [0, 1]]}', r"boundary: .*finite"),
+    (
+        "json",
+        '{"boundary": [[0, 0], [NaN, 0], [0, 1]]}',
+        r"boundary = .*: expected finite values, got nan",
+    ),
     (
         "json",
         json.dumps({"boundary": [[0, 0], [10, 10], [10, 0], [0, 10]]}),

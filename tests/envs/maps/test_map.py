@@ -70,16 +70,25 @@ WORLDS = {
             id="one-point",
         ),
         pytest.param(
-            ROOM, [[(1, 1), (2, float("nan")), (3, 3)]], r"obstacle 0: .*finite", id="nan"
+            ROOM,
+            [[(1, 1), (2, float("nan")), (3, 3)]],
+            r"obstacle 0 = .*: expected finite values, got nan",
+            id="nan",
         ),
         pytest.param(
-            ROOM, [[(1, 1), (2, float("inf")), (3, 3)]], r"obstacle 0: .*finite", id="inf"
+            ROOM,
+            [[(1, 1), (2, float("inf")), (3, 3)]],
+            r"obstacle 0 = .*: expected finite values, got inf",
+            id="inf",
         ),
         pytest.param(
             [(0, 0), (1, 0), (2, 0)], [], r"boundary: degenerate", id="collinear-boundary"
         ),
         pytest.param(
-            [(0, 0), (1, 1), (float("nan"), 0)], [], r"boundary: .*finite", id="nan-boundary"
+            [(0, 0), (1, 1), (float("nan"), 0)],
+            [],
+            r"boundary = .*: expected finite values, got nan",
+            id="nan-boundary",
         ),
         pytest.param(ROOM, [[1, 2, 3]], r"obstacle 0: .*\(n, 2\)", id="bad-shape"),
         pytest.param(
@@ -414,3 +423,12 @@ def test_arrays_are_read_only():
         m.vertices[0, 0] = 1.0
     with pytest.raises(ValueError):
         m.rings[0][0, 0] = 1.0
+
+
+@pytest.mark.parametrize(
+    "bad", [[(0, 0), ("10", 0), (10, 10)], [(0, 0), (True, 0), (10, 10)], [(0, 0), (None, 1)]]
+)
+def test_coordinates_follow_the_number_rule(bad):
+    """Strings and bools are not coordinates (envs.validation), in code as in files."""
+    with pytest.raises(InvalidMapError, match=r"^boundary = .*: expected real numbers"):
+        Map(bad, [])

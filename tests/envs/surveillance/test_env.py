@@ -98,8 +98,8 @@ def test_options_place_the_agents_exactly() -> None:
         ((1.0, 1.0), (8.0, 1.0), r"out of range: distance 7 .*\(too_far\)"),
         ((3.0, 5.0), (7.0, 5.0), r"occluded by .*(vertex|edge) \d+"),
         ((2.0, 1.0), None, r"must give both 'pursuer' and 'evader'"),
-        ((2.0, float("nan")), (2.0, 3.5), r"pursuer: expected a finite \(x, y\) position"),
-        ((1.0, 2.0, 3.0), (2.0, 3.5), r"pursuer: expected a finite \(x, y\) position"),
+        ((2.0, float("nan")), (2.0, 3.5), r"pursuer = \(2.0, nan\): expected finite values"),
+        ((1.0, 2.0, 3.0), (2.0, 3.5), r"pursuer: expected shape \(2,\), got shape \(3,\)"),
     ],
 )
 def test_bad_placements_raise_naming_positions_and_reason(pursuer, evader, pattern) -> None:

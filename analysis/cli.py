@@ -14,6 +14,8 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+from analysis.figures import cli as figures_cli
+
 __all__ = ["build_parser", "main"]
 
 DEFAULT_OUT = Path("out")
@@ -99,7 +101,7 @@ def _default_length(map_name: str) -> float:
 
 
 def _cmd_figure(args: argparse.Namespace) -> int:
-    from strategies.control.figures import draw_figure
+    from analysis.figures.evasion import draw_figure
 
     params = json.loads(args.params) if args.params else {}
     out = Path(args.out or DEFAULT_OUT / f"figure_{args.name}.png")
@@ -214,6 +216,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_evaluate)
 
     _add_train_parser(sub)
+    figures_cli.add_parser(sub)
     return parser
 
 

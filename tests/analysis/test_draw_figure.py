@@ -1,11 +1,11 @@
-"""draw_figure writes the Figs. 11, 12 and 14 reconstructions."""
+"""draw_figure (`surveil figure NAME`) writes the parametric Figs. 11, 12 and 14."""
 
 from __future__ import annotations
 
 import pytest
 
+from analysis.figures.evasion import FIGURES, draw_figure
 from envs.errors import SurveilValueError, UnknownNameError
-from strategies.control.figures import FIGURES, draw_figure
 
 pytest.importorskip("matplotlib")
 

@@ -1,0 +1,123 @@
+"""``surveil figures``: regenerate the paper's figures, print or check the report's numbers.
+
+::
+
+    surveil figures                                   # every figure into out/figures/
+    surveil figures --out docs/figures --report docs/REPRODUCTION.md   # the docs, one command
+    surveil figures --only fig03 fig06-replay         # some of them (names or prefixes)
+    surveil figures --list                            # names, paper figures, titles
+    surveil figures --numbers corridor. fig11         # the quoted numbers (by key prefix)
+    surveil figures --check docs/REPRODUCTION.md      # exit 1 if the report has drifted
+    surveil figures --update docs/REPRODUCTION.md     # rewrite its numbers, draw nothing
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+__all__ = ["add_parser", "run"]
+
+DEFAULT_OUT = Path("out") / "figures"
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Add the ``figures`` subcommand to the ``surveil`` parser."""
+    p = subparsers.add_parser(
+        "figures",
+        help="regenerate the paper's figures (and check docs/REPRODUCTION.md)",
+        description="Regenerate our version of every figure of the paper (PNGs and GIF "
+        "replays), and print, check or update the numbers docs/REPRODUCTION.md quotes.",
+    )
+    p.add_argument("--out", default=str(DEFAULT_OUT), help=f"directory (default: {DEFAULT_OUT})")
+    p.add_argument("--only", nargs="+", metavar="NAME", help="figure names or unique prefixes")
+    p.add_argument("--scale", type=float, default=1.0, help="size factor (default 1)")
+    p.add_argument("--list", action="store_true", help="list the figures and exit")
+    p.add_argument(
+        "--numbers",
+        nargs="*",
+        metavar="PREFIX",
+        help="print the report's numbers (optionally those whose key starts so)",
+    )
+    p.add_argument(
+        "--report",
+        metavar="FILE",
+        help="after drawing, rewrite FILE's tagged numbers and figure gallery",
+    )
+    p.add_argument(
+        "--check",
+        metavar="FILE",
+        help="only check FILE against the code: exit 1 listing what drifted",
+    )
+    p.add_argument(
+        "--update",
+        metavar="FILE",
+        help="only rewrite FILE's tagged numbers and figure gallery (draw nothing)",
+    )
+    p.set_defaults(func=run)
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``surveil figures``."""
+    from analysis.figures.registry import build_figure, select
+
+    if args.list:
+        for s in select(None):
+            print(f"{s.name:<24} {s.paper:<32} {s.title}")
+        return 0
+    if args.numbers is not None:
+        from analysis.figures.numbers import NUMBERS, compute_numbers
+
+        for key, text in compute_numbers(args.numbers or None).items():
+            print(f"{key:<30} {text:<24} {NUMBERS[key].what}")
+        return 0
+    if args.check:
+        return _check(Path(args.check))
+    if args.update:
+        _update(Path(args.update))
+        return 0
+    specs = select(args.only)
+    from tqdm import tqdm
+
+    out = Path(args.out)
+    bar = tqdm(specs, unit="figure", disable=not sys.stderr.isatty())
+    for s in bar:
+        bar.set_description(s.name)
+        t0 = time.perf_counter()
+        path = build_figure(s.name, out, scale=args.scale)
+        size = path.stat().st_size / 1024
+        tqdm.write(f"{path}  ({size:.0f} kB, {time.perf_counter() - t0:.1f} s)")
+    if args.report:
+        _update(Path(args.report))
+    return 0
+
+
+def _check(path: Path) -> int:
+    from analysis.figures.numbers import compute_numbers
+    from analysis.figures.report import check_report, read
+
+    problems = check_report(read(path), compute_numbers())
+    for p in problems:
+        print(f"{path}: {p}")
+    if problems:
+        print(
+            f"{len(problems)} problem(s); rewrite the numbers with: surveil figures --update "
+            f"{path} (or redraw and rewrite: --out docs/figures --report {path})"
+        )
+        return 1
+    print(f"{path}: every quoted number matches the code")
+    return 0
+
+
+def _update(path: Path) -> None:
+    from analysis.figures.numbers import compute_numbers
+    from analysis.figures.report import read, update_report
+
+    text, changes = update_report(read(path), compute_numbers())
+    path.write_text(text, encoding="utf-8")
+    for c in changes:
+        print(f"{path}: {c}")
+    print(f"{path}: {len(changes)} number(s) changed; gallery regenerated")

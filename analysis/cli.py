@@ -9,21 +9,36 @@ figures of the paper, and evaluate policies against each other.
 from __future__ import annotations
 
 import argparse
-import json
 import sys
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
+from analysis.arguments import (
+    Parser,
+    integer,
+    json_object,
+    output_dir,
+    output_file,
+    real,
+    user_error,
+)
 from analysis.figures import cli as figures_cli
+from analysis.replay import MAX_FPS
+from envs.errors import InvalidConfigError, SurveilValueError, UnknownNameError
 
 __all__ = ["build_parser", "main"]
 
 DEFAULT_OUT = Path("out")
+PARAMS_EXAMPLE = "'{\"gain\": 2.0}'"
+FIGURE_EXAMPLE = "'{\"rho\": 0.5}'"
+CONFIG_EXAMPLE = "'{\"v_evader\": 0.8}'"
 
 
 def _cmd_maps(args: argparse.Namespace) -> int:
     from envs.maps import builtin_info, builtin_names
 
+    out = output_dir("--plot", args.plot) if args.plot else None
     for name in builtin_names():
         info = builtin_info(name)
         m = info.map
@@ -31,14 +46,12 @@ def _cmd_maps(args: argparse.Namespace) -> int:
             f"{name:<12} {m.n_vertices:>4} vertices  L_min={info.l_min:g} L_max={info.l_max:g} "
             f"v_p={info.v_pursuer:g} v_e={info.v_evader:g}  {info.description}"
         )
-        if args.plot:
+        if out is not None:
             from envs.maps.plot import plot_map
 
-            out = Path(args.plot)
-            out.mkdir(parents=True, exist_ok=True)
             plot_map(m, path=out / f"{name}.png")
-    if args.plot:
-        print(f"wrote map pictures to {args.plot}/")
+    if out is not None:
+        print(f"wrote map pictures to {out}/")
     return 0
 
 
@@ -51,62 +64,173 @@ def _cmd_policies(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_play(args: argparse.Namespace) -> int:
-    from analysis.replay import write_replay
+def _env_config(flag_map: str, map_: str, overrides: dict, where: str):
+    """The env config of a run, validated before the run (names the flag at fault)."""
+    from envs.maps import builtin_names
+    from envs.surveillance.config import EnvConfig, env_parameters, resolve_map
+
+    allowed = [k for k in env_parameters() if k not in ("map", "render_mode")]
+    unknown = sorted(set(overrides) - set(allowed))
+    if unknown:
+        raise InvalidConfigError(
+            f"{where}: unknown env option(s) {unknown}; options are {', '.join(allowed)}"
+        )
+    try:
+        world = resolve_map(map_)
+    except SurveilValueError as exc:
+        raise type(exc)(f"{flag_map}: {exc}") from None
+    try:  # a built-in by name, so that its recommended parameters apply
+        return EnvConfig(map=map_ if map_ in builtin_names() else world, **overrides)
+    except SurveilValueError as exc:
+        raise type(exc)(f"{where}: {exc}") from None
+
+
+def _policy(flag: str, name: str, params_flag: str, params_text: str | None):
+    """The policy a flag names, with the parameters of its ``-params`` flag, checked."""
     from strategies.policies import make_policy
+
+    params = json_object(params_flag, params_text, example=PARAMS_EXAMPLE)
+    role = flag.lstrip("-")
+    if not name.startswith(f"{role}/"):
+        raise InvalidConfigError(
+            f"{flag} = {name!r}: expected a policy name of the form '{role}/KIND' "
+            "(see surveil policies)"
+        )
+    try:
+        return make_policy(name, **params)
+    except UnknownNameError as exc:
+        raise UnknownNameError(f"{flag}: {exc}") from None
+    except SurveilValueError as exc:  # say which flag brought the value
+        raise type(exc)(f"{params_flag if params else flag}: {exc}") from None
+
+
+def _cmd_play(args: argparse.Namespace) -> int:
     from strategies.runner import run_episode
 
-    overrides = json.loads(args.config) if args.config else {}
-    pursuer = make_policy(args.pursuer, **json.loads(args.pursuer_params or "{}"))
-    evader = make_policy(args.evader, **json.loads(args.evader_params or "{}"))
-    result = run_episode(
-        args.map,
-        pursuer,
-        evader,
-        seed=args.seed,
-        max_cycles=args.max_cycles,
-        overrides=overrides,
-        record=not args.no_gif,
-    )
-    print(result.summary())
+    # everything is checked before the episode: options, policies, the output file
+    overrides = json_object("--config", args.config, example=CONFIG_EXAMPLE)
+    if args.max_cycles is not None:
+        overrides["max_cycles"] = args.max_cycles
+    config = _env_config("--map", args.map, overrides, "--config")
+    pursuer = _policy("--pursuer", args.pursuer, "--pursuer-params", args.pursuer_params)
+    evader = _policy("--evader", args.evader, "--evader-params", args.evader_params)
+    out = None
     if not args.no_gif:
-        out = Path(args.out)
-        out.parent.mkdir(parents=True, exist_ok=True)
+        out = output_file("--out", args.out, suffixes=(".gif", ".png"), default_name="play.gif")
+    shading: tuple = ()
+    if args.overlay and out is not None:
+        from analysis.overlay import decomposition_shading
+
+        shading = decomposition_shading(config.map, config.l_min)
+    stream = None
+    if out is not None and out.suffix.lower() == ".gif":
+        from analysis.replay import GifStream
+
+        stream = GifStream(out, args.fps)  # frames go to the file as they are drawn
+    try:
+        result = run_episode(
+            args.map,
+            pursuer,
+            evader,
+            seed=args.seed,
+            overrides=overrides,
+            on_frame=stream if stream is not None and not shading else None,
+        )
+        print(result.summary())
+        if stream is not None and shading:  # redraw under the overlay, one frame at a time
+            from analysis.replay import iter_trajectory_frames
+
+            for frame in iter_trajectory_frames(result, shading=shading):
+                stream.add(frame)
+        if stream is not None:
+            stream.close()
+    except BaseException:
+        if stream is not None:
+            stream.abort()
+        raise
+    if out is not None and stream is None:  # a PNG strip: a few frames from the trajectory
+        from analysis.replay import write_replay
+
         write_replay(result, out, decomposition=args.overlay, fps=args.fps)
+    if out is not None:
         print(f"replay written to {out}")
     return 0
 
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
-    from envs.maps import load_map
+    from envs.maps import builtin_info, builtin_names, load_map
+
+    try:
+        world = load_map(args.map)
+    except SurveilValueError as exc:
+        raise type(exc)(f"map: {exc}") from None
+    length = args.length
+    if length is None:
+        if args.map not in builtin_names():
+            raise InvalidConfigError(
+                f"--length is required for map {args.map!r}: only built-in maps recommend "
+                "a rod length (their L_min)"
+            )
+        length = builtin_info(args.map).l_min
+    diameter = _diameter(world)
+    if length > diameter:
+        raise InvalidConfigError(
+            f"--length = {length:g}: a rod this long fits nowhere in map {world.name!r} "
+            f"(its widest extent is {diameter:.4g})"
+        )
+    default_name = f"decomposition_{world.name}_L{length:g}.png"
+    out = output_file(
+        "--out",
+        args.out or DEFAULT_OUT / default_name,
+        suffixes=(".png", ".pdf", ".svg"),
+        default_name=default_name,
+    )
     from strategies.cspace import decompose, draw_decomposition
 
-    world = load_map(args.map)
-    length = args.length if args.length is not None else _default_length(args.map)
     dec = decompose(world, length)
-    out = Path(args.out or DEFAULT_OUT / f"decomposition_{world.name}_L{length:g}.png")
-    out.parent.mkdir(parents=True, exist_ok=True)
+    if not dec.cells:
+        print(
+            f"a rod of length {length:g} fits nowhere in map {world.name!r}: no position "
+            "and orientation keeps it clear of the walls; nothing to decompose"
+        )
+        return 0
     draw_decomposition(dec, out, show_graph=not args.no_graph)
     print(dec.summary() if hasattr(dec, "summary") else repr(dec))
     print(f"picture written to {out}")
     return 0
 
 
-def _default_length(map_name: str) -> float:
-    from envs.maps import builtin_info, builtin_names
+def _diameter(world) -> float:
+    """The largest distance between two points of the map (between boundary vertices)."""
+    import numpy as np
 
-    if map_name in builtin_names():
-        return builtin_info(map_name).l_min
-    raise SystemExit(f"surveil: --length is required for map {map_name!r} (not a built-in)")
+    b = np.asarray(world.rings[0], dtype=float)
+    d = b[:, None, :] - b[None, :, :]
+    return float(np.sqrt((d * d).sum(axis=-1)).max())
 
 
 def _cmd_figure(args: argparse.Namespace) -> int:
-    from analysis.figures.evasion import draw_figure
+    from analysis.figures.evasion import draw_figure, figure_parameters
 
-    params = json.loads(args.params) if args.params else {}
-    out = Path(args.out or DEFAULT_OUT / f"figure_{args.name}.png")
-    out.parent.mkdir(parents=True, exist_ok=True)
-    draw_figure(args.name, out, **params)
+    params = json_object("--params", args.params, example=FIGURE_EXAMPLE)
+    known = figure_parameters(args.name)
+    unknown = sorted(set(params) - set(known))
+    if unknown:
+        raise InvalidConfigError(
+            f"--params: figure {args.name!r} has no parameter(s) {unknown}; its parameters "
+            "are " + ", ".join(f"{k} (default {v!r})" for k, v in known.items())
+        )
+    default_name = f"figure_{args.name}.png"
+    out = output_file(
+        "--out",
+        args.out or DEFAULT_OUT / default_name,
+        suffixes=(".png", ".pdf", ".svg"),
+        default_name=default_name,
+    )
+    try:
+        draw_figure(args.name, out, **params)
+    except SurveilValueError as exc:
+        raise type(exc)(f"--params: {exc}") from None
     print(f"figure written to {out}")
     return 0
 
@@ -114,7 +238,7 @@ def _cmd_figure(args: argparse.Namespace) -> int:
 def _cmd_evaluate(args: argparse.Namespace) -> int:
     from analysis.evaluate import evaluate, format_table
 
-    overrides = json.loads(args.config) if args.config else None
+    overrides = json_object("--config", args.config, example=CONFIG_EXAMPLE) or None
     table = evaluate(
         maps=args.maps,
         pursuers=args.pursuers,
@@ -153,7 +277,7 @@ def _add_train_parser(sub: argparse._SubParsersAction) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     """Return the argument parser of the ``surveil`` command."""
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="surveil",
         description="Visibility-based surveillance with a finite sensor range.",
     )
@@ -175,26 +299,34 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--evader", default="evader/shooting", help="registered evader policy")
     p.add_argument("--pursuer-params", help="pursuer parameters as JSON (see surveil policies)")
     p.add_argument("--evader-params", help='evader parameters as JSON, e.g. \'{"mode": "away"}\'')
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--max-cycles", type=int, default=None, help="episode horizon in steps")
-    p.add_argument("--config", help="env overrides as JSON, e.g. '{\"v_evader\": 0.8}'")
-    p.add_argument("--out", default=str(DEFAULT_OUT / "play.gif"), help="GIF path")
-    p.add_argument("--fps", type=int, default=20)
+    p.add_argument("--seed", type=integer(0), default=0, help="episode seed (>= 0)")
+    p.add_argument("--max-cycles", type=integer(1), default=None, help="episode horizon in steps")
+    p.add_argument("--config", help=f"env overrides as JSON, e.g. {CONFIG_EXAMPLE}")
+    p.add_argument(
+        "--out",
+        default=str(DEFAULT_OUT / "play.gif"),
+        help="replay: a .gif, a .png strip, or a directory (DIR/play.gif)",
+    )
+    p.add_argument(
+        "--fps", type=integer(1, MAX_FPS), default=20, help=f"GIF frame rate (1-{MAX_FPS})"
+    )
     p.add_argument("--overlay", action="store_true", help="draw the decomposition under the replay")
     p.add_argument("--no-gif", action="store_true", help="only print the outcome")
     p.set_defaults(func=_cmd_play)
 
     p = sub.add_parser("analyze", help="draw the critical curves, regions and graph G_L")
     p.add_argument("map", help="built-in name or map file")
-    p.add_argument("--length", type=float, default=None, help="rod length L (default: L_min)")
-    p.add_argument("--out", help="PNG path")
+    p.add_argument(
+        "--length", type=real(0.0), default=None, help="rod length L (default: a built-in's L_min)"
+    )
+    p.add_argument("--out", help="picture (.png, .pdf, .svg) or a directory")
     p.add_argument("--no-graph", action="store_true", help="omit the connectivity graph panel")
     p.set_defaults(func=_cmd_analyze)
 
     p = sub.add_parser("figure", help="draw the paper's optimal-control figures")
     p.add_argument("name", choices=["shooting", "greedy", "tractrix"])
     p.add_argument("--params", help="parameters as JSON, e.g. '{\"rho\": 0.5}'")
-    p.add_argument("--out", help="PNG path")
+    p.add_argument("--out", help="picture (.png, .pdf, .svg) or a directory")
     p.set_defaults(func=_cmd_figure)
 
     p = sub.add_parser("evaluate", help="play every pursuer against every evader")
@@ -220,14 +352,44 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class _OneLineWarnings:
+    """Show each distinct warning once, as one line: ``surveil: warning: ...``."""
+
+    def __init__(self) -> None:
+        self.seen: set[str] = set()
+
+    def __call__(self, message, category, filename, lineno, file=None, line=None) -> None:
+        text = str(message)
+        if text not in self.seen:
+            self.seen.add(text)
+            print(f"surveil: warning: {text}", file=sys.stderr if file is None else file)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``surveil`` console script."""
-    args = build_parser().parse_args(argv)
+    """Entry point of the ``surveil`` console script.
+
+    Returns:
+        0 on success, 2 for a user error (one line on stderr: ``surveil: error: ...``
+        naming the value, what was expected and where it came from), 130 when
+        interrupted. A traceback means a bug.
+    """
     try:
-        return int(args.func(args) or 0)
-    except ValueError as exc:  # project errors subclass ValueError and name the bad value
-        print(f"surveil: error: {exc}", file=sys.stderr)
-        return 2
+        args = build_parser().parse_args(argv)
+    except SystemExit as exc:  # argparse: --help (0) or a usage error (2, already printed)
+        return int(exc.code or 0) if not isinstance(exc.code, str) else 2
+    with warnings.catch_warnings():
+        warnings.showwarning = _OneLineWarnings()
+        try:
+            return int(args.func(args) or 0)
+        except KeyboardInterrupt:
+            print("surveil: interrupted", file=sys.stderr)
+            return 130
+        except Exception as exc:
+            message = user_error(exc)
+            if message is None:
+                raise  # a bug: keep the traceback
+            print(f"surveil: error: {message}", file=sys.stderr)
+            return 2
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -12,6 +12,7 @@ user's parameters, drawn by the same functions as the paper's figures.
 
 from __future__ import annotations
 
+import inspect
 import math
 from pathlib import Path
 from typing import Any
@@ -20,10 +21,18 @@ import numpy as np
 
 from analysis.figures import cases, style
 from analysis.figures.registry import register
-from envs.errors import SurveilValueError, UnknownNameError
+from envs.errors import InvalidConfigError, SurveilValueError, UnknownNameError
 from strategies.control import greedy_heading, shoot, solve_escape, tractrix
 
-__all__ = ["FIGURES", "draw_arc", "draw_figure", "draw_greedy", "draw_shooting", "draw_tractrix"]
+__all__ = [
+    "FIGURES",
+    "draw_arc",
+    "draw_figure",
+    "draw_greedy",
+    "draw_shooting",
+    "draw_tractrix",
+    "figure_parameters",
+]
 
 
 def draw_arc(ax, arc, title: str, rods: int = 6, legend: bool = True) -> None:
@@ -106,6 +115,18 @@ FIGURES = tuple(_DRAWERS)
 """Names accepted by :func:`draw_figure` (``surveil figure NAME``)."""
 
 
+def figure_parameters(name: str) -> dict[str, Any]:
+    """The parameters of figure ``name`` (``surveil figure NAME``) with their defaults.
+
+    Raises:
+        UnknownNameError: unknown ``name``.
+    """
+    if name not in _DRAWERS:
+        raise UnknownNameError(f"figure name {name!r}: expected one of {FIGURES}")
+    sig = inspect.signature(_DRAWERS[name])
+    return {k: p.default for k, p in list(sig.parameters.items())[1:]}  # after ``ax``
+
+
 def draw_figure(name: str, path: str | Path, **params: Any) -> Path:
     """Draw one parametric figure to a PNG file (``surveil figure NAME --params JSON``).
 
@@ -115,16 +136,22 @@ def draw_figure(name: str, path: str | Path, **params: Any) -> Path:
             (Fig. 12; ``theta0, x_max, L, rho, branch``) or ``"tractrix"`` (Fig. 14;
             ``t_max, L, v_e, theta0``).
         path: output file.
-        **params: figure parameters (unknown ones raise TypeError).
+        **params: figure parameters (see :func:`figure_parameters`).
 
     Returns:
         The path written.
 
     Raises:
         UnknownNameError: unknown ``name``.
+        InvalidConfigError: an unknown parameter (or a bad value, from the theory).
     """
-    if name not in _DRAWERS:
-        raise UnknownNameError(f"figure name {name!r}: expected one of {FIGURES}")
+    known = figure_parameters(name)
+    unknown = sorted(set(params) - set(known))
+    if unknown:
+        raise InvalidConfigError(
+            f"figure {name!r}: unknown parameter(s) {unknown}; its parameters are "
+            + ", ".join(f"{k} (default {v!r})" for k, v in known.items())
+        )
     with style.context():
         fig, axes = style.new_figure(6.0, 4.5)
         _DRAWERS[name](axes[0, 0], **params)

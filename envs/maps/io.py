@@ -467,8 +467,8 @@ def read_map(path: str | os.PathLike[str], *, merge: bool | None = None) -> MapD
         The map with the file's description and metadata.
 
     Raises:
-        InvalidMapError: naming the file and the problem.
-        FileNotFoundError: if the file does not exist.
+        InvalidMapError: naming the file and the problem (also a missing file, a
+            directory, an unreadable file or one that is not UTF-8 text).
     """
     p = Path(path)
     fmt = _format_of(p, for_writing=False)
@@ -477,6 +477,12 @@ def read_map(path: str | os.PathLike[str], *, merge: bool | None = None) -> MapD
         text = p.read_text(encoding="utf-8")
     except UnicodeDecodeError as exc:
         raise _fail(source, f"not UTF-8 text ({exc})") from exc
+    except FileNotFoundError:
+        raise _fail(source, "no such map file") from None
+    except IsADirectoryError:
+        raise _fail(source, "is a directory, expected a map file") from None
+    except OSError as exc:
+        raise _fail(source, f"cannot read the map file ({exc.strerror or exc})") from None
     if fmt == "wkt":
         return MapDocument(map_from_wkt(text, source=source, merge=bool(merge)))
     try:
@@ -498,8 +504,7 @@ def load_map(path_or_name: str | os.PathLike[str], *, merge: bool | None = None)
 
     Raises:
         UnknownNameError: for a name that is neither a built-in nor a map file.
-        InvalidMapError: naming the file and the problem.
-        FileNotFoundError: for a missing map file.
+        InvalidMapError: naming the file and the problem (a missing file included).
 
     Examples:
         >>> load_map("corridor").n_vertices
@@ -519,6 +524,8 @@ def load_map(path_or_name: str | os.PathLike[str], *, merge: bool | None = None)
                     f"merge={merge!r} applies to map files, not to the built-in {path_or_name!r}"
                 )
             return builtin_map(path_or_name)
+        if Path(path_or_name).is_dir():
+            raise _fail(path_or_name, "is a directory, expected a map file or a built-in name")
         if not Path(path_or_name).is_file():
             raise UnknownNameError(
                 f"unknown map {path_or_name!r}: expected a built-in name {builtin_names()} "

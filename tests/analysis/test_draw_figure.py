@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from analysis.figures.evasion import FIGURES, draw_figure
-from envs.errors import SurveilValueError, UnknownNameError
+from envs.errors import InvalidConfigError, SurveilValueError, UnknownNameError
 
 pytest.importorskip("matplotlib")
 
@@ -21,7 +21,7 @@ def test_draw_figure_with_multipliers_and_errors(tmp_path):
     draw_figure("shooting", tmp_path / "s.png", lambda1=-1.0, lambda2_0=0.41, x_e=2.0)
     with pytest.raises(UnknownNameError, match="nope"):
         draw_figure("nope", tmp_path / "x.png")
-    with pytest.raises(TypeError):
+    with pytest.raises(InvalidConfigError, match=r"unknown parameter\(s\) \['colour'\]"):
         draw_figure("tractrix", tmp_path / "x.png", colour="red")
     with pytest.raises(SurveilValueError, match="no optimal escape"):
         draw_figure(

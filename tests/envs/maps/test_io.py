@@ -226,9 +226,19 @@ def test_load_map_unknown_name_lists_choices():
     assert isinstance(info.value, KeyError) and isinstance(info.value, ValueError)
 
 
-def test_load_map_missing_file():
-    with pytest.raises(FileNotFoundError):
+def test_load_map_missing_file_directory_or_unreadable(tmp_path):
+    with pytest.raises(InvalidMapError, match=r"^/nonexistent/dir/world\.json: no such map file$"):
         load_map("/nonexistent/dir/world.json")
+    folder = tmp_path / "maps.json"
+    folder.mkdir()
+    with pytest.raises(InvalidMapError, match=r"maps\.json: is a directory, expected a map file"):
+        load_map(folder)
+    with pytest.raises(InvalidMapError, match="is a directory"):
+        load_map(str(folder))
+    binary = tmp_path / "binary.json"
+    binary.write_bytes(b"\xff\xfe\x00garbage")
+    with pytest.raises(InvalidMapError, match=r"binary\.json: not UTF-8 text"):
+        load_map(binary)
 
 
 def test_load_map_unsupported_suffix(tmp_path):

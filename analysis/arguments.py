@@ -1,0 +1,200 @@
+"""Checked command-line arguments, shared by every ``surveil`` subcommand.
+
+Every user error becomes one line, ``surveil: error: WHAT = VALUE: expected ...``, exit
+code 2, no traceback, and is found before any long work starts:
+
+* :class:`Parser` is an ``argparse.ArgumentParser`` whose errors are that one line (no
+  usage dump); subparsers inherit it.
+* :func:`integer` and :func:`real` are argparse ``type=`` functions with ranges.
+* :func:`json_object` parses a JSON option (``--config``, ``--params``) and says which
+  flag failed and where its JSON breaks.
+* :func:`output_file` and :func:`output_dir` check an output path (not a directory where
+  a file is meant, a known suffix, a parent that can be created and written) before the
+  run whose result it will hold.
+* :func:`user_error` tells a project error or a file error (reported as one line) from
+  a bug (which keeps its traceback).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import tempfile
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any, NoReturn
+
+from envs.errors import InvalidConfigError, SurveilValueError
+
+__all__ = [
+    "Parser",
+    "integer",
+    "json_object",
+    "output_dir",
+    "output_file",
+    "real",
+    "user_error",
+]
+
+PROG = "surveil"
+
+
+class Parser(argparse.ArgumentParser):
+    """``argparse.ArgumentParser`` whose errors are one line: ``surveil: error: ...``."""
+
+    def error(self, message: str) -> NoReturn:
+        """Print ``surveil: error: MESSAGE`` (flag and value first) and exit with code 2."""
+        m = re.fullmatch(r"argument (\S+?)(?:/\S+)?: ('.*?'): (.*)", message, flags=re.S)
+        if m:  # a type= check: "--seed = '-1': expected an integer >= 0"
+            message = f"{m[1]} = {m[2]}: {m[3]}"
+        else:
+            message = re.sub(r"^argument (\S+?)(?:/\S+)?: ", r"\1: ", message)
+        self.exit(2, f"{PROG}: error: {message} (see '{self.prog} --help')\n")
+
+
+def integer(minimum: int, maximum: int | None = None) -> Callable[[str], int]:
+    """An argparse ``type=``: an integer in [minimum, maximum]."""
+    expected = (
+        f"an integer >= {minimum}" if maximum is None else f"an integer in [{minimum}, {maximum}]"
+    )
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r}: expected {expected}") from None
+        if value < minimum or (maximum is not None and value > maximum):
+            raise argparse.ArgumentTypeError(f"{text!r}: expected {expected}")
+        return value
+
+    parse.__name__ = "integer"
+    return parse
+
+
+def real(minimum: float, *, strict: bool = True) -> Callable[[str], float]:
+    """An argparse ``type=``: a finite number > ``minimum`` (``strict``) or >= it."""
+    expected = f"a finite number {'>' if strict else '>='} {minimum:g}"
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r}: expected {expected}") from None
+        ok = value > minimum if strict else value >= minimum
+        if not (ok and value < float("inf")):
+            raise argparse.ArgumentTypeError(f"{text!r}: expected {expected}")
+        return value
+
+    parse.__name__ = "real"
+    return parse
+
+
+def json_object(flag: str, text: str | None, *, example: str) -> dict[str, Any]:
+    """The JSON object given to ``flag`` (``{}`` when the flag is absent).
+
+    Raises:
+        InvalidConfigError: not JSON (naming the flag and where the JSON breaks), or JSON
+            that is not an object.
+    """
+    if text is None:
+        return {}
+    try:
+        obj = json.loads(text)
+    except json.JSONDecodeError as exc:
+        near = text[max(0, exc.pos - 10) : exc.pos + 10]
+        raise InvalidConfigError(
+            f"{flag} = {text!r}: not valid JSON: {exc.msg} at column {exc.colno} "
+            f"(near {near!r}); expected an object such as {example}"
+        ) from None
+    if not isinstance(obj, dict):
+        raise InvalidConfigError(
+            f"{flag} = {text!r}: expected a JSON object such as {example}, "
+            f"got a JSON {_json_kind(obj)}"
+        )
+    return obj
+
+
+def _json_kind(obj: Any) -> str:
+    names = {list: "array", str: "string", bool: "boolean", int: "number", float: "number"}
+    return "null" if obj is None else names.get(type(obj), type(obj).__name__)
+
+
+def output_file(
+    flag: str, value: str | os.PathLike[str], *, suffixes: Sequence[str], default_name: str
+) -> Path:
+    """The file an option names, checked before the run that will fill it.
+
+    A directory (existing, or written with a trailing slash) means ``DIR/default_name``.
+    The parent directory is created if needed and must accept a new file.
+
+    Raises:
+        InvalidConfigError: a suffix not in ``suffixes``, or a parent that cannot be
+            created or written (naming the flag, the path and the reason).
+    """
+    text = os.fspath(value)
+    path = Path(text)
+    if path.is_dir() or text.endswith(("/", os.sep)):
+        path = path / default_name
+    if path.suffix.lower() not in suffixes:
+        raise InvalidConfigError(
+            f"{flag} = {text!r}: expected a file ending in {' or '.join(suffixes)}"
+        )
+    _writable_dir(flag, text, path.parent)
+    return path
+
+
+def output_dir(flag: str, value: str | os.PathLike[str]) -> Path:
+    """A directory an option names, created if needed and checked for writing.
+
+    Raises:
+        InvalidConfigError: an existing file, or a directory that cannot be created or
+            written.
+    """
+    text = os.fspath(value)
+    path = Path(text)
+    if path.exists() and not path.is_dir():
+        raise InvalidConfigError(f"{flag} = {text!r}: is a file, expected a directory")
+    _writable_dir(flag, text, path)
+    return path
+
+
+def _writable_dir(flag: str, text: str, directory: Path) -> None:
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=directory):
+            pass  # a file can be created there (os.access lies to root and on some mounts)
+    except (FileExistsError, NotADirectoryError):
+        blocker = next((p for p in (directory, *directory.parents) if p.is_file()), directory)
+        raise InvalidConfigError(
+            f"{flag} = {text!r}: cannot write in {str(directory)!r}: {str(blocker)!r} is a "
+            "file, not a directory"
+        ) from None
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise InvalidConfigError(
+            f"{flag} = {text!r}: cannot write in {str(directory) or '.'!r} ({reason})"
+        ) from None
+
+
+def user_error(exc: BaseException) -> str | None:
+    """The one-line message for an error a user caused, or ``None`` for a bug.
+
+    User errors are the project's (:class:`~envs.errors.SurveilValueError`), file errors
+    (``OSError``: missing, unreadable, unwritable) and a policy failure caused by one of
+    those (a model fed the wrong observation). Anything else is a bug and keeps its
+    traceback.
+    """
+    if isinstance(exc, SurveilValueError):
+        return str(exc)
+    if isinstance(exc, OSError):
+        if exc.filename is not None and exc.strerror:
+            return f"{exc.filename}: {exc.strerror}"
+        return str(exc) or type(exc).__name__
+    from strategies.runner import PolicyFailure
+
+    cause = exc.__cause__
+    if isinstance(exc, PolicyFailure) and cause is not None and user_error(cause) is not None:
+        return str(exc)
+    return None

@@ -1,0 +1,214 @@
+"""Every user error of ``surveil`` is one line, exit code 2, no traceback, found before the run.
+
+Each case goes through ``analysis.cli.main`` as a user's command would. "Before the run"
+is checked by the outcome line: ``play`` prints it only after an episode was played.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from PIL import Image
+
+from analysis.cli import main
+
+FAST = ["--pursuer", "pursuer/greedy", "--evader", "evader/straight", "--max-cycles", "5"]
+
+
+def _fails(capsys, argv: list[str], *needles: str) -> str:
+    """Run ``surveil ARGV``: exit code 2, one ``surveil: error:`` line naming each needle."""
+    assert main(argv) == 2
+    out, err = capsys.readouterr()
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith("surveil: error: "), err
+    assert "Traceback" not in err
+    for needle in needles:
+        assert needle in lines[0], (needle, lines[0])
+    assert "kept surveillance" not in out and "escaped" not in out  # no episode was played
+    return lines[0]
+
+
+@pytest.fixture
+def map_file(tmp_path) -> Path:
+    from envs.maps import builtin_map, save_map
+
+    path = tmp_path / "room.json"
+    save_map(builtin_map("open_room"), path)
+    return path
+
+
+# ---------------------------------------------------------------------- map files
+def test_missing_map_file(capsys, tmp_path):
+    missing = str(tmp_path / "nowhere.json")
+    _fails(capsys, ["play", "--map", missing, "--no-gif"], "--map", missing, "no such map file")
+    _fails(capsys, ["analyze", missing], "map", missing, "no such map file")
+
+
+def test_a_directory_given_as_a_map(capsys, tmp_path):
+    folder = tmp_path / "maps.json"
+    folder.mkdir()
+    _fails(capsys, ["play", "--map", str(folder), "--no-gif"], "--map", "is a directory")
+    _fails(capsys, ["analyze", str(tmp_path)], "is a directory")
+
+
+@pytest.mark.parametrize(
+    ("content", "needle"),
+    [
+        (b"", "not valid JSON"),
+        (b'{"boundary": [[0, 0], [1, 0]', "not valid JSON"),
+        (b"\xff\xfe\x00\x01", "not UTF-8"),
+        (b'{"boundary": [[0, 0], [10, 0], [10, "ten"], [0, 10]]}', "vertex 2"),
+        (b'{"boundary": [[0, 0], [10, 0], [0, 0]]}', "boundary"),
+        (b"[1, 2, 3]", "room.json"),
+    ],
+    ids=["empty", "truncated", "binary", "string-coordinate", "degenerate", "not-an-object"],
+)
+def test_a_broken_map_file_of_each_kind(capsys, tmp_path, content, needle):
+    path = tmp_path / "room.json"
+    path.write_bytes(content)
+    _fails(capsys, ["play", "--map", str(path), "--no-gif"], "--map", str(path), needle)
+
+
+# ---------------------------------------------------------------------- outputs
+def test_an_output_under_a_file_is_refused_before_the_episode(capsys, tmp_path):
+    blocker = tmp_path / "file.txt"
+    blocker.write_text("x")
+    out = str(blocker / "sub" / "replay.gif")
+    _fails(capsys, ["play", *FAST, "--out", out], "--out", "is a file, not a directory")
+    _fails(capsys, ["figure", "tractrix", "--out", out.replace(".gif", ".png")], "--out")
+    _fails(capsys, ["maps", "--plot", str(blocker)], "--plot", "is a file")
+
+
+def test_an_output_with_a_wrong_suffix(capsys, tmp_path):
+    _fails(capsys, ["play", *FAST, "--out", str(tmp_path / "r.mp4")], "--out", ".gif or .png")
+
+
+def test_a_directory_as_the_output_holds_the_default_name(capsys, tmp_path):
+    assert main(["play", "--map", "open_room", *FAST, "--out", str(tmp_path)]) == 0
+    with Image.open(tmp_path / "play.gif") as gif:
+        assert gif.n_frames == 6
+    assert main(["analyze", "corridor", "--out", str(tmp_path)]) == 0
+    assert (tmp_path / "decomposition_corridor_L2.png").stat().st_size > 1000
+    assert not (tmp_path.parent / f"{tmp_path.name}.png").exists()  # not DIR.png
+    new_dir = str(tmp_path / "figs") + "/"  # a trailing slash names a directory to create
+    assert main(["figure", "tractrix", "--out", new_dir]) == 0
+    assert (tmp_path / "figs" / "figure_tractrix.png").exists()
+    assert not list(tmp_path.glob(".*.tmp"))  # no temporary files left behind
+
+
+# ---------------------------------------------------------------------- JSON options
+@pytest.mark.parametrize(
+    ("text", "needles"),
+    [
+        ('{"foo": 1}', ["--config", "unknown env option(s) ['foo']", "l_min"]),
+        ("[1, 2]", ["--config = '[1, 2]'", "expected a JSON object", "got a JSON array"]),
+        ('{"v_evader": 0.8', ["--config", "not valid JSON", "column 17"]),
+        ("", ["--config", "not valid JSON"]),
+        ('{"l_min": -1}', ["--config: l_min = -1: expected a finite number > 0"]),
+        ('{"v_evader": "fast"}', ["--config: v_evader = 'fast'", "got str"]),
+        ('{"n_rays": true}', ["--config: n_rays = True", "got bool"]),
+    ],
+)
+def test_bad_config(capsys, text, needles):
+    _fails(capsys, ["play", *FAST, "--no-gif", "--config", text], *needles)
+
+
+@pytest.mark.parametrize(
+    ("argv", "needles"),
+    [
+        (
+            ["--pursuer", "pursuer/greedy", "--pursuer-params", '{"gain": null}'],
+            ["--pursuer-params", "policy 'pursuer/greedy': gain = None"],
+        ),
+        (
+            ["--pursuer", "pursuer/decomposition", "--pursuer-params", '{"n_bins": true}'],
+            ["--pursuer-params", "n_bins = True: expected an integer"],
+        ),
+        (
+            ["--evader", "evader/shooting", "--evader-params", '{"shoot": "no"}'],
+            ["--evader-params", "shoot = 'no': expected true or false"],
+        ),
+        (
+            ["--pursuer", "pursuer/decomposition", "--pursuer-params", '{"rays": 1e9}'],
+            ["--pursuer-params", "rays = 1000000000.0: expected an integer"],
+        ),
+        (
+            ["--evader", "evader/toward_away", "--evader-params", '{"no_such": 1}'],
+            ["--evader-params", "no parameter(s) ['no_such']"],
+        ),
+        (["--evader", "pursuer/greedy"], ["--evader = 'pursuer/greedy'", "'evader/KIND'"]),
+        (["--pursuer", "pursuer/nobody"], ["--pursuer", "unknown policy 'pursuer/nobody'"]),
+        (["--pursuer-params", "{gain: 1}"], ["--pursuer-params", "not valid JSON"]),
+    ],
+)
+def test_bad_policies_and_parameters(capsys, argv, needles):
+    _fails(capsys, ["play", "--max-cycles", "5", "--no-gif", *argv], *needles)
+
+
+def test_unknown_figure_parameter(capsys):
+    _fails(
+        capsys,
+        ["figure", "shooting", "--params", '{"bogus": 1}'],
+        "--params",
+        "no parameter(s) ['bogus']",
+        "rho (default 0.5)",
+    )
+    _fails(capsys, ["figure", "shooting", "--params", '{"rho": "half"}'], "--params", "rho")
+
+
+# ---------------------------------------------------------------------- numbers
+@pytest.mark.parametrize(
+    ("argv", "needles"),
+    [
+        (["play", "--seed", "-1"], ["--seed = '-1': expected an integer >= 0"]),
+        (["play", "--seed", "1.5"], ["--seed = '1.5'"]),
+        (["play", "--fps", "0"], ["--fps = '0': expected an integer in [1, 100]"]),
+        (["play", "--max-cycles", "0"], ["--max-cycles = '0'"]),
+        (["analyze", "corridor", "--length", "-2"], ["--length = '-2'", "> 0"]),
+        (["analyze", "corridor", "--length", "nan"], ["--length = 'nan'"]),
+        (["play", "--no-such-flag"], ["unrecognized arguments: --no-such-flag"]),
+        (["no-such-command"], ["invalid choice: 'no-such-command'"]),
+    ],
+)
+def test_bad_numbers_and_flags_name_the_flag(capsys, argv, needles):
+    _fails(capsys, argv, *needles)
+
+
+def test_analyze_needs_a_length_for_a_map_file(capsys, map_file):
+    _fails(capsys, ["analyze", str(map_file)], "--length is required", str(map_file))
+
+
+def test_analyze_refuses_a_rod_that_fits_nowhere(capsys):
+    _fails(capsys, ["analyze", "corridor", "--length", "1e9"], "--length = 1e+09", "fits nowhere")
+
+
+def test_rho_above_one_is_played_with_one_warning_line(capsys):
+    argv = ["play", *FAST, "--no-gif", "--config", json.dumps({"v_evader": 1.5})]
+    assert main(argv) == 0
+    out, err = capsys.readouterr()
+    assert "escaped" in out or "kept surveillance" in out
+    assert err.strip().splitlines() == [
+        "surveil: warning: v_evader = 1.5 > v_pursuer = 1.0 (rho = 1.5 > 1): the evader can "
+        "always escape by running at the pursuer (Sec. 5 of the paper); legal, but no pursuer "
+        "can win"
+    ]
+
+
+def test_only_user_errors_lose_their_traceback():
+    from analysis.arguments import user_error
+    from envs.errors import InvalidObservationError
+    from strategies.runner import PolicyFailure
+
+    assert user_error(ZeroDivisionError("bug")) is None
+    assert user_error(ValueError("a numpy bug")) is None  # not a project error
+    assert user_error(FileNotFoundError(2, "No such file or directory", "x.toml")) == (
+        "x.toml: No such file or directory"
+    )
+    failure = PolicyFailure("pursuer", "pursuer/sb3:m.zip", 3, "InvalidObservationError: ...")
+    failure.__cause__ = InvalidObservationError("observation: expected shape (13,)")
+    assert user_error(failure) == str(failure)
+    failure.__cause__ = KeyError("a bug inside a policy")
+    assert user_error(failure) is None

@@ -565,14 +565,21 @@ MATCHES = {
 
 @functools.cache
 def play(match: Match):
-    """Play ``match`` (deterministic: one seed drives env, start and both policies)."""
-    from analysis.evaluate import play_episode
+    """Play ``match`` with the shared episode runner (deterministic: one seed drives env,
+    start and both policies). A rho > 1 match is deliberate here, so its warning is not
+    repeated."""
+    import warnings
+
+    from envs.errors import RhoAboveOneWarning
     from strategies.policies import make_policy
+    from strategies.runner import run_episode
 
     evader = make_policy(match.evader, **dict(match.evader_params))
-    return play_episode(
-        match.map, match.pursuer, evader, seed=match.seed, overrides=dict(match.overrides)
-    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RhoAboveOneWarning)
+        return run_episode(
+            match.map, match.pursuer, evader, seed=match.seed, overrides=dict(match.overrides)
+        )
 
 
 @functools.cache

@@ -301,6 +301,12 @@ number("replay.two_rooms.time", "time of the two-rooms escape (s)", "{:.1f}")(
     lambda: _play("two_rooms").escape_time
 )
 number("replay.two_rooms.cause", "why surveillance broke")(lambda: _play("two_rooms").cause)
+number("replay.two_rooms.feature", "the wall feature the rod hit")(
+    lambda: _play("two_rooms").feature
+)
+number("replay.corner_fast.feature", "the wall feature the rod hit")(
+    lambda: _play("corner_fast").feature
+)
 number("replay.corner_fast.time", "time of the fast corner escape (s)", "{:.1f}")(
     lambda: _play("corner_fast").escape_time
 )

@@ -1,7 +1,7 @@
 """Claims in motion: short GIF replays of seeded episodes with the analytic policies.
 
 The episodes are :data:`analysis.figures.cases.MATCHES`, played with the shared episode
-loop (:func:`analysis.evaluate.play_episode`) and drawn by the env's own renderer
+runner (:func:`strategies.runner.run_episode`) and drawn by the env's own renderer
 (:func:`analysis.replay.frames_from_trajectory`), the decomposition's escapable regions
 shaded under them where it helps (:func:`analysis.overlay.decomposition_shading`). The
 GIFs are kept small: frames subsampled, a shared 64-colour palette, no dithering.

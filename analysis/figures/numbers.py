@@ -315,12 +315,18 @@ number("replay.charge.time", "time of the charge's escape (s)", "{:.2f}")(
     lambda: _play("charge").escape_time
 )
 number("replay.charge.cause", "why it broke")(lambda: _play("charge").cause)
-number("fn4.charge_wins", "charging evader wins, of 10 seeds (rho = 1.5)")(
-    lambda: cases.rho_gt_1_tally()["charge"]
-)
-number("fn4.run_away_wins", "running-away evader wins, of 10 seeds (rho = 1.5)")(
-    lambda: cases.rho_gt_1_tally()["run_away"]
-)
+for _k in cases.MATCHES:
+    number(f"tally.{_k}", f"evader wins in seeds 0-9 of the {_k} match")(
+        lambda k=_k: cases.evader_wins(k)
+    )
+
+
+@number("tally.corner_fast.on_corner", "of them, the rod occluded by the corner (5, 5)")
+def _on_corner() -> int:
+    return sum(
+        cause == "occluded" and feature is not None and feature.endswith("(5, 5)")
+        for _, cause, feature in cases.outcomes("corner_fast")
+    )
 
 
 # ------------------------------------------------------------------ Sec. 6.1

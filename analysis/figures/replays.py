@@ -160,21 +160,22 @@ def build_fig06_replay(path: Path, scale: float) -> None:
     kind="gif",
     title="rounding the corner, slow and fast evader",
     caption="""A wall-hugging evader leads round the convex corner of the Fig. 9(b) world
-    against the decomposition pursuer (seed 3). Left, ρ = 0.5: the pursuer keeps up and
-    holds. Right, ρ = 0.95: it cannot turn the rod fast enough (Sec. 7.4: near the corner
-    the required speed V_e (L - l)/l exceeds V_p) and the rod is occluded.""",
+    against the decomposition pursuer. Left, ρ = 0.5 (seed 3): the pursuer keeps up and
+    holds. Right, ρ = 1 (seed 1): it cannot turn the rod round the corner fast enough
+    (Sec. 7.4: with the evader nearer the corner than L/2 the required speed
+    V_e (L - l)/l exceeds V_p) and the rod is occluded by the corner.""",
 )
 def build_fig09_replay(path: Path, scale: float) -> None:
     """Two corner episodes side by side."""
     slow = cases.play(cases.MATCHES["corner_slow"])
-    fast = cases.play(cases.MATCHES["corner_fast"])
+    fast = cases.play(cases.MATCHES["corner_fast"])  # rho = 1
     size = _size(0.8 * scale)
     until = fast.steps * fast.dt + 3.0  # both panels until shortly after the fast escape
     panels = [
         episode_frames(
             slow, size, step=2, until=until, label="rho = 0.5: " + _outcome(slow, until)
         ),
-        episode_frames(fast, size, step=2, until=until, label="rho = 0.95: " + _outcome(fast)),
+        episode_frames(fast, size, step=2, until=until, label="rho = 1: " + _outcome(fast)),
     ]
     write_gif(path, panels)
 

@@ -62,7 +62,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
 
 def run(args: argparse.Namespace) -> int:
     """Run ``surveil figures``."""
-    from analysis.figures.registry import build_figure, select
+    from analysis.figures.registry import build_figure, check_scale, select
 
     if args.list:
         for s in select(None):
@@ -80,6 +80,7 @@ def run(args: argparse.Namespace) -> int:
         _update(Path(args.update))
         return 0
     specs = select(args.only)
+    check_scale(args.scale)  # before drawing anything
     from tqdm import tqdm
 
     out = Path(args.out)

@@ -72,7 +72,7 @@ def build_fig01(path: Path, scale: float) -> None:
     u = np.array([math.cos(th), math.sin(th)])
     P = E + L * u
     ev = rho * v_p * np.array([math.cos(al), math.sin(al)])
-    fig, axes = style.new_figure(8.4, 3.9, 1, 2, width_ratios=[1.0, 1.05])
+    fig, axes = style.new_figure(8.4, 4.3, 1, 2, width_ratios=[1.0, 1.05])
     ax = axes[0, 0]
     ax.axhline(E[1], color=style.GUIDE, lw=0.6, ls=":")
     style.draw_rod(ax, E, P, size=6)
@@ -117,25 +117,39 @@ def build_fig01(path: Path, scale: float) -> None:
     ax.annotate("rod", E + (P - E) * 0.52, color=style.ROD, fontsize=8, ha="right")
     ax.plot(*P, "o", color=style.PURSUER, ms=6)
     style.arrow(ax, P, k * ev, colour=style.EVADER, ls="--", label=" ė")
-    for rate, name, dy in ((tp, "θ̇⁺", 0.12), (tm, "θ̇⁻", -0.3)):
+    box = {"fc": "white", "ec": "none", "alpha": 0.85, "pad": 0.6}
+    for rate, name, off, ha in (
+        (tp, "θ̇⁺", (0.12, 0.1), "left"),
+        (tm, "θ̇⁻", (-0.15, -0.25), "right"),
+    ):
         vel = pursuer_velocity(ev, th, rate, L=L)
         style.arrow(ax, P, k * vel, colour=style.PURSUER)
         style.arrow(ax, P + k * ev, k * L * rate * n, colour=style.ROD, lw=1.0)
         tip = P + k * vel
         ax.annotate(
-            f"ṗ ({name} = {rate:+.3f})", tip + np.array([0.08, dy]), color=style.PURSUER, fontsize=8
+            f"ṗ with {name} = {rate:+.3f}",
+            tip + np.array(off),
+            color=style.PURSUER,
+            fontsize=8,
+            ha=ha,
+            bbox=box,
+            zorder=9,
         )
     ax.annotate(
         "|ṗ| = $V_p$",
-        P + k * v_p * np.array([math.cos(2.4), math.sin(2.4)]),
+        P + k * v_p * np.array([math.cos(2.6), math.sin(2.6)]),
+        xytext=(-4, 0),
+        textcoords="offset points",
         color=style.PURSUER,
         fontsize=8,
         ha="right",
+        bbox=box,
+        zorder=9,
     )
     ax.annotate("P", P + np.array([-0.3, 0.05]), color=style.PURSUER, fontsize=9, fontweight="bold")
     ax.set_aspect("equal")
-    ax.set_xlim(P[0] - 2.0, P[0] + 2.3)
-    ax.set_ylim(P[1] - 2.0, P[1] + 2.0)
+    ax.set_xlim(P[0] - 2.4, P[0] + 2.4)
+    ax.set_ylim(P[1] - 2.1, P[1] + 2.1)
     ax.set_xticks([])
     ax.set_yticks([])
     ax.set_title("eqs. (5)-(6): the two rates θ̇± at |ṗ| = $V_p$")

@@ -16,9 +16,13 @@ from pathlib import Path
 from envs.errors import InvalidConfigError, UnknownNameError
 from envs.validation import positive
 
+MAX_SCALE = 4.0
+"""Largest size factor (a 4x documentation figure is already a few thousand pixels wide)."""
+
 __all__ = [
     "FigureSpec",
     "build_figure",
+    "check_scale",
     "figure_names",
     "figure_spec",
     "figure_specs",
@@ -147,16 +151,24 @@ def select(names: Iterable[str] | None) -> tuple[FigureSpec, ...]:
     return tuple(s for s in specs if s.name in wanted)
 
 
+def check_scale(scale: object) -> float:
+    """``scale`` as a float in (0, :data:`MAX_SCALE`], or InvalidConfigError naming it."""
+    value = positive("scale", scale)
+    if value > MAX_SCALE:
+        raise InvalidConfigError(f"scale = {scale!r}: expected a size factor in (0, {MAX_SCALE:g}]")
+    return value
+
+
 def build_figure(name: str, out_dir: str | Path, *, scale: float = 1.0) -> Path:
     """Build one figure into ``out_dir`` (created if missing) and return its path.
 
     Args:
         name: a figure name or unique prefix (:func:`figure_names`).
         out_dir: output directory.
-        scale: size factor (1 for the documentation; smaller is faster).
+        scale: size factor in (0, 4] (1 for the documentation; smaller is faster).
     """
     spec = figure_spec(name)
-    scale = positive("scale", scale)
+    scale = check_scale(scale)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     path = out / spec.filename

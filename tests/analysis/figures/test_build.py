@@ -66,6 +66,8 @@ def test_bad_scale_is_refused(tmp_path):
         build_figure("fig12", tmp_path, scale=0)
     with pytest.raises(InvalidConfigError, match="scale"):
         build_figure("fig12", tmp_path, scale=True)
+    with pytest.raises(InvalidConfigError, match=r"scale = 100.0: expected a size factor"):
+        build_figure("fig12", tmp_path, scale=100.0)
 
 
 def test_figures_are_deterministic(tmp_path):

@@ -65,8 +65,12 @@ MATCHES = {
         (("v_evader", 1.5),),
         (("mode", "away"),),
     ),
+    "corner_charge": Match(
+        "corner", "pursuer/decomposition", "evader/toward_away", 0, (), (("mode", "toward"),)
+    ),
 }
-"""The episodes the replays show (and the report quotes)."""
+"""The episodes the replays show and the report quotes (``corner_charge``: Fig. 9(a)'s
+charge at rho = 0.5 in the world of Fig. 9(b), quoted as a tally only)."""
 
 
 @functools.cache

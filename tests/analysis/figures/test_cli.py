@@ -2,16 +2,11 @@
 
 from __future__ import annotations
 
-import shutil
-from pathlib import Path
-
 import pytest
 
 from analysis.cli import main
 
 pytest.importorskip("matplotlib")
-
-REPORT = Path(__file__).resolve().parents[3] / "docs" / "REPRODUCTION.md"
 
 
 def test_list_and_numbers(capsys):
@@ -39,33 +34,3 @@ def test_bad_input_is_a_clear_error(tmp_path, capsys):
     assert main(["figures", "--numbers", "zzz"]) == 2
     assert main(["figures", "--only", "fig12", "--scale", "-1", "--out", str(tmp_path)]) == 2
     assert "scale" in capsys.readouterr().err
-
-
-def test_check_catches_drift_and_report_repairs_it(tmp_path, capsys):
-    copy = tmp_path / "REPRODUCTION.md"
-    shutil.copy(REPORT, copy)
-    text = copy.read_text(encoding="utf-8")
-    assert "31<!--n:corridor.regions-->" in text
-    copy.write_text(
-        text.replace("31<!--n:corridor.regions-->", "19<!--n:corridor.regions-->"), encoding="utf-8"
-    )
-    assert main(["figures", "--check", str(copy)]) == 1
-    out = capsys.readouterr().out
-    assert "corridor.regions" in out and "'19'" in out
-    assert (
-        main(
-            [
-                "figures",
-                "--only",
-                "fig12",
-                "--out",
-                str(tmp_path / "f"),
-                "--scale",
-                "0.3",
-                "--report",
-                str(copy),
-            ]
-        )
-        == 0
-    )
-    assert copy.read_text(encoding="utf-8") == text

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import pytest
 
+from analysis.cli import main
 from analysis.figures.numbers import NUMBERS, compute_numbers
 from analysis.figures.report import BEGIN, END, check_report, gallery, tags, update_report
 from envs.errors import UnknownNameError
@@ -13,13 +15,39 @@ from envs.errors import UnknownNameError
 REPORT = Path(__file__).resolve().parents[3] / "docs" / "REPRODUCTION.md"
 
 
-def test_the_report_matches_the_code():
+def test_the_report_matches_the_code(tmp_path, capsys):
     """Every tagged number equals its recomputed value, every number is quoted, the
     gallery matches the registry, and no computed result is left untagged. If this fails,
     regenerate with `surveil figures --out docs/figures --report docs/REPRODUCTION.md` and
     re-read the rows whose numbers changed: their status may have changed too."""
     problems = check_report(REPORT.read_text(encoding="utf-8"), compute_numbers())
-    assert not problems, "\n".join(map(str, problems))
+    fix = (
+        "\ndocs/REPRODUCTION.md has drifted from the code. Regenerate it and the pictures with\n"
+        "    surveil figures --out docs/figures --report docs/REPRODUCTION.md\n"
+        "then re-read the rows whose numbers changed (their status may change too)."
+    )
+    assert not problems, "\n".join(map(str, problems)) + fix
+    _command_line_finds_and_repairs_drift(tmp_path, capsys)
+
+
+def _command_line_finds_and_repairs_drift(tmp_path, capsys):
+    """`surveil figures --check` finds a tampered number (exit 1) and --report puts it
+    back (part of the test above, so that the numbers are computed once)."""
+    copy = tmp_path / "REPRODUCTION.md"
+    shutil.copy(REPORT, copy)
+    text = copy.read_text(encoding="utf-8")
+    assert "31<!--n:corridor.regions-->" in text
+    copy.write_text(
+        text.replace("31<!--n:corridor.regions-->", "19<!--n:corridor.regions-->"),
+        encoding="utf-8",
+    )
+    assert main(["figures", "--check", str(copy)]) == 1
+    out = capsys.readouterr().out
+    assert "corridor.regions" in out and "'19'" in out
+    args = ["figures", "--only", "fig12", "--scale", "0.3", "--out", str(tmp_path / "f")]
+    assert main([*args, "--report", str(copy)]) == 0
+    assert copy.read_text(encoding="utf-8") == text
+    assert main(["figures", "--check", str(copy)]) == 0
 
 
 def _doc(body: str) -> str:

@@ -172,7 +172,7 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
                 "a rod length (their L_min)"
             )
         length = builtin_info(args.map).l_min
-    diameter = _diameter(world)
+    diameter = world.diameter
     if length > diameter:
         raise InvalidConfigError(
             f"--length = {length:g}: a rod this long fits nowhere in map {world.name!r} "
@@ -198,15 +198,6 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
     print(dec.summary() if hasattr(dec, "summary") else repr(dec))
     print(f"picture written to {out}")
     return 0
-
-
-def _diameter(world) -> float:
-    """The largest distance between two points of the map (between boundary vertices)."""
-    import numpy as np
-
-    b = np.asarray(world.rings[0], dtype=float)
-    d = b[:, None, :] - b[None, :, :]
-    return float(np.sqrt((d * d).sum(axis=-1)).max())
 
 
 def _cmd_figure(args: argparse.Namespace) -> int:
@@ -353,12 +344,20 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 class _OneLineWarnings:
-    """Show each distinct warning once, as one line: ``surveil: warning: ...``."""
+    """Show each distinct warning once, as one line: ``surveil: warning: ...``.
 
-    def __init__(self) -> None:
+    Deprecation warnings (a library's business, not the user's) go to the handler that
+    was installed before.
+    """
+
+    def __init__(self, previous) -> None:
+        self.previous = previous
         self.seen: set[str] = set()
 
     def __call__(self, message, category, filename, lineno, file=None, line=None) -> None:
+        if issubclass(category, (DeprecationWarning, PendingDeprecationWarning)):
+            self.previous(message, category, filename, lineno, file, line)
+            return
         text = str(message)
         if text not in self.seen:
             self.seen.add(text)
@@ -378,7 +377,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SystemExit as exc:  # argparse: --help (0) or a usage error (2, already printed)
         return int(exc.code or 0) if not isinstance(exc.code, str) else 2
     with warnings.catch_warnings():
-        warnings.showwarning = _OneLineWarnings()
+        warnings.showwarning = _OneLineWarnings(warnings.showwarning)
         try:
             return int(args.func(args) or 0)
         except KeyboardInterrupt:

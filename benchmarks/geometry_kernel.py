@@ -12,15 +12,11 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
 import time
-from pathlib import Path
 
 import numpy as np
 import shapely
 from shapely.geometry import LineString
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from envs.geometry import Kernel
 from envs.maps.map import Map

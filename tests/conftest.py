@@ -18,3 +18,13 @@ os.environ.setdefault(
         os.path.dirname(os.path.dirname(os.path.abspath(__file__))), ".pytest_cache", "surveil"
     ),
 )
+
+# SB3 creates a logger folder for every model it trains, tempdir/SB3-<date> unless
+# SB3_LOGDIR names one (stable_baselines3.common.logger.configure): keep the suite's
+# in one reused folder of the checkout instead of a dozen new ones in /tmp per run
+os.environ.setdefault(
+    "SB3_LOGDIR",
+    os.path.join(
+        os.path.dirname(os.path.dirname(os.path.abspath(__file__))), ".pytest_cache", "sb3-logs"
+    ),
+)

@@ -5,8 +5,10 @@ lidar) and what the configuration-space theory asks at many points (free orienta
 arcs with their stops, THEORY.md 1.3) lives here, precomputed once per
 :class:`~envs.maps.Map`. Get the kernel of a map with :func:`kernel_for`.
 
-Conventions (THEORY.md section 0): the evader E is at P, the pursuer at
-``Q = P + L (cos theta, sin theta)``; the rod is the segment E-Q.
+Conventions: the evader is E, the pursuer P = E + L (cos theta, sin theta), the rod the
+segment E-P (one meaning per letter, as in the env, the policies and the README; THEORY.md
+section 0 follows the paper and writes the evader's point as P and the pursuer as Q).
+Lower-case p, q name the two ends of any segment, whatever stands there.
 
 Semantics, with one length tolerance ``eps = REL_LENGTH_TOL * map.scale``:
 
@@ -18,7 +20,7 @@ Semantics, with one length tolerance ``eps = REL_LENGTH_TOL * map.scale``:
   vertex (including a vertex passed between two clear frames, and a tangent graze).
 * :meth:`Kernel.free_arcs` -- closed arcs of semi-free orientations (the rod may touch a
   wall at the arc's ends, or at an isolated tangency inside it). Zero-width arcs are
-  dropped. P on a wall blocks the obstacle side (stops ``("body", edge)``); P outside
+  dropped. E on a wall blocks the obstacle side (stops ``("body", edge)``); E outside
   free space has no arc.
 * :meth:`Kernel.ray_distances` -- lidar; a ray counts walls met from their free side.
 

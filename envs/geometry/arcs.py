@@ -1,10 +1,12 @@
 """Exact free orientations of a rod at a point (THEORY.md 1.3, "exact free arcs").
 
-For the evader end P and rod length L:
+Notation (one meaning per letter, project-wide): E is the evader, the rod's reference end
+(THEORY.md section 0 calls it P), and P = E + L (cos theta, sin theta) is the pursuer
+(THEORY.md's Q). For the evader end E and rod length L:
 
-1. clip every wall edge to the closed disk |X - P| <= L (a quadratic in the edge
+1. clip every wall edge to the closed disk |X - E| <= L (a quadratic in the edge
    parameter), giving a sub-segment [a', b'] or nothing;
-2. that sub-segment blocks the short angular arc between atan2(a' - P) and atan2(b' - P);
+2. that sub-segment blocks the short angular arc between atan2(a' - E) and atan2(b' - E);
 3. the union of those arcs, complemented on the circle, is the set of free orientations;
 4. each free arc's ends are labelled by the clipped endpoint that bounds them: an original
    vertex strictly inside the disk is ("body", vertex), a vertex on the circle is
@@ -16,11 +18,11 @@ Degenerate cases, decided with the kernel's length tolerance ``eps``:
   circle whose edges leave the disk, an edge seen end-on) are contacts, not obstacles:
   they do not split a free arc. Free arcs narrower than ``ANGLE_TOL`` are dropped, so a
   configuration pinched to a single orientation (exactly on a type-3 curve) has no arc.
-* P on a wall (a type-0 point): the obstacle side is blocked. On an edge interior that
+* E on a wall (a type-0 point): the obstacle side is blocked. On an edge interior that
   is the closed half circle behind the edge; at a vertex, the closed wedge the obstacle
   occupies there. The arcs next to it end in ("body", edge) stops, the rod lying along
-  the wall. Edges through P are not clipped (their angle at P is undefined).
-* P outside the closed free region: no free orientation (an empty tuple).
+  the wall. Edges through E are not clipped (their angle at E is undefined).
+* E outside the closed free region: no free orientation (an empty tuple).
 """
 
 from __future__ import annotations
@@ -39,36 +41,36 @@ if TYPE_CHECKING:
 __all__ = ["free_arcs_at"]
 
 
-def free_arcs_at(kernel: Kernel, px: float, py: float, L: float) -> FreeArcs:
-    """Free orientations of a rod of length ``L`` whose evader end is at P = (px, py).
+def free_arcs_at(kernel: Kernel, ex: float, ey: float, L: float) -> FreeArcs:
+    """Free orientations of a rod of length ``L`` whose evader end is at E = (ex, ey).
 
     Args:
         kernel: the map's geometry kernel.
-        px: x of P.
-        py: y of P.
+        ex: x of E.
+        ey: y of E.
         L: rod length, > 0.
 
     Returns:
-        The :class:`FreeArcs` at P.
+        The :class:`FreeArcs` at E.
     """
-    P = np.array([px, py])
+    E = np.array([ex, ey])
     eps = kernel.eps
     r = L + eps
-    cand = kernel.edges_near_box(px - r, py - r, px + r, py + r)
+    cand = kernel.edges_near_box(ex - r, ey - r, ex + r, ey + r)
     if len(cand) > kernel.numpy_threshold:
         if not isinstance(cand, np.ndarray):
             cand = np.fromiter(cand, dtype=np.intp, count=len(cand))
-        blocks = _blocked_numpy(kernel, cand, px, py, L)
+        blocks = _blocked_numpy(kernel, cand, ex, ey, L)
     else:
         blocks = _blocked_scalar(
-            kernel, cand.tolist() if isinstance(cand, np.ndarray) else cand, px, py, L
+            kernel, cand.tolist() if isinstance(cand, np.ndarray) else cand, ex, ey, L
         )
-    if blocks is None:  # P outside the closed free region
-        return FreeArcs(P, float(L), ())
+    if blocks is None:  # E outside the closed free region
+        return FreeArcs(E, float(L), ())
     lo, wid, lab_lo, lab_hi = blocks
     if not lo:
-        return FreeArcs(P, float(L), (Arc(-math.pi, math.pi, None, None),))
-    return FreeArcs(P, float(L), _complement(lo, wid, lab_lo, lab_hi))
+        return FreeArcs(E, float(L), (Arc(-math.pi, math.pi, None, None),))
+    return FreeArcs(E, float(L), _complement(lo, wid, lab_lo, lab_hi))
 
 
 Blocks = tuple[list[float], list[float], list[Stop], list[Stop]]
@@ -86,9 +88,9 @@ def _label(
 
 
 def _on_wall_blocks(
-    kernel: Kernel, px: float, py: float, on_edges: list[int]
+    kernel: Kernel, ex: float, ey: float, on_edges: list[int]
 ) -> tuple[Blocks, set[int]]:
-    """Blocked arcs for P on a wall (type 0), and the edges through P they replace."""
+    """Blocked arcs for E on a wall (type 0), and the edges through E they replace."""
     m = kernel.map
     eps = kernel.eps
     lo: list[float] = []
@@ -97,12 +99,12 @@ def _on_wall_blocks(
     lab_hi: list[Stop] = []
     skip: set[int] = set()
     ev = m.edge_vertices
-    for e in on_edges:  # P at a vertex of an edge through it: the obstacle's wedge there
+    for e in on_edges:  # E at a vertex of an edge through it: the obstacle's wedge there
         for v in (int(ev[e, 0]), int(ev[e, 1])):
             vx, vy = kernel._vxy[v]
             e_in = int(m.vertex_prev_edge[v])
             e_out = int(m.vertex_next_edge[v])
-            if e_in in skip or math.hypot(vx - px, vy - py) > eps:
+            if e_in in skip or math.hypot(vx - ex, vy - ey) > eps:
                 continue
             skip.update((e_in, e_out))
             a = math.atan2(-kernel._dirs[e_in][1], -kernel._dirs[e_in][0])
@@ -111,7 +113,7 @@ def _on_wall_blocks(
             wid.append((b - a) % TWO_PI)
             lab_lo.append(kernel._body_edge[e_in])
             lab_hi.append(kernel._body_edge[e_out])
-    for e in on_edges:  # P inside an edge: the closed half circle behind it
+    for e in on_edges:  # E inside an edge: the closed half circle behind it
         if e in skip:
             continue
         skip.add(e)
@@ -123,7 +125,7 @@ def _on_wall_blocks(
     return (lo, wid, lab_lo, lab_hi), skip
 
 
-def _blocked_scalar(kernel: Kernel, cand, px: float, py: float, L: float) -> Blocks | None:
+def _blocked_scalar(kernel: Kernel, cand, ex: float, ey: float, L: float) -> Blocks | None:
     """Blocked arcs of the candidate edges, one edge at a time (few candidates)."""
     eps = kernel.eps
     recs, dirs, vxy = kernel._recs, kernel._dirs, kernel._vxy
@@ -133,8 +135,8 @@ def _blocked_scalar(kernel: Kernel, cand, px: float, py: float, L: float) -> Blo
     for e in cand:
         ax, ay = recs[e][0], recs[e][1]
         ux, uy, length = dirs[e]
-        wx, wy = ax - px, ay - py
-        s = -(wx * ux + wy * uy)  # projection of P on the edge's line
+        wx, wy = ax - ex, ay - ey
+        s = -(wx * ux + wy * uy)  # projection of E on the edge's line
         sc = 0.0 if s < 0.0 else (length if s > length else s)
         cx, cy = wx + sc * ux, wy + sc * uy
         d2 = cx * cx + cy * cy
@@ -145,9 +147,9 @@ def _blocked_scalar(kernel: Kernel, cand, px: float, py: float, L: float) -> Blo
         else:
             near.append((e, wx, wy, ux, uy, s))
     if on_edges:
-        (lo, wid, lab_lo, lab_hi), skip = _on_wall_blocks(kernel, px, py, on_edges)
+        (lo, wid, lab_lo, lab_hi), skip = _on_wall_blocks(kernel, ex, ey, on_edges)
     else:
-        if not kernel.contains_point(px, py):
+        if not kernel.contains_point(ex, ey):
             return None
         lo, wid, lab_lo, lab_hi, skip = [], [], [], [], set()
     ev = kernel.map.edge_vertices
@@ -170,7 +172,7 @@ def _blocked_scalar(kernel: Kernel, cand, px: float, py: float, L: float) -> Blo
         ang_a = math.atan2(wy + t0 * uy, wx + t0 * ux)
         ang_b = math.atan2(wy + t1 * uy, wx + t1 * ux)
         w = (ang_b - ang_a) % TWO_PI
-        flip = w > math.pi  # P behind the edge's line: the short arc runs b' -> a'
+        flip = w > math.pi  # E behind the edge's line: the short arc runs b' -> a'
         if flip:
             w = TWO_PI - w
         if w <= ANGLE_TOL:  # zero width: a contact (tangency), not a block
@@ -178,7 +180,7 @@ def _blocked_scalar(kernel: Kernel, cand, px: float, py: float, L: float) -> Blo
         la = _label(kernel, t0 <= eps, e, e, math.sqrt(ww), L, eps)
         if t1 >= length - eps:
             vb = int(ev[e, 1])
-            lb = _label(kernel, True, vb, e, math.hypot(vxy[vb][0] - px, vxy[vb][1] - py), L, eps)
+            lb = _label(kernel, True, vb, e, math.hypot(vxy[vb][0] - ex, vxy[vb][1] - ey), L, eps)
         else:
             lb = kernel._tip_edge[e]
         if flip:
@@ -194,7 +196,7 @@ def _blocked_scalar(kernel: Kernel, cand, px: float, py: float, L: float) -> Blo
 
 
 def _blocked_numpy(
-    kernel: Kernel, idx: np.ndarray, px: float, py: float, L: float
+    kernel: Kernel, idx: np.ndarray, ex: float, ey: float, L: float
 ) -> Blocks | None:
     """Blocked arcs of the candidate edges, vectorised (many candidates)."""
     m = kernel.map
@@ -202,18 +204,18 @@ def _blocked_numpy(
     a = m.edge_start[idx]
     u = m.edge_dir[idx]
     length = m.edge_length[idx]
-    wx = a[:, 0] - px
-    wy = a[:, 1] - py
+    wx = a[:, 0] - ex
+    wy = a[:, 1] - ey
     s = -(wx * u[:, 0] + wy * u[:, 1])
     sc = np.clip(s, 0.0, length)
     dist = np.hypot(wx + sc * u[:, 0], wy + sc * u[:, 1])
     keep = dist <= L + eps
     on = keep & (dist <= eps)
     if on.any():
-        (lo, wid, lab_lo, lab_hi), skip = _on_wall_blocks(kernel, px, py, idx[on].tolist())
+        (lo, wid, lab_lo, lab_hi), skip = _on_wall_blocks(kernel, ex, ey, idx[on].tolist())
         keep &= ~on & ~np.isin(idx, list(skip))
     else:
-        if not kernel.contains_point(px, py):
+        if not kernel.contains_point(ex, ey):
             return None
         lo, wid, lab_lo, lab_hi = [], [], [], []
     idx, wx, wy, u, length, s = idx[keep], wx[keep], wy[keep], u[keep], length[keep], s[keep]
@@ -235,7 +237,7 @@ def _blocked_numpy(
         return lo, wid, lab_lo, lab_hi
     ev = m.edge_vertices
     vb = ev[idx[sel], 1]
-    db = np.hypot(m.vertices[vb, 0] - px, m.vertices[vb, 1] - py)
+    db = np.hypot(m.vertices[vb, 0] - ex, m.vertices[vb, 1] - ey)
     for k, j in enumerate(sel.tolist()):
         e = int(idx[j])
         la = _label(kernel, bool(t0[j] <= eps), e, e, math.sqrt(ww[j]), L, eps)
@@ -258,9 +260,9 @@ _PRIORITY = {("body", "edge"): 0, ("body", "vertex"): 1, ("tip", "vertex"): 2, (
 def _best(labels: list[Stop]) -> Stop:
     """The label to report when several blocked arcs end at the same angle.
 
-    Ties are structural (the rod touches two features at once, e.g. P exactly on a type-5
+    Ties are structural (the rod touches two features at once, e.g. E exactly on a type-5
     curve, or on a wall next to a vertex), so the choice must not depend on rounding:
-    the rod along the wall under P, then a body contact, then a tip contact, then the
+    the rod along the wall under E, then a body contact, then a tip contact, then the
     lowest feature index.
     """
     return min(labels, key=lambda st: (_PRIORITY[st.kind, st.feature.kind], st.feature.index))

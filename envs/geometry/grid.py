@@ -1,5 +1,6 @@
 """A uniform bucket grid over a map: which wall edges / vertices lie near a query.
 
+Segments are ``p-q`` (lower case: any two ends; capital P is the pursuer project-wide).
 Built once per kernel. Each edge is registered in every cell that it, grown by the
 kernel's tolerance ``pad``, overlaps; so any point within ``pad`` of an edge lies in a
 cell that lists it. A segment query visits, row by row, exactly the cells that the

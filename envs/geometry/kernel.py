@@ -2,6 +2,10 @@
 
 One :class:`Kernel` per :class:`~envs.maps.Map` (get it with :func:`kernel_for`, which
 caches it). Nothing here calls shapely.
+
+Notation, one meaning per letter project-wide: E is the evader, P the pursuer, the rod
+the segment E-P (THEORY.md section 0 writes them P and Q); lower-case p, q are the two
+ends of any segment, whatever stands there.
 """
 
 from __future__ import annotations
@@ -290,15 +294,16 @@ class Kernel:
             return False
         return not self._through_obstacle(px, py, qx, qy)
 
-    def line_of_sight_many(self, P: ArrayLike, Q: ArrayLike) -> np.ndarray:
+    def line_of_sight_many(self, starts: ArrayLike, ends: ArrayLike) -> np.ndarray:
         """Vectorised :meth:`line_of_sight`: (k, 2), (k, 2) -> (k,) bool."""
-        P = _points(P, "line_of_sight_many P")
-        Q = _points(Q, "line_of_sight_many Q")
-        if P.shape != Q.shape:
+        starts = _points(starts, "line_of_sight_many starts")
+        ends = _points(ends, "line_of_sight_many ends")
+        if starts.shape != ends.shape:
             raise InvalidConfigError(
-                f"line_of_sight_many: P and Q must have the same shape, got {P.shape} and {Q.shape}"
+                f"line_of_sight_many: starts and ends must have the same shape, got {starts.shape} "
+                f"and {ends.shape}"
             )
-        k = len(P)
+        k = len(starts)
         if k == 0:
             return np.ones(0, dtype=bool)
         eps = self.eps
@@ -307,7 +312,10 @@ class Kernel:
             # a (k, n_edges) broadcast
             los = self._los
             return np.fromiter(
-                (los(p[0], p[1], q[0], q[1]) for p, q in zip(P.tolist(), Q.tolist(), strict=True)),
+                (
+                    los(p[0], p[1], q[0], q[1])
+                    for p, q in zip(starts.tolist(), ends.tolist(), strict=True)
+                ),
                 dtype=bool,
                 count=k,
             )
@@ -315,15 +323,15 @@ class Kernel:
         a, b, n = self._a[None], self._b[None], self._n[None]
         chunk = max(1, 200_000 // self.map.n_edges)
         for s in range(0, k, chunk):
-            p = P[s : s + chunk, None, :]
-            q = Q[s : s + chunk, None, :]
+            p = starts[s : s + chunk, None, :]
+            q = ends[s : s + chunk, None, :]
             cross, _, vhit, _, along = segment_contacts(p, q, a, b, n, eps)
             out[s : s + chunk] = ~(cross | vhit | along).any(axis=1)
-        short = np.hypot(*(Q - P).T) <= eps
+        short = np.hypot(*(ends - starts).T) <= eps
         out[short] = True
         for i in np.flatnonzero(out & ~short).tolist():
             # nothing touched: blocked only if both ends rest on walls across an obstacle
-            if self._through_obstacle(P[i, 0], P[i, 1], Q[i, 0], Q[i, 1]):
+            if self._through_obstacle(starts[i, 0], starts[i, 1], ends[i, 0], ends[i, 1]):
                 out[i] = False
         return out
 

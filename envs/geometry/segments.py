@@ -1,11 +1,13 @@
 """Segment-versus-wall contacts, vectorised (numpy) and scalar (plain Python).
 
-Line of sight is the predicate "the *open* segment p-q touches no wall": crossing an
-edge, touching any wall vertex, or running along an edge blocks it. Contact at the
-endpoints themselves (a body resting against a wall) does not block, provided the
-segment leaves the contact into free space. All comparisons use one absolute length
-tolerance ``eps`` (``REL_LENGTH_TOL`` times the map scale), so a vertex closer than
-``eps`` to the open segment counts as touching it.
+Lower-case p, q are the two ends of any segment, whatever stands there (capital P is the
+pursuer and E the evader, project-wide). Line of sight is the predicate "the *open*
+segment p-q touches no wall": crossing an edge, touching any wall vertex, or running
+along an edge blocks it. Contact at the endpoints themselves (a body resting against a
+wall) does not block, provided the segment leaves the contact into free space. All
+comparisons use one absolute length tolerance ``eps`` (``REL_LENGTH_TOL`` times the map
+scale), so a vertex closer than ``eps`` to the open segment counts as touching it, and a
+segment within ``eps`` of an edge's line where they overlap runs along it.
 """
 
 from __future__ import annotations
@@ -73,7 +75,11 @@ def segment_contacts(
     vertex_hit = near_a & (ta > t_lo) & (ta < t_hi)
     lo = np.maximum(np.minimum(ta, tb), 0.0)
     hi = np.minimum(np.maximum(ta, tb), 1.0)
-    along = near_a & near_b & (lo < t_hi) & (hi > t_lo)
+    # collinear within eps: the edge's ends near the segment's line, or the segment's ends
+    # near the edge's line (a short segment along a long edge: the edge's far end leaves
+    # the segment's line by more than eps although the segment never leaves the edge's)
+    flat = (near_a & near_b) | ((np.abs(op) <= eps) & (np.abs(oq) <= eps))
+    along = flat & (lo < t_hi) & (hi > t_lo)
     t_vertex = np.where(along & ~vertex_hit, lo, ta)
     return crossing, t_cross, vertex_hit, t_vertex, along
 
@@ -134,30 +140,36 @@ def scan_segment(
         bpx = bx - px
         bpy = by - py
         ob = dx * bpy - dy * bpx
-        if -tol <= oa <= tol:
+        a_near = -tol <= oa <= tol
+        if a_near:
             ta = (dx * apx + dy * apy) * inv
             if t_lo < ta < t_hi:
                 if not nearest:
                     return (ta, "vertex", e)
                 if best is None or ta < best[0]:
                     best = (ta, "vertex", e)
-            if -tol <= ob <= tol:  # collinear: does the open segment run along the edge?
-                tb = (dx * bpx + dy * bpy) * inv
-                lo = max(min(ta, tb), 0.0)
-                hi = min(max(ta, tb), 1.0)
-                if lo < t_hi and hi > t_lo:
-                    if not nearest:
-                        return (lo, "edge", e)
-                    if best is None or lo < best[0]:
-                        best = (lo, "edge", e)
+        op = -(nx * apx + ny * apy)
+        oq = nx * (qx - ax) + ny * (qy - ay)
+        if (a_near and -tol <= ob <= tol) or (-eps <= op <= eps and -eps <= oq <= eps):
+            # collinear within eps (see segment_contacts): does the open segment run
+            # along the edge?
+            ta = (dx * apx + dy * apy) * inv
+            tb = (dx * bpx + dy * bpy) * inv
+            lo = max(min(ta, tb), 0.0)
+            hi = min(max(ta, tb), 1.0)
+            if lo < t_hi and hi > t_lo:
+                if not nearest:
+                    return (lo, "edge", e)
+                if best is None or lo < best[0]:
+                    best = (lo, "edge", e)
+            continue
+        if a_near:
             continue
         if oa > tol:
             if ob >= -tol:
                 continue
         elif ob <= tol:
             continue
-        op = -(nx * apx + ny * apy)
-        oq = nx * (qx - ax) + ny * (qy - ay)
         if (op > eps and oq < -eps) or (op < -eps and oq > eps):
             t = op / (op - oq)
             if not nearest:

@@ -1,6 +1,8 @@
 """Continuous-time surveillance check over one step (DESIGN.md, "Geometry kernel").
 
-The pursuer moves linearly ``p0 -> p1`` and the evader ``e0 -> e1`` over ``t in [0, 1]``.
+The pursuer P moves linearly ``p0 -> p1`` and the evader E ``e0 -> e1`` over ``t in [0, 1]``
+(one meaning per letter project-wide: P the pursuer, E the evader; THEORY.md section 0
+writes them Q and P).
 Surveillance breaks at the earliest ``t`` where
 
 * the distance ``|P(t) - E(t)|`` leaves ``[l_min, l_max]``: ``|R + t S|^2`` is a quadratic

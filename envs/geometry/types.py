@@ -1,7 +1,8 @@
 """Value types returned by the geometry kernel: sweep events, stops, free arcs.
 
-Angles follow THEORY.md section 0: theta is the direction from the evader E = P to the
-pursuer Q = P + L (cos theta, sin theta), in radians, counter-clockwise.
+Angles follow THEORY.md section 0: theta is the direction from the evader E to the
+pursuer P = E + L (cos theta, sin theta), in radians, counter-clockwise. (One meaning per
+letter, project-wide: E the evader, P the pursuer; THEORY.md writes them P and Q.)
 """
 
 from __future__ import annotations
@@ -51,11 +52,11 @@ class Stop:
 
     Attributes:
         kind: ``"body"`` (the rod's body touches the feature) or ``"tip"`` (the pursuer
-            end Q touches it).
-        feature: ``("body", convex vertex strictly inside the disk |X - P| < L)``,
+            end P touches it).
+        feature: ``("body", convex vertex strictly inside the disk |X - E| < L)``,
             ``("tip", vertex exactly on the circle)`` or ``("tip", edge)``. One more label
-            occurs only when P itself lies on a wall (a type-0 point): ``("body", edge)``,
-            the rod lying along the wall edge through P.
+            occurs only when E itself lies on a wall (a type-0 point): ``("body", edge)``,
+            the rod lying along the wall edge through E.
     """
 
     kind: str
@@ -112,7 +113,7 @@ class FreeArcs:
     """The free orientations of a rod of length ``L`` with its evader end at ``point``.
 
     Attributes:
-        point: the evader position P, shape (2,).
+        point: the evader position E, shape (2,).
         L: rod length.
         arcs: disjoint closed arcs sorted by ``lo``; empty when no orientation is free.
     """

@@ -322,6 +322,15 @@ class Map:
         hi = self.rings[0].max(axis=0)
         return (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
 
+    @functools.cached_property
+    def diameter(self) -> float:
+        """The largest distance between two points of the map: no rod longer than this
+        fits anywhere (the largest distance between two vertices of the boundary's
+        convex hull)."""
+        hull = np.asarray(self._free.convex_hull.exterior.coords, dtype=float)[:-1]
+        d = hull[:, None, :] - hull[None, :, :]
+        return float(np.sqrt(np.einsum("ijk,ijk->ij", d, d).max()))
+
     @property
     def free_region(self) -> Polygon:
         """The free region as a shapely polygon (for set-up code, not the hot path)."""

@@ -142,7 +142,17 @@ def random_start(
     hi_xy = np.array([xmax, ymax])
     range_margin, rod_clearance = spawn_margins(config)
     l_lo = config.l_min + range_margin
-    l_hi = config.l_max - range_margin
+    # no rod longer than the map's diameter fits: draw L below it (the accepted starts
+    # are distributed as before; an L_max far beyond the map no longer starves the
+    # sampler, and a range beyond the map is named as such)
+    l_hi = min(config.l_max - range_margin, m.diameter)
+    if l_lo > m.diameter:
+        raise InfeasibleError(
+            f"random start: map {m.name!r} has no two points {l_lo:.6g} apart (its diameter "
+            f"is {m.diameter:.6g}), the shortest rod a start may have (l_min = "
+            f"{config.l_min:g} plus a margin of {range_margin:.3g} for spawn_margin_steps); "
+            "lower l_min or use a larger map"
+        )
     convex = m.vertices[m.vertex_convex]
     r = config.body_radius
     for _ in range(MAX_BATCHES):

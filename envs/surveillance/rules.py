@@ -88,7 +88,7 @@ def surveillance_status(
     Args:
         kernel: the map's geometry kernel (``envs.geometry.kernel_for(map)``).
         pursuer: pursuer position Q.
-        evader: evader position P.
+        evader: evader position E.
         l_min: L_min.
         l_max: L_max.
 

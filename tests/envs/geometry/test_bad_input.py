@@ -47,5 +47,5 @@ def test_ray_angles_not_numeric(kernel, angles):
 def test_point_arrays_not_numeric(kernel, points):
     with pytest.raises(InvalidConfigError, match="free_arcs_many points"):
         kernel.free_arcs_many(points, 1.0)
-    with pytest.raises(InvalidConfigError, match="line_of_sight_many P"):
+    with pytest.raises(InvalidConfigError, match="line_of_sight_many starts"):
         kernel.line_of_sight_many(points, [(1.0, 1.0)])

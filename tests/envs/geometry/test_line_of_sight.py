@@ -145,3 +145,23 @@ def test_line_of_sight_rejects_bad_input():
     with pytest.raises(InvalidConfigError, match="same shape"):
         k.line_of_sight_many(np.zeros((3, 2)), np.zeros((2, 2)))
     assert k.line_of_sight((1, 1), (1, 1))
+
+
+@pytest.mark.parametrize(
+    ("p", "q"),
+    [
+        ((6.0, 1.0), (6.0 - 1e-15, 1.0 + 1.2e-7)),  # short, tilted by far less than eps
+        ((6.0, 1.0), (6.0 - 3e-9, 1.5)),  # within eps of the wall all along
+        ((6.0, 0.0), (5.999999999999999, 1.1990778148174307e-07)),  # from the corner
+        ((6.0, 1.0), (6.0, 1.5)),  # exactly on the wall
+    ],
+)
+def test_a_segment_lying_along_a_wall_within_eps_is_blocked(p, q):
+    """Found by hypothesis: a short segment on a long wall, its tilt below eps, was
+    visible, because the wall's far end left the segment's line by more than eps."""
+    world = aligned_blocks_map()
+    k = kernel_for(world)
+    assert world.rings[0][1].tolist() == [6.0, 0.0]  # the right wall is x = 6
+    assert not k.line_of_sight(p, q) and not k.line_of_sight(q, p)
+    assert not k.line_of_sight_many(np.array([p]), np.array([q]))[0]
+    assert k.blocking_feature(p, q) is not None

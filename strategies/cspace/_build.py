@@ -1,46 +1,94 @@
 """Building a :class:`~strategies.cspace.decomposition.Decomposition` (THEORY.md 1.3).
 
-Faces of the curve arrangement get their cells from the free arcs at a sample point;
-neighbouring faces with equal stop pairs are merged (an artefact of the polylines);
-each boundary piece gets its adjacency from two probe points; the escapable cells are
-the least fixed point of Sec. 4's definition, computed by a worklist.
+1. the exact arrangement of the critical curves (:mod:`strategies.cspace.arrangement`);
+2. each face gets its cells from the kernel's free arcs at a point deep inside it;
+   neighbouring faces with equal stop pairs are one noncritical region (a curve whose
+   crossing changes nothing, counted in ``stats["merged_faces"]``);
+3. every region is checked noncritical: at more points of each of its faces the stop
+   pairs must be the region's (failures are counted, named and warned about);
+4. each boundary piece gets its adjacency from two probe points at the exact middle of
+   one of its edges, along the exact normal, matched to the two regions' cells by their
+   stop pairs; a piece whose probes cannot be matched (it should not happen) falls back
+   to matching arcs by overlap and is counted (``Decomposition.unresolved``) and warned
+   about, never silent;
+5. the escapable cells are the least fixed point of Sec. 4's definition (a worklist).
 """
 
 from __future__ import annotations
 
-import math
+import warnings
 
 import numpy as np
 import shapely
-import shapely.ops
 from shapely.geometry import Polygon
 
 from envs.geometry import kernel_for
 from envs.geometry.types import Arc, FreeArcs
 from envs.maps.map import Map
 from strategies.cspace._arcs import OVERLAP_TOL, StopPair, overlap, pairs
-from strategies.cspace.arrangement import SNAP_REL, Arrangement, Piece, arrange
-from strategies.cspace.curves import critical_curves
-from strategies.cspace.decomposition import (
-    ADJ_EPS_REL,
-    Boundary,
-    Cell,
-    Decomposition,
-    Region,
-)
+from strategies.cspace.arrangement import Arrangement, Piece, arrange
+from strategies.cspace.curves import _curves, _walls
+from strategies.cspace.decomposition import Boundary, Cell, Decomposition, Region
+from strategies.cspace.tolerances import Tolerances, diameter
 
 __all__ = ["build_decomposition"]
 
-_PROBE_SEGMENTS = 4  # segments of a piece tried before walking out along the normal
+_PROBE_EDGES = 4  # edges of a piece tried (longest first)
+_PROBE_SHRINK = (1.0, 0.1, 0.01, 1e-3)  # probe offsets tried, times the first one
+_CHECK_POINTS = 2  # extra points per face at which the stops are checked
 
 
-def _sample_point(poly: Polygon) -> np.ndarray:
-    """A point far from the boundary of ``poly`` (pole of inaccessibility, coarse)."""
-    scale = math.sqrt(poly.area)
-    p = shapely.ops.polylabel(poly, tolerance=max(scale * 0.02, 1e-12))
-    if not poly.contains(p):
-        p = shapely.point_on_surface(poly)
-    return np.array([p.x, p.y])
+def _sample_points(faces: list[Polygon], chord: float) -> np.ndarray:
+    """A point deep inside each face (farther than the polyline error from its edges)."""
+    if not faces:
+        return np.zeros((0, 2))
+    arr = np.array(faces, dtype=object)
+    pos = shapely.point_on_surface(arr)
+    depth = shapely.distance(shapely.boundary(arr), pos)
+    area = shapely.area(arr)
+    perim = shapely.length(arr)
+    width = np.where(perim > 0, 2.0 * area / np.maximum(perim, 1e-300), 0.0)
+    weak = np.flatnonzero(((depth < 0.25 * width) | (depth < 4.0 * chord)) & (area > 0))
+    if len(weak):
+        tol = np.maximum(0.01 * np.sqrt(area[weak]), 1e-3 * width[weak])
+        mic = shapely.maximum_inscribed_circle(arr[weak], tol)
+        centre = shapely.get_point(mic, 0)
+        better = shapely.distance(shapely.boundary(arr[weak]), centre) > depth[weak]
+        pos[weak[better]] = centre[better]
+    out = np.full((len(faces), 2), np.nan)
+    ok = ~shapely.is_empty(pos)
+    out[ok] = shapely.get_coordinates(pos[ok])
+    return out
+
+
+def _depth(faces: list[Polygon], pts: np.ndarray) -> np.ndarray:
+    """Distance from each point to its face's polygon boundary."""
+    arr = np.array(faces, dtype=object)
+    return shapely.distance(shapely.boundary(arr), shapely.points(pts))
+
+
+def _check_points(
+    faces: list[Polygon], centre: np.ndarray, k: int, margin: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Up to ``k`` more points per face, halfway from the sample point to its vertices,
+    farther than ``margin`` from its polygon (which is exact only to the chord tolerance)."""
+    owner, pts = [], []
+    for f, (poly, c) in enumerate(zip(faces, centre, strict=True)):
+        ring = np.asarray(poly.exterior.coords)[:-1]
+        if len(ring) == 0:
+            continue
+        pick = ring[np.linspace(0, len(ring) - 1, k + 2).astype(int)[1:-1]]
+        owner.append(np.full(len(pick), f))
+        pts.append(0.5 * (pick + c))
+    if not pts:
+        return np.zeros(0, dtype=np.intp), np.zeros((0, 2))
+    owner = np.concatenate(owner)
+    pts = np.concatenate(pts)
+    arr = np.array(faces, dtype=object)
+    inside = shapely.contains_xy(arr[owner], pts[:, 0], pts[:, 1])
+    owner, pts = owner[inside], pts[inside]
+    deep = shapely.distance(shapely.boundary(arr[owner]), shapely.points(pts)) > margin
+    return owner[deep], pts[deep]
 
 
 def _assign(fa: FreeArcs, table: dict, rep: dict, strict: bool) -> list[int | None] | None:
@@ -74,65 +122,89 @@ def _adjacent(fa_a, ia, fa_b, ib) -> tuple[tuple[int, int], ...]:
     return tuple(sorted(adj))
 
 
-def _walk(kernel, L, p, n, table, eps, reach) -> FreeArcs | None:
-    """Free arcs at the first point ``p + s n`` (s = eps, 3 eps, ...) with the region's stops."""
-    s = eps
-    while s <= reach:
-        fa = kernel.free_arcs(p + s * n, L)
-        if set(pairs(fa)) == set(table):
-            return fa
-        s *= 3.0
+def _offsets(tol: Tolerances, length: float, width: float) -> list[float]:
+    """Probe offsets to try on one side of a piece: a fraction of the piece and of the
+    regions (``width``), shrinking to the kernel's resolution, then, to step over a
+    sliver merged into the region, up to a few sliver widths."""
+    floor = 4.0 * tol.kernel
+    eps0 = max(min(tol.probe, 0.25 * length, 0.25 * width), floor)
+    out = [max(eps0 * s, floor) for s in _PROBE_SHRINK]
+    out += [k * tol.thin for k in (2.0, 4.0, 10.0) if k * tol.thin > eps0]
+    return list(dict.fromkeys(out))
+
+
+def _side(kernel, L: float, p: np.ndarray, n: np.ndarray, offsets, cands, cells_of):
+    """The first probe ``p + eps n`` whose stops are one of the candidate regions' (a
+    tuple, or a function of the probe point and offset):
+    ``(region, arcs, cells)``; ``(-1, ...)`` when the probes leave the free region (a
+    wall beyond a sliver); ``None`` if nothing matches."""
+    for eps in offsets:
+        q = p + eps * n
+        if not kernel.contains_point(float(q[0]), float(q[1])):
+            return (-1, None, None)
+        fa = kernel.free_arcs(q, L)
+        for r in cands(q, eps) if callable(cands) else cands:
+            table, rep = cells_of[r]
+            cells = _assign(fa, table, rep, strict=True)
+            if cells is not None:
+                return r, fa, cells
     return None
 
 
-def _boundary(bid, piece: Piece, curves, kernel, L, regions_cells, eps0, reach) -> Boundary:
-    """Adjacency across a boundary piece from the free arcs at two probe points.
+def _boundary(
+    piece: Piece,
+    arr: Arrangement,
+    kernel,
+    L: float,
+    cells_of,
+    tol: Tolerances,
+    width: float,
+    cands: tuple,
+    over: tuple[bool, bool],
+) -> tuple | None:
+    """Adjacency across a boundary piece from the free arcs at two exact probe points.
 
-    The probes sit at ``+- eps`` along the normal of the piece's longest segments, at the
-    exact curve point. When the stops there are not exactly the two regions' (a thin
-    region the polylines do not resolve, within the chord tolerance), the probes walk
-    out along the normal (up to ``reach``) to the first points with the regions' stops;
-    failing that, arcs are matched to cells by overlap (``resolved=False`` either way).
+    The probes sit at the exact middle of one of the piece's edges (the longest first),
+    along the exact normal, each side at the first offset of :func:`_offsets` where the
+    stops are those of one of that side's candidate regions (its own; or, across a
+    sliver, a function of the probe point giving the regions near it: ``over``).
+
+    Returns:
+        ``(regions, point, normal, adjacent, resolved)``; ``None`` when the piece
+        separates nothing (a sliver between a region and itself, or a wall); ``"sliver"``
+        when the far side of a sliver matched no region around it.
     """
-    a, b = piece.faces
-    table_a, arcs_a = regions_cells[a]
-    table_b, arcs_b = regions_cells[b]
-    seg = piece.segments
-    lens = np.hypot(*(seg[:, 1] - seg[:, 0]).T)
-    probes = []
-    for k in np.argsort(-lens)[:_PROBE_SEGMENTS].tolist():
-        p0, p1 = seg[k]
-        d = (p1 - p0) / lens[k]
-        n = np.array([-d[1], d[0]])
-        mid = 0.5 * (p0 + p1)
-        if piece.curves:
-            c = curves[piece.curves[0]]
-            if c.shape != "segment":
-                mid = c.evaluate(c.project(mid[None]))[0][0]
-        eps = min(eps0, 1e-3 * lens[k])
-        probes.append((mid, n, eps))
-        for e in (eps, 1e-2 * eps):
-            fp = kernel.free_arcs(mid + e * n, L)
-            fm = kernel.free_arcs(mid - e * n, L)
-            ia = _assign(fp, table_a, arcs_a, strict=True)
-            ib = _assign(fm, table_b, arcs_b, strict=True)
-            if ia is not None and ib is not None:
-                return Boundary(bid, (a, b), piece.curves, seg, mid, n, _adjacent(fp, ia, fm, ib))
-    mid, n, eps = probes[0]
-    fp = _walk(kernel, L, mid, n, table_a, eps, reach)
-    fm = _walk(kernel, L, mid, -n, table_b, eps, reach)
-    if fp is None:
-        fp = kernel.free_arcs(mid + eps * n, L)
-    if fm is None:
-        fm = kernel.free_arcs(mid - eps * n, L)
-    ia = _assign(fp, table_a, arcs_a, strict=False)
-    ib = _assign(fm, table_b, arcs_b, strict=False)
-    return Boundary(bid, (a, b), piece.curves, seg, mid, n, _adjacent(fp, ia, fm, ib), False)
+    lens = arr.edge_length[piece.edges]
+    first = None
+    for k in np.argsort(-lens)[:_PROBE_EDGES].tolist():
+        p, n = arr.probe(int(piece.edges[k]), int(piece.signs[k]), L)
+        if first is None:
+            first = (p, n)
+        offs = _offsets(tol, float(lens[k]), width)
+        found = []
+        for side, sgn in ((0, 1.0), (1, -1.0)):
+            o = [e for e in offs if e > tol.thin] if over[side] else offs
+            found.append(_side(kernel, L, p, sgn * n, o, cands[side], cells_of))
+        if found[0] is None or found[1] is None:
+            continue
+        (ra, fa, ia), (rb, fb, ib) = found
+        if ra < 0 or rb < 0 or ra == rb:
+            return None
+        return (ra, rb), p, n, _adjacent(fa, ia, fb, ib), True
+    if any(over):
+        return "sliver"  # nothing beyond the sliver matches: counted, no adjacency
+    p, n = first
+    a, b = cands[0][0], cands[1][0]
+    eps = min(tol.probe, 0.25 * float(lens.max()))
+    fp = kernel.free_arcs(p + eps * n, L)
+    fm = kernel.free_arcs(p - eps * n, L)
+    ia = _assign(fp, *cells_of[a], strict=False)
+    ib = _assign(fm, *cells_of[b], strict=False)
+    return (a, b), p, n, _adjacent(fp, ia, fm, ib), False
 
 
 def _escapable(n_cells: int, boundaries: tuple[Boundary, ...], cell_region: list[int]):
     """Least fixed point of Sec. 4's definition; returns (flags, reason, via)."""
-    # for each (cell, boundary of its region): the set of adjacent cells across it
     adj: dict[tuple[int, int], set[int]] = {}
     region_bounds: dict[int, list[int]] = {}
     for b in boundaries:
@@ -168,12 +240,13 @@ def _escapable(n_cells: int, boundaries: tuple[Boundary, ...], cell_region: list
     return esc, reason, via
 
 
-def _merge_equal(arr: Arrangement, sigs: list[frozenset]) -> list[int]:
+def _merge_equal(arr: Arrangement, sigs: list[frozenset]) -> tuple[list[int], int]:
     """Group faces joined by a piece whose two sides have the same stop pairs.
 
-    Crossing a semi-free critical curve always changes the stop pairs (THEORY.md 1.4),
-    so two neighbouring faces with equal stop pairs are one noncritical region cut by an
-    artefact of the polylines (a sliver where two curves are tangent).
+    Crossing a critical curve changes the stop pairs (THEORY.md 1.4) unless the curve
+    is not critical there; two neighbouring faces with equal stop pairs are one
+    noncritical region. Returns the region of every face (-1 for slivers, whose
+    signature is ``None``) and the number of merges.
     """
     parent = list(range(len(arr.faces)))
 
@@ -183,31 +256,53 @@ def _merge_equal(arr: Arrangement, sigs: list[frozenset]) -> list[int]:
             i = parent[i]
         return i
 
+    merges = 0
     for piece in arr.pieces:
         a, b = piece.faces
-        if sigs[a] == sigs[b]:
+        if sigs[a] is not None and sigs[a] == sigs[b]:
             ra, rb = find(a), find(b)
             if ra != rb:
                 parent[max(ra, rb)] = min(ra, rb)
-    roots = sorted({find(i) for i in range(len(parent))})
+                merges += 1
+    roots = sorted({find(i) for i in range(len(parent)) if sigs[i] is not None})
     index = {r: k for k, r in enumerate(roots)}
-    return [index[find(i)] for i in range(len(parent))]
+    return [index.get(find(i), -1) for i in range(len(parent))], merges
 
 
 def build_decomposition(world: Map, L: float, chord_tol: float | None = None) -> Decomposition:
     """Compute the decomposition without touching any cache (see :func:`decompose`)."""
-    curves = critical_curves(world, L, chord_tol=chord_tol)
-    tol = next((c.tolerance for c in curves if c.tolerance > 0), chord_tol or 0.0)
-    arr: Arrangement = arrange(world, curves)
+    tol = Tolerances.of(world, L, chord_tol)
+    if L >= diameter(world):  # no segment of length L fits in the map at all
+        free = world.free_region
+        rp = free.representative_point()
+        region = Region(0, free, np.array([rp.x, rp.y]), (), ())
+        return Decomposition(world, L, _walls(world), (region,), (), (), tol.chord, {})
+    curves = _curves(world, L, tol.chord, True)
+    arr = arrange(world, curves, tol)
     kernel = kernel_for(world)
-    points = [_sample_point(f) for f in arr.faces]
-    face_arcs = [kernel.free_arcs(p, L) for p in points]
-    group = _merge_equal(arr, [frozenset(pairs(fa)) for fa in face_arcs])
+    faces = list(arr.faces)
+    points = _sample_points(faces, tol.chord)
+    # prefer the exact samples, unless the polygon's is much deeper (a fat face)
+    exact = np.isfinite(arr.depth) & ~(arr.depth < 0.1 * _depth(faces, points))
+    points[exact] = arr.samples[exact]
+    face_arcs = [
+        None if thin else kernel.free_arcs(p, L) for p, thin in zip(points, arr.sliver, strict=True)
+    ]
+    sigs = [None if fa is None else frozenset(pairs(fa)) for fa in face_arcs]
+    group, merged = _merge_equal(arr, sigs)
     n_regions = max(group, default=-1) + 1
     members: list[list[int]] = [[] for _ in range(n_regions)]
     for f, g in enumerate(group):
-        members[g].append(f)
-    rep_face = [max(m, key=lambda f: arr.faces[f].area) for m in members]
+        if g >= 0:
+            members[g].append(f)
+    rep_face = [max(m, key=lambda f: faces[f].area) for m in members]
+    # the noncritical check: more points per face must show the region's stop pairs
+    owner, extra = _check_points(faces, points, _CHECK_POINTS, 2.0 * tol.chord + tol.probe)
+    violations = [
+        (int(group[f]), p)
+        for f, p in zip(owner.tolist(), extra, strict=True)
+        if sigs[f] is not None and frozenset(pairs(kernel.free_arcs(p, L))) != sigs[f]
+    ]
     cells_tmp: list[tuple[int, StopPair, Arc]] = []
     region_cells: list[tuple[dict[StopPair, int], dict[int, Arc]]] = []
     region_ids: list[list[int]] = []
@@ -222,16 +317,39 @@ def build_decomposition(world: Map, L: float, chord_tol: float | None = None) ->
             ids.append(cid)
         region_cells.append((table, rep))
         region_ids.append(ids)
-    pieces = [
-        Piece((group[p.faces[0]], group[p.faces[1]]), p.curves, p.segments)
-        for p in arr.pieces
-        if group[p.faces[0]] != group[p.faces[1]]
-    ]
-    eps0 = ADJ_EPS_REL * world.scale
-    reach = max(30.0 * tol, 1e-4 * world.scale)
+    g_arr = np.asarray(group)
+    real = g_arr >= 0
+    f_area = np.array([f.area for f in faces])
+    f_perim = np.array([f.length for f in faces])
+    r_area = np.bincount(g_arr[real], weights=f_area[real], minlength=n_regions)
+    r_perim = np.bincount(g_arr[real], weights=f_perim[real], minlength=n_regions)
+    width = 2.0 * r_area / np.maximum(r_perim, 1e-300)
+    tree = shapely.STRtree(faces)
+
+    def near(q: np.ndarray, eps: float) -> list[int]:
+        """Regions of the faces near ``q`` (beyond a sliver; polygons are exact only to
+        the chord tolerance)."""
+        hit = tree.query(shapely.Point(q), predicate="dwithin", distance=eps + 2 * tol.chord)
+        return sorted({group[f] for f in hit.tolist() if group[f] >= 0})
+
+    found = []
+    lost = 0
+    for piece in arr.pieces:
+        fa_, fb_ = piece.faces
+        ra, rb = group[fa_], group[fb_]
+        if (ra < 0 and rb < 0) or ra == rb:
+            continue
+        ca = (ra,) if ra >= 0 else near
+        cb = (rb,) if rb >= 0 else near
+        w = min(width[r] for r in (ra, rb) if r >= 0)
+        res = _boundary(piece, arr, kernel, L, region_cells, tol, w, (ca, cb), (ra < 0, rb < 0))
+        if res == "sliver":
+            lost += 1
+        elif res is not None:
+            found.append((res, piece))
     boundaries = tuple(
-        _boundary(i, piece, curves, kernel, L, region_cells, eps0, reach)
-        for i, piece in enumerate(pieces)
+        Boundary(i, regs, piece.curves, piece.segments, p, n, adj, ok)
+        for i, ((regs, p, n, adj, ok), piece) in enumerate(found)
     )
     cell_region = [c[0] for c in cells_tmp]
     esc, reason, via = _escapable(len(cells_tmp), boundaries, cell_region)
@@ -242,17 +360,50 @@ def build_decomposition(world: Map, L: float, chord_tol: float | None = None) ->
     for b in boundaries:
         for r in b.regions:
             bounds_of[r].append(b.id)
-    grid = SNAP_REL * world.scale
     regions = tuple(
         Region(
             r,
-            arr.faces[members[r][0]]
+            faces[members[r][0]]
             if len(members[r]) == 1
-            else shapely.union_all([arr.faces[f] for f in members[r]], grid_size=grid),
+            else shapely.union_all([shapely.make_valid(faces[f]) for f in members[r]]),
             points[rep_face[r]],
             tuple(region_ids[r]),
             tuple(bounds_of[r]),
         )
         for r in range(n_regions)
     )
-    return Decomposition(world, L, curves, regions, cells, boundaries, tol)
+    stats = dict(arr.stats)
+    stats["faces"] = len(faces)
+    stats["merged_faces"] = merged
+    stats["noncritical_violations"] = len(violations)
+    stats["slivers_unresolved"] = lost
+    dec = Decomposition(world, L, curves, regions, cells, boundaries, tol.chord, stats)
+    _warn(dec, violations)
+    return dec
+
+
+def _warn(dec: Decomposition, violations) -> None:
+    """One warning naming what went wrong, if anything did (never silent)."""
+    problems = []
+    if dec.unresolved:
+        problems.append(f"{dec.unresolved} boundary pieces matched by overlap only")
+    if violations:
+        r, p = violations[0]
+        problems.append(
+            f"{len(violations)} points whose stops differ from their region's "
+            f"(first: region {r} at ({p[0]:.6g}, {p[1]:.6g}))"
+        )
+    if dec.stats.get("dangling"):
+        problems.append(f"{dec.stats['dangling']} dangling curve pieces")
+    if dec.stats.get("slivers_unresolved"):
+        problems.append(f"{dec.stats['slivers_unresolved']} pieces along slivers unresolved")
+    if dec.stats.get("orphan_holes"):
+        problems.append(f"{dec.stats['orphan_holes']} curve components outside every face")
+    if problems:
+        warnings.warn(
+            f"decompose({dec.map.name!r}, L={dec.L:g}): the arrangement is not exact: "
+            + "; ".join(problems)
+            + ". Please report this map and L.",
+            RuntimeWarning,
+            stacklevel=3,
+        )

@@ -21,12 +21,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import shapely
 
 from envs.geometry.segments import segment_contacts
 from envs.maps.map import Map
 from envs.tolerances import REL_LENGTH_TOL
 
-__all__ = ["WEDGE_TOL", "rods_semifree", "wedge_interior"]
+__all__ = ["WEDGE_TOL", "in_closed_free", "rods_semifree", "rods_semifree_near", "wedge_interior"]
 
 WEDGE_TOL = 1e-9
 """Angle (radians) by which a rod must enter an obstacle wedge to count as entering it.
@@ -128,3 +129,63 @@ def _leaves_wall(world: Map, p: np.ndarray, d: np.ndarray, eps: float) -> bool:
     on = (np.abs(h) <= eps) & (s >= 0) & (s <= world.edge_length)
     dn = world.edge_normal[on] @ d
     return bool(np.all(dn >= -WEDGE_TOL * float(np.hypot(*d))))
+
+
+def in_closed_free(world: Map, P: np.ndarray) -> np.ndarray:
+    """Which points lie in the closed free region (within the length tolerance of it)."""
+    P = np.asarray(P, dtype=float).reshape(-1, 2)
+    free = world.prepared_free_region
+    out = shapely.intersects_xy(free, P[:, 0], P[:, 1])
+    rest = np.flatnonzero(~out)
+    if len(rest):
+        eps = REL_LENGTH_TOL * world.scale
+        out[rest] = shapely.dwithin(free, shapely.points(P[rest]), eps)
+    return out
+
+
+def rods_semifree_near(
+    world: Map, P: np.ndarray, Q: np.ndarray, rod: np.ndarray, edge: np.ndarray
+) -> np.ndarray:
+    """:func:`rods_semifree` testing each rod only against the given nearby edges.
+
+    Args:
+        world: the map.
+        P: (k, 2) evader ends.
+        Q: (k, 2) pursuer ends.
+        rod: (m,) rod of each (rod, edge) pair to test.
+        edge: (m,) wall edge of each pair; every edge within reach of rod ``r`` must be
+            paired with it (a spatial-index query does that).
+
+    Returns:
+        (k,) bool.
+    """
+    P = np.asarray(P, dtype=float).reshape(-1, 2)
+    Q = np.asarray(Q, dtype=float).reshape(-1, 2)
+    out = in_closed_free(world, P)
+    if len(rod) == 0 or not out.any():
+        return out
+    eps = REL_LENGTH_TOL * world.scale
+    bad = np.zeros(len(P), dtype=bool)
+    wall_dist = np.full(len(P), np.inf)
+    for s in range(0, len(rod), _CHUNK_CELLS):
+        r = rod[s : s + _CHUNK_CELLS]
+        f = edge[s : s + _CHUNK_CELLS]
+        crossing, _, vertex_hit, _, _ = segment_contacts(
+            P[r], Q[r], world.edge_start[f], world.edge_end[f], world.edge_normal[f], eps
+        )
+        bad[r[crossing]] = True
+        a = world.edge_start[f]
+        rel = P[r] - a
+        t = np.clip((rel * world.edge_dir[f]).sum(axis=1), 0.0, world.edge_length[f])
+        foot = a + t[:, None] * world.edge_dir[f]
+        np.minimum.at(wall_dist, r, np.hypot(*(P[r] - foot).T))
+        hit = np.flatnonzero(vertex_hit & ~crossing)
+        if len(hit):
+            d = Q[r[hit]] - P[r[hit]]
+            v = f[hit]  # each wall vertex starts the edge of the same index
+            enters = wedge_interior(world, v, d) | wedge_interior(world, v, -d)
+            bad[r[hit[enters]]] = True
+    out &= ~bad
+    for i in np.flatnonzero(out & (wall_dist <= eps)).tolist():
+        out[i] = _leaves_wall(world, P[i], Q[i] - P[i], eps)
+    return out

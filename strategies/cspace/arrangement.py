@@ -1,32 +1,49 @@
-"""The arrangement of the critical curves: faces (noncritical regions) and shared boundaries.
+"""The arrangement of the critical curves: faces (noncritical regions) and their boundaries.
 
-The curve polylines and the walls are noded together with shapely's snap-rounding overlay
-(``unary_union`` with a ``grid_size`` of :data:`SNAP_REL` times the map scale, so an end
-that lies on another curve up to rounding is noded onto it), then polygonised. Each face
-in the free region is a noncritical region R (THEORY.md 1.3) up to the polyline
-tolerance of the arcs and conchoids.
+Built from the exact curves, not from their polylines:
 
-A *boundary piece* is a maximal chain of noded segments that separates the same two faces
-and comes from the same critical curve(s); the paper's adjacency (THEORY.md 1.3) is
-constant along it, so one sample point decides it.
+1. collinear overlapping segments are merged (:mod:`strategies.cspace._collinear`);
+2. every crossing, tangency and curve end lying on another curve becomes a vertex of
+   both curves (:mod:`strategies.cspace._noding`), so no curve can dangle or be lost;
+3. the curves cut at their vertices are the edges of a planar graph; at each vertex the
+   edges are ordered by the directions to their exact points a short way along (closer
+   than any other vertex, so no two of them cross in between) and the faces are traced
+   half-edge by half-edge;
+4. faces are classified: a cycle with an obstacle on its left is not free space; the
+   counter-clockwise cycles are the faces' outer boundaries, the clockwise ones their
+   holes (assigned to the smallest face around them);
+5. a face narrower than the sliver tolerance (twice its area over its perimeter) is a
+   sliver of a near-degeneracy the geometry kernel cannot resolve: it is marked, and the
+   decomposition steps over it (:mod:`strategies.cspace._build`).
+
+Polylines (within the chord tolerance) only draw the faces' polygons; the topology, the
+probe points and the normals across boundaries come from the exact curves.
+
+A *boundary piece* is a maximal chain of edges that separates the same two faces and
+lies on the same critical curve(s); the paper's adjacency (THEORY.md 1.3) is constant
+along it, so one probe pair decides it.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, field
 
 import numpy as np
 import shapely
-from scipy.spatial import cKDTree
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 from shapely.geometry import Polygon
 
 from envs.maps.map import Map
+from strategies.cspace._collinear import merge_collinear
+from strategies.cspace._noding import Curves, Noded, node
+from strategies.cspace._samples import ray_samples
+from strategies.cspace._shapes import SEGMENT, SHAPE_CODES, derivatives, points
 from strategies.cspace.curves import CriticalCurve
+from strategies.cspace.tolerances import Tolerances
 
-__all__ = ["SNAP_REL", "Arrangement", "Piece", "arrange"]
-
-SNAP_REL = 1e-9
-"""Snap-rounding grid of the overlay, relative to the map scale."""
+__all__ = ["Arrangement", "Piece", "arrange"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -34,15 +51,18 @@ class Piece:
     """A boundary piece between two faces.
 
     Attributes:
-        faces: ``(A, B)``: A lies on the left of ``segments[k][0] -> segments[k][1]``.
-        curves: indices of the critical curves the piece lies on.
-        segments: (m, 2, 2) the noded segments of the piece, each directed with A on
-            its left.
+        faces: ``(A, B)``: A lies on the left of each ``segments[k][0] -> [1]``.
+        curves: indices of the critical curves (not walls) the piece lies on.
+        segments: (m, 2, 2) the polyline segments of the piece, A on their left.
+        edges: the arrangement edges of the piece.
+        signs: per edge, +1 if A lies on the left as the edge's parameter grows, else -1.
     """
 
     faces: tuple[int, int]
     curves: tuple[int, ...]
-    segments: np.ndarray
+    segments: np.ndarray = field(repr=False)
+    edges: np.ndarray = field(repr=False)
+    signs: np.ndarray = field(repr=False)
 
     @property
     def length(self) -> float:
@@ -58,119 +78,378 @@ class Arrangement:
     Attributes:
         faces: face polygons (exteriors counter-clockwise).
         pieces: the boundary pieces between two faces.
-        wall_length: per face, the length of its boundary on the walls.
+        curves: the arrangement's curves (after merging collinear overlaps), in the local
+            frame (coordinates minus ``origin``: no cancellation far from (0, 0)).
+        noded: its vertices and edges (local frame).
+        edge_length: per edge, the length of its polyline.
+        origin: the local frame's origin (the centre of the map's bounding box).
+        samples: (F, 2) a point inside each face, found on the exact curves
+            (:mod:`strategies.cspace._samples`); NaN where that failed.
+        depth: (F,) how far that point is from the face's boundary along its ray.
+        sliver: (F,) faces narrower than the sliver tolerance (twice their area over
+            their perimeter): a near-degeneracy the kernel cannot resolve; they carry no
+            cells and the boundaries across them are found by stepping over them.
+        stats: counts for diagnostics: ``vertices``, ``edges``, ``dangling`` (edges with
+            the same face on both sides: a curve end that lies on no other curve),
+            ``slivers`` (faces too thin to probe), ``orphan_holes`` (clockwise
+            cycles inside no face), ``wide_vertices`` (see :class:`Noded`).
     """
 
     faces: tuple[Polygon, ...]
     pieces: tuple[Piece, ...]
-    wall_length: np.ndarray
+    curves: Curves = field(repr=False)
+    noded: Noded = field(repr=False)
+    edge_length: np.ndarray = field(repr=False)
+    origin: np.ndarray = field(repr=False)
+    samples: np.ndarray = field(repr=False)
+    depth: np.ndarray = field(repr=False)
+    sliver: np.ndarray = field(repr=False)
+    stats: dict[str, int] = field(default_factory=dict)
+
+    def probe(self, edge: int, sign: int, L: float) -> tuple[np.ndarray, np.ndarray]:
+        """The exact middle of an edge and the unit normal there pointing into face A."""
+        k = self.noded.curve[edge]
+        t = 0.5 * (self.noded.ta[edge] + self.noded.tb[edge])
+        kind, data = self.curves.kind[k], self.curves.data[k]
+        p = points(kind, data, t, L)[0]
+        d1, _ = derivatives(kind, data, t, L)
+        tan = d1[0] / math.hypot(*d1[0])
+        return p + self.origin, sign * np.array([-tan[1], tan[0]])
 
 
-def _snap_vertices(polylines: list[np.ndarray], r: float) -> list[np.ndarray]:
-    """Make polyline vertices closer than ``r`` bitwise identical (one representative)."""
-    sizes = [len(p) for p in polylines]
-    allv = np.concatenate(polylines)
-    pairs = cKDTree(allv).query_pairs(r, output_type="ndarray")
-    if len(pairs):
-        parent = np.arange(len(allv))
-
-        def find(i: int) -> int:
-            while parent[i] != i:
-                parent[i] = parent[parent[i]]
-                i = parent[i]
-            return i
-
-        for i, j in pairs.tolist():
-            ri, rj = find(i), find(j)
-            if ri != rj:
-                parent[max(ri, rj)] = min(ri, rj)
-        roots = np.array([find(i) for i in range(len(allv))])
-        allv = allv[roots]
-    out, s = [], 0
-    for n in sizes:
-        out.append(allv[s : s + n])
-        s += n
-    return out
+# ------------------------------------------------------------------ curves
+def _origin(world: Map) -> np.ndarray:
+    """The local origin of the arrangement: the centre of the map's bounding box."""
+    x0, y0, x1, y1 = world.bounds
+    return np.array([0.5 * (x0 + x1), 0.5 * (y0 + y1)])
 
 
-def arrange(world: Map, curves: tuple[CriticalCurve, ...]) -> Arrangement:
-    """Node and polygonise the curves; keep the faces inside the free region.
+def _local(rows: np.ndarray, kind: np.ndarray, c0: np.ndarray) -> np.ndarray:
+    """Shape data moved to the local frame (points translated by ``-c0``)."""
+    rows = rows.copy()
+    rows[:, 0:2] -= c0
+    con = kind == SHAPE_CODES["conchoid"]
+    rows[con, 2:4] -= c0
+    return rows
+
+
+def _curves(world: Map, curves: tuple[CriticalCurve, ...], tol: Tolerances) -> Curves:
+    """The arrangement's curves, in the local frame of :func:`_origin`."""
+    c0 = _origin(world)
+    seg = [k for k, c in enumerate(curves) if c.shape == "segment"]
+    other = [k for k, c in enumerate(curves) if c.shape != "segment"]
+    rows = np.array([curves[k].row for k in seg]).reshape(-1, 6)
+    rows[:, 0:2] -= c0
+    is_wall = np.array([curves[k].type == 0 for k in seg], dtype=bool)
+    lines = merge_collinear(
+        rows[:, 0:2],
+        rows[:, 2:4],
+        np.array([curves[k].t0 for k in seg], dtype=float),
+        np.array([curves[k].t1 for k in seg], dtype=float),
+        is_wall,
+        tol.merge,
+    )
+    seg_arr = np.asarray(seg, dtype=np.intp)
+    ns = len(lines.t0)
+    kind = np.concatenate([np.full(ns, SEGMENT), [curves[k].code for k in other]]).astype(int)
+    data = np.zeros((ns + len(other), 6))
+    data[:ns, 0:2], data[:ns, 2:4] = lines.o, lines.d
+    for r, k in enumerate(other):
+        data[ns + r] = curves[k].row
+    data[ns:] = _local(data[ns:], kind[ns:], c0)
+    t0 = np.concatenate([lines.t0, [curves[k].t0 for k in other]])
+    t1 = np.concatenate([lines.t1, [curves[k].t1 for k in other]])
+    sources = [tuple(int(seg_arr[s]) for s in src) for src in lines.sources]
+    sources += [(k,) for k in other]
+    plist = [np.array([a, b]) for a, b in zip(lines.t0, lines.t1, strict=True)]
+    plist += [np.asarray(curves[k].params) for k in other]
+    offsets = np.concatenate([[0], np.cumsum([len(p) for p in plist])]).astype(np.intp)
+    params = np.concatenate(plist) if plist else np.zeros(0)
+    ends = np.stack([points(kind, data, t0, tol.L), points(kind, data, t1, tol.L)], axis=1)
+    exact = np.zeros((len(kind), 2), dtype=bool)
+    for r, src in enumerate(sources[:ns]):
+        if lines.group[r] < 0 and curves[src[0]].type == 0:  # a whole wall: its map vertices
+            e = curves[src[0]].features[0].index
+            ends[r] = (world.edge_start[e] - c0, world.edge_end[e] - c0)
+            exact[r] = True
+    return Curves(
+        kind=kind,
+        data=data,
+        t0=t0,
+        t1=t1,
+        sources=sources,
+        wall_sign=np.concatenate([lines.wall_sign, np.zeros(len(other), dtype=np.int8)]),
+        group=np.concatenate([lines.group, np.full(len(other), -1)]),
+        offsets=offsets,
+        params=params,
+        ends=ends,
+        exact_ends=exact,
+    )
+
+
+# ------------------------------------------------------------------ the planar graph
+def _edge_polylines(cv: Curves, nd: Noded, L: float) -> tuple[np.ndarray, np.ndarray]:
+    """Polyline of every edge: its end vertices and the curve's polyline points between."""
+    ne = len(nd.curve)
+    order = np.argsort(nd.curve, kind="stable")
+    inner_from = np.zeros(ne, dtype=np.intp)
+    inner_to = np.zeros(ne, dtype=np.intp)
+    bounds = np.searchsorted(nd.curve[order], np.arange(len(cv) + 1))
+    for c in np.flatnonzero(np.diff(bounds)).tolist():
+        ks = order[bounds[c] : bounds[c + 1]]
+        p = cv.params[cv.offsets[c] : cv.offsets[c + 1]]
+        span = 1e-9 * (cv.t1[c] - cv.t0[c])
+        inner_from[ks] = cv.offsets[c] + np.searchsorted(p, nd.ta[ks] + span, side="right")
+        inner_to[ks] = cv.offsets[c] + np.searchsorted(p, nd.tb[ks] - span, side="left")
+    n_inner = np.maximum(inner_to - inner_from, 0)
+    counts = n_inner + 2
+    offsets = np.concatenate([[0], np.cumsum(counts)]).astype(np.intp)
+    pts = np.empty((offsets[-1], 2))
+    pts[offsets[:-1]] = nd.vertices[nd.u]
+    pts[offsets[1:] - 1] = nd.vertices[nd.v]
+    owner = np.repeat(np.arange(ne), n_inner)
+    local = np.arange(len(owner)) - np.repeat(np.cumsum(n_inner) - n_inner, n_inner)
+    pidx = inner_from[owner] + local
+    if len(owner):
+        k = nd.curve[owner]
+        pts[offsets[owner] + 1 + local] = points(cv.kind[k], cv.data[k], cv.params[pidx], L)
+    return offsets, pts
+
+
+def _rotation(cv: Curves, nd: Noded, L: float, e_len: np.ndarray) -> np.ndarray:
+    """``next`` of every half-edge (2k: u -> v, 2k + 1: v -> u) for faces on the left.
+
+    At each vertex the half-edges leave in the order of the directions from the vertex
+    to their points a quarter of the shortest incident edge along (never the tangents:
+    a vertex stands for every point within the merge tolerance, and two curves merged
+    there may pass each other in an order their tangents do not tell). No two incident
+    edges cross that close to the vertex, so that order is the arrangement's.
+    """
+    ne = len(nd.curve)
+    k = np.repeat(np.arange(ne), 2)
+    fwd = np.tile([True, False], ne)
+    t = np.where(fwd, nd.ta[k], nd.tb[k])
+    kind, data = cv.kind[nd.curve[k]], cv.data[nd.curve[k]]
+    origin = np.where(fwd, nd.u[k], nd.v[k])
+    short = np.full(len(nd.vertices), np.inf)
+    np.minimum.at(short, origin, e_len[k])
+    d1, _ = derivatives(kind, data, t, L)
+    speed = np.maximum(np.hypot(d1[:, 0], d1[:, 1]), 1e-300)
+    dt = np.minimum(0.25 * short[origin] / speed, 0.5 * (nd.tb - nd.ta)[k])
+    chord = points(kind, data, np.where(fwd, t + dt, t - dt), L) - nd.vertices[origin]
+    ang = np.arctan2(chord[:, 1], chord[:, 0])
+    order = np.lexsort((ang, origin))
+    start = np.searchsorted(origin[order], np.arange(len(nd.vertices) + 1))
+    deg = np.diff(start)
+    pos = np.empty(2 * ne, dtype=np.intp)
+    pos[order] = np.arange(2 * ne)
+    twin = np.arange(2 * ne) ^ 1
+    v = origin[twin]
+    p = pos[twin] - start[v]
+    return order[start[v] + (p - 1) % deg[v]]
+
+
+def _valid(poly: Polygon) -> Polygon:
+    """The polygon, counter-clockwise; if its polylines cross near a vertex where two
+    curves meet at a small angle (within the chord tolerance), its largest valid part."""
+    if not poly.is_empty and not poly.is_valid:
+        fixed = shapely.make_valid(poly)
+        parts = [g for g in getattr(fixed, "geoms", [fixed]) if g.geom_type == "Polygon"]
+        poly = max(parts, key=lambda g: g.area) if parts else Polygon()
+    return shapely.orient_polygons(poly, exterior_cw=False)
+
+
+def _cycles(nxt: np.ndarray) -> tuple[np.ndarray, list[np.ndarray]]:
+    """Cycle id of every half-edge and each cycle's half-edges in order."""
+    n = len(nxt)
+    cyc = np.full(n, -1, dtype=np.intp)
+    walks: list[np.ndarray] = []
+    nl = nxt.tolist()
+    for h0 in range(n):
+        if cyc[h0] >= 0:
+            continue
+        walk = [h0]
+        h = nl[h0]
+        while h != h0:
+            walk.append(h)
+            h = nl[h]
+        arr = np.asarray(walk, dtype=np.intp)
+        cyc[arr] = len(walks)
+        walks.append(arr)
+    return cyc, walks
+
+
+def arrange(world: Map, curves: tuple[CriticalCurve, ...], tol: Tolerances) -> Arrangement:
+    """Node the exact curves, trace the faces in the free region and their boundaries.
 
     Args:
         world: the map.
         curves: the critical curves (walls included).
+        tol: the decomposition's tolerances.
 
     Returns:
         The :class:`Arrangement`.
     """
-    g = SNAP_REL * world.scale
-    polylines = _snap_vertices([c.points for c in curves], 4 * g)
-    lines = [shapely.linestrings(p) for p in polylines]
-    noded = shapely.unary_union(lines, grid_size=g)
-    polys = shapely.get_parts(shapely.polygonize(shapely.get_parts(noded)))
-    faces = []
-    for poly in polys:
-        if poly.area <= (10 * g) ** 2:
-            continue
-        rp = shapely.point_on_surface(poly)
-        if world.contains([[rp.x, rp.y]])[0]:
-            faces.append(shapely.orient_polygons(poly, exterior_cw=False))
-    # directed segments: the face on the left of each
-    left: dict[tuple[float, float, float, float], int] = {}
-    for f, poly in enumerate(faces):
-        for ring in (poly.exterior, *poly.interiors):
-            c = np.asarray(ring.coords)
-            for p, q in zip(c[:-1].tolist(), c[1:].tolist(), strict=True):
-                left[(p[0], p[1], q[0], q[1])] = f
-    wall_length = np.zeros(len(faces))
-    internal = []
-    for (x0, y0, x1, y1), f in left.items():
-        other = left.get((x1, y1, x0, y0))
-        if other is None:
-            wall_length[f] += float(np.hypot(x1 - x0, y1 - y0))
-        elif f < other:
-            internal.append((x0, y0, x1, y1, f, other))
-    pieces = _group_pieces(internal, curves, polylines, g)
-    return Arrangement(tuple(faces), pieces, wall_length)
+    L = tol.L
+    cv = _curves(world, curves, tol)
+    c0 = _origin(world)
+    nd = node(cv, L, tol, world.vertices - c0)
+    ne = len(nd.curve)
+    offsets, pts = _edge_polylines(cv, nd, L)
+    # signed area and length of every edge's polyline (local frame: no cancellation)
+    rel = pts
+    seg_owner = np.repeat(np.arange(ne), np.diff(offsets) - 1)
+    a_i = np.delete(np.arange(len(pts)), offsets[1:] - 1)
+    cross = rel[a_i, 0] * rel[a_i + 1, 1] - rel[a_i + 1, 0] * rel[a_i, 1]
+    e_area = 0.5 * np.bincount(seg_owner, weights=cross, minlength=ne)
+    e_len = np.bincount(seg_owner, weights=np.hypot(*(pts[a_i + 1] - pts[a_i]).T), minlength=ne)
+    nxt = _rotation(cv, nd, L, e_len)
+    cyc, walks = _cycles(nxt)
+    nc = len(walks)
+    h_edge = np.arange(2 * ne) // 2
+    h_fwd = np.arange(2 * ne) % 2 == 0
+    c_area = np.bincount(cyc, weights=np.where(h_fwd, 1.0, -1.0) * e_area[h_edge], minlength=nc)
+    ws = cv.wall_sign[nd.curve[h_edge]]
+    blocked_h = (h_fwd & (ws < 0)) | (~h_fwd & (ws > 0))
+    blocked = np.bincount(cyc, weights=blocked_h, minlength=nc) > 0
+    bridge = cyc[0::2] == cyc[1::2]
+    area_tol = tol.merge**2
+    all_bridges = np.bincount(cyc, weights=~bridge[h_edge], minlength=nc) == 0
+    # faces: counter-clockwise cycles, and degenerate ones (zero area but not a tree of
+    # dangling edges: two edges whose polylines coincide), which join a neighbour below
+    degenerate = ~blocked & (np.abs(c_area) <= area_tol) & ~all_bridges
+    outer = np.flatnonzero((~blocked & (c_area > area_tol)) | degenerate)
+    inner = np.flatnonzero(~blocked & (c_area <= area_tol) & ~degenerate)
+
+    # rings: the half-edges of a cycle in order, bridges skipped, each polyline's last
+    # point dropped (it is the next one's first)
+    def ring(cid: int) -> np.ndarray:
+        hs = walks[cid]
+        hs = hs[~bridge[h_edge[hs]]]
+        if len(hs) == 0:
+            return np.zeros((0, 2))
+        k = h_edge[hs]
+        cnt = np.diff(offsets)[k] - 1
+        st = np.where(h_fwd[hs], offsets[k], offsets[k + 1] - 1)
+        dr = np.where(h_fwd[hs], 1, -1)
+        rep = np.repeat(np.arange(len(hs)), cnt)
+        loc = np.arange(len(rep)) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+        return pts[st[rep] + dr[rep] * loc]
+
+    shells = [ring(c) for c in outer.tolist()]
+    shell_polys = [Polygon(r) if len(r) >= 3 else Polygon() for r in shells]
+    face_of_cycle = np.full(nc, -1, dtype=np.intp)
+    face_of_cycle[outer] = np.arange(len(outer))
+    holes: list[list[np.ndarray]] = [[] for _ in outer]
+    orphans = 0
+    if len(inner) and len(outer):
+        h0 = np.array([walks[c][0] for c in inner.tolist()], dtype=np.intp)
+        starts = nd.vertices[np.where(h_fwd[h0], nd.u[h_edge[h0]], nd.v[h_edge[h0]])]
+        tree = shapely.STRtree(shell_polys)
+        qi, qf = tree.query(shapely.points(starts), predicate="within")
+        areas = c_area[outer]
+        best = np.full(len(inner), -1, dtype=np.intp)
+        best_area = np.full(len(inner), np.inf)
+        for i, f in zip(qi.tolist(), qf.tolist(), strict=True):
+            if areas[f] < best_area[i]:
+                best[i], best_area[i] = f, areas[f]
+        face_of_cycle[inner] = best
+        orphans = int(np.count_nonzero(best < 0))
+        for i, c in enumerate(inner.tolist()):
+            if best[i] >= 0 and c_area[c] < -area_tol:
+                r = ring(c)
+                if len(r) >= 3:
+                    holes[best[i]].append(r)
+    faces = [
+        _valid(Polygon(s, h) if h else p)
+        for s, h, p in zip(shells, holes, shell_polys, strict=True)
+    ]
+    face_h = face_of_cycle[cyc]
+    # slivers: faces narrower than the sliver tolerance (their cells are not probed;
+    # the boundaries across them are resolved by stepping over them, see _build)
+    nf = len(faces)
+    f_area = np.array([f.area for f in faces])
+    has = face_h >= 0
+    f_perim = np.bincount(face_h[has], weights=e_len[h_edge[has]], minlength=nf)
+    sliver = 2.0 * f_area < tol.thin * f_perim
+    samples, depth = _face_samples(cv, nd, tol, faces, face_h, e_len, bridge)
+    faces = list(shapely.transform(np.array(faces, dtype=object), lambda x: x + c0))
+    pieces = _pieces(cv, nd, curves, face_h, offsets, pts + c0)
+    stats = {
+        "vertices": len(nd.vertices),
+        "edges": ne,
+        "dangling": int(np.count_nonzero(bridge & ~blocked[cyc[0::2]])),
+        "slivers": int(np.count_nonzero(sliver)),
+        "orphan_holes": orphans,
+        "wide_vertices": nd.n_clusters_wide,
+    }
+    return Arrangement(tuple(faces), pieces, cv, nd, e_len, c0, samples + c0, depth, sliver, stats)
 
 
-def _group_pieces(internal, curves, polylines, g: float) -> tuple[Piece, ...]:
-    if not internal:
+def _face_samples(cv, nd, tol, faces, face_h, e_len, bridge):
+    """Exact points inside the faces: from the middle of each face's longest edge."""
+    nf = len(faces)
+    h = np.arange(len(face_h))
+    ok = (face_h >= 0) & ~bridge[h // 2]
+    h = h[ok]
+    order = np.lexsort((-e_len[h // 2], face_h[h]))
+    h = h[order]
+    first = np.searchsorted(face_h[h], np.arange(nf))
+    has = first < len(h)
+    has[has] = face_h[h[first[has]]] == np.arange(nf)[has]
+    best = h[np.minimum(first, len(h) - 1)]
+    k = best // 2
+    sign = np.where(best % 2 == 0, 1.0, -1.0)
+    bounds = np.array([f.bounds if not f.is_empty else (0, 0, 0, 0) for f in faces]).reshape(-1, 4)
+    reach = 1.01 * np.hypot(bounds[:, 2] - bounds[:, 0], bounds[:, 3] - bounds[:, 1]) + tol.merge
+    pts, depth = ray_samples(cv, tol.L, nd.curve[k], nd.ta[k], nd.tb[k], sign, reach, tol.touch)
+    pts[~has] = np.nan
+    depth[~has] = np.nan
+    return pts, depth
+
+
+def _pieces(cv, nd, curves, face_h, offsets, pts) -> tuple[Piece, ...]:
+    fl, fr = face_h[0::2], face_h[1::2]
+    sel = np.flatnonzero((fl >= 0) & (fr >= 0) & (fl != fr))
+    if len(sel) == 0:
         return ()
-    seg = np.array([s[:4] for s in internal]).reshape(-1, 2, 2)
-    fa = np.array([s[4] for s in internal])
-    fb = np.array([s[5] for s in internal])
-    mids = shapely.points(0.5 * (seg[:, 0] + seg[:, 1]))
-    tree = shapely.STRtree([shapely.linestrings(p) for p in polylines])
-    qi, ci = tree.query(mids, predicate="dwithin", distance=8 * g)
-    src: list[list[int]] = [[] for _ in range(len(seg))]
-    for i, c in zip(qi.tolist(), ci.tolist(), strict=True):
-        if curves[c].type != 0:
-            src[i].append(c)
-    keys = [(int(fa[i]), int(fb[i]), tuple(sorted(src[i]))) for i in range(len(seg))]
-    # union segments of the same key that share an endpoint
-    parent = list(range(len(seg)))
-
-    def find(i: int) -> int:
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
-    at: dict[tuple, int] = {}
-    for i in range(len(seg)):
-        for end in (seg[i, 0], seg[i, 1]):
-            k = (keys[i], float(end[0]), float(end[1]))
-            j = at.setdefault(k, i)
-            if j != i:
-                ri, rj = find(i), find(j)
-                if ri != rj:
-                    parent[ri] = rj
-    groups: dict[int, list[int]] = {}
-    for i in range(len(seg)):
-        groups.setdefault(find(i), []).append(i)
+    a = np.minimum(fl[sel], fr[sel])
+    b = np.maximum(fl[sel], fr[sel])
+    sign = np.where(fl[sel] == a, 1, -1)
+    src = [tuple(s for s in cv.sources[c] if curves[s].type != 0) for c in nd.curve[sel].tolist()]
+    keys = {}
+    kid = np.array(
+        [
+            keys.setdefault((int(x), int(y), s), len(keys))
+            for x, y, s in zip(a, b, src, strict=True)
+        ],
+        dtype=np.intp,
+    )
+    # edges of one key that share a vertex belong to one piece
+    n = len(sel)
+    ends = np.concatenate([nd.u[sel], nd.v[sel]])
+    which = np.concatenate([np.arange(n), np.arange(n)])
+    combo = np.stack([np.concatenate([kid, kid]), ends], axis=1)
+    _, inv = np.unique(combo, axis=0, return_inverse=True)
+    inv = inv.ravel()
+    g = coo_matrix((np.ones(2 * n), (which, n + inv)), shape=(n + inv.max() + 1,) * 2)
+    _, lab = connected_components(g, directed=False)
+    lab = lab[:n]
     out = []
-    for members in groups.values():
-        a, b, src_c = keys[members[0]]
-        out.append(Piece((a, b), src_c, seg[members]))
+    inv_keys = {v: k for k, v in keys.items()}
+    order = np.argsort(lab, kind="stable")
+    bounds = np.searchsorted(lab[order], np.arange(lab.max() + 2))
+    for g_id in range(lab.max() + 1):
+        mem = order[bounds[g_id] : bounds[g_id + 1]]
+        if len(mem) == 0:
+            continue
+        x, y, s = inv_keys[int(kid[mem[0]])]
+        segs = []
+        for m in mem.tolist():
+            e = sel[m]
+            poly = pts[offsets[e] : offsets[e + 1]]
+            if sign[m] < 0:
+                poly = poly[::-1]
+            segs.append(np.stack([poly[:-1], poly[1:]], axis=1))
+        out.append(Piece((x, y), s, np.concatenate(segs), sel[mem], sign[mem]))
     return tuple(out)

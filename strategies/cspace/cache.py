@@ -20,14 +20,13 @@ import tempfile
 from pathlib import Path
 
 from envs.maps.map import Map
+from strategies.cspace import tolerances as _tol
 from strategies.cspace._build import build_decomposition
-from strategies.cspace.arrangement import SNAP_REL
-from strategies.cspace.curves import CHORD_TOL_REL
-from strategies.cspace.decomposition import ADJ_EPS_REL, Decomposition
+from strategies.cspace.decomposition import Decomposition
 
 __all__ = ["FORMAT_VERSION", "cache_path", "cached_decomposition", "resolve_cache_dir"]
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 """Bump when the decomposition's content or pickle layout changes."""
 
 
@@ -42,7 +41,14 @@ def resolve_cache_dir(directory: str | os.PathLike[str] | None = None) -> Path:
 def _key(world: Map, L: float, chord_tol: float | None) -> dict:
     return {
         "format": FORMAT_VERSION,
-        "constants": (CHORD_TOL_REL, SNAP_REL, ADJ_EPS_REL),
+        "constants": (
+            _tol.CHORD_TOL_REL,
+            _tol.MERGE_REL,
+            _tol.TOUCH_REL,
+            _tol.THIN_REL,
+            _tol.PROBE_REL,
+            tuple(sorted(_tol.KERNEL_FLOOR.items())),
+        ),
         "map": world.digest,
         "L": float(L).hex(),
         "chord_tol": None if chord_tol is None else float(chord_tol).hex(),

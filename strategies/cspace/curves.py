@@ -3,12 +3,16 @@
 :func:`critical_curves` builds every candidate of :mod:`strategies.cspace._candidates`,
 keeps the parts where the contact configuration is semi-free (the rod touches the
 defining features and lies in the closed free region,
-:func:`~strategies.cspace._rod.rods_semifree`),
-and returns them as :class:`CriticalCurve` pieces with their exact geometry and a polyline.
+:func:`~strategies.cspace._rod.rods_semifree_near`), and returns them as
+:class:`CriticalCurve` pieces with their exact geometry and a polyline.
 
-Geometry: segments (types 0, 1, 3, 4) are exact; arcs (type 2) and conchoids (type 5)
+Every piece ends exactly at a breakpoint of its candidate (a closed form, or a root
+polished to double precision), i.e. exactly where the rod gains or loses a contact,
+which is a point of another critical curve or of a wall: nothing is left to a sampling
+grid. Segments (types 0, 1, 3, 4) are exact; arcs (type 2) and conchoids (type 5) also
 carry a polyline whose vertices lie on the exact curve and whose chords stay within
-``tolerance`` of it (:data:`CHORD_TOL_REL` times L by default).
+``tolerance`` of it (:data:`CHORD_TOL_REL` times L by default), for pictures and region
+polygons only.
 """
 
 from __future__ import annotations
@@ -22,13 +26,21 @@ from shapely.geometry import LineString
 from envs.errors import InvalidConfigError
 from envs.maps.map import Feature, Map
 from envs.tolerances import REL_LENGTH_TOL
-from strategies.cspace._candidates import _Cand, candidates, evaluate
-from strategies.cspace._rod import rods_semifree
+from envs.validation import positive
+from strategies.cspace._candidates import Candidates, candidates
+from strategies.cspace._rod import rods_semifree_near
+from strategies.cspace._shapes import (
+    SEGMENT,
+    SHAPE_CODES,
+    SHAPE_NAMES,
+    orientation,
+    points,
+    polyline_params,
+    project,
+)
+from strategies.cspace.tolerances import CHORD_TOL_REL
 
 __all__ = ["CHORD_TOL_REL", "TYPE_NAMES", "CriticalCurve", "check_length", "critical_curves"]
-
-CHORD_TOL_REL = 1e-4
-"""Default polyline tolerance of arcs and conchoids, relative to the rod length L."""
 
 TYPE_NAMES = {
     0: "wall (P on the boundary)",
@@ -40,7 +52,7 @@ TYPE_NAMES = {
 }
 """One-line description of each critical-curve type (THEORY.md 1.2)."""
 
-_BISECT_STEPS = 52  # halvings of a grid cell: down to the double-precision floor
+_PAIRS_PER_BATCH = 2_000_000  # (rod, edge) pairs tested per vectorised batch of the clip
 
 
 @dataclass(frozen=True, eq=False)
@@ -52,12 +64,13 @@ class CriticalCurve:
         features: the wall features that define it (edge; vertex; two vertices;
             vertex and edge; vertex and edge).
         shape: ``"segment"``, ``"arc"`` or ``"conchoid"``.
-        data: the exact parameters of the shape (see :mod:`strategies.cspace._candidates`).
+        data: the exact parameters of the shape (see :mod:`strategies.cspace._shapes`).
         t0, t1: the piece's parameter interval.
         L: rod length.
         points: (m, 2) polyline; its vertices lie on the exact curve.
         tolerance: bound on the distance between the polyline and the exact curve (0 for
             segments).
+        params: (m,) the parameters of the polyline's vertices.
     """
 
     type: int
@@ -69,39 +82,43 @@ class CriticalCurve:
     L: float
     points: np.ndarray = field(repr=False)
     tolerance: float = 0.0
+    params: np.ndarray | None = field(default=None, repr=False)
+
+    @property
+    def code(self) -> int:
+        """The shape code of :mod:`strategies.cspace._shapes`."""
+        return SHAPE_CODES[self.shape]
+
+    @property
+    def row(self) -> np.ndarray:
+        """The exact data padded to six numbers (the vectorised layout)."""
+        out = np.zeros(6)
+        out[: len(self.data)] = self.data
+        return out
 
     def evaluate(self, t: np.ndarray | float) -> tuple[np.ndarray, np.ndarray]:
         """Evader positions P (k, 2) and contact orientations theta (k,) at parameters t.
 
         For type 0 (a wall) theta is NaN: no rod contact defines it.
         """
-        P, theta = evaluate(self.shape, np.asarray(self.data), np.atleast_1d(t), self.L)
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        P = points(self.code, self.row, t, self.L)
         if self.type == 0:
-            theta = np.full(len(theta), np.nan)
-        return P, theta
+            return P, np.full(len(t), np.nan)
+        return P, orientation(self.code, self.row, t, self.L)
 
     def project(self, points: np.ndarray) -> np.ndarray:
-        """Parameters of the exact curve points nearest to ``points``.
+        """Parameters of the exact curve points nearest to ``points``, clipped to the piece.
 
         For conchoids: the point in line with ``points`` and the vertex.
         """
         p = np.atleast_2d(np.asarray(points, dtype=float))
-        d = np.asarray(self.data)
-        if self.shape == "segment":
-            t = (p - d[0:2]) @ d[2:4]
-        elif self.shape == "arc":
-            ang = np.arctan2(p[:, 1] - d[1], p[:, 0] - d[0])
-            t = self.t0 + (ang - self.t0) % (2 * math.pi)
+        t = project(self.code, self.row, p, self.t0)
+        if self.shape == "arc":  # past the end: back to whichever end is nearer
             over = t > self.t1
             back = t - 2 * math.pi
             t = np.where(over & (self.t0 - back < t - self.t1), self.t0, t)
-        else:  # conchoid: the tip Q where the line from p through v meets the edge
-            v, a, u = d[0:2], d[2:4], d[4:6]
-            w = v - p
-            den = w[:, 0] * u[1] - w[:, 1] * u[0]
-            num = (a - p)[:, 0] * w[:, 1] - (a - p)[:, 1] * w[:, 0]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                t = np.where(np.abs(den) > 1e-300, num / den, self.t0)
+        t = np.where(np.isfinite(t), t, self.t0)
         return np.clip(t, self.t0, self.t1)
 
     @property
@@ -120,17 +137,9 @@ class CriticalCurve:
         return f"type {self.type} (" + ", ".join(str(f) for f in self.features) + ")"
 
 
-def check_length(L: float, what: str = "L") -> float:
-    """Return ``L`` as a float or raise :class:`InvalidConfigError` unless finite and > 0."""
-    try:
-        v = float(L)
-    except (TypeError, ValueError) as exc:
-        raise InvalidConfigError(
-            f"{what}: expected a rod length (a number > 0), got {L!r}"
-        ) from exc
-    if not math.isfinite(v) or v <= 0:
-        raise InvalidConfigError(f"{what}: expected a finite rod length > 0, got {L!r}")
-    return v
+def check_length(L: object, what: str = "L") -> float:
+    """Return ``L`` as a float or raise :class:`InvalidConfigError` unless a finite number > 0."""
+    return positive(what, L)
 
 
 def _check_map(world: object) -> Map:
@@ -140,120 +149,62 @@ def _check_map(world: object) -> Map:
 
 
 # ------------------------------------------------------------------------ the clip
-def _semifree(
-    world: Map, L: float, cands: list[_Cand], idx: np.ndarray, t: np.ndarray
-) -> np.ndarray:
-    """Semi-free test of candidate ``idx[k]`` at parameter ``t[k]``, vectorised by shape."""
-    out = np.zeros(len(t), dtype=bool)
-    for shape in ("segment", "arc", "conchoid"):
-        sel = np.flatnonzero(np.array([cands[i].shape == shape for i in idx], dtype=bool))
-        if len(sel) == 0:
-            continue
-        data = np.array([cands[i].data for i in idx[sel]])
-        P, theta = evaluate(shape, data, t[sel], L)
-        Q = P + L * np.stack([np.cos(theta), np.sin(theta)], axis=1)
-        out[sel] = rods_semifree(world, P, Q)
-    return out
+def _intervals(cand: Candidates) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Sub-intervals between consecutive breakpoints: (candidate, lo, hi), sorted."""
+    live = np.flatnonzero(cand.t1 > cand.t0)
+    bc, bt = cand.break_c, cand.break_t
+    inside = np.isfinite(bt) & (bt > cand.t0[bc]) & (bt < cand.t1[bc])
+    c = np.concatenate([live, live, bc[inside]])
+    t = np.concatenate([cand.t0[live], cand.t1[live], bt[inside]])
+    order = np.lexsort((t, c))
+    c, t = c[order], t[order]
+    if len(c) == 0:
+        return c, t, t
+    tol = 1e-12 * (np.abs(t) + (cand.t1 - cand.t0)[c] + 1.0)
+    keep = np.concatenate([[True], (c[1:] != c[:-1]) | (np.diff(t) > tol[1:])])
+    c, t = c[keep], t[keep]
+    last = np.concatenate([c[1:] != c[:-1], [True]])
+    t[last] = cand.t1[c[last]]  # each candidate's exact end
+    same = c[1:] == c[:-1]
+    return c[:-1][same], t[:-1][same], t[1:][same]
 
 
-def _clip(world: Map, L: float, cands: list[_Cand]) -> list[tuple[_Cand, float, float]]:
-    """Semi-free parameter intervals of every candidate."""
-    xs_all, exact_all = [], []
-    mid_idx, mid_t = [], []
-    for i, c in enumerate(cands):
-        span = c.t1 - c.t0
-        if span <= 0:
-            xs_all.append(np.zeros(0))
-            exact_all.append(np.zeros(0, dtype=bool))
-            continue
-        b = c.breaks[(c.breaks > c.t0) & (c.breaks < c.t1)]
-        grid = np.linspace(c.t0, c.t1, c.grid + 2)[1:-1] if c.grid else np.zeros(0)
-        xs = np.concatenate([[c.t0, c.t1], b, grid])
-        exact = np.concatenate([np.ones(2 + len(b), dtype=bool), np.zeros(len(grid), dtype=bool)])
-        order = np.lexsort((~exact, xs))
-        xs, exact = xs[order], exact[order]
-        keep = np.concatenate([[True], np.diff(xs) > 1e-12 * max(span, 1.0)])
-        xs, exact = xs[keep], exact[keep]
-        xs_all.append(xs)
-        exact_all.append(exact)
-        mid_idx.append(np.full(len(xs) - 1, i))
-        mid_t.append(0.5 * (xs[:-1] + xs[1:]))
-    if not mid_t:
-        return []
-    midx = np.concatenate(mid_idx)
-    mt = np.concatenate(mid_t)
-    ok = _semifree(world, L, cands, midx, mt)
-    # split per candidate, find runs, collect ends that need bisection
-    pieces: list[list] = []
-    tasks: list[tuple[int, int, float, float]] = []  # (piece, end 0/1, true t, false t)
-    pos = 0
-    for i, xs in enumerate(xs_all):
-        m = len(xs) - 1
-        if m <= 0:
-            continue
-        flags = ok[pos : pos + m]
-        mids = mt[pos : pos + m]
-        pos += m
-        exact = exact_all[i]
-        k = 0
-        while k < m:
-            if not flags[k]:
-                k += 1
-                continue
-            j = k
-            while j + 1 < m and flags[j + 1]:
-                j += 1
-            piece = [i, xs[k], xs[j + 1]]
-            pieces.append(piece)
-            if not exact[k]:
-                tasks.append((len(pieces) - 1, 1, mids[k], mids[k - 1]))
-            if not exact[j + 1]:
-                tasks.append((len(pieces) - 1, 2, mids[j], mids[j + 1]))
-            k = j + 1
-    if tasks:
-        pidx = np.array([pieces[p][0] for p, *_ in tasks])
-        good = np.array([t[2] for t in tasks])
-        bad = np.array([t[3] for t in tasks])
-        for _ in range(_BISECT_STEPS):
-            mid = 0.5 * (good + bad)
-            f = _semifree(world, L, cands, pidx, mid)
-            good = np.where(f, mid, good)
-            bad = np.where(f, bad, mid)
-        for (p, end, *_), g in zip(tasks, good.tolist(), strict=True):
-            pieces[p][end] = g
-    return [(cands[i], a, b) for i, a, b in pieces if b > a]
+def _clip(world: Map, L: float, cand: Candidates) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Semi-free pieces ``(candidate, t_start, t_end)`` of every candidate."""
+    ic, lo, hi = _intervals(cand)
+    if len(ic) == 0:
+        return ic, lo, hi
+    ptr = np.searchsorted(cand.near_c, np.arange(len(cand) + 1))
+    counts = ptr[ic + 1] - ptr[ic]
+    ok = np.zeros(len(ic), dtype=bool)
+    start = 0
+    csum = np.cumsum(counts)
+    while start < len(ic):
+        base = csum[start - 1] if start else 0
+        stop = int(np.searchsorted(csum, base + _PAIRS_PER_BATCH, side="right"))
+        stop = max(stop, start + 1)
+        sl = slice(start, stop)
+        mid = 0.5 * (lo[sl] + hi[sl])
+        k, d = cand.kind[ic[sl]], cand.data[ic[sl]]
+        P = points(k, d, mid, L)
+        th = orientation(k, d, mid, L)
+        Q = P + L * np.stack([np.cos(th), np.sin(th)], axis=1)
+        cnt = counts[sl]
+        rod = np.repeat(np.arange(stop - start), cnt)
+        first = np.repeat(ptr[ic[sl]], cnt)
+        offs = np.arange(len(rod)) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+        edge = cand.near_e[first + offs]
+        ok[sl] = rods_semifree_near(world, P, Q, rod, edge)
+        start = stop
+    # maximal runs of semi-free sub-intervals of one candidate
+    prev_ok = np.concatenate([[False], ok[:-1] & (ic[1:] == ic[:-1])])
+    next_ok = np.concatenate([ok[1:] & (ic[1:] == ic[:-1]), [False]])
+    starts = np.flatnonzero(ok & ~prev_ok)
+    ends = np.flatnonzero(ok & ~next_ok)
+    return ic[starts], lo[starts], hi[ends]
 
 
-# ------------------------------------------------------------------------ polylines
-def _polyline(c: _Cand, a: float, b: float, L: float, tol: float) -> np.ndarray:
-    if c.shape == "segment":
-        P, _ = evaluate(c.shape, np.asarray(c.data), np.array([a, b]), L)
-        return P
-    if c.shape == "arc":
-        R = c.data[2]
-        step = 2.0 * math.acos(max(-1.0, 1.0 - tol / R)) if tol < 2 * R else math.pi
-        n = max(1, math.ceil((b - a) / step))
-        t = np.linspace(a, b, n + 1)
-        sp = [s for s in c.specials if a < s < b]
-        if sp:
-            t = np.unique(np.concatenate([t, sp]))
-        return evaluate(c.shape, np.asarray(c.data), t, L)[0]
-    # conchoid: adaptive subdivision until each chord's midpoint deviation is <= tol
-    data = np.asarray(c.data)
-    t = np.linspace(a, b, 9)
-    for _ in range(30):
-        P, _ = evaluate(c.shape, data, t, L)
-        tm = 0.5 * (t[:-1] + t[1:])
-        Pm, _ = evaluate(c.shape, data, tm, L)
-        chord = 0.5 * (P[:-1] + P[1:])
-        dev = np.hypot(*(Pm - chord).T)
-        bad = dev > 0.25 * tol
-        if not bad.any():
-            break
-        t = np.sort(np.concatenate([t, tm[bad]]))
-    return evaluate(c.shape, data, t, L)[0]
-
-
+# ------------------------------------------------------------------------ assembly
 def _walls(world: Map) -> list[CriticalCurve]:
     out = []
     for e in range(world.n_edges):
@@ -262,7 +213,16 @@ def _walls(world: Map) -> list[CriticalCurve]:
         pts = np.stack([world.edge_start[e], world.edge_end[e]])
         out.append(
             CriticalCurve(
-                0, (Feature("edge", e),), "segment", (*a, *u, math.nan), 0.0, ln, 0.0, pts
+                0,
+                (Feature("edge", e),),
+                "segment",
+                (*a.tolist(), *u.tolist(), math.nan),
+                0.0,
+                ln,
+                0.0,
+                pts,
+                0.0,
+                np.array([0.0, ln]),
             )
         )
     return out
@@ -289,24 +249,42 @@ def critical_curves(
     world = _check_map(map)
     L = check_length(L)
     tol = CHORD_TOL_REL * L if chord_tol is None else check_length(chord_tol, "chord_tol")
-    cands = candidates(world, L)
-    min_len = 10 * REL_LENGTH_TOL * world.scale
+    return _curves(world, L, tol, include_walls)
+
+
+def _curves(world: Map, L: float, tol: float, include_walls: bool) -> tuple[CriticalCurve, ...]:
+    eps = REL_LENGTH_TOL * world.scale
+    cand = candidates(world, L, eps)
+    ic, a, b = _clip(world, L, cand)
+    order = np.lexsort((a, ic, cand.type[ic]))
+    ic, a, b = ic[order], a[order], b[order]
+    kind, data = cand.kind[ic], cand.data[ic]
+    offsets, params = polyline_params(kind, data, a, b, L, tol)
+    owner = np.repeat(np.arange(len(ic)), np.diff(offsets))
+    pts = points(kind[owner], data[owner], params, L) if len(owner) else np.zeros((0, 2))
+    seg_len = np.hypot(*np.diff(pts, axis=0).T) if len(pts) > 1 else np.zeros(0)
+    inner = owner[1:] == owner[:-1] if len(owner) > 1 else np.zeros(0, dtype=bool)
+    length = np.bincount(owner[1:][inner], weights=seg_len[inner], minlength=len(ic))
+    min_len = 10 * eps
     out = _walls(world) if include_walls else []
-    for c, a, b in sorted(_clip(world, L, cands), key=lambda x: x[0].type):
-        pts = _polyline(c, a, b, L, tol)
-        if float(np.hypot(*np.diff(pts, axis=0).T).sum()) <= min_len:
+    width = {SEGMENT: 5, 1: 3, 2: 6}
+    for k in range(len(ic)):
+        if length[k] <= min_len:
             continue
+        sl = slice(offsets[k], offsets[k + 1])
+        shape = int(kind[k])
         out.append(
             CriticalCurve(
-                c.type,
-                c.features,
-                c.shape,
-                tuple(float(x) for x in c.data),
-                float(a),
-                float(b),
+                int(cand.type[ic[k]]),
+                cand.features[ic[k]],
+                SHAPE_NAMES[shape],
+                tuple(float(x) for x in data[k, : width[shape]]),
+                float(a[k]),
+                float(b[k]),
                 L,
-                pts,
-                0.0 if c.shape == "segment" else tol,
+                pts[sl],
+                0.0 if shape == SEGMENT else tol,
+                params[sl],
             )
         )
     return tuple(out)

@@ -2,8 +2,9 @@
 
 Sections 3-4 of the paper, THEORY.md 1.3:
 
-* **regions**: faces of the arrangement of the semi-free critical curves
-  (:mod:`strategies.cspace.arrangement`);
+* **regions**: faces of the exact arrangement of the semi-free critical curves
+  (:mod:`strategies.cspace.arrangement`; faces with equal stops on both sides of a curve
+  are one region), each checked noncritical at several points;
 * **cells**: above each region, one cell per free arc at a sample point of the region,
   keyed by its stop pair ``(s-, s+)`` (constant over the region);
 * **adjacency** across a boundary piece shared by regions R and R': at a point p of the
@@ -14,7 +15,10 @@ Sections 3-4 of the paper, THEORY.md 1.3:
   above R is escapable if across some boundary piece of R (not a wall: the evader cannot
   cross walls) (a) no cell is adjacent to kappa, or (b) every adjacent cell is escapable;
 * **Prop. 2**: the evader wins if some region carries only escapable cells (a region
-  with no free orientation at all counts: the rod cannot exist there).
+  with no free orientation at all counts: the rod cannot exist there). When no rod of
+  length L fits anywhere in the map, :meth:`Decomposition.summary` says so.
+
+The tolerances the result is exact up to are stated in :mod:`strategies.cspace.tolerances`.
 """
 
 from __future__ import annotations
@@ -33,11 +37,9 @@ from envs.geometry.types import Arc, FreeArcs
 from envs.maps.map import Map
 from strategies.cspace._arcs import StopPair, pairs
 from strategies.cspace.curves import CriticalCurve, _check_map, check_length
+from strategies.cspace.tolerances import diameter
 
 __all__ = ["Boundary", "Cell", "CellArc", "Decomposition", "Region", "decompose"]
-
-ADJ_EPS_REL = 1e-6
-"""Offset (relative to the map scale) of the two probe points across a boundary piece."""
 
 
 @dataclass(frozen=True)
@@ -145,7 +147,14 @@ class Decomposition:
         graph: the connectivity graph G_L (networkx) over cell ids; node attributes
             ``region``, ``stops``, ``escapable``; edge attribute ``boundaries``.
         chord_tol: polyline tolerance of arcs and conchoids.
-        unresolved: number of boundary pieces matched by overlap, not stops.
+        unresolved: number of boundary pieces matched by overlap, not stops (0 unless
+            the arrangement is not exact; a warning says so when it happens).
+        stats: counts from the build: ``vertices``, ``edges``, ``faces`` of the
+            arrangement, ``merged_faces`` (neighbours with equal stops),
+            ``slivers`` (faces too thin to probe), and the exactness checks, all 0 on
+            a sound build: ``dangling`` (curve pieces with one face on both sides),
+            ``orphan_holes``, ``noncritical_violations`` (check points whose stops are
+            not their region's), ``slivers_unresolved``.
     """
 
     def __init__(
@@ -157,6 +166,7 @@ class Decomposition:
         cells: tuple[Cell, ...],
         boundaries: tuple[Boundary, ...],
         chord_tol: float,
+        stats: dict[str, int] | None = None,
     ) -> None:
         self.map = world
         self.L = L
@@ -166,6 +176,7 @@ class Decomposition:
         self.boundaries = boundaries
         self.chord_tol = chord_tol
         self.unresolved = sum(not b.resolved for b in boundaries)
+        self.stats = dict(stats or {})
         g = nx.Graph()
         for c in cells:
             g.add_node(c.id, region=c.region, stops=c.stops, escapable=c.escapable)
@@ -203,6 +214,16 @@ class Decomposition:
         self._index()
 
     # ------------------------------------------------------------------ verdict
+    @property
+    def rod_fits(self) -> bool:
+        """Whether a rod of length L fits somewhere in the map (some cell exists)."""
+        return bool(self.cells)
+
+    @property
+    def exact(self) -> bool:
+        """Whether every exactness check of the build passed (see ``stats``)."""
+        return not self.unresolved and not any(self.stats.get(k) for k in _CHECKS)
+
     @property
     def escapable(self) -> frozenset[int]:
         """Ids of the escapable cells."""
@@ -307,10 +328,19 @@ class Decomposition:
             f"  {len(self.regions)} regions, {len(self.cells)} cells, "
             f"{self.graph.number_of_edges()} adjacencies, {n_esc} escapable cells",
         ]
-        if self.unresolved:
-            lines.append(f"  {self.unresolved} boundary pieces matched by overlap only")
+        if not self.exact:
+            bad = {k: v for k, v in self.stats.items() if v and k in _CHECKS}
+            if self.unresolved:
+                bad["matched by overlap only"] = self.unresolved
+            lines.append("  NOT EXACT: " + ", ".join(f"{k} {v}" for k, v in bad.items()))
         w = self.witness_region
-        if w is None:
+        if not self.rod_fits:
+            lines.append(
+                f"  verdict: no rod of length L = {self.L:g} fits anywhere in this map "
+                f"(its diameter is {diameter(self.map):.4g}): every position and "
+                "orientation is blocked, so surveillance at this distance is impossible"
+            )
+        elif w is None:
             lines.append("  verdict: every region has a non-escapable cell: the pursuer can hold")
         else:
             x, y = w.point
@@ -325,6 +355,9 @@ class Decomposition:
             f"Decomposition(map={self.map.name!r}, L={self.L:g}, regions={len(self.regions)}, "
             f"cells={len(self.cells)}, evader_wins={self.evader_wins})"
         )
+
+
+_CHECKS = ("dangling", "orphan_holes", "noncritical_violations", "slivers_unresolved")
 
 
 def _point(point: object, what: str = "point") -> np.ndarray:

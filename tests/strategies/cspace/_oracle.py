@@ -85,3 +85,106 @@ def resolvable(arcs, step: float) -> bool:
         return True
     gaps = [(arcs[(k + 1) % len(arcs)].lo - a.hi) % (2 * math.pi) for k, a in enumerate(arcs)]
     return min(a.width for a in arcs) > step and min(gaps) > step
+
+
+# ---------------------------------------------------------------------- slanted worlds
+def _regular(n: int, r: float, c=(0.0, 0.0), phase: float = 0.0) -> np.ndarray:
+    a = phase + 2 * math.pi * np.arange(n) / n
+    return np.c_[c[0] + r * np.cos(a), c[1] + r * np.sin(a)]
+
+
+def _star(n: int, r_out: float, r_in: float, c, phase: float = 0.0) -> np.ndarray:
+    a = phase + math.pi * np.arange(2 * n) / n
+    r = np.where(np.arange(2 * n) % 2 == 0, r_out, r_in)
+    return np.c_[c[0] + r * np.cos(a), c[1] + r * np.sin(a)]
+
+
+def _rotated(points, angle: float) -> np.ndarray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.asarray(points, dtype=float) @ np.array([[c, s], [-s, c]])
+
+
+TILTED_BLOCK = [(6.924, 4.301), (4.916, 3.676), (5.431, 2.022), (7.438, 2.647)]
+"""Issue 10: the block whose verdict along L used to be non-monotone (wrong in 2.84-3.04)."""
+
+
+def tilted_block() -> Map:
+    """A 12 x 8 room with one tilted block (issue 10)."""
+    return Map([(0, 0), (12, 0), (12, 8), (0, 8)], [TILTED_BLOCK], name="tilted_block")
+
+
+def slanted_corridor(angle: float = 0.4) -> Map:
+    """Fig. 3's corridor world turned by ``angle``: every wall slanted."""
+    return Map(_rotated(CORRIDOR, angle), name="slanted_corridor")
+
+
+def skew_corridor() -> Map:
+    """A dead-end corridor whose walls are neither parallel nor axis-aligned."""
+    return Map(
+        [(0, -5), (10, -5), (10, 5), (0, 5), (0, 0.6), (-6, 1.8), (-6.2, 0.9), (0, -0.6)],
+        name="skew_corridor",
+    )
+
+
+def triangles() -> Map:
+    return Map(
+        [(0, 0), (12, 0), (12, 9), (0, 9)],
+        [_regular(3, 1.5, (3, 3), 0.3), _regular(3, 1.2, (8, 5), 1.1), _regular(3, 1.0, (5, 7), 2)],
+        name="triangles",
+    )
+
+
+def hexagons() -> Map:
+    """A hexagonal room with two hexagonal pillars."""
+    return Map(
+        _regular(6, 9, (0, 0), 0.1),
+        [_regular(6, 1.5, (-2.5, 1), 0.2), _regular(6, 1.3, (2.8, -1.5), 0.5)],
+        name="hexagons",
+    )
+
+
+def stars() -> Map:
+    """Two star-shaped (non-convex) obstacles."""
+    return Map(
+        [(0, 0), (14, 0), (14, 10), (0, 10)],
+        [_star(5, 1.8, 0.8, (4, 4), 0.2), _star(4, 1.5, 0.6, (10, 6), 0.7)],
+        name="stars",
+    )
+
+
+def rotated_room() -> Map:
+    """A room with two blocks, all turned by an odd angle."""
+    return Map(
+        _rotated([(0, 0), (10, 0), (10, 7), (0, 7)], 0.37),
+        [
+            _rotated([(3, 2), (5, 2), (5, 4), (3, 4)], 0.37),
+            _rotated([(6.5, 3), (8, 3), (8, 5.5), (6.5, 5.5)], 0.37),
+        ],
+        name="rotated_room",
+    )
+
+
+def stops_constant(dec, rng, per_region: int = 6, inset: float | None = None) -> tuple[int, list]:
+    """Check that the kernel's stop pairs are the region's at random points of each region.
+
+    Points are drawn at least ``inset`` (default three polyline tolerances) inside each
+    region's polygon. Returns the number of points checked and the failures.
+    """
+    from envs.geometry import kernel_for
+
+    kernel = kernel_for(dec.map)
+    inset = 3 * dec.chord_tol if inset is None else inset
+    n, bad = 0, []
+    for r in dec.regions:
+        want = frozenset(dec.cells[c].stops for c in r.cells)
+        inner = r.polygon.buffer(-inset)
+        if inner.is_empty:
+            continue
+        xmin, ymin, xmax, ymax = inner.bounds
+        pts = rng.uniform([xmin, ymin], [xmax, ymax], size=(40 * per_region, 2))
+        pts = pts[shapely.contains_xy(inner, pts[:, 0], pts[:, 1])][:per_region]
+        for p in pts:
+            n += 1
+            if stop_pairs(kernel.free_arcs(p, dec.L)) != want:
+                bad.append((r.id, tuple(p)))
+    return n, bad

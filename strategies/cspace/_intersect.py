@@ -1,0 +1,220 @@
+"""Exact intersections and tangencies of critical-curve pieces, vectorised over pairs.
+
+* segment-segment, segment-arc and arc-arc: closed forms; a line and a circle (or two
+  circles) closer than ``touch`` without crossing *touch* at one point (the foot of the
+  perpendicular, the point between the circles), so an exact tangency (a type-1 line
+  ending on the type-2 arc it is tangent to) gives one point whatever the rounding;
+* anything with a conchoid: the conchoid is sampled (uniformly in its tip parameter and
+  in its rod angle, which resolves both its ends and its apex) and the other curve's
+  implicit function is followed along it; sign changes are bisected to double precision,
+  and so are the zeros of its derivative between samples of one sign (local extrema):
+  an extremum that crosses zero brackets two roots, one closer than ``touch`` to zero is
+  a tangency.
+
+Each routine returns flat arrays ``(pair, tA, tB)``: pair index, the parameter on the
+first curve and on the second (unclamped: the caller checks them against the pieces'
+parameter ranges).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from strategies.cspace._shapes import derivatives, gradient, implicit, points
+
+__all__ = ["arc_arc", "conchoid_samples", "sampled_roots", "seg_arc", "seg_seg"]
+
+_PARALLEL = 1e-12  # |sin| of the angle below which two segments are parallel
+_BISECT = 64  # halvings of a bracket: below double precision on any interval
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def seg_seg(oa, da, ob, db):
+    """Crossings of lines ``oa + t da`` and ``ob + s db`` (unit directions), (k,) pairs.
+
+    Returns:
+        ``(pair, ta, tb)`` for the non-parallel pairs.
+    """
+    den = _cross(da, db)
+    ok = np.abs(den) > _PARALLEL
+    r = ob - oa
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ta = _cross(r, db) / den
+        tb = _cross(r, da) / den
+    idx = np.flatnonzero(ok)
+    return idx, ta[idx], tb[idx]
+
+
+def seg_arc(o, d, c, R, touch: float):
+    """Points of line ``o + t d`` on circle ``|x - c| = R``: ``(pair, t, psi)``."""
+    f = c - o
+    tf = (f * d).sum(axis=1)  # foot of the perpendicular from c
+    h = np.abs(_cross(d, f))  # distance from c to the line
+    tangent = np.abs(h - R) <= touch
+    cross = ~tangent & (h < R)
+    s = np.sqrt(np.where(cross, R * R - h * h, 0.0))
+    pair = np.concatenate([np.flatnonzero(tangent), np.flatnonzero(cross), np.flatnonzero(cross)])
+    t = np.concatenate([tf[tangent], (tf - s)[cross], (tf + s)[cross]])
+    x = o[pair] + t[:, None] * d[pair]
+    rel = x - c[pair]
+    psi = np.arctan2(rel[:, 1], rel[:, 0])
+    return pair, t, psi
+
+
+def arc_arc(c1, R1, c2, R2, touch: float, same: float):
+    """Points on both circles ``|x - c1| = R1`` and ``|x - c2| = R2``: ``(pair, psi1, psi2)``.
+
+    Circles with centres closer than ``same`` are skipped (one vertex: one circle).
+    """
+    e = c2 - c1
+    D = np.hypot(e[:, 0], e[:, 1])
+    ok = D > same
+    with np.errstate(divide="ignore", invalid="ignore"):
+        eu = e / D[:, None]
+    outer = ok & (np.abs(D - (R1 + R2)) <= touch)
+    inner = ok & ~outer & (np.abs(D - np.abs(R1 - R2)) <= touch)
+    cross = ok & ~outer & ~inner & (D < R1 + R2) & (D > np.abs(R1 - R2))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a = (D * D + R1 * R1 - R2 * R2) / (2.0 * D)
+    hh = np.sqrt(np.where(cross, np.maximum(R1 * R1 - a * a, 0.0), 0.0))
+    perp = np.stack([-eu[:, 1], eu[:, 0]], axis=1)
+    sign_in = np.where(R1 >= R2, 1.0, -1.0)
+    pair = np.concatenate(
+        [np.flatnonzero(outer), np.flatnonzero(inner), np.flatnonzero(cross), np.flatnonzero(cross)]
+    )
+    base = (
+        c1[pair]
+        + eu[pair] * np.concatenate([R1[outer], (sign_in * R1)[inner], a[cross], a[cross]])[:, None]
+    )
+    off = np.concatenate([np.zeros(outer.sum() + inner.sum()), hh[cross], -hh[cross]])
+    x = base + off[:, None] * perp[pair]
+    r1 = x - c1[pair]
+    r2 = x - c2[pair]
+    return pair, np.arctan2(r1[:, 1], r1[:, 0]), np.arctan2(r2[:, 1], r2[:, 0])
+
+
+def conchoid_samples(data: np.ndarray, lo: np.ndarray, hi: np.ndarray, n: int):
+    """Sample parameters of conchoid pieces: ``n`` uniform in the tip parameter ``s`` and
+    ``n`` uniform in the rod angle ``phi`` (``s = c + h tan phi``), merged and sorted.
+
+    Returns:
+        ``(owner, t)`` flat arrays, sorted by owner then parameter.
+    """
+    k = len(lo)
+    if k == 0:
+        return np.zeros(0, dtype=np.intp), np.zeros(0)
+    v, a, u = data[:, 0:2], data[:, 2:4], data[:, 4:6]
+    nrm = np.stack([-u[:, 1], u[:, 0]], axis=1)
+    c = ((v - a) * u).sum(axis=1)
+    h = np.abs(((v - a) * nrm).sum(axis=1))
+    j = np.arange(n + 1) / n
+    s_uni = lo[:, None] + (hi - lo)[:, None] * j
+    p0 = np.arctan2(lo - c, h)
+    p1 = np.arctan2(hi - c, h)
+    s_phi = c[:, None] + h[:, None] * np.tan(p0[:, None] + (p1 - p0)[:, None] * j)
+    s_phi = np.clip(s_phi, lo[:, None], hi[:, None])
+    t = np.concatenate([s_uni, s_phi[:, 1:-1]], axis=1)
+    t.sort(axis=1)
+    owner = np.repeat(np.arange(k), t.shape[1])
+    return owner, t.ravel()
+
+
+def sampled_roots(
+    kind_a, data_a, owner, t, kind_b, data_b, L: float, touch: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Zeros of ``g(t) = F_B(P_A(t))`` along sampled curves A (pairs ``owner``).
+
+    Args:
+        kind_a, data_a: per pair, the sampled curve A.
+        owner: (m,) pair of each sample, sorted, samples increasing within a pair.
+        t: (m,) sample parameters on A.
+        kind_b, data_b: per pair, the curve B whose implicit function is followed.
+        L: rod length.
+        touch: extrema of |g| at most this are tangencies (one root at the extremum).
+
+    Returns:
+        ``(pair, tA, touching)``: roots on A and whether each is a tangency.
+    """
+    ka, da = np.asarray(kind_a)[owner], data_a[owner]
+    kb, db = np.asarray(kind_b)[owner], data_b[owner]
+
+    def g(sel, tt):
+        return implicit(kb[sel], db[sel], points(ka[sel], da[sel], tt, L), L)
+
+    def dg(sel, tt):
+        d1, _ = derivatives(ka[sel], da[sel], tt, L)
+        grad = gradient(kb[sel], db[sel], points(ka[sel], da[sel], tt, L), L)
+        return (d1 * grad).sum(axis=1)
+
+    allidx = np.arange(len(t))
+    val = g(allidx, t)
+    same = owner[1:] == owner[:-1]
+    fin = np.isfinite(val)
+    ok = same & fin[1:] & fin[:-1]
+    left = np.flatnonzero(ok & (np.sign(val[1:]) * np.sign(val[:-1]) < 0))
+    zero = np.flatnonzero(fin & (val == 0.0))
+    # brackets [t_k, t_k+1] with a sign change
+    lo_i, hi_i = left, left + 1
+    brackets = [(owner[lo_i], t[lo_i], t[hi_i], val[lo_i])]
+    # local extrema of |g| between samples of one sign: refine, then split or touch
+    mid = (
+        np.flatnonzero(
+            ok[:-1]
+            & ok[1:]
+            & (np.sign(val[:-2]) == np.sign(val[1:-1]))
+            & (np.sign(val[2:]) == np.sign(val[1:-1]))
+            & (np.abs(val[1:-1]) <= np.abs(val[:-2]))
+            & (np.abs(val[1:-1]) <= np.abs(val[2:]))
+        )
+        + 1
+    )
+    touch_pair = np.zeros(0, dtype=np.intp)
+    touch_t = np.zeros(0)
+    if len(mid):
+        sgn = np.sign(val[mid])
+        a, b = t[mid - 1], t[mid + 1]
+        # the extremum of sgn * g: the zero of its derivative, bisected to full precision
+        slope_a, slope_b = sgn * dg(mid, a), sgn * dg(mid, b)
+        ok_b = (slope_a < 0) & (slope_b > 0)
+        mid, sgn, a, b = mid[ok_b], sgn[ok_b], a[ok_b], b[ok_b]
+        for _ in range(_BISECT):
+            m = 0.5 * (a + b)
+            up = sgn * dg(mid, m) > 0
+            a = np.where(up, a, m)
+            b = np.where(up, m, b)
+        tm = 0.5 * (a + b)
+        fm = sgn * g(mid, tm)
+        dips = np.flatnonzero(fm < 0)  # two crossings around the extremum
+        if len(dips):
+            m = mid[dips]
+            brackets.append((owner[m], t[m - 1], tm[dips], val[m - 1]))
+            brackets.append((owner[m], tm[dips], t[m + 1], -val[m + 1]))
+        near = np.flatnonzero((fm >= 0) & (fm <= touch))
+        touch_pair = owner[mid[near]]
+        touch_t = tm[near]
+    bp = np.concatenate([b[0] for b in brackets])
+    ba = np.concatenate([b[1] for b in brackets])
+    bb = np.concatenate([b[2] for b in brackets])
+    bs = np.sign(np.concatenate([b[3] for b in brackets]))  # sign of g at ba
+    if len(bp):
+        sel = _sample_index(owner, bp)
+        for _ in range(_BISECT):
+            m = 0.5 * (ba + bb)
+            same_sign = np.sign(g(sel, m)) == bs
+            ba = np.where(same_sign, m, ba)
+            bb = np.where(same_sign, bb, m)
+    pair = np.concatenate([bp, owner[zero], touch_pair])
+    tA = np.concatenate([0.5 * (ba + bb), t[zero], touch_t])
+    touching = np.concatenate(
+        [np.zeros(len(bp) + len(zero), dtype=bool), np.ones(len(touch_pair), dtype=bool)]
+    )
+    return pair.astype(np.intp), tA, touching
+
+
+def _sample_index(owner: np.ndarray, pair: np.ndarray) -> np.ndarray:
+    """Index of a sample of each pair (for the per-sample curve data in ``g``)."""
+    first = np.searchsorted(owner, pair)
+    return first

@@ -1,0 +1,190 @@
+"""The exact arrangement on slanted and non-rectilinear worlds, and its degenerate cases.
+
+Oracles: the geometry kernel's exact free arcs at many points of every region (stops
+must be the region's), a shapely brute force of the free orientations, the answer on the
+same world moved by a similarity (a rotation by an odd angle, a scaling by 1e-3 or 1e3,
+a translation by 1e6 must change no count and no verdict), and Prop. 3 (the verdict is
+monotone in L).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from envs.maps import Map, random_map
+from strategies.cspace import decompose
+from tests.strategies.cspace._oracle import (
+    brute_free,
+    circular_runs,
+    hexagons,
+    resolvable,
+    rotated_room,
+    skew_corridor,
+    slanted_corridor,
+    stars,
+    stops_constant,
+    tilted_block,
+    triangles,
+)
+
+WORLDS = {
+    "tilted_block": (tilted_block, 2.9),
+    "slanted_corridor": (slanted_corridor, 1.7),
+    "skew_corridor": (skew_corridor, 3.3),
+    "triangles": (triangles, 2.5),
+    "hexagons": (hexagons, 3.3),
+    "stars": (stars, 2.2),
+    "rotated_room": (rotated_room, 1.7),
+    "random_star": (lambda: random_map(2, n_vertices=16, kind="star"), 1.7),
+    "random_convex": (lambda: random_map(4, n_vertices=12, kind="convex"), 1.0),
+}
+
+
+def _fingerprint(dec):
+    return (len(dec.regions), len(dec.cells), len(dec.escapable), dec.evader_wins)
+
+
+def _similar(world: Map, angle: float, scale: float, offset) -> Map:
+    c, s = math.cos(angle), math.sin(angle)
+    return world.transformed([[scale * c, -scale * s], [scale * s, scale * c]], offset)
+
+
+@pytest.fixture(scope="module")
+def decs():
+    return {name: decompose(make(), L) for name, (make, L) in WORLDS.items()}
+
+
+# ---------------------------------------------------------------------- issue 10's cases
+def test_tilted_block_verdict_is_monotone_in_L():
+    """Issue 10: the verdict read pursuer / evader / pursuer / evader along L, and handed
+    the pursuer a safe cell in 2.84-3.04 where the grids say the evader wins."""
+    world = tilted_block()
+    Ls = np.round(np.arange(2.50, 3.21, 0.04), 2)
+    wins = [decompose(world, float(L)).evader_wins for L in Ls]
+    assert wins == sorted(wins), dict(zip(Ls.tolist(), wins, strict=True))
+    assert not wins[0] and wins[-1]
+    for L in (2.84, 2.94, 3.04):
+        dec = decompose(world, L)
+        assert dec.evader_wins and dec.exact, (L, dec.stats)
+
+
+@pytest.mark.parametrize("offset", [(0.5, 0.0), (0.0, -3.25), (1e6, 1e6)])
+def test_translating_a_slanted_corridor_keeps_every_count(offset):
+    """Issue 10: translating the slanted corridor by (0.5, 0) changed 67 regions to 66."""
+    for L in (1.7, 2.5, 3.3):
+        base = decompose(slanted_corridor(), L)
+        moved = decompose(_similar(slanted_corridor(), 0.0, 1.0, offset), L)
+        assert _fingerprint(moved) == _fingerprint(base), (L, offset)
+        assert base.exact and moved.exact
+
+
+# ---------------------------------------------------------------------- against oracles
+@pytest.mark.parametrize("name", list(WORLDS))
+def test_stops_are_constant_inside_every_region(name, decs):
+    dec = decs[name]
+    assert dec.exact, dec.stats
+    assert dec.stats["dangling"] == 0 and dec.unresolved == 0
+    n, bad = stops_constant(dec, np.random.default_rng(3), per_region=6)
+    assert not bad, bad[:5]
+    assert n > 3 * len(dec.regions)
+
+
+@pytest.mark.parametrize("name", ["tilted_block", "stars", "hexagons", "skew_corridor"])
+def test_cells_are_the_brute_force_free_arcs(name, decs):
+    """At each region's point: as many cells as free arcs in a shapely brute force."""
+    dec = decs[name]
+    checked = 0
+    for r in dec.regions:
+        arcs = [dec.cells[c].arc for c in r.cells]
+        if not resolvable(arcs, 4 * 2 * math.pi / 2048):
+            continue
+        mask = brute_free(dec.map, r.point, dec.L, n=2048)
+        if len(arcs) == 1 and arcs[0].is_full:
+            assert mask.all()
+        else:
+            assert circular_runs(mask) == len(arcs) or (not arcs and not mask.any()), r.id
+        checked += 1
+    assert checked > 0.6 * len(dec.regions)
+
+
+@pytest.mark.parametrize(
+    ("angle", "scale", "offset"),
+    [(0.7137, 1.0, (0.0, 0.0)), (0.0, 1e-3, (0.0, 0.0)), (0.0, 1e3, (0.0, 0.0)),
+     (0.0, 1.0, (1e6, -1e6)), (2.345, 7.3, (-1234.5, 77.7))],
+)  # fmt: skip
+def test_counts_and_verdicts_are_invariant_under_similarities(angle, scale, offset, decs):
+    for name in ("tilted_block", "stars", "triangles", "random_star"):
+        make, L = WORLDS[name]
+        moved = decompose(_similar(make(), angle, scale, offset), L * scale)
+        assert _fingerprint(moved) == _fingerprint(decs[name]), name
+        assert moved.exact, (name, moved.stats)
+
+
+@pytest.mark.parametrize("name", ["skew_corridor", "hexagons", "rotated_room"])
+def test_prop3_the_verdict_is_monotone_in_L(name):
+    make, _ = WORLDS[name]
+    world = make()
+    wins = [decompose(world, L).evader_wins for L in np.linspace(0.8, 4.0, 9)]
+    assert wins == sorted(wins), wins
+
+
+# ---------------------------------------------------------------------- degenerate cases
+def _box(x0, y0, x1, y1):
+    return [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
+
+
+DEGENERATE = {
+    # the type-1 line of each corridor wall runs along the opposite wall
+    "corridor_width_L": (
+        Map([(0, -4), (8, -4), (8, 4), (0, 4), (0, 1), (-6, 1), (-6, -1), (0, -1)]),
+        2.0,
+    ),
+    # vertices exactly L and 2L apart: arcs through vertices, arcs tangent to arcs
+    "vertices_at_L": (
+        Map(
+            [(0, 0), (12, 0), (12, 8), (0, 8)],
+            [_box(3, 3, 4, 4), _box(6, 3, 7, 4), _box(4, 6, 5, 7)],
+        ),
+        2.0,
+    ),
+    # collinear edges of different obstacles: type-4 extensions run along walls
+    "collinear_edges": (
+        Map(
+            [(0, 0), (14, 0), (14, 8), (0, 8)],
+            [_box(2, 3, 4, 5), _box(5.5, 3, 7, 4.2), _box(9, 2, 11, 3)],
+        ),
+        1.9,
+    ),
+    # a vertex exactly L from a wall (its arc tangent to the wall, the wall's type-1
+    # line through the vertex) and three curves through v + L n at every convex vertex
+    "vertex_L_from_wall": (
+        Map(
+            [(0, 0), (10, 0), (10, 10), (0, 10)],
+            [_box(3, 3, 5, 5), [(6.5, 6), (8.5, 6.4), (7, 8)]],
+        ),
+        2.0,
+    ),
+}
+
+
+@pytest.mark.parametrize("name", list(DEGENERATE))
+def test_degenerate_worlds_are_exact_and_invariant(name):
+    world, L = DEGENERATE[name]
+    dec = decompose(world, L)
+    assert dec.exact, dec.stats
+    n, bad = stops_constant(dec, np.random.default_rng(1), per_region=5)
+    assert not bad, bad[:5]
+    assert n > 2 * len(dec.regions)
+    for angle, scale, offset in ((0.9431, 1.0, (0.0, 0.0)), (0.0, 1e3, (1e6, 0.0))):
+        moved = decompose(_similar(world, angle, scale, offset), L * scale)
+        assert _fingerprint(moved) == _fingerprint(dec), (angle, scale, offset)
+
+
+def test_a_rod_longer_than_the_map_is_said_not_to_fit():
+    dec = decompose(tilted_block(), 1e9)
+    assert not dec.rod_fits and dec.evader_wins
+    assert "no rod of length L = 1e+09 fits anywhere" in dec.summary()
+    assert "no rod" not in decompose(tilted_block(), 2.0).summary()

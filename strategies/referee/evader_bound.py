@@ -1,0 +1,336 @@
+"""The evader bound: starts from which the evader provably breaks surveillance.
+
+The discretisation favours the pursuer everywhere, so a win here is a win in the real
+game against any pursuer:
+
+* **Information.** The evader commits to a straight move for a step of ``tau``; the
+  pursuer sees it before moving.
+* **Evader.** It sits exactly on the certified lattice and moves along lattice vectors of
+  length <= V_e tau whose paths keep ``body_radius`` from the walls (standing still
+  included): a restriction, which only costs it.
+* **Pursuer.** Located by its cell only (anywhere in it); in one step it may end in any
+  open cell within V_p tau of its cell: a superset of what it can do.
+* **Losing set, robust and only at step boundaries.** The evader wins a step only when
+  surveillance is broken at its end for *every* pursuer position in the cell: the whole
+  cell out of range, or every rod from the evader to the cell blocked. Breaks inside a
+  step are ignored (they would only help the evader). Robust occlusion uses the fact of
+  :mod:`strategies.referee.robust`: when the cell's free part is convex and no convex
+  vertex lies in the hull of the evader and the cell's disc, all rods to the cell are
+  blocked as soon as one is, and one is when the segment to a point of the cell crosses a
+  wall properly.
+
+The evader's winning set is the least fixed point (an attractor): broken states, then
+states with a move all of whose pursuer successors are already winning. The round at which
+a state enters is its *rank*: the evader breaks surveillance within ``rank`` steps from it.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from strategies.referee._fixpoint import erode, reach_rectangles
+from strategies.referee.lattice import Lattice, segment_wall_distance
+from strategies.referee.robust import (
+    convex_corners,
+    fan_hits_vertex,
+    segment_crosses_walls,
+    square_range,
+)
+from strategies.referee.spec import GameSpec, Resolution
+
+__all__ = ["EvaderBound", "solve_evader_bound"]
+
+
+@dataclass
+class EvaderBound:
+    """The solved evader bound.
+
+    Attributes:
+        spec: the game.
+        res: the resolution.
+        lattice: cells and the evader's lattice.
+        vectors: (n_moves, 2) evader moves in cells (row 0 is standing still).
+        targets: (n_points, n_moves) point reached by each move, -1 if not allowed.
+        win: (n_points, W, W) states (evader point, pursuer cell) the evader wins from.
+        rank: (n_points, W, W) int32, the round at which a state became winning (0: broken
+            already), -1 if it never did.
+        choice: (n_points, W, W) int16, the move that made a state winning (-1: none).
+        iterations: rounds of the fixed point.
+        seconds: wall time of the build and of the fixed point.
+    """
+
+    spec: GameSpec
+    res: Resolution
+    lattice: Lattice
+    vectors: np.ndarray
+    targets: np.ndarray
+    win: np.ndarray
+    rank: np.ndarray
+    choice: np.ndarray
+    iterations: int
+    seconds: dict[str, float]
+
+    def to_arrays(self) -> dict[str, np.ndarray]:
+        """The solved arrays (for the on-disk cache); the rest is rebuilt from spec/res."""
+        return {
+            "win": self.win,
+            "rank": self.rank,
+            "choice": self.choice,
+            "iterations": np.array(self.iterations),
+            "seconds": np.array([self.seconds.get("build", 0.0), self.seconds.get("solve", 0.0)]),
+        }
+
+    @classmethod
+    def from_arrays(cls, spec: GameSpec, res: Resolution, arrays) -> EvaderBound:
+        """Rebuild a bound from :meth:`to_arrays` output (the lattice is recomputed)."""
+        lat = Lattice(spec, res, "evader")
+        vectors, targets = lat.moves(spec.v_evader * res.tau)
+        shape = (lat.n_points, lat.W, lat.W)
+        for name in ("win", "rank", "choice"):
+            if arrays[name].shape != shape:
+                raise ValueError(
+                    f"cached evader bound {name} has shape {arrays[name].shape}, expected {shape}"
+                )
+        sec = arrays["seconds"]
+        return cls(
+            spec=spec,
+            res=res,
+            lattice=lat,
+            vectors=vectors,
+            targets=targets,
+            win=arrays["win"].astype(bool),
+            rank=arrays["rank"].astype(np.int32),
+            choice=arrays["choice"].astype(np.int16),
+            iterations=int(arrays["iterations"]),
+            seconds={"build": float(sec[0]), "solve": float(sec[1])},
+        )
+
+    @property
+    def reach(self) -> float:
+        """How far the pursuer may get in one step, plus the margin: V_p tau + margin."""
+        return self.spec.v_pursuer * self.res.tau + self.spec.margin
+
+    def plan(self, pursuer, evader) -> tuple[np.ndarray, int] | None:
+        """A certified next lattice point for the evader from the real positions.
+
+        The evader moves straight to a lattice point at most V_e tau away (its path
+        keeping the body radius from the walls); whatever the pursuer does, it ends in an
+        open cell within V_p tau of its real position, and every such state must be
+        winning. Among the certified moves, the one with the smallest worst rank wins.
+
+        Returns:
+            ``(target (2,), steps)``: the point and a bound on the referee steps left
+            until surveillance breaks (including this one); None if no move is certified.
+        """
+        spec, lat = self.spec, self.lattice
+        p = np.asarray(pursuer, dtype=float)
+        e = np.asarray(evader, dtype=float)
+        step = spec.v_evader * self.res.tau
+        cand = np.flatnonzero(np.hypot(*(lat.points - e).T) <= step * (1.0 + 1e-12))
+        if len(cand) == 0:
+            return None
+        B = lat.points[cand]
+        clear = segment_wall_distance(np.broadcast_to(e, B.shape), B, spec.map)
+        cand = cand[clear >= spec.body_radius * (1.0 - 1e-9) - spec.margin]
+        cells = _cells_within(lat, p, self.reach)
+        best: tuple[int, int] | None = None
+        for k in cand.tolist():
+            ab = lat.window_cell(np.array([k]), cells)
+            inside = (ab[:, 0] >= 0) & (ab[:, 0] < lat.W) & (ab[:, 1] >= 0) & (ab[:, 1] < lat.W)
+            r = self.rank[k, ab[inside, 0], ab[inside, 1]]
+            if (r < 0).any():
+                continue
+            worst = int(r.max()) if len(r) else 0  # cells off the window: out of range
+            if best is None or worst < best[1]:
+                best = (k, worst)
+        if best is None:
+            return None
+        return lat.points[best[0]].copy(), best[1] + 1
+
+    def certifies(self, pursuer, evader) -> bool:
+        """Whether the evader provably breaks surveillance from this real start."""
+        return self.plan(pursuer, evader) is not None
+
+    def escape_steps(self, pursuer, evader) -> int | None:
+        """Referee steps within which the evader breaks surveillance (None: not certified)."""
+        got = self.plan(pursuer, evader)
+        return None if got is None else got[1]
+
+    def fraction(self) -> float:
+        """Fraction of the states (evader point, open pursuer cell possibly in range) won."""
+        dom = self._domain()
+        return float(self.win[dom].mean()) if dom.any() else 0.0
+
+    def _domain(self) -> np.ndarray:
+        lat = self.lattice
+        open_w = lat.windows(lat.cell_open, False)
+        return open_w & ~_range_broken(lat, self.spec)[None]
+
+
+def _cells_within(lat: Lattice, p: np.ndarray, r: float) -> np.ndarray:
+    lo = np.floor((p - r - lat.anchor) / lat.h - 0.5).astype(int)
+    hi = np.ceil((p + r - lat.anchor) / lat.h + 0.5).astype(int)
+    ii, jj = np.meshgrid(np.arange(lo[0], hi[0] + 1), np.arange(lo[1], hi[1] + 1), indexing="ij")
+    ij = np.stack([ii.ravel(), jj.ravel()], axis=1)
+    c = lat.anchor + lat.h * ij
+    dx = np.maximum(np.abs(c[:, 0] - p[0]) - 0.5 * lat.h, 0.0)
+    dy = np.maximum(np.abs(c[:, 1] - p[1]) - 0.5 * lat.h, 0.0)
+    ij = ij[np.hypot(dx, dy) <= r]
+    return ij[lat.cell_open_at(ij)]
+
+
+def _range_broken(lat: Lattice, spec: GameSpec) -> np.ndarray:
+    """(W, W): window cells entirely out of range of the window's centre."""
+    near, far = square_range(lat.offsets[..., 0], lat.offsets[..., 1], 0.5 * lat.h)
+    m = spec.margin
+    return (near > spec.l_max + m) | (far < spec.l_min - m)
+
+
+def _occlusion_broken(lat: Lattice, spec: GameSpec, candidates: np.ndarray) -> np.ndarray:
+    """(n_points, W, W): among ``candidates``, the states robustly occluded."""
+    world = spec.map
+    convex, rep = lat.convex_cells()
+    conv_w = lat.windows(convex, False)
+    rep_w = lat.windows(rep, np.nan)
+    cand = candidates & conv_w
+    R = lat.delta + spec.margin
+    ox, oy = lat.offsets[..., 0], lat.offsets[..., 1]
+    verts, din, dout = convex_corners(world)
+    for v, di, do in zip(verts, din, dout, strict=True):
+        rel = v[None, :] - lat.points
+        near = np.hypot(*rel.T) <= spec.l_max + R + lat.h
+        for s in range(0, lat.n_points, 256):
+            ks = np.arange(s, min(s + 256, lat.n_points))
+            ks = ks[near[ks]]
+            if len(ks) == 0:
+                continue
+            hit = fan_hits_vertex(
+                0.0,
+                0.0,
+                rel[ks, 0][:, None, None],
+                rel[ks, 1][:, None, None],
+                ox,
+                oy,
+                R,
+                di,
+                do,
+                spec.margin,
+            )
+            cand[ks] &= ~hit
+    k_i, a_i, b_i = np.nonzero(cand)
+    out = np.zeros(cand.shape, dtype=bool)
+    if len(k_i):
+        P = lat.points[k_i]
+        Q = rep_w[k_i, a_i, b_i]
+        ok = np.isfinite(Q).all(axis=1)
+        crossed = np.zeros(len(k_i), dtype=bool)
+        crossed[ok] = segment_crosses_walls(P[ok], Q[ok], world.edge_start, world.edge_end)
+        out[k_i[crossed], a_i[crossed], b_i[crossed]] = True
+    return out
+
+
+def solve_evader_bound(spec: GameSpec, res: Resolution, *, progress: bool = False) -> EvaderBound:
+    """Solve the pursuer-favoured discrete game (see the module docstring).
+
+    Args:
+        spec: the game.
+        res: the resolution.
+        progress: print one line per round.
+
+    Returns:
+        The :class:`EvaderBound`.
+    """
+    t0 = time.perf_counter()
+    lat = Lattice(spec, res, "evader")
+    vectors, targets = lat.moves(spec.v_evader * res.tau)
+    open_w = lat.windows(lat.cell_open, False)
+    rbroken = _range_broken(lat, spec)[None]
+    live = open_w & ~rbroken
+    X = (open_w & rbroken) | _occlusion_broken(lat, spec, live)
+    t1 = time.perf_counter()
+    rank = np.where(X, 0, -1).astype(np.int32)
+    choice = np.full(X.shape, -1, dtype=np.int16)
+    closed = ~open_w  # the pursuer cannot be in closed cells: they never save it
+    rects = reach_rectangles(spec.v_pursuer * res.tau + spec.margin, lat.h)
+    # B(q, o): every pursuer successor of the cell at offset o from point q is won. The
+    # evader's move shifts offsets by up to its step, which can leave q's window (the
+    # evader walked away), so B is computed on a window padded by that much: cells off
+    # the window are out of range (won), but the pursuer may walk back into range.
+    pad = int(np.abs(vectors).max()) if len(vectors) else 0
+    B = _erode_padded(X | closed, rects, pad)
+    preds: list[list[int]] = [[] for _ in range(lat.n_points)]
+    for k, row in enumerate(targets):
+        for q in set(row[row >= 0].tolist()):
+            preds[q].append(k)
+    dirty = np.ones(lat.n_points, dtype=bool)
+    iterations = 0
+    while True:
+        iterations += 1
+        todo = np.zeros(lat.n_points, dtype=bool)
+        for q in np.flatnonzero(dirty):
+            todo[preds[q]] = True
+        ks = np.flatnonzero(todo)
+        gain, first = _gains(ks, X, B, open_w, vectors, targets, pad)
+        changed = gain.any(axis=(1, 2))
+        if progress:
+            print(f"evader bound: round {iterations}, {int(gain.sum())} states won")
+        if not changed.any():
+            break
+        kc = ks[changed]
+        X[kc] |= gain[changed]
+        rank[kc] = np.where(gain[changed], iterations, rank[kc])
+        choice[kc] = np.where(gain[changed], first[changed], choice[kc])
+        dirty = np.zeros(lat.n_points, dtype=bool)
+        dirty[kc] = True
+        B[kc] = _erode_padded(X[kc] | closed[kc], rects, pad)
+    t2 = time.perf_counter()
+    return EvaderBound(
+        spec=spec,
+        res=res,
+        lattice=lat,
+        vectors=vectors,
+        targets=targets,
+        win=X,
+        rank=rank,
+        choice=choice,
+        iterations=iterations,
+        seconds={"build": t1 - t0, "solve": t2 - t1},
+    )
+
+
+def _erode_padded(X: np.ndarray, rects, pad: int) -> np.ndarray:
+    """Erosion of X padded by ``pad`` won (out-of-range) cells on every side."""
+    if pad == 0:
+        return erode(X, rects, border=True)
+    Xp = np.pad(X, ((0, 0), (pad, pad), (pad, pad)), constant_values=True)
+    return erode(Xp, rects, border=True)
+
+
+def _gains(ks, X, B, open_w, vectors, targets, pad, chunk: int = 256):
+    """For points ``ks``: states not yet won that have a move whose every pursuer
+    successor is won (B at the target, B padded by ``pad``), and the first such move."""
+    if len(ks) > chunk:
+        parts = [
+            _gains(ks[s : s + chunk], X, B, open_w, vectors, targets, pad, chunk)
+            for s in range(0, len(ks), chunk)
+        ]
+        return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
+    W = X.shape[1]
+    gain = np.zeros((len(ks), W, W), dtype=bool)
+    first = np.full((len(ks), W, W), -1, dtype=np.int16)
+    if len(ks) == 0:
+        return gain, first
+    todo = open_w[ks] & ~X[ks]
+    for j, vec in enumerate(vectors):
+        tj = targets[ks, j]
+        valid = np.flatnonzero(tj >= 0)
+        if len(valid) == 0:
+            continue
+        dx, dy = int(vec[0]), int(vec[1])
+        g = B[tj[valid], pad - dx : pad - dx + W, pad - dy : pad - dy + W] & todo[valid]
+        first[valid] = np.where(g & (first[valid] < 0), j, first[valid])
+        gain[valid] |= g
+    return gain, first

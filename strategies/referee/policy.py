@@ -1,0 +1,168 @@
+"""Policies that play the referee's certified strategies in the env.
+
+A referee policy recomputes its plan every referee step (``tau``, a whole number of env
+steps): it reads both real positions, asks its bound for a certified straight move to a
+lattice point (:meth:`PursuerBound.plan`, :meth:`EvaderBound.plan`) and drives there at
+constant velocity, re-aiming at the target each env step so that float32 observations do
+not make it drift. From a start its bound certifies, it cannot lose (pursuer) or fail to
+break surveillance within the certified number of steps (evader), whatever the opponent
+does: that is what the tests check, episode by episode, against every registered opponent.
+
+Off certified states it falls back to a simple heuristic (the pursuer keeps the distance
+at the middle of the sensor range, the evader charges the pursuer) and records that it
+did, in :attr:`RefereePolicy.uncertified_steps`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from envs.errors import InvalidConfigError
+from strategies.policies.base import BasePolicy, Snapshot, unit
+from strategies.referee.evader_bound import EvaderBound
+from strategies.referee.pursuer_bound import PursuerBound
+
+__all__ = ["RefereeEvader", "RefereePursuer", "env_steps_per_referee_step"]
+
+
+def env_steps_per_referee_step(tau: float, dt: float) -> int:
+    """The whole number of env steps in one referee step.
+
+    Raises:
+        InvalidConfigError: ``tau`` is not a multiple of ``dt`` (to 1e-9 relative).
+    """
+    k = max(1, round(tau / dt))
+    if abs(k * dt - tau) > 1e-9 * max(tau, dt):
+        raise InvalidConfigError(
+            f"referee step tau = {tau!r} is not a whole number of env steps dt = {dt!r}; "
+            "build the resolution with Resolution.for_role(..., dt=dt)"
+        )
+    return k
+
+
+class _RefereePolicy(BasePolicy):
+    """Shared plumbing: step counting, target following, the certified flag."""
+
+    role_name = ""
+
+    def __init__(self, bound, *, name: str | None = None) -> None:
+        super().__init__(name=name or f"{self.role_name}/referee")
+        self.roles = (self.role_name,)
+        self.bound = bound
+        self._k = 1
+        self._target: np.ndarray | None = None
+        self._fallback = np.zeros(2)
+        self.uncertified_steps = 0
+        self.referee_steps = 0
+
+    def _reset(self) -> None:
+        spec = self.bound.spec
+        cfg = self.config
+        for attr in ("l_min", "l_max", "v_pursuer", "v_evader"):
+            if not math.isclose(getattr(cfg, attr), getattr(spec, attr), rel_tol=1e-12):
+                raise InvalidConfigError(
+                    f"policy {self.name!r}: the env's {attr} = {getattr(cfg, attr)!r} differs "
+                    f"from the solved game's {getattr(spec, attr)!r}"
+                )
+        if self.map.digest != spec.map.digest:
+            raise InvalidConfigError(
+                f"policy {self.name!r}: the env's map {self.map.name!r} is not the solved map "
+                f"{spec.map.name!r}"
+            )
+        if cfg.body_radius > spec.body_radius * (1 + 1e-12):
+            raise InvalidConfigError(
+                f"policy {self.name!r}: the env's body_radius = {cfg.body_radius!r} exceeds "
+                f"the solved clearance {spec.body_radius!r}"
+            )
+        self._k = env_steps_per_referee_step(self.bound.res.tau, cfg.dt)
+        self._target = None
+        self.uncertified_steps = 0
+        self.referee_steps = 0
+
+    def _decide(self, snap: Snapshot) -> np.ndarray:
+        phase = self._steps % self._k
+        mine = snap.pursuer if self.role == "pursuer" else snap.evader
+        if phase == 0:
+            self.referee_steps += 1
+            self._target = self._plan(snap)
+            if self._target is None:
+                self.uncertified_steps += 1
+                self._fallback = self._heuristic(snap)
+        if self._target is None:
+            return self._fallback
+        remaining = (self._k - phase) * float(self.config.dt)
+        return (self._target - mine) / remaining
+
+    def _plan(self, snap: Snapshot) -> np.ndarray | None:
+        raise NotImplementedError
+
+    def _heuristic(self, snap: Snapshot) -> np.ndarray:
+        raise NotImplementedError
+
+
+class RefereePursuer(_RefereePolicy):
+    """Plays the pursuer bound's certified strategy.
+
+    Args:
+        bound: a solved :class:`PursuerBound` of the env's game (same map, range and
+            speeds; its ``tau`` a whole number of env steps).
+        name: registry-style name.
+    """
+
+    role_name = "pursuer"
+
+    def __init__(self, bound: PursuerBound, *, name: str | None = None) -> None:
+        if not isinstance(bound, PursuerBound):
+            raise InvalidConfigError(
+                f"RefereePursuer: expected a PursuerBound, got {type(bound).__name__}"
+            )
+        super().__init__(bound, name=name)
+
+    def _plan(self, snap: Snapshot) -> np.ndarray | None:
+        return self.bound.plan(snap.pursuer, snap.evader)
+
+    def _heuristic(self, snap: Snapshot) -> np.ndarray:
+        spec = self.bound.spec
+        mid = 0.5 * (spec.l_min + spec.l_max)
+        rod = snap.pursuer - snap.evader
+        return unit(rod) * (mid - snap.L) / float(self.config.dt)
+
+
+class RefereeEvader(_RefereePolicy):
+    """Plays the evader bound's certified strategy.
+
+    Args:
+        bound: a solved :class:`EvaderBound` of the env's game.
+        name: registry-style name.
+
+    Attributes:
+        certified_steps: when the first referee step was certified, the bound on the
+            referee steps it needed to break surveillance (None otherwise).
+    """
+
+    role_name = "evader"
+
+    def __init__(self, bound: EvaderBound, *, name: str | None = None) -> None:
+        if not isinstance(bound, EvaderBound):
+            raise InvalidConfigError(
+                f"RefereeEvader: expected an EvaderBound, got {type(bound).__name__}"
+            )
+        super().__init__(bound, name=name)
+        self.certified_steps: int | None = None
+
+    def _reset(self) -> None:
+        super()._reset()
+        self.certified_steps = None
+
+    def _plan(self, snap: Snapshot) -> np.ndarray | None:
+        got = self.bound.plan(snap.pursuer, snap.evader)
+        if got is None:
+            return None
+        if self.referee_steps == 1:
+            self.certified_steps = got[1]
+        return got[0]
+
+    def _heuristic(self, snap: Snapshot) -> np.ndarray:
+        return unit(snap.pursuer - snap.evader) * self.bound.spec.v_evader

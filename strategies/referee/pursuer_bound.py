@@ -1,0 +1,410 @@
+"""The pursuer bound: starts from which the pursuer provably holds surveillance forever.
+
+The discretisation favours the evader everywhere, so a win here is a win in the real
+game (continuous time, any evader, and the env at any step that divides ``tau``):
+
+* **Information.** The pursuer commits to a straight move for a whole step of ``tau``;
+  the evader sees it and moves as it likes *during* the step (any path of speed <= V_e,
+  re-planned continuously).
+* **Pursuer.** It sits exactly on the certified lattice and moves along lattice vectors
+  of length <= V_p tau whose paths keep ``body_radius`` from the walls: a restriction of
+  the real pursuer (finite headings, including standing still), which only costs it.
+* **Evader.** Located by its cell only (anywhere in it). Over a step it can be anywhere in
+  the disc of radius ``delta + V_e tau t`` about its cell's centre (delta the cell's
+  half-diagonal, plus :data:`~strategies.referee.spec.MARGIN_REL`), and it may end in any
+  open cell within V_e tau of its cell: a superset of what it can do.
+* **Losing set, checked continuously over the step.** The range test holds for every
+  pursuer-evader pair the discs allow, at every instant (closed form). Occlusion: the rod
+  is clear at the step's start (surveillance held so far); while neither end touches a
+  wall, it can become blocked only by sweeping a convex obstacle vertex, and every rod of
+  the step lies in the hull of the pursuer's path and the evader's disc
+  (:func:`~strategies.referee.robust.sweep_hits_vertex`, ``sweep_pieces`` pieces per
+  step). So no convex vertex in those hulls means no occlusion.
+
+The pursuer's winning set is the greatest fixed point ``W = {x : exists a safe move whose
+every evader successor is in W}``, computed by iterating from the safe states, with a
+worklist of the windows that changed.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from envs.geometry import kernel_for
+from strategies.referee._fixpoint import erode, reach_rectangles, shifted
+from strategies.referee.lattice import Lattice, segment_wall_distance
+from strategies.referee.robust import convex_corners, sweep_hits_vertex, sweep_range_ok
+from strategies.referee.spec import GameSpec, Resolution
+
+__all__ = ["PursuerBound", "solve_pursuer_bound"]
+
+
+@dataclass
+class PursuerBound:
+    """The solved pursuer bound.
+
+    Attributes:
+        spec: the game.
+        res: the resolution.
+        lattice: cells and the pursuer's lattice.
+        vectors: (n_moves, 2) pursuer moves in cells (row 0 is standing still).
+        targets: (n_points, n_moves) point reached by each move, -1 if not allowed.
+        win: (n_points, W, W) states (pursuer point, evader cell) from which the pursuer
+            provably holds.
+        choice: (n_points, W, W) int16, a winning move of each winning state (-1 elsewhere).
+        iterations: fixed-point sweeps until nothing changed.
+        seconds: wall time of the build and of the fixed point.
+    """
+
+    spec: GameSpec
+    res: Resolution
+    lattice: Lattice
+    vectors: np.ndarray
+    targets: np.ndarray
+    win: np.ndarray
+    choice: np.ndarray
+    iterations: int
+    seconds: dict[str, float]
+
+    # ------------------------------------------------------------------ storage
+    def to_arrays(self) -> dict[str, np.ndarray]:
+        """The solved arrays (for the on-disk cache); the rest is rebuilt from spec/res."""
+        return {
+            "win": self.win,
+            "choice": self.choice,
+            "iterations": np.array(self.iterations),
+            "seconds": np.array([self.seconds.get("build", 0.0), self.seconds.get("solve", 0.0)]),
+        }
+
+    @classmethod
+    def from_arrays(cls, spec: GameSpec, res: Resolution, arrays) -> PursuerBound:
+        """Rebuild a bound from :meth:`to_arrays` output (the lattice is recomputed)."""
+        lat = Lattice(spec, res, "pursuer")
+        vectors, targets = lat.moves(spec.v_pursuer * res.tau)
+        shape = (lat.n_points, lat.W, lat.W)
+        if arrays["win"].shape != shape or arrays["choice"].shape != shape:
+            raise ValueError(
+                f"cached pursuer bound has shape {arrays['win'].shape}, expected {shape}"
+            )
+        sec = arrays["seconds"]
+        return cls(
+            spec=spec,
+            res=res,
+            lattice=lat,
+            vectors=vectors,
+            targets=targets,
+            win=arrays["win"].astype(bool),
+            choice=arrays["choice"].astype(np.int16),
+            iterations=int(arrays["iterations"]),
+            seconds={"build": float(sec[0]), "solve": float(sec[1])},
+        )
+
+    # ------------------------------------------------------------------ queries
+    @property
+    def reach(self) -> float:
+        """How far the evader may get in one step, plus the margin: V_e tau + margin."""
+        return self.spec.v_evader * self.res.tau + self.spec.margin
+
+    def state(self, pursuer: np.ndarray, evader: np.ndarray) -> tuple[int, int, int] | None:
+        """The state ``(k, a, b)`` of a pursuer on the lattice and an evader anywhere, or
+        None if the pursuer is not on a lattice point or the evader is out of the window."""
+        lat = self.lattice
+        p = np.asarray(pursuer, dtype=float)
+        ij = np.rint((p - lat.anchor) / lat.h).astype(np.int64)
+        if np.hypot(*(lat.anchor + lat.h * ij - p)) > self.spec.margin:
+            return None
+        k = int(lat.point_index(ij[None])[0])
+        if k < 0:
+            return None
+        a, b = lat.window_cell(np.array([k]), lat.cell_of(np.asarray(evader, dtype=float)))[0]
+        if not (0 <= a < lat.W and 0 <= b < lat.W):
+            return None
+        return k, int(a), int(b)
+
+    def plan(self, pursuer, evader) -> np.ndarray | None:
+        """A certified next lattice point for the pursuer from the real positions, or None.
+
+        Checks the step from the *real* pursuer and evader positions (the evader's disc
+        is centred on its real position, not its cell): a straight move to a lattice point
+        at most V_p tau away whose path keeps the body radius, safe over the whole step,
+        and whose every evader successor cell (within V_e tau of the real evader) is a
+        winning state. Among the certified moves, the shortest is returned (standing still
+        when it is certified).
+
+        Args:
+            pursuer: real (x, y) of the pursuer.
+            evader: real (x, y) of the evader.
+
+        Returns:
+            The target point (2,), or None when no certified move exists.
+        """
+        spec, lat = self.spec, self.lattice
+        p = np.asarray(pursuer, dtype=float)
+        e = np.asarray(evader, dtype=float)
+        step = spec.v_pursuer * self.res.tau
+        near = np.hypot(*(lat.points - p).T) <= step * (1.0 + 1e-12)
+        cand = np.flatnonzero(near)
+        if len(cand) == 0:
+            return None
+        order = np.argsort(np.hypot(*(lat.points[cand] - p).T), kind="stable")
+        cand = cand[order]
+        B = lat.points[cand]
+        clear = segment_wall_distance(np.broadcast_to(p, B.shape), B, spec.map)
+        cand = cand[clear >= spec.body_radius * (1.0 - 1e-9) - spec.margin]
+        if len(cand) == 0:
+            return None
+        g = spec.v_evader * self.res.tau
+        m = spec.margin
+        rel = e - p  # the evader relative to the pursuer's start
+        d = lat.points[cand] - p
+        ok = sweep_range_ok(rel[0], rel[1], d[:, 0], d[:, 1], m, g, spec.l_min, spec.l_max)
+        ok &= ~_sweep_hits_any(spec, p, d, e, m, g, self.res.sweep_pieces)
+        # successors: every open cell within V_e tau (+ margin) of the real evader
+        cells = _cells_within(lat, e, g + m)
+        for i in np.flatnonzero(ok):
+            k = int(cand[i])
+            ab = lat.window_cell(np.array([k]), cells)
+            inside = (ab[:, 0] >= 0) & (ab[:, 0] < lat.W) & (ab[:, 1] >= 0) & (ab[:, 1] < lat.W)
+            if not inside.all():
+                continue
+            if self.win[k, ab[:, 0], ab[:, 1]].all():
+                return lat.points[k].copy()
+        return None
+
+    def certifies(self, pursuer, evader) -> bool:
+        """Whether the pursuer provably holds from this real start: surveillance holds at
+        the start (range and line of sight) and :meth:`plan` finds a certified move."""
+        spec = self.spec
+        p = np.asarray(pursuer, dtype=float)
+        e = np.asarray(evader, dtype=float)
+        L = float(np.hypot(*(p - e)))
+        if not (spec.l_min <= L <= spec.l_max):
+            return False
+        if not kernel_for(spec.map).line_of_sight(p, e):
+            return False
+        return self.plan(p, e) is not None
+
+    def fraction(self) -> float:
+        """Fraction of the states (pursuer point, open evader cell in range) that win."""
+        dom = self._domain()
+        return float(self.win[dom].mean()) if dom.any() else 0.0
+
+    def _domain(self) -> np.ndarray:
+        lat = self.lattice
+        open_w = lat.windows(lat.cell_open, False)
+        return open_w & _range0(lat, self.spec)[None]
+
+
+def _range0(lat: Lattice, spec: GameSpec) -> np.ndarray:
+    """(W, W): window cells whose whole disc is in range of the window's centre."""
+    R0 = lat.delta + spec.margin
+    dist = np.hypot(lat.offsets[..., 0], lat.offsets[..., 1])
+    return (dist - R0 >= spec.l_min) & (dist + R0 <= spec.l_max)
+
+
+def _cells_within(lat: Lattice, e: np.ndarray, r: float) -> np.ndarray:
+    """Fine indices of the open cells within distance r of the point e."""
+    lo = np.floor((e - r - lat.anchor) / lat.h - 0.5).astype(int)
+    hi = np.ceil((e + r - lat.anchor) / lat.h + 0.5).astype(int)
+    ii, jj = np.meshgrid(np.arange(lo[0], hi[0] + 1), np.arange(lo[1], hi[1] + 1), indexing="ij")
+    ij = np.stack([ii.ravel(), jj.ravel()], axis=1)
+    c = lat.anchor + lat.h * ij
+    dx = np.maximum(np.abs(c[:, 0] - e[0]) - 0.5 * lat.h, 0.0)
+    dy = np.maximum(np.abs(c[:, 1] - e[1]) - 0.5 * lat.h, 0.0)
+    ij = ij[np.hypot(dx, dy) <= r]
+    return ij[lat.cell_open_at(ij)]
+
+
+def _sweep_hits_any(spec, p, d, c, R0, g, pieces) -> np.ndarray:
+    """For moves d (n, 2) of a pursuer at p and an evader disc D(c, R0 + g t): whether
+    some convex vertex may be grazed during the step."""
+    verts, din, dout = convex_corners(spec.map)
+    hit = np.zeros(len(d), dtype=bool)
+    rel = c - p
+    for v, di, do in zip(verts - p, din, dout, strict=True):
+        for q in range(pieces):
+            t0, t1 = q / pieces, (q + 1) / pieces
+            hit |= sweep_hits_vertex(
+                t0 * d[:, 0],
+                t0 * d[:, 1],
+                t1 * d[:, 0],
+                t1 * d[:, 1],
+                v[0],
+                v[1],
+                rel[0],
+                rel[1],
+                R0 + g * t1,
+                di,
+                do,
+                spec.margin,
+            )
+    return hit
+
+
+# ---------------------------------------------------------------------- the solver
+def _safe_tables(lat: Lattice, spec: GameSpec, res: Resolution, vectors, targets, domain):
+    """Packed (n_moves, n_points, W, packed W) tables: move j is safe from state (k, a, b)."""
+    n, W = lat.n_points, lat.W
+    h = lat.h
+    R0 = lat.delta + spec.margin
+    g = spec.v_evader * res.tau
+    ox, oy = lat.offsets[..., 0], lat.offsets[..., 1]
+    verts, din, dout = convex_corners(spec.map)
+    dmax = float(np.max(np.hypot(*vectors.T))) * h if len(vectors) else 0.0
+    # candidates per convex vertex: states whose every possible rod hull comes near it
+    cand = []
+    rad = max(dmax, R0 + g)
+    for v, di, do in zip(verts, din, dout, strict=True):
+        rel = v[None, :] - lat.points  # (n, 2): the vertex seen from each pursuer point
+        reach = np.hypot(*rel.T) <= spec.l_max + R0 + g + dmax
+        ks = np.flatnonzero(reach)
+        for s in range(0, len(ks), 256):
+            kk = ks[s : s + 256]
+            vx = rel[kk, 0][:, None, None]
+            vy = rel[kk, 1][:, None, None]
+            # distance from v to the segment [0, o] (the pursuer-to-cell-centre rod)
+            L2 = ox * ox + oy * oy
+            with np.errstate(divide="ignore", invalid="ignore"):
+                t = np.clip((vx * ox + vy * oy) / L2, 0.0, 1.0)
+            near = np.hypot(vx - t * ox, vy - t * oy) <= rad
+            near &= domain[kk]
+            k_i, a_i, b_i = np.nonzero(near)
+            cand.append((v, di, do, kk[k_i], a_i, b_i))
+    tables = []
+    for j, vec in enumerate(vectors):
+        d = vec.astype(float) * h
+        ok = domain & (targets[:, j] >= 0)[:, None, None]
+        ok &= sweep_range_ok(ox, oy, d[0], d[1], R0, g, spec.l_min, spec.l_max)[None]
+        for v, di, do, kk, aa, bb in cand:
+            if len(kk) == 0:
+                continue
+            rx = v[0] - lat.points[kk, 0]
+            ry = v[1] - lat.points[kk, 1]
+            cx = ox[aa, bb]
+            cy = oy[aa, bb]
+            hit = np.zeros(len(kk), dtype=bool)
+            for q in range(res.sweep_pieces):
+                t0, t1 = q / res.sweep_pieces, (q + 1) / res.sweep_pieces
+                hit |= sweep_hits_vertex(
+                    t0 * d[0],
+                    t0 * d[1],
+                    t1 * d[0],
+                    t1 * d[1],
+                    rx,
+                    ry,
+                    cx,
+                    cy,
+                    R0 + g * t1,
+                    di,
+                    do,
+                    spec.margin,
+                )
+            ok[kk[hit], aa[hit], bb[hit]] = False
+        tables.append(np.packbits(ok, axis=-1))
+    return np.stack(tables) if tables else np.zeros((0, n, W, (W + 7) // 8), np.uint8)
+
+
+def _unpack(table: np.ndarray, W: int) -> np.ndarray:
+    return np.unpackbits(table, axis=-1, count=W).view(bool)
+
+
+def solve_pursuer_bound(spec: GameSpec, res: Resolution, *, progress: bool = False) -> PursuerBound:
+    """Solve the evader-favoured discrete game (see the module docstring).
+
+    Args:
+        spec: the game.
+        res: the resolution.
+        progress: print one line per fixed-point sweep.
+
+    Returns:
+        The :class:`PursuerBound`.
+    """
+    t0 = time.perf_counter()
+    lat = Lattice(spec, res, "pursuer")
+    vectors, targets = lat.moves(spec.v_pursuer * res.tau)
+    open_w = lat.windows(lat.cell_open, False)
+    domain = open_w & _range0(lat, spec)[None]
+    safe = _safe_tables(lat, spec, res, vectors, targets, domain)
+    t1 = time.perf_counter()
+    W = lat.W
+    n_moves = len(vectors)
+    rects = reach_rectangles(spec.v_evader * res.tau + spec.margin, lat.h)
+    # X: the current over-approximation of the winning set (decreases to the fixed point)
+    X = np.zeros_like(domain)
+    for j in range(n_moves):
+        X |= _unpack(safe[j], W)
+    closed = ~open_w  # cells the evader cannot occupy never constrain the pursuer
+    A = erode(X | closed, rects, border=False)
+    # predecessors: which points have a move into point q
+    preds: list[list[int]] = [[] for _ in range(lat.n_points)]
+    for k, row in enumerate(targets):
+        for q in set(row[row >= 0].tolist()):
+            preds[q].append(k)
+    dirty = np.ones(lat.n_points, dtype=bool)
+    iterations = 0
+    while True:
+        iterations += 1
+        todo = np.zeros(lat.n_points, dtype=bool)
+        for q in np.flatnonzero(dirty):
+            todo[preds[q]] = True
+        ks = np.flatnonzero(todo)
+        new = _best_moves(ks, X, A, safe, vectors, targets, W)[0]
+        changed = (new != X[ks]).any(axis=(1, 2))
+        if progress:
+            print(f"pursuer bound: sweep {iterations}, {int(changed.sum())} windows changed")
+        if not changed.any():
+            break
+        X[ks] = new
+        dirty = np.zeros(lat.n_points, dtype=bool)
+        dirty[ks[changed]] = True
+        d = np.flatnonzero(dirty)
+        A[d] = erode(X[d] | closed[d], rects, border=False)
+    all_k = np.arange(lat.n_points)
+    _, choice = _best_moves(all_k, X, A, safe, vectors, targets, W, want_choice=True)
+    t2 = time.perf_counter()
+    return PursuerBound(
+        spec=spec,
+        res=res,
+        lattice=lat,
+        vectors=vectors,
+        targets=targets,
+        win=X,
+        choice=choice,
+        iterations=iterations,
+        seconds={"build": t1 - t0, "solve": t2 - t1},
+    )
+
+
+def _best_moves(ks, X, A, safe, vectors, targets, W, want_choice=False, chunk: int = 256):
+    """For points ``ks``: which states of X have a safe move into A (the states all of
+    whose evader successors are in X), and (``want_choice``) the first such move, -1 if
+    none."""
+    if len(ks) > chunk:
+        parts = [
+            _best_moves(ks[s : s + chunk], X, A, safe, vectors, targets, W, want_choice, chunk)
+            for s in range(0, len(ks), chunk)
+        ]
+        new = np.concatenate([p[0] for p in parts])
+        return new, (np.concatenate([p[1] for p in parts]) if want_choice else None)
+    new = np.zeros((len(ks), W, W), dtype=bool)
+    choice = np.full((len(ks), W, W), -1, dtype=np.int16) if want_choice else None
+    if len(ks) == 0:
+        return new, choice
+    Xk = X[ks]
+    for j, vec in enumerate(vectors):
+        tj = targets[ks, j]
+        valid = np.flatnonzero(tj >= 0)
+        if len(valid) == 0:
+            continue
+        good = _unpack(safe[j][ks[valid]], W)
+        good &= shifted(A[tj[valid]], int(vec[0]), int(vec[1]), False)
+        good &= Xk[valid]
+        if want_choice:
+            sub = choice[valid]
+            sub[good & (sub < 0)] = j
+            choice[valid] = sub
+        new[valid] |= good
+    return new, choice

@@ -1,0 +1,386 @@
+"""The referee: both bounds of one game, and what they are for.
+
+* :func:`solve` (and :func:`referee_for` from an env config) computes, or loads from the
+  on-disk cache, the pursuer bound and the evader bound at one resolution.
+* :meth:`Referee.classify` labels a start ``"pursuer"`` (the pursuer provably holds),
+  ``"evader"`` (the evader provably breaks surveillance, within a certified time) or
+  ``"unknown"`` (between the bounds: the resolution error).
+* :meth:`Referee.lattice_starts` and :meth:`Referee.sample_starts` enumerate and draw
+  certified starts for test oracles and training curricula; :func:`label_starts` labels
+  env starts given as ``{"pursuer": (x, y), "evader": (x, y)}``.
+* :meth:`Referee.summary` reports the fractions of each label over all lattice starts and
+  the gap between the bounds.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from envs import validation as V
+from envs.errors import InvalidConfigError
+from envs.geometry import kernel_for
+from strategies.referee.cache import load_arrays, save_arrays
+from strategies.referee.evader_bound import EvaderBound, solve_evader_bound
+from strategies.referee.pursuer_bound import PursuerBound, solve_pursuer_bound
+from strategies.referee.spec import GameSpec, Resolution
+
+__all__ = [
+    "LABELS",
+    "Referee",
+    "StartSet",
+    "cached_evader_bound",
+    "cached_pursuer_bound",
+    "label_starts",
+    "referee_for",
+    "solve",
+]
+
+LABELS = ("pursuer", "evader", "unknown")
+"""What a start can be labelled: who provably wins it, or unknown."""
+
+
+def cached_pursuer_bound(
+    spec: GameSpec,
+    res: Resolution,
+    *,
+    cache: bool = True,
+    cache_dir: str | os.PathLike | None = None,
+    progress: bool = False,
+) -> PursuerBound:
+    """The pursuer bound of ``spec`` at ``res``, from the cache or solved (and stored)."""
+    if cache:
+        arrays = load_arrays(
+            "pursuer", spec, res, ("win", "choice", "iterations", "seconds"), cache_dir
+        )
+        if arrays is not None:
+            try:
+                return PursuerBound.from_arrays(spec, res, arrays)
+            except ValueError:
+                pass
+    bound = solve_pursuer_bound(spec, res, progress=progress)
+    if cache:
+        try:
+            save_arrays("pursuer", spec, res, bound.to_arrays(), cache_dir)
+        except OSError:
+            pass  # a read-only or full disk only costs the recomputation next time
+    return bound
+
+
+def cached_evader_bound(
+    spec: GameSpec,
+    res: Resolution,
+    *,
+    cache: bool = True,
+    cache_dir: str | os.PathLike | None = None,
+    progress: bool = False,
+) -> EvaderBound:
+    """The evader bound of ``spec`` at ``res``, from the cache or solved (and stored)."""
+    if cache:
+        arrays = load_arrays(
+            "evader", spec, res, ("win", "rank", "choice", "iterations", "seconds"), cache_dir
+        )
+        if arrays is not None:
+            try:
+                return EvaderBound.from_arrays(spec, res, arrays)
+            except ValueError:
+                pass
+    bound = solve_evader_bound(spec, res, progress=progress)
+    if cache:
+        try:
+            save_arrays("evader", spec, res, bound.to_arrays(), cache_dir)
+        except OSError:
+            pass
+    return bound
+
+
+@dataclass(frozen=True)
+class StartSet:
+    """Starts with both players on their lattices, and their labels.
+
+    Attributes:
+        pursuer: (n, 2) pursuer positions.
+        evader: (n, 2) evader positions.
+        label: (n,) ``"pursuer"``, ``"evader"`` or ``"unknown"``.
+        escape_steps: (n,) for evader-labelled starts, the certified bound on referee steps
+            until surveillance breaks (-1 elsewhere).
+    """
+
+    pursuer: np.ndarray
+    evader: np.ndarray
+    label: np.ndarray
+    escape_steps: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.label)
+
+    def counts(self) -> dict[str, int]:
+        """How many starts carry each label."""
+        return {k: int(np.count_nonzero(self.label == k)) for k in LABELS}
+
+    def fractions(self) -> dict[str, float]:
+        """The share of each label (zeros when empty)."""
+        n = max(1, len(self))
+        return {k: v / n for k, v in self.counts().items()}
+
+
+@dataclass
+class Referee:
+    """Both bounds of one game.
+
+    Attributes:
+        spec: the game.
+        pursuer: the pursuer bound (certifies pursuer wins).
+        evader: the evader bound (certifies evader wins).
+    """
+
+    spec: GameSpec
+    pursuer: PursuerBound
+    evader: EvaderBound
+
+    # ------------------------------------------------------------------ single starts
+    def classify(self, pursuer, evader) -> str:
+        """``"pursuer"``, ``"evader"`` or ``"unknown"`` for one real start.
+
+        Raises:
+            InvalidConfigError: a position is not a finite (x, y) point.
+        """
+        p = V.point("pursuer", pursuer)
+        e = V.point("evader", evader)
+        if self.pursuer.certifies(p, e):
+            return "pursuer"
+        if self.evader.certifies(p, e):
+            return "evader"
+        return "unknown"
+
+    def escape_time(self, pursuer, evader) -> float | None:
+        """A certified bound on the time the evader needs to break surveillance from this
+        start (None when the start is not certified for the evader)."""
+        steps = self.evader.escape_steps(V.point("pursuer", pursuer), V.point("evader", evader))
+        return None if steps is None else steps * self.evader.res.tau
+
+    # ------------------------------------------------------------------ many starts
+    def lattice_starts(self, *, margin: float = 0.0) -> StartSet:
+        """Every start with the pursuer on the pursuer bound's lattice and the evader on the
+        evader bound's lattice that surveillance holds at (range with ``margin`` inside it,
+        line of sight), labelled by array lookups (the state-level certificates)."""
+        spec = self.spec
+        m = V.nonnegative("margin", margin)
+        P = self.pursuer.lattice.points
+        E = self.evader.lattice.points
+        pi, ei = _pairs_in_range(P, E, spec.l_min + m, spec.l_max - m)
+        ker = kernel_for(spec.map)
+        if len(pi):
+            clear = ker.line_of_sight_many(P[pi], E[ei])
+            pi, ei = pi[clear], ei[clear]
+        label = np.full(len(pi), "unknown", dtype=object)
+        steps = np.full(len(pi), -1, dtype=np.int64)
+        if len(pi):
+            pw = _lookup(self.pursuer.lattice, self.pursuer.win, pi, E[ei], False)
+            er = _lookup(self.evader.lattice, self.evader.rank, ei, P[pi], -1)
+            ew = er >= 0
+            label[ew] = "evader"
+            steps[ew] = er[ew]  # rank n: surveillance breaks within n steps
+            label[pw] = "pursuer"
+            if np.any(pw & ew):  # both certified: impossible unless a bound is wrong
+                raise AssertionError(
+                    f"referee: {int(np.count_nonzero(pw & ew))} starts certified for both "
+                    f"players on map {spec.map.name!r}"
+                )
+        return StartSet(P[pi], E[ei], label.astype(str), steps)
+
+    def sample_starts(
+        self,
+        n: int,
+        rng: np.random.Generator,
+        *,
+        kind: str = "pursuer",
+        jitter: bool = True,
+        margin: float = 0.0,
+    ) -> list[dict[str, tuple[float, float]]]:
+        """Draw ``n`` starts of one label, as env ``reset`` options.
+
+        The certified player sits on its lattice point; with ``jitter`` the other one is
+        moved uniformly inside its cell (its certificate covers the whole cell), keeping
+        its clearance and the line of sight.
+
+        Args:
+            n: how many (>= 0); draws with replacement when fewer exist.
+            rng: the only source of randomness.
+            kind: ``"pursuer"``, ``"evader"`` or ``"unknown"``.
+            jitter: move the uncertified player off its lattice point.
+            margin: keep the start's distance this far inside [l_min, l_max].
+
+        Raises:
+            InvalidConfigError: bad ``kind`` or ``n``, or no start of that kind exists.
+        """
+        n = V.integer("n", n, minimum=0)
+        kind = V.choice("kind", kind, LABELS)
+        starts = self.lattice_starts(margin=margin)
+        idx = np.flatnonzero(starts.label == kind)
+        if len(idx) == 0:
+            raise InvalidConfigError(
+                f"sample_starts: no {kind!r}-labelled start on map {self.spec.map.name!r} "
+                f"at this resolution (counts {starts.counts()})"
+            )
+        pick = rng.choice(idx, size=n, replace=n > len(idx))
+        out = []
+        for i in pick.tolist():
+            p, e = starts.pursuer[i].copy(), starts.evader[i].copy()
+            if jitter and kind != "unknown":
+                if kind == "pursuer":
+                    e = self._jitter(e, p, self.pursuer.lattice.h, rng, margin)
+                else:
+                    p = self._jitter(p, e, self.evader.lattice.h, rng, margin)
+            out.append(
+                {"pursuer": (float(p[0]), float(p[1])), "evader": (float(e[0]), float(e[1]))}
+            )
+        return out
+
+    def _jitter(self, x, other, h, rng, margin) -> np.ndarray:
+        spec = self.spec
+        ker = kernel_for(spec.map)
+        for _ in range(16):
+            y = x + rng.uniform(-0.5 * h, 0.5 * h, size=2) * (1.0 - 1e-9)
+            L = float(np.hypot(*(y - other)))
+            if not (spec.l_min + margin <= L <= spec.l_max - margin):
+                continue
+            if spec.map.distance_to_walls(y[None])[0] < spec.body_radius:
+                continue
+            if not spec.map.contains(y[None])[0] or not ker.line_of_sight(y, other):
+                continue
+            return y
+        return x
+
+    # ------------------------------------------------------------------ reports
+    def summary(self, *, margin: float = 0.0) -> dict[str, Any]:
+        """Sizes, timings and the label fractions over all lattice starts.
+
+        ``gap`` is the fraction of starts neither bound certifies: the resolution error.
+        """
+        starts = self.lattice_starts(margin=margin)
+        fr = starts.fractions()
+        pb, eb = self.pursuer, self.evader
+        return {
+            "map": self.spec.map.name,
+            "rho": self.spec.rho,
+            "starts": len(starts),
+            "pursuer": fr["pursuer"],
+            "evader": fr["evader"],
+            "gap": fr["unknown"],
+            "pursuer_bound": {
+                "cell": pb.res.cell,
+                "spacing": pb.res.spacing,
+                "tau": pb.res.tau,
+                "states": int(pb.win.size),
+                "iterations": pb.iterations,
+                "seconds": dict(pb.seconds),
+            },
+            "evader_bound": {
+                "cell": eb.res.cell,
+                "spacing": eb.res.spacing,
+                "tau": eb.res.tau,
+                "states": int(eb.win.size),
+                "iterations": eb.iterations,
+                "seconds": dict(eb.seconds),
+            },
+        }
+
+
+def _pairs_in_range(P: np.ndarray, E: np.ndarray, lo: float, hi: float):
+    """Index pairs (i, j) with lo <= |P[i] - E[j]| <= hi."""
+    from scipy.spatial import cKDTree
+
+    tree = cKDTree(E)
+    pi, ei = [], []
+    for i, nbrs in enumerate(tree.query_ball_point(P, hi)):
+        if not nbrs:
+            continue
+        nb = np.asarray(nbrs)
+        d = np.hypot(*(E[nb] - P[i]).T)
+        nb = nb[d >= lo]
+        pi.append(np.full(len(nb), i))
+        ei.append(nb)
+    if not pi:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    return np.concatenate(pi).astype(np.int64), np.concatenate(ei).astype(np.int64)
+
+
+def _lookup(lat, table: np.ndarray, k: np.ndarray, other: np.ndarray, fill):
+    """``table[k, window cell of other]`` (``fill`` off the window)."""
+    ab = lat.cell_of(other) - lat.point_cells[k] + lat.hw
+    inside = (ab >= 0).all(axis=1) & (ab < lat.W).all(axis=1)
+    out = np.full(len(k), fill, dtype=table.dtype)
+    out[inside] = table[k[inside], ab[inside, 0], ab[inside, 1]]
+    return out
+
+
+def solve(
+    spec: GameSpec,
+    cells_per_lmin: float = 20.0,
+    *,
+    coarse: int = 4,
+    steps: float = 2.0,
+    sweep_pieces: int = 2,
+    dt: float | None = None,
+    cache: bool = True,
+    cache_dir: str | os.PathLike | None = None,
+    progress: bool = False,
+) -> Referee:
+    """Solve (or load) both bounds of ``spec`` at one resolution.
+
+    Each bound gets :meth:`Resolution.for_role` with the same cell and lattice, so both
+    lattices coincide; only the step ``tau`` differs (each certified player covers
+    ``steps`` lattice spacings per step).
+
+    Args:
+        spec: the game.
+        cells_per_lmin: opponent cells per L_min (the resolution; the gap shrinks as it
+            grows, the cost grows about as its fourth power).
+        coarse: cells per spacing of the certified lattices.
+        steps: lattice spacings per step of the certified player.
+        sweep_pieces: pieces per step of the pursuer bound's sweep test.
+        dt: round each ``tau`` up to a whole number of this env step (for referee policies).
+        cache: read and write the on-disk cache.
+        cache_dir: cache directory (default ``$SURVEIL_CACHE_DIR`` or ``~/.cache/surveil``).
+        progress: print the fixed points' progress.
+    """
+    if not isinstance(spec, GameSpec):
+        raise InvalidConfigError(f"solve: expected a GameSpec, got {type(spec).__name__}")
+    kw = dict(coarse=coarse, steps=steps, sweep_pieces=sweep_pieces, dt=dt)
+    rp = Resolution.for_role(spec, "pursuer", cells_per_lmin, **kw)
+    re = Resolution.for_role(spec, "evader", cells_per_lmin, **kw)
+    return Referee(
+        spec=spec,
+        pursuer=cached_pursuer_bound(spec, rp, cache=cache, cache_dir=cache_dir, progress=progress),
+        evader=cached_evader_bound(spec, re, cache=cache, cache_dir=cache_dir, progress=progress),
+    )
+
+
+def referee_for(config: Any, cells_per_lmin: float = 20.0, **kwargs: Any) -> Referee:
+    """:func:`solve` for the game an env config plays (its map, range, speeds, body
+    radius), with each ``tau`` a whole number of the config's ``dt``."""
+    spec = GameSpec.from_config(config)
+    kwargs.setdefault("dt", config.dt)
+    return solve(spec, cells_per_lmin, **kwargs)
+
+
+def label_starts(referee: Referee, starts: Iterable[Mapping[str, Any]]) -> list[str]:
+    """Labels of env starts ``{"pursuer": (x, y), "evader": (x, y)}`` (see
+    :meth:`Referee.classify`).
+
+    Raises:
+        InvalidConfigError: a start is not such a mapping.
+    """
+    out = []
+    for i, s in enumerate(starts):
+        if not isinstance(s, Mapping) or "pursuer" not in s or "evader" not in s:
+            raise InvalidConfigError(
+                f"label_starts: start {i} = {s!r}: expected {{'pursuer': (x, y), 'evader': (x, y)}}"
+            )
+        out.append(referee.classify(s["pursuer"], s["evader"]))
+    return out

@@ -14,26 +14,53 @@ from scipy.ndimage import minimum_filter1d
 __all__ = ["erode", "reach_rectangles", "shifted"]
 
 
-def reach_rectangles(reach: float, h: float) -> list[tuple[int, int]]:
+MAX_RECTANGLES = 8
+"""Rectangles per stencil: a larger exact stencil is covered by this many (a superset)."""
+
+
+def reach_rectangles(
+    reach: float, h: float, max_rects: int | None = MAX_RECTANGLES
+) -> list[tuple[int, int]]:
     """The opponent's one-step cell stencil as a union of centred rectangles.
 
     From a cell, the opponent (anywhere in it, moving at most ``reach``) can end in the
     cells within ``reach`` of the cell in the Euclidean distance between squares: offsets
     ``(i, j)`` with ``max(|i| - 1, 0)^2 + max(|j| - 1, 0)^2 <= (reach / h)^2``. That set is
     the union over ``k = 0 .. floor(reach / h)`` of the rectangles with half-sides
-    ``(k + 1, floor(sqrt((reach / h)^2 - k^2)) + 1)``.
+    ``(k + 1, floor(sqrt((reach / h)^2 - k^2)) + 1)`` (fewer: nested ones are dropped).
+
+    A large stencil costs one pass per rectangle, so beyond ``max_rects`` it is covered by
+    ``max_rects`` rectangles whose corners lie evenly in angle on the staircase: a
+    superset, which over-approximates the opponent a little more (sound for both bounds,
+    whose opponents must be over-approximated).
 
     Returns:
         ``[(half_x, half_y), ...]``.
     """
     r = reach / h
-    out: list[tuple[int, int]] = []
-    for k in range(math.floor(r + 1e-9) + 1):
-        w = math.floor(math.sqrt(max(r * r - k * k, 0.0)) + 1e-9)
-        if out and out[-1][1] == w + 1:
-            out[-1] = (k + 1, w + 1)  # the previous rectangle lies inside this one
+    K = math.floor(r + 1e-9)
+    widths = [math.floor(math.sqrt(max(r * r - k * k, 0.0)) + 1e-9) for k in range(K + 1)]
+    exact: list[tuple[int, int]] = []
+    for k, w in enumerate(widths):
+        if exact and exact[-1][1] == w + 1:
+            exact[-1] = (k + 1, w + 1)  # the previous rectangle lies inside this one
         else:
-            out.append((k + 1, w + 1))
+            exact.append((k + 1, w + 1))
+    if max_rects is None or len(exact) <= max_rects:
+        return exact
+    # rows k_1 < ... < k_m = K spread in angle; rectangle j reaches row k_j with the width
+    # of the first row after k_{j-1}, so it covers every exact rectangle in between
+    rows = sorted(
+        {
+            min(K, round(r * math.sin(0.5 * math.pi * j / max_rects)))
+            for j in range(1, max_rects + 1)
+        }
+        | {K}
+    )
+    out, prev = [], -1
+    for k in rows:
+        out.append((k + 1, widths[prev + 1] + 1))
+        prev = k
     return out
 
 

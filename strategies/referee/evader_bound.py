@@ -30,6 +30,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import ndimage
 
 from strategies.referee._fixpoint import erode, reach_rectangles
 from strategies.referee.lattice import Lattice, segment_wall_distance
@@ -190,44 +191,78 @@ def _range_broken(lat: Lattice, spec: GameSpec) -> np.ndarray:
 
 
 def _occlusion_broken(lat: Lattice, spec: GameSpec, candidates: np.ndarray) -> np.ndarray:
-    """(n_points, W, W): among ``candidates``, the states robustly occluded."""
+    """(n_points, W, W): among ``candidates``, the states robustly occluded.
+
+    A state (evader point e, pursuer cell c) is robustly occluded when cell ∩ F is convex,
+    no rod from e to the cell's disc can graze a convex vertex
+    (:func:`~strategies.referee.robust.fan_hits_vertex`), and the rod to one point of the
+    cell crosses a wall properly. Neighbouring cells that lie inside free space and pass
+    the grazing test share their visibility (the rods to their union vary without
+    grazing), so the line of sight is tested once per connected group of them.
+    """
     world = spec.map
-    convex, rep = lat.convex_cells()
-    conv_w = lat.windows(convex, False)
-    rep_w = lat.windows(rep, np.nan)
-    cand = candidates & conv_w
+    out = np.zeros(candidates.shape, dtype=bool)
+    if not world.vertex_convex.any():
+        return out  # a convex free region: no rod between two of its points is blocked
+    convex, rep, interior = lat.convex_cells()
+    cand = candidates & lat.windows(convex, False)
     R = lat.delta + spec.margin
     ox, oy = lat.offsets[..., 0], lat.offsets[..., 1]
+    L2 = np.maximum(ox * ox + oy * oy, 1e-300)
     verts, din, dout = convex_corners(world)
     for v, di, do in zip(verts, din, dout, strict=True):
         rel = v[None, :] - lat.points
-        near = np.hypot(*rel.T) <= spec.l_max + R + lat.h
+        near_pt = np.hypot(*rel.T) <= spec.l_max + R + lat.h
         for s in range(0, lat.n_points, 256):
             ks = np.arange(s, min(s + 256, lat.n_points))
-            ks = ks[near[ks]]
+            ks = ks[near_pt[ks]]
             if len(ks) == 0:
+                continue
+            vx = rel[ks, 0][:, None, None]
+            vy = rel[ks, 1][:, None, None]
+            # a rod from e through v to the disc passes within R of the centre's segment
+            t = np.clip((vx * ox + vy * oy) / L2, 0.0, 1.0)
+            near = (np.hypot(vx - t * ox, vy - t * oy) <= R + spec.margin) & cand[ks]
+            k_i, a_i, b_i = np.nonzero(near)
+            if len(k_i) == 0:
                 continue
             hit = fan_hits_vertex(
                 0.0,
                 0.0,
-                rel[ks, 0][:, None, None],
-                rel[ks, 1][:, None, None],
-                ox,
-                oy,
+                vx[k_i, 0, 0],
+                vy[k_i, 0, 0],
+                ox[a_i, b_i],
+                oy[a_i, b_i],
                 R,
                 di,
                 do,
                 spec.margin,
             )
-            cand[ks] &= ~hit
-    k_i, a_i, b_i = np.nonzero(cand)
-    out = np.zeros(cand.shape, dtype=bool)
-    if len(k_i):
+            cand[ks[k_i[hit]], a_i[hit], b_i[hit]] = False
+    edges = (world.edge_start, world.edge_end)
+    # groups of interior candidate cells, 4-connected within each window
+    inner = cand & lat.windows(interior, False)
+    structure = np.zeros((3, 3, 3), dtype=bool)
+    structure[1] = [[0, 1, 0], [1, 1, 1], [0, 1, 0]]
+    labels, n_groups = ndimage.label(inner, structure=structure)
+    if n_groups:
+        flat = labels.ravel()
+        first = np.zeros(n_groups + 1, dtype=np.int64)
+        nz = np.flatnonzero(flat)
+        uniq, idx = np.unique(flat[nz], return_index=True)
+        first[uniq] = nz[idx]
+        k_i, a_i, b_i = np.unravel_index(first[1:], labels.shape)
         P = lat.points[k_i]
-        Q = rep_w[k_i, a_i, b_i]
+        Q = P + lat.offsets[a_i, b_i]  # an interior cell's centre is in free space
+        crossed = np.concatenate([[False], segment_crosses_walls(P, Q, *edges)])
+        out |= crossed[labels]
+    # the cells meeting a wall, one by one through their free point
+    k_i, a_i, b_i = np.nonzero(cand & ~inner)
+    if len(k_i):
+        Q = lat.windows(rep, np.nan)[k_i, a_i, b_i]
         ok = np.isfinite(Q).all(axis=1)
         crossed = np.zeros(len(k_i), dtype=bool)
-        crossed[ok] = segment_crosses_walls(P[ok], Q[ok], world.edge_start, world.edge_end)
+        crossed[ok] = segment_crosses_walls(lat.points[k_i[ok]], Q[ok], *edges)
         out[k_i[crossed], a_i[crossed], b_i[crossed]] = True
     return out
 

@@ -178,15 +178,17 @@ class Lattice:
         out[inside] = self.cell_open[a[inside], b[inside]]
         return out
 
-    def convex_cells(self) -> tuple[np.ndarray, np.ndarray]:
-        """For each open cell: whether cell ∩ F is convex, and a point of cell ∩ F_c'.
+    def convex_cells(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """For each open cell: whether cell ∩ F is convex, a point of cell ∩ F_c', and
+        whether the whole cell lies in free space (its centre as that point).
 
         Used by the evader bound's robust occlusion test. A cell whose centre is at least
         ``max(delta, c')`` inside free space is convex with its centre as the point; the
         others (cells meeting a wall) are clipped with shapely.
 
         Returns:
-            ``(convex, rep)``: (nx, ny) bool and (nx, ny, 2) float (NaN where not open).
+            ``(convex, rep, interior)``: (nx, ny) bool, (nx, ny, 2) float (NaN where not
+            open) and (nx, ny) bool.
         """
         world = self.spec.map
         c = self.centers.reshape(-1, 2)
@@ -209,7 +211,8 @@ class Lattice:
             got = np.full((len(todo), 2), np.nan)
             got[ok] = shapely.get_coordinates(shapely.point_on_surface(sub[ok]))
             rep[todo] = got
-        return convex.reshape(self.nx, self.ny), rep.reshape(self.nx, self.ny, 2)
+        shape = (self.nx, self.ny)
+        return convex.reshape(shape), rep.reshape(*shape, 2), inside.reshape(shape)
 
     # ------------------------------------------------------------------ certified lattice
     def _certified_points(self) -> None:

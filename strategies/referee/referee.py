@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from envs import validation as V
-from envs.errors import InvalidConfigError
+from envs.errors import InvalidConfigError, InvalidPlacementError
 from envs.geometry import kernel_for
 from strategies.referee.cache import load_arrays, save_arrays
 from strategies.referee.evader_bound import EvaderBound, solve_evader_bound
@@ -148,9 +148,22 @@ class Referee:
 
         Raises:
             InvalidConfigError: a position is not a finite (x, y) point.
+            InvalidPlacementError: surveillance does not hold at the start (out of range
+                or occluded), so it is not a start of the game.
         """
         p = V.point("pursuer", pursuer)
         e = V.point("evader", evader)
+        spec = self.spec
+        L = float(np.hypot(*(p - e)))
+        if not spec.l_min <= L <= spec.l_max:
+            raise InvalidPlacementError(
+                f"start pursuer={tuple(p.tolist())}, evader={tuple(e.tolist())}: distance "
+                f"{L:.6g} outside [l_min, l_max] = [{spec.l_min:g}, {spec.l_max:g}]"
+            )
+        if not kernel_for(spec.map).line_of_sight(p, e):
+            raise InvalidPlacementError(
+                f"start pursuer={tuple(p.tolist())}, evader={tuple(e.tolist())}: occluded"
+            )
         if self.pursuer.certifies(p, e):
             return "pursuer"
         if self.evader.certifies(p, e):
@@ -321,9 +334,10 @@ def _lookup(lat, table: np.ndarray, k: np.ndarray, other: np.ndarray, fill):
 
 def solve(
     spec: GameSpec,
-    cells_per_lmin: float = 20.0,
+    cells_per_lmin: float = 24.0,
     *,
-    coarse: int = 4,
+    pursuer_coarse: int | None = None,
+    evader_coarse: int | None = None,
     steps: float = 2.0,
     sweep_pieces: int = 2,
     dt: float | None = None,
@@ -333,15 +347,24 @@ def solve(
 ) -> Referee:
     """Solve (or load) both bounds of ``spec`` at one resolution.
 
-    Each bound gets :meth:`Resolution.for_role` with the same cell and lattice, so both
-    lattices coincide; only the step ``tau`` differs (each certified player covers
-    ``steps`` lattice spacings per step).
+    Each bound gets :meth:`Resolution.for_role` with the same cells; each certified
+    player covers ``steps`` lattice spacings of its own lattice per step. The pursuer
+    bound loses about a cell per step to the evader's unknown position within its cell,
+    so the evader should cover several cells per step (a coarse pursuer lattice, a long
+    step); but the evader also roams freely during the pursuer's committed step, which
+    eats the sensor range from both ends (a short step). The default lattice,
+    ``round(2 / rho)`` cells (2 to 12), lets the evader cover about four cells per step.
+    The evader bound loses the pursuer's foreknowledge of the evader's step (a short step
+    is better) but needs the evader to cover a few lattice spacings per step: its
+    default lattice is ``round(8 rho)`` cells (2 to 8). Both lattices share the cells'
+    anchor, so a start with each player on its lattice can be certified either way.
 
     Args:
         spec: the game.
         cells_per_lmin: opponent cells per L_min (the resolution; the gap shrinks as it
             grows, the cost grows about as its fourth power).
-        coarse: cells per spacing of the certified lattices.
+        pursuer_coarse: cells per spacing of the pursuer bound's lattice (None: auto).
+        evader_coarse: cells per spacing of the evader bound's lattice (None: auto).
         steps: lattice spacings per step of the certified player.
         sweep_pieces: pieces per step of the pursuer bound's sweep test.
         dt: round each ``tau`` up to a whole number of this env step (for referee policies).
@@ -351,9 +374,13 @@ def solve(
     """
     if not isinstance(spec, GameSpec):
         raise InvalidConfigError(f"solve: expected a GameSpec, got {type(spec).__name__}")
-    kw = dict(coarse=coarse, steps=steps, sweep_pieces=sweep_pieces, dt=dt)
-    rp = Resolution.for_role(spec, "pursuer", cells_per_lmin, **kw)
-    re = Resolution.for_role(spec, "evader", cells_per_lmin, **kw)
+    kw = dict(steps=steps, sweep_pieces=sweep_pieces, dt=dt)
+    if pursuer_coarse is None:
+        pursuer_coarse = int(min(12, max(2, round(2.0 / spec.rho))))
+    if evader_coarse is None:
+        evader_coarse = int(min(8, max(2, round(8.0 * spec.rho))))
+    rp = Resolution.for_role(spec, "pursuer", cells_per_lmin, coarse=pursuer_coarse, **kw)
+    re = Resolution.for_role(spec, "evader", cells_per_lmin, coarse=evader_coarse, **kw)
     return Referee(
         spec=spec,
         pursuer=cached_pursuer_bound(spec, rp, cache=cache, cache_dir=cache_dir, progress=progress),
@@ -361,7 +388,7 @@ def solve(
     )
 
 
-def referee_for(config: Any, cells_per_lmin: float = 20.0, **kwargs: Any) -> Referee:
+def referee_for(config: Any, cells_per_lmin: float = 24.0, **kwargs: Any) -> Referee:
     """:func:`solve` for the game an env config plays (its map, range, speeds, body
     radius), with each ``tau`` a whole number of the config's ``dt``."""
     spec = GameSpec.from_config(config)
@@ -375,6 +402,7 @@ def label_starts(referee: Referee, starts: Iterable[Mapping[str, Any]]) -> list[
 
     Raises:
         InvalidConfigError: a start is not such a mapping.
+        InvalidPlacementError: surveillance does not hold at a start.
     """
     out = []
     for i, s in enumerate(starts):

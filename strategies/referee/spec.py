@@ -186,7 +186,7 @@ class Resolution:
         cls,
         spec: GameSpec,
         role: str,
-        cells_per_lmin: float = 10.0,
+        cells_per_lmin: float = 24.0,
         *,
         coarse: int = 4,
         steps: float = 2.0,

@@ -1,0 +1,162 @@
+"""The discretisation: cells, certified lattice, moves, windows, stencils and erosions."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import shapely
+
+from envs.errors import InvalidConfigError
+from strategies.referee import Resolution
+from strategies.referee._fixpoint import erode, reach_rectangles, shifted
+from strategies.referee.lattice import Lattice, segment_wall_distance
+from tests.strategies.referee.conftest import dead_end, spec
+
+
+def _stencil(rects):
+    return {(i, j) for a, b in rects for i in range(-a, a + 1) for j in range(-b, b + 1)}
+
+
+@pytest.mark.parametrize("r", [0.0, 0.4, 1.0, 1.5, 2.3, 4.1, 7.0])
+def test_reach_rectangles_cover_exactly_the_cells_within_reach(r):
+    exact = {
+        (i, j)
+        for i in range(-12, 13)
+        for j in range(-12, 13)
+        if max(abs(i) - 1, 0) ** 2 + max(abs(j) - 1, 0) ** 2 <= r * r + 1e-9
+    }
+    assert _stencil(reach_rectangles(r, 1.0, None)) == exact
+    # the square-to-square distance is the reach: a brute force over cell points
+    pts = np.linspace(-0.5, 0.5, 5)
+    for i, j in [(2, 1), (0, 3), (1, 1)]:
+        gap = min(math.hypot(i + a - b, j + c - d) for a in pts for b in pts for c in pts
+                  for d in pts)  # fmt: skip
+        assert ((i, j) in exact) == (gap <= r + 1e-9)
+
+
+@pytest.mark.parametrize("r", [16.0, 40.0])
+def test_large_stencils_are_covered_by_few_rectangles(r):
+    few = reach_rectangles(r, 1.0)
+    exact = _stencil(reach_rectangles(r, 1.0, None))
+    assert len(few) <= 8
+    got = _stencil(few)
+    assert got >= exact  # a superset: the opponent is over-approximated, never missed
+    assert len(got) <= 1.06 * len(exact)
+
+
+@pytest.mark.parametrize("border", [True, False])
+def test_erode_matches_brute_force(border):
+    rng = np.random.default_rng(0)
+    X = rng.random((3, 15, 15)) > 0.08
+    rects = reach_rectangles(2.2, 1.0, None)
+    st = _stencil(rects)
+    got = erode(X, rects, border)
+    for k in range(3):
+        for a in range(15):
+            for b in range(15):
+                want = all(
+                    X[k, a + i, b + j] if (0 <= a + i < 15 and 0 <= b + j < 15) else border
+                    for i, j in st
+                )
+                assert got[k, a, b] == want
+
+
+def test_shifted_reads_the_offset_cell():
+    Y = np.random.default_rng(1).random((2, 7, 7)) > 0.5
+    out = shifted(Y, 2, -1, fill=True)
+    for a in range(7):
+        for b in range(7):
+            src = (a - 2, b + 1)
+            want = Y[:, src[0], src[1]] if (0 <= src[0] < 7 and 0 <= src[1] < 7) else True
+            assert np.array_equal(out[:, a, b], np.broadcast_to(want, (2,)))
+
+
+@pytest.fixture(scope="module")
+def lattice():
+    s = spec(dead_end(), 0.5)
+    return Lattice(s, Resolution(cell=0.125, coarse=2, tau=0.5), "pursuer")
+
+
+def test_open_cells_cover_the_opponent_region(lattice):
+    s = lattice.spec
+    rng = np.random.default_rng(4)
+    x0, y0, x1, y1 = s.map.bounds
+    pts = rng.uniform((x0, y0), (x1, y1), size=(4000, 2))
+    inside = s.map.contains(pts) & (s.map.distance_to_walls(pts) >= s.opponent_clearance)
+    assert lattice.cell_open_at(lattice.cell_of(pts[inside])).all()
+    # and an open cell does meet the region (here: not more than a cell beyond it)
+    centers = lattice.centers[lattice.cell_open]
+    far = shapely.distance(lattice.opponent_region, shapely.points(centers))
+    assert far.max() <= lattice.delta + 1e-9
+
+
+def test_certified_points_and_moves_keep_the_body_radius(lattice):
+    s = lattice.spec
+    assert (s.map.distance_to_walls(lattice.points) >= s.body_radius).all()
+    assert np.allclose((lattice.points - lattice.anchor) / lattice.spacing,
+                       np.rint((lattice.points - lattice.anchor) / lattice.spacing))  # fmt: skip
+    vec, targets = lattice.moves(0.5)
+    assert tuple(vec[0]) == (0, 0) and (targets[:, 0] == np.arange(lattice.n_points)).all()
+    assert (np.hypot(*vec.T) * lattice.h <= 0.5 + 1e-12).all()
+    # symmetric under the square's symmetries (rotations, reflections)
+    vs = {tuple(v) for v in vec}
+    assert vs == {(-b, a) for a, b in vs} == {(b, a) for a, b in vs}
+    walls = shapely.LinearRing(s.map.rings[0])
+    for k in range(0, lattice.n_points, 7):
+        for j, t in enumerate(targets[k]):
+            if t < 0 or j == 0:
+                continue
+            seg = shapely.LineString([lattice.points[k], lattice.points[t]])
+            assert walls.distance(seg) >= s.body_radius * (1 - 1e-9)
+            assert np.allclose(lattice.points[t] - lattice.points[k], vec[j] * lattice.h)
+
+
+def test_moves_that_would_cut_a_corner_are_refused(lattice):
+    vec, targets = lattice.moves(0.5)
+    A = np.repeat(lattice.points, len(vec), axis=0)
+    B = A + np.tile(vec, (lattice.n_points, 1)) * lattice.h
+    clear = segment_wall_distance(A, B, lattice.spec.map).reshape(lattice.n_points, -1)
+    dest = lattice.point_index((lattice.point_cells[:, None, :] + vec[None]).reshape(-1, 2))
+    allowed = (clear >= lattice.spec.body_radius * (1 - 1e-9)) & (dest.reshape(clear.shape) >= 0)
+    allowed[:, 0] = True
+    assert np.array_equal(targets >= 0, allowed)
+    assert (~allowed).any()  # the corridor's mouth does refuse some
+
+
+def test_segment_wall_distance_matches_shapely():
+    world = dead_end()
+    rng = np.random.default_rng(9)
+    A = rng.uniform((-2.5, -2.5), (5, 2.5), size=(200, 2))
+    B = A + rng.uniform(-1, 1, size=(200, 2))
+    got = segment_wall_distance(A, B, world)
+    walls = shapely.LinearRing(world.rings[0])
+    want = shapely.distance(walls, shapely.linestrings(np.stack([A, B], axis=1)))
+    assert got == pytest.approx(want, abs=1e-12)
+
+
+def test_windows_gather_the_cells_around_each_point(lattice):
+    grid = np.arange(lattice.nx * lattice.ny, dtype=float).reshape(lattice.nx, lattice.ny)
+    win = lattice.windows(grid, -1.0)
+    for k in (0, lattice.n_points // 2, lattice.n_points - 1):
+        i, j = lattice.point_cells[k] - (lattice.i0, lattice.j0)
+        for a, b in [(0, 0), (lattice.hw, lattice.hw), (lattice.W - 1, 3)]:
+            gi, gj = i + a - lattice.hw, j + b - lattice.hw
+            want = grid[gi, gj] if (0 <= gi < lattice.nx and 0 <= gj < lattice.ny) else -1.0
+            assert win[k, a, b] == want
+        # the window's centre is the point itself
+        assert np.allclose(lattice.centers[i, j], lattice.points[k])
+
+
+def test_too_fine_or_empty_lattices_are_refused():
+    s = spec(dead_end(), 0.5)
+    with pytest.raises(InvalidConfigError, match="too fine"):
+        Lattice(s, Resolution(cell=1e-4), "pursuer")
+    narrow = spec(dead_end(), 0.5, opponent_clearance=0.05)
+    with pytest.raises(InvalidConfigError, match="no lattice point"):
+        Lattice(
+            type(narrow)(narrow.map, 1.0, 2.0, body_radius=2.4),
+            Resolution(cell=0.5, coarse=3),
+            "pursuer",
+        )

@@ -1,0 +1,48 @@
+"""The referee as a test oracle for the analytic policies (issue 13).
+
+From a start the referee certifies for the pursuer, the decomposition pursuer should hold
+against every evader; from one it certifies for the evader, the shooting evader should
+break surveillance against every pursuer, within a horizon proportional to the map's
+diameter over V_e. A failure here is a weakness of the policy, not of the game: the
+referee's own strategies win the same episodes (``test_policies.py``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from strategies.policies.registry import make_policy, policy_names
+from strategies.referee import RefereeEvader, RefereePursuer
+from tests.strategies.referee.conftest import DT, play
+
+
+def _diameter_time(ref) -> float:
+    x0, y0, x1, y1 = ref.spec.map.bounds
+    return math.hypot(x1 - x0, y1 - y0) / ref.spec.v_evader
+
+
+def test_decomposition_pursuer_holds_from_certified_starts(open_slow):
+    starts = open_slow.sample_starts(3, np.random.default_rng(5), kind="pursuer")
+    evaders = [make_policy(n) for n in policy_names("evader")] + [RefereeEvader(open_slow.evader)]
+    for start in starts:
+        for evader in evaders:
+            winner, steps, cause = play(
+                open_slow, make_policy("pursuer/decomposition"), evader, start, max_cycles=200
+            )
+            assert winner == "pursuer", (start, evader.name, steps, cause)
+
+
+@pytest.mark.parametrize("fixture", ["corridor_half", "open_fast"])
+def test_shooting_evader_escapes_from_certified_starts(fixture, request):
+    ref = request.getfixturevalue(fixture)
+    starts = ref.sample_starts(3, np.random.default_rng(6), kind="evader")
+    pursuers = [make_policy(n) for n in policy_names("pursuer")] + [RefereePursuer(ref.pursuer)]
+    horizon = round(2 * _diameter_time(ref) / DT)
+    for start in starts:
+        for pursuer in pursuers:
+            winner, steps, _ = play(ref, pursuer, make_policy("evader/shooting"), start,
+                                    max_cycles=horizon)  # fmt: skip
+            assert winner == "evader", (start, pursuer.name, steps)

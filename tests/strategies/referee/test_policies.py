@@ -1,0 +1,65 @@
+"""The certificates in the env: the referee's own strategies, played episode by episode
+against every registered opponent, win wherever the referee says they do."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from envs.errors import InvalidConfigError
+from envs.surveillance.config import EnvConfig
+from strategies.policies.registry import make_policy, policy_names
+from strategies.referee import RefereeEvader, RefereePursuer
+from strategies.referee.policy import env_steps_per_referee_step
+from tests.strategies.referee.conftest import DT, RADIUS, play
+
+
+def _starts(ref, kind, n, seed):
+    return ref.sample_starts(n, np.random.default_rng(seed), kind=kind)
+
+
+def _opponents(role, ref):
+    """Every registered policy of ``role``, plus the referee's own heuristic (a charger
+    for the evader, a range keeper for the pursuer) on uncertified states."""
+    names = [make_policy(n) for n in policy_names(role)]
+    extra = RefereeEvader(ref.evader) if role == "evader" else RefereePursuer(ref.pursuer)
+    return [*names, extra]
+
+
+def test_referee_pursuer_holds_from_certified_starts_against_every_evader(open_slow):
+    for start in _starts(open_slow, "pursuer", 3, seed=1):
+        for evader in _opponents("evader", open_slow):
+            pursuer = RefereePursuer(open_slow.pursuer)
+            winner, steps, cause = play(open_slow, pursuer, evader, start, max_cycles=200)
+            assert winner == "pursuer", (start, evader.name, steps, cause)
+            assert pursuer.uncertified_steps == 0, (start, evader.name)
+
+
+@pytest.mark.parametrize("fixture", ["corridor_half", "open_fast"])
+def test_referee_evader_escapes_in_the_certified_time_against_every_pursuer(fixture, request):
+    ref = request.getfixturevalue(fixture)
+    k = env_steps_per_referee_step(ref.evader.res.tau, DT)
+    for start in _starts(ref, "evader", 3, seed=2):
+        bound = ref.escape_time(start["pursuer"], start["evader"])
+        assert bound is not None
+        for pursuer in _opponents("pursuer", ref):
+            evader = RefereeEvader(ref.evader)
+            horizon = round(bound / DT) + k
+            winner, steps, _cause = play(ref, pursuer, evader, start, max_cycles=horizon)
+            assert winner == "evader", (start, pursuer.name, steps)
+            assert steps * DT <= bound + 1e-9, (start, pursuer.name, steps, bound)
+            assert evader.uncertified_steps == 0
+
+
+def test_referee_policies_refuse_a_different_game(open_slow):
+    pursuer = RefereePursuer(open_slow.pursuer)
+    other = EnvConfig(map=open_slow.spec.map, l_min=1.0, l_max=2.5, v_evader=0.2,
+                      body_radius=RADIUS)  # fmt: skip
+    with pytest.raises(InvalidConfigError, match="l_max"):
+        pursuer.reset(role="pursuer", map=other.map, config=other, seed=0)
+    odd = EnvConfig(map=open_slow.spec.map, l_min=1.0, l_max=2.0, v_evader=0.2, dt=0.07,
+                    body_radius=RADIUS)  # fmt: skip
+    with pytest.raises(InvalidConfigError, match="whole number of env steps"):
+        pursuer.reset(role="pursuer", map=odd.map, config=odd, seed=0)
+    with pytest.raises(InvalidConfigError, match="expected a PursuerBound"):
+        RefereePursuer(open_slow.evader)

@@ -52,28 +52,18 @@ def corridor_half():
 
 
 def play(ref, pursuer, evader, start, max_cycles: int, seed: int = 0):
-    """One env episode of the referee's game between two policies from ``start``.
+    """One env episode of the referee's game between two policies from ``start``, through
+    the shared episode runner.
 
     Returns:
         ``(winner, steps, cause)``: ``"evader"`` with the step surveillance broke at and
         why, or ``"pursuer"`` when it held to ``max_cycles``.
     """
-    from envs import surveillance_v0
+    from strategies.runner import run_episode
 
     s = ref.spec
-    env = surveillance_v0.parallel_env(
-        map=s.map, l_min=s.l_min, l_max=s.l_max, v_pursuer=s.v_pursuer, v_evader=s.v_evader,
-        body_radius=RADIUS, dt=DT, max_cycles=max_cycles,
-    )  # fmt: skip
-    obs, _ = env.reset(seed=seed, options=start)
-    pursuer.reset(role="pursuer", map=env.config.map, config=env.config, seed=seed)
-    evader.reset(role="evader", map=env.config.map, config=env.config, seed=seed + 1)
-    steps = 0
-    while env.agents:
-        actions = {"pursuer_0": pursuer.act(obs["pursuer_0"]),
-                   "evader_0": evader.act(obs["evader_0"])}  # fmt: skip
-        obs, _, term, _, infos = env.step(actions)
-        steps += 1
-        if any(term.values()):
-            return "evader", steps, infos["pursuer_0"].get("cause")
-    return "pursuer", steps, None
+    overrides = {"l_min": s.l_min, "l_max": s.l_max, "v_pursuer": s.v_pursuer,
+                 "v_evader": s.v_evader, "body_radius": RADIUS, "dt": DT}  # fmt: skip
+    r = run_episode(s.map, pursuer, evader, seed, max_cycles=max_cycles, overrides=overrides,
+                    start=start)  # fmt: skip
+    return r.winner, r.steps, r.cause

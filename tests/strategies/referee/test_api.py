@@ -95,7 +95,7 @@ def test_summary_reports_fractions_sizes_and_timings(open_slow):
 
 
 def test_referee_for_an_env_config_plays_in_whole_env_steps(tmp_path):
-    cfg = EnvConfig(map=open_room(), l_min=1.0, l_max=2.0, v_evader=1.5, body_radius=RADIUS,
+    cfg = EnvConfig(map=open_room(), l_min=1.0, l_max=2.0, v_evader=0.9, body_radius=RADIUS,
                     dt=0.15)  # fmt: skip
     ref = referee_for(cfg, 8, pursuer_coarse=2, evader_coarse=4, cache_dir=tmp_path)
     for bound in (ref.pursuer, ref.evader):

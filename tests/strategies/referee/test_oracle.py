@@ -35,6 +35,7 @@ def test_decomposition_pursuer_holds_from_certified_starts(open_slow):
             assert winner == "pursuer", (start, evader.name, steps, cause)
 
 
+@pytest.mark.filterwarnings("ignore::envs.errors.RhoAboveOneWarning")  # rho = 1.5: on purpose
 @pytest.mark.parametrize("fixture", ["corridor_half", "open_fast"])
 def test_shooting_evader_escapes_from_certified_starts(fixture, request):
     ref = request.getfixturevalue(fixture)

@@ -35,6 +35,7 @@ def test_referee_pursuer_holds_from_certified_starts_against_every_evader(open_s
             assert pursuer.uncertified_steps == 0, (start, evader.name)
 
 
+@pytest.mark.filterwarnings("ignore::envs.errors.RhoAboveOneWarning")  # rho = 1.5: on purpose
 @pytest.mark.parametrize("fixture", ["corridor_half", "open_fast"])
 def test_referee_evader_escapes_in_the_certified_time_against_every_pursuer(fixture, request):
     ref = request.getfixturevalue(fixture)

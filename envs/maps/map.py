@@ -67,8 +67,6 @@ def _as_ring(points: object, what: str) -> np.ndarray:
         raise InvalidMapError(
             f"{what}: expected an (n, 2) array of vertices, got shape {arr.shape}"
         )
-    if not np.all(np.isfinite(arr)):
-        raise InvalidMapError(f"{what}: vertices must be finite, got {arr.tolist()}")
     if len(arr) >= 2 and np.array_equal(arr[0], arr[-1]):
         arr = arr[:-1]
     if len(arr) < 3:
@@ -149,7 +147,11 @@ class Map:
         name: str = "custom",
         merge: bool = False,
     ) -> None:
-        self.name = str(name)
+        try:
+            self.name = validation.string("name", name)
+            merge = validation.boolean("merge", merge)
+        except InvalidConfigError as exc:
+            raise InvalidMapError(str(exc)) from None
         b = _as_ring(boundary, "boundary")
         span = float(np.linalg.norm(b.max(axis=0) - b.min(axis=0)))
         if span <= 0:
@@ -434,22 +436,10 @@ class Map:
             offset: translation.
         """
         try:
-            m = np.asarray(matrix, dtype=float)
-            o = np.asarray(offset, dtype=float)
-        except (TypeError, ValueError) as exc:
-            raise InvalidMapError(
-                f"transformed: expected a 2x2 matrix and an (x, y) offset, got {matrix!r} "
-                f"and {offset!r}"
-            ) from exc
-        if (
-            m.shape != (2, 2)
-            or o.shape != (2,)
-            or not (np.isfinite(m).all() and np.isfinite(o).all())
-        ):
-            raise InvalidMapError(
-                f"transformed: expected a finite 2x2 matrix and a finite (x, y) offset, got "
-                f"{m.tolist()} and {o.tolist()}"
-            )
+            m = validation.finite_array("transformed matrix", matrix, shape=(2, 2))
+            o = validation.point("transformed offset", offset)
+        except InvalidConfigError as exc:
+            raise InvalidMapError(str(exc)) from None
         f = lambda r: r @ m.T + o
         return Map(
             f(self.boundary), [f(q) for q in self.obstacles], name=self.name, merge=self.merged

@@ -17,10 +17,10 @@ from gymnasium.utils import EzPickle, seeding
 from pettingzoo import AECEnv, ParallelEnv
 from pettingzoo.utils.conversions import parallel_to_aec
 
+from envs import validation
 from envs.errors import (
     EpisodeStateError,
     InvalidActionError,
-    InvalidConfigError,
     InvalidPlacementError,
 )
 from envs.geometry import Kernel, kernel_for
@@ -153,11 +153,7 @@ class parallel_env(ParallelEnv, EzPickle):
             InfeasibleError: no random start exists (see ``random_start``).
         """
         if seed is not None:
-            if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-                raise InvalidConfigError(
-                    f"reset: seed must be None or an integer >= 0, got {type(seed).__name__} "
-                    f"{seed!r}"
-                )
+            seed = validation.integer("seed", seed, minimum=0, where="reset")
             self.np_random, self._np_random_seed = seeding.np_random(int(seed))
         if options is not None and not isinstance(options, Mapping):
             raise InvalidPlacementError(

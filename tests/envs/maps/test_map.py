@@ -432,3 +432,19 @@ def test_coordinates_follow_the_number_rule(bad):
     """Strings and bools are not coordinates (envs.validation), in code as in files."""
     with pytest.raises(InvalidMapError, match=r"^boundary = .*: expected real numbers"):
         Map(bad, [])
+
+
+def test_name_merge_and_transforms_follow_the_number_rule():
+    square = [(0, 0), (4, 0), (4, 4), (0, 4)]
+    with pytest.raises(InvalidMapError, match=r"merge = 'yes': expected true or false"):
+        Map(square, merge="yes")
+    with pytest.raises(InvalidMapError, match=r"name = 3: expected a non-empty string"):
+        Map(square, name=3)
+    m = Map(square)
+    with pytest.raises(InvalidMapError, match=r"transformed matrix = .*: expected an array"):
+        m.transformed([["1", 0], [0, 1]])
+    with pytest.raises(InvalidMapError, match=r"transformed offset = \[True, 0\]"):
+        m.transformed(np.eye(2), [True, 0])
+    with pytest.raises(InvalidMapError, match=r"transformed matrix = .*: expected finite"):
+        m.transformed([[np.nan, 0], [0, 1]])
+    assert m.transformed(np.eye(2), (1, 2)).bounds == (1.0, 2.0, 5.0, 6.0)

@@ -36,6 +36,7 @@ def test_two_rooms_shooting_evader_escapes_from_every_pursuer(pursuer):
 
 @pytest.mark.parametrize("map_name", ["corridor", "open_room", "pillars", "two_rooms"])
 @pytest.mark.parametrize("pursuer", ["pursuer/decomposition", "pursuer/greedy"])
+@pytest.mark.filterwarnings("ignore::envs.errors.RhoAboveOneWarning")  # rho > 1 on purpose
 def test_faster_evader_escapes_everywhere(map_name, pursuer):
     r = play_episode(
         map_name, pursuer, "evader/shooting", 0, max_cycles=400, overrides={"v_evader": 1.5}

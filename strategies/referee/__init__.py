@@ -16,7 +16,10 @@ rises. Both bounds are fixed points over (certified lattice point, opponent cell
 with the geometry kernel's continuous occlusion semantics (a rod can become blocked only
 by sweeping a convex obstacle vertex; :mod:`.robust`). Solutions are cached on disk
 (:mod:`.cache`). :class:`RefereePursuer` and :class:`RefereeEvader` play the certified
-strategies in the env; :func:`draw_referee` draws the winning sets.
+strategies in the env; :func:`label_starts` and :func:`sample_starts` serve training
+curricula; :func:`regret` and :func:`tournament_regret` report how often each policy
+loses a start the referee certifies winnable; :func:`strategies.referee.draw.draw_referee`
+draws the winning sets.
 
 Example::
 
@@ -37,8 +40,10 @@ from strategies.referee.referee import (
     cached_pursuer_bound,
     label_starts,
     referee_for,
+    sample_starts,
     solve,
 )
+from strategies.referee.regrets import Regret, regret, regret_table, tournament_regret
 from strategies.referee.spec import MARGIN_REL, GameSpec, Resolution
 
 __all__ = [
@@ -50,13 +55,18 @@ __all__ = [
     "Referee",
     "RefereeEvader",
     "RefereePursuer",
+    "Regret",
     "Resolution",
     "StartSet",
     "cached_evader_bound",
     "cached_pursuer_bound",
     "label_starts",
     "referee_for",
+    "regret",
+    "regret_table",
+    "sample_starts",
     "solve",
     "solve_evader_bound",
     "solve_pursuer_bound",
+    "tournament_regret",
 ]

@@ -37,6 +37,7 @@ __all__ = [
     "cached_pursuer_bound",
     "label_starts",
     "referee_for",
+    "sample_starts",
     "solve",
 ]
 
@@ -396,19 +397,57 @@ def referee_for(config: Any, cells_per_lmin: float = 24.0, **kwargs: Any) -> Ref
     return solve(spec, cells_per_lmin, **kwargs)
 
 
-def label_starts(referee: Referee, starts: Iterable[Mapping[str, Any]]) -> list[str]:
+def _as_referee(obj: Any, solve_kwargs: Mapping[str, Any]) -> Referee:
+    """``obj`` itself when it is a :class:`Referee`, else :func:`referee_for` of it (an env
+    config: anything with ``map, l_min, l_max, v_pursuer, v_evader, body_radius, dt``)."""
+    if isinstance(obj, Referee):
+        return obj
+    if not all(hasattr(obj, k) for k in ("map", "l_min", "l_max", "v_pursuer", "v_evader")):
+        raise InvalidConfigError(
+            f"expected a Referee or an env config, got {type(obj).__name__} {obj!r:.80}"
+        )
+    return referee_for(obj, **solve_kwargs)
+
+
+def label_starts(
+    referee: Referee | Any, starts: Iterable[Mapping[str, Any]], **solve_kwargs: Any
+) -> list[str]:
     """Labels of env starts ``{"pursuer": (x, y), "evader": (x, y)}`` (see
     :meth:`Referee.classify`).
+
+    Args:
+        referee: a solved :class:`Referee`, or an env config (solved with
+            :func:`referee_for` and ``solve_kwargs``, cached on disk).
+        starts: the starts.
+        **solve_kwargs: for :func:`referee_for` (``cells_per_lmin``, ``cache_dir``...).
 
     Raises:
         InvalidConfigError: a start is not such a mapping.
         InvalidPlacementError: surveillance does not hold at a start.
     """
+    ref = _as_referee(referee, solve_kwargs)
     out = []
     for i, s in enumerate(starts):
         if not isinstance(s, Mapping) or "pursuer" not in s or "evader" not in s:
             raise InvalidConfigError(
                 f"label_starts: start {i} = {s!r}: expected {{'pursuer': (x, y), 'evader': (x, y)}}"
             )
-        out.append(referee.classify(s["pursuer"], s["evader"]))
+        out.append(ref.classify(s["pursuer"], s["evader"]))
     return out
+
+
+def sample_starts(
+    referee: Referee | Any,
+    n: int,
+    rng: np.random.Generator,
+    *,
+    kind: str = "pursuer",
+    jitter: bool = True,
+    margin: float = 0.0,
+    **solve_kwargs: Any,
+) -> list[dict[str, tuple[float, float]]]:
+    """Certified starts of one kind for training curricula (:meth:`Referee.sample_starts`),
+    from a :class:`Referee` or an env config (solved and cached as in :func:`label_starts`).
+    """
+    ref = _as_referee(referee, solve_kwargs)
+    return ref.sample_starts(n, rng, kind=kind, jitter=jitter, margin=margin)

@@ -1,0 +1,306 @@
+"""Each policy's regret: the share of the starts the referee certifies winnable for its
+role that it nevertheless lost.
+
+A pursuer's winnable starts are those certified for the pursuer (it can hold forever); an
+evader's are those certified for the evader *within the match's horizon* (the certified
+escape time fits in ``max_cycles * dt``). Starts the referee leaves unknown, or certifies
+for the opponent, say nothing about a policy and are only counted.
+
+* :func:`regret` computes :class:`Regret` rows from match outcomes (plain mappings: the
+  map, the env parameters, the start positions, the winner).
+* :func:`regret_table` formats them (a header row, then one row per policy).
+* :func:`tournament_regret` is the hook the tournament report calls with its run's spec
+  and match rows (it rebuilds each match's game and start from the records the shared
+  runner wrote, or from the seed when a row carries no record).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from scipy.stats import binomtest
+
+from envs import validation as V
+from envs.errors import InvalidConfigError, InvalidPlacementError
+from envs.maps import Map
+from strategies.referee.referee import Referee, solve
+from strategies.referee.spec import GameSpec
+
+__all__ = ["Regret", "regret", "regret_table", "tournament_regret"]
+
+DEFAULT_CELLS_PER_LMIN = 16.0
+"""Resolution of the referees built for regret (cached on disk, so paid once per game)."""
+
+
+@dataclass(frozen=True)
+class Regret:
+    """One policy's regret.
+
+    Attributes:
+        role: ``"pursuer"`` or ``"evader"``.
+        policy: its name.
+        matches: matches it played.
+        winnable: of those, starts certified winnable for its role (within the horizon).
+        lost: of the winnable, those it lost.
+        unknown: matches from starts neither bound certifies.
+        hopeless: matches from starts certified for its opponent.
+    """
+
+    role: str
+    policy: str
+    matches: int
+    winnable: int
+    lost: int
+    unknown: int
+    hopeless: int
+
+    @property
+    def rate(self) -> float:
+        """lost / winnable (NaN when nothing was winnable)."""
+        return self.lost / self.winnable if self.winnable else math.nan
+
+    def interval(self, confidence: float = 0.95) -> tuple[float, float]:
+        """Wilson interval of the rate (NaNs when nothing was winnable)."""
+        if not self.winnable:
+            return math.nan, math.nan
+        ci = binomtest(self.lost, self.winnable).proportion_ci(confidence, method="wilson")
+        return float(ci.low), float(ci.high)
+
+
+def _game_key(world: Map, params: Mapping[str, float]) -> tuple:
+    return (world.digest, *(float(params[k]) for k in _PARAMS))
+
+
+_PARAMS = ("l_min", "l_max", "v_pursuer", "v_evader", "body_radius", "dt")
+
+
+def regret(
+    matches: Iterable[Mapping[str, Any]],
+    *,
+    cells_per_lmin: float = DEFAULT_CELLS_PER_LMIN,
+    referees: dict | None = None,
+    cache: bool = True,
+    cache_dir: str | os.PathLike | None = None,
+) -> list[Regret]:
+    """Regret of every policy in ``matches``.
+
+    Args:
+        matches: mappings with ``map`` (a :class:`Map`), ``l_min``, ``l_max``,
+            ``v_pursuer``, ``v_evader``, ``body_radius``, ``dt``, ``max_cycles``,
+            ``pursuer`` and ``evader`` (policy names), ``start`` (``{"pursuer": (x, y),
+            "evader": (x, y)}``) and ``winner`` (``"pursuer"`` or ``"evader"``).
+        cells_per_lmin: resolution of the referees (one per game, solved or loaded from
+            the cache).
+        referees: a dict to reuse referees across calls (filled in place), keyed by game.
+        cache: use the referees' on-disk cache.
+        cache_dir: its directory.
+
+    Returns:
+        One :class:`Regret` per (role, policy), pursuers first, sorted by name.
+
+    Raises:
+        InvalidConfigError: a match lacks a field or has a bad value (named).
+    """
+    referees = {} if referees is None else referees
+    tally: dict[tuple[str, str], list[int]] = {}
+    for i, m in enumerate(matches):
+        where = f"match {i}"
+        world, params, start, winner, horizon = _read_match(m, where)
+        key = _game_key(world, params)
+        ref = referees.get(key)
+        if ref is None:
+            spec = GameSpec(world, params["l_min"], params["l_max"], params["v_pursuer"],
+                            params["v_evader"], body_radius=params["body_radius"])  # fmt: skip
+            ref = referees[key] = solve(
+                spec, cells_per_lmin, dt=params["dt"], cache=cache, cache_dir=cache_dir
+            )
+        label, escape = _label(ref, start)
+        for role in ("pursuer", "evader"):
+            t = tally.setdefault((role, str(m[role])), [0, 0, 0, 0, 0])
+            t[0] += 1
+            other = "evader" if role == "pursuer" else "pursuer"
+            winnable = label == role and (role == "pursuer" or escape <= horizon + 1e-9)
+            if winnable:
+                t[1] += 1
+                t[2] += winner != role
+            elif label == other:
+                t[4] += 1
+            else:
+                t[3] += 1
+    rows = [Regret(r, p, *v) for (r, p), v in tally.items()]
+    return sorted(rows, key=lambda x: (x.role != "pursuer", x.policy))
+
+
+def _read_match(m: Mapping[str, Any], where: str):
+    if not isinstance(m, Mapping):
+        raise InvalidConfigError(f"{where}: expected a mapping, got {type(m).__name__}")
+    missing = [k for k in ("map", "pursuer", "evader", "start", "winner", "max_cycles", *_PARAMS)
+               if k not in m]  # fmt: skip
+    if missing:
+        raise InvalidConfigError(f"{where}: missing {missing}")
+    world = m["map"]
+    if not isinstance(world, Map):
+        raise InvalidConfigError(f"{where}: map = {world!r}: expected an envs.maps.Map")
+    params = {k: V.positive(k, m[k], where=where) for k in _PARAMS}
+    start = m["start"]
+    if not isinstance(start, Mapping) or "pursuer" not in start or "evader" not in start:
+        raise InvalidConfigError(f"{where}: start = {start!r}: expected pursuer and evader")
+    start = {k: V.point(f"start {k}", start[k], where=where) for k in ("pursuer", "evader")}
+    winner = V.choice("winner", m["winner"], ("pursuer", "evader"), where=where)
+    horizon = V.integer("max_cycles", m["max_cycles"], minimum=1, where=where) * params["dt"]
+    return world, params, start, winner, horizon
+
+
+def _label(ref: Referee, start) -> tuple[str, float]:
+    try:
+        label = ref.classify(start["pursuer"], start["evader"])
+    except InvalidPlacementError:
+        return "unknown", math.inf  # surveillance did not hold at the start: not a game
+    if label == "evader":
+        t = ref.escape_time(start["pursuer"], start["evader"])
+        return label, math.inf if t is None else t
+    return label, math.inf
+
+
+def regret_table(rows: Iterable[Regret], confidence: float = 0.95) -> list[list[str]]:
+    """A table of regrets: a header row, then one row per policy."""
+    out = [["role", "policy", "matches", "certified winnable", "lost", "regret [95% CI]",
+            "unknown", "certified for the opponent"]]  # fmt: skip
+    for r in rows:
+        if r.winnable:
+            lo, hi = r.interval(confidence)
+            rate = f"{r.rate:.2f} [{lo:.2f}, {hi:.2f}]"
+        else:
+            rate = "-"
+        out.append([r.role, r.policy, str(r.matches), str(r.winnable), str(r.lost), rate,
+                    str(r.unknown), str(r.hopeless)])  # fmt: skip
+    return out
+
+
+# ---------------------------------------------------------------------- the tournament hook
+def tournament_regret(
+    spec: Mapping[str, Any] | str,
+    rows: Iterable[Mapping[str, Any]],
+    *,
+    geometry: Mapping[str, Any] | None = None,
+    cells_per_lmin: float = DEFAULT_CELLS_PER_LMIN,
+    cache: bool = True,
+    cache_dir: str | os.PathLike | None = None,
+) -> list[list[str]]:
+    """The regret table of a tournament run, for its report.
+
+    Args:
+        spec: the run's normalised spec (its ``to_dict()``, or that as JSON): ``maps``
+            (``label``, ``source``, ``digest``), ``env``, ``variants``.
+        rows: its matches. Each needs ``status``, ``winner``, ``pursuer``, ``evader`` and
+            either ``record`` (the shared runner's :meth:`EpisodeResult.to_record`, as a
+            dict or JSON: start positions, overrides, map) or ``map``, ``variant``,
+            ``start`` (the start kind) and ``seed`` (the start is drawn again exactly as
+            the runner drew it).
+        geometry: map digest -> map as our JSON schema (what the store keeps), for maps
+            that are neither built-in nor loadable from their source.
+        cells_per_lmin: resolution of the referees.
+        cache: use the referees' on-disk cache.
+        cache_dir: its directory.
+
+    Returns:
+        :func:`regret_table`'s rows (only matches played out, status ``"ok"``).
+    """
+    if isinstance(spec, str):
+        spec = json.loads(spec)
+    maps = {m["label"]: m for m in spec.get("maps", [])}
+    variants = {v.get("label", ""): v for v in spec.get("variants", [])}
+    matches = []
+    for row in rows:
+        if row.get("status", "ok") != "ok" or row.get("winner") not in ("pursuer", "evader"):
+            continue
+        record = row.get("record")
+        if isinstance(record, str):
+            record = json.loads(record)
+        if record:  # the runner's record: the resolved env parameters and the start
+            name = record.get("map")
+            world = _map_of(name, record.get("map_digest"), maps, geometry)
+            params = {**_builtin_params(name), **dict(record.get("overrides") or {})}
+            cfg = _config(world, params, None)
+            start = record["start"]
+        else:  # resolve the parameters as the spec does and draw the start again
+            entry = maps.get(row["map"], {})
+            source = entry.get("source", row["map"])
+            world = _map_of(source, entry.get("digest"), maps, geometry)
+            variant = variants.get(row.get("variant", ""), {})
+            params = {**_builtin_params(source), **dict(spec.get("env") or {}),
+                      **dict(variant.get("overrides") or {})}  # fmt: skip
+            cfg = _config(world, params, variant.get("rho"))
+            start = _redraw_start(cfg, row)
+        matches.append({
+            "map": world, **{k: getattr(cfg, k) for k in _PARAMS},
+            "max_cycles": cfg.max_cycles, "pursuer": row["pursuer"], "evader": row["evader"],
+            "start": start, "winner": row["winner"],
+        })  # fmt: skip
+    return regret_table(
+        regret(matches, cells_per_lmin=cells_per_lmin, cache=cache, cache_dir=cache_dir)
+    )
+
+
+def _builtin_params(name) -> dict[str, float]:
+    from envs.maps import builtin_info, builtin_names
+
+    if isinstance(name, str) and name in builtin_names():
+        return builtin_info(name).params()
+    return {}
+
+
+def _map_of(source, digest, maps, geometry) -> Map:
+    from envs.maps import builtin_names, load_map
+    from envs.maps.io import map_from_dict
+
+    world = None
+    if geometry and digest in geometry:
+        g = geometry[digest]
+        world = map_from_dict(json.loads(g) if isinstance(g, str) else g).map
+    elif isinstance(source, str):
+        if source in maps:
+            source = maps[source].get("source", source)
+        if source in builtin_names() or os.path.exists(str(source)):
+            world = load_map(source)
+    if world is None:
+        raise InvalidConfigError(f"tournament_regret: cannot find the map {source!r}")
+    if digest and world.digest != digest:
+        raise InvalidConfigError(
+            f"tournament_regret: map {source!r} has changed since the run (digest "
+            f"{world.digest[:12]} != {str(digest)[:12]})"
+        )
+    return world
+
+
+def _config(world: Map, params: Mapping[str, Any], rho):
+    """The env config of a match (``rho`` sets v_evader = rho v_pursuer, as a spec's
+    variant does)."""
+    import warnings
+
+    from envs.errors import RhoAboveOneWarning
+    from envs.surveillance.config import EnvConfig
+
+    kw = {k: v for k, v in params.items() if k not in ("map", "map_digest", "render_mode")}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RhoAboveOneWarning)
+        cfg = EnvConfig(map=world, **kw)
+        if rho is not None:
+            kw["v_evader"] = float(rho) * cfg.v_pursuer
+            cfg = EnvConfig(map=world, **kw)
+    return cfg
+
+
+def _redraw_start(cfg, row: Mapping[str, Any]):
+    """The start the shared runner drew for this row's seed and start kind."""
+    from strategies.policies.starts import sample_start
+    from strategies.runner import episode_seeds
+
+    _, s_start, _, _ = episode_seeds(int(row["seed"]))
+    return sample_start(cfg, np.random.default_rng(s_start), kind=row.get("start", "safe"))

@@ -1,0 +1,130 @@
+"""Regret: the share of certified-winnable starts a policy loses, and the tournament hook."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from envs.errors import InvalidConfigError
+from strategies.referee import Regret, regret, regret_table, tournament_regret
+from strategies.runner import run_episode
+from tests.strategies.referee.conftest import DT, L_MAX, L_MIN, RADIUS
+
+
+def _match(ref, start, pursuer, evader, winner, max_cycles=200):
+    s = ref.spec
+    return {"map": s.map, "l_min": s.l_min, "l_max": s.l_max, "v_pursuer": s.v_pursuer,
+            "v_evader": s.v_evader, "body_radius": RADIUS, "dt": DT, "max_cycles": max_cycles,
+            "pursuer": pursuer, "evader": evader, "start": start, "winner": winner}  # fmt: skip
+
+
+def test_regret_counts_only_certified_winnable_starts(corridor_half):
+    refs = {}
+    rng = np.random.default_rng(0)
+    won_e = corridor_half.sample_starts(3, rng, kind="evader")
+    unknown = corridor_half.sample_starts(2, rng, kind="unknown")
+    matches = [
+        _match(corridor_half, won_e[0], "p/a", "e/x", "evader"),
+        _match(corridor_half, won_e[1], "p/a", "e/x", "pursuer"),  # e/x blew a won start
+        _match(corridor_half, won_e[2], "p/b", "e/y", "evader"),
+        _match(corridor_half, unknown[0], "p/a", "e/y", "pursuer"),
+        _match(corridor_half, unknown[1], "p/b", "e/x", "evader"),
+    ]
+    rows = {(r.role, r.policy): r for r in regret(matches, referees=refs, cache=False)}
+    assert len(refs) == 1  # one game, solved once
+    # the referee of the test fixture and this one agree on the labels
+    assert rows[("evader", "e/x")] == Regret("evader", "e/x", 3, 2, 1, 1, 0)
+    assert rows[("evader", "e/y")] == Regret("evader", "e/y", 2, 1, 0, 1, 0)
+    assert rows[("pursuer", "p/a")] == Regret("pursuer", "p/a", 3, 0, 0, 1, 2)
+    assert math.isnan(rows[("pursuer", "p/a")].rate)
+    assert rows[("evader", "e/x")].rate == 0.5
+    lo, hi = rows[("evader", "e/x")].interval()
+    assert 0.0 < lo < 0.5 < hi < 1.0
+    # a certified escape longer than the match's horizon is not winnable in that match
+    short = _match(corridor_half, won_e[0], "p/a", "e/z", "pursuer", max_cycles=1)
+    (z,) = [r for r in regret([short], referees=refs) if r.policy == "e/z"]
+    assert z.winnable == 0 and z.unknown == 1
+
+
+def test_regret_table_formats_rates_with_intervals():
+    table = regret_table([Regret("pursuer", "p", 10, 4, 1, 6, 0), Regret("evader", "e", 5, 0,
+                                                                         0, 5, 0)])  # fmt: skip
+    assert table[0][0] == "role" and len(table) == 3
+    assert table[1][5].startswith("0.25 [") and table[2][5] == "-"
+
+
+def test_regret_rejects_malformed_matches(corridor_half):
+    good = _match(corridor_half, {"pursuer": (-2.2, 0.0), "evader": (-0.9, 0.0)}, "p", "e",
+                  "evader")  # fmt: skip
+    with pytest.raises(InvalidConfigError, match=r"match 0: missing \['winner'\]"):
+        regret([{k: v for k, v in good.items() if k != "winner"}])
+    with pytest.raises(InvalidConfigError, match="winner = 'draw'"):
+        regret([{**good, "winner": "draw"}])
+    with pytest.raises(InvalidConfigError, match=r"dt = -0\.1"):
+        regret([{**good, "dt": -0.1}])
+
+
+def test_tournament_regret_from_runner_records(corridor_half):
+    """Rows carrying the shared runner's record: its start and parameters are used."""
+    world = corridor_half.spec.map
+    overrides = {"l_min": L_MIN, "l_max": L_MAX, "v_pursuer": 1.0, "v_evader": 0.5,
+                 "body_radius": RADIUS, "dt": DT}  # fmt: skip
+    rows = []
+    for i, start in enumerate(corridor_half.sample_starts(2, np.random.default_rng(1),
+                                                          kind="evader")):  # fmt: skip
+        r = run_episode(world, "pursuer/greedy", "evader/shooting", i, max_cycles=300,
+                        overrides=overrides, start=start)  # fmt: skip
+        rows.append({"status": "ok", "winner": r.winner, "pursuer": r.pursuer,
+                     "evader": r.evader, "record": json.dumps(r.to_record())})  # fmt: skip
+    rows.append({"status": "forfeit", "winner": "pursuer", "pursuer": "x", "evader": "y"})
+    spec = {"maps": [{"label": world.name, "source": "<inline>", "digest": world.digest}]}
+    table = tournament_regret(json.dumps(spec), rows, geometry={world.digest: world.to_dict()},
+                              cells_per_lmin=12, cache=False)  # fmt: skip
+    by_policy = {row[1]: row for row in table[1:]}
+    assert set(by_policy) == {"pursuer/greedy", "evader/shooting"}
+    assert by_policy["evader/shooting"][3] == "2"  # both starts certified for the evader
+    assert by_policy["pursuer/greedy"][7] == "2"  # ... so hopeless for the pursuer
+
+
+def test_tournament_regret_redraws_the_runners_start_from_the_seed(monkeypatch):
+    """Rows without a record: the start is drawn again exactly as the runner drew it."""
+    rows, starts = [], []
+    for seed in (0, 1):
+        r = run_episode("open_room", "pursuer/greedy", "evader/straight", seed, max_cycles=50,
+                        overrides={"v_evader": 0.25}, start="valid")  # fmt: skip
+        starts.append(r.start)
+        rows.append({"status": "ok", "winner": r.winner, "pursuer": r.pursuer,
+                     "evader": r.evader, "map": "open_room", "variant": "slow",
+                     "start": "valid", "seed": seed})  # fmt: skip
+    spec = {"maps": [{"label": "open_room", "source": "open_room"}], "env": {"max_cycles": 50},
+            "variants": [{"label": "slow", "overrides": {}, "rho": 0.25}]}  # fmt: skip
+    from strategies.referee import regrets
+
+    seen = []
+
+    def spy(matches, **kw):
+        matches = list(matches)
+        seen.extend(matches)
+        return regret(matches, **kw)
+
+    monkeypatch.setattr(regrets, "regret", spy)
+    table = tournament_regret(spec, rows, cells_per_lmin=6, cache=False)
+    for m, s in zip(seen, starts, strict=True):
+        assert np.allclose(m["start"]["pursuer"], s["pursuer"])
+        assert np.allclose(m["start"]["evader"], s["evader"])
+    assert all(m["v_evader"] == 0.25 and m["max_cycles"] == 50 for m in seen)
+    assert len(table) == 3
+
+
+def test_tournament_regret_refuses_a_changed_map(corridor_half):
+    rows = [{"status": "ok", "winner": "pursuer", "pursuer": "a", "evader": "b",
+             "map": "m", "variant": "", "start": "valid", "seed": 0}]  # fmt: skip
+    spec = {"maps": [{"label": "m", "source": "open_room", "digest": "0" * 64}]}
+    with pytest.raises(InvalidConfigError, match="has changed since the run"):
+        tournament_regret(spec, rows, cache=False)
+    spec = {"maps": [{"label": "m", "source": "/nonexistent/map.json"}]}
+    with pytest.raises(InvalidConfigError, match="cannot find the map"):
+        tournament_regret(spec, rows, cache=False)

@@ -24,9 +24,10 @@ if ! "$VENV/bin/python" -c "import torch" 2>/dev/null; then
     "$VENV/bin/python" -m pip install --quiet "torch==2.13.0"
 fi
 CONSTRAINTS="$VENV/min-constraints.txt"
-# the extras the quick subset needs: rendering (pygame-ce, pillow, imageio), analysis
-# (matplotlib) and training (stable-baselines3), plus the test tools
-"$PY" - "$CONSTRAINTS" <<'EOF'
+# every extra's bounds too (render, analysis, train, bench, test); tomli reads
+# pyproject.toml on Python 3.10
+"$VENV/bin/python" -m pip install --quiet "tomli>=2.0; python_version < '3.11'"
+"$VENV/bin/python" - "$CONSTRAINTS" <<'EOF'
 import re
 import sys
 

@@ -138,9 +138,12 @@ def output_file(
     if path.is_dir() or text.endswith(("/", os.sep)):
         path = path / default_name
     if path.suffix.lower() not in suffixes:
-        raise InvalidConfigError(
-            f"{flag} = {text!r}: expected a file ending in {' or '.join(suffixes)}"
+        listed = (
+            " or ".join(suffixes)
+            if len(suffixes) < 3
+            else (f"{', '.join(suffixes[:-1])} or {suffixes[-1]}")
         )
+        raise InvalidConfigError(f"{flag} = {text!r}: expected a file ending in {listed}")
     _writable_dir(flag, text, path.parent)
     return path
 

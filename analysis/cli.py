@@ -14,6 +14,7 @@ import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
+from analysis import referee_cli
 from analysis.arguments import (
     Parser,
     integer,
@@ -340,6 +341,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     _add_train_parser(sub)
     figures_cli.add_parser(sub)
+    referee_cli.add_parser(sub)
     return parser
 
 

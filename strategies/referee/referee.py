@@ -14,6 +14,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
@@ -357,8 +358,9 @@ def solve(
     ``round(2 / rho)`` cells (2 to 12), lets the evader cover about four cells per step.
     The evader bound loses the pursuer's foreknowledge of the evader's step (a short step
     is better) but needs the evader to cover a few lattice spacings per step: its
-    default lattice is ``round(8 rho)`` cells (2 to 8). Both lattices share the cells'
-    anchor, so a start with each player on its lattice can be certified either way.
+    default lattice is ``round(8 rho)`` cells (2 to 8). Neither lattice is coarser than a
+    quarter of the sensor range ``l_max - l_min``. Both share the cells' anchor, so a
+    start with each player on its lattice can be certified either way.
 
     Args:
         spec: the game.
@@ -376,10 +378,14 @@ def solve(
     if not isinstance(spec, GameSpec):
         raise InvalidConfigError(f"solve: expected a GameSpec, got {type(spec).__name__}")
     kw = dict(steps=steps, sweep_pieces=sweep_pieces, dt=dt)
+    # at least four lattice spacings across the sensor range [l_min, l_max]
+    cap = max(2, math.floor((spec.l_max - spec.l_min) * V.positive("cells_per_lmin",
+                                                                  cells_per_lmin)
+                            / (4.0 * spec.l_min)))  # fmt: skip
     if pursuer_coarse is None:
-        pursuer_coarse = int(min(12, max(2, round(2.0 / spec.rho))))
+        pursuer_coarse = int(min(12, cap, max(2, round(2.0 / spec.rho))))
     if evader_coarse is None:
-        evader_coarse = int(min(8, max(2, round(8.0 * spec.rho))))
+        evader_coarse = int(min(8, cap, max(2, round(8.0 * spec.rho))))
     rp = Resolution.for_role(spec, "pursuer", cells_per_lmin, coarse=pursuer_coarse, **kw)
     re = Resolution.for_role(spec, "evader", cells_per_lmin, coarse=evader_coarse, **kw)
     return Referee(

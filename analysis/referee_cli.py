@@ -1,0 +1,116 @@
+"""``surveil referee``: solve the bounded-speed game of a world, label starts, draw it.
+
+::
+
+    surveil referee corridor                          # summary at the default resolution
+    surveil referee corner --cells-per-lmin 24 --out out/referee_corner.png
+    surveil referee my_map.json --config '{"v_evader": 0.25}' --classify 3 1 4.5 1
+    surveil referee open_room --sample 5 --kind pursuer   # certified starts, as JSON lines
+
+The game is the one ``surveil play`` plays on that world (a built-in map's recommended
+range and speeds, then ``--config``). The solution is cached on disk (``$SURVEIL_CACHE_DIR``),
+so a second call is fast.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+from analysis.arguments import integer, json_object, output_file, real
+
+__all__ = ["add_parser", "run"]
+
+CONFIG_EXAMPLE = "'{\"v_evader\": 0.25}'"
+
+
+def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Add the ``referee`` subcommand to the ``surveil`` parser."""
+    p = subparsers.add_parser(
+        "referee",
+        help="solve the bounded-speed game: who provably wins from which start",
+        description="Solve the bounded-speed surveillance game of a world at one resolution: "
+        "the starts the pursuer provably holds from, those the evader provably escapes from, "
+        "and the gap between them (the resolution error).",
+    )
+    p.add_argument("map", help="built-in name or map file")
+    p.add_argument("--config", help=f"env overrides as JSON, e.g. {CONFIG_EXAMPLE}")
+    p.add_argument(
+        "--cells-per-lmin",
+        type=real(0.0),
+        default=16.0,
+        help="resolution: opponent cells per L_min (default 16; the cost grows as its 4th power)",
+    )
+    p.add_argument("--out", help="draw the winning sets to this picture (.png, .pdf, .svg)")
+    p.add_argument(
+        "--classify",
+        nargs=4,
+        type=float,
+        metavar=("PX", "PY", "EX", "EY"),
+        help="label the start with the pursuer at (PX, PY) and the evader at (EX, EY)",
+    )
+    p.add_argument("--sample", type=integer(1), help="print this many certified starts")
+    p.add_argument("--kind", choices=["pursuer", "evader", "unknown"], default="pursuer")
+    p.add_argument("--seed", type=integer(0), default=0, help="seed of --sample (>= 0)")
+    p.add_argument("--no-cache", action="store_true", help="neither read nor write the cache")
+    p.set_defaults(func=run)
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``surveil referee``."""
+    import numpy as np
+
+    from envs.errors import SurveilValueError
+    from envs.surveillance.config import EnvConfig
+    from strategies.referee import referee_for
+    from strategies.runner import map_parameters
+
+    overrides = json_object("--config", args.config, example=CONFIG_EXAMPLE)
+    out = None
+    if args.out:
+        out = output_file(
+            "--out", args.out, suffixes=(".png", ".pdf", ".svg"), default_name="referee.png"
+        )
+    try:
+        world, params = map_parameters(args.map)
+    except SurveilValueError as exc:
+        raise type(exc)(f"map: {exc}") from None
+    cfg = EnvConfig(map=world, **{**params, **overrides})
+    t = time.perf_counter()
+    ref = referee_for(cfg, args.cells_per_lmin, cache=not args.no_cache)
+    s = ref.summary()
+    print(
+        f"{world.name}: rho = {cfg.rho:g}, L in [{cfg.l_min:g}, {cfg.l_max:g}], "
+        f"{args.cells_per_lmin:g} cells per L_min ({time.perf_counter() - t:.1f} s)"
+    )
+    print(
+        f"  {s['starts']} lattice starts: pursuer wins {s['pursuer']:.1%}, evader wins "
+        f"{s['evader']:.1%}, unknown {s['gap']:.1%} (the resolution error)"
+    )
+    for role in ("pursuer", "evader"):
+        b = s[f"{role}_bound"]
+        print(
+            f"  {role} bound: cell {b['cell']:.4g}, lattice {b['spacing']:.4g}, step "
+            f"{b['tau']:.4g} s, {b['states']} states, {b['iterations']} sweeps, "
+            f"{b['seconds']['build'] + b['seconds']['solve']:.1f} s"
+        )
+    if args.classify is not None:
+        px, py, ex, ey = args.classify
+        label = ref.classify((px, py), (ex, ey))
+        extra = ""
+        if label == "evader":
+            extra = f" (surveillance breaks within {ref.escape_time((px, py), (ex, ey)):.1f} s)"
+        print(f"start pursuer ({px:g}, {py:g}), evader ({ex:g}, {ey:g}): {label}{extra}")
+    if args.sample:
+        rng = np.random.default_rng(args.seed)
+        for start in ref.sample_starts(args.sample, rng, kind=args.kind):
+            print(json.dumps(start))
+    if out is not None:
+        from strategies.referee.draw import draw_referee
+
+        draw_referee(ref, path=Path(out))
+        print(f"wrote {out}")
+    return 0

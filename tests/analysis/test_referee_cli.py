@@ -1,0 +1,44 @@
+"""``surveil referee``: the summary, a labelled start, certified starts, the picture, errors."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from analysis.cli import main
+
+
+@pytest.mark.filterwarnings("ignore::envs.errors.RhoAboveOneWarning")  # rho = 1.5 on purpose
+def test_referee_summary_classify_sample_and_picture(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", str(tmp_path / "cache"))
+    out = tmp_path / "ref.png"
+    code = main(["referee", "open_room", "--config", '{"v_evader": 1.5}', "--cells-per-lmin",
+                 "8", "--classify", "5", "8", "5", "5", "--sample", "2", "--kind", "evader",
+                 "--out", str(out)])  # fmt: skip
+    assert code == 0
+    text = capsys.readouterr().out.splitlines()
+    assert text[0].startswith("open_room: rho = 1.5, L in [2, 4], 8 cells per L_min")
+    assert "evader wins 100.0%" in text[1]
+    assert text[4].startswith("start pursuer (5, 8), evader (5, 5): evader (surveillance breaks")
+    starts = [json.loads(line) for line in text[5:7]]
+    assert all(set(s) == {"pursuer", "evader"} for s in starts)
+    assert out.stat().st_size > 10_000
+    assert any((tmp_path / "cache" / "referee").iterdir())  # solved once, cached
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["referee", "nowhere"], "map: unknown map 'nowhere'"),
+        (["referee", "open_room", "--config", "[1]"], "--config = '[1]': expected a JSON object"),
+        (["referee", "open_room", "--cells-per-lmin", "-2"], "--cells-per-lmin = '-2'"),
+        (["referee", "open_room", "--cells-per-lmin", "4", "--classify", "1", "1", "9", "9"],
+         "distance 11.3137 outside [l_min, l_max] = [2, 4]"),
+    ],
+)  # fmt: skip
+def test_referee_bad_input_is_one_line(argv, message, capsys, tmp_path, monkeypatch):
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", str(tmp_path))
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("surveil: error:") and message in err and "Traceback" not in err

@@ -136,8 +136,9 @@ def draw_referee(
 
     Args:
         referee: the solved referee.
-        evaders: (k, 2) evader positions (default: three evader lattice points spread
-            over the map, the one with the most unknown starts among them).
+        evaders: (k, 2) evader positions (default: three evader lattice points, where
+            the evader wins the largest share of starts, where the pursuer does, and far
+            from those).
         path: also save the figure there.
         size: panel size in inches.
 
@@ -170,14 +171,19 @@ def draw_referee(
 
 
 def _spread(pts: np.ndarray, fr: np.ndarray, counts: np.ndarray, k: int = 3) -> np.ndarray:
-    """``k`` evader points far apart (farthest-point sampling from the most mixed one)."""
+    """``k`` informative evader points: the one where the evader wins the largest share,
+    the one where the pursuer does, then the farthest from those chosen."""
     ok = counts > 0
     if not ok.any():
         return pts[:1]
     pts, fr = pts[ok], fr[ok]
-    first = int(np.argmax(fr[:, 2] + 0.5 * np.minimum(fr[:, 0], fr[:, 1])))
-    chosen = [first]
-    d = np.hypot(*(pts - pts[first]).T)
+    chosen: list[int] = []
+    for col in (1, 0):  # evader's share, then pursuer's share
+        if fr[:, col].max() > 0:
+            chosen.append(int(np.argmax(fr[:, col] + 1e-3 * np.minimum(fr[:, 0], fr[:, 1]))))
+    if not chosen:
+        chosen.append(0)
+    d = np.min([np.hypot(*(pts - pts[c]).T) for c in chosen], axis=0)
     while len(chosen) < min(k, len(pts)):
         nxt = int(np.argmax(d))
         chosen.append(nxt)

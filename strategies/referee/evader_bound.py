@@ -130,7 +130,7 @@ class EvaderBound:
         p = np.asarray(pursuer, dtype=float)
         e = np.asarray(evader, dtype=float)
         step = spec.v_evader * self.res.tau
-        cand = np.flatnonzero(np.hypot(*(lat.points - e).T) <= step * (1.0 + 1e-12))
+        cand = lat.points_within(e, step)
         if len(cand) == 0:
             return None
         B = lat.points[cand]

@@ -240,6 +240,16 @@ class Lattice:
         """Number of certified lattice points."""
         return len(self.points)
 
+    def points_within(self, x: np.ndarray, radius: float) -> np.ndarray:
+        """Indices of the certified points within ``radius`` of the real position ``x``,
+        nearest first. A tenth of the robust margin is allowed beyond ``radius``: a
+        policy reads its position from a float32 observation, a few 1e-7 off its lattice
+        point, and must keep its full-length moves (the robust tests absorb the overshoot).
+        """
+        d = np.hypot(*(self.points - np.asarray(x, dtype=float)).T)
+        idx = np.flatnonzero(d <= radius + 0.1 * self.spec.margin)
+        return idx[np.argsort(d[idx], kind="stable")]
+
     def point_index(self, ij: np.ndarray) -> np.ndarray:
         """Index of the certified point at fine indices ``ij`` (k, 2), or -1."""
         ij = np.atleast_2d(ij)

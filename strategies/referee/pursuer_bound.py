@@ -145,12 +145,9 @@ class PursuerBound:
         p = np.asarray(pursuer, dtype=float)
         e = np.asarray(evader, dtype=float)
         step = spec.v_pursuer * self.res.tau
-        near = np.hypot(*(lat.points - p).T) <= step * (1.0 + 1e-12)
-        cand = np.flatnonzero(near)
+        cand = lat.points_within(p, step)
         if len(cand) == 0:
             return None
-        order = np.argsort(np.hypot(*(lat.points[cand] - p).T), kind="stable")
-        cand = cand[order]
         B = lat.points[cand]
         clear = segment_wall_distance(np.broadcast_to(p, B.shape), B, spec.map)
         cand = cand[clear >= spec.body_radius * (1.0 - 1e-9) - spec.margin]

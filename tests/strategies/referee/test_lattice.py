@@ -160,3 +160,19 @@ def test_too_fine_or_empty_lattices_are_refused():
             Resolution(cell=0.5, coarse=3),
             "pursuer",
         )
+
+
+def test_points_within_keeps_full_length_moves_from_float32_positions(lattice):
+    # a policy's position is read from a float32 observation: a few 1e-7 off its point;
+    # the moves of exactly the full length must stay available (without them the evader
+    # of the pillar room stalled, its certified bound never decreasing)
+    k = lattice.n_points // 2
+    x = lattice.points[k]
+    full = 2 * lattice.spacing
+    exact = set(lattice.points_within(x, full).tolist())
+    assert any(np.isclose(np.hypot(*(lattice.points[i] - x)), full) for i in exact)
+    for off in ((4e-7, 0.0), (0.0, -4e-7), (-3e-7, 3e-7), (3e-7, 3e-7)):
+        assert set(lattice.points_within(x + np.array(off), full).tolist()) >= exact
+    near = lattice.points_within(x, full)
+    d = np.hypot(*(lattice.points[near] - x).T)
+    assert (np.diff(d) >= 0).all() and near[0] == k

@@ -52,6 +52,31 @@ def test_referee_evader_escapes_in_the_certified_time_against_every_pursuer(fixt
             assert evader.uncertified_steps == 0
 
 
+class _RankLog(RefereeEvader):
+    """A referee evader that records the certified bound at each of its referee steps."""
+
+    def _reset(self):
+        super()._reset()
+        self.bounds = []
+
+    def _plan(self, snap):
+        got = self.bound.plan(snap.pursuer, snap.evader)
+        self.bounds.append(None if got is None else got[1])
+        return None if got is None else got[0]
+
+
+def test_referee_evader_makes_progress_every_step(corridor_half):
+    """The certified number of steps left drops by one every referee step: the float32
+    positions the policy reads do not cost it its full-length moves (they did)."""
+    for start in _starts(corridor_half, "evader", 2, seed=4):
+        for name in ("pursuer/greedy", "pursuer/decomposition"):
+            evader = _RankLog(corridor_half.evader)
+            winner, _, _ = play(corridor_half, make_policy(name), evader, start, 300)
+            assert winner == "evader"
+            b = evader.bounds
+            assert None not in b and b == list(range(b[0], b[0] - len(b), -1)), b
+
+
 def test_referee_policies_refuse_a_different_game(open_slow):
     pursuer = RefereePursuer(open_slow.pursuer)
     other = EnvConfig(map=open_slow.spec.map, l_min=1.0, l_max=2.5, v_evader=0.2,

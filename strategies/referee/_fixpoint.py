@@ -11,7 +11,7 @@ import math
 import numpy as np
 from scipy.ndimage import minimum_filter1d
 
-__all__ = ["erode", "reach_rectangles", "shifted"]
+__all__ = ["Worklist", "erode", "reach_rectangles", "shifted"]
 
 
 MAX_RECTANGLES = 8
@@ -100,3 +100,35 @@ def shifted(Y: np.ndarray, dx: int, dy: int, fill: bool) -> np.ndarray:
         :, max(0, -dx) : W - max(0, dx), max(0, -dy) : W - max(0, dy)
     ]
     return out
+
+
+class Worklist:
+    """Which certified points a fixed-point sweep must revisit.
+
+    A point's states change only when the states its moves lead to have changed, so after
+    the first sweep only the predecessors of the points that changed are recomputed.
+
+    Args:
+        targets: (n_points, n_moves) the point each move reaches, -1 if none.
+    """
+
+    def __init__(self, targets: np.ndarray) -> None:
+        n = len(targets)
+        preds: list[set[int]] = [set() for _ in range(n)]
+        for k, row in enumerate(targets):
+            for q in row[row >= 0].tolist():
+                preds[q].add(k)
+        self._preds = [np.fromiter(sorted(p), dtype=np.int64) for p in preds]
+        self.dirty = np.ones(n, dtype=bool)
+
+    def todo(self) -> np.ndarray:
+        """The points whose states may change in the next sweep."""
+        mark = np.zeros(len(self.dirty), dtype=bool)
+        for q in np.flatnonzero(self.dirty):
+            mark[self._preds[q]] = True
+        return np.flatnonzero(mark)
+
+    def changed(self, points: np.ndarray) -> None:
+        """Record the points whose states changed in this sweep."""
+        self.dirty = np.zeros(len(self.dirty), dtype=bool)
+        self.dirty[points] = True

@@ -28,11 +28,13 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
 from scipy import ndimage
 
-from strategies.referee._fixpoint import erode, reach_rectangles
+from strategies.referee._bound import SolvedBound
+from strategies.referee._fixpoint import Worklist, erode, reach_rectangles
 from strategies.referee.lattice import Lattice, segment_wall_distance
 from strategies.referee.robust import (
     convex_corners,
@@ -46,7 +48,7 @@ __all__ = ["EvaderBound", "solve_evader_bound"]
 
 
 @dataclass
-class EvaderBound:
+class EvaderBound(SolvedBound):
     """The solved evader bound.
 
     Attributes:
@@ -63,51 +65,14 @@ class EvaderBound:
         seconds: wall time of the build and of the fixed point.
     """
 
-    spec: GameSpec
-    res: Resolution
-    lattice: Lattice
-    vectors: np.ndarray
-    targets: np.ndarray
+    role: ClassVar[str] = "evader"
+    tables: ClassVar[dict[str, Any]] = {"win": bool, "rank": np.int32, "choice": np.int16}
+
     win: np.ndarray
     rank: np.ndarray
     choice: np.ndarray
     iterations: int
     seconds: dict[str, float]
-
-    def to_arrays(self) -> dict[str, np.ndarray]:
-        """The solved arrays (for the on-disk cache); the rest is rebuilt from spec/res."""
-        return {
-            "win": self.win,
-            "rank": self.rank,
-            "choice": self.choice,
-            "iterations": np.array(self.iterations),
-            "seconds": np.array([self.seconds.get("build", 0.0), self.seconds.get("solve", 0.0)]),
-        }
-
-    @classmethod
-    def from_arrays(cls, spec: GameSpec, res: Resolution, arrays) -> EvaderBound:
-        """Rebuild a bound from :meth:`to_arrays` output (the lattice is recomputed)."""
-        lat = Lattice(spec, res, "evader")
-        vectors, targets = lat.moves(spec.v_evader * res.tau)
-        shape = (lat.n_points, lat.W, lat.W)
-        for name in ("win", "rank", "choice"):
-            if arrays[name].shape != shape:
-                raise ValueError(
-                    f"cached evader bound {name} has shape {arrays[name].shape}, expected {shape}"
-                )
-        sec = arrays["seconds"]
-        return cls(
-            spec=spec,
-            res=res,
-            lattice=lat,
-            vectors=vectors,
-            targets=targets,
-            win=arrays["win"].astype(bool),
-            rank=arrays["rank"].astype(np.int32),
-            choice=arrays["choice"].astype(np.int16),
-            iterations=int(arrays["iterations"]),
-            seconds={"build": float(sec[0]), "solve": float(sec[1])},
-        )
 
     @property
     def reach(self) -> float:
@@ -136,7 +101,7 @@ class EvaderBound:
         B = lat.points[cand]
         clear = segment_wall_distance(np.broadcast_to(e, B.shape), B, spec.map)
         cand = cand[clear >= spec.body_radius * (1.0 - 1e-9) - spec.margin]
-        cells = _cells_within(lat, p, self.reach)
+        cells = lat.open_cells_within(p, self.reach)
         best: tuple[int, int] | None = None
         for k in cand.tolist():
             ab = lat.window_cell(np.array([k]), cells)
@@ -169,18 +134,6 @@ class EvaderBound:
         lat = self.lattice
         open_w = lat.windows(lat.cell_open, False)
         return open_w & ~_range_broken(lat, self.spec)[None]
-
-
-def _cells_within(lat: Lattice, p: np.ndarray, r: float) -> np.ndarray:
-    lo = np.floor((p - r - lat.anchor) / lat.h - 0.5).astype(int)
-    hi = np.ceil((p + r - lat.anchor) / lat.h + 0.5).astype(int)
-    ii, jj = np.meshgrid(np.arange(lo[0], hi[0] + 1), np.arange(lo[1], hi[1] + 1), indexing="ij")
-    ij = np.stack([ii.ravel(), jj.ravel()], axis=1)
-    c = lat.anchor + lat.h * ij
-    dx = np.maximum(np.abs(c[:, 0] - p[0]) - 0.5 * lat.h, 0.0)
-    dy = np.maximum(np.abs(c[:, 1] - p[1]) - 0.5 * lat.h, 0.0)
-    ij = ij[np.hypot(dx, dy) <= r]
-    return ij[lat.cell_open_at(ij)]
 
 
 def _range_broken(lat: Lattice, spec: GameSpec) -> np.ndarray:
@@ -296,18 +249,11 @@ def solve_evader_bound(spec: GameSpec, res: Resolution, *, progress: bool = Fals
     # the window are out of range (won), but the pursuer may walk back into range.
     pad = int(np.abs(vectors).max()) if len(vectors) else 0
     B = _erode_padded(X | closed, rects, pad)
-    preds: list[list[int]] = [[] for _ in range(lat.n_points)]
-    for k, row in enumerate(targets):
-        for q in set(row[row >= 0].tolist()):
-            preds[q].append(k)
-    dirty = np.ones(lat.n_points, dtype=bool)
+    work = Worklist(targets)
     iterations = 0
     while True:
         iterations += 1
-        todo = np.zeros(lat.n_points, dtype=bool)
-        for q in np.flatnonzero(dirty):
-            todo[preds[q]] = True
-        ks = np.flatnonzero(todo)
+        ks = work.todo()
         gain, first = _gains(ks, X, B, open_w, vectors, targets, pad)
         changed = gain.any(axis=(1, 2))
         if progress:
@@ -318,8 +264,7 @@ def solve_evader_bound(spec: GameSpec, res: Resolution, *, progress: bool = Fals
         X[kc] |= gain[changed]
         rank[kc] = np.where(gain[changed], iterations, rank[kc])
         choice[kc] = np.where(gain[changed], first[changed], choice[kc])
-        dirty = np.zeros(lat.n_points, dtype=bool)
-        dirty[kc] = True
+        work.changed(kc)
         B[kc] = _erode_padded(X[kc] | closed[kc], rects, pad)
     t2 = time.perf_counter()
     return EvaderBound(

@@ -178,6 +178,22 @@ class Lattice:
         out[inside] = self.cell_open[a[inside], b[inside]]
         return out
 
+    def open_cells_within(self, x: np.ndarray, r: float) -> np.ndarray:
+        """Fine (i, j) indices of the open cells within distance ``r`` of the point ``x``
+        (the cells a player at ``x`` can end in after moving at most ``r``)."""
+        x = np.asarray(x, dtype=float)
+        lo = np.floor((x - r - self.anchor) / self.h - 0.5).astype(int)
+        hi = np.ceil((x + r - self.anchor) / self.h + 0.5).astype(int)
+        ii, jj = np.meshgrid(
+            np.arange(lo[0], hi[0] + 1), np.arange(lo[1], hi[1] + 1), indexing="ij"
+        )
+        ij = np.stack([ii.ravel(), jj.ravel()], axis=1)
+        c = self.anchor + self.h * ij
+        dx = np.maximum(np.abs(c[:, 0] - x[0]) - 0.5 * self.h, 0.0)
+        dy = np.maximum(np.abs(c[:, 1] - x[1]) - 0.5 * self.h, 0.0)
+        ij = ij[np.hypot(dx, dy) <= r]
+        return ij[self.cell_open_at(ij)]
+
     def convex_cells(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """For each open cell: whether cell ∩ F is convex, a point of cell ∩ F_c', and
         whether the whole cell lies in free space (its centre as that point).

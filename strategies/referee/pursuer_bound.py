@@ -30,11 +30,13 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numpy as np
 
 from envs.geometry import kernel_for
-from strategies.referee._fixpoint import erode, reach_rectangles, shifted
+from strategies.referee._bound import SolvedBound
+from strategies.referee._fixpoint import Worklist, erode, reach_rectangles, shifted
 from strategies.referee.lattice import Lattice, segment_wall_distance
 from strategies.referee.robust import convex_corners, sweep_hits_vertex, sweep_range_ok
 from strategies.referee.spec import GameSpec, Resolution
@@ -43,7 +45,7 @@ __all__ = ["PursuerBound", "solve_pursuer_bound"]
 
 
 @dataclass
-class PursuerBound:
+class PursuerBound(SolvedBound):
     """The solved pursuer bound.
 
     Attributes:
@@ -59,48 +61,13 @@ class PursuerBound:
         seconds: wall time of the build and of the fixed point.
     """
 
-    spec: GameSpec
-    res: Resolution
-    lattice: Lattice
-    vectors: np.ndarray
-    targets: np.ndarray
+    role: ClassVar[str] = "pursuer"
+    tables: ClassVar[dict[str, Any]] = {"win": bool, "choice": np.int16}
+
     win: np.ndarray
     choice: np.ndarray
     iterations: int
     seconds: dict[str, float]
-
-    # ------------------------------------------------------------------ storage
-    def to_arrays(self) -> dict[str, np.ndarray]:
-        """The solved arrays (for the on-disk cache); the rest is rebuilt from spec/res."""
-        return {
-            "win": self.win,
-            "choice": self.choice,
-            "iterations": np.array(self.iterations),
-            "seconds": np.array([self.seconds.get("build", 0.0), self.seconds.get("solve", 0.0)]),
-        }
-
-    @classmethod
-    def from_arrays(cls, spec: GameSpec, res: Resolution, arrays) -> PursuerBound:
-        """Rebuild a bound from :meth:`to_arrays` output (the lattice is recomputed)."""
-        lat = Lattice(spec, res, "pursuer")
-        vectors, targets = lat.moves(spec.v_pursuer * res.tau)
-        shape = (lat.n_points, lat.W, lat.W)
-        if arrays["win"].shape != shape or arrays["choice"].shape != shape:
-            raise ValueError(
-                f"cached pursuer bound has shape {arrays['win'].shape}, expected {shape}"
-            )
-        sec = arrays["seconds"]
-        return cls(
-            spec=spec,
-            res=res,
-            lattice=lat,
-            vectors=vectors,
-            targets=targets,
-            win=arrays["win"].astype(bool),
-            choice=arrays["choice"].astype(np.int16),
-            iterations=int(arrays["iterations"]),
-            seconds={"build": float(sec[0]), "solve": float(sec[1])},
-        )
 
     # ------------------------------------------------------------------ queries
     @property
@@ -160,7 +127,7 @@ class PursuerBound:
         ok = sweep_range_ok(rel[0], rel[1], d[:, 0], d[:, 1], m, g, spec.l_min, spec.l_max)
         ok &= ~_sweep_hits_any(spec, p, d, e, m, g, self.res.sweep_pieces)
         # successors: every open cell within V_e tau (+ margin) of the real evader
-        cells = _cells_within(lat, e, g + m)
+        cells = lat.open_cells_within(e, g + m)
         for i in np.flatnonzero(ok):
             k = int(cand[i])
             ab = lat.window_cell(np.array([k]), cells)
@@ -200,19 +167,6 @@ def _range0(lat: Lattice, spec: GameSpec) -> np.ndarray:
     R0 = lat.delta + spec.margin
     dist = np.hypot(lat.offsets[..., 0], lat.offsets[..., 1])
     return (dist - R0 >= spec.l_min) & (dist + R0 <= spec.l_max)
-
-
-def _cells_within(lat: Lattice, e: np.ndarray, r: float) -> np.ndarray:
-    """Fine indices of the open cells within distance r of the point e."""
-    lo = np.floor((e - r - lat.anchor) / lat.h - 0.5).astype(int)
-    hi = np.ceil((e + r - lat.anchor) / lat.h + 0.5).astype(int)
-    ii, jj = np.meshgrid(np.arange(lo[0], hi[0] + 1), np.arange(lo[1], hi[1] + 1), indexing="ij")
-    ij = np.stack([ii.ravel(), jj.ravel()], axis=1)
-    c = lat.anchor + lat.h * ij
-    dx = np.maximum(np.abs(c[:, 0] - e[0]) - 0.5 * lat.h, 0.0)
-    dy = np.maximum(np.abs(c[:, 1] - e[1]) - 0.5 * lat.h, 0.0)
-    ij = ij[np.hypot(dx, dy) <= r]
-    return ij[lat.cell_open_at(ij)]
 
 
 def _sweep_hits_any(spec, p, d, c, R0, g, pieces) -> np.ndarray:
@@ -335,19 +289,11 @@ def solve_pursuer_bound(spec: GameSpec, res: Resolution, *, progress: bool = Fal
         X |= _unpack(safe[j], W)
     closed = ~open_w  # cells the evader cannot occupy never constrain the pursuer
     A = erode(X | closed, rects, border=False)
-    # predecessors: which points have a move into point q
-    preds: list[list[int]] = [[] for _ in range(lat.n_points)]
-    for k, row in enumerate(targets):
-        for q in set(row[row >= 0].tolist()):
-            preds[q].append(k)
-    dirty = np.ones(lat.n_points, dtype=bool)
+    work = Worklist(targets)
     iterations = 0
     while True:
         iterations += 1
-        todo = np.zeros(lat.n_points, dtype=bool)
-        for q in np.flatnonzero(dirty):
-            todo[preds[q]] = True
-        ks = np.flatnonzero(todo)
+        ks = work.todo()
         new = _best_moves(ks, X, A, safe, vectors, targets, W)[0]
         changed = (new != X[ks]).any(axis=(1, 2))
         if progress:
@@ -355,9 +301,8 @@ def solve_pursuer_bound(spec: GameSpec, res: Resolution, *, progress: bool = Fal
         if not changed.any():
             break
         X[ks] = new
-        dirty = np.zeros(lat.n_points, dtype=bool)
-        dirty[ks[changed]] = True
-        d = np.flatnonzero(dirty)
+        d = ks[changed]
+        work.changed(d)
         A[d] = erode(X[d] | closed[d], rects, border=False)
     all_k = np.arange(lat.n_points)
     _, choice = _best_moves(all_k, X, A, safe, vectors, targets, W, want_choice=True)

@@ -46,6 +46,26 @@ LABELS = ("pursuer", "evader", "unknown")
 """What a start can be labelled: who provably wins it, or unknown."""
 
 
+def _cached(kind, cls, solver, spec, res, cache, cache_dir, progress):
+    """The bound ``kind`` of ``spec`` at ``res``: loaded from the cache, or solved and
+    stored (a read-only or full disk only costs the recomputation next time)."""
+    if cache:
+        names = (*cls.tables, "iterations", "seconds")
+        arrays = load_arrays(kind, spec, res, names, cache_dir)
+        if arrays is not None:
+            try:
+                return cls.from_arrays(spec, res, arrays)
+            except ValueError:
+                pass
+    bound = solver(spec, res, progress=progress)
+    if cache:
+        try:
+            save_arrays(kind, spec, res, bound.to_arrays(), cache_dir)
+        except OSError:
+            pass
+    return bound
+
+
 def cached_pursuer_bound(
     spec: GameSpec,
     res: Resolution,
@@ -55,22 +75,8 @@ def cached_pursuer_bound(
     progress: bool = False,
 ) -> PursuerBound:
     """The pursuer bound of ``spec`` at ``res``, from the cache or solved (and stored)."""
-    if cache:
-        arrays = load_arrays(
-            "pursuer", spec, res, ("win", "choice", "iterations", "seconds"), cache_dir
-        )
-        if arrays is not None:
-            try:
-                return PursuerBound.from_arrays(spec, res, arrays)
-            except ValueError:
-                pass
-    bound = solve_pursuer_bound(spec, res, progress=progress)
-    if cache:
-        try:
-            save_arrays("pursuer", spec, res, bound.to_arrays(), cache_dir)
-        except OSError:
-            pass  # a read-only or full disk only costs the recomputation next time
-    return bound
+    return _cached("pursuer", PursuerBound, solve_pursuer_bound, spec, res, cache, cache_dir,
+                   progress)  # fmt: skip
 
 
 def cached_evader_bound(
@@ -82,22 +88,8 @@ def cached_evader_bound(
     progress: bool = False,
 ) -> EvaderBound:
     """The evader bound of ``spec`` at ``res``, from the cache or solved (and stored)."""
-    if cache:
-        arrays = load_arrays(
-            "evader", spec, res, ("win", "rank", "choice", "iterations", "seconds"), cache_dir
-        )
-        if arrays is not None:
-            try:
-                return EvaderBound.from_arrays(spec, res, arrays)
-            except ValueError:
-                pass
-    bound = solve_evader_bound(spec, res, progress=progress)
-    if cache:
-        try:
-            save_arrays("evader", spec, res, bound.to_arrays(), cache_dir)
-        except OSError:
-            pass
-    return bound
+    return _cached("evader", EvaderBound, solve_evader_bound, spec, res, cache, cache_dir,
+                   progress)  # fmt: skip
 
 
 @dataclass(frozen=True)

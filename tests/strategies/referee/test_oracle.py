@@ -16,6 +16,7 @@ import pytest
 
 from strategies.policies.registry import make_policy, policy_names
 from strategies.referee import RefereeEvader, RefereePursuer
+from strategies.runner import run_episode
 from tests.strategies.referee.conftest import DT, play
 
 
@@ -47,3 +48,49 @@ def test_shooting_evader_escapes_from_certified_starts(fixture, request):
             winner, steps, _ = play(ref, pursuer, make_policy("evader/shooting"), start,
                                     max_cycles=horizon)  # fmt: skip
             assert winner == "evader", (start, pursuer.name, steps)
+
+
+@pytest.fixture(scope="module")
+def corner_referee():
+    """The L-shaped hall of Fig. 9(b) at its recommended parameters (rho = 0.5): an arm
+    5 wide is a dead end where a charger herds the pursuer (evader wins from ~7% of the
+    lattice starts at this resolution, none for an infinitely fast pursuer)."""
+    from envs.maps import builtin_info
+    from envs.surveillance.config import EnvConfig
+    from strategies.referee import referee_for
+
+    info = builtin_info("corner")
+    return referee_for(EnvConfig(map=info.map, **info.params()), 24)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue 13, evader half: from starts the referee certifies for the evader in the "
+    "corner world (herding the pursuer into a dead-end arm), evader/shooting does not break "
+    "surveillance against pursuer/greedy within 2 diameters / V_e; the referee's own evader "
+    "does, within 10 s (benchmarks: see the referee's closing note)",
+)
+def test_shooting_evader_escapes_from_certified_starts_in_the_corner_world(corner_referee):
+    from envs.maps import builtin_info
+
+    info = builtin_info("corner")
+    horizon = round(2 * _diameter_time(corner_referee) / 0.1)
+    for i, start in enumerate(corner_referee.sample_starts(3, np.random.default_rng(0),
+                                                            kind="evader")):  # fmt: skip
+        r = run_episode(info.map, "pursuer/greedy", "evader/shooting", i, max_cycles=horizon,
+                        overrides=info.params(), start=start)  # fmt: skip
+        assert r.winner == "evader", (start, r.steps)
+
+
+def test_referee_evader_wins_the_corner_worlds_certified_starts(corner_referee):
+    """The same starts are won by the referee's evader: the failure above is the policy's."""
+    from envs.maps import builtin_info
+
+    info = builtin_info("corner")
+    for i, start in enumerate(corner_referee.sample_starts(3, np.random.default_rng(0),
+                                                            kind="evader")):  # fmt: skip
+        bound = corner_referee.escape_time(**start)
+        r = run_episode(info.map, "pursuer/greedy", RefereeEvader(corner_referee.evader), i,
+                        max_cycles=round(bound / 0.1) + 5, overrides=info.params(),
+                        start=start)  # fmt: skip
+        assert r.winner == "evader" and r.escape_time <= bound + 1e-9

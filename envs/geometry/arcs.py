@@ -288,7 +288,9 @@ def _complement(
         items.append((rel, rel + w, i))
         if rel + w > TWO_PI:
             items.append((rel - TWO_PI, rel + w - TWO_PI, i))
-    items.append((TWO_PI, TWO_PI + wid[first], first))  # the cut arc again, one turn on
+        if rel <= ANGLE_TOL:  # the arcs starting at the cut again, one turn on: all of
+            # them, so that the labels do not depend on which came first in the list
+            items.append((TWO_PI + rel, TWO_PI + rel + w, i))
     items.sort()
     gaps = []
     cmax = -math.inf

@@ -26,7 +26,6 @@ along it, so one probe pair decides it.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -83,9 +82,10 @@ class Arrangement:
         noded: its vertices and edges (local frame).
         edge_length: per edge, the length of its polyline.
         origin: the local frame's origin (the centre of the map's bounding box).
-        samples: (F, 2) a point inside each face, found on the exact curves
-            (:mod:`strategies.cspace._samples`); NaN where that failed.
-        depth: (F,) how far that point is from the face's boundary along its ray.
+        face_of_half_edge: the face on the left of each half-edge (2k: edge k as its
+            parameter grows, 2k + 1: backwards), -1 outside the free region.
+        bridge: per edge, whether it has the same face on both sides.
+        tol: the tolerances it was built with.
         sliver: (F,) faces narrower than the sliver tolerance (twice their area over
             their perimeter): a near-degeneracy the kernel cannot resolve; they carry no
             cells and the boundaries across them are found by stepping over them.
@@ -101,20 +101,30 @@ class Arrangement:
     noded: Noded = field(repr=False)
     edge_length: np.ndarray = field(repr=False)
     origin: np.ndarray = field(repr=False)
-    samples: np.ndarray = field(repr=False)
-    depth: np.ndarray = field(repr=False)
     sliver: np.ndarray = field(repr=False)
+    face_of_half_edge: np.ndarray = field(repr=False)
+    bridge: np.ndarray = field(repr=False)
+    tol: Tolerances = field(repr=False)
     stats: dict[str, int] = field(default_factory=dict)
 
-    def probe(self, edge: int, sign: int, L: float) -> tuple[np.ndarray, np.ndarray]:
-        """The exact middle of an edge and the unit normal there pointing into face A."""
-        k = self.noded.curve[edge]
-        t = 0.5 * (self.noded.ta[edge] + self.noded.tb[edge])
+    def probes(self, edges: np.ndarray, signs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The exact middles of edges and the unit normals there, pointing to the left
+        (``signs`` +1) or right (-1) of each edge's growing parameter."""
+        edges = np.asarray(edges, dtype=np.intp)
+        k = self.noded.curve[edges]
+        t = 0.5 * (self.noded.ta[edges] + self.noded.tb[edges])
         kind, data = self.curves.kind[k], self.curves.data[k]
-        p = points(kind, data, t, L)[0]
-        d1, _ = derivatives(kind, data, t, L)
-        tan = d1[0] / math.hypot(*d1[0])
-        return p + self.origin, sign * np.array([-tan[1], tan[0]])
+        p = points(kind, data, t, self.tol.L)
+        d1, _ = derivatives(kind, data, t, self.tol.L)
+        tan = d1 / np.hypot(d1[:, 0], d1[:, 1])[:, None]
+        n = np.asarray(signs, dtype=float)[:, None] * np.stack([-tan[:, 1], tan[:, 0]], axis=1)
+        return p + self.origin, n
+
+    def exact_samples(self, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Points inside the given faces found on the exact curves, and their depth along
+        the ray (NaN where no ray could be cast): see :mod:`strategies.cspace._samples`."""
+        pts, depth = _face_samples(self, np.asarray(faces, dtype=np.intp))
+        return pts + self.origin, depth
 
 
 # ------------------------------------------------------------------ curves
@@ -321,58 +331,46 @@ def arrange(world: Map, curves: tuple[CriticalCurve, ...], tol: Tolerances) -> A
     outer = np.flatnonzero((~blocked & (c_area > area_tol)) | degenerate)
     inner = np.flatnonzero(~blocked & (c_area <= area_tol) & ~degenerate)
 
-    # rings: the half-edges of a cycle in order, bridges skipped, each polyline's last
-    # point dropped (it is the next one's first)
-    def ring(cid: int) -> np.ndarray:
-        hs = walks[cid]
-        hs = hs[~bridge[h_edge[hs]]]
-        if len(hs) == 0:
-            return np.zeros((0, 2))
-        k = h_edge[hs]
-        cnt = np.diff(offsets)[k] - 1
-        st = np.where(h_fwd[hs], offsets[k], offsets[k + 1] - 1)
-        dr = np.where(h_fwd[hs], 1, -1)
-        rep = np.repeat(np.arange(len(hs)), cnt)
-        loc = np.arange(len(rep)) - np.repeat(np.cumsum(cnt) - cnt, cnt)
-        return pts[st[rep] + dr[rep] * loc]
-
-    shells = [ring(c) for c in outer.tolist()]
-    shell_polys = [Polygon(r) if len(r) >= 3 else Polygon() for r in shells]
+    # rings: the half-edges of each cycle in order, bridges skipped, each polyline's last
+    # point dropped (it is the next one's first); all cycles at once
+    ring_xy, ring_off = _rings(walks, bridge, h_edge, h_fwd, offsets, pts)
+    n_pts = np.diff(ring_off)
+    shells = _polygons(ring_xy, ring_off, outer)
     face_of_cycle = np.full(nc, -1, dtype=np.intp)
     face_of_cycle[outer] = np.arange(len(outer))
-    holes: list[list[np.ndarray]] = [[] for _ in outer]
     orphans = 0
+    faces = list(shells)
     if len(inner) and len(outer):
         h0 = np.array([walks[c][0] for c in inner.tolist()], dtype=np.intp)
         starts = nd.vertices[np.where(h_fwd[h0], nd.u[h_edge[h0]], nd.v[h_edge[h0]])]
-        tree = shapely.STRtree(shell_polys)
+        tree = shapely.STRtree(shells)
         qi, qf = tree.query(shapely.points(starts), predicate="within")
         areas = c_area[outer]
+        order = np.lexsort((areas[qf], qi))  # per hole, the smallest face around it first
+        qi, qf = qi[order], qf[order]
+        firsts = np.concatenate([[True], qi[1:] != qi[:-1]]) if len(qi) else qi.astype(bool)
         best = np.full(len(inner), -1, dtype=np.intp)
-        best_area = np.full(len(inner), np.inf)
-        for i, f in zip(qi.tolist(), qf.tolist(), strict=True):
-            if areas[f] < best_area[i]:
-                best[i], best_area[i] = f, areas[f]
+        best[qi[firsts]] = qf[firsts]
         face_of_cycle[inner] = best
         orphans = int(np.count_nonzero(best < 0))
+        holes: dict[int, list[np.ndarray]] = {}
         for i, c in enumerate(inner.tolist()):
-            if best[i] >= 0 and c_area[c] < -area_tol:
-                r = ring(c)
-                if len(r) >= 3:
-                    holes[best[i]].append(r)
-    faces = [
-        _valid(Polygon(s, h) if h else p)
-        for s, h, p in zip(shells, holes, shell_polys, strict=True)
-    ]
+            if best[i] >= 0 and c_area[c] < -area_tol and n_pts[c] >= 3:
+                holes.setdefault(int(best[i]), []).append(ring_xy[ring_off[c] : ring_off[c + 1]])
+        for f, hl in holes.items():
+            faces[f] = Polygon(shells[f].exterior.coords, hl)
+    bad = np.flatnonzero(~shapely.is_valid(np.array(faces, dtype=object)))
+    for f in bad.tolist():
+        faces[f] = _valid(faces[f])
+    faces = list(shapely.orient_polygons(np.array(faces, dtype=object), exterior_cw=False))
     face_h = face_of_cycle[cyc]
     # slivers: faces narrower than the sliver tolerance (their cells are not probed;
     # the boundaries across them are resolved by stepping over them, see _build)
     nf = len(faces)
-    f_area = np.array([f.area for f in faces])
+    f_area = shapely.area(np.array(faces, dtype=object))
     has = face_h >= 0
     f_perim = np.bincount(face_h[has], weights=e_len[h_edge[has]], minlength=nf)
     sliver = 2.0 * f_area < tol.thin * f_perim
-    samples, depth = _face_samples(cv, nd, tol, faces, face_h, e_len, bridge)
     faces = list(shapely.transform(np.array(faces, dtype=object), lambda x: x + c0))
     pieces = _pieces(cv, nd, curves, face_h, offsets, pts + c0)
     stats = {
@@ -383,29 +381,67 @@ def arrange(world: Map, curves: tuple[CriticalCurve, ...], tol: Tolerances) -> A
         "orphan_holes": orphans,
         "wide_vertices": nd.n_clusters_wide,
     }
-    return Arrangement(tuple(faces), pieces, cv, nd, e_len, c0, samples + c0, depth, sliver, stats)
+    return Arrangement(tuple(faces), pieces, cv, nd, e_len, c0, sliver, face_h, bridge, tol, stats)
 
 
-def _face_samples(cv, nd, tol, faces, face_h, e_len, bridge):
-    """Exact points inside the faces: from the middle of each face's longest edge."""
-    nf = len(faces)
+def _face_samples(arr: Arrangement, sel: np.ndarray):
+    """Exact points inside faces ``sel``: from the middle of each one's longest edge."""
+    face_h, e_len = arr.face_of_half_edge, arr.edge_length
+    nd, cv, tol = arr.noded, arr.curves, arr.tol
     h = np.arange(len(face_h))
-    ok = (face_h >= 0) & ~bridge[h // 2]
+    ok = (face_h >= 0) & ~arr.bridge[h // 2] & np.isin(face_h, sel)
     h = h[ok]
     order = np.lexsort((-e_len[h // 2], face_h[h]))
     h = h[order]
-    first = np.searchsorted(face_h[h], np.arange(nf))
+    first = np.searchsorted(face_h[h], sel)
     has = first < len(h)
-    has[has] = face_h[h[first[has]]] == np.arange(nf)[has]
-    best = h[np.minimum(first, len(h) - 1)]
+    has[has] = face_h[h[first[has]]] == sel[has]
+    out = np.full((len(sel), 2), np.nan)
+    depth = np.full(len(sel), np.nan)
+    if not has.any():
+        return out, depth
+    best = h[first[has]]
     k = best // 2
     sign = np.where(best % 2 == 0, 1.0, -1.0)
-    bounds = np.array([f.bounds if not f.is_empty else (0, 0, 0, 0) for f in faces]).reshape(-1, 4)
-    reach = 1.01 * np.hypot(bounds[:, 2] - bounds[:, 0], bounds[:, 3] - bounds[:, 1]) + tol.merge
-    pts, depth = ray_samples(cv, tol.L, nd.curve[k], nd.ta[k], nd.tb[k], sign, reach, tol.touch)
-    pts[~has] = np.nan
-    depth[~has] = np.nan
-    return pts, depth
+    bounds = shapely.bounds(np.array([arr.faces[f] for f in sel[has]], dtype=object))
+    reach = 1.01 * np.hypot(bounds[:, 2] - bounds[:, 0], bounds[:, 3] - bounds[:, 1])
+    reach = np.where(np.isfinite(reach), reach, 0.0) + tol.merge
+    pts, d = ray_samples(cv, tol.L, nd.curve[k], nd.ta[k], nd.tb[k], sign, reach, tol.touch)
+    out[has], depth[has] = pts, d
+    return out, depth
+
+
+def _rings(walks, bridge, h_edge, h_fwd, offsets, pts):
+    """The polyline rings of all cycles: (points, per-cycle offsets)."""
+    nc = len(walks)
+    lens = np.array([len(w) for w in walks], dtype=np.intp)
+    hs = np.concatenate(walks) if walks else np.zeros(0, dtype=np.intp)
+    cyc = np.repeat(np.arange(nc), lens)
+    keep = ~bridge[h_edge[hs]]
+    hs, cyc = hs[keep], cyc[keep]
+    k = h_edge[hs]
+    cnt = np.diff(offsets)[k] - 1
+    st = np.where(h_fwd[hs], offsets[k], offsets[k + 1] - 1)
+    dr = np.where(h_fwd[hs], 1, -1)
+    rep = np.repeat(np.arange(len(hs)), cnt)
+    loc = np.arange(len(rep)) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+    xy = pts[st[rep] + dr[rep] * loc]
+    per = np.bincount(cyc, weights=cnt, minlength=nc).astype(np.intp)
+    return xy, np.concatenate([[0], np.cumsum(per)])
+
+
+def _polygons(xy: np.ndarray, off: np.ndarray, cycles: np.ndarray) -> list[Polygon]:
+    """Polygons of the given cycles' rings (empty for rings of fewer than 3 points)."""
+    out = [Polygon()] * len(cycles)
+    n = off[cycles + 1] - off[cycles]
+    ok = np.flatnonzero(n >= 3)
+    if len(ok):
+        idx = np.concatenate([np.arange(off[c], off[c + 1]) for c in cycles[ok].tolist()])
+        ring_id = np.repeat(np.arange(len(ok)), n[ok])
+        rings = shapely.linearrings(xy[idx], indices=ring_id)
+        for j, poly in zip(ok.tolist(), shapely.polygons(rings).tolist(), strict=True):
+            out[j] = poly
+    return out
 
 
 def _pieces(cv, nd, curves, face_h, offsets, pts) -> tuple[Piece, ...]:

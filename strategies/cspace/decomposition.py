@@ -155,6 +155,7 @@ class Decomposition:
             a sound build: ``dangling`` (curve pieces with one face on both sides),
             ``orphan_holes``, ``noncritical_violations`` (check points whose stops are
             not their region's), ``slivers_unresolved``.
+        timings: seconds spent in each phase of the build (empty when loaded).
     """
 
     def __init__(
@@ -177,17 +178,34 @@ class Decomposition:
         self.chord_tol = chord_tol
         self.unresolved = sum(not b.resolved for b in boundaries)
         self.stats = dict(stats or {})
-        g = nx.Graph()
-        for c in cells:
-            g.add_node(c.id, region=c.region, stops=c.stops, escapable=c.escapable)
-        for b in boundaries:
-            for i, j in b.adjacent:
-                if g.has_edge(i, j):
-                    g.edges[i, j]["boundaries"].append(b.id)
-                else:
-                    g.add_edge(i, j, boundaries=[b.id])
-        self.graph = g
+        self.timings: dict[str, float] = {}
+        self._graph: nx.Graph | None = None
         self._index()
+
+    @property
+    def graph(self) -> nx.Graph:
+        """The connectivity graph G_L (networkx), built on first use.
+
+        Nodes are cell ids with attributes ``region``, ``stops``, ``escapable``; an edge
+        joins adjacent cells, with attribute ``boundaries`` (the pieces across which).
+        """
+        if self._graph is None:
+            g = nx.Graph()
+            for c in self.cells:
+                g.add_node(c.id, region=c.region, stops=c.stops, escapable=c.escapable)
+            for b in self.boundaries:
+                for i, j in b.adjacent:
+                    if g.has_edge(i, j):
+                        g.edges[i, j]["boundaries"].append(b.id)
+                    else:
+                        g.add_edge(i, j, boundaries=[b.id])
+            self._graph = g
+        return self._graph
+
+    @property
+    def n_adjacencies(self) -> int:
+        """Number of adjacent cell pairs (edges of G_L), without building the graph."""
+        return len({(min(i, j), max(i, j)) for b in self.boundaries for i, j in b.adjacent})
 
     # ------------------------------------------------------------------ indexing
     def _index(self) -> None:
@@ -205,12 +223,14 @@ class Decomposition:
 
     def __getstate__(self) -> dict:
         state = self.__dict__.copy()
-        for k in ("_tree", "_cell_of", "_neighbours", "_kernel"):
+        for k in ("_tree", "_cell_of", "_neighbours", "_kernel", "_graph"):
             state.pop(k, None)
         return state
 
     def __setstate__(self, state: dict) -> None:
         self.__dict__.update(state)
+        self._graph = None
+        self.timings = getattr(self, "timings", {})
         self._index()
 
     # ------------------------------------------------------------------ verdict
@@ -326,7 +346,7 @@ class Decomposition:
             f"decomposition of {self.map.name!r} at L = {self.L:g}",
             "  critical curves by type 0-5: " + ", ".join(str(int(t)) for t in types),
             f"  {len(self.regions)} regions, {len(self.cells)} cells, "
-            f"{self.graph.number_of_edges()} adjacencies, {n_esc} escapable cells",
+            f"{self.n_adjacencies} adjacencies, {n_esc} escapable cells",
         ]
         if not self.exact:
             bad = {k: v for k, v in self.stats.items() if v and k in _CHECKS}

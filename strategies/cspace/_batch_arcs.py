@@ -1,0 +1,314 @@
+"""The kernel's exact free arcs at many points at once, vectorised (for building).
+
+:meth:`envs.geometry.Kernel.free_arcs` answers one point in tens of microseconds; a
+large decomposition asks at hundreds of thousands of points (a sample per face, two
+probes per boundary, check points). This module computes the same answer for a whole
+batch with numpy: the same formulas as :mod:`envs.geometry.arcs` (clip each wall edge to
+the disk of radius L, the blocked short arc, the complement on the circle, the stop
+labels with the same ties), so the stop pairs it reports are the kernel's and the cells
+built from them are found again by the kernel at query time (a test checks them point
+by point). Points within the kernel's tolerance of a wall (the rod lying along a wall)
+are left to the kernel itself.
+
+Stops are encoded as integers: ``priority << 32 | feature index`` with the kernel's tie
+priority (body on an edge 0, body on a vertex 1, tip at a vertex 2, tip on an edge 3),
+so the smallest code is the kernel's choice among tied labels; -1 is "no stop" (the
+full circle).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import shapely
+
+from envs.geometry import kernel_for
+from envs.geometry.types import Arc, FreeArcs, Stop
+from envs.maps.map import Feature, Map
+from envs.tolerances import ANGLE_TOL
+from strategies.cspace._candidates import wall_index
+
+__all__ = ["ArcBatch", "free_arcs_batch", "stop_code", "stop_of"]
+
+TWO_PI = 2.0 * math.pi
+_KINDS = (("body", "edge"), ("body", "vertex"), ("tip", "vertex"), ("tip", "edge"))
+_PRI = {k: i for i, k in enumerate(_KINDS)}
+_CHUNK = 600_000  # (point, edge) pairs per vectorised chunk (memory stays flat)
+
+
+def stop_code(stop: Stop | None) -> int:
+    """The integer code of a stop (-1 for ``None``)."""
+    if stop is None:
+        return -1
+    return (_PRI[stop.kind, stop.feature.kind] << 32) | stop.feature.index
+
+
+def stop_of(code: int) -> Stop | None:
+    """The stop of an integer code."""
+    if code < 0:
+        return None
+    kind, feat = _KINDS[code >> 32]
+    return Stop(kind, Feature(feat, code & 0xFFFFFFFF))
+
+
+@dataclass
+class ArcBatch:
+    """Free arcs at many points.
+
+    Attributes:
+        offsets: arcs of point ``i`` are ``offsets[i]:offsets[i + 1]`` (none: no free
+            orientation; one arc with codes -1: the full circle).
+        lo, hi: arc bounds (``lo`` in ``[-pi, pi)``, sorted within a point).
+        code_lo, code_hi: stop codes.
+    """
+
+    offsets: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    code_lo: np.ndarray
+    code_hi: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.offsets) - 1
+
+    def keys(self, i: int) -> tuple[tuple[int, int], ...]:
+        """The stop-code pairs at point ``i``, in arc order."""
+        s = slice(self.offsets[i], self.offsets[i + 1])
+        return tuple(zip(self.code_lo[s].tolist(), self.code_hi[s].tolist(), strict=True))
+
+    def arcs(self, i: int) -> tuple[Arc, ...]:
+        """The kernel's :class:`Arc` objects at point ``i``."""
+        s = slice(self.offsets[i], self.offsets[i + 1])
+        return tuple(
+            Arc(a, b, stop_of(x), stop_of(y))
+            for a, b, x, y in zip(
+                self.lo[s].tolist(),
+                self.hi[s].tolist(),
+                self.code_lo[s].tolist(),
+                self.code_hi[s].tolist(),
+                strict=True,
+            )
+        )
+
+
+def _label_codes(world: Map, e, at_vertex, v, dist_v, L, eps):
+    """Codes of clipped edge ends (THEORY.md 1.3 step 4, the kernel's ``_label``)."""
+    tip_vertex = np.abs(dist_v - L) <= eps
+    pri = np.where(~at_vertex, 3, np.where(tip_vertex, 2, 1)).astype(np.int64)
+    feat = np.where(~at_vertex, e, v).astype(np.int64)
+    return (pri << 32) | feat
+
+
+def _blocks(world: Map, P: np.ndarray, L: float, eps: float, pid: np.ndarray, e: np.ndarray):
+    """Blocked arcs of edges ``e`` seen from points ``P[pid]`` (pairs within reach)."""
+    a = world.edge_start[e]
+    u = world.edge_dir[e]
+    length = world.edge_length[e]
+    wx = a[:, 0] - P[pid, 0]
+    wy = a[:, 1] - P[pid, 1]
+    s = -(wx * u[:, 0] + wy * u[:, 1])
+    sc = np.clip(s, 0.0, length)
+    dist = np.hypot(wx + sc * u[:, 0], wy + sc * u[:, 1])
+    keep = dist <= L + eps
+    on = keep & (dist <= eps)
+    ww = wx * wx + wy * wy
+    disc = s * s - (ww - L * L)
+    ok = keep & (disc >= 0.0)
+    sq = np.sqrt(np.where(ok, disc, 0.0))
+    t0 = np.maximum(s - sq, 0.0)
+    t1 = np.minimum(s + sq, length)
+    ok &= t0 <= t1
+    ang_a = np.arctan2(wy + t0 * u[:, 1], wx + t0 * u[:, 0])
+    ang_b = np.arctan2(wy + t1 * u[:, 1], wx + t1 * u[:, 0])
+    w = (ang_b - ang_a) % TWO_PI
+    flip = w > math.pi
+    w = np.where(flip, TWO_PI - w, w)
+    start = np.where(flip, ang_b, ang_a)
+    sel = np.flatnonzero(ok & (w > ANGLE_TOL))
+    e_s = e[sel]
+    la = _label_codes(world, e_s, t0[sel] <= eps, e_s, np.sqrt(ww[sel]), L, eps)
+    vb = world.edge_vertices[e_s, 1]
+    db = np.hypot(world.vertices[vb, 0] - P[pid[sel], 0], world.vertices[vb, 1] - P[pid[sel], 1])
+    at_b = t1[sel] >= length[sel] - eps
+    lb = _label_codes(world, e_s, at_b, vb, db, L, eps)
+    f = flip[sel]
+    code_lo = np.where(f, lb, la)
+    code_hi = np.where(f, la, lb)
+    return pid[sel], start[sel], w[sel], code_lo, code_hi, pid[on]
+
+
+def _complement(n: int, g, lo, wid, clo, chi):
+    """Complements on the circle of each point's blocked arcs: the kernel's sweep, done on
+    padded (point, arc) tables a chunk of points at a time (row-wise sorts, exact float
+    arithmetic as in :func:`envs.geometry.arcs._complement`)."""
+    full = np.zeros(n, dtype=bool)
+    full[g[wid >= TWO_PI - ANGLE_TOL]] = True
+    keep = ~full[g]
+    g, lo, wid, clo, chi = g[keep], lo[keep], wid[keep], clo[keep], chi[keep]
+    if len(g) > 1 and not np.all(g[1:] >= g[:-1]):  # the index query returns them sorted
+        order = np.argsort(g, kind="stable")
+        g, lo, wid, clo, chi = g[order], lo[order], wid[order], clo[order], chi[order]
+    rank = _rank(g)
+    heads = np.flatnonzero(np.concatenate([[True], g[1:] != g[:-1]])) if len(g) else g
+    pts = g[heads]
+    bounds = np.concatenate([heads, [len(g)]])
+    per = max(1, 200_000 // (int(rank.max(initial=0)) + 1))
+    out = []
+    for k0 in range(0, len(pts), per):
+        k1 = min(len(pts), k0 + per)
+        sl = slice(bounds[k0], bounds[k1])
+        out.append(_sweep(pts[k0:k1], g[sl], rank[sl], lo[sl], wid[sl], clo[sl], chi[sl]))
+    if not out:
+        z = np.zeros(0)
+        return np.zeros(0, dtype=np.intp), z, z, z.astype(np.int64), z.astype(np.int64), full
+    gg, a_lo, a_hi, code_lo, code_hi = (np.concatenate(x) for x in zip(*out, strict=True))
+    return gg, a_lo, a_hi, code_lo, code_hi, full
+
+
+def _sweep(pts, g, rank, lo, wid, clo, chi):
+    """The kernel's gap sweep for one chunk of points, on padded (point, arc) tables."""
+    big = np.iinfo(np.int64).max
+    row = np.searchsorted(pts, g)
+    shape = (len(pts), int(rank.max()) + 1)
+    LO = np.full(shape, np.inf)
+    W = np.zeros(shape)
+    CL = np.full(shape, big)
+    CH = np.full(shape, big)
+    LO[row, rank], W[row, rank], CL[row, rank], CH[row, rank] = lo, wid, clo, chi
+    valid = np.isfinite(LO)
+    first = np.argmin(LO, axis=1)  # the first arc of least start, as the kernel's min()
+    c = LO[np.arange(shape[0]), first]
+    rel = np.where(valid, (np.where(valid, LO, 0.0) - c[:, None]) % TWO_PI, np.inf)
+    rel[np.arange(shape[0]), first] = 0.0
+    top = rel + W
+    # extra items, compacted: arcs past 2 pi again one turn back, arcs at the cut again
+    # one turn on (a few per point at most)
+    wrap = valid & (top > TWO_PI)
+    cut = valid & (rel <= ANGLE_TOL)
+    er, ec = np.nonzero(wrap | cut)  # rows and columns of the arcs with extra items
+    er2 = np.concatenate([er[wrap[er, ec]], er[cut[er, ec]]])
+    ec2 = np.concatenate([ec[wrap[er, ec]], ec[cut[er, ec]]])
+    shift = np.concatenate([np.full(int(wrap.sum()), -TWO_PI), np.full(int(cut.sum()), TWO_PI)])
+    o = np.lexsort((ec2, er2))
+    er2, ec2, shift = er2[o], ec2[o], shift[o]
+    xr = _rank(er2)
+    xw = int(xr.max()) + 1 if len(xr) else 0
+    XR = np.full((shape[0], xw), np.inf)
+    XH = np.full((shape[0], xw), -np.inf)
+    XL = np.full((shape[0], xw), big)
+    XC = np.full((shape[0], xw), big)
+    XR[er2, xr] = rel[er2, ec2] + shift
+    XH[er2, xr] = top[er2, ec2] + shift
+    XL[er2, xr], XC[er2, xr] = CL[er2, ec2], CH[er2, ec2]
+    R = np.concatenate([rel, XR], axis=1)
+    H = np.concatenate([np.where(valid, top, -np.inf), XH], axis=1)
+    CLs = np.concatenate([CL, XL], axis=1)
+    CHs = np.concatenate([CH, XC], axis=1)
+    o = np.argsort(R, axis=1, kind="stable")
+    R = np.take_along_axis(R, o, axis=1)
+    H = np.take_along_axis(H, o, axis=1)
+    CLs = np.take_along_axis(CLs, o, axis=1)
+    CHs = np.take_along_axis(CHs, o, axis=1)
+    run = np.maximum.accumulate(H, axis=1)
+    prev = np.concatenate([np.full((shape[0], 1), -np.inf), run[:, :-1]], axis=1)
+    gr, gc = np.nonzero(np.isfinite(prev) & np.isfinite(R) & (R - prev > ANGLE_TOL))
+    start, end = prev[gr, gc], R[gr, gc]
+    code_lo = np.where(np.abs(H[gr] - start[:, None]) <= ANGLE_TOL, CHs[gr], big).min(axis=1)
+    code_hi = np.where(np.abs(R[gr] - end[:, None]) <= ANGLE_TOL, CLs[gr], big).min(axis=1)
+    a_lo = (c[gr] + start + math.pi) % TWO_PI - math.pi
+    a_lo = np.where(a_lo >= math.pi, -math.pi, a_lo)
+    a_hi = a_lo + (end - start)
+    gg = pts[gr]
+    o = np.lexsort((a_lo, gg))
+    return gg[o], a_lo[o], a_hi[o], code_lo[o], code_hi[o]
+
+
+def _rank(g: np.ndarray) -> np.ndarray:
+    """Position of each element among the equal values before it (g sorted)."""
+    if len(g) == 0:
+        return g
+    start = np.flatnonzero(np.concatenate([[True], g[1:] != g[:-1]]))
+    first = np.repeat(start, np.diff(np.concatenate([start, [len(g)]])))
+    return np.arange(len(g)) - first
+
+
+def free_arcs_batch(world: Map, points: np.ndarray, L: float) -> ArcBatch:
+    """The kernel's free arcs at each of (k, 2) points for rod length ``L``.
+
+    Points are processed in chunks sized so that their (point, edge) pairs stay below a
+    few million: the memory used does not grow with the number of points.
+    """
+    P = np.asarray(points, dtype=float).reshape(-1, 2)
+    n = len(P)
+    kernel = kernel_for(world)
+    eps = kernel.eps
+    tree = wall_index(world).tree
+    inside = shapely.contains_xy(world.prepared_free_region, P[:, 0], P[:, 1])
+    # edges per point: estimated from a sample, to size the chunks
+    probe = P[:: max(1, n // 200)]
+    k = len(tree.query(shapely.points(probe), predicate="dwithin", distance=L + eps)[0])
+    per_point = max(1.0, k / max(1, len(probe)))
+    step = max(1, int(_CHUNK / per_point))
+    on = np.zeros(n, dtype=bool)
+    has = np.zeros(n, dtype=bool)
+    out = []
+    for s0 in range(0, n, step):
+        s1 = min(n, s0 + step)
+        pid, e = tree.query(shapely.points(P[s0:s1]), predicate="dwithin", distance=L + eps)
+        g, lo, wid, clo, chi, on_local = _blocks(world, P[s0:s1], L, eps, pid, e.astype(np.intp))
+        on[s0 + on_local] = True
+        has[s0 + g] = True
+        gg, a_lo, a_hi, c_lo, c_hi, _ = _complement(s1 - s0, g, lo, wid, clo, chi)
+        out.append((gg + s0, a_lo, a_hi, c_lo, c_hi))
+    gg, a_lo, a_hi, c_lo, c_hi = (np.concatenate(x) for x in zip(*out, strict=True))
+    # assemble: kernel fallback for points on walls, full circles, no arcs outside
+    counts = np.bincount(gg, minlength=n)
+    counts[~inside | on] = 0
+    full_circle = inside & ~on & ~has
+    counts[full_circle] = 1
+    offsets = np.concatenate([[0], np.cumsum(counts)])
+    out_lo = np.empty(offsets[-1])
+    out_hi = np.empty(offsets[-1])
+    out_cl = np.empty(offsets[-1], dtype=np.int64)
+    out_ch = np.empty(offsets[-1], dtype=np.int64)
+    use = inside[gg] & ~on[gg]
+    pos = offsets[gg[use]] + _rank(gg[use])
+    out_lo[pos], out_hi[pos], out_cl[pos], out_ch[pos] = a_lo[use], a_hi[use], c_lo[use], c_hi[use]
+    fc = offsets[:-1][full_circle]
+    out_lo[fc], out_hi[fc], out_cl[fc], out_ch[fc] = -math.pi, math.pi, -1, -1
+    batch = ArcBatch(offsets, out_lo, out_hi, out_cl, out_ch)
+    wall_pts = np.flatnonzero(on)
+    if len(wall_pts):
+        batch = _patch(batch, wall_pts, [kernel.free_arcs(P[i], L) for i in wall_pts])
+    return batch
+
+
+def _patch(batch: ArcBatch, idx: np.ndarray, arcs: list[FreeArcs]) -> ArcBatch:
+    """Replace the arcs of points ``idx`` with the kernel's answers."""
+    n = len(batch)
+    counts = np.diff(batch.offsets)
+    counts[idx] = [len(fa.arcs) for fa in arcs]
+    offsets = np.concatenate([[0], np.cumsum(counts)])
+    m = offsets[-1]
+    lo, hi = np.empty(m), np.empty(m)
+    cl, ch = np.empty(m, dtype=np.int64), np.empty(m, dtype=np.int64)
+    mask = np.ones(n, dtype=bool)
+    mask[idx] = False
+    keep = np.flatnonzero(mask)
+    old_c = np.diff(batch.offsets)[keep]
+    src = np.repeat(batch.offsets[:-1][keep], old_c) + _rank(np.repeat(keep, old_c))
+    dst = np.repeat(offsets[:-1][keep], old_c) + _rank(np.repeat(keep, old_c))
+    lo[dst], hi[dst], cl[dst], ch[dst] = (
+        batch.lo[src],
+        batch.hi[src],
+        batch.code_lo[src],
+        batch.code_hi[src],
+    )
+    for i, fa in zip(idx.tolist(), arcs, strict=True):
+        for k, arc in enumerate(fa.arcs):
+            j = offsets[i] + k
+            lo[j], hi[j] = arc.lo, arc.hi
+            cl[j], ch[j] = stop_code(arc.stop_lo), stop_code(arc.stop_hi)
+    return ArcBatch(offsets, lo, hi, cl, ch)

@@ -1,0 +1,315 @@
+"""Adjacency across boundary pieces, from probe points on the exact curves, in batches.
+
+Footnote 3 of the paper: cells on the two sides of a critical curve are adjacent iff
+their free arcs overlap with positive length next to it. Each boundary piece is probed at
+the exact middle of one of its edges, along the exact normal, a small offset to each
+side; the free arcs there (all probes of a round at once,
+:func:`~strategies.cspace._batch_arcs.free_arcs_batch`) must carry exactly the stop
+pairs of the region on that side, which identifies each arc's cell. A side whose probe
+does not match tries a smaller offset, then other edges of the piece (longest first);
+across a sliver (a face too thin to probe) it steps over the sliver and takes whichever
+region lies beyond. Sides are matched independently, round after round, until each is
+matched or out of attempts; a piece whose sides never match falls back to matching
+arcs by overlap and is counted as unresolved (never silently).
+
+Stop-pair sets are compared through an order-independent 64-bit hash of their pairs
+(:func:`signature_hashes`); a match is then confirmed on the pairs themselves.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import shapely
+
+from envs.maps.map import Map
+from strategies.cspace._arcs import OVERLAP_TOL
+from strategies.cspace._batch_arcs import ArcBatch, free_arcs_batch
+from strategies.cspace.arrangement import Arrangement
+
+__all__ = ["PROBE_EDGES", "PROBE_SHRINK", "Probed", "probe_pieces", "signature_hashes"]
+
+PROBE_EDGES = 4
+"""Edges of a piece tried (longest first)."""
+
+PROBE_SHRINK = (1.0, 0.1, 0.01, 1e-3)
+"""Probe offsets tried on an edge, times the first one."""
+
+_THIN_STEPS = (2.0, 4.0, 10.0, 30.0)  # offsets past a sliver, times the sliver tolerance
+_TWO_PI = 2.0 * math.pi
+
+
+@dataclass
+class Probed:
+    """One boundary piece, probed.
+
+    Attributes:
+        piece: index into ``Arrangement.pieces``.
+        regions: ``(A, B)``.
+        point: the probe point on the exact curve.
+        normal: unit normal there, pointing into A.
+        adjacent: pairs (cell of A, cell of B) whose arcs overlap across it.
+        resolved: False if the sides were matched by overlap (not by stops).
+    """
+
+    piece: int
+    regions: tuple[int, int]
+    point: np.ndarray
+    normal: np.ndarray
+    adjacent: tuple[tuple[int, int], ...]
+    resolved: bool = True
+
+
+def _mix(x: np.ndarray) -> np.ndarray:
+    """splitmix64 finaliser, vectorised (uint64, wrapping arithmetic)."""
+    x = x.astype(np.uint64)
+    x ^= x >> np.uint64(30)
+    x *= np.uint64(0xBF58476D1CE4E5B9)
+    x ^= x >> np.uint64(27)
+    x *= np.uint64(0x94D049BB133111EB)
+    x ^= x >> np.uint64(31)
+    return x
+
+
+def signature_hashes(batch: ArcBatch) -> np.ndarray:
+    """Per point, an order-independent 64-bit hash of its set of stop pairs."""
+    with np.errstate(over="ignore"):
+        h = _mix(_mix(batch.code_lo.astype(np.uint64)) ^ batch.code_hi.astype(np.uint64))
+        out = np.zeros(len(batch), dtype=np.uint64)
+        counts = np.diff(batch.offsets)
+        has = np.flatnonzero(counts)
+        if len(has):
+            out[has] = np.add.reduceat(h, batch.offsets[:-1][has])
+    return out
+
+
+def _offsets(tol, length: np.ndarray, width: np.ndarray, over: np.ndarray) -> np.ndarray:
+    """(k, 7) offsets to try on one side of an edge (NaN: none): a fraction of the edge
+    and of the regions (``width``) shrinking to the kernel's resolution, then a few
+    sliver widths; across a sliver (``over``) only the sliver widths."""
+    floor = 4.0 * tol.kernel
+    eps0 = np.maximum(np.minimum(np.minimum(tol.probe, 0.25 * length), 0.25 * width), floor)
+    shrink = np.maximum(eps0[:, None] * np.asarray(PROBE_SHRINK)[None, :], floor)
+    shrink[:, 1:][shrink[:, 1:] == shrink[:, :-1]] = np.nan  # clamped to the floor: once
+    thin = np.asarray(_THIN_STEPS[:3]) * tol.thin
+    past = np.where(thin[None, :] > eps0[:, None], thin[None, :], np.nan)
+    out = np.concatenate([shrink, past], axis=1)
+    over_row = np.full(out.shape, np.nan)
+    over_row[:, : len(_THIN_STEPS)] = np.asarray(_THIN_STEPS) * tol.thin
+    return np.where(over[:, None], over_row, out)
+
+
+def _arc_overlaps(lo1, hi1, full1, lo2, hi2, full2) -> np.ndarray:
+    """Length of the overlap of closed arcs, elementwise (``_arcs.overlap``)."""
+    best = np.full(len(lo1), -np.inf)
+    for s in (-_TWO_PI, 0.0, _TWO_PI):
+        best = np.maximum(best, np.minimum(hi1, hi2 + s) - np.maximum(lo1, lo2 + s))
+    best = np.where(full1, hi2 - lo2, best)
+    return np.where(full2 & ~full1, hi1 - lo1, best)
+
+
+def probe_pieces(
+    world: Map,
+    arr: Arrangement,
+    region_of_face: np.ndarray,
+    sigs: list[frozenset],
+    cells: list[dict],
+    width: np.ndarray,
+) -> tuple[list[Probed], int]:
+    """Probe every piece separating two regions (or a region and a sliver).
+
+    Args:
+        world: the map.
+        arr: the arrangement.
+        region_of_face: region of each face (-1 for slivers).
+        sigs: per region, its set of stop-code pairs.
+        cells: per region, stop-code pair -> cell id.
+        width: per region, twice its area over its perimeter.
+
+    Returns:
+        The probed pieces and the number of pieces along slivers that could not be
+        resolved (dropped, counted).
+    """
+    tol = arr.tol
+    L = tol.L
+    sig_hash = np.array([_set_hash(s) for s in sigs], dtype=np.uint64)
+    # the jobs: pieces between two different regions (or a region and a sliver)
+    fa = np.array([p.faces[0] for p in arr.pieces], dtype=np.intp)
+    fb = np.array([p.faces[1] for p in arr.pieces], dtype=np.intp)
+    ra, rb = region_of_face[fa], region_of_face[fb]
+    job = np.flatnonzero(~((ra < 0) & (rb < 0)) & (ra != rb))
+    n_jobs = len(job)
+    # each job's edges, longest first (at most PROBE_EDGES)
+    n_e = np.array([len(arr.pieces[i].edges) for i in job.tolist()], dtype=np.intp)
+    e_all = np.concatenate([arr.pieces[i].edges for i in job.tolist()]) if n_jobs else n_e
+    s_all = np.concatenate([arr.pieces[i].signs for i in job.tolist()]) if n_jobs else n_e
+    owner = np.repeat(np.arange(n_jobs), n_e)
+    order = np.lexsort((-arr.edge_length[e_all], owner))
+    e_all, s_all, owner = e_all[order], s_all[order], owner[order]
+    rank = np.arange(len(owner)) - np.repeat(np.cumsum(n_e) - n_e, n_e)
+    keep = rank < PROBE_EDGES
+    e_all, s_all, owner, rank = e_all[keep], s_all[keep], owner[keep], rank[keep]
+    edge_tab = np.full((n_jobs, PROBE_EDGES), -1, dtype=np.intp)
+    sign_tab = np.zeros((n_jobs, PROBE_EDGES))
+    edge_tab[owner, rank], sign_tab[owner, rank] = e_all, s_all
+    regs = np.stack([ra[job], rb[job]], axis=1)
+    real_w = np.where(regs >= 0, width[np.maximum(regs, 0)], np.inf).min(axis=1)
+    # attempts per (job, side): PROBE_EDGES edges x 7 offsets, in order
+    length = np.where(edge_tab >= 0, arr.edge_length[np.maximum(edge_tab, 0)], np.nan)
+    offs = np.stack(
+        [
+            _offsets(
+                tol,
+                length.ravel(),
+                np.repeat(real_w, PROBE_EDGES),
+                np.repeat(regs[:, side] < 0, PROBE_EDGES),
+            ).reshape(n_jobs, PROBE_EDGES, -1)
+            for side in (0, 1)
+        ],
+        axis=1,
+    )  # fmt: skip  (job, side, edge, offset)
+    n_off = offs.shape[3]
+    found = np.full((n_jobs, 2), -2, dtype=np.intp)  # region matched, -1: a wall, -2: none
+    hit_arcs: dict[tuple[int, int], list] = {}
+    hit_pn: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+    first_pn: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+    face_tree = shapely.STRtree(list(arr.faces))
+    sig_regions: dict[int, list[int]] = {}
+    for r, h in enumerate(sig_hash.tolist()):
+        sig_regions.setdefault(h, []).append(r)
+    for attempt in range(PROBE_EDGES * n_off):
+        k, o = divmod(attempt, n_off)
+        eps = offs[:, :, k, o]
+        todo_j, todo_s = np.nonzero((found == -2) & np.isfinite(eps) & (edge_tab[:, k, None] >= 0))
+        if len(todo_j) == 0:
+            if not ((found == -2) & np.isfinite(offs[:, :, k:, :]).any(axis=(2, 3))).any():
+                break
+            continue
+        p, n = arr.probes(edge_tab[todo_j, k], sign_tab[todo_j, k])
+        side_sign = np.where(todo_s == 0, 1.0, -1.0)
+        q = p + (side_sign * eps[todo_j, todo_s])[:, None] * n
+        batch = free_arcs_batch(world, q, L)
+        h = signature_hashes(batch)
+        r = regs[todo_j, todo_s]
+        ok = (r >= 0) & (h == sig_hash[np.maximum(r, 0)])
+        for t in np.flatnonzero(ok | (r < 0)).tolist():
+            j, s = int(todo_j[t]), int(todo_s[t])
+            keys = batch.keys(t)
+            if r[t] >= 0:
+                if frozenset(keys) != sigs[r[t]]:
+                    continue  # a hash collision: not a match
+                match = int(r[t])
+            else:  # across a sliver: a wall beyond, or a region near the probe with these stops
+                if not shapely.contains_xy(world.prepared_free_region, *q[t]):
+                    found[j, s] = -1
+                    continue
+                near = face_tree.query(
+                    shapely.Point(q[t]), predicate="dwithin", distance=eps[j, s] + 2 * tol.chord
+                )
+                cands = {int(region_of_face[f]) for f in near.tolist()} - {-1}
+                match = next(
+                    (c for c in sig_regions.get(int(h[t]), ()) if c in cands and
+                     frozenset(keys) == sigs[c]), -2
+                )  # fmt: skip
+                if match < 0:
+                    continue
+            found[j, s] = match
+            sl = slice(batch.offsets[t], batch.offsets[t + 1])
+            hit_arcs[(j, s)] = (keys, batch.lo[sl], batch.hi[sl])
+            if s == 0:
+                hit_pn[j] = (p[t], n[t])
+        for t in range(len(todo_j)):
+            first_pn.setdefault(int(todo_j[t]), (p[t], n[t]))
+    return _finish(world, arr, job, regs, found, hit_arcs, hit_pn, first_pn, cells)
+
+
+def _set_hash(keys: frozenset) -> int:
+    codes = np.array(sorted(keys), dtype=np.int64).reshape(-1, 2)
+    batch = ArcBatch(np.array([0, len(codes)]), np.zeros(len(codes)), np.zeros(len(codes)),
+                     codes[:, 0], codes[:, 1])  # fmt: skip
+    return int(signature_hashes(batch)[0])
+
+
+def _finish(world, arr, job, regs, found, hit_arcs, hit_pn, first_pn, cells):
+    """Adjacency of the matched pieces (vectorised overlaps), fallbacks for the rest."""
+    both = np.flatnonzero((found[:, 0] >= 0) & (found[:, 1] >= 0) & (found[:, 0] != found[:, 1]))
+    rows_j, ka, kb, lo1, hi1, lo2, hi2 = [], [], [], [], [], [], []
+    for j in both.tolist():
+        keys_a, la, ha = hit_arcs[(j, 0)]
+        keys_b, lb, hb = hit_arcs[(j, 1)]
+        na, nb = len(keys_a), len(keys_b)
+        rows_j.append(np.full(na * nb, j))
+        ka += [x for x in keys_a for _ in range(nb)]
+        kb += list(keys_b) * na
+        lo1.append(np.repeat(la, nb)), hi1.append(np.repeat(ha, nb))
+        lo2.append(np.tile(lb, na)), hi2.append(np.tile(hb, na))
+    adjacent: dict[int, set] = {int(j): set() for j in both.tolist()}
+    if rows_j:
+        rows = np.concatenate(rows_j)
+        full_a = np.array([k == (-1, -1) for k in ka], dtype=bool)
+        full_b = np.array([k == (-1, -1) for k in kb], dtype=bool)
+        ov = _arc_overlaps(
+            np.concatenate(lo1), np.concatenate(hi1), full_a,
+            np.concatenate(lo2), np.concatenate(hi2), full_b,
+        )  # fmt: skip
+        for t in np.flatnonzero(ov > OVERLAP_TOL).tolist():
+            j = int(rows[t])
+            adjacent[j].add((cells[found[j, 0]][ka[t]], cells[found[j, 1]][kb[t]]))
+    out = []
+    lost = 0
+    for j in range(len(job)):
+        i = int(job[j])
+        a, b = int(found[j, 0]), int(found[j, 1])
+        if a >= 0 and b >= 0:
+            if a != b:
+                p, n = hit_pn[j]
+                out.append(Probed(i, (a, b), p, n, tuple(sorted(adjacent[j]))))
+            continue
+        if a == -1 or b == -1:
+            continue  # a sliver between a region and a wall: no boundary
+        if regs[j, 0] < 0 or regs[j, 1] < 0:
+            lost += 1
+            continue
+        out.append(_fallback(world, arr, i, (int(regs[j, 0]), int(regs[j, 1])), first_pn[j], cells))
+    out.sort(key=lambda pr: pr.piece)
+    return out, lost
+
+
+def _fallback(world, arr, i, regions, pn, cells) -> Probed:
+    """Match each side's arcs to the region's cells by overlap (counted as unresolved)."""
+    from envs.geometry import kernel_for
+    from strategies.cspace._batch_arcs import stop_code
+
+    kernel = kernel_for(world)
+    tol = arr.tol
+    p, n = pn
+    piece = arr.pieces[i]
+    eps = min(tol.probe, 0.25 * float(arr.edge_length[piece.edges].max()))
+    sides = []
+    for sgn in (1.0, -1.0):
+        fa = kernel.free_arcs(p + sgn * eps * n, tol.L)
+        sides.append([((stop_code(a.stop_lo), stop_code(a.stop_hi)), a.lo, a.hi) for a in fa.arcs])
+    adj = set()
+    for ka, lo1, hi1 in sides[0]:
+        for kb, lo2, hi2 in sides[1]:
+            ca = _nearest_cell(cells[regions[0]], ka)
+            cb = _nearest_cell(cells[regions[1]], kb)
+            ov = _arc_overlaps(
+                np.array([lo1]), np.array([hi1]), np.array([ka == (-1, -1)]),
+                np.array([lo2]), np.array([hi2]), np.array([kb == (-1, -1)]),
+            )[0]  # fmt: skip
+            if ca is not None and cb is not None and ov > OVERLAP_TOL:
+                adj.add((ca, cb))
+    return Probed(i, regions, p, n, tuple(sorted(adj)), False)
+
+
+def _nearest_cell(table: dict, key) -> int | None:
+    """The region's cell with this stop pair, else with one stop in common, else none."""
+    if key in table:
+        return table[key]
+    for k, c in table.items():
+        if k[0] == key[0] or k[1] == key[1]:
+            return c
+    return None

@@ -6,7 +6,10 @@
 * :func:`critical_lengths`, :func:`stratified_graph`, :func:`surveillance_verdict`: variable
   L (Prop. 1, Sec. 3's graph G, Prop. 4);
 * :func:`draw_decomposition`: the picture (the paper's Figs. 3, 5-8);
-* :mod:`strategies.cspace.grid_oracle`: an independent grid computation of the verdict.
+* :mod:`strategies.cspace.grids`: regular grids of evader positions over a free region.
+
+The independent grid computation of the verdict that the tests compare against lives
+with the tests (``tests/oracles/grid_oracle.py``).
 """
 
 from strategies.cspace.curves import CHORD_TOL_REL, TYPE_NAMES, CriticalCurve, critical_curves

@@ -169,9 +169,15 @@ def _type1(world: Map, L: float, eps: float, index: WallIndex):
     bt = np.concatenate([lam, (rel * u[c]).sum(axis=1)[strip]])
     feats = [(Feature("edge", e),) for e in range(n)]
     return (
-        np.full(n, 1), np.full(n, SEGMENT), data, np.zeros(n), world.edge_length.copy(),
-        feats, (c, f), (bc, bt),
-    )  # fmt: skip
+        np.full(n, 1),
+        np.full(n, SEGMENT),
+        data,
+        np.zeros(n),
+        world.edge_length.copy(),
+        feats,
+        (c, f),
+        (bc, bt),
+    )
 
 
 def _free_wedges(world: Map) -> tuple[np.ndarray, np.ndarray]:
@@ -213,9 +219,15 @@ def _type2(world: Map, L: float, eps: float, index: WallIndex):
     bt = start[bc] + (ang - start[bc]) % TWO_PI
     feats = [(Feature("vertex", i),) for i in range(nv)]
     return (
-        np.full(nv, 2), np.full(nv, ARC), data, start.copy(), start + span, feats,
-        (c, f), (bc, bt),
-    )  # fmt: skip
+        np.full(nv, 2),
+        np.full(nv, ARC),
+        data,
+        start.copy(),
+        start + span,
+        feats,
+        (c, f),
+        (bc, bt),
+    )
 
 
 def _sliding(world: Map, L: float, eps: float, index: WallIndex, o, e, T):
@@ -250,9 +262,15 @@ def _type3(world: Map, L: float, eps: float, index: WallIndex):
     empty = (np.zeros(0, dtype=int),) * 2
     if index.convex_tree is None or len(cv) < 2:
         return (
-            np.zeros(0, int), np.zeros(0, int), np.zeros((0, 6)), np.zeros(0), np.zeros(0),
-            [], empty, (np.zeros(0, int), np.zeros(0)),
-        )  # fmt: skip
+            np.zeros(0, int),
+            np.zeros(0, int),
+            np.zeros((0, 6)),
+            np.zeros(0),
+            np.zeros(0),
+            [],
+            empty,
+            (np.zeros(0, int), np.zeros(0)),
+        )
     pairs = index.convex_tree.query_pairs(L, output_type="ndarray")
     ij = np.concatenate([pairs, pairs[:, ::-1]]) if len(pairs) else np.zeros((0, 2), int)
     i, j = cv[ij[:, 0]], cv[ij[:, 1]]

@@ -169,7 +169,7 @@ def probe_pieces(
             for side in (0, 1)
         ],
         axis=1,
-    )  # fmt: skip  (job, side, edge, offset)
+    )  # (job, side, edge, offset)
     n_off = offs.shape[3]
     found = np.full((n_jobs, 2), -2, dtype=np.intp)  # region matched, -1: a wall, -2: none
     hit_arcs: dict[tuple[int, int], list] = {}
@@ -210,9 +210,13 @@ def probe_pieces(
                 )
                 cands = {int(region_of_face[f]) for f in near.tolist()} - {-1}
                 match = next(
-                    (c for c in sig_regions.get(int(h[t]), ()) if c in cands and
-                     frozenset(keys) == sigs[c]), -2
-                )  # fmt: skip
+                    (
+                        c
+                        for c in sig_regions.get(int(h[t]), ())
+                        if c in cands and frozenset(keys) == sigs[c]
+                    ),
+                    -2,
+                )
                 if match < 0:
                     continue
             found[j, s] = match
@@ -227,8 +231,13 @@ def probe_pieces(
 
 def _set_hash(keys: frozenset) -> int:
     codes = np.array(sorted(keys), dtype=np.int64).reshape(-1, 2)
-    batch = ArcBatch(np.array([0, len(codes)]), np.zeros(len(codes)), np.zeros(len(codes)),
-                     codes[:, 0], codes[:, 1])  # fmt: skip
+    batch = ArcBatch(
+        np.array([0, len(codes)]),
+        np.zeros(len(codes)),
+        np.zeros(len(codes)),
+        codes[:, 0],
+        codes[:, 1],
+    )
     return int(signature_hashes(batch)[0])
 
 
@@ -251,9 +260,13 @@ def _finish(world, arr, job, regs, found, hit_arcs, hit_pn, first_pn, cells):
         full_a = np.array([k == (-1, -1) for k in ka], dtype=bool)
         full_b = np.array([k == (-1, -1) for k in kb], dtype=bool)
         ov = _arc_overlaps(
-            np.concatenate(lo1), np.concatenate(hi1), full_a,
-            np.concatenate(lo2), np.concatenate(hi2), full_b,
-        )  # fmt: skip
+            np.concatenate(lo1),
+            np.concatenate(hi1),
+            full_a,
+            np.concatenate(lo2),
+            np.concatenate(hi2),
+            full_b,
+        )
         for t in np.flatnonzero(ov > OVERLAP_TOL).tolist():
             j = int(rows[t])
             adjacent[j].add((cells[found[j, 0]][ka[t]], cells[found[j, 1]][kb[t]]))
@@ -297,9 +310,13 @@ def _fallback(world, arr, i, regions, pn, cells) -> Probed:
             ca = _nearest_cell(cells[regions[0]], ka)
             cb = _nearest_cell(cells[regions[1]], kb)
             ov = _arc_overlaps(
-                np.array([lo1]), np.array([hi1]), np.array([ka == (-1, -1)]),
-                np.array([lo2]), np.array([hi2]), np.array([kb == (-1, -1)]),
-            )[0]  # fmt: skip
+                np.array([lo1]),
+                np.array([hi1]),
+                np.array([ka == (-1, -1)]),
+                np.array([lo2]),
+                np.array([hi2]),
+                np.array([kb == (-1, -1)]),
+            )[0]
             if ca is not None and cb is not None and ov > OVERLAP_TOL:
                 adj.add((ca, cb))
     return Probed(i, regions, p, n, tuple(sorted(adj)), False)

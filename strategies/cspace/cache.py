@@ -1,33 +1,59 @@
-"""On-disk cache of decompositions, keyed by the map's digest and the parameters.
+"""On-disk cache of decompositions: keyed, checksummed, verified on load, code-free.
 
 Policies and tournaments ask for the same decomposition many times, across processes.
 Files live in ``$SURVEIL_CACHE_DIR`` (default ``~/.cache/surveil``) under ``cspace/``:
 
-* the file name is a SHA-256 of :data:`FORMAT_VERSION`, the numerical constants the
+* the file name is a SHA-256 of the key: :data:`FORMAT_VERSION`, the tolerances the
   result depends on, the map's wall digest (:attr:`envs.maps.Map.digest`), L and the
   chord tolerance, so a changed map or parameter can never hit a stale file;
-* the pickle also stores the key material, checked again on load (a renamed or
-  corrupted file is ignored and recomputed);
-* writes are atomic: a temporary file in the same directory, then ``os.replace``.
+* the file is a one-line JSON header (the key again, the body's length and SHA-256, the
+  build's statistics) followed by an ``.npz`` body of plain numeric arrays
+  (:mod:`strategies.cspace._serial`), read with ``allow_pickle=False``: loading a cache
+  file cannot run code;
+* on load the header's key must equal the expected key and the body its checksum; a
+  damaged or mismatched file (truncated, a flipped bit, empty, another map's entry
+  copied over) is rebuilt and rewritten, with a one-line warning naming the file;
+* writes are atomic (a temporary file in the same directory, then ``os.replace``); a
+  directory that cannot be written gets one warning per process, then the cache is
+  skipped for it.
 """
 
 from __future__ import annotations
 
 import hashlib
+import io
+import json
 import os
-import pickle
 import tempfile
+import warnings
+from collections.abc import Callable
 from pathlib import Path
+
+import numpy as np
 
 from envs.maps.map import Map
 from strategies.cspace import tolerances as _tol
-from strategies.cspace._build import build_decomposition
+from strategies.cspace._serial import from_arrays, to_arrays
 from strategies.cspace.decomposition import Decomposition
 
-__all__ = ["FORMAT_VERSION", "cache_path", "cached_decomposition", "resolve_cache_dir"]
+__all__ = [
+    "FORMAT_VERSION",
+    "CacheWarning",
+    "cache_path",
+    "cached_decomposition",
+    "resolve_cache_dir",
+]
 
-FORMAT_VERSION = 2
-"""Bump when the decomposition's content or pickle layout changes."""
+FORMAT_VERSION = 3
+"""Bump when the decomposition's content or the file layout changes."""
+
+MAGIC = b"SURVEIL-CSPACE-DECOMPOSITION\n"
+
+_UNWRITABLE: set[str] = set()  # directories already warned about (one warning each)
+
+
+class CacheWarning(RuntimeWarning):
+    """A cache file was damaged or mismatched (rebuilt), or could not be written."""
 
 
 def resolve_cache_dir(directory: str | os.PathLike[str] | None = None) -> Path:
@@ -39,16 +65,20 @@ def resolve_cache_dir(directory: str | os.PathLike[str] | None = None) -> Path:
 
 
 def _key(world: Map, L: float, chord_tol: float | None) -> dict:
+    return json.loads(json.dumps(_raw_key(world, L, chord_tol)))  # as read back from a file
+
+
+def _raw_key(world: Map, L: float, chord_tol: float | None) -> dict:
     return {
         "format": FORMAT_VERSION,
-        "constants": (
+        "tolerances": [
             _tol.CHORD_TOL_REL,
             _tol.MERGE_REL,
             _tol.TOUCH_REL,
             _tol.THIN_REL,
             _tol.PROBE_REL,
-            tuple(sorted(_tol.KERNEL_FLOOR.items())),
-        ),
+            sorted(_tol.KERNEL_FLOOR.items()),
+        ],
         "map": world.digest,
         "L": float(L).hex(),
         "chord_tol": None if chord_tol is None else float(chord_tol).hex(),
@@ -59,34 +89,102 @@ def cache_path(
     world: Map, L: float, chord_tol: float | None = None, directory: str | os.PathLike | None = None
 ) -> Path:
     """The file that holds (or would hold) the decomposition of ``world`` at ``L``."""
-    key = _key(world, L, chord_tol)
-    h = hashlib.sha256(repr(sorted(key.items())).encode()).hexdigest()[:40]
-    return resolve_cache_dir(directory) / "cspace" / f"decomposition-v{FORMAT_VERSION}-{h}.pkl"
+    key = json.dumps(_key(world, L, chord_tol), sort_keys=True)
+    h = hashlib.sha256(key.encode()).hexdigest()[:40]
+    return resolve_cache_dir(directory) / "cspace" / f"decomposition-v{FORMAT_VERSION}-{h}.cache"
 
 
-def _read(path: Path, key: dict) -> Decomposition | None:
+def _encode(key: dict, dec: Decomposition) -> bytes:
+    buf = io.BytesIO()
+    np.savez(buf, **to_arrays(dec))
+    body = buf.getvalue()
+    header = {
+        "key": key,
+        "bytes": len(body),
+        "sha256": hashlib.sha256(body).hexdigest(),
+        "stats": dec.stats,
+    }
+    return MAGIC + json.dumps(header, sort_keys=True).encode() + b"\n" + body
+
+
+class _Bad(Exception):
+    """Why a cache file cannot be used."""
+
+
+def _decode(raw: bytes, key: dict, world: Map) -> Decomposition:
+    if not raw:
+        raise _Bad("empty file")
+    if not raw.startswith(MAGIC):
+        raise _Bad("not a decomposition cache file")
+    end = raw.find(b"\n", len(MAGIC))
+    if end < 0:
+        raise _Bad("truncated header")
     try:
-        with path.open("rb") as fh:
-            payload = pickle.load(fh)
-    except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError, ValueError):
+        header = json.loads(raw[len(MAGIC) : end].decode())
+    except (UnicodeDecodeError, ValueError) as exc:
+        raise _Bad(f"unreadable header ({exc})") from None
+    if not isinstance(header, dict) or header.get("key") != key:
+        raise _Bad("its key is another map's or another parameter's")
+    body = raw[end + 1 :]
+    if len(body) != header.get("bytes"):
+        raise _Bad(f"truncated ({len(body)} of {header.get('bytes')} bytes)")
+    if hashlib.sha256(body).hexdigest() != header.get("sha256"):
+        raise _Bad("checksum mismatch (damaged)")
+    try:
+        with np.load(io.BytesIO(body), allow_pickle=False) as data:
+            arrays = {k: data[k] for k in data.files}
+        return from_arrays(world, arrays, dict(header.get("stats") or {}))
+    except Exception as exc:  # a valid checksum on content we cannot read: a bug or an old layout
+        raise _Bad(f"unreadable content ({type(exc).__name__}: {exc})") from None
+
+
+def _read(path: Path, key: dict, world: Map) -> Decomposition | None:
+    try:
+        raw = path.read_bytes()
+    except (FileNotFoundError, NotADirectoryError):  # no entry (the write warns if it fails)
         return None
-    if not isinstance(payload, dict) or payload.get("key") != key:
+    except OSError as exc:
+        warnings.warn(
+            f"decomposition cache {path}: cannot read ({exc}); rebuilding",
+            CacheWarning,
+            stacklevel=4,
+        )
         return None
-    dec = payload.get("decomposition")
-    if not isinstance(dec, Decomposition) or dec.map.digest != key["map"]:
+    try:
+        return _decode(raw, key, world)
+    except _Bad as why:
+        warnings.warn(
+            f"decomposition cache {path}: {why}; rebuilding it", CacheWarning, stacklevel=4
+        )
         return None
-    return dec
 
 
 def _write(path: Path, key: dict, dec: Decomposition) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent)
+    directory = path.parent
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=directory)
+    except OSError as exc:
+        if str(directory) not in _UNWRITABLE:
+            _UNWRITABLE.add(str(directory))
+            warnings.warn(
+                f"decomposition cache directory {directory} is not writable ({exc}); "
+                "decompositions will be recomputed (set SURVEIL_CACHE_DIR to change it)",
+                CacheWarning,
+                stacklevel=4,
+            )
+        return
     try:
         with os.fdopen(fd, "wb") as fh:
-            pickle.dump({"key": key, "decomposition": dec}, fh, protocol=pickle.HIGHEST_PROTOCOL)
+            fh.write(_encode(key, dec))
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         Path(tmp).unlink(missing_ok=True)
+        if isinstance(exc, OSError):
+            warnings.warn(
+                f"decomposition cache {path}: cannot write ({exc})", CacheWarning, stacklevel=4
+            )
+            return
         raise
 
 
@@ -96,22 +194,26 @@ def cached_decomposition(
     *,
     chord_tol: float | None = None,
     cache_dir: str | os.PathLike[str] | None = None,
+    build: Callable[[], Decomposition] | None = None,
 ) -> Decomposition:
-    """The decomposition of ``world`` at ``L``, from the cache or computed and stored.
+    """The decomposition of ``world`` at ``L``, from the cache or built and stored.
 
     Args:
         world: the map.
         L: rod length.
         chord_tol: polyline tolerance (part of the key).
         cache_dir: directory (default ``$SURVEIL_CACHE_DIR`` or ``~/.cache/surveil``).
+        build: how to build it on a miss (default: ``build_decomposition``).
     """
     key = _key(world, L, chord_tol)
     path = cache_path(world, L, chord_tol, cache_dir)
-    dec = _read(path, key) if path.exists() else None
+    dec = _read(path, key, world)
     if dec is None:
-        dec = build_decomposition(world, L, chord_tol)
-        try:
-            _write(path, key, dec)
-        except OSError:
-            pass  # a read-only or full disk only costs the recomputation next time
+        if build is None:
+            from strategies.cspace._build import build_decomposition
+
+            dec = build_decomposition(world, L, chord_tol)
+        else:
+            dec = build()
+        _write(path, key, dec)
     return dec

@@ -409,6 +409,8 @@ def decompose(
     chord_tol: float | None = None,
     cache: bool = False,
     cache_dir=None,
+    progress: bool | None = None,
+    memory_budget: float | str | None = None,
 ) -> Decomposition:
     """The decomposition K_L of the slice Q_L for rod length ``L`` (Secs. 3-4).
 
@@ -419,21 +421,48 @@ def decompose(
             ``CHORD_TOL_REL * L``).
         cache: read and write the on-disk cache (:mod:`strategies.cspace.cache`).
         cache_dir: cache directory (default ``$SURVEIL_CACHE_DIR`` or ``~/.cache/surveil``).
+        progress: show a progress bar on standard error (``None``: when the build is
+            estimated to take more than a few seconds and standard error is a terminal).
+        memory_budget: refuse, before starting, a build estimated to need more memory
+            (bytes, or ``"2GB"``; default ``$SURVEIL_MEMORY_BUDGET`` or half the RAM).
 
     Returns:
         The :class:`Decomposition`.
 
     Raises:
-        InvalidConfigError: for a non-map or a bad ``L`` / ``chord_tol``.
+        InvalidConfigError: for a non-map or a bad ``L`` / ``chord_tol`` / budget.
+        InfeasibleError: if the build would exceed the memory budget (the message gives
+            the estimate and how to change it).
     """
+    from strategies.cspace._budget import memory_budget as _budget
+
     world = _check_map(map)
     L = check_length(L)
     if chord_tol is not None:
         chord_tol = check_length(chord_tol, "chord_tol")
+    if progress is not None and not isinstance(progress, bool):
+        raise InvalidConfigError(f"progress = {progress!r}: expected True, False or None")
+    budget = _budget(memory_budget)
+
+    def build() -> Decomposition:
+        return _build(world, L, chord_tol, progress, budget)
+
     if cache:
         from strategies.cspace.cache import cached_decomposition
 
-        return cached_decomposition(world, L, chord_tol=chord_tol, cache_dir=cache_dir)
-    from strategies.cspace._build import build_decomposition
+        return cached_decomposition(world, L, chord_tol=chord_tol, cache_dir=cache_dir, build=build)
+    return build()
 
-    return build_decomposition(world, L, chord_tol)
+
+def _build(world: Map, L: float, chord_tol, progress: bool | None, budget: float):
+    from strategies.cspace._budget import check_budget
+    from strategies.cspace._build import build_decomposition
+    from strategies.cspace._progress import Progress
+
+    show = progress
+    if L < diameter(world):
+        est = check_budget(world, L, budget)
+        if show is None and est.seconds < 5.0:
+            show = False
+    bar = Progress(show, label=f"decompose {world.name} L={L:g}")
+    return build_decomposition(world, L, chord_tol, bar)

@@ -33,8 +33,8 @@ import numpy as np
 
 from envs.errors import InvalidConfigError
 from envs.maps import Map
-from envs.tolerances import REL_LENGTH_TOL
 from strategies.cspace.cache import resolve_cache_dir
+from strategies.cspace.grids import grid_points
 
 __all__ = ["NO_PATH", "SOURCE", "SafetyTable", "grid_points", "safety_table"]
 
@@ -45,8 +45,6 @@ TABLE_VERSION = 2
 
 SOURCE = "decomposition"
 """What the table is built from (part of the cache key): the exact cells of K_L."""
-
-_CHUNK = 65536
 
 
 @dataclass(frozen=True, eq=False)
@@ -143,32 +141,6 @@ def _circular_distance(safe: np.ndarray, step: int) -> np.ndarray:
 def cache_dir() -> Path:
     """Directory of the on-disk table cache: the decompositions' (``$SURVEIL_CACHE_DIR``)."""
     return resolve_cache_dir()
-
-
-@functools.lru_cache(maxsize=4)
-def _axis(lo: float, hi: float, resolution: float) -> np.ndarray:
-    """Grid abscissae with spacing ``resolution``, centred in ``[lo, hi]``."""
-    n = max(1, math.floor((hi - lo) / resolution))
-    return lo + 0.5 * ((hi - lo) - (n - 1) * resolution) + resolution * np.arange(n)
-
-
-def grid_points(world: Map, resolution: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Grid points strictly inside the free region: (origin, cell index array, points)."""
-    xmin, ymin, xmax, ymax = world.bounds
-    xs, ys = _axis(xmin, xmax, resolution), _axis(ymin, ymax, resolution)
-    gi, gj = np.meshgrid(np.arange(len(xs)), np.arange(len(ys)), indexing="ij")
-    cand = np.stack([xs[gi.ravel()], ys[gj.ravel()]], axis=1)
-    keep = np.zeros(len(cand), dtype=bool)
-    for s in range(0, len(cand), _CHUNK):
-        c = cand[s : s + _CHUNK]
-        ok = world.contains(c)
-        ok[ok] = world.distance_to_walls(c[ok]) > REL_LENGTH_TOL * world.scale
-        keep[s : s + _CHUNK] = ok
-    idx = np.flatnonzero(keep)
-    cell = np.full(gi.size, -1, dtype=np.int32)
-    cell[idx] = np.arange(len(idx), dtype=np.int32)
-    origin = np.array([xs[0], ys[0]], dtype=float)
-    return origin, cell.reshape(gi.shape), cand[idx]
 
 
 def _arc_bins(arcs, centres: np.ndarray) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""Tests of the grid oracle for the Section 4 verdict (strategies.cspace.grid_oracle)."""
+"""Tests of the grid oracle for the Section 4 verdict (tests/oracles/grid_oracle.py)."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from shapely.geometry import LineString
 
 from envs.errors import InvalidConfigError, InvalidPlacementError
 from envs.maps import Map
-from strategies.cspace import grid_oracle as go
+from tests.oracles import grid_oracle as go
 
 L = 2.0  # L = L_min = 2, corridor width 1 (THEORY 3)
 

@@ -3,7 +3,7 @@
 Two independent computations of Sec. 4's escapable cells: critical curves, regions and
 stop-keyed cells on one side, a grid of evader positions with arcs followed along each
 step on the other. The grid's errors are one-sided (see the module docstring of
-``strategies.cspace.grid_oracle``): what it calls escapable must be escapable exactly;
+``tests.oracles.grid_oracle``): what it calls escapable must be escapable exactly;
 it may miss escapes through regions thinner than its spacing.
 """
 
@@ -15,7 +15,7 @@ import shapely
 from shapely.geometry import LineString
 
 from envs.maps import Map
-from strategies.cspace import grid_oracle as go
+from tests.oracles import grid_oracle as go
 from tests.strategies.cspace.test_grid_oracle import (
     corridor_world,
     open_room,

@@ -21,8 +21,8 @@ from shapely.geometry import LineString
 from envs.geometry import kernel_for
 from envs.maps import builtin_map
 from strategies.cspace import decompose
-from strategies.cspace.grid_oracle import grid_graph
 from strategies.policies.safety import SOURCE, TABLE_VERSION, safety_table
+from tests.oracles.grid_oracle import grid_graph
 
 RES = 0.25
 L = 2.0

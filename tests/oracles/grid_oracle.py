@@ -57,6 +57,7 @@ from envs.geometry import kernel_for
 from envs.geometry.types import Arc
 from envs.maps.map import Map
 from envs.tolerances import REL_LENGTH_TOL
+from strategies.cspace.grids import grid_axis
 
 __all__ = [
     "OVERLAP_TOL",
@@ -111,11 +112,7 @@ def _as_point(point: Sequence[float] | np.ndarray) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- geometry
-def _axis(lo: float, hi: float, resolution: float) -> np.ndarray:
-    """Grid abscissae with spacing ``resolution``, centred in ``[lo, hi]``."""
-    n = max(1, math.floor((hi - lo) / resolution))
-    start = lo + 0.5 * ((hi - lo) - (n - 1) * resolution)
-    return start + resolution * np.arange(n)
+_axis = grid_axis  # the product's grid (strategies.cspace.grids), so both sample alike
 
 
 def _clearance(map_: Map, points: np.ndarray) -> np.ndarray:

@@ -1,0 +1,71 @@
+"""Regular grids of evader positions over a map's free region (product code).
+
+Tables that policies look up (the safety table, the escape plan's walks) and test
+oracles sample the free region on a grid; this module is the one place that makes it.
+The grid is centred in the map's bounding box, and a point belongs to it when it lies
+strictly inside the free region (farther than the geometry kernel's length tolerance
+from every wall). Membership is decided by shapely's prepared predicates, vectorised,
+so a grid of millions of points over a map of thousands of walls takes seconds, not the
+``points x walls`` work of a brute-force distance.
+
+Example:
+    >>> from envs.maps import Map
+    >>> room = Map([(0, 0), (4, 0), (4, 2), (0, 2)], [[(1, 0.5), (2, 0.5), (2, 1.5), (1, 1.5)]])
+    >>> origin, cell, pts = grid_points(room, 0.5)
+    >>> origin.tolist(), cell.shape, len(pts)
+    ([0.25, 0.25], (8, 4), 28)
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import shapely
+
+from envs.maps.map import Map
+from envs.tolerances import REL_LENGTH_TOL
+
+__all__ = ["grid_axis", "grid_points"]
+
+_CHUNK = 1 << 20  # points per vectorised membership test
+
+
+def grid_axis(lo: float, hi: float, resolution: float) -> np.ndarray:
+    """Grid abscissae with spacing ``resolution``, centred in ``[lo, hi]`` (at least one)."""
+    n = max(1, math.floor((hi - lo) / resolution))
+    return lo + 0.5 * ((hi - lo) - (n - 1) * resolution) + resolution * np.arange(n)
+
+
+def grid_points(world: Map, resolution: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The grid points strictly inside the free region.
+
+    Args:
+        world: the map.
+        resolution: grid spacing (> 0).
+
+    Returns:
+        ``(origin, cell, points)``: the position of grid index (0, 0); an (nx, ny) int32
+        array giving each grid node's row in ``points`` (-1 outside the free region);
+        the (k, 2) free points in row order (x index major).
+    """
+    xmin, ymin, xmax, ymax = world.bounds
+    xs, ys = grid_axis(xmin, xmax, resolution), grid_axis(ymin, ymax, resolution)
+    free = world.prepared_free_region
+    walls = shapely.boundary(world.free_region)
+    shapely.prepare(walls)
+    eps = REL_LENGTH_TOL * world.scale
+    keep = np.zeros(len(xs) * len(ys), dtype=bool)
+    gi = np.repeat(np.arange(len(xs)), len(ys))
+    gj = np.tile(np.arange(len(ys)), len(xs))
+    for s in range(0, len(keep), _CHUNK):
+        x, y = xs[gi[s : s + _CHUNK]], ys[gj[s : s + _CHUNK]]
+        ok = shapely.contains_xy(free, x, y)
+        idx = np.flatnonzero(ok)
+        ok[idx] = ~shapely.dwithin(walls, shapely.points(x[idx], y[idx]), eps)
+        keep[s : s + _CHUNK] = ok
+    idx = np.flatnonzero(keep)
+    cell = np.full(len(keep), -1, dtype=np.int32)
+    cell[idx] = np.arange(len(idx), dtype=np.int32)
+    pts = np.stack([xs[gi[idx]], ys[gj[idx]]], axis=1)
+    return np.array([xs[0], ys[0]]), cell.reshape(len(xs), len(ys)), pts

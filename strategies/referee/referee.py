@@ -332,7 +332,8 @@ def solve(
     *,
     pursuer_coarse: int | None = None,
     evader_coarse: int | None = None,
-    steps: float = 2.0,
+    pursuer_steps: float = 3.0,
+    evader_steps: float = 2.0,
     sweep_pieces: int = 2,
     dt: float | None = None,
     cache: bool = True,
@@ -342,17 +343,21 @@ def solve(
     """Solve (or load) both bounds of ``spec`` at one resolution.
 
     Each bound gets :meth:`Resolution.for_role` with the same cells; each certified
-    player covers ``steps`` lattice spacings of its own lattice per step. The pursuer
-    bound loses about a cell per step to the evader's unknown position within its cell,
-    so the evader should cover several cells per step (a coarse pursuer lattice, a long
-    step); but the evader also roams freely during the pursuer's committed step, which
-    eats the sensor range from both ends (a short step). The default lattice,
-    ``round(2 / rho)`` cells (2 to 12), lets the evader cover about four cells per step.
-    The evader bound loses the pursuer's foreknowledge of the evader's step (a short step
-    is better) but needs the evader to cover a few lattice spacings per step: its
-    default lattice is ``round(8 rho)`` cells (2 to 8). Neither lattice is coarser than a
-    quarter of the sensor range ``l_max - l_min``. Both share the cells' anchor, so a
-    start with each player on its lattice can be certified either way.
+    player covers a few lattice spacings of its own lattice per step. The pursuer bound
+    loses about a cell per step to the evader's unknown position within its cell, so the
+    evader should cover several cells per step (a coarse pursuer lattice, a long step);
+    but the evader also roams freely during the pursuer's committed step, which eats the
+    sensor range from both ends (a short step). The default lattice, ``round(2 / rho)``
+    cells (2 to 12), with the pursuer covering three spacings per step, lets the evader
+    cover about six cells per step; three spacings rather than two also give the pursuer
+    moves in 16 directions rather than 8, without which the bound collapses at some
+    resolutions (the open room at rho = 0.2: 0% certified at 12 and 14 cells per L_min
+    with two spacings, 88-90% with three). The evader bound loses the pursuer's
+    foreknowledge of the evader's step (a short step is better: two spacings) but needs
+    the evader to cover a few lattice spacings per step: its default lattice is
+    ``round(8 rho)`` cells (2 to 8). Neither lattice is coarser than a quarter of the
+    sensor range ``l_max - l_min``. Both share the cells' anchor, so a start with each
+    player on its lattice can be certified either way.
 
     Args:
         spec: the game.
@@ -360,7 +365,8 @@ def solve(
             grows, the cost grows about as its fourth power).
         pursuer_coarse: cells per spacing of the pursuer bound's lattice (None: auto).
         evader_coarse: cells per spacing of the evader bound's lattice (None: auto).
-        steps: lattice spacings per step of the certified player.
+        pursuer_steps: lattice spacings the pursuer covers per step (pursuer bound).
+        evader_steps: lattice spacings the evader covers per step (evader bound).
         sweep_pieces: pieces per step of the pursuer bound's sweep test.
         dt: round each ``tau`` up to a whole number of this env step (for referee policies).
         cache: read and write the on-disk cache.
@@ -369,7 +375,7 @@ def solve(
     """
     if not isinstance(spec, GameSpec):
         raise InvalidConfigError(f"solve: expected a GameSpec, got {type(spec).__name__}")
-    kw = dict(steps=steps, sweep_pieces=sweep_pieces, dt=dt)
+    kw = dict(sweep_pieces=sweep_pieces, dt=dt)
     # at least four lattice spacings across the sensor range [l_min, l_max]
     cap = max(2, math.floor((spec.l_max - spec.l_min) * V.positive("cells_per_lmin",
                                                                   cells_per_lmin)
@@ -378,8 +384,10 @@ def solve(
         pursuer_coarse = int(min(12, cap, max(2, round(2.0 / spec.rho))))
     if evader_coarse is None:
         evader_coarse = int(min(8, cap, max(2, round(8.0 * spec.rho))))
-    rp = Resolution.for_role(spec, "pursuer", cells_per_lmin, coarse=pursuer_coarse, **kw)
-    re = Resolution.for_role(spec, "evader", cells_per_lmin, coarse=evader_coarse, **kw)
+    rp = Resolution.for_role(spec, "pursuer", cells_per_lmin, coarse=pursuer_coarse,
+                             steps=pursuer_steps, **kw)  # fmt: skip
+    re = Resolution.for_role(spec, "evader", cells_per_lmin, coarse=evader_coarse,
+                             steps=evader_steps, **kw)  # fmt: skip
     return Referee(
         spec=spec,
         pursuer=cached_pursuer_bound(spec, rp, cache=cache, cache_dir=cache_dir, progress=progress),

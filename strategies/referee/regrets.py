@@ -16,6 +16,7 @@ for the opponent, say nothing about a policy and are only counted.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
@@ -192,6 +193,7 @@ def tournament_regret(
     cells_per_lmin: float = DEFAULT_CELLS_PER_LMIN,
     cache: bool = True,
     cache_dir: str | os.PathLike | None = None,
+    strict: bool = False,
 ) -> list[list[str]]:
     """The regret table of a tournament run, for its report.
 
@@ -208,44 +210,64 @@ def tournament_regret(
         cells_per_lmin: resolution of the referees.
         cache: use the referees' on-disk cache.
         cache_dir: its directory.
+        strict: raise on a match whose game cannot be rebuilt (a map not found or
+            changed since the run); by default such matches are left out and a last row
+            says how many and why, so a report still renders.
 
     Returns:
         :func:`regret_table`'s rows (only matches played out, status ``"ok"``).
+
+    Raises:
+        InvalidConfigError: with ``strict``, a match whose game cannot be rebuilt.
     """
     if isinstance(spec, str):
         spec = json.loads(spec)
     maps = {m["label"]: m for m in spec.get("maps", [])}
     variants = {v.get("label", ""): v for v in spec.get("variants", [])}
-    matches = []
+    matches, skipped = [], []
     for row in rows:
         if row.get("status", "ok") != "ok" or row.get("winner") not in ("pursuer", "evader"):
             continue
-        record = row.get("record")
-        if isinstance(record, str):
-            record = json.loads(record)
-        if record:  # the runner's record: the resolved env parameters and the start
-            name = record.get("map")
-            world = _map_of(name, record.get("map_digest"), maps, geometry)
-            params = {**_builtin_params(name), **dict(record.get("overrides") or {})}
-            cfg = _config(world, params, None)
-            start = record["start"]
-        else:  # resolve the parameters as the spec does and draw the start again
-            entry = maps.get(row["map"], {})
-            source = entry.get("source", row["map"])
-            world = _map_of(source, entry.get("digest"), maps, geometry)
-            variant = variants.get(row.get("variant", ""), {})
-            params = {**_builtin_params(source), **dict(spec.get("env") or {}),
-                      **dict(variant.get("overrides") or {})}  # fmt: skip
-            cfg = _config(world, params, variant.get("rho"))
-            start = _redraw_start(cfg, row)
-        matches.append({
-            "map": world, **{k: getattr(cfg, k) for k in _PARAMS},
-            "max_cycles": cfg.max_cycles, "pursuer": row["pursuer"], "evader": row["evader"],
-            "start": start, "winner": row["winner"],
-        })  # fmt: skip
-    return regret_table(
+        try:
+            matches.append(_match_of(row, spec, maps, variants, geometry))
+        except (InvalidConfigError, InvalidPlacementError) as exc:
+            if strict:
+                raise
+            skipped.append(str(exc))
+    table = regret_table(
         regret(matches, cells_per_lmin=cells_per_lmin, cache=cache, cache_dir=cache_dir)
     )
+    if skipped:
+        note = f"{len(skipped)} matches not counted: {skipped[0]}"
+        table.append(["-", note, *[""] * (len(table[0]) - 2)])
+    return table
+
+
+def _match_of(row, spec, maps, variants, geometry) -> dict[str, Any]:
+    """The match mapping :func:`regret` reads, rebuilt from one tournament row."""
+    record = row.get("record")
+    if isinstance(record, str):
+        record = json.loads(record)
+    if record:  # the runner's record: the resolved env parameters and the start
+        name = record.get("map")
+        world = _map_of(name, record.get("map_digest"), maps, geometry)
+        params = {**_builtin_params(name), **dict(record.get("overrides") or {})}
+        cfg = _config(world, params, None)
+        start = record["start"]
+    else:  # resolve the parameters as the spec does and draw the start again
+        entry = maps.get(row["map"], {})
+        source = entry.get("source", row["map"])
+        world = _map_of(source, entry.get("digest"), maps, geometry)
+        variant = variants.get(row.get("variant", ""), {})
+        params = {**_builtin_params(source), **dict(spec.get("env") or {}),
+                  **dict(variant.get("overrides") or {})}  # fmt: skip
+        cfg = _config(world, params, variant.get("rho"))
+        start = _redraw_start(cfg, row)
+    return {
+        "map": world, **{k: getattr(cfg, k) for k in _PARAMS},
+        "max_cycles": cfg.max_cycles, "pursuer": row["pursuer"], "evader": row["evader"],
+        "start": start, "winner": row["winner"],
+    }  # fmt: skip
 
 
 def _builtin_params(name) -> dict[str, float]:
@@ -303,4 +325,5 @@ def _redraw_start(cfg, row: Mapping[str, Any]):
     from strategies.runner import episode_seeds
 
     _, s_start, _, _ = episode_seeds(int(row["seed"]))
-    return sample_start(cfg, np.random.default_rng(s_start), kind=row.get("start", "safe"))
+    judge = dataclasses.replace(cfg, observation="state")  # as the runner judges starts
+    return sample_start(judge, np.random.default_rng(s_start), kind=row.get("start", "safe"))

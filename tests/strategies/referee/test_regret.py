@@ -124,7 +124,11 @@ def test_tournament_regret_refuses_a_changed_map(corridor_half):
              "map": "m", "variant": "", "start": "valid", "seed": 0}]  # fmt: skip
     spec = {"maps": [{"label": "m", "source": "open_room", "digest": "0" * 64}]}
     with pytest.raises(InvalidConfigError, match="has changed since the run"):
-        tournament_regret(spec, rows, cache=False)
+        tournament_regret(spec, rows, cache=False, strict=True)
+    # a report still renders: the match is left out and the last row says why
+    table = tournament_regret(spec, rows, cache=False)
+    assert len(table) == 2 and "1 matches not counted" in table[1][1]
+    assert "has changed since the run" in table[1][1] and len(table[1]) == len(table[0])
     spec = {"maps": [{"label": "m", "source": "/nonexistent/map.json"}]}
     with pytest.raises(InvalidConfigError, match="cannot find the map"):
-        tournament_regret(spec, rows, cache=False)
+        tournament_regret(spec, rows, cache=False, strict=True)

@@ -36,6 +36,13 @@ def reach_rectangles(
 
     Returns:
         ``[(half_x, half_y), ...]``.
+
+    Examples:
+        Within one cell's width of a cell: the 3 x 3 block and the four cells two away
+        along the axes (a plus-shaped 5 x 5 without its corners' neighbours):
+
+        >>> reach_rectangles(1.0, 1.0)
+        [(1, 2), (2, 1)]
     """
     r = reach / h
     K = math.floor(r + 1e-9)

@@ -140,6 +140,16 @@ class Referee:
     def classify(self, pursuer, evader) -> str:
         """``"pursuer"``, ``"evader"`` or ``"unknown"`` for one real start.
 
+        Examples:
+            A slow evader in an open room: the pursuer holds from a start in the middle.
+
+            >>> from envs.maps import Map
+            >>> room = Map([(0, 0), (5, 0), (5, 5), (0, 5)])
+            >>> spec = GameSpec(room, 1.0, 2.0, v_pursuer=1.0, v_evader=0.2, body_radius=0.05)
+            >>> ref = solve(spec, 12, cache=False)
+            >>> ref.classify((2.5, 4.0), (2.5, 2.5))
+            'pursuer'
+
         Raises:
             InvalidConfigError: a position is not a finite (x, y) point.
             InvalidPlacementError: surveillance does not hold at the start (out of range

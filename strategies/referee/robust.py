@@ -73,8 +73,10 @@ def _cone_normals(vx, vy, cx, cy, R):
 
 def _clip(lo, hi, alpha, beta):
     """Intersect [lo, hi] with {s : alpha + s beta >= 0}."""
+    alpha = np.asarray(alpha, dtype=float)
+    beta = np.asarray(beta, dtype=float)
     with np.errstate(divide="ignore", invalid="ignore"):
-        root = -alpha / beta
+        root = np.divide(-alpha, beta)
     lo = np.where(beta > 0, np.maximum(lo, root), lo)
     hi = np.where(beta < 0, np.minimum(hi, root), hi)
     return np.where((beta == 0) & (alpha < 0), np.inf, lo), hi
@@ -104,6 +106,18 @@ def sweep_hits_vertex(ax, ay, bx, by, vx, vy, cx, cy, R, din, dout, eta=0.0) -> 
 
     Returns:
         Boolean array (broadcast shape): True when some rod of the family may graze v.
+
+    Examples:
+        A square obstacle in the first quadrant, its corner v at the origin (the wall
+        arrives along -x and leaves along +y, free space on the left). A pursuer down
+        and to the left, in the wedge opposite the obstacle, never grazes v, however
+        close the evader's disc; beside the obstacle, below its bottom edge, it may:
+
+        >>> din, dout = (-1.0, 0.0), (0.0, 1.0)
+        >>> bool(sweep_hits_vertex(-1.0, -1.2, -1.3, -0.9, 0, 0, 0.1, 0.1, 0.3, din, dout))
+        False
+        >>> bool(sweep_hits_vertex(1.5, -1.0, 1.5, -1.0, 0, 0, -0.1, 0.1, 0.3, din, dout))
+        True
     """
     inside, npx, npy, nmx, nmy = _cone_normals(vx, vy, cx, cy, R)
     shape = np.broadcast(ax, bx, vx, cx, R).shape
@@ -164,7 +178,13 @@ def sweep_range_ok(ox, oy, dx, dy, R0, g, l_min, l_max) -> np.ndarray:
 
 def square_range(ox, oy, half) -> tuple[np.ndarray, np.ndarray]:
     """Smallest and largest distance from the origin to the squares of half-side ``half``
-    centred at (ox, oy)."""
+    centred at (ox, oy).
+
+    Examples:
+        >>> near, far = square_range(3.0, 4.0, 0.5)
+        >>> round(float(near), 4), round(float(far), 4)
+        (4.3012, 5.7009)
+    """
     ax = np.abs(ox)
     ay = np.abs(oy)
     near = np.hypot(np.maximum(ax - half, 0.0), np.maximum(ay - half, 0.0))

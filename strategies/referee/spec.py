@@ -208,6 +208,14 @@ class Resolution:
             sweep_pieces: see :class:`Resolution`.
             dt: when given (an env's step), ``tau`` is rounded up to a whole number of
                 ``dt``, so referee policies can play the result in that env.
+
+        Examples:
+            >>> from envs.maps import Map
+            >>> room = Map([(0, 0), (10, 0), (10, 10), (0, 10)])
+            >>> spec = GameSpec(room, l_min=2.0, l_max=4.0, v_pursuer=1.0, v_evader=0.5)
+            >>> res = Resolution.for_role(spec, "pursuer", 20, coarse=4, steps=2)
+            >>> res.cell, res.spacing, res.tau
+            (0.1, 0.4, 0.8)
         """
         V.choice("role", role, ("pursuer", "evader"))
         cpl = V.positive("cells_per_lmin", cells_per_lmin)

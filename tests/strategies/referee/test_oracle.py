@@ -36,6 +36,26 @@ def test_decomposition_pursuer_holds_from_certified_starts(open_slow):
             assert winner == "pursuer", (start, evader.name, steps, cause)
 
 
+def test_decomposition_pursuer_holds_from_certified_starts_in_a_pillar_room():
+    """An 8 x 8 room with a 1 x 1 pillar at rho = 0.1: the referee certifies ~90% of the
+    starts for the pursuer; the decomposition pursuer holds them against every evader,
+    the referee's charger included."""
+    from envs.maps import Map
+    from strategies.referee import solve
+    from tests.strategies.referee.conftest import spec
+
+    room = Map([(0, 0), (8, 0), (8, 8), (0, 8)], [[(3.5, 3.5), (4.5, 3.5), (4.5, 4.5),
+                                                   (3.5, 4.5)]], name="pillar8")  # fmt: skip
+    ref = solve(spec(room, 0.1), 16, dt=DT, cache=False)
+    assert ref.summary()["pursuer"] > 0.8
+    evaders = [make_policy(n) for n in policy_names("evader")] + [RefereeEvader(ref.evader)]
+    for start in ref.sample_starts(3, np.random.default_rng(7), kind="pursuer"):
+        for evader in evaders:
+            winner, steps, cause = play(ref, make_policy("pursuer/decomposition"), evader, start,
+                                        max_cycles=300)  # fmt: skip
+            assert winner == "pursuer", (start, evader.name, steps, cause)
+
+
 @pytest.mark.filterwarnings("ignore::envs.errors.RhoAboveOneWarning")  # rho = 1.5: on purpose
 @pytest.mark.parametrize("fixture", ["corridor_half", "open_fast"])
 def test_shooting_evader_escapes_from_certified_starts(fixture, request):

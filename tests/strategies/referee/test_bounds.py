@@ -164,3 +164,82 @@ def test_labels_are_invariant_under_symmetries_of_the_lattice(matrix):
     assert mapped.keys() == other.keys()
     assert mapped == other
     assert set(mapped.values()) >= {"evader"}  # not a vacuous comparison
+
+
+def test_safe_steps_never_break_under_the_env_kernels_sweep(open_slow):
+    """An independent check of the pursuer bound's losing set: for states and moves it
+    calls safe, random real evaders (anywhere in the cell, anywhere within reach at the
+    step's end, moving straight as the env interpolates a step) never break surveillance
+    under the geometry kernel's continuous sweep (the dead end: occlusion at its mouth)."""
+    from envs.geometry import kernel_for
+    from strategies.referee.pursuer_bound import _safe_tables, _unpack
+
+    rng = np.random.default_rng(3)
+    s = spec(dead_end(), 0.2)
+    corridor = solve_pursuer_bound(s, Resolution.for_role(s, "pursuer", 16, coarse=4, steps=3))
+    for pb in (corridor, open_slow.pursuer):
+        lat, spec_ = pb.lattice, pb.spec
+        ker = kernel_for(spec_.map)
+        dom = pb._domain()
+        safe = _safe_tables(lat, spec_, pb.res, pb.vectors, pb.targets, dom)
+        g = spec_.v_evader * pb.res.tau
+        checked = 0
+        verts = spec_.map.vertices[spec_.map.vertex_convex]
+        for j in rng.choice(len(pb.vectors), size=min(6, len(pb.vectors)), replace=False):
+            ok = _unpack(safe[j], lat.W)
+            k, a, b = np.nonzero(ok)
+            if len(verts):  # mostly rods passing near a convex vertex: where occlusion is
+                P, C = lat.points[k], lat.points[k] + lat.offsets[a, b]
+                d = np.full(len(k), np.inf)
+                for v in verts:
+                    t = np.clip(np.einsum("ij,ij->i", v - P, C - P)
+                                / np.einsum("ij,ij->i", C - P, C - P), 0, 1)  # fmt: skip
+                    d = np.minimum(d, np.hypot(*(P + t[:, None] * (C - P) - v).T))
+                near = np.flatnonzero(d < 0.5)
+                k, a, b = k[near], a[near], b[near]
+            for i in rng.choice(len(k), size=min(60, len(k)), replace=False):
+                p0 = lat.points[k[i]]
+                p1 = p0 + pb.vectors[j] * lat.h
+                c = p0 + lat.offsets[a[i], b[i]]
+                e0 = c + rng.uniform(-0.5, 0.5, 2) * lat.h
+                angle = rng.uniform(0, 2 * np.pi)
+                e1 = e0 + rng.uniform(0, g) * np.array([np.cos(angle), np.sin(angle)])
+                ends = np.stack([e0, e1])
+                clear = spec_.map.distance_to_walls(ends) >= spec_.opponent_clearance
+                if not (clear.all() and spec_.map.contains(ends).all()):
+                    continue  # not a real evader position
+                if not ker.line_of_sight(p0, e0):
+                    continue  # the step starts broken: not a state the pursuer is in
+                event = ker.sweep(p0, e0, p1, e1, spec_.l_min, spec_.l_max)
+                assert event is None, (p0, e0, p1, e1, event)
+                checked += 1
+        assert checked > 100
+
+
+def test_broken_states_are_broken_for_every_pursuer_in_the_cell(corridor_half):
+    """The evader bound's robust breaks, checked with the geometry kernel: every pursuer
+    position in the cell is out of range or out of sight of the evader."""
+    from envs.geometry import kernel_for
+    from envs.surveillance.rules import surveillance_status
+
+    eb = corridor_half.evader
+    lat, spec = eb.lattice, corridor_half.spec
+    ker = kernel_for(spec.map)
+    live = eb._domain() & (eb.rank == 0)  # robustly broken, not merely out of range
+    k, a, b = np.nonzero(live)
+    assert len(k) > 50
+    rng = np.random.default_rng(4)
+    checked = 0
+    for i in rng.choice(len(k), size=min(300, len(k)), replace=False):
+        e = lat.points[k[i]]
+        c = e + lat.offsets[a[i], b[i]]
+        for _ in range(5):
+            p = c + rng.uniform(-0.5, 0.5, 2) * lat.h
+            if not spec.map.contains(p[None])[0]:
+                continue
+            if spec.map.distance_to_walls(p[None])[0] < spec.opponent_clearance:
+                continue
+            status = surveillance_status(ker, tuple(p), tuple(e), spec.l_min, spec.l_max)
+            assert not status.holds, (p, e)
+            checked += 1
+    assert checked > 100

@@ -41,7 +41,8 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
         "--cells-per-lmin",
         type=real(0.0),
         default=16.0,
-        help="resolution: opponent cells per L_min (default 16; the cost grows as its 4th power)",
+        help="resolution: opponent cells per L_min (default 16; the states grow about as its "
+        "third to fourth power)",
     )
     p.add_argument("--out", help="draw the winning sets to this picture (.png, .pdf, .svg)")
     p.add_argument(

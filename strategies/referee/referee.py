@@ -372,7 +372,8 @@ def solve(
     Args:
         spec: the game.
         cells_per_lmin: opponent cells per L_min (the resolution; the gap shrinks as it
-            grows, the cost grows about as its fourth power).
+            grows, the states grow about as its third to fourth power, see
+            ``benchmarks/referee_scaling.py``).
         pursuer_coarse: cells per spacing of the pursuer bound's lattice (None: auto).
         evader_coarse: cells per spacing of the evader bound's lattice (None: auto).
         pursuer_steps: lattice spacings the pursuer covers per step (pursuer bound).

@@ -21,6 +21,7 @@ from strategies.policies.cooperative import (
 from strategies.policies.decomposition import DecompositionPursuer
 from strategies.policies.registry import register_policy
 from strategies.policies.shooting import ShootingEvader
+from strategies.referee.policy import RefereeEvader, RefereePursuer
 
 register_policy("pursuer/random", RandomPolicy, "uniform random velocity (baseline)")
 register_policy("evader/random", RandomPolicy, "uniform random velocity (baseline)")
@@ -68,4 +69,16 @@ register_policy(
     "evader/shooting",
     ShootingEvader,
     "escape plans through escapable cells, optimal escape arcs (Sec. 6), else pressure",
+)
+register_policy(
+    "pursuer/referee",
+    RefereePursuer,
+    "the bounded-speed referee's certified pursuer (solves the game at reset, cached); "
+    "keeps mid-range where nothing is certified",
+)
+register_policy(
+    "evader/referee",
+    RefereeEvader,
+    "the bounded-speed referee's certified evader (solves the game at reset, cached); "
+    "charges the pursuer where nothing is certified",
 )

@@ -10,7 +10,12 @@ does: that is what the tests check, episode by episode, against every registered
 
 Off certified states it falls back to a simple heuristic (the pursuer keeps the distance
 at the middle of the sensor range, the evader charges the pursuer) and records that it
-did, in :attr:`RefereePolicy.uncertified_steps`.
+did, in ``uncertified_steps``.
+
+Built without a bound (``make_policy("evader/referee", cells_per_lmin=16)``), a policy
+solves the env's game at reset, at that resolution and with its ``tau`` a whole number of
+env steps (:func:`strategies.referee.referee_for`; cached on disk, so only the first
+episode on a world pays).
 """
 
 from __future__ import annotations
@@ -19,6 +24,7 @@ import math
 
 import numpy as np
 
+from envs import validation as V
 from envs.errors import InvalidConfigError
 from strategies.policies.base import BasePolicy, Snapshot, unit
 from strategies.referee.evader_bound import EvaderBound
@@ -42,15 +48,42 @@ def env_steps_per_referee_step(tau: float, dt: float) -> int:
     return k
 
 
+_SOLVED: dict = {}
+"""The referees solved in this process, by (game, resolution, dt): episodes on the same
+world reuse them instead of reloading the disk cache at every reset."""
+
+
+def _solved(config, cells_per_lmin: float):
+    from strategies.referee.referee import referee_for
+    from strategies.referee.spec import GameSpec
+
+    key = (GameSpec.from_config(config), float(cells_per_lmin), float(config.dt))
+    ref = _SOLVED.get(key)
+    if ref is None:
+        ref = referee_for(config, cells_per_lmin)
+        if len(_SOLVED) >= 8:
+            _SOLVED.pop(next(iter(_SOLVED)))
+        _SOLVED[key] = ref
+    return ref
+
+
 class _RefereePolicy(BasePolicy):
     """Shared plumbing: step counting, target following, the certified flag."""
 
     role_name = ""
+    bound_type: type = object
 
-    def __init__(self, bound, *, name: str | None = None) -> None:
+    def __init__(self, bound=None, *, cells_per_lmin: float = 16.0, name: str | None = None):
         super().__init__(name=name or f"{self.role_name}/referee")
+        if bound is not None and not isinstance(bound, self.bound_type):
+            raise InvalidConfigError(
+                f"{type(self).__name__}: expected a {self.bound_type.__name__}, got "
+                f"{type(bound).__name__}"
+            )
         self.roles = (self.role_name,)
         self.bound = bound
+        self._solve = bound is None
+        self.cells_per_lmin = V.positive("cells_per_lmin", cells_per_lmin)
         self._k = 1
         self._target: np.ndarray | None = None
         self._fallback = np.zeros(2)
@@ -58,8 +91,11 @@ class _RefereePolicy(BasePolicy):
         self.referee_steps = 0
 
     def _reset(self) -> None:
-        spec = self.bound.spec
         cfg = self.config
+        if self._solve:
+            ref = _solved(cfg, self.cells_per_lmin)
+            self.bound = ref.pursuer if self.role_name == "pursuer" else ref.evader
+        spec = self.bound.spec
         for attr in ("l_min", "l_max", "v_pursuer", "v_evader"):
             if not math.isclose(getattr(cfg, attr), getattr(spec, attr), rel_tol=1e-12):
                 raise InvalidConfigError(
@@ -107,18 +143,14 @@ class RefereePursuer(_RefereePolicy):
 
     Args:
         bound: a solved :class:`PursuerBound` of the env's game (same map, range and
-            speeds; its ``tau`` a whole number of env steps).
+            speeds; its ``tau`` a whole number of env steps); None: solve the env's game
+            at reset.
+        cells_per_lmin: the resolution of that solve.
         name: registry-style name.
     """
 
     role_name = "pursuer"
-
-    def __init__(self, bound: PursuerBound, *, name: str | None = None) -> None:
-        if not isinstance(bound, PursuerBound):
-            raise InvalidConfigError(
-                f"RefereePursuer: expected a PursuerBound, got {type(bound).__name__}"
-            )
-        super().__init__(bound, name=name)
+    bound_type = PursuerBound
 
     def _plan(self, snap: Snapshot) -> np.ndarray | None:
         return self.bound.plan(snap.pursuer, snap.evader)
@@ -134,7 +166,9 @@ class RefereeEvader(_RefereePolicy):
     """Plays the evader bound's certified strategy.
 
     Args:
-        bound: a solved :class:`EvaderBound` of the env's game.
+        bound: a solved :class:`EvaderBound` of the env's game; None: solve the env's
+            game at reset.
+        cells_per_lmin: the resolution of that solve.
         name: registry-style name.
 
     Attributes:
@@ -143,13 +177,10 @@ class RefereeEvader(_RefereePolicy):
     """
 
     role_name = "evader"
+    bound_type = EvaderBound
 
-    def __init__(self, bound: EvaderBound, *, name: str | None = None) -> None:
-        if not isinstance(bound, EvaderBound):
-            raise InvalidConfigError(
-                f"RefereeEvader: expected an EvaderBound, got {type(bound).__name__}"
-            )
-        super().__init__(bound, name=name)
+    def __init__(self, bound=None, *, cells_per_lmin: float = 16.0, name: str | None = None):
+        super().__init__(bound, cells_per_lmin=cells_per_lmin, name=name)
         self.certified_steps: int | None = None
 
     def _reset(self) -> None:

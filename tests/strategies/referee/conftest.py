@@ -52,6 +52,11 @@ def corridor_half():
 
 
 def play(ref, pursuer, evader, start, max_cycles: int, seed: int = 0):
+    """:func:`play_spec` on the referee's game."""
+    return play_spec(ref.spec, pursuer, evader, start, max_cycles, seed)
+
+
+def play_spec(s, pursuer, evader, start, max_cycles: int, seed: int = 0):
     """One env episode of the referee's game between two policies from ``start``, through
     the shared episode runner.
 
@@ -61,7 +66,6 @@ def play(ref, pursuer, evader, start, max_cycles: int, seed: int = 0):
     """
     from strategies.runner import run_episode
 
-    s = ref.spec
     overrides = {"l_min": s.l_min, "l_max": s.l_max, "v_pursuer": s.v_pursuer,
                  "v_evader": s.v_evader, "body_radius": RADIUS, "dt": DT}  # fmt: skip
     r = run_episode(s.map, pursuer, evader, seed, max_cycles=max_cycles, overrides=overrides,

@@ -11,7 +11,13 @@ from envs.surveillance.config import EnvConfig
 from strategies.policies.registry import make_policy, policy_names
 from strategies.referee import RefereeEvader, RefereePursuer
 from strategies.referee.policy import env_steps_per_referee_step
-from tests.strategies.referee.conftest import DT, RADIUS, play
+from tests.strategies.referee.conftest import DT, RADIUS, play, play_spec
+
+
+def _registered(role: str) -> list[str]:
+    """The registered policies of ``role`` but the referee's own, which these tests add
+    with the fixture's solved bound (the registered one would solve the game again)."""
+    return [n for n in policy_names(role) if not n.endswith("/referee")]
 
 
 def _starts(ref, kind, n, seed):
@@ -21,7 +27,7 @@ def _starts(ref, kind, n, seed):
 def _opponents(role, ref):
     """Every registered policy of ``role``, plus the referee's own heuristic (a charger
     for the evader, a range keeper for the pursuer) on uncertified states."""
-    names = [make_policy(n) for n in policy_names(role)]
+    names = [make_policy(n) for n in _registered(role)]
     extra = RefereeEvader(ref.evader) if role == "evader" else RefereePursuer(ref.pursuer)
     return [*names, extra]
 
@@ -89,3 +95,23 @@ def test_referee_policies_refuse_a_different_game(open_slow):
         pursuer.reset(role="pursuer", map=odd.map, config=odd, seed=0)
     with pytest.raises(InvalidConfigError, match="expected a PursuerBound"):
         RefereePursuer(open_slow.evader)
+
+
+def test_registered_referee_policies_solve_their_game_at_reset(tmp_path, monkeypatch):
+    """``make_policy("evader/referee")`` solves the env's game when reset (cached on disk and
+    in the process) and plays it: from a start its bound certifies, it wins."""
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", str(tmp_path))
+    from strategies.referee import policy as referee_policy
+    from tests.strategies.referee.conftest import dead_end, spec
+
+    monkeypatch.setattr(referee_policy, "_SOLVED", {})
+    s = spec(dead_end(), 0.5)
+    evader = make_policy("evader/referee", cells_per_lmin=12)
+    winner, _steps, _ = play_spec(s, make_policy("pursuer/greedy"), evader,
+                                 {"pursuer": (-2.2, 0.0), "evader": (-0.9, 0.0)}, 300)  # fmt: skip
+    assert winner == "evader" and evader.uncertified_steps == 0
+    assert evader.certified_steps is not None
+    assert any((tmp_path / "referee").iterdir())
+    assert len(referee_policy._SOLVED) == 1
+    with pytest.raises(InvalidConfigError, match="cells_per_lmin = 0"):
+        make_policy("pursuer/referee", cells_per_lmin=0)

@@ -35,6 +35,7 @@ __all__ = ["ArcBatch", "free_arcs_batch", "stop_code", "stop_of"]
 TWO_PI = 2.0 * math.pi
 _KINDS = (("body", "edge"), ("body", "vertex"), ("tip", "vertex"), ("tip", "edge"))
 _PRI = {k: i for i, k in enumerate(_KINDS)}
+_END_ON = 1e-9  # edges seen nearly end-on (tie-prone) are not merged into chains
 _CHUNK = 600_000  # (point, edge) pairs per vectorised chunk (memory stays flat)
 
 
@@ -136,7 +137,111 @@ def _blocks(world: Map, P: np.ndarray, L: float, eps: float, pid: np.ndarray, e:
     f = flip[sel]
     code_lo = np.where(f, lb, la)
     code_hi = np.where(f, la, lb)
-    return pid[sel], start[sel], w[sel], code_lo, code_hi, pid[on]
+    g, lo, wid = pid[sel], start[sel], w[sel]
+    # runs of consecutive wall edges wholly inside the disk become one blocked arc
+    inner = (
+        (t0[sel] == 0.0)
+        & (t1[sel] == length[sel])
+        & (np.sqrt(ww[sel]) < L - eps)
+        & (db < L - eps)
+        & (wid > _END_ON)
+    )
+    if np.count_nonzero(inner) > 2 * len(P):
+        k = np.flatnonzero(inner)
+        merged, used = _chains(world, g[k], e_s[k], vb[k], ang_a[sel][k], ang_b[sel][k])
+        rest = np.ones(len(g), dtype=bool)
+        rest[k[used]] = False
+        mg, mlo, mw, mcl, mch = merged
+        g = np.concatenate([g[rest], mg])
+        lo = np.concatenate([lo[rest], mlo])
+        wid = np.concatenate([wid[rest], mw])
+        code_lo = np.concatenate([code_lo[rest], mcl])
+        code_hi = np.concatenate([code_hi[rest], mch])
+        o = np.argsort(g, kind="stable")
+        g, lo, wid, code_lo, code_hi = g[o], lo[o], wid[o], code_lo[o], code_hi[o]
+    return g, lo, wid, code_lo, code_hi, pid[on]
+
+
+def _chains(world: Map, g, e, vb, ang_a, ang_b):
+    """Merge chains of consecutive wall edges wholly inside the disk (one point each).
+
+    The blocked arcs of consecutive edges share their end angles, so a chain's union is
+    one arc, from the least to the greatest of its vertices' angles unwrapped along the
+    chain; its ends are body contacts with the vertices there (the least code among
+    vertices tied within ANGLE_TOL, as the kernel picks among tied arcs). Chains that
+    close on themselves (a whole obstacle inside the disk) are left alone.
+
+    Returns:
+        ``((g, lo, wid, code_lo, code_hi) of the merged arcs, indices of the edges used)``.
+    """
+    m = len(g)
+    order = np.lexsort((e, g))
+    gs, es = g[order], e[order]
+    nxt = world.vertex_next_edge[vb[order]]
+    link = (gs[1:] == gs[:-1]) & (es[1:] == nxt[:-1])  # k + 1 follows k along a wall ring
+    start = np.concatenate([[True], ~link])
+    run = np.cumsum(start) - 1
+    heads = np.flatnonzero(start)
+    tails = np.concatenate([heads[1:] - 1, [m - 1]])
+    # a ring's last edges and its first edges are one chain (the numbering wraps): the
+    # later run goes first; a run that closes on itself (a whole ring) is left alone
+    # for each run, the run whose head follows its tail
+    follow_key = gs[tails].astype(np.int64) * world.n_edges + nxt[tails]
+    head_key = gs[heads].astype(np.int64) * world.n_edges + es[heads]
+    pos = np.minimum(np.searchsorted(head_key, follow_key), len(heads) - 1)
+    nxt_run = np.where(head_key[pos] == follow_key, pos, -1)
+    closed = nxt_run == np.arange(len(heads))
+    joined = (nxt_run >= 0) & ~closed
+    # chain id of each run: a run joined before another takes that one's id
+    chain_of_run = np.arange(len(heads))
+    chain_of_run[joined] = nxt_run[joined]
+    # order inside a chain: the joining run's elements first
+    first_part = np.zeros(len(heads), dtype=bool)
+    first_part[joined] = True
+    idx_sorted = np.flatnonzero(~closed[run])
+    ch = chain_of_run[run[idx_sorted]]
+    part = np.where(first_part[run[idx_sorted]], 0, 1)
+    o = np.lexsort((idx_sorted, part, ch))
+    idx = order[idx_sorted[o]]
+    head = ch[o]
+    if len(idx) == 0:
+        z = np.zeros(0, dtype=np.int64)
+        return (z, np.zeros(0), np.zeros(0), z, z), z
+    delta = (ang_b[idx] - ang_a[idx] + math.pi) % TWO_PI - math.pi  # each edge's short arc
+    first = np.flatnonzero(np.concatenate([[True], head[1:] != head[:-1]]))
+    sizes = np.diff(np.concatenate([first, [len(idx)]]))
+    # per-chain running sums on a padded table (one global cumsum would lose digits)
+    col = np.arange(len(idx)) - np.repeat(first, sizes)
+    table = np.zeros((len(first), int(sizes.max())))
+    row = np.repeat(np.arange(len(first)), sizes)
+    table[row, col] = delta
+    end = np.cumsum(table, axis=1)[row, col]  # angle of each edge's end, from the first vertex
+    beg = end - delta
+    lo_c = np.minimum.reduceat(np.minimum(beg, end), first)
+    hi_c = np.maximum.reduceat(np.maximum(beg, end), first)
+    chain = row
+    big = np.iinfo(np.int64).max
+    body = np.int64(1) << 32
+    tol = ANGLE_TOL
+    lo_e, hi_e = lo_c[chain], hi_c[chain]
+    code_b, code_e = body | e[idx], body | vb[idx]
+    cl = np.minimum(
+        np.minimum.reduceat(np.where(np.abs(beg - lo_e) <= tol, code_b, big), first),
+        np.minimum.reduceat(np.where(np.abs(end - lo_e) <= tol, code_e, big), first),
+    )
+    ch = np.minimum(
+        np.minimum.reduceat(np.where(np.abs(beg - hi_e) <= tol, code_b, big), first),
+        np.minimum.reduceat(np.where(np.abs(end - hi_e) <= tol, code_e, big), first),
+    )
+    # the raw angle of the vertex at the least end (as the kernel computes it)
+    d_beg, d_end = np.abs(beg - lo_e), np.abs(end - lo_e)
+    raw = np.where(d_beg <= d_end, ang_a[idx], ang_b[idx])
+    at = np.minimum(d_beg, d_end)
+    best = np.minimum.reduceat(at, first)
+    hit = np.flatnonzero(at == best[chain])
+    pick = hit[np.concatenate([[True], chain[hit][1:] != chain[hit][:-1]])]
+    lo = raw[pick]
+    return (g[idx[first]], lo, hi_c - lo_c, cl, ch), idx
 
 
 def _complement(n: int, g, lo, wid, clo, chi):

@@ -26,7 +26,7 @@ import shapely
 
 from envs.maps.map import Map
 from strategies.cspace._batch_arcs import ArcBatch, free_arcs_batch, stop_of
-from strategies.cspace._probing import probe_pieces
+from strategies.cspace._probing import probe_pieces, signature_hashes
 from strategies.cspace._progress import Progress
 from strategies.cspace.arrangement import Arrangement, arrange
 from strategies.cspace.curves import _curves, _walls
@@ -209,7 +209,15 @@ def build_decomposition(
     r_perim = np.bincount(group[real], weights=f_perim[real], minlength=n_regions)
     width = 2.0 * r_area / np.maximum(r_perim, 1e-300)
     step("boundaries", pieces=len(arr.pieces))
-    probed, lost = probe_pieces(world, arr, group, sig_r, region_cells, width)
+    r_hash = signature_hashes(batch)[rep_face]
+    s_hash = np.zeros(len(faces), dtype=np.uint64)
+    thin = np.flatnonzero(arr.sliver)
+    if len(thin):
+        at, _ = arr.exact_samples(thin)
+        ok = np.isfinite(at[:, 0])
+        if ok.any():
+            s_hash[thin[ok]] = signature_hashes(free_arcs_batch(world, at[ok], L))
+    probed, lost = probe_pieces(world, arr, group, sig_r, region_cells, width, r_hash, s_hash)
     boundaries = tuple(
         Boundary(
             i,

@@ -159,6 +159,7 @@ def sampled_roots(
     # brackets [t_k, t_k+1] with a sign change
     lo_i, hi_i = left, left + 1
     brackets = [(owner[lo_i], t[lo_i], t[hi_i], val[lo_i])]
+    brackets += _end_brackets(owner, t, val, fin, touch, g, dg)
     # local extrema of |g| between samples of one sign: refine, then split or touch
     mid = (
         np.flatnonzero(
@@ -212,6 +213,46 @@ def sampled_roots(
         [np.zeros(len(bp) + len(zero), dtype=bool), np.ones(len(touch_pair), dtype=bool)]
     )
     return pair.astype(np.intp), tA, touching
+
+
+def _end_brackets(owner, t, val, fin, touch, g, dg):
+    """A curve ending on B may cross B again before its next sample: g is zero at the end
+    and has one sign at the next sample, but leaves the end the other way. Bracket that
+    second root: between the extremum (a zero of g', bisected) and the next sample."""
+    out = []
+    n = len(t)
+    first = np.flatnonzero(np.concatenate([[True], owner[1:] != owner[:-1]]))
+    last = np.concatenate([first[1:] - 1, [n - 1]])
+    for end, nb in ((first, first + 1), (last, last - 1)):
+        ok = (nb >= 0) & (nb < n)
+        end, nb = end[ok], nb[ok]
+        ok = (owner[nb] == owner[end]) & fin[end] & fin[nb] & (np.abs(val[end]) <= touch)
+        ok &= val[nb] != 0.0
+        end, nb = end[ok], nb[ok]
+        if len(end) == 0:
+            continue
+        s_nb = np.sign(val[nb])
+        toward = np.where(nb > end, 1.0, -1.0)  # direction from the end to its neighbour
+        leaves = np.sign(toward * dg(end, t[end])) == -s_nb  # g first goes the other way
+        end, nb, s_nb, toward = end[leaves], nb[leaves], s_nb[leaves], toward[leaves]
+        if len(end) == 0:
+            continue
+        a, b = t[end], t[nb]  # the extremum: where toward * g' turns to sign s_nb
+        good = np.sign(toward * dg(end, b)) == s_nb
+        end, nb, s_nb, toward, a, b = (x[good] for x in (end, nb, s_nb, toward, a, b))
+        for _ in range(_BISECT):
+            m = 0.5 * (a + b)
+            turned = np.sign(toward * dg(end, m)) == s_nb
+            b = np.where(turned, m, b)
+            a = np.where(turned, a, m)
+        ext = 0.5 * (a + b)
+        gext = g(end, ext)
+        cross = np.sign(gext) == -s_nb
+        lo = np.minimum(ext, t[nb])[cross]
+        hi = np.maximum(ext, t[nb])[cross]
+        glo = np.where(ext < t[nb], gext, val[nb])[cross]
+        out.append((owner[end[cross]], lo, hi, glo))
+    return out
 
 
 def _sample_index(owner: np.ndarray, pair: np.ndarray) -> np.ndarray:

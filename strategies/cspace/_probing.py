@@ -117,6 +117,8 @@ def probe_pieces(
     sigs: list[frozenset],
     cells: list[dict],
     width: np.ndarray,
+    region_hash: np.ndarray | None = None,
+    sliver_hash: np.ndarray | None = None,
 ) -> tuple[list[Probed], int]:
     """Probe every piece separating two regions (or a region and a sliver).
 
@@ -127,6 +129,11 @@ def probe_pieces(
         sigs: per region, its set of stop-code pairs.
         cells: per region, stop-code pair -> cell id.
         width: per region, twice its area over its perimeter.
+        region_hash: per region, :func:`signature_hashes` of its stop pairs (computed
+            from ``sigs`` if not given).
+        sliver_hash: per face, the hash of the stops inside it if it is a sliver: a probe
+            that never gets out of the sliver (an end of it, seen along its length) means
+            the piece is that end, which separates nothing once the sliver is collapsed.
 
     Returns:
         The probed pieces and the number of pieces along slivers that could not be
@@ -134,7 +141,9 @@ def probe_pieces(
     """
     tol = arr.tol
     L = tol.L
-    sig_hash = np.array([_set_hash(s) for s in sigs], dtype=np.uint64)
+    if region_hash is None:
+        region_hash = np.array([_set_hash(s) for s in sigs], dtype=np.uint64)
+    sig_hash = np.asarray(region_hash, dtype=np.uint64)
     # the jobs: pieces between two different regions (or a region and a sliver)
     fa = np.array([p.faces[0] for p in arr.pieces], dtype=np.intp)
     fb = np.array([p.faces[1] for p in arr.pieces], dtype=np.intp)
@@ -172,6 +181,10 @@ def probe_pieces(
     )  # (job, side, edge, offset)
     n_off = offs.shape[3]
     found = np.full((n_jobs, 2), -2, dtype=np.intp)  # region matched, -1: a wall, -2: none
+    inside = np.zeros((n_jobs, 2), dtype=bool)  # a probe stayed inside the sliver
+    own = np.zeros((n_jobs, 2), dtype=np.uint64)
+    if sliver_hash is not None:
+        own = np.stack([sliver_hash[fa[job]], sliver_hash[fb[job]]], axis=1).astype(np.uint64)
     hit_arcs: dict[tuple[int, int], list] = {}
     hit_pn: dict[int, tuple[np.ndarray, np.ndarray]] = {}
     first_pn: dict[int, tuple[np.ndarray, np.ndarray]] = {}
@@ -218,6 +231,7 @@ def probe_pieces(
                     -2,
                 )
                 if match < 0:
+                    inside[j, s] |= bool(h[t] == own[j, s])
                     continue
             found[j, s] = match
             sl = slice(batch.offsets[t], batch.offsets[t + 1])
@@ -226,6 +240,7 @@ def probe_pieces(
                 hit_pn[j] = (p[t], n[t])
         for t in range(len(todo_j)):
             first_pn.setdefault(int(todo_j[t]), (p[t], n[t]))
+    found[(found == -2) & inside] = -1  # the end of a sliver: nothing beyond to adjoin
     return _finish(world, arr, job, regs, found, hit_arcs, hit_pn, first_pn, cells)
 
 
@@ -281,7 +296,7 @@ def _finish(world, arr, job, regs, found, hit_arcs, hit_pn, first_pn, cells):
                 out.append(Probed(i, (a, b), p, n, tuple(sorted(adjacent[j]))))
             continue
         if a == -1 or b == -1:
-            continue  # a sliver between a region and a wall: no boundary
+            continue  # a sliver between a region and a wall, or its end: no boundary
         if regs[j, 0] < 0 or regs[j, 1] < 0:
             lost += 1
             continue

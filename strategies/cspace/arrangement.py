@@ -373,6 +373,14 @@ def arrange(world: Map, curves: tuple[CriticalCurve, ...], tol: Tolerances) -> A
     sliver = 2.0 * f_area < tol.thin * f_perim
     faces = list(shapely.transform(np.array(faces, dtype=object), lambda x: x + c0))
     pieces = _pieces(cv, nd, curves, face_h, offsets, pts + c0)
+    arr = Arrangement(tuple(faces), pieces, cv, nd, e_len, c0, sliver, face_h, bridge, tol, {})
+    # the polygons are exact only to the chord tolerance (two short curved edges between
+    # the same vertices are one chord twice): a face thin on its polygon is a sliver only
+    # if it is thin on the exact curves too (twice the depth of its exact sample point)
+    cand = np.flatnonzero(sliver)
+    if len(cand):
+        _, depth = arr.exact_samples(cand)
+        sliver[cand[np.isfinite(depth) & (2.0 * depth > tol.thin)]] = False
     stats = {
         "vertices": len(nd.vertices),
         "edges": ne,
@@ -403,9 +411,12 @@ def _face_samples(arr: Arrangement, sel: np.ndarray):
     best = h[first[has]]
     k = best // 2
     sign = np.where(best % 2 == 0, 1.0, -1.0)
-    bounds = shapely.bounds(np.array([arr.faces[f] for f in sel[has]], dtype=object))
-    reach = 1.01 * np.hypot(bounds[:, 2] - bounds[:, 0], bounds[:, 3] - bounds[:, 1])
-    reach = np.where(np.isfinite(reach), reach, 0.0) + tol.merge
+    # no ray inside a face is longer than half its boundary (polygons may be degenerate)
+    fh = face_h >= 0
+    perim = np.bincount(
+        face_h[fh], weights=e_len[np.flatnonzero(fh) // 2], minlength=len(arr.faces)
+    )
+    reach = 0.5 * perim[sel[has]] + tol.merge
     pts, d = ray_samples(cv, tol.L, nd.curve[k], nd.ta[k], nd.tb[k], sign, reach, tol.touch)
     out[has], depth[has] = pts, d
     return out, depth

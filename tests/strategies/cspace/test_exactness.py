@@ -188,3 +188,27 @@ def test_a_rod_longer_than_the_map_is_said_not_to_fit():
     assert not dec.rod_fits and dec.evader_wins
     assert "no rod of length L = 1e+09 fits anywhere" in dec.summary()
     assert "no rod" not in decompose(tilted_block(), 2.0).summary()
+
+
+@pytest.mark.parametrize(
+    ("seed", "n", "kind", "L"),
+    [
+        (231749, 22, "polygons", 2.5929),  # a conchoid crossing an arc just after ending on it
+        (769705, 20, "star", 3.16358),  # the same, a star obstacle
+        (898051, 13, "polygons", 3.02846),  # two short curved edges sharing their ends
+        (906808, 24, "rectangles", 2.29834),  # the end of a sliver, probed along its length
+    ],
+)
+def test_worlds_once_found_inexact_by_random_search(seed, n, kind, L):
+    dec = decompose(random_map(seed, n_vertices=n, kind=kind), L)
+    assert dec.exact, dec.stats
+    n_pts, bad = stops_constant(dec, np.random.default_rng(seed), per_region=3)
+    assert not bad and n_pts > len(dec.regions)
+
+
+def test_office_is_exact():
+    """Integer coordinates, three arcs nearly concurrent at a wall (a sliver)."""
+    from envs.maps import builtin_map
+
+    dec = decompose(builtin_map("office"), 2.0)
+    assert dec.exact, dec.stats

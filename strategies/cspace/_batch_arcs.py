@@ -18,6 +18,7 @@ full circle).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -46,8 +47,9 @@ def stop_code(stop: Stop | None) -> int:
     return (_PRI[stop.kind, stop.feature.kind] << 32) | stop.feature.index
 
 
+@functools.lru_cache(maxsize=1 << 16)
 def stop_of(code: int) -> Stop | None:
-    """The stop of an integer code."""
+    """The stop of an integer code (one shared immutable object per code)."""
     if code < 0:
         return None
     kind, feat = _KINDS[code >> 32]

@@ -185,9 +185,11 @@ def probe_pieces(
     own = np.zeros((n_jobs, 2), dtype=np.uint64)
     if sliver_hash is not None:
         own = np.stack([sliver_hash[fa[job]], sliver_hash[fb[job]]], axis=1).astype(np.uint64)
-    hit_arcs: dict[tuple[int, int], list] = {}
-    hit_pn: dict[int, tuple[np.ndarray, np.ndarray]] = {}
-    first_pn: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+    hits = []  # per round: (job, side, arcs: code_lo, code_hi, lo, hi, owner position)
+    hit_p = np.full((n_jobs, 2, 2), np.nan)  # (job, side, xy)
+    hit_n = np.full((n_jobs, 2, 2), np.nan)
+    first_p = np.full((n_jobs, 2), np.nan)
+    first_n = np.full((n_jobs, 2), np.nan)
     face_tree = shapely.STRtree(list(arr.faces))
     sig_regions: dict[int, list[int]] = {}
     for r, h in enumerate(sig_hash.tolist()):
@@ -201,47 +203,52 @@ def probe_pieces(
                 break
             continue
         p, n = arr.probes(edge_tab[todo_j, k], sign_tab[todo_j, k])
+        fresh = np.isnan(first_p[todo_j, 0])
+        first_p[todo_j[fresh]], first_n[todo_j[fresh]] = p[fresh], n[fresh]
         side_sign = np.where(todo_s == 0, 1.0, -1.0)
         q = p + (side_sign * eps[todo_j, todo_s])[:, None] * n
         batch = free_arcs_batch(world, q, L)
         h = signature_hashes(batch)
         r = regs[todo_j, todo_s]
-        ok = (r >= 0) & (h == sig_hash[np.maximum(r, 0)])
-        for t in np.flatnonzero(ok | (r < 0)).tolist():
+        match = np.where((r >= 0) & (h == sig_hash[np.maximum(r, 0)]), r, -2)
+        # across a sliver: a wall beyond, or a region near the probe with these stops
+        for t in np.flatnonzero(r < 0).tolist():
             j, s = int(todo_j[t]), int(todo_s[t])
-            keys = batch.keys(t)
-            if r[t] >= 0:
-                if frozenset(keys) != sigs[r[t]]:
-                    continue  # a hash collision: not a match
-                match = int(r[t])
-            else:  # across a sliver: a wall beyond, or a region near the probe with these stops
-                if not shapely.contains_xy(world.prepared_free_region, *q[t]):
-                    found[j, s] = -1
-                    continue
-                near = face_tree.query(
-                    shapely.Point(q[t]), predicate="dwithin", distance=eps[j, s] + 2 * tol.chord
-                )
-                cands = {int(region_of_face[f]) for f in near.tolist()} - {-1}
-                match = next(
-                    (
-                        c
-                        for c in sig_regions.get(int(h[t]), ())
-                        if c in cands and frozenset(keys) == sigs[c]
-                    ),
-                    -2,
-                )
-                if match < 0:
-                    inside[j, s] |= bool(h[t] == own[j, s])
-                    continue
-            found[j, s] = match
-            sl = slice(batch.offsets[t], batch.offsets[t + 1])
-            hit_arcs[(j, s)] = (keys, batch.lo[sl], batch.hi[sl])
-            if s == 0:
-                hit_pn[j] = (p[t], n[t])
-        for t in range(len(todo_j)):
-            first_pn.setdefault(int(todo_j[t]), (p[t], n[t]))
+            if not shapely.contains_xy(world.prepared_free_region, *q[t]):
+                found[j, s] = -1
+                continue
+            near = face_tree.query(
+                shapely.Point(q[t]), predicate="dwithin", distance=eps[j, s] + 2 * tol.chord
+            )
+            cands = {int(region_of_face[f]) for f in near.tolist()} - {-1}
+            keys = frozenset(batch.keys(t))
+            m = [c for c in sig_regions.get(int(h[t]), ()) if c in cands and keys == sigs[c]]
+            if m:
+                match[t] = m[0]
+            else:
+                inside[j, s] |= bool(h[t] == own[j, s])
+        got = np.flatnonzero(match >= 0)
+        if len(got) == 0:
+            continue
+        jj, ss = todo_j[got], todo_s[got]
+        found[jj, ss] = match[got]
+        hit_p[jj, ss], hit_n[jj, ss] = p[got], n[got]
+        cnt = np.diff(batch.offsets)[got]
+        arc = np.repeat(batch.offsets[got], cnt) + _rank(np.repeat(np.arange(len(got)), cnt))
+        hits.append(
+            (np.repeat(jj, cnt), np.repeat(ss, cnt), batch.code_lo[arc], batch.code_hi[arc],
+             batch.lo[arc], batch.hi[arc])
+        )  # fmt: skip
     found[(found == -2) & inside] = -1  # the end of a sliver: nothing beyond to adjoin
-    return _finish(world, arr, job, regs, found, hit_arcs, hit_pn, first_pn, cells)
+    return _finish(world, arr, job, regs, found, hits, hit_p, hit_n, first_p, first_n, cells)
+
+
+def _rank(g: np.ndarray) -> np.ndarray:
+    """Position of each element among the equal values before it (g grouped)."""
+    if len(g) == 0:
+        return g
+    start = np.flatnonzero(np.concatenate([[True], g[1:] != g[:-1]]))
+    return np.arange(len(g)) - np.repeat(start, np.diff(np.concatenate([start, [len(g)]])))
 
 
 def _set_hash(keys: frozenset) -> int:
@@ -256,52 +263,52 @@ def _set_hash(keys: frozenset) -> int:
     return int(signature_hashes(batch)[0])
 
 
-def _finish(world, arr, job, regs, found, hit_arcs, hit_pn, first_pn, cells):
+def _finish(world, arr, job, regs, found, hits, hit_p, hit_n, first_p, first_n, cells):
     """Adjacency of the matched pieces (vectorised overlaps), fallbacks for the rest."""
-    both = np.flatnonzero((found[:, 0] >= 0) & (found[:, 1] >= 0) & (found[:, 0] != found[:, 1]))
-    rows_j, ka, kb, lo1, hi1, lo2, hi2 = [], [], [], [], [], [], []
-    for j in both.tolist():
-        keys_a, la, ha = hit_arcs[(j, 0)]
-        keys_b, lb, hb = hit_arcs[(j, 1)]
-        na, nb = len(keys_a), len(keys_b)
-        rows_j.append(np.full(na * nb, j))
-        ka += [x for x in keys_a for _ in range(nb)]
-        kb += list(keys_b) * na
-        lo1.append(np.repeat(la, nb)), hi1.append(np.repeat(ha, nb))
-        lo2.append(np.tile(lb, na)), hi2.append(np.tile(hb, na))
-    adjacent: dict[int, set] = {int(j): set() for j in both.tolist()}
-    if rows_j:
-        rows = np.concatenate(rows_j)
-        full_a = np.array([k == (-1, -1) for k in ka], dtype=bool)
-        full_b = np.array([k == (-1, -1) for k in kb], dtype=bool)
-        ov = _arc_overlaps(
-            np.concatenate(lo1),
-            np.concatenate(hi1),
-            full_a,
-            np.concatenate(lo2),
-            np.concatenate(hi2),
-            full_b,
-        )
+    n_jobs = len(job)
+    both = (found[:, 0] >= 0) & (found[:, 1] >= 0) & (found[:, 0] != found[:, 1])
+    adjacent: dict[int, list] = {}
+    if hits:
+        hj, hs, clo, chi, lo, hi = (np.concatenate(x) for x in zip(*hits, strict=True))
+        keep = both[hj]
+        hj, hs, clo, chi, lo, hi = hj[keep], hs[keep], clo[keep], chi[keep], lo[keep], hi[keep]
+        o = np.lexsort((hs, hj))
+        hj, hs, clo, chi, lo, hi = hj[o], hs[o], clo[o], chi[o], lo[o], hi[o]
+        na = np.bincount(hj[hs == 0], minlength=n_jobs)
+        nb = np.bincount(hj[hs == 1], minlength=n_jobs)
+        start = np.concatenate([[0], np.cumsum(na + nb)])[:-1]  # each job: A arcs, then B
+        jobs = np.flatnonzero(na * nb > 0)
+        per = (na * nb)[jobs]
+        pj = np.repeat(jobs, per)
+        kk = np.arange(per.sum()) - np.repeat(np.cumsum(per) - per, per)
+        ia = start[pj] + kk // nb[pj]
+        ib = start[pj] + na[pj] + kk % nb[pj]
+        full_a = (clo[ia] == -1) & (chi[ia] == -1)
+        full_b = (clo[ib] == -1) & (chi[ib] == -1)
+        ov = _arc_overlaps(lo[ia], hi[ia], full_a, lo[ib], hi[ib], full_b)
         for t in np.flatnonzero(ov > OVERLAP_TOL).tolist():
-            j = int(rows[t])
-            adjacent[j].add((cells[found[j, 0]][ka[t]], cells[found[j, 1]][kb[t]]))
+            j = int(pj[t])
+            a, b = int(ia[t]), int(ib[t])
+            pair = (cells[found[j, 0]][(int(clo[a]), int(chi[a]))],
+                    cells[found[j, 1]][(int(clo[b]), int(chi[b]))])  # fmt: skip
+            adjacent.setdefault(j, []).append(pair)
     out = []
     lost = 0
-    for j in range(len(job)):
+    for j in range(n_jobs):
         i = int(job[j])
         a, b = int(found[j, 0]), int(found[j, 1])
         if a >= 0 and b >= 0:
             if a != b:
-                p, n = hit_pn[j]
-                out.append(Probed(i, (a, b), p, n, tuple(sorted(adjacent[j]))))
+                adj = tuple(sorted(set(adjacent.get(j, ()))))
+                out.append(Probed(i, (a, b), hit_p[j, 0].copy(), hit_n[j, 0].copy(), adj))
             continue
         if a == -1 or b == -1:
             continue  # a sliver between a region and a wall, or its end: no boundary
         if regs[j, 0] < 0 or regs[j, 1] < 0:
             lost += 1
             continue
-        out.append(_fallback(world, arr, i, (int(regs[j, 0]), int(regs[j, 1])), first_pn[j], cells))
-    out.sort(key=lambda pr: pr.piece)
+        pn = (first_p[j], first_n[j])
+        out.append(_fallback(world, arr, i, (int(regs[j, 0]), int(regs[j, 1])), pn, cells))
     return out, lost
 
 

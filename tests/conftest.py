@@ -28,3 +28,12 @@ os.environ.setdefault(
         os.path.dirname(os.path.dirname(os.path.abspath(__file__))), ".pytest_cache", "sb3-logs"
     ),
 )
+
+# property tests draw fresh examples on every run; CI (SURVEIL_CI=1, set by .ci/run) plays
+# a fixed derandomised sequence so a landing cannot hinge on a lucky draw, while local runs
+# keep exploring
+from hypothesis import settings as _hypothesis_settings
+
+_hypothesis_settings.register_profile("ci", derandomize=True, print_blob=True)
+if os.environ.get("SURVEIL_CI"):
+    _hypothesis_settings.load_profile("ci")

@@ -3,7 +3,8 @@
 ``surveil play`` is the main job: one episode on a built-in world between two registered
 policies, its outcome printed and its replay written to a GIF. The other subcommands list
 maps, draw the configuration-space decomposition of a world, draw the optimal-control
-figures of the paper, and evaluate policies against each other.
+figures of the paper, and play tournaments between policies (``surveil tournament``,
+``surveil report``; ``surveil evaluate`` is a quick one-off tournament from flags).
 """
 
 from __future__ import annotations
@@ -227,31 +228,6 @@ def _cmd_figure(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_evaluate(args: argparse.Namespace) -> int:
-    from analysis.evaluate import evaluate, format_table
-
-    overrides = json_object("--config", args.config, example=CONFIG_EXAMPLE) or None
-    table = evaluate(
-        maps=args.maps,
-        pursuers=args.pursuers,
-        evaders=args.evaders,
-        seeds=range(args.seeds),
-        max_cycles=args.max_cycles,
-        overrides=overrides,
-        start=args.start,
-        results_path=Path(args.results) if args.results else None,
-        workers=args.workers,
-    )
-    print(format_table(table))
-    if args.plot:
-        from analysis.plots import plot_matchups
-
-        Path(args.plot).parent.mkdir(parents=True, exist_ok=True)
-        plot_matchups(table, args.plot)
-        print(f"table picture written to {args.plot}")
-    return 0
-
-
 def _cmd_train(args: argparse.Namespace) -> int:
     # DESIGN.md: analysis calls training only from the command line
     from training.cli import run_train
@@ -321,24 +297,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="picture (.png, .pdf, .svg) or a directory")
     p.set_defaults(func=_cmd_figure)
 
-    p = sub.add_parser("evaluate", help="play every pursuer against every evader")
-    p.add_argument("--maps", nargs="+", default=["corridor", "two_rooms"])
-    p.add_argument("--pursuers", nargs="+", default=["pursuer/decomposition", "pursuer/greedy"])
-    p.add_argument("--evaders", nargs="+", default=["evader/shooting", "evader/straight"])
-    p.add_argument("--seeds", type=int, default=10, help="number of seeded starts per match")
-    p.add_argument("--max-cycles", type=int, default=None)
-    p.add_argument("--config", help="env overrides as JSON, e.g. '{\"v_evader\": 0.8}'")
-    p.add_argument(
-        "--start",
-        choices=["safe", "valid"],
-        default="safe",
-        help="starts in a non-escapable cell at L_min (safe) or any valid configuration",
-    )
-    p.add_argument("--workers", type=int, default=1, help="processes to play in")
-    p.add_argument("--results", help="JSONL file written as matches finish (resumable)")
-    p.add_argument("--plot", help="also draw the table as heat maps to this PNG")
-    p.set_defaults(func=_cmd_evaluate)
+    from analysis.tournament.cli import add_parsers as add_tournament_parsers
 
+    add_tournament_parsers(sub)
     _add_train_parser(sub)
     figures_cli.add_parser(sub)
     referee_cli.add_parser(sub)

@@ -57,6 +57,7 @@ __all__ = [
     "PolicyFailure",
     "Transition",
     "build_env",
+    "check_observation_options",
     "episode_seeds",
     "map_parameters",
     "observation_options",
@@ -269,10 +270,15 @@ def observation_options(policy: Any) -> dict[str, Any] | None:
         opts = opts()
     if opts is None:
         return {"observation": "state"} if getattr(policy, "uses_state", True) else None
-    return _checked_options(opts, f"policy {getattr(policy, 'name', policy)!r}")
+    return check_observation_options(opts, f"policy {getattr(policy, 'name', policy)!r}")
 
 
-def _checked_options(opts: Any, where: str) -> dict[str, Any]:
+def check_observation_options(opts: Any, where: str) -> dict[str, Any]:
+    """``opts`` as a dict of :data:`OBSERVATION_OPTIONS` with a known observation kind.
+
+    Raises:
+        InvalidConfigError: naming ``where``, the bad field or kind.
+    """
     from envs.surveillance.config import OBSERVATION_KINDS
 
     if not isinstance(opts, Mapping):
@@ -534,7 +540,7 @@ def _requests(
     out = {}
     for role, pol in policies.items():
         if explicit.get(role) is not None:
-            req = _checked_options(explicit[role], f"observations[{role!r}]")
+            req = check_observation_options(explicit[role], f"observations[{role!r}]")
         else:
             req = observation_options(pol)
         out[role] = dict(default) if req is None else req

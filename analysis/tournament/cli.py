@@ -1,0 +1,248 @@
+"""``surveil tournament``, ``surveil report``, ``surveil export`` and the ``evaluate`` alias.
+
+``surveil tournament SPEC`` plays a spec (a TOML file, or the name of a shipped spec:
+``surveil tournament --list``) into a store, resuming what is already there, and prints
+the overall table. ``surveil report STORE`` writes the Markdown and HTML report,
+``surveil export STORE FILE.csv|FILE.jsonl`` flat files. ``surveil evaluate`` builds a
+one-off spec from flags (the old interface) and runs it the same way.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from importlib import resources
+from pathlib import Path
+
+from envs.errors import InvalidConfigError
+
+__all__ = ["add_parsers", "format_cells", "shipped_specs"]
+
+EXIT_SIGNAL = {"SIGINT": 130, "SIGTERM": 143}
+
+
+def shipped_specs() -> dict[str, Path]:
+    """The specs shipped in ``analysis/specs`` by name."""
+    root = resources.files("analysis").joinpath("specs")
+    return {
+        p.name[: -len(".toml")]: Path(str(p)) for p in root.iterdir() if p.name.endswith(".toml")
+    }
+
+
+def _spec_path(text: str) -> Path:
+    path = Path(text)
+    if path.is_file():
+        return path
+    shipped = shipped_specs()
+    if text in shipped:
+        return shipped[text]
+    raise InvalidConfigError(
+        f"tournament spec {text!r}: no such file and no shipped spec of that name; shipped "
+        f"specs: {', '.join(sorted(shipped))}"
+    )
+
+
+def format_cells(cells, scope: str | None = None) -> str:
+    """Plain-text table of cells (one scope, or all)."""
+    head = ("scope", "pursuer", "evader", "n", "held [95% CI]", "mean escape s [95% CI]", "causes")
+    body = []
+    for c in cells:
+        if scope is not None and c.scope != scope:
+            continue
+        esc = "-" if math.isnan(c.escape_mean) else f"{c.escape_mean:.2f}"
+        if math.isfinite(c.escape_lo):
+            esc += f" [{max(c.escape_lo, 0.0):.2f}, {c.escape_hi:.2f}]"
+        rate = "-" if math.isnan(c.rate) else f"{c.rate:.2f} [{c.lo:.2f}, {c.hi:.2f}]"
+        causes = ",".join(f"{k}:{v}" for k, v in sorted(c.causes.items()))
+        body.append((c.scope, c.pursuer, c.evader, str(c.n), rate, esc, causes))
+    widths = [max(len(row[i]) for row in [head, *body]) for i in range(len(head))]
+    line = lambda cells: "  ".join(x.ljust(w) for x, w in zip(cells, widths, strict=True))
+    return "\n".join([line(head), line(["-" * w for w in widths]), *map(line, body)])
+
+
+def _print_outcome(summary, store: Path, report: str | None, replays: bool) -> int:
+    from analysis.tournament import statistics as st
+    from analysis.tournament.report import write_report
+    from analysis.tournament.store import Store
+
+    print(summary.describe())
+    with Store(store, create=False) as db:
+        rows = db.rows(summary.run_id)
+        cells = st.cells(rows)
+        scopes = {c.scope for c in cells}
+        print(format_cells(cells, st.OVERALL if st.OVERALL in scopes else None))
+        if report:
+            files = write_report(db, report, run_id=summary.run_id, replays=replays)
+            print(f"report written to {files['html']} and {files['markdown']}")
+    if summary.interrupted:
+        return EXIT_SIGNAL.get(summary.interrupted, 130)
+    return 0
+
+
+def _cmd_tournament(args: argparse.Namespace) -> int:
+    from analysis.tournament.driver import default_store, run_tournament
+    from analysis.tournament.spec import load_spec
+
+    if args.list:
+        for name, path in sorted(shipped_specs().items()):
+            spec = load_spec(path)
+            print(f"{name:<14} {spec.description}")
+        return 0
+    if args.spec is None:
+        raise InvalidConfigError("surveil tournament: give a SPEC (a .toml file or --list)")
+    path = _spec_path(args.spec)
+    spec = load_spec(path)
+    store = Path(args.store) if args.store else default_store(spec)
+    hint = f"surveil tournament {args.spec} --store {store}"
+    if args.backend != "process":
+        hint += f" --backend {args.backend}"
+    summary = run_tournament(
+        spec,
+        store,
+        backend=args.backend,
+        workers=args.workers,
+        address=args.address,
+        retry_errors=args.retry_errors,
+        progress=not args.no_progress,
+        resume_hint=hint,
+    )
+    report = args.report
+    if report is None and not summary.interrupted and args.report_default:
+        report = str(store.with_name(store.stem + "_report"))
+    return _print_outcome(summary, store, report, not args.no_replays)
+
+
+def _cmd_report(args: argparse.Namespace) -> int:
+    from analysis.tournament.report import write_report
+
+    store = Path(args.store)
+    out = args.out or str(store.with_name(store.stem + "_report"))
+    files = write_report(store, out, run_id=args.run, replays=not args.no_replays)
+    print(f"report written to {files['html']} and {files['markdown']}")
+    return 0
+
+
+def _cmd_export(args: argparse.Namespace) -> int:
+    from analysis.tournament.store import Store
+
+    with Store(args.store, create=False) as db:
+        run = db.run(args.run)
+        path = db.export(run["run_id"], args.out)
+        print(f"{len(db.rows(run['run_id']))} matches of run {run['run_id']} written to {path}")
+    return 0
+
+
+def _cmd_evaluate(args: argparse.Namespace) -> int:
+    import json
+
+    from analysis.tournament.driver import run_tournament
+    from analysis.tournament.spec import spec_from_dict
+
+    env = json.loads(args.config) if args.config else {}
+    if args.max_cycles is not None:
+        env["max_cycles"] = args.max_cycles
+    store = Path(args.results or "out/evaluate.sqlite")
+    if store.suffix.lower() in (".jsonl", ".json", ".csv", ".ndjson"):
+        raise InvalidConfigError(
+            f"--results {store}: results now go to a SQLite store (e.g. out/evaluate.sqlite); "
+            "write flat files with: surveil export STORE FILE.csv"
+        )
+    spec = spec_from_dict(
+        {
+            "name": "evaluate",
+            "maps": args.maps,
+            "pursuers": args.pursuers,
+            "evaders": args.evaders,
+            "seeds": args.seeds,
+            "start": args.start,
+            "env": env,
+        },
+        source="surveil evaluate",
+    )
+    summary = run_tournament(
+        spec,
+        store,
+        backend="serial" if args.workers <= 1 else "process",
+        workers=max(args.workers, 1),
+        progress=not args.no_progress,
+        resume_hint="the same surveil evaluate command",
+    )
+    code = _print_outcome(summary, store, None, False)
+    if args.plot:
+        from analysis.tournament import statistics as st
+        from analysis.tournament.report import heatmaps_png
+        from analysis.tournament.store import Store
+
+        with Store(store, create=False) as db:
+            cells = st.cells(db.rows(summary.run_id))
+        out = Path(args.plot)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_bytes(heatmaps_png(st.payoff_matrices(cells), cells))
+        print(f"table picture written to {out}")
+    return code
+
+
+def add_parsers(sub: argparse._SubParsersAction) -> None:
+    """Add ``tournament``, ``report``, ``export`` and ``evaluate`` to the ``surveil`` CLI."""
+    p = sub.add_parser(
+        "tournament",
+        help="play a tournament spec into a resumable store (see analysis/specs)",
+        description="Play every match of a TOML spec, storing each as it finishes; rerun to "
+        "resume. Ctrl-C stops cleanly.",
+    )
+    p.add_argument("spec", nargs="?", help="a spec file, or a shipped spec's name (--list)")
+    p.add_argument("--list", action="store_true", help="list the shipped specs")
+    p.add_argument("--store", help="SQLite store (default: out/tournaments/NAME.sqlite)")
+    p.add_argument("--backend", choices=["serial", "process", "ray"], default="process")
+    p.add_argument("--workers", type=int, default=None, help="processes, or local Ray CPUs")
+    p.add_argument("--address", help="Ray cluster address (with --backend ray)")
+    p.add_argument("--retry-errors", action="store_true", help="replay matches stored as errors")
+    p.add_argument("--report", help="also write the report to this directory")
+    p.add_argument(
+        "--no-report",
+        dest="report_default",
+        action="store_false",
+        help="do not write the report beside the store when the run completes",
+    )
+    p.add_argument("--no-replays", action="store_true", help="report without GIF replays")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_tournament)
+
+    p = sub.add_parser("report", help="write a tournament's Markdown and HTML report")
+    p.add_argument("store", help="the tournament's SQLite store")
+    p.add_argument("--run", help="run id (prefix) or name (default: the latest)")
+    p.add_argument("--out", help="directory (default: STORE_report beside the store)")
+    p.add_argument("--no-replays", action="store_true", help="skip the GIF replays")
+    p.set_defaults(func=_cmd_report)
+
+    p = sub.add_parser("export", help="export a tournament's results as CSV or JSON lines")
+    p.add_argument("store", help="the tournament's SQLite store")
+    p.add_argument("out", help="FILE.csv, FILE.jsonl or FILE.ndjson")
+    p.add_argument("--run", help="run id (prefix) or name (default: the latest)")
+    p.set_defaults(func=_cmd_export)
+
+    p = sub.add_parser(
+        "evaluate", help="quick matchup table from flags (a one-off tournament spec)"
+    )
+    p.add_argument("--maps", nargs="+", default=["corridor", "two_rooms"])
+    p.add_argument("--pursuers", nargs="+", default=["pursuer/decomposition", "pursuer/greedy"])
+    p.add_argument("--evaders", nargs="+", default=["evader/shooting", "evader/straight"])
+    p.add_argument("--seeds", type=int, default=10, help="number of seeded starts per match")
+    p.add_argument("--max-cycles", type=int, default=None)
+    p.add_argument("--config", help="env overrides as JSON, e.g. '{\"v_evader\": 0.8}'")
+    p.add_argument(
+        "--start",
+        choices=["safe", "valid"],
+        default="safe",
+        help="starts in a non-escapable cell at L_min (safe) or any valid one",
+    )
+    p.add_argument("--workers", type=int, default=1, help="processes to play in")
+    p.add_argument("--results", help="SQLite store (default: out/evaluate.sqlite; resumable)")
+    p.add_argument("--plot", help="also draw the table as heat maps to this PNG")
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_evaluate)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit("use: surveil tournament SPEC")

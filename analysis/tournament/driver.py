@@ -1,0 +1,208 @@
+"""The driver: plan a spec's matches, skip those already stored, play the rest, store each.
+
+:func:`run_tournament` is the Python API behind ``surveil tournament``. It takes the
+store's write lock, records the run and its plan, hands the unplayed matches to an
+executor and commits every outcome as it arrives (one transaction per match). Ctrl-C
+or SIGTERM stops it within a second or two: workers are stopped, the matches in flight
+are dropped (they are replayed on resume), and the summary says how to resume. A rerun
+of the same spec on the same store resumes; nothing stored is played again.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import sys
+import threading
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from analysis.tournament.executors import Executor, SerialExecutor, make_executor
+from analysis.tournament.identity import plan
+from analysis.tournament.spec import Spec, load_spec
+from analysis.tournament.store import Store
+from analysis.tournament.worker import context_for
+
+__all__ = ["RunSummary", "default_store", "run_tournament"]
+
+
+def default_store(spec: Spec) -> Path:
+    """Where a spec's results go unless told: ``out/tournaments/<name>.sqlite``."""
+    return Path("out") / "tournaments" / f"{spec.name}.sqlite"
+
+
+@dataclass
+class RunSummary:
+    """What one invocation of :func:`run_tournament` did.
+
+    Attributes:
+        run_id, name: the run (the spec's hash and name).
+        store: the store file.
+        planned: distinct matches the spec plans.
+        reused: of those, already in the store when the run started.
+        played: matches finished by this invocation.
+        forfeits, errors: of ``played``, how many ended so.
+        interrupted: ``None``, or the signal that stopped the run (``"SIGINT"``...).
+        seconds: wall-clock time of this invocation.
+        backend: the executor's description.
+    """
+
+    run_id: str
+    name: str
+    store: Path
+    planned: int
+    reused: int
+    played: int = 0
+    forfeits: int = 0
+    errors: int = 0
+    interrupted: str | None = None
+    seconds: float = 0.0
+    backend: str = ""
+    messages: list[str] = field(default_factory=list)
+
+    @property
+    def complete(self) -> bool:
+        """Every planned match has a result."""
+        return self.reused + self.played >= self.planned and self.interrupted is None
+
+    def describe(self) -> str:
+        """A few lines for the terminal."""
+        rate = self.played / self.seconds if self.seconds > 0 else 0.0
+        head = (
+            f"run {self.run_id} ({self.name}) in {self.store}: {self.reused + self.played} of "
+            f"{self.planned} matches stored ({self.reused} reused, {self.played} played now "
+            f"in {self.seconds:.1f} s, {rate:.2f}/s, {self.backend})"
+        )
+        if self.forfeits or self.errors:
+            head += f"; {self.forfeits} forfeits, {self.errors} errors (see the report)"
+        return "\n".join([head, *self.messages])
+
+
+def run_tournament(
+    spec: Spec | str | os.PathLike[str],
+    store: str | os.PathLike[str] | None = None,
+    *,
+    backend: str = "process",
+    workers: int | None = None,
+    address: str | None = None,
+    executor: Executor | None = None,
+    retry_errors: bool = False,
+    progress: bool = True,
+    resume_hint: str | None = None,
+) -> RunSummary:
+    """Play a tournament into a store, resuming what is already there.
+
+    Args:
+        spec: a :class:`Spec` or the path of a TOML spec.
+        store: the SQLite store (default: :func:`default_store`).
+        backend: ``"serial"``, ``"process"`` or ``"ray"``.
+        workers: processes (process backend) or CPUs of a local Ray instance.
+        address: a Ray cluster address (ray backend).
+        executor: an executor to use instead of ``backend``/``workers``/``address``.
+        retry_errors: replay matches stored as ``error`` (e.g. after fixing a map).
+        progress: show a progress bar (matches done, rate, ETA) on stderr.
+        resume_hint: the command that resumes, printed when interrupted.
+
+    Returns:
+        The :class:`RunSummary` (``interrupted`` set if a signal stopped it).
+
+    Raises:
+        InvalidConfigError: a bad spec, store or backend.
+        StoreBusyError: another driver is writing to the store.
+    """
+    t0 = time.monotonic()
+    if not isinstance(spec, Spec):
+        spec = load_spec(spec)
+    path = Path(store) if store is not None else default_store(spec)
+    db = Store(path)
+    ex: Executor | None = None
+    summary: RunSummary | None = None
+    try:
+        db.lock()
+        matches = list(plan(spec))
+        unique = list({m.match_id: (m, d) for m, d in matches}.values())
+        from envs.maps.io import map_to_dict
+
+        geometry = {m.digest: (m.map.name, map_to_dict(m.map)) for m in spec.maps}
+        done = db.begin_run(spec.run_id, spec.name, spec.to_dict(), unique, geometry)
+        if retry_errors:
+            done = db.finished(spec.run_id, include_errors=False)
+        todo = [m for m, _ in unique if m.match_id not in done]
+        summary = RunSummary(spec.run_id, spec.name, path, len(unique), len(unique) - len(todo))
+        if not todo:
+            summary.backend = "nothing to play"
+            db.end_run(spec.run_id, "finished")
+            return summary
+        ctx = context_for(spec)
+        ex = executor or make_executor(backend, workers=workers, address=address)
+        summary.backend = ex.describe()
+        _play(db, spec, todo, ctx, ex, summary, progress)
+        status = "interrupted" if summary.interrupted else "finished"
+        db.end_run(spec.run_id, status)
+        if summary.interrupted:
+            hint = resume_hint or "run the same spec on the same store again"
+            summary.messages.append(
+                f"stopped by {summary.interrupted}: {summary.reused + summary.played} of "
+                f"{summary.planned} matches are stored in {path}; to resume: {hint}"
+            )
+        return summary
+    finally:
+        if ex is not None:
+            ex.close()
+        db.close()
+        if summary is not None:
+            summary.seconds = time.monotonic() - t0
+
+
+def _play(
+    db: Store, spec: Spec, todo: list, ctx: Any, ex: Executor, summary: RunSummary, progress: bool
+) -> None:
+    from tqdm import tqdm
+
+    tqdm.monitor_interval = 0  # no monitor thread: the process backend forks workers
+    stop = threading.Event()
+    caught: list[str] = []
+
+    def on_signal(signum: int, frame: Any) -> None:
+        name = signal.Signals(signum).name
+        first = not caught
+        caught.append(name)
+        stop.set()
+        # the serial backend plays in this thread: abandon the match in progress
+        if not first or (isinstance(ex, SerialExecutor) and ex.in_match):
+            raise KeyboardInterrupt(name)
+
+    handlers = {}
+    if threading.current_thread() is threading.main_thread():
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            handlers[sig] = signal.signal(sig, on_signal)
+    bar = tqdm(
+        total=summary.planned,
+        initial=summary.reused,
+        desc=spec.name,
+        unit="match",
+        disable=not progress,
+        file=sys.stderr,
+        dynamic_ncols=True,
+        smoothing=0.05,
+    )
+    try:
+        for out in ex.run(todo, ctx, stop):
+            db.record(spec.run_id, out)
+            summary.played += 1
+            summary.forfeits += out.get("status") == "forfeit"
+            summary.errors += out.get("status") == "error"
+            bar.update(1)
+            if summary.forfeits or summary.errors:
+                bar.set_postfix(forfeits=summary.forfeits, errors=summary.errors, refresh=False)
+    except KeyboardInterrupt as exc:
+        if not caught:
+            caught.append(str(exc) or "SIGINT")
+    finally:
+        bar.close()
+        for sig, h in handlers.items():
+            signal.signal(sig, h)
+    if caught:
+        summary.interrupted = caught[0]

@@ -1,0 +1,403 @@
+"""Backends that play matches: serial, a process pool, Ray. One small interface.
+
+An executor's :meth:`Executor.run` takes the matches still to play, the worker
+:class:`~analysis.tournament.worker.Context` and a ``stop`` event, and yields one outcome
+dict per finished match, as it finishes. The driver stores each one at once. When
+``stop`` is set the executor returns within a fraction of a second, and :meth:`close`
+leaves no process behind. A new backend is one class.
+
+* :class:`SerialExecutor` -- in the driver's process (tests, debugging, profiling).
+* :class:`ProcessExecutor` -- N worker processes fed batches through pipes (default).
+  Workers die with the driver even on SIGKILL (``PR_SET_PDEATHSIG`` on Linux, a
+  parent-watching thread elsewhere), ignore Ctrl-C (the driver handles it), and a worker
+  whose match runs past the time limit plus :data:`KILL_GRACE` is killed and replaced.
+* :class:`RayExecutor` -- Ray core tasks (``ray.init(address=...)`` for a cluster, a local
+  instance otherwise), the context put in the object store once, batches of about
+  :data:`TARGET_BATCH_SECONDS` each.
+"""
+
+from __future__ import annotations
+
+import collections
+import math
+import multiprocessing as mp
+import os
+import signal
+import sys
+import threading
+import time
+from collections.abc import Iterator, Sequence
+from multiprocessing.connection import Connection, wait
+from typing import Any
+
+from analysis.tournament.identity import Match
+from analysis.tournament.worker import Context, play, play_batch
+
+__all__ = [
+    "BACKENDS",
+    "KILL_GRACE",
+    "TARGET_BATCH_SECONDS",
+    "Executor",
+    "ProcessExecutor",
+    "RayExecutor",
+    "SerialExecutor",
+    "make_executor",
+]
+
+BACKENDS = ("serial", "process", "ray")
+TARGET_BATCH_SECONDS = 1.0
+"""Aim for tasks of about this long (fewer messages; Ray's per-task cost is ~ms)."""
+KILL_GRACE = 5.0
+"""Seconds past a match's time limit before its worker process is killed."""
+POLL = 0.1
+"""Seconds between checks of the stop event and the deadlines."""
+
+
+class Executor:
+    """The interface: ``run`` yields outcomes; ``close`` releases every resource."""
+
+    name = "executor"
+
+    def run(self, matches: Sequence[Match], ctx: Context, stop: threading.Event) -> Iterator[dict]:
+        """Play ``matches``; yield one outcome dict per finished match."""
+        raise NotImplementedError
+
+    def close(self) -> None:
+        """Stop all work and release processes (idempotent)."""
+
+    def describe(self) -> str:
+        """One line for logs: the backend and its parallelism."""
+        return self.name
+
+
+class _Batcher:
+    """Batch sizes aiming at :data:`TARGET_BATCH_SECONDS` from measured match times."""
+
+    def __init__(self, workers: int) -> None:
+        self.workers = max(1, workers)
+        self.total = 0.0
+        self.count = 0
+
+    def observe(self, outcome: dict) -> None:
+        seconds = outcome.get("wall_seconds")
+        if seconds is not None:
+            self.total += float(seconds)
+            self.count += 1
+
+    def size(self, remaining: int) -> int:
+        if self.count == 0:
+            return 1  # measure first
+        per_match = max(self.total / self.count, 1e-4)
+        size = max(1, int(TARGET_BATCH_SECONDS / per_match))
+        fair = max(1, math.ceil(remaining / (2 * self.workers)))  # keep every worker fed
+        return min(size, fair)
+
+
+# --------------------------------------------------------------------------- serial
+class SerialExecutor(Executor):
+    """Plays in the driver's process, one match at a time.
+
+    A policy that hangs inside C code with signals blocked cannot be interrupted here;
+    use the process backend for untrusted policies.
+    """
+
+    name = "serial"
+
+    def __init__(self) -> None:
+        self.in_match = False
+
+    def run(self, matches: Sequence[Match], ctx: Context, stop: threading.Event) -> Iterator[dict]:
+        for m in matches:
+            if stop.is_set():
+                return
+            self.in_match = True
+            try:
+                out = play(m, ctx)
+            finally:
+                self.in_match = False
+            yield out
+
+
+# --------------------------------------------------------------------------- processes
+def _die_with_parent(parent: int) -> None:
+    """Make this worker die when the driver dies, however it dies."""
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
+        except (OSError, AttributeError):  # pragma: no cover
+            pass
+    if os.getppid() != parent:  # the parent died before prctl took effect
+        os._exit(1)
+
+    def watch() -> None:  # portable fallback
+        while True:
+            time.sleep(0.5)
+            if os.getppid() != parent:
+                os._exit(1)
+
+    threading.Thread(target=watch, daemon=True).start()
+
+
+def _worker_main(conn: Connection, ctx: Context, parent: int) -> None:
+    _die_with_parent(parent)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the driver's business
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    while True:
+        try:
+            batch = conn.recv()
+        except (EOFError, OSError):
+            break
+        if batch is None:
+            break
+        for m in batch:
+            conn.send(("start", m.match_id, time.monotonic()))
+            conn.send(("done", play(m, ctx)))
+    conn.close()
+
+
+class _Worker:
+    def __init__(self, mpctx: Any, ctx: Context) -> None:
+        self.conn, child = mpctx.Pipe()
+        self.proc = mpctx.Process(
+            target=_worker_main,
+            args=(child, ctx, os.getpid()),
+            daemon=True,
+            name="surveil-tournament-worker",
+        )
+        self.proc.start()
+        child.close()
+        self.batch: collections.deque[Match] = collections.deque()
+        self.current: Match | None = None
+        self.since = 0.0
+
+    def kill(self) -> None:
+        if self.proc.is_alive():
+            self.proc.kill()
+        self.proc.join(timeout=2.0)
+        self.conn.close()
+
+
+class ProcessExecutor(Executor):
+    """N worker processes fed batches of matches through pipes.
+
+    Args:
+        workers: processes (default: the CPUs available to this process).
+        start_method: multiprocessing start method (default ``"fork"`` where available:
+            workers start in milliseconds and see everything the driver registered).
+    """
+
+    name = "process"
+
+    def __init__(self, workers: int | None = None, *, start_method: str | None = None) -> None:
+        if workers is None:
+            affinity = getattr(os, "sched_getaffinity", None)
+            workers = len(affinity(0)) if affinity else (os.cpu_count() or 1)
+        from envs.validation import integer
+
+        self.workers = integer("workers", workers, minimum=1)
+        if start_method is None:
+            start_method = "fork" if "fork" in mp.get_all_start_methods() else "spawn"
+        self.mpctx = mp.get_context(start_method)
+        self.pool: list[_Worker] = []
+
+    def describe(self) -> str:
+        return f"process ({self.workers} workers)"
+
+    def run(self, matches: Sequence[Match], ctx: Context, stop: threading.Event) -> Iterator[dict]:
+        todo = collections.deque(matches)
+        batcher = _Batcher(self.workers)
+        self.pool = [_Worker(self.mpctx, ctx) for _ in range(min(self.workers, len(todo)))]
+        while (todo or any(w.batch or w.current for w in self.pool)) and not stop.is_set():
+            for w in self.pool:
+                if not w.batch and w.current is None and todo:
+                    n = batcher.size(len(todo))
+                    batch = [todo.popleft() for _ in range(min(n, len(todo)))]
+                    w.batch.extend(batch)
+                    w.conn.send(batch)
+            ready = wait([w.conn for w in self.pool if w.batch or w.current], timeout=POLL)
+            for w in list(self.pool):
+                if w.conn not in ready:
+                    continue
+                try:
+                    while w.conn.poll():
+                        msg = w.conn.recv()
+                        if msg[0] == "start":
+                            w.current, w.since = w.batch.popleft(), time.monotonic()
+                        else:
+                            w.current = None
+                            batcher.observe(msg[1])
+                            yield msg[1]
+                            if stop.is_set():
+                                return
+                except (EOFError, OSError):
+                    # the worker died (killed by the OOM killer, a segfault in a policy...)
+                    lost = w.current
+                    yield from self._replace(w, ctx, todo, lost, "worker process died")
+            now = time.monotonic()
+            for w in list(self.pool):
+                if w.current is not None and now - w.since > ctx.time_limit + KILL_GRACE:
+                    yield from self._replace(
+                        w,
+                        ctx,
+                        todo,
+                        w.current,
+                        f"killed: no answer {ctx.time_limit + KILL_GRACE:g} s into the match "
+                        "(a hang the time limit could not interrupt)",
+                    )
+
+    def _replace(
+        self, w: _Worker, ctx: Context, todo: collections.deque, lost: Match | None, why: str
+    ) -> Iterator[dict]:
+        w.kill()
+        todo.extendleft(reversed(w.batch))  # the unplayed rest goes back to the queue
+        self.pool.remove(w)
+        if lost is not None:
+            yield {"match_id": lost.match_id, "status": "error", "error": why}
+        if todo:
+            self.pool.append(_Worker(self.mpctx, ctx))
+
+    def close(self) -> None:
+        for w in self.pool:
+            if w.proc.is_alive():
+                w.proc.terminate()
+        deadline = time.monotonic() + 1.0
+        for w in self.pool:
+            w.proc.join(timeout=max(0.0, deadline - time.monotonic()))
+            w.kill()
+        self.pool = []
+
+
+# --------------------------------------------------------------------------- ray
+_RAY_CONTEXTS: dict[str, Context] = {}
+
+
+def _ray_play(batch: list[Match], ctx_box: list[Any]) -> list[dict]:
+    """A Ray task: fetch the run's context once per worker process, play the batch."""
+    import ray
+
+    ref = ctx_box[0]
+    key = ref.hex()
+    if key not in _RAY_CONTEXTS:
+        _RAY_CONTEXTS.clear()
+        _RAY_CONTEXTS[key] = ray.get(ref)
+    return play_batch(batch, _RAY_CONTEXTS[key])
+
+
+class RayExecutor(Executor):
+    """Ray core tasks, each a batch of matches.
+
+    Args:
+        address: a running cluster (``"auto"``, ``"ray://host:10001"``...); ``None``
+            starts a local instance with ``num_cpus`` CPUs (shut down by :meth:`close`).
+        num_cpus: CPUs of a local instance (default: all).
+    """
+
+    name = "ray"
+
+    def __init__(self, address: str | None = None, num_cpus: int | None = None) -> None:
+        try:
+            import ray
+        except ModuleNotFoundError as exc:
+            from envs.errors import InvalidConfigError
+
+            raise InvalidConfigError("--backend ray needs Ray: pip install 'surveil[ray]'") from exc
+        self.ray = ray
+        self.started = False
+        if not ray.is_initialized():
+            kwargs: dict[str, Any] = {
+                "include_dashboard": False,
+                "log_to_driver": False,
+                "configure_logging": False,
+            }
+            if address is None:
+                kwargs["num_cpus"] = num_cpus
+            ray.init(address=address, **kwargs)
+            self.started = True
+        self.cpus = max(1, int(ray.cluster_resources().get("CPU", 1)))
+        self.task = ray.remote(num_cpus=1, max_retries=0)(_ray_play)
+        self.inflight: dict[Any, tuple[list[Match], float]] = {}
+
+    def describe(self) -> str:
+        return f"ray ({self.cpus} CPUs)"
+
+    def run(self, matches: Sequence[Match], ctx: Context, stop: threading.Event) -> Iterator[dict]:
+        ray = self.ray
+        box = [ray.put(ctx)]  # shipped once; models travel inside it
+        todo = collections.deque(matches)
+        batcher = _Batcher(self.cpus)
+        solo: set[str] = set()  # matches of a timed-out batch, replayed one by one
+        while (todo or self.inflight) and not stop.is_set():
+            while todo and len(self.inflight) < 2 * self.cpus:
+                n = 1 if todo[0].match_id in solo else batcher.size(len(todo))
+                batch = [todo.popleft() for _ in range(min(n, len(todo)))]
+                ref = self.task.remote(batch, box)
+                self.inflight[ref] = (batch, time.monotonic())
+            done, _ = ray.wait(list(self.inflight), num_returns=1, timeout=POLL)
+            for ref in done:
+                batch, _ = self.inflight.pop(ref)
+                try:
+                    outcomes = ray.get(ref)
+                except Exception as exc:  # the task's worker died
+                    if len(batch) > 1:
+                        solo.update(m.match_id for m in batch)
+                        todo.extendleft(reversed(batch))
+                        continue
+                    outcomes = [
+                        {
+                            "match_id": batch[0].match_id,
+                            "status": "error",
+                            "error": f"Ray task failed: {type(exc).__name__}: {exc}",
+                        }
+                    ]
+                for out in outcomes:
+                    batcher.observe(out)
+                    yield out
+            now = time.monotonic()
+            for ref, (batch, since) in list(self.inflight.items()):
+                if now - since > len(batch) * (ctx.time_limit + 1.0) + KILL_GRACE:
+                    ray.cancel(ref, force=True)
+                    self.inflight.pop(ref)
+                    if len(batch) > 1:  # isolate the hanging match
+                        solo.update(m.match_id for m in batch)
+                        todo.extendleft(reversed(batch))
+                    else:
+                        yield {
+                            "match_id": batch[0].match_id,
+                            "status": "error",
+                            "error": "killed: the Ray task overran the time limit",
+                        }
+
+    def close(self) -> None:
+        for ref in list(self.inflight):
+            try:
+                self.ray.cancel(ref, force=True)
+            except Exception:  # pragma: no cover - already finished
+                pass
+        self.inflight.clear()
+        if self.started and self.ray.is_initialized():
+            self.ray.shutdown()
+            self.started = False
+
+
+def make_executor(
+    backend: str, *, workers: int | None = None, address: str | None = None
+) -> Executor:
+    """The executor of ``backend`` (``"serial"``, ``"process"``, ``"ray"``).
+
+    Raises:
+        InvalidConfigError: an unknown backend, or ``address`` without Ray.
+    """
+    from envs.errors import InvalidConfigError
+
+    if backend not in BACKENDS:
+        raise InvalidConfigError(f"backend = {backend!r}: expected one of {list(BACKENDS)}")
+    if address is not None and backend != "ray":
+        raise InvalidConfigError(f"--address applies to the ray backend, not {backend!r}")
+    if backend == "serial":
+        return SerialExecutor()
+    if backend == "process":
+        return ProcessExecutor(workers)
+    return RayExecutor(address, workers)

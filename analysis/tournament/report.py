@@ -1,0 +1,565 @@
+"""Tournament reports: Markdown beside its pictures, and one self-contained HTML page.
+
+:func:`write_report` reads a run from a store and writes ``report.md``, ``report.html``
+(images embedded as data URIs: the page can be mailed on its own) and the pictures
+(``heatmaps.png``, ``ratings.png``, ``replay_*.gif``) into a directory. Sections:
+
+1. the run (spec, counts, forfeits and errors);
+2. payoff matrices per map and overall as heat maps and tables (held rate with its
+   Wilson interval, mean time to escape, causes);
+3. the zero-sum game of each matrix: Nash mixtures, value, exploitability;
+4. Bradley-Terry ratings with bootstrap intervals;
+5. paired comparisons on shared starts (McNemar exact, Holm-adjusted);
+6. regret on certified starts (filled by the referee, :mod:`strategies.referee`, when it
+   offers ``tournament_regret``);
+7. replays of the most decisive matches, re-simulated from their seeds through the
+   shared runner (and checked against the stored outcome), as GIFs.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+import json
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from analysis.tournament import statistics as st
+from analysis.tournament.store import Store
+
+__all__ = ["Analysis", "analyse", "write_report"]
+
+MAX_REPLAYS = 4
+REPLAY_FRAMES = 90
+REPLAY_SIZE = 260
+
+
+@dataclass
+class Analysis:
+    """Everything a report shows, computed from one run's rows."""
+
+    run: dict[str, Any]
+    rows: list[dict[str, Any]]
+    cells: list[st.Cell]
+    matrices: list[st.Matrix]
+    games: list[st.Game]
+    ratings: list[st.Rating]
+    paired: list[st.PairedComparison]
+    errors: list[dict[str, Any]]
+    notes: list[str] = field(default_factory=list)
+
+
+def analyse(store: Store | str | os.PathLike[str], run_id: str | None = None) -> Analysis:
+    """Compute the statistics of a run (default: the store's latest)."""
+    db = store if isinstance(store, Store) else Store(store, create=False)
+    run = db.run(run_id)
+    rows = db.rows(run["run_id"])
+    cells = st.cells(rows)
+    matrices = st.payoff_matrices(cells)
+    return Analysis(
+        run=run,
+        rows=rows,
+        cells=cells,
+        matrices=matrices,
+        games=st.games(matrices),
+        ratings=st.ratings(rows),
+        paired=st.paired_comparisons(rows),
+        errors=db.errors(run["run_id"]),
+    )
+
+
+# --------------------------------------------------------------------------- pictures
+def _png(fig: Any) -> bytes:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    return buf.getvalue()
+
+
+def heatmaps_png(matrices: list[st.Matrix], cells: list[st.Cell]) -> bytes:
+    """One heat map per scope: held rate, its Wilson interval and the mean escape time."""
+    from matplotlib.figure import Figure
+
+    by = {(c.scope, c.pursuer, c.evader): c for c in cells}
+    n = len(matrices)
+    cols = min(n, 3)
+    rows = math.ceil(n / cols)
+    ps = max(len(m.pursuers) for m in matrices)
+    es = max(len(m.evaders) for m in matrices)
+    fig = Figure(figsize=(cols * (1.8 + 1.2 * es), rows * (1.3 + 0.6 * ps)), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(rows, cols, squeeze=False)).ravel()
+    image = None
+    for ax, m in zip(axes, matrices, strict=False):
+        image = ax.imshow(m.rate, cmap="RdYlBu", vmin=0.0, vmax=1.0, aspect="auto")
+        for i, p in enumerate(m.pursuers):
+            for j, e in enumerate(m.evaders):
+                c = by.get((m.scope, p, e))
+                if c is None or c.n == 0:
+                    continue
+                esc = "" if math.isnan(c.escape_mean) else f"\n{c.escape_mean:.1f} s"
+                colour = "white" if c.rate < 0.3 or c.rate > 0.8 else "black"
+                ax.text(
+                    j,
+                    i,
+                    f"{c.rate:.2f}\n[{c.lo:.2f}, {c.hi:.2f}]{esc}",
+                    ha="center",
+                    va="center",
+                    fontsize=6.5,
+                    color=colour,
+                )
+        ax.set_xticks(
+            range(len(m.evaders)),
+            [_short(e) for e in m.evaders],
+            rotation=30,
+            ha="right",
+            fontsize=7,
+        )
+        ax.set_yticks(range(len(m.pursuers)), [_short(p) for p in m.pursuers], fontsize=7)
+        ax.set_title(f"{m.scope} (n <= {int(m.n.max())} per cell)", fontsize=8)
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    if image is not None:
+        fig.colorbar(image, ax=axes[:n].tolist(), shrink=0.8).set_label(
+            "surveillance held to the horizon (rate)", fontsize=8
+        )
+    fig.suptitle(
+        "pursuers (rows) vs evaders (columns): held rate, 95% CI, mean escape time", fontsize=9
+    )
+    return _png(fig)
+
+
+def ratings_png(ratings: list[st.Rating]) -> bytes:
+    """Strengths with their bootstrap intervals, pursuers and evaders on one scale."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(6.0, 0.9 + 0.32 * len(ratings)), layout="constrained")
+    ax = fig.subplots()
+    y = np.arange(len(ratings))[::-1]
+    for k, r in zip(y, ratings, strict=True):
+        colour = "#2856dc" if r.role == "pursuer" else "#dc3232"
+        ax.errorbar(
+            r.strength,
+            k,
+            xerr=[[r.strength - r.lo], [r.hi - r.strength]],
+            fmt="o",
+            color=colour,
+            capsize=3,
+        )
+    ax.set_yticks(y, [f"{r.role[0].upper()}: {_short(r.label)}" for r in ratings], fontsize=7)
+    ax.axvline(0.0, color="grey", lw=0.6)
+    ax.set_xlabel(
+        "Bradley-Terry strength (logit; pursuer minus evader = log-odds of holding)", fontsize=8
+    )
+    return _png(fig)
+
+
+def _short(label: str) -> str:
+    return label.split("/", 1)[-1] if label.count("/") == 1 else label
+
+
+# --------------------------------------------------------------------------- replays
+@dataclass
+class Replay:
+    """A re-simulated match: its caption, GIF bytes and whether it matched the store."""
+
+    title: str
+    gif: bytes
+    consistent: bool
+
+
+def _decisive(a: Analysis) -> list[dict[str, Any]]:
+    """Per map scope: the Nash-heaviest pursuer vs evader, their quickest escape or a hold."""
+    picks = []
+    best = {g.scope: g for g in a.games}
+    strength = {(r.role, r.label): r.strength for r in a.ratings}
+    scopes = [m.scope for m in a.matrices if m.scope != st.OVERALL]
+    for scope in scopes[:MAX_REPLAYS]:
+        g = best.get(scope)
+        if g is not None:
+            p = max(g.pursuers, key=g.pursuers.get)
+            e = max(g.evaders, key=g.evaders.get)
+        else:
+            m = next(m for m in a.matrices if m.scope == scope)
+            p = max(m.pursuers, key=lambda x: strength.get(("pursuer", x), 0.0))
+            e = max(m.evaders, key=lambda x: strength.get(("evader", x), 0.0))
+        variants = len({r["variant"] for r in a.rows}) > 1
+        starts = len({r["start"] for r in a.rows}) > 1
+        mine = [
+            r
+            for r in a.rows
+            if r["pursuer"] == p
+            and r["evader"] == e
+            and r["status"] == "ok"
+            and st.scope_of(r, variants=variants, starts=starts) == scope
+        ]
+        escapes = [r for r in mine if r["winner"] == "evader"]
+        if escapes:
+            picks.append(min(escapes, key=lambda r: r["escape_time"]))
+        elif mine:
+            picks.append(mine[0])
+    return picks
+
+
+def _replay(db: Store, run: dict[str, Any], row: dict[str, Any]) -> Replay | None:
+    from envs.maps.io import map_from_dict
+    from strategies.policies import make_policy
+    from strategies.runner import run_episode
+
+    ident = json.loads(
+        db.conn.execute(
+            "SELECT identity FROM matches WHERE match_id = ?", (row["match_id"],)
+        ).fetchone()[0]
+    )
+    geometry = db.map_geometry(ident["map"])
+    if geometry is None:
+        return None
+    world = map_from_dict(geometry, source="store").map
+    spec = run["spec"]
+    entries = {(p["role"], p["label"]): p for p in (*spec["pursuers"], *spec["evaders"])}
+    pols = {}
+    for role in ("pursuer", "evader"):
+        entry = entries[(role, row[role])]
+        if entry["model"] is not None:
+            path = entry.get("model_path")
+            if not path or not Path(path).is_file() or _sha(path) != entry["model"]:
+                return None  # the model file is gone or changed: no faithful replay
+            pols[role] = make_policy(f"{role}/sb3:{path}", **entry["params"])
+        else:
+            pols[role] = make_policy(entry["name"], **entry["params"])
+    result = run_episode(
+        world,
+        pols["pursuer"],
+        pols["evader"],
+        ident["seed"],
+        overrides=ident["env"],
+        start=ident["start"],
+        observations={
+            "pursuer": ident["pursuer"]["observation"],
+            "evader": ident["evader"]["observation"],
+        },
+    )
+    consistent = result.winner == row["winner"] and result.steps == row["steps"]
+    outcome = (
+        f"escape at {result.escape_time:.1f} s ({result.cause})"
+        if result.winner == "evader"
+        else f"held {result.steps} steps"
+    )
+    title = f"{row['map']}: {row['pursuer']} vs {row['evader']}, seed {row['seed']}: {outcome}"
+    return Replay(title, _gif(result), consistent)
+
+
+def _sha(path: str) -> str:
+    import hashlib
+
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def _gif(result: Any) -> bytes:
+    from PIL import Image
+
+    from envs.surveillance.render import Snapshot, render_frame
+
+    traj = result.trajectory
+    last = len(traj) - 1
+    picks = sorted({round(k * last / max(REPLAY_FRAMES - 1, 1)) for k in range(REPLAY_FRAMES)})
+    frames = []
+    for k in picks:
+        p, e = traj[k]
+        broken = k == last and result.winner == "evader"
+        lo = max(0, k - 60)
+        frames.append(
+            Image.fromarray(
+                render_frame(
+                    Snapshot(
+                        map=result.map_obj,
+                        pursuer=tuple(p),
+                        evader=tuple(e),
+                        l_min=result.config.l_min,
+                        l_max=result.config.l_max,
+                        body_radius=result.config.body_radius,
+                        surveillance=not broken,
+                        cause=result.cause if broken else None,
+                        step=k,
+                        time=k * result.dt,
+                        trail_pursuer=tuple(map(tuple, traj[lo : k + 1, 0])),
+                        trail_evader=tuple(map(tuple, traj[lo : k + 1, 1])),
+                    ),
+                    size=REPLAY_SIZE,
+                )
+            )
+        )
+    buf = io.BytesIO()
+    durations = [60] * (len(frames) - 1) + [1500]
+    frames[0].save(
+        buf, format="GIF", save_all=True, append_images=frames[1:], duration=durations, loop=0
+    )
+    return buf.getvalue()
+
+
+# --------------------------------------------------------------------------- writing
+def _regret_section(a: Analysis) -> tuple[str, str]:
+    """The referee's regret table (Markdown, HTML), or a note saying where it will come."""
+    try:
+        from strategies.referee import tournament_regret  # type: ignore[attr-defined]
+    except ImportError:
+        text = (
+            "Not available yet: the referee (`strategies.referee`) will report each policy's "
+            "regret here, the fraction of certified-winnable starts it loses."
+        )
+        return text, f"<p>{html.escape(text)}</p>"
+    table = tournament_regret(a.run["spec"], a.rows)
+    return _md_table(table), _html_table(table)
+
+
+def _fmt(x: float, digits: int = 2) -> str:
+    return "-" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.{digits}f}"
+
+
+def _tables(a: Analysis) -> dict[str, list[list[str]]]:
+    t: dict[str, list[list[str]]] = {}
+    t["cells"] = [
+        ["scope", "pursuer", "evader", "n", "held [95% CI]", "mean escape s [95% CI]", "causes"]
+    ]
+    for c in a.cells:
+        esc = _fmt(c.escape_mean)
+        if math.isfinite(c.escape_lo):
+            esc += f" [{max(c.escape_lo, 0):.2f}, {c.escape_hi:.2f}]"
+        t["cells"].append(
+            [
+                c.scope,
+                c.pursuer,
+                c.evader,
+                str(c.n),
+                f"{_fmt(c.rate)} [{c.lo:.2f}, {c.hi:.2f}]",
+                esc,
+                ", ".join(f"{k}: {v}" for k, v in sorted(c.causes.items())),
+            ]
+        )
+    t["games"] = [
+        [
+            "scope",
+            "value (held rate)",
+            "pursuer mixture",
+            "evader mixture",
+            "pursuer exploitability",
+            "evader exploitability",
+        ]
+    ]
+    for g in a.games:
+        mix = lambda d: ", ".join(f"{k}: {v:.2f}" for k, v in d.items() if v > 0.005) or "-"
+        t["games"].append(
+            [
+                g.scope,
+                f"{g.value:.3f}",
+                mix(g.pursuers),
+                mix(g.evaders),
+                ", ".join(f"{k}: {v:.2f}" for k, v in g.pursuer_exploitability.items()),
+                ", ".join(f"{k}: {v:.2f}" for k, v in g.evader_exploitability.items()),
+            ]
+        )
+    t["ratings"] = [["role", "policy", "strength", "95% interval", "matches"]]
+    for r in a.ratings:
+        t["ratings"].append(
+            [r.role, r.label, f"{r.strength:+.2f}", f"[{r.lo:+.2f}, {r.hi:+.2f}]", str(r.matches)]
+        )
+    t["paired"] = [
+        ["role", "a", "b", "shared starts", "a only", "b only", "p (McNemar)", "p (Holm)"]
+    ]
+    for p in a.paired:
+        t["paired"].append(
+            [
+                p.role,
+                p.a,
+                p.b,
+                str(p.pairs),
+                str(p.a_only),
+                str(p.b_only),
+                f"{p.p_value:.3g}",
+                f"{p.p_holm:.3g}",
+            ]
+        )
+    t["errors"] = [["match", "kind", "message"]]
+    for e in a.errors[:50]:
+        t["errors"].append([str(e["match_id"])[:12], e["kind"], e["message"]])
+    return t
+
+
+def _md_table(rows: list[list[str]]) -> str:
+    if len(rows) < 2:
+        return "(none)"
+    esc = lambda s: str(s).replace("|", "\\|")
+    lines = ["| " + " | ".join(map(esc, rows[0])) + " |", "|" + "---|" * len(rows[0])]
+    lines += ["| " + " | ".join(map(esc, r)) + " |" for r in rows[1:]]
+    return "\n".join(lines)
+
+
+def _html_table(rows: list[list[str]]) -> str:
+    if len(rows) < 2:
+        return "<p>(none)</p>"
+    head = "".join(f"<th>{html.escape(str(c))}</th>" for c in rows[0])
+    body = "".join(
+        "<tr>" + "".join(f"<td>{html.escape(str(c))}</td>" for c in r) + "</tr>" for r in rows[1:]
+    )
+    return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+
+
+_CSS = """body{font-family:system-ui,sans-serif;max-width:1100px;margin:2em auto;padding:0 1em;
+color:#222}table{border-collapse:collapse;font-size:13px;margin:.5em 0 1.5em}
+td,th{border:1px solid #ccc;padding:3px 7px;text-align:left}th{background:#f0f0f4}
+img{max-width:100%}figure{display:inline-block;margin:.5em}figcaption{font-size:12px}
+.warn{color:#a40}"""
+
+
+def write_report(
+    store: Store | str | os.PathLike[str],
+    out_dir: str | os.PathLike[str],
+    *,
+    run_id: str | None = None,
+    replays: bool = True,
+) -> dict[str, Path]:
+    """Write ``report.md``, ``report.html`` and the pictures of a run into ``out_dir``.
+
+    Returns:
+        ``{"markdown": path, "html": path, ...}`` of every file written.
+    """
+    db = store if isinstance(store, Store) else Store(store, create=False)
+    a = analyse(db, run_id)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    files: dict[str, Path] = {}
+    images: list[tuple[str, str, bytes, str]] = []  # (section, file, bytes, caption)
+    if a.matrices:
+        images.append(
+            ("matrices", "heatmaps.png", heatmaps_png(a.matrices, a.cells), "held rate per pairing")
+        )
+    if a.ratings:
+        images.append(("ratings", "ratings.png", ratings_png(a.ratings), "ratings"))
+    if replays:
+        for k, row in enumerate(_decisive(a)):
+            rep = _replay(db, a.run, row)
+            if rep is None:
+                a.notes.append(f"no replay of {row['match_id'][:12]}: model or map unavailable")
+                continue
+            if not rep.consistent:
+                a.notes.append(
+                    f"replay of {row['match_id'][:12]} differs from the stored "
+                    "outcome: the code changed since it was played (set the spec's "
+                    "salt to replay everything)"
+                )
+            images.append(("replays", f"replay_{k}.gif", rep.gif, rep.title))
+    for _, name, data, _ in images:
+        (out / name).write_bytes(data)
+        files[name] = out / name
+    tables = _tables(a)
+    regret_md, regret_html = _regret_section(a)
+    files["markdown"] = out / "report.md"
+    files["markdown"].write_text(_markdown(a, tables, images, regret_md), encoding="utf-8")
+    files["html"] = out / "report.html"
+    files["html"].write_text(_html(a, tables, images, regret_html), encoding="utf-8")
+    return files
+
+
+def _header(a: Analysis) -> list[str]:
+    run, spec = a.run, a.run["spec"]
+    statuses = {s: sum(r["status"] == s for r in a.rows) for s in ("ok", "forfeit", "error")}
+    return [
+        f"run `{run['run_id']}` ({run['status']}): {run['done']} of {run['planned']} matches "
+        f"stored; {statuses['forfeit']} forfeits, {statuses['error']} errors",
+        f"maps: {', '.join(m['label'] for m in spec['maps'])}; seeds: {len(spec['seeds'])}; "
+        f"starts: {', '.join(spec['starts'])}; time limit {spec['time_limit']:g} s per match",
+        f"env: {json.dumps(spec['env'])}; grid: "
+        f"{', '.join(v['label'] for v in spec['variants'] if v['label']) or 'none'}",
+    ]
+
+
+_SECTIONS = [
+    (
+        "matrices",
+        "Payoff matrices",
+        "cells",
+        "Held rate = share of matches in which the pursuer kept surveillance to the horizon "
+        "(95% Wilson interval); mean time to escape over the escapes (Student t interval).",
+    ),
+    (
+        "games",
+        "Zero-sum games (Nash equilibria)",
+        "games",
+        "The pursuer maximises the held rate, the evader minimises it. Value = the held rate the "
+        "equilibrium pursuer mixture guarantees against any evader of the roster; "
+        "exploitability = how much a best-responding opponent gains against a pure policy.",
+    ),
+    (
+        "ratings",
+        "Ratings",
+        "ratings",
+        "Bradley-Terry strengths pooled over maps: P(hold) = sigmoid(pursuer - evader), "
+        "MAP fit with a N(0, 3^2) prior, 95% posterior (Laplace) intervals.",
+    ),
+    (
+        "paired",
+        "Paired comparisons on shared starts",
+        "paired",
+        "Same-role policies on the same seeded starts against the same opponent: McNemar's "
+        "exact test on the discordant pairs (a won where b lost, and conversely).",
+    ),
+]
+
+
+def _markdown(a: Analysis, tables: dict, images: list, regret: str) -> str:
+    name = a.run["name"]
+    lines = [f"# Tournament report: {name}", "", *[f"- {h}" for h in _header(a)], ""]
+    lines += [f"> {n}" for n in a.notes]
+    for key, title, table, text in _SECTIONS:
+        lines += [f"## {title}", "", text, ""]
+        lines += [f"![{cap}]({f})" for sec, f, _, cap in images if sec == key]
+        lines += ["", _md_table(tables[table]), ""]
+    lines += ["## Regret on certified starts", "", regret, "", "## Replays", ""]
+    reps = [(f, cap) for sec, f, _, cap in images if sec == "replays"]
+    lines += [f"![{cap}]({f})\n\n{cap}\n" for f, cap in reps] or ["(none)"]
+    lines += ["", "## Errors and forfeits", "", _md_table(tables["errors"]), ""]
+    return "\n".join(lines)
+
+
+def _uri(name: str, data: bytes) -> str:
+    mime = "image/gif" if name.endswith(".gif") else "image/png"
+    return f"data:{mime};base64,{base64.b64encode(data).decode()}"
+
+
+def _html(a: Analysis, tables: dict, images: list, regret: str) -> str:
+    esc = html.escape
+    name = esc(a.run["name"])
+    parts = [
+        f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
+        f"<title>Tournament report: {name}</title><style>{_CSS}</style></head><body>",
+        f"<h1>Tournament report: {name}</h1><ul>",
+    ]
+    parts += [f"<li>{esc(h)}</li>" for h in _header(a)] + ["</ul>"]
+    parts += [f"<p class='warn'>{esc(n)}</p>" for n in a.notes]
+    for key, title, table, text in _SECTIONS:
+        parts += [f"<h2 id='{key}'>{esc(title)}</h2><p>{esc(text)}</p>"]
+        parts += [
+            f"<img src='{_uri(f, d)}' alt='{esc(cap)}'>" for sec, f, d, cap in images if sec == key
+        ]
+        parts.append(_html_table(tables[table]))
+    parts += [
+        "<h2 id='regret'>Regret on certified starts</h2>",
+        regret,
+        "<h2 id='replays'>Replays</h2>",
+    ]
+    reps = [(f, d, cap) for sec, f, d, cap in images if sec == "replays"]
+    parts += [
+        f"<figure><img src='{_uri(f, d)}' alt='{esc(cap)}'><figcaption>{esc(cap)}"
+        "</figcaption></figure>"
+        for f, d, cap in reps
+    ] or ["<p>(none)</p>"]
+    parts += [
+        "<h2 id='errors'>Errors and forfeits</h2>",
+        _html_table(tables["errors"]),
+        "</body></html>",
+    ]
+    return "\n".join(parts)

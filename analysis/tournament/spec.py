@@ -1,0 +1,534 @@
+"""Tournament specs: a TOML file (or a dict) validated on load, with errors naming the field.
+
+A spec names the roster, the maps, a grid of env parameters, the start kind and the
+seeds::
+
+    name = "quick"                      # the run's name (default: the file's stem)
+    description = "greedy vs baselines"
+    maps = ["corridor", "two_rooms", "worlds/office.json"]   # built-ins or map files
+    seeds = 10                          # seeds 0..9, or a list [3, 5, 8]
+    start = "safe"                      # "safe", "valid", or a list of both
+    time_limit = 120                    # wall-clock seconds per match (forfeit beyond)
+    salt = ""                           # mixed into every match identity (e.g. a code SHA)
+
+    pursuers = ["pursuer/decomposition", "pursuer/greedy"]   # names, or tables:
+    [[evaders]]
+    policy = "evader/toward_away"       # a registered name ...
+    params = { mode = "away" }          # ... with parameters
+    label = "away"                      # how reports call it (default: the name)
+    [[evaders]]
+    model = "zoo:ppo_evader_vs_greedy_open_room"   # or a path to an SB3 model zip
+    observation = { observation = "state" }        # default: from its provenance.json
+
+    [env]                               # env overrides for every match
+    max_cycles = 300
+    [grid]                              # each combination is a variant
+    rho = [0.3, 0.5]                    # v_evader = rho * v_pursuer
+    l_max = [3.0, 4.0]
+
+Every pairing on a map plays the same seeded starts (common random numbers): the start
+depends only on the map, the env config and the seed. Relative paths are relative to
+the spec file. Roster entries with the same identity (name, parameters, model file
+content, observation) are merged with a warning; two different entries with one label
+are an error.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import importlib.util
+import itertools
+import json
+import os
+import warnings
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from envs.errors import InvalidConfigError
+from envs.validation import choice, integer, mapping, positive, real, string
+
+__all__ = [
+    "ENV_FIELDS",
+    "MapEntry",
+    "PolicyEntry",
+    "Spec",
+    "Variant",
+    "load_spec",
+    "spec_from_dict",
+]
+
+ENV_FIELDS = (
+    "l_min",
+    "l_max",
+    "v_pursuer",
+    "v_evader",
+    "dt",
+    "max_cycles",
+    "observation",
+    "n_rays",
+    "lidar_range",
+    "reward",
+    "body_radius",
+    "spawn_margin_steps",
+)
+"""``EnvConfig`` fields a spec may set in ``[env]`` and ``[grid]`` (besides ``rho``)."""
+
+_TOP = {
+    "name",
+    "description",
+    "maps",
+    "seeds",
+    "start",
+    "time_limit",
+    "salt",
+    "pursuers",
+    "evaders",
+    "env",
+    "grid",
+}
+_ENTRY_KEYS = {"policy", "params", "label", "model", "algo", "deterministic", "observation"}
+_START_KINDS = ("safe", "valid")
+DEFAULT_TIME_LIMIT = 300.0
+
+
+@dataclass(frozen=True)
+class PolicyEntry:
+    """One roster entry.
+
+    Attributes:
+        role: ``"pursuer"`` or ``"evader"``.
+        label: its name in reports (unique within the role).
+        name: the registry name (``"pursuer/greedy"``), or ``"ROLE/sb3"`` for a model.
+        params: ``make_policy`` parameters.
+        model: the model file (absolute path) or ``None``.
+        model_sha256: SHA-256 of the model file's bytes (its identity, not its path).
+        observation: explicit observation options, or ``None`` (the policy's own).
+    """
+
+    role: str
+    label: str
+    name: str
+    params: dict[str, Any] = field(default_factory=dict)
+    model: str | None = None
+    model_sha256: str | None = None
+    observation: dict[str, Any] | None = None
+
+    def identity(self) -> dict[str, Any]:
+        """What decides this policy's play: name, parameters, model content, observation."""
+        return {
+            "name": self.name,
+            "params": self.params,
+            "model": self.model_sha256,
+            "observation": self.observation,
+        }
+
+
+@dataclass(frozen=True)
+class MapEntry:
+    """One map: its label, where it came from, the Map and the built-in parameters."""
+
+    label: str
+    source: str
+    map: Any
+    params: dict[str, float]
+
+    @property
+    def digest(self) -> str:
+        """The map's geometry digest (its identity, not its path)."""
+        return self.map.digest
+
+
+@dataclass(frozen=True)
+class Variant:
+    """One combination of the grid: its label and env overrides (``rho`` kept apart)."""
+
+    label: str
+    overrides: dict[str, Any]
+    rho: float | None = None
+
+
+@dataclass(frozen=True)
+class Spec:
+    """A validated tournament spec (see the module docstring)."""
+
+    name: str
+    description: str
+    source: str
+    maps: tuple[MapEntry, ...]
+    pursuers: tuple[PolicyEntry, ...]
+    evaders: tuple[PolicyEntry, ...]
+    seeds: tuple[int, ...]
+    starts: tuple[str, ...]
+    env: dict[str, Any]
+    variants: tuple[Variant, ...]
+    time_limit: float
+    salt: str = ""
+
+    def env_config(self, map_entry: MapEntry, variant: Variant) -> dict[str, Any]:
+        """The resolved env parameters of a (map, variant): every field but the map."""
+        from envs.surveillance.config import EnvConfig
+
+        kwargs = {**map_entry.params, **self.env, **variant.overrides}
+        if variant.rho is not None:
+            vp = kwargs.get("v_pursuer", _default("v_pursuer"))
+            kwargs["v_evader"] = variant.rho * float(vp)
+        where = f"{self.source} [env]/[grid] {variant.label or ''} on map {map_entry.label!r}"
+        try:
+            cfg = EnvConfig(map=map_entry.map, **kwargs)
+        except ValueError as exc:
+            raise InvalidConfigError(f"{where}: {exc}") from exc
+        d = cfg.to_dict()
+        for k in ("map", "map_digest", "render_mode"):
+            d.pop(k)
+        return d
+
+    def policies(self) -> dict[str, PolicyEntry]:
+        """Every roster entry by ``"ROLE:label"``."""
+        return {f"{p.role}:{p.label}": p for p in (*self.pursuers, *self.evaders)}
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON-ready, normalised description (what identifies the run)."""
+        return {
+            "name": self.name,
+            "description": self.description,
+            "maps": [{"label": m.label, "source": m.source, "digest": m.digest} for m in self.maps],
+            "pursuers": [_entry_dict(p) for p in self.pursuers],
+            "evaders": [_entry_dict(p) for p in self.evaders],
+            "seeds": list(self.seeds),
+            "starts": list(self.starts),
+            "env": self.env,
+            "variants": [dataclasses.asdict(v) for v in self.variants],
+            "time_limit": self.time_limit,
+            "salt": self.salt,
+        }
+
+    @property
+    def run_id(self) -> str:
+        """Content hash of the normalised spec: the same spec resumes the same run."""
+        text = json.dumps(self.to_dict(), sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def _entry_dict(p: PolicyEntry) -> dict[str, Any]:
+    return {"role": p.role, "label": p.label, "model_path": p.model, **p.identity()}
+
+
+def _default(name: str) -> Any:
+    from envs.surveillance.config import EnvConfig
+
+    return {f.name: f.default for f in dataclasses.fields(EnvConfig)}[name]
+
+
+# --------------------------------------------------------------------------- loading
+def load_spec(path: str | os.PathLike[str]) -> Spec:
+    """Read and validate a TOML spec.
+
+    Raises:
+        InvalidConfigError: naming the file, the field and what was expected.
+    """
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # pragma: no cover - Python 3.10
+        import tomli as tomllib
+
+    p = Path(path)
+    if not p.is_file():
+        raise InvalidConfigError(f"tournament spec {str(p)!r}: no such file")
+    try:
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise InvalidConfigError(f"{p}: not valid TOML ({exc})") from exc
+    return spec_from_dict(data, source=str(p), base_dir=p.parent, default_name=p.stem)
+
+
+def spec_from_dict(
+    data: Mapping[str, Any],
+    *,
+    source: str = "<spec>",
+    base_dir: str | os.PathLike[str] | None = None,
+    default_name: str = "tournament",
+) -> Spec:
+    """Validate a spec given as a dict (the parsed TOML); see :func:`load_spec`."""
+    d = mapping("spec", data, where=source)
+    unknown = sorted(set(d) - _TOP)
+    if unknown:
+        raise InvalidConfigError(f"{source}: unknown field(s) {unknown}; a spec has {sorted(_TOP)}")
+    base = Path(base_dir) if base_dir is not None else Path.cwd()
+    name = string("name", d.get("name", default_name), where=source)
+    description = string("description", d.get("description", ""), where=source, nonempty=False)
+    for required in ("maps", "pursuers", "evaders"):
+        if required not in d:
+            raise InvalidConfigError(f"{source}: missing field {required!r}")
+    maps = _maps(d["maps"], source, base)
+    pursuers = _roster(d["pursuers"], "pursuer", source, base)
+    evaders = _roster(d["evaders"], "evader", source, base)
+    seeds = _seeds(d.get("seeds", 10), source)
+    starts = _starts(d.get("start", "safe"), source)
+    env = _env_table(d.get("env", {}), f"{source} [env]")
+    variants = _grid(d.get("grid", {}), f"{source} [grid]")
+    time_limit = positive("time_limit", d.get("time_limit", DEFAULT_TIME_LIMIT), where=source)
+    salt = string("salt", d.get("salt", ""), where=source, nonempty=False)
+    spec = Spec(
+        name=name,
+        description=description,
+        source=source,
+        maps=maps,
+        pursuers=pursuers,
+        evaders=evaders,
+        seeds=seeds,
+        starts=starts,
+        env=env,
+        variants=variants,
+        time_limit=time_limit,
+        salt=salt,
+    )
+    for m in spec.maps:  # every (map, variant) must make a valid env config
+        for v in spec.variants:
+            spec.env_config(m, v)
+    return spec
+
+
+def _list(name: str, value: Any, where: str) -> list[Any]:
+    if isinstance(value, (str, bytes)) or not isinstance(value, (list, tuple)):
+        value = [value]
+    if not value:
+        raise InvalidConfigError(f"{where}: {name} = []: expected at least one entry")
+    return list(value)
+
+
+def _maps(value: Any, source: str, base: Path) -> tuple[MapEntry, ...]:
+    from envs.maps import builtin_info, builtin_names, load_map
+
+    out: dict[str, MapEntry] = {}
+    for i, item in enumerate(_list("maps", value, source)):
+        where = f"{source} [maps #{i + 1}]"
+        text = string("map", item, where=where)
+        if text in builtin_names():
+            info = builtin_info(text)
+            entry = MapEntry(text, f"builtin:{text}", info.map, dict(info.params()))
+        else:
+            path = (base / text).resolve()
+            if not path.is_file():
+                raise InvalidConfigError(
+                    f"{where}: map = {text!r}: neither a built-in map {builtin_names()} nor a "
+                    f"map file (looked for {path})"
+                )
+            try:
+                world = load_map(path)
+            except (ValueError, OSError) as exc:
+                raise InvalidConfigError(f"{where}: map = {text!r}: {exc}") from exc
+            entry = MapEntry(text, str(path), world, {})
+        if entry.label in out:
+            warnings.warn(f"{where}: map {text!r} is listed twice; playing it once", stacklevel=3)
+            continue
+        out[entry.label] = entry
+    digests: dict[str, str] = {}
+    for m in out.values():
+        if m.digest in digests and out[digests[m.digest]].params == m.params:
+            raise InvalidConfigError(
+                f"{source}: maps {digests[m.digest]!r} and {m.label!r} are the same world "
+                f"(digest {m.digest[:12]}); list it once"
+            )
+        digests[m.digest] = m.label
+    return tuple(out.values())
+
+
+def _roster(value: Any, role: str, source: str, base: Path) -> tuple[PolicyEntry, ...]:
+    section = f"{role}s"
+    entries: list[PolicyEntry] = []
+    for i, item in enumerate(_list(section, value, source)):
+        where = f"{source} [{section} #{i + 1}]"
+        entries.append(_entry(item, role, where, base))
+    merged: dict[str, PolicyEntry] = {}
+    by_identity: dict[str, str] = {}
+    for e in entries:
+        ident = json.dumps(e.identity(), sort_keys=True)
+        if ident in by_identity:
+            warnings.warn(
+                f"{source} [{section}]: {e.label!r} repeats {by_identity[ident]!r} (same "
+                "policy, parameters and model); merged into one entry",
+                stacklevel=3,
+            )
+            continue
+        if e.label in merged:
+            raise InvalidConfigError(
+                f"{source} [{section}]: two different entries are labelled {e.label!r}; "
+                "give them distinct labels"
+            )
+        by_identity[ident] = e.label
+        merged[e.label] = e
+    return tuple(merged.values())
+
+
+def _entry(item: Any, role: str, where: str, base: Path) -> PolicyEntry:
+    from strategies.policies import make_policy
+
+    if isinstance(item, str):
+        item = {"policy": item}
+    d = mapping("entry", item, where=where)
+    unknown = sorted(set(d) - _ENTRY_KEYS)
+    if unknown:
+        raise InvalidConfigError(
+            f"{where}: unknown field(s) {unknown}; expected {sorted(_ENTRY_KEYS)}"
+        )
+    if ("policy" in d) == ("model" in d):
+        raise InvalidConfigError(
+            f"{where}: give exactly one of 'policy' (a name) or 'model' (a file)"
+        )
+    observation = None
+    if "observation" in d:
+        from strategies.runner import check_observation_options
+
+        observation = check_observation_options(d["observation"], f"{where} observation")
+    if "policy" in d:
+        name = string("policy", d["policy"], where=where)
+        if name.partition("/")[0] != role:
+            raise InvalidConfigError(
+                f"{where}: policy = {name!r}: a {role} entry needs a '{role}/KIND' name"
+            )
+        for k in ("algo", "deterministic"):
+            if k in d:
+                raise InvalidConfigError(f"{where}: {k!r} applies to 'model' entries only")
+        params = mapping("params", d.get("params", {}), where=where)
+        try:
+            make_policy(name, **params)  # the name and parameters are checked here
+        except ValueError as exc:
+            raise InvalidConfigError(f"{where}: {exc}") from exc
+        label = string("label", d.get("label", name), where=where)
+        return PolicyEntry(role, label, name, _canonical(params), None, None, observation)
+    text = string("model", d["model"], where=where)
+    path = _model_path(text, where, base)
+    digest = hashlib.sha256(path.read_bytes()).hexdigest()
+    provenance = _provenance(path)
+    if provenance.get("role") not in (None, role):
+        raise InvalidConfigError(
+            f"{where}: model {text!r} was trained as a {provenance['role']}, not a {role}"
+        )
+    params: dict[str, Any] = {}
+    algo = d.get("algo", provenance.get("algo"))
+    if algo is not None:
+        params["algo"] = string("algo", algo, where=where).upper()
+    if "deterministic" in d:
+        from envs.validation import boolean
+
+        params["deterministic"] = boolean("deterministic", d["deterministic"], where=where)
+    if observation is None:
+        env_cfg = provenance.get("env_config") or {}
+        if isinstance(env_cfg, Mapping) and env_cfg.get("observation"):
+            observation = {"observation": env_cfg["observation"]}
+            if env_cfg["observation"] != "state":
+                observation["n_rays"] = env_cfg.get("n_rays", _default("n_rays"))
+                observation["lidar_range"] = env_cfg.get("lidar_range")
+    label = string("label", d.get("label", text), where=where)
+    return PolicyEntry(role, label, f"{role}/sb3", params, str(path), digest, observation)
+
+
+def _canonical(params: Mapping[str, Any]) -> dict[str, Any]:
+    return json.loads(json.dumps(dict(params), sort_keys=True))
+
+
+def zoo_dir() -> Path | None:
+    """The shipped model zoo's directory, found without importing ``training``."""
+    spec = importlib.util.find_spec("training")
+    if spec is None or not spec.submodule_search_locations:
+        return None
+    return Path(next(iter(spec.submodule_search_locations))) / "zoo" / "models"
+
+
+def _model_path(text: str, where: str, base: Path) -> Path:
+    if text.startswith("zoo:"):
+        name = text[len("zoo:") :]
+        root = zoo_dir()
+        path = None if root is None else root / name / "model.zip"
+        if path is None or not path.is_file():
+            known = sorted(p.name for p in root.iterdir()) if root and root.is_dir() else []
+            raise InvalidConfigError(
+                f"{where}: model = {text!r}: no zoo model {name!r}; known: {known}"
+            )
+        return path
+    path = (base / text).resolve()
+    if not path.is_file():
+        raise InvalidConfigError(f"{where}: model = {text!r}: no such file ({path})")
+    return path
+
+
+def _provenance(model: Path) -> dict[str, Any]:
+    prov = model.parent / "provenance.json"
+    try:
+        data = json.loads(prov.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return {}
+    return data if isinstance(data, dict) else {}
+
+
+def _seeds(value: Any, source: str) -> tuple[int, ...]:
+    if isinstance(value, (list, tuple)):
+        seeds = [integer(f"seeds[{i}]", s, minimum=0, where=source) for i, s in enumerate(value)]
+        if not seeds:
+            raise InvalidConfigError(f"{source}: seeds = []: expected at least one seed")
+        if len(set(seeds)) != len(seeds):
+            raise InvalidConfigError(f"{source}: seeds = {seeds}: a seed is repeated")
+        return tuple(seeds)
+    n = integer("seeds", value, minimum=1, where=source)
+    return tuple(range(n))
+
+
+def _starts(value: Any, source: str) -> tuple[str, ...]:
+    kinds = [choice("start", s, _START_KINDS, where=source) for s in _list("start", value, source)]
+    return tuple(dict.fromkeys(kinds))
+
+
+def _env_value(key: str, value: Any, where: str) -> Any:
+    if key == "observation":
+        return choice(key, value, ("state", "lidar"), where=where)
+    if key == "reward":
+        return choice(key, value, ("zero_sum", "sparse"), where=where)
+    if key in ("max_cycles", "n_rays"):
+        return integer(key, value, minimum=1, where=where)
+    if key == "spawn_margin_steps":
+        return integer(key, value, minimum=0, where=where)
+    if key == "lidar_range" and value is None:
+        return None
+    if key == "rho":
+        return positive(key, value, where=where)
+    return real(key, value, where=where)
+
+
+def _env_table(value: Any, where: str) -> dict[str, Any]:
+    d = mapping("env", value, where=where)
+    unknown = sorted(set(d) - set(ENV_FIELDS))
+    if unknown:
+        raise InvalidConfigError(
+            f"{where}: unknown env parameter(s) {unknown}; expected {list(ENV_FIELDS)}"
+        )
+    return {k: _env_value(k, v, where) for k, v in d.items()}
+
+
+def _grid(value: Any, where: str) -> tuple[Variant, ...]:
+    d = mapping("grid", value, where=where)
+    allowed = (*ENV_FIELDS, "rho")
+    unknown = sorted(set(d) - set(allowed))
+    if unknown:
+        raise InvalidConfigError(
+            f"{where}: unknown grid parameter(s) {unknown}; expected {list(allowed)}"
+        )
+    if "rho" in d and "v_evader" in d:
+        raise InvalidConfigError(f"{where}: give 'rho' or 'v_evader', not both")
+    axes = []
+    for k, v in d.items():
+        values = [_env_value(k, x, where) for x in _list(k, v, where)]
+        if len(set(map(repr, values))) != len(values):
+            raise InvalidConfigError(f"{where}: {k} = {values}: a value is repeated")
+        axes.append([(k, x) for x in values])
+    if not axes:
+        return (Variant("", {}),)
+    out = []
+    for combo in itertools.product(*axes):
+        overrides = {k: v for k, v in combo if k != "rho"}
+        rho = next((v for k, v in combo if k == "rho"), None)
+        label = ",".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in combo)
+        out.append(Variant(label, overrides, rho))
+    return tuple(out)

@@ -1,0 +1,396 @@
+"""The tournament store: one SQLite file in WAL mode, written only by the driver.
+
+Tables:
+
+* ``runs`` -- one row per spec (``run_id`` = the spec's content hash): name, the
+  normalised spec, when it was created and last updated, its status.
+* ``run_matches`` -- the matches a run plans, with the labels its reports use.
+* ``matches`` -- one row per match identity (primary key), with the identity document.
+* ``maps`` -- the geometry of every map by digest, so reports re-simulate replays even
+  after a map file changed.
+* ``results`` -- one row per finished match: ``ok`` (played out), ``forfeit`` (a policy
+  raised or overran its time: the other side wins) or ``error`` (the match could not be
+  played, e.g. no start exists; nobody wins).
+* ``errors`` -- every failure, including worker crashes that left no result.
+
+Each finished match is one transaction, so killing the driver at any moment (SIGKILL
+included) loses at most the matches in flight and never leaves a half-written result.
+Results are shared between runs by identity: a different spec on the same store reuses
+every match it has in common and never sees the others.
+
+One writer at a time: :meth:`Store.lock` takes an exclusive ``flock`` on ``STORE.lock``
+(released by the kernel if the driver dies); a second driver is refused with a message
+naming the holder. Readers (reports, exports) need no lock: WAL lets them read while a
+run writes.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import json
+import os
+import socket
+import sqlite3
+import time
+from collections.abc import Iterable, Iterator, Mapping
+from pathlib import Path
+from typing import Any
+
+from envs.errors import InvalidConfigError, SurveilValueError
+
+__all__ = ["RESULT_FIELDS", "SCHEMA_VERSION", "Store", "StoreBusyError"]
+
+SCHEMA_VERSION = 1
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS runs (
+    run_id TEXT PRIMARY KEY, name TEXT NOT NULL, spec TEXT NOT NULL,
+    created REAL NOT NULL, updated REAL NOT NULL, status TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS maps (digest TEXT PRIMARY KEY, name TEXT, geometry TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS matches (match_id TEXT PRIMARY KEY, identity TEXT NOT NULL);
+CREATE TABLE IF NOT EXISTS run_matches (
+    run_id TEXT NOT NULL REFERENCES runs, match_id TEXT NOT NULL REFERENCES matches,
+    seq INTEGER NOT NULL, map TEXT NOT NULL, variant TEXT NOT NULL, pursuer TEXT NOT NULL,
+    evader TEXT NOT NULL, start TEXT NOT NULL, seed INTEGER NOT NULL,
+    PRIMARY KEY (run_id, match_id));
+CREATE TABLE IF NOT EXISTS results (
+    match_id TEXT PRIMARY KEY REFERENCES matches,
+    status TEXT NOT NULL CHECK (status IN ('ok', 'forfeit', 'error')),
+    winner TEXT CHECK (winner IN ('pursuer', 'evader')), cause TEXT, feature TEXT,
+    escape_time REAL, steps INTEGER, dt REAL, blame TEXT, error TEXT,
+    decide_pursuer REAL, decide_evader REAL, wall_seconds REAL, record TEXT,
+    finished REAL NOT NULL);
+CREATE TABLE IF NOT EXISTS errors (
+    id INTEGER PRIMARY KEY AUTOINCREMENT, run_id TEXT, match_id TEXT, kind TEXT NOT NULL,
+    message TEXT NOT NULL, at REAL NOT NULL);
+CREATE INDEX IF NOT EXISTS run_matches_seq ON run_matches (run_id, seq);
+"""
+
+RESULT_FIELDS = (
+    "status",
+    "winner",
+    "cause",
+    "feature",
+    "escape_time",
+    "steps",
+    "dt",
+    "blame",
+    "error",
+    "decide_pursuer",
+    "decide_evader",
+    "wall_seconds",
+    "record",
+)
+"""Columns of ``results`` an outcome dict fills (besides ``match_id``)."""
+
+ROW_FIELDS = (
+    "seq",
+    "match_id",
+    "map",
+    "variant",
+    "pursuer",
+    "evader",
+    "start",
+    "seed",
+    *RESULT_FIELDS[:-1],
+)
+
+
+class StoreBusyError(SurveilValueError):
+    """Another driver holds the store's write lock."""
+
+
+class Store:
+    """A tournament store at ``path`` (created on first use).
+
+    Args:
+        path: the SQLite file.
+        create: create it if missing (readers pass ``False``).
+
+    Raises:
+        InvalidConfigError: the file is not a tournament store, or of another schema.
+    """
+
+    def __init__(self, path: str | os.PathLike[str], *, create: bool = True) -> None:
+        self.path = Path(path)
+        if self.path.is_dir():
+            raise InvalidConfigError(f"store {str(self.path)!r} is a directory, not a file")
+        if not create and not self.path.is_file():
+            raise InvalidConfigError(f"store {str(self.path)!r}: no such file")
+        if create:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._lock_file = None
+        try:
+            self.conn = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
+            self.conn.row_factory = sqlite3.Row
+            mode = self.conn.execute("PRAGMA journal_mode=WAL").fetchone()[0]
+            if mode.lower() != "wal":  # pragma: no cover - e.g. a network file system
+                raise InvalidConfigError(f"store {self.path}: cannot use WAL mode (got {mode})")
+            # NORMAL in WAL mode: a committed match survives any crash of this process
+            self.conn.execute("PRAGMA synchronous=NORMAL")
+            self.conn.execute("PRAGMA foreign_keys=ON")
+            self._init_schema()
+        except sqlite3.DatabaseError as exc:
+            raise InvalidConfigError(
+                f"store {str(self.path)!r} is not a tournament store (SQLite): {exc}"
+            ) from exc
+
+    def _init_schema(self) -> None:
+        with self.transaction() as c:
+            for stmt in _SCHEMA.strip().split(";"):
+                if stmt.strip():
+                    c.execute(stmt)
+            c.execute("INSERT OR IGNORE INTO meta VALUES ('schema', ?)", (str(SCHEMA_VERSION),))
+            row = c.execute("SELECT value FROM meta WHERE key = 'schema'").fetchone()
+        if int(row[0]) != SCHEMA_VERSION:
+            raise InvalidConfigError(
+                f"store {self.path} has schema version {row[0]}, this surveil reads "
+                f"{SCHEMA_VERSION}; use a new store or export the old one with its version"
+            )
+
+    # ---------------------------------------------------------------- transactions
+    @contextlib.contextmanager
+    def transaction(self) -> Iterator[sqlite3.Connection]:
+        """``BEGIN IMMEDIATE`` ... ``COMMIT`` (``ROLLBACK`` on any exception)."""
+        self.conn.execute("BEGIN IMMEDIATE")
+        try:
+            yield self.conn
+        except BaseException:
+            self.conn.execute("ROLLBACK")
+            raise
+        self.conn.execute("COMMIT")
+
+    def close(self) -> None:
+        """Release the lock (if held) and close the connection (idempotent)."""
+        self.unlock()
+        with contextlib.suppress(sqlite3.Error):
+            self.conn.close()
+
+    def __enter__(self) -> Store:
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+    # ---------------------------------------------------------------- the write lock
+    def lock(self) -> None:
+        """Take the single-writer lock, or raise :class:`StoreBusyError` naming the holder."""
+        import fcntl
+
+        lock_path = self.path.with_name(self.path.name + ".lock")
+        f = open(lock_path, "a+", encoding="utf-8")  # held until unlock()
+        try:
+            fcntl.flock(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            f.seek(0)
+            holder = f.read().strip() or "another process"
+            f.close()
+            raise StoreBusyError(
+                f"store {self.path} is being written by {holder}; wait for that run to "
+                "finish (or stop it) before starting another on this store, or use --store "
+                "with another file"
+            ) from None
+        f.seek(0)
+        f.truncate()
+        f.write(
+            f"pid {os.getpid()} on {socket.gethostname()} since "
+            f"{time.strftime('%Y-%m-%d %H:%M:%S')}"
+        )
+        f.flush()
+        self._lock_file = f
+
+    def unlock(self) -> None:
+        """Release the write lock (idempotent)."""
+        if self._lock_file is not None:
+            import fcntl
+
+            with contextlib.suppress(OSError, ValueError):
+                self._lock_file.truncate(0)
+                fcntl.flock(self._lock_file.fileno(), fcntl.LOCK_UN)
+            self._lock_file.close()
+            self._lock_file = None
+
+    # ---------------------------------------------------------------- runs
+    def begin_run(
+        self,
+        run_id: str,
+        name: str,
+        spec: Mapping[str, Any],
+        matches: Iterable[tuple[Any, Mapping[str, Any]]],
+        maps: Mapping[str, tuple[str, dict[str, Any]]],
+    ) -> set[str]:
+        """Record a run and its planned matches; return the ids already finished.
+
+        Args:
+            run_id: the spec's content hash.
+            name: the run's name.
+            spec: the normalised spec.
+            matches: ``(Match, identity document)`` pairs in play order.
+            maps: ``{digest: (name, geometry dict)}``.
+        """
+        now = time.time()
+        with self.transaction() as c:
+            c.execute(
+                "INSERT INTO runs VALUES (?, ?, ?, ?, ?, 'running') ON CONFLICT(run_id) "
+                "DO UPDATE SET updated = excluded.updated, status = 'running'",
+                (run_id, name, json.dumps(spec, sort_keys=True), now, now),
+            )
+            c.executemany(
+                "INSERT OR IGNORE INTO maps VALUES (?, ?, ?)",
+                [(d, n, json.dumps(g)) for d, (n, g) in maps.items()],
+            )
+            rows, idents = [], []
+            for seq, (m, doc) in enumerate(matches):
+                idents.append((m.match_id, json.dumps(doc, sort_keys=True)))
+                rows.append(
+                    (
+                        run_id,
+                        m.match_id,
+                        seq,
+                        m.map,
+                        m.variant,
+                        m.pursuer,
+                        m.evader,
+                        m.start,
+                        m.seed,
+                    )
+                )
+            c.executemany("INSERT OR IGNORE INTO matches VALUES (?, ?)", idents)
+            c.executemany("INSERT OR IGNORE INTO run_matches VALUES (?,?,?,?,?,?,?,?,?)", rows)
+        return self.finished(run_id)
+
+    def finished(self, run_id: str, *, include_errors: bool = True) -> set[str]:
+        """Match ids of ``run_id`` that have a result (``error`` ones unless excluded)."""
+        sql = (
+            "SELECT r.match_id FROM run_matches r JOIN results s ON s.match_id = r.match_id "
+            "WHERE r.run_id = ?"
+        )
+        if not include_errors:
+            sql += " AND s.status != 'error'"
+        return {row[0] for row in self.conn.execute(sql, (run_id,))}
+
+    def end_run(self, run_id: str, status: str) -> None:
+        """Mark a run ``finished``, ``interrupted`` or ``decided``."""
+        with self.transaction() as c:
+            c.execute(
+                "UPDATE runs SET status = ?, updated = ? WHERE run_id = ?",
+                (status, time.time(), run_id),
+            )
+
+    def runs(self) -> list[dict[str, Any]]:
+        """Every run, newest first, with its counts of planned and finished matches."""
+        out = []
+        for r in self.conn.execute("SELECT * FROM runs ORDER BY updated DESC"):
+            planned, done = self.conn.execute(
+                "SELECT COUNT(*), COUNT(s.match_id) FROM run_matches m LEFT JOIN results s "
+                "ON s.match_id = m.match_id WHERE m.run_id = ?",
+                (r["run_id"],),
+            ).fetchone()
+            out.append({**dict(r), "spec": json.loads(r["spec"]), "planned": planned, "done": done})
+        return out
+
+    def run(self, run_id: str | None = None) -> dict[str, Any]:
+        """One run (default: the most recently updated); ``run_id`` may be a prefix.
+
+        Raises:
+            InvalidConfigError: no such run (listing the known ones).
+        """
+        runs = self.runs()
+        if not runs:
+            raise InvalidConfigError(f"store {self.path} has no runs yet")
+        if run_id is None:
+            return runs[0]
+        hits = [r for r in runs if r["run_id"].startswith(run_id) or r["name"] == run_id]
+        if len(hits) != 1:
+            known = ", ".join(f"{r['run_id']} ({r['name']})" for r in runs)
+            what = "no run" if not hits else "more than one run"
+            raise InvalidConfigError(f"store {self.path}: {what} matches {run_id!r}; runs: {known}")
+        return hits[0]
+
+    # ---------------------------------------------------------------- results
+    def record(self, run_id: str, outcome: Mapping[str, Any]) -> None:
+        """Store one finished match (one transaction); errors also go to ``errors``."""
+        values = [outcome.get(k) for k in RESULT_FIELDS]
+        with self.transaction() as c:
+            c.execute(
+                f"INSERT OR REPLACE INTO results (match_id, {', '.join(RESULT_FIELDS)}, finished) "
+                f"VALUES ({', '.join('?' * (len(RESULT_FIELDS) + 2))})",
+                (outcome["match_id"], *values, time.time()),
+            )
+            if outcome.get("status") != "ok":
+                c.execute(
+                    "INSERT INTO errors (run_id, match_id, kind, message, at) VALUES (?,?,?,?,?)",
+                    (
+                        run_id,
+                        outcome["match_id"],
+                        outcome["status"],
+                        outcome.get("error") or "",
+                        time.time(),
+                    ),
+                )
+
+    def log_error(self, run_id: str, match_id: str | None, kind: str, message: str) -> None:
+        """Record a failure that left no result (a crashed or killed worker)."""
+        with self.transaction() as c:
+            c.execute(
+                "INSERT INTO errors (run_id, match_id, kind, message, at) VALUES (?,?,?,?,?)",
+                (run_id, match_id, kind, message, time.time()),
+            )
+
+    def rows(self, run_id: str) -> list[dict[str, Any]]:
+        """The finished matches of ``run_id`` (in plan order) as flat dicts."""
+        cols = ", ".join(
+            f"m.{k}"
+            if k in ("seq", "match_id", "map", "variant", "pursuer", "evader", "start", "seed")
+            else f"s.{k}"
+            for k in ROW_FIELDS
+        )
+        sql = (
+            f"SELECT {cols} FROM run_matches m JOIN results s ON s.match_id = m.match_id "
+            "WHERE m.run_id = ? ORDER BY m.seq"
+        )
+        return [dict(r) for r in self.conn.execute(sql, (run_id,))]
+
+    def errors(self, run_id: str) -> list[dict[str, Any]]:
+        """The failures logged by ``run_id``, oldest first."""
+        sql = "SELECT * FROM errors WHERE run_id = ? ORDER BY id"
+        return [dict(r) for r in self.conn.execute(sql, (run_id,))]
+
+    def record_of(self, match_id: str) -> dict[str, Any] | None:
+        """The stored episode record of one match (``None`` if not played)."""
+        row = self.conn.execute(
+            "SELECT record FROM results WHERE match_id = ?", (match_id,)
+        ).fetchone()
+        return None if row is None or row[0] is None else json.loads(row[0])
+
+    def map_geometry(self, digest: str) -> dict[str, Any] | None:
+        """The stored geometry (``envs.maps.io.map_to_dict`` form) of a map digest."""
+        row = self.conn.execute("SELECT geometry FROM maps WHERE digest = ?", (digest,)).fetchone()
+        return None if row is None else json.loads(row[0])
+
+    # ---------------------------------------------------------------- export
+    def export(self, run_id: str, path: str | os.PathLike[str]) -> Path:
+        """Write a run's results as CSV (``.csv``) or JSON lines (``.jsonl``/``.ndjson``).
+
+        Raises:
+            InvalidConfigError: another suffix.
+        """
+        path = Path(path)
+        suffix = path.suffix.lower()
+        if suffix not in (".csv", ".jsonl", ".ndjson"):
+            raise InvalidConfigError(
+                f"export path {str(path)!r}: expected a .csv, .jsonl or .ndjson file"
+            )
+        rows = self.rows(run_id)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with path.open("w", encoding="utf-8", newline="") as f:
+            if suffix == ".csv":
+                writer = csv.DictWriter(f, fieldnames=list(ROW_FIELDS))
+                writer.writeheader()
+                writer.writerows(rows)
+            else:
+                for r in rows:
+                    f.write(json.dumps(r, sort_keys=True) + "\n")
+        return path

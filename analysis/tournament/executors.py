@@ -185,13 +185,20 @@ class ProcessExecutor(Executor):
 
     Args:
         workers: processes (default: the CPUs available to this process).
+        kill_grace: seconds past the time limit before a silent worker is killed.
         start_method: multiprocessing start method (default ``"fork"`` where available:
             workers start in milliseconds and see everything the driver registered).
     """
 
     name = "process"
 
-    def __init__(self, workers: int | None = None, *, start_method: str | None = None) -> None:
+    def __init__(
+        self,
+        workers: int | None = None,
+        *,
+        start_method: str | None = None,
+        kill_grace: float = KILL_GRACE,
+    ) -> None:
         if workers is None:
             affinity = getattr(os, "sched_getaffinity", None)
             workers = len(affinity(0)) if affinity else (os.cpu_count() or 1)
@@ -201,6 +208,7 @@ class ProcessExecutor(Executor):
         if start_method is None:
             start_method = "fork" if "fork" in mp.get_all_start_methods() else "spawn"
         self.mpctx = mp.get_context(start_method)
+        self.kill_grace = float(kill_grace)
         self.pool: list[_Worker] = []
 
     def describe(self) -> str:
@@ -238,13 +246,13 @@ class ProcessExecutor(Executor):
                     yield from self._replace(w, ctx, todo, lost, "worker process died")
             now = time.monotonic()
             for w in list(self.pool):
-                if w.current is not None and now - w.since > ctx.time_limit + KILL_GRACE:
+                if w.current is not None and now - w.since > ctx.time_limit + self.kill_grace:
                     yield from self._replace(
                         w,
                         ctx,
                         todo,
                         w.current,
-                        f"killed: no answer {ctx.time_limit + KILL_GRACE:g} s into the match "
+                        f"killed: no answer {ctx.time_limit + self.kill_grace:g} s into the match "
                         "(a hang the time limit could not interrupt)",
                     )
 

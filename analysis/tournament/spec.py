@@ -48,7 +48,7 @@ from pathlib import Path
 from typing import Any
 
 from envs.errors import InvalidConfigError
-from envs.validation import choice, integer, mapping, positive, real, string
+from envs.validation import choice, integer, mapping, positive, string
 
 __all__ = [
     "ENV_FIELDS",
@@ -175,7 +175,8 @@ class Spec:
         if variant.rho is not None:
             vp = kwargs.get("v_pursuer", _default("v_pursuer"))
             kwargs["v_evader"] = variant.rho * float(vp)
-        where = f"{self.source} [env]/[grid] {variant.label or ''} on map {map_entry.label!r}"
+        where = f"{self.source} [env]" + (f" [grid] {variant.label}" if variant.label else "")
+        where += f" on map {map_entry.label!r}"
         try:
             cfg = EnvConfig(map=map_entry.map, **kwargs)
         except ValueError as exc:
@@ -285,9 +286,16 @@ def spec_from_dict(
         time_limit=time_limit,
         salt=salt,
     )
+    seen: dict[str, str] = {}
     for m in spec.maps:  # every (map, variant) must make a valid env config
-        for v in spec.variants:
-            spec.env_config(m, v)
+        games = json.dumps([spec.env_config(m, v) for v in spec.variants], sort_keys=True)
+        key = m.digest + games
+        if key in seen:
+            raise InvalidConfigError(
+                f"{source}: maps {seen[key]!r} and {m.label!r} are the same world with the "
+                f"same parameters (digest {m.digest[:12]}); list it once"
+            )
+        seen[key] = m.label
     return spec
 
 
@@ -325,14 +333,6 @@ def _maps(value: Any, source: str, base: Path) -> tuple[MapEntry, ...]:
             warnings.warn(f"{where}: map {text!r} is listed twice; playing it once", stacklevel=3)
             continue
         out[entry.label] = entry
-    digests: dict[str, str] = {}
-    for m in out.values():
-        if m.digest in digests and out[digests[m.digest]].params == m.params:
-            raise InvalidConfigError(
-                f"{source}: maps {digests[m.digest]!r} and {m.label!r} are the same world "
-                f"(digest {m.digest[:12]}); list it once"
-            )
-        digests[m.digest] = m.label
     return tuple(out.values())
 
 
@@ -492,9 +492,7 @@ def _env_value(key: str, value: Any, where: str) -> Any:
         return integer(key, value, minimum=0, where=where)
     if key == "lidar_range" and value is None:
         return None
-    if key == "rho":
-        return positive(key, value, where=where)
-    return real(key, value, where=where)
+    return positive(key, value, where=where)
 
 
 def _env_table(value: Any, where: str) -> dict[str, Any]:

@@ -99,7 +99,7 @@ def test_bad_input_is_a_clear_error(capsys):
 
 
 def test_evaluate_prints_the_table_resumes_and_plots(tmp_path, capsys):
-    results, picture = tmp_path / "runs.jsonl", tmp_path / "table.png"
+    results, picture = tmp_path / "runs.sqlite", tmp_path / "table.png"
     argv = [
         "evaluate",
         "--maps",
@@ -117,16 +117,18 @@ def test_evaluate_prints_the_table_resumes_and_plots(tmp_path, capsys):
         str(results),
         "--plot",
         str(picture),
+        "--no-progress",
     ]
     assert main(argv) == 0
     first = capsys.readouterr().out
     assert "pursuer/greedy" in first and "evader/random" in first
-    assert len(results.read_text().splitlines()) == 4  # 2 evaders x 2 seeds, as they finish
+    assert "4 of 4 matches stored" in first  # 2 evaders x 2 seeds, stored as they finish
     assert picture.stat().st_size > 1000
-    # a second run replays nothing: every episode is already in the results file
+    # a second run replays nothing: every match is already in the store
     assert main(argv) == 0
-    assert len(results.read_text().splitlines()) == 4
-    assert capsys.readouterr().out.splitlines()[-4:] == first.splitlines()[-4:]
+    second = capsys.readouterr().out
+    assert "4 reused, 0 played" in second
+    assert second.splitlines()[-5:-1] == first.splitlines()[-5:-1]
 
 
 def test_policies_lists_the_registry_and_play_takes_parameters(tmp_path, capsys):

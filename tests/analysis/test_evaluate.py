@@ -75,18 +75,18 @@ def test_faster_evader_straight_away_breaks_range():
     assert r.winner == "evader" and r.cause in ("too_far", "occluded", "too_close")
 
 
-def test_evaluate_writes_jsonl_and_resumes(tmp_path):
-    path = tmp_path / "res.jsonl"
+def test_evaluate_is_a_resumable_one_off_tournament(tmp_path):
+    path = tmp_path / "res.sqlite"
     kw = dict(max_cycles=30, results_path=path, progress=False)
     rows = evaluate(["open_room"], ["pursuer/greedy"], ["evader/random"], range(3), **kw)
     assert len(rows) == 1 and rows[0].n == 3
     assert rows[0].rate_lo <= rows[0].rate <= rows[0].rate_hi
-    lines = path.read_text().splitlines()
-    assert len(lines) == 3
-    path.write_text("\n".join(lines[:2]) + "\n" + lines[2][:10])  # cut off mid-line
     again = evaluate(["open_room"], ["pursuer/greedy"], ["evader/random"], range(3), **kw)
-    assert again == rows  # the cut episode was replayed, identically
-    assert len([x for x in path.read_text().splitlines() if x.strip()]) == 4
+    assert again == rows  # stored matches are reused, not replayed
+    twice = evaluate(
+        ["open_room"], ["pursuer/greedy", "pursuer/greedy"], ["evader/random"], range(3), **kw
+    )
+    assert [r.n for r in twice] == [3]  # a repeated name is one entry
     text = format_table(again)
     assert "pursuer/greedy" in text and "evader/random" in text
 

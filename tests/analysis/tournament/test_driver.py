@@ -1,0 +1,220 @@
+"""Running tournaments: backends agree, failures forfeit, interruptions resume exactly."""
+
+from __future__ import annotations
+
+import os
+import signal
+import sqlite3
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+
+from analysis.tournament import Store, run_tournament, spec_from_dict
+from analysis.tournament.executors import ProcessExecutor
+
+from .conftest import comparable
+
+
+def test_serial_and_process_backends_store_the_same_results(tmp_path, small_spec):
+    spec = spec_from_dict(small_spec)
+    a = run_tournament(spec, tmp_path / "a.sqlite", backend="serial", progress=False)
+    b = run_tournament(spec, tmp_path / "b.sqlite", backend="process", workers=2, progress=False)
+    assert a.played == b.played == 24 and a.complete and b.complete
+    with Store(tmp_path / "a.sqlite") as x, Store(tmp_path / "b.sqlite") as y:
+        assert comparable(x.rows(a.run_id)) == comparable(y.rows(b.run_id))
+
+
+@pytest.mark.parametrize("backend", ["serial", "process"])
+def test_raising_and_hanging_policies_forfeit_and_the_run_goes_on(tmp_path, test_policies, backend):
+    d = {
+        "maps": ["open_room"],
+        "pursuers": ["pursuer/greedy"],
+        "evaders": ["evader/test_raising", "evader/test_hanging", "evader/random"],
+        "seeds": 2,
+        "start": "valid",
+        "time_limit": 0.5,
+        "env": {"max_cycles": 40},
+    }
+    t0 = time.monotonic()
+    s = run_tournament(
+        spec_from_dict(d), tmp_path / "s.sqlite", backend=backend, workers=2, progress=False
+    )
+    assert time.monotonic() - t0 < 15
+    assert s.played == 6 and s.forfeits == 4 and s.errors == 0
+    with Store(tmp_path / "s.sqlite") as db:
+        rows = {(r["evader"], r["seed"]): r for r in db.rows(s.run_id)}
+        errors = db.errors(s.run_id)
+    for seed in (0, 1):
+        raised = rows[("evader/test_raising", seed)]
+        assert raised["status"] == "forfeit" and raised["winner"] == "pursuer"
+        assert raised["blame"] == "evader" and "ZeroDivisionError" in raised["error"]
+        assert "step 3" in raised["error"]
+        hung = rows[("evader/test_hanging", seed)]
+        assert hung["status"] == "forfeit" and hung["blame"] == "evader"
+        assert "time limit" in hung["error"]
+        assert rows[("evader/random", seed)]["status"] == "ok"
+    assert len(errors) == 4 and {e["kind"] for e in errors} == {"forfeit"}
+
+
+def test_a_hang_that_ignores_signals_is_killed(tmp_path, test_policies):
+    d = {
+        "maps": ["open_room"],
+        "pursuers": ["pursuer/greedy"],
+        "evaders": ["evader/test_deaf", "evader/random"],
+        "seeds": 2,
+        "start": "valid",
+        "time_limit": 0.5,
+        "env": {"max_cycles": 30},
+    }
+    ex = ProcessExecutor(2, kill_grace=1.0)
+    s = run_tournament(spec_from_dict(d), tmp_path / "s.sqlite", executor=ex, progress=False)
+    assert s.played == 4 and s.errors == 2
+    with Store(tmp_path / "s.sqlite") as db:
+        rows = db.rows(s.run_id)
+    deaf = [r for r in rows if r["evader"] == "evader/test_deaf"]
+    assert all(r["status"] == "error" and "killed" in r["error"] for r in deaf)
+    assert all(r["status"] == "ok" for r in rows if r["evader"] == "evader/random")
+
+
+_SCRIPT = textwrap.dedent(
+    """
+    import sys, time
+    from strategies.policies import register_policy
+    from strategies.policies.baselines import RandomPolicy
+
+    class SlowPursuer(RandomPolicy):
+        def _decide(self, snap):
+            time.sleep(0.002)
+            return super()._decide(snap)
+
+    register_policy("pursuer/test_slow", SlowPursuer, "test only")
+    from analysis.cli import main
+    sys.exit(main(sys.argv[1:]))
+    """
+)
+
+_SPEC = textwrap.dedent(
+    """
+    name = "killme"
+    maps = ["open_room", "corridor"]
+    pursuers = ["pursuer/test_slow", "pursuer/greedy"]
+    evaders = ["evader/straight", "evader/random"]
+    seeds = 5
+    start = "valid"
+    [env]
+    max_cycles = 80
+    """
+)
+
+
+def _children(pid: int) -> set[int]:
+    out = set()
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                stat = (entry / "stat").read_text()
+            except OSError:
+                continue
+            if int(stat.rsplit(")", 1)[1].split()[1]) == pid:
+                out.add(int(entry.name))
+    return out
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+def _start(tmp_path: Path, store: Path) -> subprocess.Popen:
+    (tmp_path / "driver.py").write_text(_SCRIPT)
+    (tmp_path / "killme.toml").write_text(_SPEC)
+    env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "MPLBACKEND": "Agg"}
+    return subprocess.Popen(
+        [
+            sys.executable,
+            str(tmp_path / "driver.py"),
+            "tournament",
+            str(tmp_path / "killme.toml"),
+            "--store",
+            str(store),
+            "--workers",
+            "2",
+            "--no-progress",
+            "--no-report",
+        ],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
+def _wait_for_results(store: Path, k: int, proc: subprocess.Popen, timeout: float = 60) -> set:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        assert proc.poll() is None, proc.communicate()
+        if store.exists():
+            try:
+                con = sqlite3.connect(store)
+                n = con.execute("SELECT COUNT(*) FROM results").fetchone()[0]
+                con.close()
+            except sqlite3.Error:
+                n = 0
+            if n >= k:
+                return _children(proc.pid)
+        time.sleep(0.05)
+    raise AssertionError("the driver stored too few results in time")
+
+
+@pytest.fixture
+def slow_spec(tmp_path, test_policies):
+    (tmp_path / "killme.toml").write_text(_SPEC)
+    from analysis.tournament import load_spec
+
+    return load_spec(tmp_path / "killme.toml")
+
+
+def test_sigkill_mid_run_then_resume_loses_nothing(tmp_path, slow_spec):
+    store = tmp_path / "k.sqlite"
+    proc = _start(tmp_path, store)
+    workers = _wait_for_results(store, 6, proc)
+    assert len(workers) == 2
+    proc.kill()
+    proc.wait(timeout=10)
+    deadline = time.monotonic() + 5
+    while any(_alive(w) for w in workers) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not any(_alive(w) for w in workers), "orphaned workers after SIGKILL"
+    with Store(store) as db:
+        stored = len(db.rows(slow_spec.run_id))
+    assert 6 <= stored < 40
+    resumed = run_tournament(slow_spec, store, backend="process", workers=2, progress=False)
+    assert resumed.reused == stored and resumed.played == 40 - stored
+    whole = run_tournament(slow_spec, tmp_path / "whole.sqlite", backend="serial", progress=False)
+    with Store(store) as a, Store(tmp_path / "whole.sqlite") as b:
+        got, want = a.rows(slow_spec.run_id), b.rows(whole.run_id)
+        assert a.conn.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 40  # no duplicate
+    assert comparable(got) == comparable(want)
+
+
+def test_sigterm_stops_quickly_says_how_to_resume_and_leaves_no_orphans(tmp_path, slow_spec):
+    store = tmp_path / "t.sqlite"
+    proc = _start(tmp_path, store)
+    workers = _wait_for_results(store, 3, proc)
+    t0 = time.monotonic()
+    proc.send_signal(signal.SIGTERM)
+    out, err = proc.communicate(timeout=10)
+    assert time.monotonic() - t0 < 3.0
+    assert proc.returncode == 143
+    assert "Traceback" not in err
+    assert "to resume: surveil tournament" in out + err and str(store) in out + err
+    assert not any(_alive(w) for w in workers)
+    with Store(store) as db:
+        assert db.run(slow_spec.run_id)["status"] == "interrupted"

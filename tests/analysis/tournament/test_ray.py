@@ -1,0 +1,39 @@
+"""The Ray backend on a real local 2-CPU Ray instance (one test: Ray takes seconds to start)."""
+
+from __future__ import annotations
+
+import pytest
+
+from analysis.tournament import Store, run_tournament, spec_from_dict
+
+from .conftest import comparable
+
+ray = pytest.importorskip(
+    "ray", reason="the ray extra is not installed (pip install 'surveil[ray]')"
+)
+
+
+def test_ray_backend_matches_the_serial_backend_and_ships_models(tmp_path, small_spec):
+    from analysis.tournament.executors import RayExecutor
+    from analysis.tournament.spec import zoo_dir
+
+    model = zoo_dir() / "ppo_evader_vs_greedy_open_room" / "model.zip"
+    d = {
+        **small_spec,
+        "maps": ["open_room"],
+        "seeds": 2,
+        "evaders": ["evader/straight", {"model": str(model), "label": "ppo"}],
+    }
+    spec = spec_from_dict(d)
+    serial = run_tournament(spec, tmp_path / "serial.sqlite", backend="serial", progress=False)
+    ex = RayExecutor(num_cpus=2)  # ray.init(num_cpus=2): a real local instance
+    try:
+        assert ray.is_initialized() and ray.cluster_resources()["CPU"] == 2
+        assert ex.describe() == "ray (2 CPUs)"
+        remote = run_tournament(spec, tmp_path / "ray.sqlite", executor=ex, progress=False)
+    finally:
+        ex.close()
+    assert not ray.is_initialized()  # the instance it started is shut down
+    assert remote.played == serial.played == 8 and remote.errors == 0
+    with Store(tmp_path / "serial.sqlite") as a, Store(tmp_path / "ray.sqlite") as b:
+        assert comparable(a.rows(serial.run_id)) == comparable(b.rows(remote.run_id))

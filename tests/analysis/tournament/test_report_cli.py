@@ -1,0 +1,116 @@
+"""The report renders (HTML parses, images exist and decode); the command line works."""
+
+from __future__ import annotations
+
+import base64
+import io
+import re
+from html.parser import HTMLParser
+
+import pytest
+from PIL import Image
+
+from analysis.cli import main
+from analysis.tournament import Store, run_tournament, spec_from_dict
+from analysis.tournament.report import write_report
+
+
+class _Page(HTMLParser):
+    def __init__(self):
+        super().__init__()
+        self.images, self.ids, self.tables = [], [], 0
+
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        if tag == "img":
+            self.images.append(a)
+        if "id" in a:
+            self.ids.append(a["id"])
+        self.tables += tag == "table"
+
+
+def test_report_renders_with_heat_maps_ratings_and_replays(tmp_path, small_spec):
+    store = tmp_path / "s.sqlite"
+    run_tournament(spec_from_dict(small_spec), store, backend="serial", progress=False)
+    files = write_report(store, tmp_path / "rep")
+    page = _Page()
+    page.feed(files["html"].read_text())
+    page.close()
+    assert {"matrices", "games", "ratings", "paired", "regret", "replays", "errors"} <= set(
+        page.ids
+    )
+    assert page.tables >= 4
+    kinds = []
+    for img in page.images:
+        head, data = img["src"].split(",", 1)
+        assert head.startswith("data:image/") and img["alt"]
+        with Image.open(io.BytesIO(base64.b64decode(data))) as im:
+            kinds.append(im.format)
+            if im.format == "GIF":
+                assert im.n_frames > 5
+    assert kinds.count("PNG") == 2 and kinds.count("GIF") >= 2  # one replay per map
+    md = files["markdown"].read_text()
+    for name in re.findall(r"\]\(([^)]+)\)", md):
+        assert (tmp_path / "rep" / name).is_file()
+    assert "differs from the stored outcome" not in md  # replays re-simulate faithfully
+
+
+def test_cli_tournament_report_export_and_errors(tmp_path, capsys):
+    spec = tmp_path / "mini.toml"
+    spec.write_text(
+        'maps = ["open_room"]\npursuers = ["pursuer/greedy"]\n'
+        'evaders = ["evader/random", "evader/straight"]\nseeds = 2\n[env]\nmax_cycles = 20\n'
+    )
+    store = tmp_path / "mini.sqlite"
+    argv = ["tournament", str(spec), "--store", str(store), "--no-progress", "--backend", "serial"]
+    assert main([*argv, "--no-report"]) == 0
+    out = capsys.readouterr().out
+    assert "4 of 4 matches stored" in out and "evader/straight" in out
+    assert main([*argv, "--no-report"]) == 0  # resumes: nothing to play
+    assert "4 reused, 0 played" in capsys.readouterr().out
+    assert main(["report", str(store), "--out", str(tmp_path / "r"), "--no-replays"]) == 0
+    assert (tmp_path / "r" / "report.html").is_file()
+    assert main(["export", str(store), str(tmp_path / "x.csv")]) == 0
+    assert len((tmp_path / "x.csv").read_text().splitlines()) == 5
+    assert main(["tournament", "--list"]) == 0
+    assert "quick" in capsys.readouterr().out
+    for bad, message in [
+        (["tournament", str(tmp_path / "missing.toml")], "no such file"),
+        (["report", str(tmp_path / "missing.sqlite")], "no such file"),
+        (["export", str(store), str(tmp_path / "x.txt")], ".csv"),
+        (["evaluate", "--results", str(tmp_path / "old.jsonl")], "SQLite store"),
+    ]:
+        capsys.readouterr()
+        assert main(bad) == 2
+        err = capsys.readouterr().err
+        assert message in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+def test_evaluate_is_a_one_off_tournament_without_double_counting(tmp_path, capsys):
+    store = tmp_path / "e.sqlite"
+    argv = [
+        "evaluate",
+        "--maps",
+        "open_room",
+        "--pursuers",
+        "pursuer/greedy",
+        "pursuer/greedy",
+        "--evaders",
+        "evader/random",
+        "--seeds",
+        "3",
+        "--max-cycles",
+        "20",
+        "--results",
+        str(store),
+        "--no-progress",
+        "--plot",
+        str(tmp_path / "t.png"),
+    ]
+    with pytest.warns(UserWarning, match="merged"):
+        assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "3 of 3 matches stored" in out  # the repeated pursuer is played once
+    assert (tmp_path / "t.png").stat().st_size > 1000
+    with Store(store) as db:
+        assert db.conn.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 3

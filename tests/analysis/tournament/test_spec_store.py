@@ -1,0 +1,207 @@
+"""Specs validated on load, match identity by content, the SQLite store and its lock."""
+
+from __future__ import annotations
+
+import csv
+import json
+import shutil
+import sqlite3
+
+import pytest
+
+from analysis.tournament import Store, StoreBusyError, load_spec, run_tournament, spec_from_dict
+from analysis.tournament.identity import plan
+from analysis.tournament.spec import zoo_dir
+from envs.errors import InvalidConfigError
+
+from .conftest import comparable
+
+
+@pytest.mark.parametrize(
+    ("patch", "message"),
+    [
+        ({"pursuers": ["pursuer/nope"]}, r"\[pursuers #1\].*pursuer/nope"),
+        ({"pursuers": ["evader/random"]}, r"\[pursuers #1\].*'pursuer/KIND'"),
+        (
+            {"evaders": [{"policy": "evader/toward_away", "params": {"mode": "sideways"}}]},
+            r"\[evaders #1\]",
+        ),
+        ({"evaders": [{"policy": "evader/random", "colour": "red"}]}, r"unknown field.*colour"),
+        ({"seeds": 0}, r"seeds = 0"),
+        ({"seeds": [1, 1]}, r"repeated"),
+        ({"seeds": True}, r"seeds = True"),
+        ({"start": "anywhere"}, r"start = 'anywhere'"),
+        ({"maps": ["atlantis"]}, r"\[maps #1\].*atlantis"),
+        ({"env": {"l_min": -1}}, r"\[env\].*l_min = -1"),
+        ({"env": {"max_cycles": 1.5}}, r"\[env\].*max_cycles"),
+        ({"env": {"bogus": 1}}, r"\[env\].*bogus"),
+        ({"grid": {"rho": [0.5, "fast"]}}, r"\[grid\].*rho = 'fast'"),
+        ({"grid": {"rho": [0.5], "v_evader": [1.0]}}, r"rho.*v_evader"),
+        ({"env": {"l_max": 1.0}}, r"l_max"),
+        ({"time_limit": 0}, r"time_limit = 0"),
+        ({"colour": "red"}, r"unknown field.*colour"),
+        ({"evaders": [{"model": "zoo:no_such_model"}]}, r"no zoo model 'no_such_model'"),
+    ],
+)
+def test_bad_specs_name_the_field(small_spec, patch, message):
+    with pytest.raises(InvalidConfigError, match=message):
+        spec_from_dict({**small_spec, **patch}, source="SPEC.toml")
+
+
+def test_toml_spec_and_relative_map_files(tmp_path):
+    world = {
+        "name": "box",
+        "boundary": [[0, 0], [12, 0], [12, 8], [0, 8]],
+        "obstacles": [[[5, 3], [7, 3], [7, 5], [5, 5]]],
+    }
+    (tmp_path / "worlds").mkdir()
+    (tmp_path / "worlds" / "box.json").write_text(json.dumps(world))
+    (tmp_path / "t.toml").write_text(
+        'maps = ["worlds/box.json", "open_room"]\npursuers = ["pursuer/greedy"]\n'
+        'evaders = ["evader/random"]\nseeds = [4, 7]\n[grid]\nrho = [0.5, 0.8]\n'
+    )
+    spec = load_spec(tmp_path / "t.toml")
+    assert spec.name == "t" and [m.label for m in spec.maps] == ["worlds/box.json", "open_room"]
+    assert [v.label for v in spec.variants] == ["rho=0.5", "rho=0.8"]
+    cfg = spec.env_config(spec.maps[1], spec.variants[1])
+    assert cfg["v_evader"] == pytest.approx(0.8 * cfg["v_pursuer"])
+    assert len(list(plan(spec))) == 2 * 2 * 2  # seeds x maps x variants
+    (tmp_path / "bad.toml").write_text("maps = [")
+    with pytest.raises(InvalidConfigError, match="not valid TOML"):
+        load_spec(tmp_path / "bad.toml")
+
+
+def test_duplicate_roster_entries_are_merged_or_rejected(small_spec):
+    with pytest.warns(UserWarning, match="merged"):
+        spec = spec_from_dict({**small_spec, "pursuers": ["pursuer/greedy", "pursuer/greedy"]})
+    assert [p.label for p in spec.pursuers] == ["pursuer/greedy"]
+    assert len(list(plan(spec))) == 2 * 1 * 2 * 3  # not counted twice
+    with pytest.raises(InvalidConfigError, match="labelled 'g'"):
+        spec_from_dict(
+            {
+                **small_spec,
+                "pursuers": [
+                    {"policy": "pursuer/greedy", "label": "g"},
+                    {"policy": "pursuer/greedy", "params": {"gain": 2.0}, "label": "g"},
+                ],
+            }
+        )
+    with pytest.raises(InvalidConfigError, match="same world"):
+        spec_from_dict({**small_spec, "maps": ["corridor", str(_builtin_file("corridor"))]})
+
+
+def _builtin_file(name):
+    from importlib import resources
+
+    return resources.files("envs.maps").joinpath("data", f"{name}.json")
+
+
+def test_a_changed_map_file_makes_new_matches(tmp_path, small_spec):
+    world = {
+        "name": "box",
+        "boundary": [[0, 0], [12, 0], [12, 8], [0, 8]],
+        "obstacles": [[[5, 3], [7, 3], [7, 5], [5, 5]]],
+    }
+    path = tmp_path / "box.json"
+    path.write_text(json.dumps(world))
+    d = {**small_spec, "maps": ["box.json"], "seeds": 2}
+    store = tmp_path / "s.sqlite"
+    first = run_tournament(
+        spec_from_dict(d, base_dir=tmp_path), store, backend="serial", progress=False
+    )
+    assert first.played == first.planned == 8
+    again = run_tournament(
+        spec_from_dict(d, base_dir=tmp_path), store, backend="serial", progress=False
+    )
+    assert again.played == 0 and again.reused == 8  # same content: nothing replayed
+    world["obstacles"][0][0] = [4.5, 3]  # edit the file in place, same path and name
+    path.write_text(json.dumps(world))
+    edited = run_tournament(
+        spec_from_dict(d, base_dir=tmp_path), store, backend="serial", progress=False
+    )
+    assert edited.run_id != first.run_id and edited.reused == 0 and edited.played == 8
+    with Store(store) as db:
+        assert len(db.runs()) == 2
+        ids_first = {r["match_id"] for r in db.rows(first.run_id)}
+        ids_edited = {r["match_id"] for r in db.rows(edited.run_id)}
+    assert not ids_first & ids_edited  # never mixed in
+
+
+def test_a_changed_model_file_makes_new_matches(tmp_path):
+    src = zoo_dir() / "ppo_pursuer_vs_straight_open_room"
+    shutil.copytree(src, tmp_path / "m")
+    d = {
+        "maps": ["open_room"],
+        "pursuers": [{"model": "m/model.zip", "label": "ppo"}],
+        "evaders": ["evader/straight"],
+        "seeds": 2,
+        "env": {"max_cycles": 30},
+    }
+    spec = spec_from_dict(d, base_dir=tmp_path)
+    assert spec.pursuers[0].observation == {"observation": "state"}  # from provenance.json
+    store = tmp_path / "s.sqlite"
+    s1 = run_tournament(spec, store, backend="serial", progress=False)
+    assert s1.played == 2 and s1.errors == 0 and s1.forfeits == 0
+    with (tmp_path / "m" / "model.zip").open("ab") as f:
+        f.write(b"retrained")  # same path, new content
+    s2 = run_tournament(
+        spec_from_dict(d, base_dir=tmp_path), store, backend="serial", progress=False
+    )
+    assert s2.run_id != s1.run_id and s2.reused == 0
+
+
+def test_store_lock_refuses_a_second_writer(tmp_path, small_spec):
+    store = tmp_path / "s.sqlite"
+    holder = Store(store)
+    holder.lock()
+    try:
+        with pytest.raises(StoreBusyError, match=r"being written by pid \d+"):
+            run_tournament(spec_from_dict(small_spec), store, backend="serial", progress=False)
+    finally:
+        holder.close()
+    done = run_tournament(spec_from_dict(small_spec), store, backend="serial", progress=False)
+    assert done.played == 24  # the lock is free again
+
+
+def test_store_rejects_foreign_files_and_exports(tmp_path, small_spec):
+    bogus = tmp_path / "notes.sqlite"
+    bogus.write_text("hello, not a database" * 100)
+    with pytest.raises(InvalidConfigError, match="not a tournament store"):
+        Store(bogus)
+    with pytest.raises(InvalidConfigError, match="no such file"):
+        Store(tmp_path / "missing.sqlite", create=False)
+    store = tmp_path / "s.sqlite"
+    summary = run_tournament(spec_from_dict(small_spec), store, backend="serial", progress=False)
+    with Store(store) as db:
+        rows = db.rows(summary.run_id)
+        db.export(summary.run_id, tmp_path / "r.csv")
+        db.export(summary.run_id, tmp_path / "r.jsonl")
+        with pytest.raises(InvalidConfigError, match=r"\.csv"):
+            db.export(summary.run_id, tmp_path / "r.txt")
+        assert db.run(summary.run_id[:6])["name"] == "small"
+        with pytest.raises(InvalidConfigError, match="no run"):
+            db.run("zzz")
+    with (tmp_path / "r.csv").open() as f:
+        flat = list(csv.DictReader(f))
+    assert len(flat) == len(rows) == 24 and flat[0]["match_id"] == rows[0]["match_id"]
+    lines = (tmp_path / "r.jsonl").read_text().splitlines()
+    assert [json.loads(x)["match_id"] for x in lines] == [r["match_id"] for r in rows]
+    # the journal mode is WAL and a match's result is one row keyed by its identity
+    con = sqlite3.connect(store)
+    assert con.execute("PRAGMA journal_mode").fetchone()[0] == "wal"
+    assert con.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 24
+    con.close()
+
+
+def test_a_different_spec_reuses_shared_matches(tmp_path, small_spec):
+    store = tmp_path / "s.sqlite"
+    a = run_tournament(spec_from_dict(small_spec), store, backend="serial", progress=False)
+    wider = {**small_spec, "name": "wider", "seeds": 4}
+    b = run_tournament(spec_from_dict(wider), store, backend="serial", progress=False)
+    assert b.reused == 24 and b.played == 8 and a.run_id != b.run_id
+    with Store(store) as db:
+        narrow, wide = db.rows(a.run_id), db.rows(b.run_id)
+    assert len(narrow) == 24 and len(wide) == 32  # each run sees only its own matches
+    by_id = {r["match_id"]: r for r in comparable(wide)}
+    for r in comparable(narrow):
+        assert by_id[r["match_id"]] == r | {"seq": by_id[r["match_id"]]["seq"]}

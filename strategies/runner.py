@@ -317,7 +317,7 @@ class _Observer:
         self.env = env
         self.agent = AGENT[role]
         mine = _settings(cfg, opts)
-        self.config = cfg if mine == _settings(cfg, {}) else dataclasses.replace(cfg, **opts)
+        self.config = cfg if mine == _settings(cfg, {}) else _replace(cfg, **opts)
         self.options = dict(zip(OBSERVATION_OPTIONS[: len(mine)], mine, strict=False))
         if mine == _settings(cfg, {}):
             self.mode = "env"
@@ -547,8 +547,19 @@ def _requests(
     return out
 
 
+def _replace(config: Any, **changes: Any) -> Any:
+    """A copy of an env config with other observation settings (warned about already)."""
+    import warnings
+
+    from envs.errors import RhoAboveOneWarning
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RhoAboveOneWarning)
+        return dataclasses.replace(config, **changes)
+
+
 def _state_config(config: Any) -> Any:
-    return dataclasses.replace(config, observation="state")
+    return _replace(config, observation="state")
 
 
 def _emit_frame(env: Any, sink: Callable | None, frames: list | None) -> None:

@@ -168,17 +168,24 @@ class Spec:
     salt: str = ""
 
     def env_config(self, map_entry: MapEntry, variant: Variant) -> dict[str, Any]:
-        """The resolved env parameters of a (map, variant): every field but the map."""
+        """The resolved env parameters of a (map, variant): every field but the map.
+
+        ``rho`` sets ``v_evader = rho * v_pursuer`` (the pursuer's speed as resolved).
+        A rho above 1 is legal here without a warning per match (see :func:`spec_from_dict`).
+        """
+        from envs.errors import RhoAboveOneWarning
         from envs.surveillance.config import EnvConfig
 
         kwargs = {**map_entry.params, **self.env, **variant.overrides}
-        if variant.rho is not None:
-            vp = kwargs.get("v_pursuer", _default("v_pursuer"))
-            kwargs["v_evader"] = variant.rho * float(vp)
         where = f"{self.source} [env]" + (f" [grid] {variant.label}" if variant.label else "")
         where += f" on map {map_entry.label!r}"
         try:
-            cfg = EnvConfig(map=map_entry.map, **kwargs)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RhoAboveOneWarning)
+                cfg = EnvConfig(map=map_entry.map, **kwargs)
+                if variant.rho is not None:
+                    kwargs["v_evader"] = variant.rho * cfg.v_pursuer
+                    cfg = EnvConfig(map=map_entry.map, **kwargs)
         except ValueError as exc:
             raise InvalidConfigError(f"{where}: {exc}") from exc
         d = cfg.to_dict()
@@ -218,9 +225,9 @@ def _entry_dict(p: PolicyEntry) -> dict[str, Any]:
 
 
 def _default(name: str) -> Any:
-    from envs.surveillance.config import EnvConfig
+    from envs.surveillance.config import env_parameters
 
-    return {f.name: f.default for f in dataclasses.fields(EnvConfig)}[name]
+    return env_parameters()[name]
 
 
 # --------------------------------------------------------------------------- loading
@@ -287,8 +294,15 @@ def spec_from_dict(
         salt=salt,
     )
     seen: dict[str, str] = {}
+    fast: list[str] = []
     for m in spec.maps:  # every (map, variant) must make a valid env config
-        games = json.dumps([spec.env_config(m, v) for v in spec.variants], sort_keys=True)
+        configs = [spec.env_config(m, v) for v in spec.variants]
+        fast += [
+            f"{m.label} {v.label}".strip()
+            for v, c in zip(spec.variants, configs, strict=True)
+            if c["v_evader"] > c["v_pursuer"]
+        ]
+        games = json.dumps(configs, sort_keys=True)
         key = m.digest + games
         if key in seen:
             raise InvalidConfigError(
@@ -296,6 +310,14 @@ def spec_from_dict(
                 f"same parameters (digest {m.digest[:12]}); list it once"
             )
         seen[key] = m.label
+    if fast:
+        from envs.errors import RhoAboveOneWarning
+
+        warnings.warn(
+            f"{source}: rho > 1 in {fast}: the evader can always escape there (Sec. 5)",
+            RhoAboveOneWarning,
+            stacklevel=2,
+        )
     return spec
 
 

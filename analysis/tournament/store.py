@@ -18,10 +18,10 @@ included) loses at most the matches in flight and never leaves a half-written re
 Results are shared between runs by identity: a different spec on the same store reuses
 every match it has in common and never sees the others.
 
-One writer at a time: :meth:`Store.lock` takes an exclusive ``flock`` on ``STORE.lock``
-(released by the kernel if the driver dies); a second driver is refused with a message
-naming the holder. Readers (reports, exports) need no lock: WAL lets them read while a
-run writes.
+One writer at a time: :meth:`Store.lock` takes an exclusive POSIX lock on ``STORE.lock``
+(released by the kernel if the driver dies, not inherited by its workers); a second
+driver is refused with a message naming the holder. Readers (reports, exports) need no
+lock: WAL lets them read while a run writes.
 """
 
 from __future__ import annotations
@@ -96,6 +96,10 @@ ROW_FIELDS = (
     "seed",
     *RESULT_FIELDS[:-1],
 )
+
+
+_HELD: set[str] = set()
+"""Lock files held by this process (POSIX locks do not conflict within a process)."""
 
 
 class StoreBusyError(SurveilValueError):
@@ -176,14 +180,22 @@ class Store:
 
     # ---------------------------------------------------------------- the write lock
     def lock(self) -> None:
-        """Take the single-writer lock, or raise :class:`StoreBusyError` naming the holder."""
+        """Take the single-writer lock, or raise :class:`StoreBusyError` naming the holder.
+
+        A POSIX record lock (``lockf``) on ``STORE.lock``: the kernel releases it when the
+        driver dies, however it dies, and forked workers do not inherit it. Within one
+        process a registry of held stores plays the same part.
+        """
         import fcntl
 
         lock_path = self.path.with_name(self.path.name + ".lock")
+        key = str(lock_path.resolve())
         f = open(lock_path, "a+", encoding="utf-8")  # held until unlock()
         try:
-            fcntl.flock(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
+            if key in _HELD:
+                raise BlockingIOError
+            fcntl.lockf(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
             f.seek(0)
             holder = f.read().strip() or "another process"
             f.close()
@@ -192,6 +204,7 @@ class Store:
                 "finish (or stop it) before starting another on this store, or use --store "
                 "with another file"
             ) from None
+        _HELD.add(key)
         f.seek(0)
         f.truncate()
         f.write(
@@ -199,17 +212,20 @@ class Store:
             f"{time.strftime('%Y-%m-%d %H:%M:%S')}"
         )
         f.flush()
-        self._lock_file = f
+        self._lock_file = (f, key)
 
     def unlock(self) -> None:
         """Release the write lock (idempotent)."""
         if self._lock_file is not None:
             import fcntl
 
+            f, key = self._lock_file
             with contextlib.suppress(OSError, ValueError):
-                self._lock_file.truncate(0)
-                fcntl.flock(self._lock_file.fileno(), fcntl.LOCK_UN)
-            self._lock_file.close()
+                f.truncate(0)
+                f.flush()
+                fcntl.lockf(f.fileno(), fcntl.LOCK_UN)
+            f.close()
+            _HELD.discard(key)
             self._lock_file = None
 
     # ---------------------------------------------------------------- runs

@@ -26,6 +26,7 @@ import signal
 import tempfile
 import threading
 import traceback
+import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,6 +34,7 @@ from typing import Any
 
 from analysis.tournament.identity import Match
 from analysis.tournament.spec import PolicyEntry, Spec
+from envs.errors import RhoAboveOneWarning
 
 __all__ = ["Context", "MatchTimeout", "context_for", "play", "play_batch"]
 
@@ -148,7 +150,8 @@ def play(match: Match, ctx: Context) -> dict[str, Any]:
         e = ctx.policies[f"evader:{match.evader}"]
         env = ctx.envs[(match.map, match.variant)]
         observations = {"pursuer": p.observation, "evader": e.observation}
-        with _alarm(ctx.time_limit + ALARM_GRACE):
+        with _alarm(ctx.time_limit + ALARM_GRACE), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RhoAboveOneWarning)  # said once, at spec load
             result = run_episode(
                 ctx.maps[match.map],
                 build_policy(ctx, p),

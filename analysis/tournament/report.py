@@ -53,6 +53,7 @@ class Analysis:
     paired: list[st.PairedComparison]
     errors: list[dict[str, Any]]
     notes: list[str] = field(default_factory=list)
+    geometry: dict[str, Any] = field(default_factory=dict)  # map digest -> stored geometry
 
 
 def analyse(store: Store | str | os.PathLike[str], run_id: str | None = None) -> Analysis:
@@ -71,7 +72,13 @@ def analyse(store: Store | str | os.PathLike[str], run_id: str | None = None) ->
         ratings=st.ratings(rows),
         paired=st.paired_comparisons(rows),
         errors=db.errors(run["run_id"]),
+        geometry={m["digest"]: db.map_geometry(m["digest"]) for m in _spec(run).get("maps", [])},
     )
+
+
+def _spec(run: dict[str, Any]) -> dict[str, Any]:
+    spec = run["spec"]
+    return json.loads(spec) if isinstance(spec, str) else spec
 
 
 # --------------------------------------------------------------------------- pictures
@@ -312,7 +319,8 @@ def _regret_section(a: Analysis) -> tuple[str, str]:
             "regret here, the fraction of certified-winnable starts it loses."
         )
         return text, f"<p>{html.escape(text)}</p>"
-    table = tournament_regret(a.run["spec"], a.rows)
+    geometry = {d: g for d, g in a.geometry.items() if g is not None}
+    table = tournament_regret(a.run["spec"], a.rows, geometry=geometry)
     return _md_table(table), _html_table(table)
 
 

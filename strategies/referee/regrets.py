@@ -270,9 +270,17 @@ def _match_of(row, spec, maps, variants, geometry) -> dict[str, Any]:
     }  # fmt: skip
 
 
+def _builtin_name(source):
+    """A tournament spec names a built-in map's source ``builtin:NAME``."""
+    if isinstance(source, str) and source.startswith("builtin:"):
+        return source[len("builtin:") :]
+    return source
+
+
 def _builtin_params(name) -> dict[str, float]:
     from envs.maps import builtin_info, builtin_names
 
+    name = _builtin_name(name)
     if isinstance(name, str) and name in builtin_names():
         return builtin_info(name).params()
     return {}
@@ -289,6 +297,7 @@ def _map_of(source, digest, maps, geometry) -> Map:
     elif isinstance(source, str):
         if source in maps:
             source = maps[source].get("source", source)
+        source = _builtin_name(source)
         if source in builtin_names() or os.path.exists(str(source)):
             world = load_map(source)
     if world is None:

@@ -52,6 +52,11 @@ def test_report_renders_with_heat_maps_ratings_and_replays(tmp_path, small_spec)
     for name in re.findall(r"\]\(([^)]+)\)", md):
         assert (tmp_path / "rep" / name).is_file()
     assert "differs from the stored outcome" not in md  # replays re-simulate faithfully
+    # the referee rebuilt every match's game from the spec's built-in maps (source
+    # "builtin:NAME", their recommended parameters) and counted all 24
+    regret = md.split("## Regret", 1)[1].split("\n## ", 1)[0]
+    assert "not counted" not in regret
+    assert re.search(r"\| pursuer \| pursuer/greedy \| 12 \|", regret)
 
 
 def test_cli_tournament_report_export_and_errors(tmp_path, capsys):

@@ -47,7 +47,7 @@ class DecompositionPursuer(BasePolicy):
     """Pursuer that keeps the configuration in admissible, non-escapable cells at L_min.
 
     Args:
-        resolution: grid spacing of the safety table (map units).
+        resolution: grid spacing of the safety table (default L_min / 20: no unit dependence).
         n_bins: orientation bins of the table.
         rays: probe rays around the evader.
         probe_every: use every k-th grid sample along a ray as a probe.
@@ -60,7 +60,7 @@ class DecompositionPursuer(BasePolicy):
     def __init__(
         self,
         *,
-        resolution: float = 0.1,
+        resolution: float | None = None,
         n_bins: int = 144,
         rays: int = 16,
         probe_every: int = 3,
@@ -69,7 +69,7 @@ class DecompositionPursuer(BasePolicy):
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
-        self.resolution = positive_param("resolution", resolution)
+        self.resolution = None if resolution is None else positive_param("resolution", resolution)
         self.n_bins = count_param("n_bins", n_bins, 8, NO_PATH - 1)
         self.rays = count_param("rays", rays, 4, MAX_RAYS)
         self.probe_every = count_param("probe_every", probe_every, 1, MAX_RAYS)
@@ -82,7 +82,8 @@ class DecompositionPursuer(BasePolicy):
         # the pursuer's disc keeps its centre body_radius off the walls, so the rod tip
         # meets a wall as if the rod were that much longer (Prop. 3: fewer free arcs)
         self.table_length = round(self.L_target + c.body_radius, 6)
-        self.table = safety_table(c.map, self.table_length, self.resolution, self.n_bins)
+        res = self.resolution if self.resolution is not None else c.l_min / 20.0
+        self.table = safety_table(c.map, self.table_length, res, self.n_bins)
         rho = c.rho
         # Sec. 6.1: the evader can hold the pursuer's best rate down to (V_p/L) sqrt(1 - rho^2)
         self.omega = c.v_pursuer * math.sqrt(max(1.0 - rho * rho, 0.05)) / c.l_min

@@ -26,22 +26,35 @@ import functools
 import hashlib
 import math
 import os
+import tempfile
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from envs.errors import InvalidConfigError
+from envs import validation
+from envs.errors import InfeasibleError
 from envs.maps import Map
-from strategies.cspace.cache import resolve_cache_dir
+from strategies.cspace import _budget
+from strategies.cspace.cache import CacheWarning, resolve_cache_dir
 from strategies.cspace.grids import grid_points
 
-__all__ = ["NO_PATH", "SOURCE", "SafetyTable", "grid_points", "safety_table"]
+__all__ = [
+    "NO_PATH",
+    "SOURCE",
+    "CacheWarning",
+    "SafetyTable",
+    "default_resolution",
+    "grid_points",
+    "safety_table",
+    "table_bytes",
+]
 
 NO_PATH = 255
 """Entry of the rotation tables meaning "no safe orientation at this point"."""
 
-TABLE_VERSION = 2
+TABLE_VERSION = 3
 
 SOURCE = "decomposition"
 """What the table is built from (part of the cache key): the exact cells of K_L."""
@@ -176,7 +189,14 @@ def _classified(dec, p: np.ndarray, step: float):
     return arcs, None
 
 
-def _build(world: Map, L: float, resolution: float, n_bins: int) -> SafetyTable:
+_PROGRESS_POINTS = 20_000  # tables with more grid points show a bar (on a terminal)
+
+
+def _build(
+    world: Map, L: float, resolution: float, n_bins: int, progress: bool | None = None
+) -> SafetyTable:
+    from tqdm import tqdm
+
     from strategies.cspace import decompose
 
     dec = decompose(world, L, cache=True)
@@ -184,7 +204,15 @@ def _build(world: Map, L: float, resolution: float, n_bins: int) -> SafetyTable:
     centres = -math.pi + (np.arange(n_bins) + 0.5) * (2.0 * math.pi / n_bins)
     free = np.zeros((len(pts), n_bins), dtype=bool)
     safe = np.zeros_like(free)
-    for i, p in enumerate(pts):
+    show = progress if progress is not None else (None if len(pts) > _PROGRESS_POINTS else False)
+    bar = tqdm(
+        pts,
+        desc=f"safety table {world.name} L={L:g}",
+        unit="pt",
+        disable=None if show is None else not show,
+        leave=False,
+    )
+    for i, p in enumerate(bar):
         arcs, safe_arcs = _classified(dec, p, resolution)
         free[i] = _arc_bins(arcs, centres)
         if safe_arcs is not None:  # unresolved: no guarantee claimed, the free bins stand in
@@ -206,66 +234,168 @@ def _build(world: Map, L: float, resolution: float, n_bins: int) -> SafetyTable:
     )
 
 
+_ARRAYS = ("origin", "cell", "free", "safe", "guaranteed", "ccw", "cw")
+_UNWRITABLE: set[str] = set()  # cache directories already warned about
+
+
+def default_resolution(L: float) -> float:
+    """The grid spacing a table uses unless told otherwise: ``L / 20``.
+
+    Relative to the rod, so a map drawn in centimetres or kilometres gets the same table
+    as the same map in metres (0.1 on the built-in worlds, where L_min = 2).
+    """
+    return float(L) / 20.0
+
+
+def table_bytes(world: Map, resolution: float, n_bins: int) -> float:
+    """Estimated memory of a table: free-region grid points x (4 bytes per bin + 9).
+
+    Each point holds ``free``, ``safe`` (bool), ``ccw``, ``cw`` (uint8) per bin, a row
+    index and a flag; the grid's index array adds 4 bytes per node of the bounding box.
+    """
+    x0, y0, x1, y1 = world.bounds
+    nodes = max(1.0, (x1 - x0) / resolution) * max(1.0, (y1 - y0) / resolution)
+    points = world.free_region.area / resolution**2
+    return points * (4 * n_bins + 9) + 4 * nodes
+
+
 @functools.lru_cache(maxsize=16)
 def safety_table(
-    world: Map, L: float, resolution: float = 0.1, n_bins: int = 144, *, disk_cache: bool = True
+    world: Map,
+    L: float,
+    resolution: float | None = None,
+    n_bins: int = 144,
+    *,
+    disk_cache: bool = True,
+    memory_budget: object = None,
+    progress: bool | None = None,
 ) -> SafetyTable:
     """The :class:`SafetyTable` of ``world`` at rod length ``L`` (cached).
 
     Args:
         world: the map.
         L: rod length, normally L_min.
-        resolution: grid spacing.
+        resolution: grid spacing (default :func:`default_resolution`: ``L / 20``).
         n_bins: orientation bins (< 255).
-        disk_cache: read and write ``$SURVEIL_CACHE_DIR``.
+        disk_cache: read and write ``$SURVEIL_CACHE_DIR``. A file carries its key and a
+            SHA-256 of its arrays, is read without pickle, and is verified on load; a
+            damaged or mismatched one (truncated, a flipped bit, empty, another table
+            copied over it) is rebuilt with a one-line :class:`CacheWarning` naming it.
+        memory_budget: bytes (or ``"2GB"``) the table may take; default
+            ``$SURVEIL_MEMORY_BUDGET`` or half the RAM, as for decompositions.
+        progress: a progress bar over the grid points (``None``: on a terminal, for
+            large tables).
 
     Raises:
         InvalidConfigError: non-positive L or resolution, or a bad bin count.
+        InfeasibleError: the table's estimated memory exceeds the budget (the message
+            gives the estimate and the resolution that would fit).
     """
-    if not (math.isfinite(L) and L > 0 and math.isfinite(resolution) and resolution > 0):
-        raise InvalidConfigError(
-            f"L and resolution must be > 0, got L={L!r}, resolution={resolution!r}"
+    where = "safety_table"
+    L = validation.positive("L", L, where=where)
+    if resolution is None:
+        resolution = default_resolution(L)
+    resolution = validation.positive("resolution", resolution, where=where)
+    n_bins = validation.integer("n_bins", n_bins, minimum=8, maximum=NO_PATH - 1, where=where)
+    budget = _budget.memory_budget(memory_budget)
+    need = table_bytes(world, resolution, n_bins)
+    if need > budget:
+        fit = resolution * math.sqrt(need / budget) * 1.05
+        raise InfeasibleError(
+            f"safety_table(map {world.name!r}, L = {L:g}, resolution = {resolution:g}): the "
+            f"table would need about {need / 1e9:.1f} GB, more than the memory budget of "
+            f"{budget / 1e9:.1f} GB; use resolution >= {fit:.3g} or raise the budget "
+            "($SURVEIL_MEMORY_BUDGET)"
         )
-    if not 8 <= int(n_bins) < NO_PATH:
-        raise InvalidConfigError(f"n_bins must be in [8, {NO_PATH}), got {n_bins!r}")
-    key = hashlib.sha256(
-        f"{TABLE_VERSION}|{SOURCE}|{world.digest}|{L!r}|{resolution!r}|{n_bins}".encode()
-    ).hexdigest()[:24]
-    path = cache_dir() / f"safety_{key}.npz"
-    if disk_cache and path.exists():
-        try:
-            with np.load(path) as z:
-                return SafetyTable(
-                    L=float(L),
-                    resolution=float(resolution),
-                    origin=z["origin"],
-                    shape=tuple(int(v) for v in z["cell"].shape),
-                    n_bins=int(n_bins),
-                    cell=z["cell"],
-                    free=z["free"],
-                    safe=z["safe"],
-                    guaranteed=z["guaranteed"],
-                    ccw=z["ccw"],
-                    cw=z["cw"],
-                )
-        except (OSError, KeyError, ValueError):
-            pass  # a damaged cache file: rebuild it
-    table = _build(world, float(L), float(resolution), int(n_bins))
+    key = (
+        f"{TABLE_VERSION}|{SOURCE}|{world.digest}|{float(L).hex()}|{float(resolution).hex()}"
+        f"|{n_bins}"
+    )
+    path = cache_dir() / f"safety_{hashlib.sha256(key.encode()).hexdigest()[:24]}.npz"
     if disk_cache:
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            tmp = path.with_suffix(f".{os.getpid()}.tmp.npz")
-            np.savez_compressed(
-                tmp,
-                origin=table.origin,
-                cell=table.cell,
-                free=table.free,
-                safe=table.safe,
-                guaranteed=table.guaranteed,
-                ccw=table.ccw,
-                cw=table.cw,
-            )
-            os.replace(tmp, path)
-        except OSError:
-            pass  # a read-only home: keep the table in memory only
+        table = _read(path, key, float(L), float(resolution), n_bins)
+        if table is not None:
+            return table
+    table = _build(world, float(L), float(resolution), n_bins, progress)
+    if disk_cache:
+        _write(path, key, table)
     return table
+
+
+def _checksum(arrays: dict[str, np.ndarray]) -> str:
+    h = hashlib.sha256()
+    for name in _ARRAYS:
+        a = np.ascontiguousarray(arrays[name])
+        h.update(f"{name}|{a.dtype.str}|{a.shape}|".encode())
+        h.update(a.tobytes())
+    return h.hexdigest()
+
+
+def _read(path: Path, key: str, L: float, resolution: float, n_bins: int) -> SafetyTable | None:
+    """The table stored at ``path`` if it is intact and is the one asked for, else None."""
+    if not path.exists():
+        return None
+    try:
+        with open(path, "rb") as fh, np.load(fh, allow_pickle=False) as z:
+            arrays = {name: z[name] for name in _ARRAYS}
+            stored_key, stored_sum = str(z["key"]), str(z["sha256"])
+        if stored_key != key:
+            raise ValueError("it holds another table (key mismatch)")
+        if stored_sum != _checksum(arrays):
+            raise ValueError("its checksum does not match its content")
+        cell = arrays["cell"]
+        n = int(cell.max()) + 1 if cell.size else 0
+        shapes_ok = arrays["free"].shape == (n, n_bins) == arrays["ccw"].shape
+        if not shapes_ok or cell.ndim != 2:
+            raise ValueError("its arrays have inconsistent shapes")
+        return SafetyTable(
+            L=L,
+            resolution=resolution,
+            origin=arrays["origin"],
+            shape=(int(cell.shape[0]), int(cell.shape[1])),
+            n_bins=n_bins,
+            cell=cell,
+            free=arrays["free"],
+            safe=arrays["safe"],
+            guaranteed=arrays["guaranteed"],
+            ccw=arrays["ccw"],
+            cw=arrays["cw"],
+        )
+    except Exception as exc:
+        why = str(exc) or type(exc).__name__
+        warnings.warn(
+            f"safety table cache {path}: unusable ({why}); rebuilding it",
+            CacheWarning,
+            stacklevel=4,
+        )
+        return None
+
+
+def _write(path: Path, key: str, table: SafetyTable) -> None:
+    arrays = {name: getattr(table, name) for name in _ARRAYS}
+    directory = path.parent
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp.npz", dir=directory)
+    except OSError as exc:
+        if str(directory) not in _UNWRITABLE:
+            _UNWRITABLE.add(str(directory))
+            warnings.warn(
+                f"safety table cache directory {directory} is not writable ({exc}); tables "
+                "will be recomputed (set SURVEIL_CACHE_DIR to change it)",
+                CacheWarning,
+                stacklevel=4,
+            )
+        return
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            np.savez_compressed(fh, key=np.array(key), sha256=np.array(_checksum(arrays)), **arrays)
+        os.replace(tmp, path)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        warnings.warn(
+            f"safety table cache {path}: cannot write ({exc})", CacheWarning, stacklevel=4
+        )
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise

@@ -55,7 +55,7 @@ class ShootingEvader(BasePolicy):
     """Evader that follows guaranteed escape plans and optimal escape arcs.
 
     Args:
-        resolution: grid spacing of the cspace tables.
+        resolution: grid spacing of the cspace tables (default L_min / 20).
         rays: candidate directions around the evader.
         probe_every: every k-th grid sample along a ray is a candidate.
         replan: steps between shooting re-plans.
@@ -67,7 +67,7 @@ class ShootingEvader(BasePolicy):
     def __init__(
         self,
         *,
-        resolution: float = 0.1,
+        resolution: float | None = None,
         rays: int = 24,
         probe_every: int = 3,
         replan: int = 5,
@@ -75,7 +75,7 @@ class ShootingEvader(BasePolicy):
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
-        self.resolution = positive_param("resolution", resolution)
+        self.resolution = None if resolution is None else positive_param("resolution", resolution)
         self.rays = count_param("rays", rays, 4, MAX_RAYS)
         self.probe_every = count_param("probe_every", probe_every, 1, MAX_RAYS)
         self.replan = validation.integer("replan", replan, minimum=1)
@@ -84,8 +84,9 @@ class ShootingEvader(BasePolicy):
     def _reset(self) -> None:
         c = self.config
         self.L_eff = round(c.l_min + c.body_radius, 6)
-        self.table = safety_table(c.map, self.L_eff, self.resolution)
-        self.plan = escape_plan(c.map, self.L_eff, self.resolution)
+        res = self.resolution if self.resolution is not None else c.l_min / 20.0
+        self.table = safety_table(c.map, self.L_eff, res)
+        self.plan = escape_plan(c.map, self.L_eff, res)
         self.kernel = kernel_for(c.map)
         self.rho = c.rho
         omega_max = c.v_pursuer * (1.0 + min(self.rho, 1.0)) / c.l_min  # Sec. 6.1 maximum

@@ -169,3 +169,54 @@ class WallHuggingEvader(BasePolicy):
         radial = np.clip(self.gain * err / self.v_max, -1.0, 1.0)
         v = radial * n + math.sqrt(max(0.0, 1.0 - radial * radial)) * tangent
         return self.v_max * v
+
+
+class OrbitEvader(BasePolicy):
+    """Circle the nearest obstacle at distance ``offset`` (an adversary for the pursuer).
+
+    Darting round a pillar's convex corners is what a pursuer that probes the evader's
+    reach along straight rays misses (issue 13). The evader walks round the obstacle
+    nearest to it (the outer wall where the map has none), counter-clockwise with
+    ``direction = 1``, clockwise with ``-1``, holding ``offset`` from it.
+
+    Args:
+        offset: distance kept from the obstacle.
+        direction: ``1`` (counter-clockwise round the obstacle) or ``-1``.
+        gain: rate (1/s) of the correction toward that distance.
+    """
+
+    def __init__(
+        self,
+        *,
+        offset: float = 0.5,
+        direction: int = 1,
+        gain: float = 4.0,
+        name: str | None = None,
+    ) -> None:
+        super().__init__(name=name)
+        self.offset = positive_param("offset", offset)
+        self.direction = validation.choice("direction", direction, (1, -1))
+        self.gain = positive_param("gain", gain)
+
+    def _reset(self) -> None:
+        m = self.map
+        holes = m.edge_ring > 0
+        self._edges = np.flatnonzero(holes) if holes.any() else np.arange(len(m.edge_ring))
+
+    def _decide(self, snap: Snapshot) -> np.ndarray:
+        m, e = self.map, snap.evader
+        idx = self._edges
+        rel = e[None, :] - m.edge_start[idx]
+        t = np.clip(np.einsum("ej,ej->e", rel, m.edge_dir[idx]), 0.0, m.edge_length[idx])
+        closest = m.edge_start[idx] + t[:, None] * m.edge_dir[idx]
+        d2 = np.einsum("ej,ej->e", e - closest, e - closest)
+        k = int(np.argmin(d2))
+        away = e - closest[k]
+        dist = math.sqrt(float(d2[k]))
+        n = away / dist if dist > 1e-12 else m.edge_normal[idx[k]]
+        # obstacles are rings with free space on their left: -90 degrees keeps the
+        # obstacle on the right (clockwise round it), +90 counter-clockwise
+        tangent = self.direction * np.array([-n[1], n[0]])
+        radial = np.clip(self.gain * (self.offset - dist) / self.v_max, -1.0, 1.0)
+        v = radial * n + math.sqrt(max(0.0, 1.0 - radial * radial)) * tangent
+        return self.v_max * v

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from strategies.policies.baselines import (
     GreedyPursuer,
+    OrbitEvader,
     RandomPolicy,
     StraightLineEvader,
     TowardAwayEvader,
@@ -44,6 +45,11 @@ register_policy(
     "evader/wall_hugging",
     WallHuggingEvader,
     "goes to the nearest wall and follows it, wall on the right",
+)
+register_policy(
+    "evader/orbit",
+    OrbitEvader,
+    "circles the nearest obstacle (pillar) at a fixed distance: darts round its corners",
 )
 register_policy(
     "pursuer/tractrix",

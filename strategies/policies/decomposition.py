@@ -28,6 +28,7 @@ import math
 
 import numpy as np
 
+from envs import validation
 from strategies.control.kinematics import pursuer_velocity_holding_range, theta_dot
 from strategies.policies.base import (
     MAX_RAYS,
@@ -53,6 +54,10 @@ class DecompositionPursuer(BasePolicy):
         probe_every: use every k-th grid sample along a ray as a probe.
         hysteresis: weight of the rotation needed to reach a target, in units of V.
         distance_gain: rate (1/s) of the correction of L toward L_min.
+        turn_rate: the rotation rate the evader is assumed to impose (eq. 6, Sec. 6.1):
+            ``"both"``, ``(V_p / L) sqrt(1 - rho^2)``, the least rate when the rod may
+            turn either way; ``"one"``, ``(V_p / L)(1 - rho)``, the least rate in one
+            given direction (conservative: what the start sampler judges with).
     """
 
     roles = ("pursuer",)
@@ -66,6 +71,7 @@ class DecompositionPursuer(BasePolicy):
         probe_every: int = 3,
         hysteresis: float = 0.25,
         distance_gain: float = 3.0,
+        turn_rate: str = "both",
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
@@ -75,6 +81,7 @@ class DecompositionPursuer(BasePolicy):
         self.probe_every = count_param("probe_every", probe_every, 1, MAX_RAYS)
         self.hysteresis = nonnegative_param("hysteresis", hysteresis)
         self.distance_gain = positive_param("distance_gain", distance_gain)
+        self.turn_rate = validation.choice("turn_rate", turn_rate, ("both", "one"))
 
     def _reset(self) -> None:
         c = self.config
@@ -85,8 +92,14 @@ class DecompositionPursuer(BasePolicy):
         res = self.resolution if self.resolution is not None else c.l_min / 20.0
         self.table = safety_table(c.map, self.table_length, res, self.n_bins)
         rho = c.rho
-        # Sec. 6.1: the evader can hold the pursuer's best rate down to (V_p/L) sqrt(1 - rho^2)
-        self.omega = c.v_pursuer * math.sqrt(max(1.0 - rho * rho, 0.05)) / c.l_min
+        # Sec. 6.1, eq. (6): the evader can hold the pursuer's rate down to
+        # (V_p/L) sqrt(1 - rho^2) when the pursuer may turn either way (it takes the
+        # faster), but to (V_p/L)(1 - rho) in one given direction: the rate to assume when
+        # only one way round is safe ("one"; the start sampler's conservative judge)
+        if self.turn_rate == "one":
+            self.omega = c.v_pursuer * max(1.0 - rho, 0.05) / c.l_min
+        else:
+            self.omega = c.v_pursuer * math.sqrt(max(1.0 - rho * rho, 0.05)) / c.l_min
         self.horizon = horizon = math.pi / self.omega
         h = self.table.resolution
         n_r = max(2, math.ceil(c.v_evader * horizon / h))
@@ -117,18 +130,24 @@ class DecompositionPursuer(BasePolicy):
         if row < 0:
             return np.zeros(tab.n_bins)
         value = np.full(tab.n_bins, self.horizon)
-        rows = tab.rows(evader + self._offsets).reshape(self.rays, self._n_r)
+        value = np.minimum(value, self._probe_values(evader))
+        need0 = tab.need[row]
+        return np.where(need0 > 0, -self._turn_lut[need0], value)
+
+    def _probe_values(self, origin: np.ndarray) -> np.ndarray:
+        """The least margin over the probes on rays from ``origin`` (see above)."""
+        tab = self.table
+        rows = tab.rows(origin + self._offsets).reshape(self.rays, self._n_r)
         reach = np.cumsum(rows < 0, axis=1) == 0  # a ray stops at the first wall
         sub_rows = rows[:, self._probe_cols]
         sub_ok = reach[:, self._probe_cols]
         r = sub_rows[sub_ok]
-        if r.size:
-            t_e = np.broadcast_to(self._t_e, sub_rows.shape)[sub_ok]
-            # lut: seconds to turn by a number of bins; a safe bin (0) never threatens
-            v = t_e[:, None] - self._turn_lut[tab.need[r]]
-            value = np.minimum(value, v.min(axis=0))
-        need0 = tab.need[row]
-        return np.where(need0 > 0, -self._turn_lut[need0], value)
+        if not r.size:
+            return np.full(tab.n_bins, self.horizon)
+        t_e = np.broadcast_to(self._t_e, sub_rows.shape)[sub_ok]
+        # lut: seconds to turn by a number of bins; a safe bin (0) never threatens
+        v = t_e[:, None] - self._turn_lut[tab.need[r]]
+        return v.min(axis=0)
 
     def _target(self, snap: Snapshot) -> tuple[float, int]:
         """Signed rotation (radians) toward the best reachable orientation, and its bin."""
@@ -140,15 +159,31 @@ class DecompositionPursuer(BasePolicy):
         value = self.orientation_values(snap.evader)
         free = tab.free[row]
         nb = tab.n_bins
-        # bins reachable by turning through free orientations, each way round
-        ccw_run = np.roll(free, -b0)
-        cw_run = np.roll(free[::-1], b0 + 1)
-        ccw_run[0] = cw_run[0] = True  # the current bin (the rod is free right now)
+        # bins reachable by turning through free orientations, each way round. The table
+        # is built for the rod L_target + body radius; the real rod (shorter, e.g. with
+        # the pursuer pressed to a wall) is clear right now even where the table reads
+        # the current bin as blocked, so each scan starts from the nearest orientation
+        # the table calls free on its side (the bins in between are crossed, not
+        # targeted): otherwise no candidate is left and the pursuer stops turning.
+        ccw_run = np.roll(free, -b0)  # ccw_run[k]: bin b0 + k is free
+        cw_run = np.roll(free[::-1], b0 + 1)  # cw_run[k]: bin b0 - k is free
+        ccw_run[0] = cw_run[0] = True
+        blocked = not free[b0] and free.any()
+        gap_ccw = gap_cw = 0  # table-blocked bins crossed before the first free one
+        if blocked:
+            gap_ccw = int(np.argmax(ccw_run[1:]))
+            gap_cw = int(np.argmax(cw_run[1:]))
+            ccw_run[1 : gap_ccw + 1] = True
+            cw_run[1 : gap_cw + 1] = True
         n_ccw = int(np.argmin(ccw_run)) if not ccw_run.all() else nb
         n_cw = int(np.argmin(cw_run)) if not cw_run.all() else nb
         steps = np.arange(nb)
-        cand_bins = np.concatenate([(b0 + steps[:n_ccw]) % nb, (b0 - steps[1:n_cw]) % nb])
-        cand_rot = np.concatenate([steps[:n_ccw], -steps[1:n_cw]]).astype(float)
+        ccw_steps = steps[gap_ccw + 1 if blocked else 0 : n_ccw]
+        cw_steps = steps[gap_cw + 1 : n_cw]
+        cand_bins = np.concatenate([(b0 + ccw_steps) % nb, (b0 - cw_steps) % nb])
+        cand_rot = np.concatenate([ccw_steps, -cw_steps]).astype(float)
+        if cand_bins.size == 0:
+            return 0.0, b0
         score = value[cand_bins] - self.hysteresis * np.abs(cand_rot) * self._bw / self.omega
         if self.last_target is not None:  # prefer keeping the previous goal on ties
             score = score + 1e-9 * (cand_bins == self.last_target)

@@ -53,7 +53,10 @@ def sample_start(
         return {"pursuer": (float(p[0]), float(p[1])), "evader": (float(e[0]), float(e[1]))}
     from strategies.policies.decomposition import DecompositionPursuer
 
-    judge = DecompositionPursuer()
+    # the judge assumes the evader holds the rod's rotation to (V_p/L)(1 - rho), the
+    # least rate in one given direction (eq. 6, Sec. 6.1), not the sqrt(1 - rho^2) of a
+    # pursuer free to turn either way: a start called safe is safe at the slower rate
+    judge = DecompositionPursuer(turn_rate="one")
     judge.reset(role="pursuer", map=config.map, config=config, seed=0)
     tab = judge.table
     if not tab.guaranteed.any():  # Prop. 2: nothing is safe anywhere
@@ -86,6 +89,12 @@ def _near_l_min(config, kernel, rng, judge, tab, angle_margin):
                     continue
             if not kernel.line_of_sight(p[i], e[i]):
                 continue
+            # the rod at its real start length (plus the pursuer's disc) is free, with
+            # the same angular margin, not only the table's shorter one
+            if angle_margin is not None and not _free_with_margin(
+                kernel, e[i], length + r, float(theta[i]), angle_margin
+            ):
+                continue
             if angle_margin is not None:
                 row = tab.row(e[i])
                 if row < 0 or not tab.guaranteed[row]:
@@ -104,3 +113,13 @@ def _near_l_min(config, kernel, rng, judge, tab, angle_margin):
         f"no {'safe' if angle_margin is not None else 'valid'} start at L = {length:.4g} found "
         f"on map {m.name!r} in {MAX_BATCHES * BATCH} proposals"
     )
+
+
+def _free_with_margin(kernel, e, L: float, theta: float, margin: float) -> bool:
+    """The rod of length ``L`` from ``e`` is free at every orientation within ``margin``."""
+    for arc in kernel.free_arcs(e, L).arcs:
+        if arc.is_full:
+            return True
+        if (theta - margin - arc.lo) % (2.0 * math.pi) + 2.0 * margin <= arc.width:
+            return True
+    return False

@@ -1,0 +1,139 @@
+"""Does the decomposition pursuer hold from safe starts? Variants of the paper's worlds.
+
+Issue 13's goal: from safe starts on worlds where the pursuer wins (Prop. 2 false), at
+rho <= 0.5, the decomposition pursuer holds every episode against every evader in the
+registry, on rotated, rescaled and off-centre variants of the paper's worlds. This plays
+seeded episodes through the shared runner (:func:`strategies.runner.run_episode`) on
+each variant against each evader and prints the held rate per world and evader, every
+loss (seed, cause, time: replay it with ``surveil play``), and the decomposition
+pursuer's decision time per step against the greedy pursuer's (a reference measured in
+the same run).
+
+Usage::
+
+    python benchmarks/pursuer_holds.py [--seeds 10] [--rho 0.3 0.5] [--workers 2]
+        [--max-cycles 600] [--worlds corridor corner ...]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import multiprocessing as mp
+import os
+import time
+
+import numpy as np
+
+from envs.maps import builtin_info
+from strategies.runner import run_episode
+
+EVADERS = [
+    "evader/shooting",
+    "evader/straight",
+    "evader/toward_away",
+    "evader/toward_away:away",
+    "evader/wall_hugging",
+    "evader/random",
+]
+WORLDS = ["corridor", "corner", "l_hall", "open_room"]
+# (label, rotation in radians, scale, offset)
+VARIANTS = [
+    ("as is", 0.0, 1.0, (0.0, 0.0)),
+    ("rot 0.37", 0.37, 1.0, (0.0, 0.0)),
+    ("x0.1", 0.0, 0.1, (0.0, 0.0)),
+    ("x10 rot 1.1", 1.1, 10.0, (0.0, 0.0)),
+    ("off-centre", 0.0, 1.0, (13.7, -4.2)),
+]
+
+
+def _world(name: str, rot: float, scale: float, offset):
+    info = builtin_info(name)
+    c, s = math.cos(rot), math.sin(rot)
+    m = info.map.transformed(scale * np.array([[c, -s], [s, c]]), offset)
+    params = dict(info.params())
+    for k in ("l_min", "l_max", "v_pursuer", "v_evader"):
+        if k in params:
+            params[k] = params[k] * scale
+    return m, params
+
+
+def _evader(label: str):
+    if label == "evader/toward_away:away":
+        from strategies.policies import make_policy
+
+        return make_policy("evader/toward_away", mode="away")
+    return label
+
+
+def _play(job):
+    world, variant, rho, evader, seed, max_cycles = job
+    label, rot, scale, offset = variant
+    m, params = _world(world, rot, scale, offset)
+    params["v_evader"] = rho * params["v_pursuer"]
+    params["body_radius"] = 0.2 * scale
+    out = {}
+    for pursuer in ("pursuer/decomposition", "pursuer/greedy"):
+        r = run_episode(
+            m, pursuer, _evader(evader), seed, max_cycles=max_cycles, overrides=params, start="safe"
+        )
+        out[pursuer] = (r.winner, r.cause, r.escape_time, r.decide_seconds["pursuer"])
+    return world, label, rho, evader, seed, out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", type=int, default=3)
+    ap.add_argument("--rho", type=float, nargs="+", default=[0.3, 0.5])
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--max-cycles", type=int, default=600)
+    ap.add_argument("--worlds", nargs="+", default=WORLDS)
+    ap.add_argument("--variants", nargs="+", default=[v[0] for v in VARIANTS])
+    args = ap.parse_args(argv)
+    print(f"load average: {os.getloadavg()}")
+    variants = [v for v in VARIANTS if v[0] in args.variants]
+    jobs = [
+        (w, v, rho, e, s, args.max_cycles)
+        for w in args.worlds
+        for v in variants
+        for rho in args.rho
+        for e in EVADERS
+        for s in range(args.seeds)
+    ]
+    t0 = time.perf_counter()
+    with mp.get_context("spawn").Pool(args.workers) as pool:
+        results = pool.map(_play, jobs, chunksize=4)
+    wall = time.perf_counter() - t0
+    held: dict[tuple, list[int]] = {}
+    losses = []
+    decide = {p: [] for p in ("pursuer/decomposition", "pursuer/greedy")}
+    for world, label, rho, evader, seed, out in results:
+        for p in decide:
+            decide[p].append(out[p][3])
+        winner, cause, t, _ = out["pursuer/decomposition"]
+        key = (world, evader)
+        h = held.setdefault(key, [0, 0, 0])
+        h[0] += winner == "pursuer"
+        h[1] += 1
+        h[2] += out["pursuer/greedy"][0] == "pursuer"
+        if winner != "pursuer":
+            losses.append((world, label, rho, evader, seed, cause, t))
+    print(f"{len(jobs)} x 2 episodes in {wall:.0f} s ({args.workers} workers)")
+    print(f"{'world':<10}{'evader':<26}{'decomposition held':>20}{'greedy held':>14}")
+    for (world, evader), (h, n, g) in sorted(held.items()):
+        print(f"{world:<10}{evader:<26}{f'{h}/{n}':>20}{f'{g}/{n}':>14}")
+    total = sum(v[0] for v in held.values()), sum(v[1] for v in held.values())
+    print(f"decomposition pursuer held {total[0]}/{total[1]} from safe starts")
+    d, g = (float(np.mean(decide[p])) for p in ("pursuer/decomposition", "pursuer/greedy"))
+    print(
+        f"decision time per step: decomposition {1e3 * d:.3f} ms, greedy {1e3 * g:.3f} ms "
+        f"(ratio {d / g:.1f}x)"
+    )
+    for loss in losses:
+        world, label, rho, evader, seed, cause, t = loss
+        print(f"  lost: {world} [{label}] rho={rho} {evader} seed={seed}: {cause} at {t}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -39,6 +39,7 @@ from strategies.policies.base import (
     nonnegative_param,
     positive_param,
 )
+from strategies.policies.lazy_table import LazySafetyTable
 from strategies.policies.safety import NO_PATH, safety_table
 
 __all__ = ["DecompositionPursuer"]
@@ -58,9 +59,15 @@ class DecompositionPursuer(BasePolicy):
             ``"both"``, ``(V_p / L) sqrt(1 - rho^2)``, the least rate when the rod may
             turn either way; ``"one"``, ``(V_p / L)(1 - rho)``, the least rate in one
             given direction (conservative: what the start sampler judges with).
+        table: ``"eager"`` (the whole map's safety table, built once and cached on
+            disk), ``"lazy"`` (classified around the evader as it goes, for large
+            maps: ready at once, memory grows with the area visited) or ``"auto"``
+            (lazy when the eager table would have more than :attr:`EAGER_TABLE_POINTS`
+            grid points: its build costs about 0.1 ms a point).
     """
 
     roles = ("pursuer",)
+    EAGER_TABLE_POINTS = 50_000  # grid points above which "auto" fills the table lazily
 
     def __init__(
         self,
@@ -72,6 +79,7 @@ class DecompositionPursuer(BasePolicy):
         hysteresis: float = 0.25,
         distance_gain: float = 3.0,
         turn_rate: str = "both",
+        table: str = "auto",
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
@@ -82,6 +90,7 @@ class DecompositionPursuer(BasePolicy):
         self.hysteresis = nonnegative_param("hysteresis", hysteresis)
         self.distance_gain = positive_param("distance_gain", distance_gain)
         self.turn_rate = validation.choice("turn_rate", turn_rate, ("both", "one"))
+        self.table_kind = validation.choice("table", table, ("auto", "eager", "lazy"))
 
     def _reset(self) -> None:
         c = self.config
@@ -90,7 +99,14 @@ class DecompositionPursuer(BasePolicy):
         # meets a wall as if the rod were that much longer (Prop. 3: fewer free arcs)
         self.table_length = round(self.L_target + c.body_radius, 6)
         res = self.resolution if self.resolution is not None else c.l_min / 20.0
-        self.table = safety_table(c.map, self.table_length, res, self.n_bins)
+        kind = self.table_kind
+        if kind == "auto":
+            big = c.map.free_region.area / res**2 > self.EAGER_TABLE_POINTS
+            kind = "lazy" if big else "eager"
+        if kind == "lazy":
+            self.table = LazySafetyTable(c.map, self.table_length, res, self.n_bins)
+        else:
+            self.table = safety_table(c.map, self.table_length, res, self.n_bins)
         rho = c.rho
         # Sec. 6.1, eq. (6): the evader can hold the pursuer's rate down to
         # (V_p/L) sqrt(1 - rho^2) when the pursuer may turn either way (it takes the
@@ -137,14 +153,15 @@ class DecompositionPursuer(BasePolicy):
     def _probe_values(self, origin: np.ndarray) -> np.ndarray:
         """The least margin over the probes on rays from ``origin`` (see above)."""
         tab = self.table
-        rows = tab.rows(origin + self._offsets).reshape(self.rays, self._n_r)
-        reach = np.cumsum(rows < 0, axis=1) == 0  # a ray stops at the first wall
-        sub_rows = rows[:, self._probe_cols]
+        points = origin + self._offsets
+        inside = tab.inside(points).reshape(self.rays, self._n_r)
+        reach = np.cumsum(~inside, axis=1) == 0  # a ray stops at the first wall
         sub_ok = reach[:, self._probe_cols]
-        r = sub_rows[sub_ok]
-        if not r.size:
+        if not sub_ok.any():
             return np.full(tab.n_bins, self.horizon)
-        t_e = np.broadcast_to(self._t_e, sub_rows.shape)[sub_ok]
+        probes = points.reshape(self.rays, self._n_r, 2)[:, self._probe_cols][sub_ok]
+        r = tab.rows(probes)  # only the probes' orientations are looked up
+        t_e = np.broadcast_to(self._t_e, sub_ok.shape)[sub_ok]
         # lut: seconds to turn by a number of bins; a safe bin (0) never threatens
         v = t_e[:, None] - self._turn_lut[tab.need[r]]
         return v.min(axis=0)

@@ -1,0 +1,194 @@
+"""A safety table filled on demand, for maps too large to tabulate up front.
+
+:func:`strategies.policies.safety.safety_table` classifies every grid point of the map
+when it is built: on a 200 m x 200 m floor plan at L_min = 3 that is 1.7 million points,
+about 1 GB and 200 s. A pursuer only ever looks at the points around the evader (its
+probes reach ``V_e pi / omega``), so :class:`LazySafetyTable` has the same grid, the
+same rows and the same answers as the eager table, but classifies a grid point the first
+time a lookup touches it (``Decomposition.free_arcs`` and ``safe_arcs``, exact, about
+0.1 ms a point) and keeps it. Ready as soon as the decomposition is; memory grows with
+the area the evader has visited, not with the map.
+
+Example:
+    >>> from envs.maps import builtin_map
+    >>> from strategies.policies.safety import safety_table
+    >>> world = builtin_map("corridor")
+    >>> lazy = LazySafetyTable(world, 2.2, 0.5, 36)
+    >>> eager = safety_table(world, 2.2, 0.5, 36, disk_cache=False)
+    >>> import numpy as np
+    >>> p = np.array([[3.0, 1.0], [8.0, -2.0]])
+    >>> rows = lazy.rows(p)  # classifies the two points: look them up afterwards
+    >>> bool((lazy.free[rows] == eager.free[eager.rows(p)]).all()), lazy.classified
+    (True, 2)
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import shapely
+
+from envs.maps import Map
+from envs.tolerances import REL_LENGTH_TOL
+from strategies.cspace.grids import grid_axis
+from strategies.policies.safety import (
+    SafetyTable,
+    _arc_bins,
+    _circular_distance,
+    _classified,
+)
+
+__all__ = ["LazySafetyTable"]
+
+_UNKNOWN = -2  # a grid node not classified yet (-1: outside the free region)
+
+
+class LazySafetyTable:
+    """The :class:`~strategies.policies.safety.SafetyTable` of a map, filled on demand.
+
+    Attributes ``free``, ``safe``, ``guaranteed``, ``ccw``, ``cw`` and ``need`` hold the
+    rows classified so far; :meth:`rows` and :meth:`row` classify what they touch first,
+    so indexing those arrays with rows just returned is always valid.
+
+    Args:
+        world: the map.
+        L: rod length.
+        resolution: grid spacing (the eager table's grid: same origin, same nodes).
+        n_bins: orientation bins.
+    """
+
+    bin_width = SafetyTable.bin_width
+    bin_of = SafetyTable.bin_of
+    bin_centre = SafetyTable.bin_centre
+    row = SafetyTable.row
+
+    def __init__(self, world: Map, L: float, resolution: float, n_bins: int) -> None:
+        from strategies.cspace import decompose
+
+        self.map = world
+        self.L = float(L)
+        self.resolution = float(resolution)
+        self.n_bins = int(n_bins)
+        self.decomposition = decompose(world, self.L, cache=True)
+        xmin, ymin, xmax, ymax = world.bounds
+        self._xs = grid_axis(xmin, xmax, self.resolution)
+        self._ys = grid_axis(ymin, ymax, self.resolution)
+        self.origin = np.array([self._xs[0], self._ys[0]])
+        self.shape = (len(self._xs), len(self._ys))
+        self._cell = np.full(self.shape, _UNKNOWN, dtype=np.int32)
+        self._member = np.zeros(self.shape, dtype=np.int8)  # 0 unknown, 1 inside, 2 not
+        self._centres = -math.pi + (np.arange(self.n_bins) + 0.5) * self.bin_width
+        self._walls = shapely.boundary(world.free_region)
+        shapely.prepare(self._walls)
+        self._eps = REL_LENGTH_TOL * world.scale
+        self._n = 0
+        cap = 1024
+        self._free = np.zeros((cap, self.n_bins), dtype=bool)
+        self._safe = np.zeros_like(self._free)
+        self._guaranteed = np.zeros(cap, dtype=bool)
+        self._ccw = np.zeros((cap, self.n_bins), dtype=np.uint8)
+        self._cw = np.zeros_like(self._ccw)
+        self._need = np.zeros_like(self._ccw)
+
+    # ------------------------------------------------------------- the classified rows
+    free = property(lambda self: self._free[: self._n])
+    safe = property(lambda self: self._safe[: self._n])
+    guaranteed = property(lambda self: self._guaranteed[: self._n])
+    ccw = property(lambda self: self._ccw[: self._n])
+    cw = property(lambda self: self._cw[: self._n])
+    need = property(lambda self: self._need[: self._n])
+
+    @property
+    def classified(self) -> int:
+        """Grid points classified so far (inside the free region)."""
+        return self._n
+
+    def inside(self, points: np.ndarray) -> np.ndarray:
+        """Whether the grid points nearest to (k, 2) points lie in the free region.
+
+        Membership only (a vectorised point-in-polygon test per new node, memoised):
+        the orientations are classified when :meth:`rows` asks for them.
+        """
+        idx = self._index(points)
+        ok = (idx[:, 0] >= 0) & (idx[:, 0] < self.shape[0]) & (idx[:, 1] >= 0)
+        ok &= idx[:, 1] < self.shape[1]
+        out = np.zeros(len(idx), dtype=bool)
+        member = self._member[idx[ok, 0], idx[ok, 1]]
+        if (member == 0).any():
+            todo = np.unique(idx[ok][member == 0], axis=0)
+            self._membership(todo)
+            member = self._member[idx[ok, 0], idx[ok, 1]]
+        out[ok] = member == 1
+        return out
+
+    def _index(self, points: np.ndarray) -> np.ndarray:
+        return np.rint((np.asarray(points, dtype=float) - self.origin) / self.resolution).astype(
+            np.int64
+        )
+
+    def _membership(self, nodes: np.ndarray) -> np.ndarray:
+        """Decide (and memoise) which grid nodes (k, 2) lie in the free region."""
+        x, y = self._xs[nodes[:, 0]], self._ys[nodes[:, 1]]
+        inside = shapely.contains_xy(self.map.prepared_free_region, x, y)
+        at = np.flatnonzero(inside)
+        inside[at] = ~shapely.dwithin(self._walls, shapely.points(x[at], y[at]), self._eps)
+        self._member[nodes[:, 0], nodes[:, 1]] = np.where(inside, 1, 2)
+        return inside
+
+    def rows(self, points: np.ndarray) -> np.ndarray:
+        """Table rows of the grid points nearest to (k, 2) points (-1 outside)."""
+        idx = np.rint((np.asarray(points, dtype=float) - self.origin) / self.resolution).astype(
+            np.int64
+        )
+        ok = (idx[:, 0] >= 0) & (idx[:, 0] < self.shape[0]) & (idx[:, 1] >= 0)
+        ok &= idx[:, 1] < self.shape[1]
+        out = np.full(len(idx), -1, dtype=np.int64)
+        vals = self._cell[idx[ok, 0], idx[ok, 1]]
+        if (vals == _UNKNOWN).any():
+            todo = np.unique(idx[ok][vals == _UNKNOWN], axis=0)
+            self._classify(todo)
+            vals = self._cell[idx[ok, 0], idx[ok, 1]]
+        out[ok] = vals
+        return out
+
+    def _classify(self, nodes: np.ndarray) -> None:
+        """Classify grid nodes (k, 2) as the eager table's build does."""
+        x, y = self._xs[nodes[:, 0]], self._ys[nodes[:, 1]]
+        member = self._member[nodes[:, 0], nodes[:, 1]]
+        inside = member == 1
+        if (member == 0).any():
+            inside[member == 0] = self._membership(nodes[member == 0])
+        self._cell[nodes[~inside, 0], nodes[~inside, 1]] = -1
+        new = nodes[inside]
+        if not len(new):
+            return
+        self._grow(self._n + len(new))
+        pts = np.stack([x[inside], y[inside]], axis=1)
+        rows = np.arange(self._n, self._n + len(new))
+        for r, p in zip(rows, pts, strict=True):
+            arcs, safe_arcs = _classified(self.decomposition, p, self.resolution)
+            self._free[r] = _arc_bins(arcs, self._centres)
+            if safe_arcs is not None:
+                self._safe[r] = self._free[r] & _arc_bins(safe_arcs, self._centres)
+        sl = slice(self._n, self._n + len(new))
+        g = self._safe[sl].any(axis=1)
+        self._guaranteed[sl] = g
+        self._safe[sl] = np.where(g[:, None], self._safe[sl], self._free[sl])
+        self._ccw[sl] = _circular_distance(self._safe[sl], +1)
+        self._cw[sl] = _circular_distance(self._safe[sl], -1)
+        self._need[sl] = np.minimum(self._ccw[sl], self._cw[sl])
+        self._cell[new[:, 0], new[:, 1]] = rows
+        self._n += len(new)
+
+    def _grow(self, n: int) -> None:
+        cap = len(self._guaranteed)
+        if n <= cap:
+            return
+        while cap < n:
+            cap *= 2
+        for name in ("_free", "_safe", "_guaranteed", "_ccw", "_cw", "_need"):
+            old = getattr(self, name)
+            new = np.zeros((cap, *old.shape[1:]), dtype=old.dtype)
+            new[: self._n] = old[: self._n]
+            setattr(self, name, new)

@@ -1,0 +1,71 @@
+"""The lazily filled safety table answers exactly as the eager one, and the pursuer plays alike."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from envs.maps import builtin_map
+from strategies.policies import make_policy
+from strategies.policies.lazy_table import LazySafetyTable
+from strategies.policies.safety import safety_table
+from strategies.runner import run_episode
+
+
+def _world(name: str, angle: float):
+    c, s = math.cos(angle), math.sin(angle)
+    return builtin_map(name).transformed(np.array([[c, -s], [s, c]]), (3.0, -1.0))
+
+
+@pytest.mark.parametrize(("name", "angle"), [("corridor", 0.0), ("l_hall", 0.61)])
+def test_lazy_rows_equal_the_eager_tables(name, angle):
+    world = _world(name, angle)
+    eager = safety_table(world, 2.2, 0.25, 48, disk_cache=False)
+    lazy = LazySafetyTable(world, 2.2, 0.25, 48)
+    assert np.allclose(lazy.origin, eager.origin) and lazy.shape == eager.shape
+    rng = np.random.default_rng(1)
+    x0, y0, x1, y1 = world.bounds
+    pts = rng.uniform((x0 - 1, y0 - 1), (x1 + 1, y1 + 1), size=(400, 2))
+    assert np.array_equal(lazy.inside(pts), eager.rows(pts) >= 0)  # membership alone
+    assert lazy.classified == 0  # ... classifies nothing
+    rl, re = lazy.rows(pts), eager.rows(pts)
+    assert np.array_equal(rl < 0, re < 0)  # the same nodes are in the free region
+    ok = re >= 0
+    assert ok.sum() > 100
+    for name_ in ("free", "safe", "guaranteed", "ccw", "cw", "need"):
+        assert np.array_equal(getattr(lazy, name_)[rl[ok]], getattr(eager, name_)[re[ok]]), name_
+    # only what was looked up is classified
+    assert lazy.classified == len(np.unique(rl[ok])) < len(eager.free)
+    for p in pts[:20]:  # row() looks around points just outside, as the eager one does
+        r1, r2 = lazy.row(p), eager.row(p)
+        assert (r1 < 0) == (r2 < 0)
+        if r2 >= 0:
+            assert np.array_equal(lazy.free[r1], eager.free[r2])
+
+
+def test_the_pursuer_plays_the_same_episode_with_either_table():
+    world = _world("corridor", 0.3)
+    runs = []
+    for table in ("eager", "lazy"):
+        p = make_policy("pursuer/decomposition", table=table)
+        r = run_episode(world, p, "evader/shooting", 4, max_cycles=150, start="safe")
+        assert type(p.table).__name__ == ("LazySafetyTable" if table == "lazy" else "SafetyTable")
+        runs.append(r)
+    assert np.array_equal(runs[0].trajectory, runs[1].trajectory)
+    assert runs[0].winner == runs[1].winner
+
+
+@pytest.mark.parametrize("p", [0.0, 0.03, 0.5, 1.0])
+def test_rotation_distances_against_brute_force(p):
+    from strategies.policies.safety import NO_PATH, _circular_distance
+
+    rng = np.random.default_rng(2)
+    safe = rng.random((40, 36)) < p
+    for step in (1, -1):
+        got = _circular_distance(safe, step)
+        for i in range(len(safe)):
+            for b in range(36):
+                ks = [k for k in range(36) if safe[i, (b + step * k) % 36]]
+                assert got[i, b] == (ks[0] if ks else NO_PATH)

@@ -8,13 +8,15 @@ from __future__ import annotations
 
 import argparse
 import math
-from collections.abc import Sequence
+import sys
+from collections.abc import Callable, Sequence
 
+from envs.errors import SurveilValueError
 from training.config import load_config
 from training.selfplay import self_play
 from training.train import TrainResult, train
 
-__all__ = ["add_train_arguments", "cli_train", "run_train"]
+__all__ = ["add_train_arguments", "cli_train", "run_cli", "run_train"]
 
 
 def add_train_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
@@ -58,18 +60,44 @@ def run_train(args: argparse.Namespace) -> int:
 
 
 def cli_train(argv: Sequence[str] | None = None) -> int:
-    """``surveil train CONFIG [--output-dir D] [--timesteps N] [--seed S] [--self-play R]``.
+    """``python -m training CONFIG [--output-dir D] [--timesteps N] [--seed S] [--self-play R]``.
 
     Args:
-        argv: the arguments after ``train`` (``None``: ``sys.argv[1:]``).
+        argv: the arguments (``None``: ``sys.argv[1:]``).
 
     Returns:
-        The exit code (0).
+        The exit code: 0, 2 for a user error (one line on stderr naming the value), 130
+        when interrupted. A traceback means a bug.
     """
     parser = add_train_arguments(
-        argparse.ArgumentParser(prog="surveil train", description="Train a policy with SB3.")
+        argparse.ArgumentParser(prog="python -m training", description="Train a policy with SB3.")
     )
-    return run_train(parser.parse_args(None if argv is None else list(argv)))
+    return run_cli(
+        "python -m training", lambda: run_train(parser.parse_args(None if argv is None else argv))
+    )
+
+
+def run_cli(prog: str, func: Callable[[], int]) -> int:
+    """Run a command's body under the project's error contract.
+
+    User errors (the project's ``SurveilValueError``, files that cannot be read or
+    written) print one line ``PROG: error: ...`` and return 2; Ctrl-C returns 130;
+    argparse's own exits pass through; anything else is a bug and keeps its traceback.
+    """
+    try:
+        return int(func() or 0)
+    except SystemExit as exc:  # argparse: --help (0) or a usage error (2, already printed)
+        return exc.code if isinstance(exc.code, int) else 2
+    except KeyboardInterrupt:
+        print(f"{prog}: interrupted", file=sys.stderr)
+        return 130
+    except (SurveilValueError, OSError) as exc:
+        if isinstance(exc, OSError) and exc.filename is not None and exc.strerror:
+            message = f"{exc.filename}: {exc.strerror}"
+        else:
+            message = str(exc) or type(exc).__name__
+        print(f"{prog}: error: {message}", file=sys.stderr)
+        return 2
 
 
 def summary(result: TrainResult) -> str:

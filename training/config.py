@@ -201,6 +201,8 @@ class TrainConfig:
                 f"algo_kwargs: {unknown} are not arguments of stable_baselines3."
                 f"{self.algo.upper()}; known: {sorted(known - _ALGO_MANAGED)}"
             )
+        for key, value in self.algo_kwargs.items():
+            _check_algo_value(self.algo, key, value)
 
     # ----------------------------------------------------------------- conversions
     @classmethod
@@ -279,6 +281,80 @@ def _toml_value(v: Any) -> str:
     if v is None:
         raise InvalidConfigError("config: TOML has no null; drop the key instead of None")
     raise InvalidConfigError(f"config: cannot write {type(v).__name__} {v!r} as TOML")
+
+
+# What SB3 would otherwise accept and fail on deep inside training (n_epochs = 0 is an
+# UnboundLocalError in PPO.train; ent_coef = "abc" a ValueError from float()): the
+# numeric arguments of PPO and SAC, with the values they take.
+_ALGO_VALUES: dict[str, tuple[str, float | None, float | None]] = {
+    # name: (kind, lower bound, upper bound); kind "int" or "real", bounds inclusive
+    "n_epochs": ("int", 1, None),
+    "clip_range": ("real", 1e-12, None),
+    "gae_lambda": ("real", 0.0, 1.0),
+    "vf_coef": ("real", 0.0, None),
+    "max_grad_norm": ("real", 1e-12, None),
+    "target_kl": ("real", 1e-12, None),
+    "buffer_size": ("int", 1, None),
+    "learning_starts": ("int", 0, None),
+    "tau": ("real", 1e-12, 1.0),
+    "gradient_steps": ("int", -1, None),
+    "target_update_interval": ("int", 1, None),
+    "stats_window_size": ("int", 1, None),
+    "sde_sample_freq": ("int", -1, None),
+    "normalize_advantage": ("bool", None, None),
+    "use_sde": ("bool", None, None),
+    "optimize_memory_usage": ("bool", None, None),
+}
+
+
+def _check_algo_value(algo: str, key: str, value: Any) -> None:
+    """Raise InvalidConfigError for an ``[algo_kwargs]`` value SB3 would choke on."""
+    where = f"[algo_kwargs] {key}"
+    if key == "ent_coef":
+        auto = isinstance(value, str) and (value == "auto" or value.startswith("auto_"))
+        if algo == "sac" and auto:
+            try:
+                tail = value[5:]
+                if tail and not float(tail) > 0:
+                    raise ValueError
+            except ValueError:
+                raise InvalidConfigError(
+                    f"{where} = {value!r}: expected 'auto', 'auto_<initial value > 0>' "
+                    "or a number >= 0"
+                ) from None
+            return
+        real = isinstance(value, (int, float)) and not isinstance(value, bool)
+        if not real or not math.isfinite(value) or value < 0:
+            expected = "a number >= 0" + (" or 'auto'" if algo == "sac" else "")
+            raise InvalidConfigError(f"{where} = {value!r}: expected {expected}")
+        return
+    if key not in _ALGO_VALUES:
+        return
+    kind, lo, hi = _ALGO_VALUES[key]
+    if kind == "bool":
+        if not isinstance(value, bool):
+            raise InvalidConfigError(f"{where} = {value!r}: expected true or false")
+        return
+    if kind == "int":
+        ok = isinstance(value, int) and not isinstance(value, bool)
+    else:
+        ok = isinstance(value, (int, float)) and not isinstance(value, bool)
+        ok = ok and math.isfinite(value)
+    if ok and lo is not None:
+        ok = value >= lo
+    if ok and hi is not None:
+        ok = value <= hi
+    if not ok:
+        what = "an integer" if kind == "int" else "a number"
+        bounds = " and ".join(
+            b
+            for b in (
+                (f">= {lo:g}" if lo is not None else ""),
+                (f"<= {hi:g}" if hi is not None else ""),
+            )
+            if b
+        )
+        raise InvalidConfigError(f"{where} = {value!r}: expected {what} {bounds}".rstrip())
 
 
 class _Checker:

@@ -25,6 +25,7 @@ import re
 import subprocess
 import sys
 import time
+import warnings
 from dataclasses import asdict, dataclass, field
 from importlib import metadata
 from pathlib import Path
@@ -41,6 +42,7 @@ from training.single_agent import SingleAgentEnv, sb3_params
 __all__ = [
     "ENV_NAME",
     "EVAL_SEED_OFFSET",
+    "CheckpointWarning",
     "EvalResult",
     "TrainResult",
     "evaluate_model",
@@ -282,6 +284,48 @@ def _new_model(config: TrainConfig, vec_env):
     return cls("MlpPolicy", vec_env, **kwargs)
 
 
+def _load_checkpoint(out: Path, cls, vec_env):
+    """The newest checkpoint that loads, as ``(timesteps, path, model)``, or None.
+
+    A damaged checkpoint (truncated by a crash, a flipped bit) is skipped with a one-line
+    warning naming it, and the next older one is tried: an intact older checkpoint is
+    never blocked by a broken newer one.
+    """
+    ckdir = out / "checkpoints"
+    if not ckdir.is_dir():
+        return None
+    found = sorted(
+        ((int(m.group(1)), p) for p in ckdir.iterdir() if (m := _CKPT.match(p.name))),
+        reverse=True,
+    )
+    for done, path in found:
+        try:
+            return done, path, cls.load(str(path), env=vec_env, device="cpu")
+        except Exception as exc:  # a damaged zip fails in zipfile, json, torch or pickle
+            warnings.warn(
+                f"checkpoint {path} cannot be loaded ({type(exc).__name__}: {exc}); "
+                "trying an older one",
+                CheckpointWarning,
+                stacklevel=3,
+            )
+    return None
+
+
+class CheckpointWarning(RuntimeWarning):
+    """A checkpoint could not be loaded and was skipped."""
+
+
+def _quiet_logger(model) -> None:
+    """Give SB3 a logger that writes nothing, so ``learn`` makes no SB3-<date> folder.
+
+    Without one, SB3 configures a default logger in the system temp directory on every
+    ``learn`` call (``stable_baselines3.common.utils.configure_logger``).
+    """
+    from stable_baselines3.common.logger import Logger
+
+    model.set_logger(Logger(folder=None, output_formats=[]))
+
+
 def _checkpoint_callback(config: TrainConfig, out: Path, start: int):
     from stable_baselines3.common.callbacks import BaseCallback
 
@@ -349,20 +393,22 @@ def train(
     out = Path(config.output_dir)
     out.mkdir(parents=True, exist_ok=True)
     _check_resumable(config, out)
-    _atomic_write(out / "config.toml", config.to_toml())
     model_path, prov_path = out / "model.zip", out / "provenance.json"
+    previous = None
     if model_path.is_file() and prov_path.is_file():
-        prov = read_provenance(out)
-        if prov.get("timesteps", -1) >= config.total_timesteps:
-            return _result_from_provenance(config, out, prov)
+        previous = read_provenance(out)
+        if previous.get("timesteps", -1) >= config.total_timesteps:
+            # a finished run at least this long: returned as is, and its config.toml
+            # (the values that produced the model) is left alone
+            return _result_from_provenance(config, out, previous)
+    _atomic_write(out / "config.toml", config.to_toml())
 
     vec_env = _make_vec_env(config)
     cls = _algo_class(config.algo)
-    ckpt = latest_checkpoint(out)
+    ckpt = _load_checkpoint(out, cls, vec_env)
     resumed_from = None
     if ckpt is not None:
-        done, path = ckpt
-        model = cls.load(str(path), env=vec_env, device="cpu")
+        done, path, model = ckpt
         buf = out / "checkpoints" / "replay_buffer.pkl"
         if config.algo == "sac" and buf.is_file():
             model.load_replay_buffer(str(buf))
@@ -377,6 +423,7 @@ def train(
     else:
         model = _new_model(config, vec_env)
         done = 0
+    _quiet_logger(model)
     remaining = config.total_timesteps - model.num_timesteps
     if remaining > 0:
         cbs = [_checkpoint_callback(config, out, model.num_timesteps), *(callbacks or [])]
@@ -428,6 +475,17 @@ def train(
         "evaluation": None if evaluation is None else evaluation.to_dict(),
         "created": time.strftime("%Y-%m-%dT%H:%M:%S%z"),
     }
+    # every segment of the run, oldest first: a resumed or extended run keeps the story
+    segment = {
+        k: provenance[k]
+        for k in ("created", "timesteps", "resumed_from", "resumed_at", "train_seconds")
+    }
+    segment["git_sha"] = provenance.get("git_sha")
+    segment["total_timesteps"] = config.total_timesteps
+    history = list((previous or {}).get("history") or [])
+    if previous is not None and not history:  # written before histories were kept
+        history = [{k: previous.get(k) for k in segment}]
+    provenance["history"] = [*history, segment]
     _atomic_write(prov_path, json.dumps(provenance, indent=2) + "\n")
     return TrainResult(
         config, out, model_path, prov_path, timesteps, wall, resumed_from, evaluation

@@ -3,6 +3,16 @@
 ``make_policy("pursuer/sb3:models/ppo_pursuer.zip")`` builds an :class:`SB3Policy`; the
 zip is loaded on the first :meth:`~SB3Policy.reset` (stable-baselines3 and torch are
 imported only then). The algorithm is read from the zip's metadata unless given.
+
+**Only load model files you trust.** A stable-baselines3 zip holds pickled Python
+objects (and SB3 unpickles them on load): a crafted model file runs arbitrary code on
+the machine that loads it, as any pickle does. The models shipped in ``training/zoo``
+come with this repository; treat a model from elsewhere like a program from elsewhere.
+
+When a ``provenance.json`` written by :mod:`training` sits beside the zip, the policy
+checks it on load: a model trained as a pursuer refuses to play the evader (and the
+reverse), and the observation the model was trained on (``state`` or ``lidar`` with its
+rays and range) is what the shared runner gives it (:attr:`SB3Policy.observation_options`).
 """
 
 from __future__ import annotations
@@ -14,13 +24,17 @@ from typing import Any
 
 import numpy as np
 
-from envs.errors import InvalidConfigError
+from envs.errors import InvalidConfigError, InvalidObservationError
 from strategies.policies.base import BasePolicy
 
 __all__ = ["SB3_ALGORITHMS", "SB3Policy"]
 
 SB3_ALGORITHMS = ("A2C", "DDPG", "PPO", "SAC", "TD3")
 """Algorithms :class:`SB3Policy` can load (continuous actions)."""
+
+
+_PLAY_ONLY = {"lr_schedule": 0.0, "learning_rate": 0.0, "clip_range": 0.0}
+"""SB3 ``custom_objects`` for a model that only acts (its training schedules unused)."""
 
 
 def _algo_from_zip(path: Path) -> str:
@@ -71,6 +85,26 @@ class SB3Policy(BasePolicy):
         self.algo = algo.upper() if algo else None
         self.deterministic = bool(deterministic)
         self.model: Any = None
+        self.provenance = _provenance(self.path)
+        trained = None if self.provenance is None else self.provenance.get("role")
+        if trained is not None and trained != role:
+            raise InvalidConfigError(
+                f"{self.name}: this model was trained as the {trained} (its provenance.json "
+                f"says role = {trained!r}); it cannot play the {role}"
+            )
+
+    @property
+    def observation_options(self) -> dict[str, Any] | None:
+        """The observation the model was trained on (from its provenance), if known."""
+        env = (self.provenance or {}).get("env_config") or {}
+        if "observation" not in env:
+            return None
+        opts = {"observation": env["observation"]}
+        if env["observation"] == "lidar":
+            opts["n_rays"] = env.get("n_rays", 32)
+            if env.get("lidar_range") is not None:
+                opts["lidar_range"] = env["lidar_range"]
+        return opts
 
     def _reset(self) -> None:
         if self.model is None:
@@ -79,13 +113,53 @@ class SB3Policy(BasePolicy):
             import stable_baselines3
 
             algo = self.algo or _algo_from_zip(self.path)
-            self.model = getattr(stable_baselines3, algo).load(str(self.path), device="cpu")
+            try:
+                # playing needs no schedules: replacing them skips unpickling the saved
+                # lambdas, which fails with a warning across Python/SB3 versions
+                self.model = getattr(stable_baselines3, algo).load(
+                    str(self.path), device="cpu", custom_objects=_PLAY_ONLY
+                )
+            except Exception as exc:  # a damaged zip: say which file, in one line
+                raise InvalidConfigError(
+                    f"{self.name}: cannot load the model file {self.path} "
+                    f"({type(exc).__name__}: {exc})"
+                ) from exc
         seed = int(self.rng.integers(2**31 - 1))
         self.model.set_random_seed(seed)
 
     def act(self, observation: np.ndarray) -> np.ndarray:
-        """The model's action for one observation, clipped to [-1, 1]."""
+        """The model's action for one observation, clipped to [-1, 1].
+
+        Raises:
+            InvalidObservationError: the observation's shape is not the one the model
+                was trained on (another observation kind or ray count).
+        """
         if self.role is None:
             raise InvalidConfigError(f"policy {self.name!r}: call reset() before act()")
-        action, _ = self.model.predict(np.asarray(observation), deterministic=self.deterministic)
+        obs = np.asarray(observation)
+        want = self.model.observation_space.shape
+        if obs.shape != want:
+            raise InvalidObservationError(
+                f"{self.name}: observation of shape {obs.shape}, but the model was trained "
+                f"on shape {want} (observation options {self.observation_options})"
+            )
+        action, _ = self.model.predict(obs, deterministic=self.deterministic)
         return np.clip(np.asarray(action, dtype=np.float32), -1.0, 1.0)
+
+
+def _provenance(path: Path) -> dict[str, Any] | None:
+    """The ``provenance.json`` beside a model zip, or None if there is none.
+
+    Raises:
+        InvalidConfigError: it exists but is not a JSON object (naming the file).
+    """
+    prov = path.parent / "provenance.json"
+    if not prov.is_file():
+        return None
+    try:
+        data = json.loads(prov.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise InvalidConfigError(f"{prov}: unreadable provenance ({exc})") from exc
+    if not isinstance(data, dict):
+        raise InvalidConfigError(f"{prov}: expected a JSON object, got {type(data).__name__}")
+    return data

@@ -8,11 +8,16 @@ import math
 import sys
 
 from training import zoo
+from training.cli import run_cli
 from training.train import evaluate_model
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Run the zoo command line; returns the exit code."""
+    """Run the zoo command line; returns the exit code (2 and one line for a user error)."""
+    return run_cli("python -m training.zoo", lambda: _main(argv))
+
+
+def _main(argv: list[str] | None) -> int:
     parser = argparse.ArgumentParser(prog="python -m training.zoo", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("list", help="names of the shipped models")

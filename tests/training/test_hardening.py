@@ -1,0 +1,138 @@
+"""Training's files and entry points under damage and bad input (issue 11, training side).
+
+A damaged newest checkpoint falls back to an intact older one with a warning naming it;
+a rerun with a smaller budget leaves the finished run's config.toml alone; provenance
+keeps every segment of a resumed run; no SB3 logger folder lands in the temp directory;
+models check their role and observation on load; both ``python -m`` entry points turn
+every user error into one line and exit code 2.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import pytest
+
+from envs import surveillance_v0
+from envs.errors import InvalidConfigError, InvalidObservationError
+from strategies.policies import make_policy
+from tests.training.test_train import Interrupt
+from training.cli import cli_train
+from training.config import TrainConfig
+from training.train import CheckpointWarning, latest_checkpoint, train
+from training.zoo.__main__ import main as zoo_main
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_a_damaged_newest_checkpoint_falls_back_to_an_older_one(tiny):
+    config = tiny(eval_episodes=0)
+    with pytest.raises(KeyboardInterrupt):
+        train(config, callbacks=[Interrupt(at=150)])
+    out = Path(config.output_dir)
+    ckpts = sorted((out / "checkpoints").glob("ckpt_*.zip"))
+    assert [p.name for p in ckpts] == ["ckpt_128.zip", "ckpt_64.zip"]
+    newest = out / "checkpoints" / "ckpt_128.zip"
+    newest.write_bytes(newest.read_bytes()[:200])  # truncated by a crash
+    with pytest.warns(CheckpointWarning, match="ckpt_128.zip"):
+        result = train(config)
+    assert result.resumed_from.name == "ckpt_64.zip" and result.timesteps == 256
+
+
+def test_provenance_keeps_the_history_and_a_smaller_rerun_keeps_the_config(tiny):
+    config = tiny(eval_episodes=0, total_timesteps=128)
+    train(config)
+    longer = train(config.replace(total_timesteps=192))
+    prov = json.loads(longer.provenance_path.read_text())
+    assert [h["timesteps"] for h in prov["history"]] == [128, 192]
+    assert prov["history"][1]["resumed_at"] == 128
+    toml = (Path(config.output_dir) / "config.toml").read_text()
+    assert "total_timesteps = 192" in toml
+    again = train(config.replace(total_timesteps=64))  # finished already: returned as is
+    assert again.timesteps == 192
+    assert (Path(config.output_dir) / "config.toml").read_text() == toml
+
+
+def test_training_leaves_no_logger_folder_in_the_temp_directory(tiny, monkeypatch):
+    monkeypatch.delenv("SB3_LOGDIR", raising=False)
+    before = set(Path(tempfile.gettempdir()).glob("SB3-*"))
+    train(tiny(eval_episodes=0, total_timesteps=64))
+    assert set(Path(tempfile.gettempdir()).glob("SB3-*")) == before
+
+
+def test_a_model_checks_its_role_and_observation(tiny):
+    result = train(tiny(eval_episodes=0, total_timesteps=64))
+    with pytest.raises(InvalidConfigError, match="trained as the pursuer"):
+        make_policy(f"evader/sb3:{result.model_path}")
+    policy = make_policy(f"pursuer/sb3:{result.model_path}")
+    assert policy.observation_options == {"observation": "state"}
+    env = surveillance_v0.parallel_env(map="open_room", observation="lidar", n_rays=8)
+    obs, _ = env.reset(seed=0)
+    policy.reset(role="pursuer", map=env.config.map, config=env.config, seed=0)
+    with pytest.raises(InvalidObservationError, match="trained on shape"):
+        policy.act(obs["pursuer_0"])
+    env.close()
+
+
+def test_a_damaged_model_file_names_the_file(tmp_path):
+    bad = tmp_path / "model.zip"
+    bad.write_bytes(b"PK\x03\x04 not really a zip")
+    policy = make_policy(f"pursuer/sb3:{bad}", algo="PPO")
+    env = surveillance_v0.parallel_env(map="open_room")
+    with pytest.raises(InvalidConfigError, match=str(bad)):
+        policy.reset(role="pursuer", map=env.config.map, config=env.config, seed=0)
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        ("[algo_kwargs]\nn_epochs = 0\n", "n_epochs = 0: expected an integer >= 1"),
+        ('[algo_kwargs]\nent_coef = "abc"\n', "ent_coef = 'abc': expected a number >= 0"),
+        ("[algo_kwargs]\ngae_lambda = 2\n", "gae_lambda = 2: expected a number >= 0 and <= 1"),
+        ('seed = "x"\n', "seed"),
+        ("[env]\nfoo = 1\n", "unknown key"),
+    ],
+)
+def test_python_m_training_reports_bad_configs_in_one_line(tmp_path, capsys, extra, message):
+    cfg = tmp_path / "c.toml"
+    head = 'role = "pursuer"\nopponent = "evader/straight"\ntotal_timesteps = 64\n'
+    head += f'output_dir = "{tmp_path / "run"}"\n'
+    if extra.startswith("seed"):
+        head, extra = head + extra, ""
+    cfg.write_text(head + extra)
+    assert cli_train([str(cfg)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("python -m training: error:") and message in err
+    assert "Traceback" not in err and err.count("\n") == 1
+
+
+def test_python_m_training_zoo_reports_bad_input_in_one_line(capsys):
+    assert zoo_main(["info", "no_such_model"]) == 2
+    assert "unknown zoo model 'no_such_model'" in capsys.readouterr().err
+    name = "ppo_pursuer_vs_straight_open_room"
+    assert zoo_main(["evaluate", name, "--opponent", "evader/nope", "--episodes", "1"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("python -m training.zoo: error:") and "evader/nope" in err
+
+
+def test_the_entry_points_run_as_modules(tmp_path):
+    """The real ``python -m`` processes: exit code 2, one line, no traceback."""
+    cfg = tmp_path / "c.toml"
+    cfg.write_text('role = "pursuer"\nopponent = "evader/straight"\n[algo_kwargs]\nn_epochs = 0\n')
+    for args in (["-m", "training", str(cfg)], ["-m", "training.zoo", "info", "x"]):
+        r = subprocess.run([sys.executable, *args], capture_output=True, text=True, cwd=ROOT)
+        assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
+        assert r.stderr.count("\n") == 1
+
+
+def test_config_values_are_checked_before_sb3_sees_them():
+    for kw in ({"n_epochs": 0}, {"ent_coef": "abc"}, {"clip_range": -1.0}, {"use_sde": 1}):
+        with pytest.raises(InvalidConfigError, match=next(iter(kw))):
+            TrainConfig(role="pursuer", opponent="evader/straight", algo_kwargs=kw)
+    TrainConfig(role="evader", opponent="pursuer/greedy", algo="sac",
+                algo_kwargs={"ent_coef": "auto_0.1"})  # fmt: skip
+    assert latest_checkpoint(Path("/nonexistent")) is None

@@ -38,6 +38,7 @@ if sys.version_info >= (3, 11):
 else:  # pragma: no cover - Python 3.10 reads TOML with the tomli backport
     import tomli as tomllib
 
+from envs import validation
 from envs.errors import InvalidConfigError
 from envs.surveillance.config import EnvConfig, env_parameters
 from strategies.policies.base import check_role
@@ -266,7 +267,12 @@ def load_config(path: str | os.PathLike[str], **overrides: Any) -> TrainConfig:
     except tomllib.TOMLDecodeError as exc:
         raise InvalidConfigError(f"config: {str(p)!r} is not valid TOML ({exc})") from exc
     data.update(overrides)
-    return TrainConfig.from_dict(data)
+    try:
+        return TrainConfig.from_dict(data)
+    except InvalidConfigError as exc:  # name the file the value came from
+        msg = str(exc)
+        msg = msg[len("config.toml: ") :] if msg.startswith("config.toml: ") else msg
+        raise InvalidConfigError(f"{p}: {msg}") from None
 
 
 def _toml_value(v: Any) -> str:
@@ -358,7 +364,9 @@ def _check_algo_value(algo: str, key: str, value: Any) -> None:
 
 
 class _Checker:
-    """Validators that raise InvalidConfigError naming the field."""
+    """The config's validators: :mod:`envs.validation`'s rules, located in the config file."""
+
+    where = "config.toml"
 
     @staticmethod
     def role(value: Any) -> str:
@@ -366,42 +374,29 @@ class _Checker:
             return check_role(value)
         except InvalidConfigError:
             raise InvalidConfigError(
-                f"role: expected 'pursuer' or 'evader', got {value!r}"
+                f"config.toml: role = {value!r}: expected 'pursuer' or 'evader'"
             ) from None
 
-    @staticmethod
-    def string(name: str, value: Any) -> str:
-        if not isinstance(value, str) or not value:
-            raise InvalidConfigError(f"{name}: expected a non-empty string, got {value!r}")
-        return value
+    def string(self, name: str, value: Any) -> str:
+        return validation.string(name, value, where=self.where)
 
-    @staticmethod
-    def choice(name: str, value: Any, options: tuple[str, ...]) -> str:
-        if value not in options:
-            raise InvalidConfigError(f"{name}: expected one of {list(options)}, got {value!r}")
-        return value
+    def choice(self, name: str, value: Any, options: tuple[str, ...]) -> str:
+        return validation.choice(name, value, options, where=self.where)
 
-    @staticmethod
-    def integer(name: str, value: Any, minimum: int) -> int:
-        if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
-            raise InvalidConfigError(f"{name}: expected an integer >= {minimum}, got {value!r}")
-        return int(value)
+    def integer(self, name: str, value: Any, minimum: int) -> int:
+        return validation.integer(name, value, minimum=minimum, where=self.where)
 
-    @staticmethod
-    def positive(name: str, value: Any) -> float:
-        ok = isinstance(value, (int, float)) and not isinstance(value, bool)
-        if not ok or not math.isfinite(value) or value <= 0:
-            raise InvalidConfigError(f"{name}: expected a finite number > 0, got {value!r}")
-        return float(value)
+    def positive(self, name: str, value: Any) -> float:
+        return validation.positive(name, value, where=self.where)
 
-    @staticmethod
-    def table(name: str, value: Any, allowed: tuple[str, ...] | None = None) -> dict[str, Any]:
-        if not isinstance(value, dict):
-            raise InvalidConfigError(f"{name}: expected a table (dict), got {value!r}")
+    def table(
+        self, name: str, value: Any, allowed: tuple[str, ...] | None = None
+    ) -> dict[str, Any]:
+        d = validation.mapping(name, value, where=f"{self.where} [{name}]")
         if allowed is not None:
-            unknown = sorted(set(value) - set(allowed))
+            unknown = sorted(set(d) - set(allowed))
             if unknown:
                 raise InvalidConfigError(
-                    f"{name}: unknown key(s) {unknown}; allowed: {list(allowed)}"
+                    f"[{name}]: unknown key(s) {unknown}; allowed: {list(allowed)}; in {self.where}"
                 )
-        return dict(value)
+        return dict(d)

@@ -177,7 +177,13 @@ class EscapePlan:
         c = self.dec.cell_at(float(point[0]), float(point[1]), float(theta))
         return -1 if c is None else c.id
 
-    def witness(self, cell: int, point: np.ndarray, clearance: float = 0.0) -> Witness | None:
+    def witness(
+        self,
+        cell: int,
+        point: np.ndarray,
+        clearance: float = 0.0,
+        exclude: frozenset[int] = frozenset(),
+    ) -> Witness | None:
         """The crossing of one of ``cell``'s vias nearest to ``point``.
 
         Candidates are the point of each via piece nearest to ``point`` (projection onto
@@ -185,6 +191,13 @@ class EscapePlan:
         must keep ``clearance`` from the walls (the evader's disc). The first candidate
         reachable in a straight line inside the cell's region is taken, else the
         nearest one.
+
+        Args:
+            cell: the configuration's cell.
+            point: the evader's position.
+            clearance: the least distance from the walls of a usable crossing.
+            exclude: via pieces not to use (ones the evader could not reach, or that
+                would take it back where it came from).
 
         Returns:
             The :class:`Witness`, or ``None`` if the cell is not escapable or no crossing
@@ -197,6 +210,8 @@ class EscapePlan:
         p = np.asarray(point, dtype=float)
         cands = []  # (distance, boundary, point, normal out of the region)
         for b in self.vias[cell]:
+            if b in exclude:
+                continue
             p0, d, ln, nrm, s, seg, clear = self._pieces[b]
             if not len(ln):
                 continue

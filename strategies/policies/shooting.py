@@ -81,6 +81,9 @@ class ShootingEvader(BasePolicy):
         self.replan = validation.integer("replan", replan, minimum=1)
         self.shoot = flag_param("shoot", shoot)
 
+    STALL_STEPS = 10  # steps without getting closer to a crossing before giving it up
+    PRESSURE_HOLD = 20  # steps a toward/away choice is kept in the fallback
+
     def _reset(self) -> None:
         c = self.config
         self.L_eff = round(c.l_min + c.body_radius, 6)
@@ -107,6 +110,14 @@ class ShootingEvader(BasePolicy):
         self._arc: tuple[np.ndarray, float, np.ndarray] | None = None  # (start, frame, path)
         self._arc_age = 0
         self._plan_cell, self._plan_lost, self._witness = -1, False, None
+        # progress toward the witness: a crossing the evader cannot reach (its disc
+        # pressed to a corner on the way) or one that leads back where it came from is
+        # excluded for that cell, and another is chosen
+        self._excluded: dict[int, set[int]] = {}
+        self._best_gap, self._stall = math.inf, 0
+        self._came_through: tuple[int, int] | None = None  # (cell left, piece crossed)
+        self._trail: list[tuple[int, int]] = []  # the last crossings (cell left, piece)
+        self._pressure_dir, self._pressure_age = 1.0, 0
         self.mode = "start"
 
     # ------------------------------------------------------------------ candidates
@@ -185,11 +196,22 @@ class ShootingEvader(BasePolicy):
                 return c.v_evader * unit(self.plan.points[nxt] - e)
         self.mode = "pressure"
         u = unit(snap.rod)
-        if len(cand) and np.isfinite(margin[best]):
-            toward = float(np.dot(cand[best] - e, u)) >= 0.0
-        else:
-            toward = True
-        return c.v_evader * (u if toward else -u)
+        # hold the choice toward / away from the pursuer for a while: flipping it every
+        # step (as the best candidate's side changes) left the evader in place
+        if self._pressure_age <= 0:
+            if len(cand) and np.isfinite(margin[best]):
+                self._pressure_dir = 1.0 if float(np.dot(cand[best] - e, u)) >= 0.0 else -1.0
+            else:
+                self._pressure_dir = 1.0
+            self._pressure_age = self.PRESSURE_HOLD
+        self._pressure_age -= 1
+        v = self._pressure_dir * u
+        if self.map.distance_to_walls(e[None])[0] <= c.body_radius + 2.0 * c.v_evader * c.dt:
+            # against a wall the push is lost: slide along it instead, the way that
+            # turns the rod fastest (perpendicular to it)
+            n = np.array([-u[1], u[0]])
+            v = n if self._pressure_dir > 0 else -n
+        return c.v_evader * v
 
     def _plan_heading(self, e: np.ndarray, theta: float) -> np.ndarray | None:
         """Heading of the guaranteed escape plan, or ``None`` if the cell is not escapable
@@ -213,16 +235,47 @@ class ShootingEvader(BasePolicy):
             self._plan_lost = True
         else:
             self._plan_lost = False
+        step = self.config.v_evader * self.config.dt
         if cell != last:
+            if last >= 0 and self._witness is not None:
+                # crossed from `last` through its witness piece: never straight back
+                self._came_through = (last, self._witness.boundary)
+                self._trail.append((last, self._witness.boundary))
+                if len(self._trail) >= 2 and self._trail[-2][0] == cell:
+                    # back in the cell of two crossings ago (A -> B -> A: two pieces at a
+                    # junction, or either side of a region thinner than a step): neither
+                    # crossing made progress, so both are out
+                    for c_, b_ in self._trail[-2:]:
+                        self._excluded.setdefault(c_, set()).add(b_)
+                del self._trail[:-4]
             self._plan_cell = cell
-            self._witness = plan.witness(cell, e, self.config.body_radius)  # None if safe
+            self._new_witness(cell, e)
+        elif self._witness is not None:
+            gap = float(np.linalg.norm(self._witness.target - e))
+            if gap < self._best_gap - 0.25 * step:
+                self._best_gap, self._stall = gap, 0
+            else:
+                self._stall += 1
+            if self._stall >= self.STALL_STEPS:  # not getting closer: that crossing is out
+                self._excluded.setdefault(cell, set()).add(self._witness.boundary)
+                self._new_witness(cell, e)
         w = self._witness
         if w is None:
             return None
-        step = self.config.v_evader * self.config.dt
         if np.linalg.norm(w.cross - e) <= step:
             return w.normal.copy()
         return unit(w.target - e)
+
+    def _new_witness(self, cell: int, e: np.ndarray) -> None:
+        """Choose the crossing for ``cell``, leaving out excluded pieces and the way back."""
+        exclude = set(self._excluded.get(cell, ()))
+        if self._came_through is not None:
+            # the piece just crossed, seen from the new side, leads back: skip it
+            exclude.add(self._came_through[1])
+        self._witness = self.plan.witness(
+            cell, e, self.config.body_radius, exclude=frozenset(exclude)
+        )
+        self._best_gap, self._stall = math.inf, 0
 
     def _start_arc(
         self, e: np.ndarray, theta: float, target: np.ndarray, branch: str

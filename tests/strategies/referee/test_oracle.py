@@ -93,7 +93,8 @@ def corner_referee():
     strict=True,
     reason="issue 13, evader half: from starts the referee certifies for the evader in the "
     "corner world (herding the pursuer into a dead-end arm), evader/shooting does not break "
-    "surveillance against pursuer/greedy within 2 diameters / V_e; the referee's own evader "
+    "surveillance against pursuer/greedy within 2 diameters / V_e from the first of the three "
+    "(it escapes from the other two since the loop/stall fixes); the referee's own evader "
     "does, within 10 s (benchmarks: see the referee's closing note)",
 )
 def test_shooting_evader_escapes_from_certified_starts_in_the_corner_world(corner_referee):

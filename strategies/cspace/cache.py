@@ -28,6 +28,7 @@ import tempfile
 import warnings
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -42,6 +43,7 @@ __all__ = [
     "cache_path",
     "cached_decomposition",
     "resolve_cache_dir",
+    "write_cache_file",
 ]
 
 FORMAT_VERSION = 3
@@ -160,6 +162,18 @@ def _read(path: Path, key: dict, world: Map) -> Decomposition | None:
 
 
 def _write(path: Path, key: dict, dec: Decomposition) -> None:
+    write_cache_file(path, lambda fh: fh.write(_encode(key, dec)), "decomposition")
+
+
+def write_cache_file(path: Path, write: Callable[[Any], Any], what: str) -> None:
+    """Write a cache file atomically; never fail the caller over it.
+
+    ``write(fh)`` fills a temporary file in the same directory, which then replaces
+    ``path`` (readers see the old file or the new one, never half of one). A directory
+    that cannot be written gets one :class:`CacheWarning` per process (``what`` names
+    the kind of entry: "decomposition", "safety table"), then the cache is skipped; a
+    failed write warns and leaves nothing behind.
+    """
     directory = path.parent
     try:
         directory.mkdir(parents=True, exist_ok=True)
@@ -168,22 +182,20 @@ def _write(path: Path, key: dict, dec: Decomposition) -> None:
         if str(directory) not in _UNWRITABLE:
             _UNWRITABLE.add(str(directory))
             warnings.warn(
-                f"decomposition cache directory {directory} is not writable ({exc}); "
-                "decompositions will be recomputed (set SURVEIL_CACHE_DIR to change it)",
+                f"{what} cache directory {directory} is not writable ({exc}); entries "
+                "will be recomputed (set SURVEIL_CACHE_DIR to change it)",
                 CacheWarning,
                 stacklevel=4,
             )
         return
     try:
         with os.fdopen(fd, "wb") as fh:
-            fh.write(_encode(key, dec))
+            write(fh)
         os.replace(tmp, path)
     except BaseException as exc:
         Path(tmp).unlink(missing_ok=True)
         if isinstance(exc, OSError):
-            warnings.warn(
-                f"decomposition cache {path}: cannot write ({exc})", CacheWarning, stacklevel=4
-            )
+            warnings.warn(f"{what} cache {path}: cannot write ({exc})", CacheWarning, stacklevel=4)
             return
         raise
 

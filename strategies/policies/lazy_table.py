@@ -62,6 +62,7 @@ class LazySafetyTable:
     bin_of = SafetyTable.bin_of
     bin_centre = SafetyTable.bin_centre
     row = SafetyTable.row
+    grid_index = SafetyTable.grid_index
 
     def __init__(self, world: Map, L: float, resolution: float, n_bins: int) -> None:
         from strategies.cspace import decompose
@@ -110,9 +111,7 @@ class LazySafetyTable:
         Membership only (a vectorised point-in-polygon test per new node, memoised):
         the orientations are classified when :meth:`rows` asks for them.
         """
-        idx = self._index(points)
-        ok = (idx[:, 0] >= 0) & (idx[:, 0] < self.shape[0]) & (idx[:, 1] >= 0)
-        ok &= idx[:, 1] < self.shape[1]
+        idx, ok = self.grid_index(points)
         out = np.zeros(len(idx), dtype=bool)
         member = self._member[idx[ok, 0], idx[ok, 1]]
         if (member == 0).any():
@@ -121,11 +120,6 @@ class LazySafetyTable:
             member = self._member[idx[ok, 0], idx[ok, 1]]
         out[ok] = member == 1
         return out
-
-    def _index(self, points: np.ndarray) -> np.ndarray:
-        return np.rint((np.asarray(points, dtype=float) - self.origin) / self.resolution).astype(
-            np.int64
-        )
 
     def _membership(self, nodes: np.ndarray) -> np.ndarray:
         """Decide (and memoise) which grid nodes (k, 2) lie in the free region."""
@@ -138,11 +132,7 @@ class LazySafetyTable:
 
     def rows(self, points: np.ndarray) -> np.ndarray:
         """Table rows of the grid points nearest to (k, 2) points (-1 outside)."""
-        idx = np.rint((np.asarray(points, dtype=float) - self.origin) / self.resolution).astype(
-            np.int64
-        )
-        ok = (idx[:, 0] >= 0) & (idx[:, 0] < self.shape[0]) & (idx[:, 1] >= 0)
-        ok &= idx[:, 1] < self.shape[1]
+        idx, ok = self.grid_index(points)
         out = np.full(len(idx), -1, dtype=np.int64)
         vals = self._cell[idx[ok, 0], idx[ok, 1]]
         if (vals == _UNKNOWN).any():

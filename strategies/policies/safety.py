@@ -25,8 +25,6 @@ from __future__ import annotations
 import functools
 import hashlib
 import math
-import os
-import tempfile
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,7 +35,7 @@ from envs import validation
 from envs.errors import InfeasibleError
 from envs.maps import Map
 from strategies.cspace import _budget
-from strategies.cspace.cache import CacheWarning, resolve_cache_dir
+from strategies.cspace.cache import CacheWarning, resolve_cache_dir, write_cache_file
 from strategies.cspace.grids import grid_points
 
 __all__ = [
@@ -109,13 +107,18 @@ class SafetyTable:
         """Centre orientation of bin(s) ``b``."""
         return -math.pi + (np.asarray(b) + 0.5) * self.bin_width
 
-    def rows(self, points: np.ndarray) -> np.ndarray:
-        """Table rows of the grid points nearest to (k, 2) points (-1 outside)."""
+    def grid_index(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Grid indices (k, 2) of the nodes nearest to (k, 2) points, and which lie on it."""
         idx = np.rint((np.asarray(points, dtype=float) - self.origin) / self.resolution).astype(
             np.int64
         )
         ok = (idx[:, 0] >= 0) & (idx[:, 0] < self.shape[0]) & (idx[:, 1] >= 0)
         ok &= idx[:, 1] < self.shape[1]
+        return idx, ok
+
+    def rows(self, points: np.ndarray) -> np.ndarray:
+        """Table rows of the grid points nearest to (k, 2) points (-1 outside)."""
+        idx, ok = self.grid_index(points)
         out = np.full(len(idx), -1, dtype=np.int64)
         out[ok] = self.cell[idx[ok, 0], idx[ok, 1]]
         return out
@@ -242,7 +245,6 @@ def _build(
 
 
 _ARRAYS = ("origin", "cell", "free", "safe", "guaranteed", "ccw", "cw")
-_UNWRITABLE: set[str] = set()  # cache directories already warned about
 
 
 def default_resolution(L: float) -> float:
@@ -380,29 +382,8 @@ def _read(path: Path, key: str, L: float, resolution: float, n_bins: int) -> Saf
 
 def _write(path: Path, key: str, table: SafetyTable) -> None:
     arrays = {name: getattr(table, name) for name in _ARRAYS}
-    directory = path.parent
-    try:
-        directory.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp.npz", dir=directory)
-    except OSError as exc:
-        if str(directory) not in _UNWRITABLE:
-            _UNWRITABLE.add(str(directory))
-            warnings.warn(
-                f"safety table cache directory {directory} is not writable ({exc}); tables "
-                "will be recomputed (set SURVEIL_CACHE_DIR to change it)",
-                CacheWarning,
-                stacklevel=4,
-            )
-        return
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            np.savez_compressed(fh, key=np.array(key), sha256=np.array(_checksum(arrays)), **arrays)
-        os.replace(tmp, path)
-    except OSError as exc:
-        Path(tmp).unlink(missing_ok=True)
-        warnings.warn(
-            f"safety table cache {path}: cannot write ({exc})", CacheWarning, stacklevel=4
-        )
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+
+    def write(fh) -> None:
+        np.savez_compressed(fh, key=np.array(key), sha256=np.array(_checksum(arrays)), **arrays)
+
+    write_cache_file(path, write, "safety table")

@@ -82,7 +82,6 @@ class ShootingEvader(BasePolicy):
         self.shoot = flag_param("shoot", shoot)
 
     STALL_STEPS = 10  # steps without getting closer to a crossing before giving it up
-    PRESSURE_HOLD = 20  # steps a toward/away choice is kept in the fallback
 
     def _reset(self) -> None:
         c = self.config
@@ -117,7 +116,6 @@ class ShootingEvader(BasePolicy):
         self._best_gap, self._stall = math.inf, 0
         self._came_through: tuple[int, int] | None = None  # (cell left, piece crossed)
         self._trail: list[tuple[int, int]] = []  # the last crossings (cell left, piece)
-        self._pressure_dir, self._pressure_age = 1.0, 0
         self.mode = "start"
 
     # ------------------------------------------------------------------ candidates
@@ -195,23 +193,17 @@ class ShootingEvader(BasePolicy):
                 self.mode = "region"
                 return c.v_evader * unit(self.plan.points[nxt] - e)
         self.mode = "pressure"
+        # charge: straight at the pursuer minimises its best rotation rate (Sec. 6.1, the
+        # toward/away strategy) and, with bounded speeds, herds it backwards into walls and
+        # dead ends (Sec. 5); running away only ever leads into a corner. (Choosing toward
+        # or away by the best candidate's side, as before, flipped every step and left the
+        # evader in place.)
         u = unit(snap.rod)
-        # hold the choice toward / away from the pursuer for a while: flipping it every
-        # step (as the best candidate's side changes) left the evader in place
-        if self._pressure_age <= 0:
-            if len(cand) and np.isfinite(margin[best]):
-                self._pressure_dir = 1.0 if float(np.dot(cand[best] - e, u)) >= 0.0 else -1.0
-            else:
-                self._pressure_dir = 1.0
-            self._pressure_age = self.PRESSURE_HOLD
-        self._pressure_age -= 1
-        v = self._pressure_dir * u
         if self.map.distance_to_walls(e[None])[0] <= c.body_radius + 2.0 * c.v_evader * c.dt:
-            # against a wall the push is lost: slide along it instead, the way that
-            # turns the rod fastest (perpendicular to it)
-            n = np.array([-u[1], u[0]])
-            v = n if self._pressure_dir > 0 else -n
-        return c.v_evader * v
+            # against a wall the push is lost: slide along it, perpendicular to the rod
+            # (which turns the rod fastest)
+            return c.v_evader * np.array([-u[1], u[0]])
+        return c.v_evader * u
 
     def _plan_heading(self, e: np.ndarray, theta: float) -> np.ndarray | None:
         """Heading of the guaranteed escape plan, or ``None`` if the cell is not escapable

@@ -6,10 +6,16 @@ executor and commits every outcome as it arrives (one transaction per match). Ct
 or SIGTERM stops it within a second or two: workers are stopped, the matches in flight
 are dropped (they are replayed on resume), and the summary says how to resume. A rerun
 of the same spec on the same store resumes; nothing stored is played again.
+
+A spec with an ``[sprt]`` table stops as soon as Wald's sequential test on the
+candidate's and the baseline's paired starts is decided (run status ``decided``); the
+matches left are not played. Matches are planned seed-major, so pairs complete as the
+run goes.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import signal
 import sys
@@ -25,7 +31,7 @@ from analysis.tournament.spec import Spec, load_spec
 from analysis.tournament.store import Store
 from analysis.tournament.worker import context_for
 
-__all__ = ["RunSummary", "default_store", "run_tournament"]
+__all__ = ["RunSummary", "Sequential", "default_store", "run_tournament"]
 
 
 def default_store(spec: Spec) -> Path:
@@ -45,6 +51,7 @@ class RunSummary:
         played: matches finished by this invocation.
         forfeits, errors: of ``played``, how many ended so.
         interrupted: ``None``, or the signal that stopped the run (``"SIGINT"``...).
+        decided: with an ``[sprt]`` table, the test's decision once it stopped the run.
         seconds: wall-clock time of this invocation.
         backend: the executor's description.
     """
@@ -58,6 +65,7 @@ class RunSummary:
     forfeits: int = 0
     errors: int = 0
     interrupted: str | None = None
+    decided: str | None = None
     seconds: float = 0.0
     backend: str = ""
     messages: list[str] = field(default_factory=list)
@@ -65,7 +73,9 @@ class RunSummary:
     @property
     def complete(self) -> bool:
         """Every planned match has a result."""
-        return self.reused + self.played >= self.planned and self.interrupted is None
+        if self.interrupted is not None:
+            return False
+        return self.decided is not None or self.reused + self.played >= self.planned
 
     def describe(self) -> str:
         """A few lines for the terminal."""
@@ -131,15 +141,23 @@ def run_tournament(
             done = db.finished(spec.run_id, include_errors=False)
         todo = [m for m, _ in unique if m.match_id not in done]
         summary = RunSummary(spec.run_id, spec.name, path, len(unique), len(unique) - len(todo))
+        test = Sequential(spec.sprt, db.rows(spec.run_id)) if spec.sprt else None
+        if test is not None and test.decision is not None:
+            todo = []
+            summary.decided = test.decision
+            summary.messages.append(test.describe())
         if not todo:
             summary.backend = "nothing to play"
-            db.end_run(spec.run_id, "finished")
+            db.end_run(spec.run_id, "decided" if summary.decided else "finished")
             return summary
         ctx = context_for(spec)
         ex = executor or make_executor(backend, workers=workers, address=address)
         summary.backend = ex.describe()
-        _play(db, spec, todo, ctx, ex, summary, progress)
+        _play(db, spec, todo, ctx, ex, summary, progress, test)
         status = "interrupted" if summary.interrupted else "finished"
+        if summary.decided and not summary.interrupted:
+            status = "decided"
+            summary.messages.append(test.describe())
         db.end_run(spec.run_id, status)
         if summary.interrupted:
             hint = resume_hint or "run the same spec on the same store again"
@@ -156,8 +174,80 @@ def run_tournament(
             summary.seconds = time.monotonic() - t0
 
 
+class Sequential:
+    """Wald's SPRT of an ``[sprt]`` table, fed one finished match at a time.
+
+    A start (map, variant, opponent, seed, start kind) counts once both the candidate and
+    the baseline have a result on it; it is discordant when exactly one of them won.
+
+    Args:
+        cfg: the spec's validated ``[sprt]`` table.
+        rows: matches already stored (flat dicts as :meth:`Store.rows` returns).
+    """
+
+    def __init__(self, cfg: dict[str, Any], rows: list[dict[str, Any]] = ()) -> None:
+        self.cfg = cfg
+        self.role = cfg["role"]
+        self.other = "evader" if self.role == "pursuer" else "pursuer"
+        self.wins: dict[tuple, dict[str, bool]] = {}
+        self.a_only = self.b_only = 0
+        self.decision: str | None = None
+        for r in rows:
+            self.add(r)
+
+    def add(self, row: dict[str, Any]) -> str | None:
+        """Count one finished match (a row with labels, ``status`` and ``winner``)."""
+        label = row[self.role]
+        if label not in (self.cfg["candidate"], self.cfg["baseline"]):
+            return self.decision
+        if row.get("status") == "error" or not row.get("winner"):
+            return self.decision
+        key = (row["map"], row["variant"], row[self.other], row["seed"], row["start"])
+        pair = self.wins.setdefault(key, {})
+        pair[label] = row["winner"] == self.role
+        if len(pair) == 2:
+            a, b = pair[self.cfg["candidate"]], pair[self.cfg["baseline"]]
+            self.a_only += a and not b
+            self.b_only += b and not a
+            if self.decision is None:
+                from analysis.tournament.statistics import sprt
+
+                verdict = sprt(
+                    self.a_only,
+                    self.b_only,
+                    p1=self.cfg["p1"],
+                    alpha=self.cfg["alpha"],
+                    beta=self.cfg["beta"],
+                )
+                self.decision = None if verdict == "undecided" else verdict
+        return self.decision
+
+    def describe(self) -> str:
+        """One line: the comparison, the counts and the decision."""
+        c = self.cfg
+        verdict = {"a better": "better", "not better": "not better"}.get(self.decision or "")
+        head = (
+            f"sprt ({c['role']}s, p1 = {c['p1']:g}, alpha = {c['alpha']:g}, beta = {c['beta']:g})"
+        )
+        counts = (
+            f"discordant starts: {self.a_only} won by the candidate only, "
+            f"{self.b_only} by the baseline only"
+        )
+        if verdict is None:
+            return f"{head}: undecided ({counts})"
+        who = f"{c['candidate']!r} is {verdict} than {c['baseline']!r}"
+        return f"{head}: {who} ({counts}); the run stopped"
+
+
 def _play(
-    db: Store, spec: Spec, todo: list, ctx: Any, ex: Executor, summary: RunSummary, progress: bool
+    db: Store,
+    spec: Spec,
+    todo: list,
+    ctx: Any,
+    ex: Executor,
+    summary: RunSummary,
+    progress: bool,
+    test: Sequential | None = None,
 ) -> None:
     from tqdm import tqdm
 
@@ -188,9 +278,15 @@ def _play(
         dynamic_ncols=True,
         smoothing=0.05,
     )
+    by_id = {m.match_id: m for m in todo} if test is not None else {}
     try:
         for out in ex.run(todo, ctx, stop):
             db.record(spec.run_id, out)
+            if test is not None and out["match_id"] in by_id:
+                m = by_id[out["match_id"]]
+                if test.add({**dataclasses.asdict(m), **out}) and not summary.decided:
+                    summary.decided = test.decision
+                    stop.set()
             summary.played += 1
             summary.forfeits += out.get("status") == "forfeit"
             summary.errors += out.get("status") == "error"

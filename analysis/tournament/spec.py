@@ -25,6 +25,13 @@ seeds::
     [grid]                              # each combination is a variant
     rho = [0.3, 0.5]                    # v_evader = rho * v_pursuer
     l_max = [3.0, 4.0]
+    [sprt]                              # optional: stop once "candidate vs baseline" is decided
+    role = "pursuer"                    # whose roster both labels are in
+    candidate = "pursuer/decomposition"
+    baseline = "pursuer/greedy"
+    p1 = 0.65                           # H1: P(candidate wins a discordant start) = p1 (H0: 0.5)
+    alpha = 0.05                        # error rates of Wald's test
+    beta = 0.05
 
 Every pairing on a map plays the same seeded starts (common random numbers): the start
 depends only on the map, the env config and the seed. Relative paths are relative to
@@ -48,7 +55,7 @@ from pathlib import Path
 from typing import Any
 
 from envs.errors import InvalidConfigError
-from envs.validation import choice, integer, mapping, positive, string
+from envs.validation import choice, integer, mapping, positive, string, unit_interval
 
 __all__ = [
     "ENV_FIELDS",
@@ -88,7 +95,9 @@ _TOP = {
     "evaders",
     "env",
     "grid",
+    "sprt",
 }
+_SPRT_KEYS = {"role", "candidate", "baseline", "p1", "alpha", "beta"}
 _ENTRY_KEYS = {"policy", "params", "label", "model", "algo", "deterministic", "observation"}
 _START_KINDS = ("safe", "valid")
 DEFAULT_TIME_LIMIT = 300.0
@@ -166,6 +175,7 @@ class Spec:
     variants: tuple[Variant, ...]
     time_limit: float
     salt: str = ""
+    sprt: dict[str, Any] | None = None
 
     def env_config(self, map_entry: MapEntry, variant: Variant) -> dict[str, Any]:
         """The resolved env parameters of a (map, variant): every field but the map.
@@ -211,6 +221,7 @@ class Spec:
             "variants": [dataclasses.asdict(v) for v in self.variants],
             "time_limit": self.time_limit,
             "salt": self.salt,
+            **({"sprt": self.sprt} if self.sprt is not None else {}),
         }
 
     @property
@@ -279,6 +290,9 @@ def spec_from_dict(
     variants = _grid(d.get("grid", {}), f"{source} [grid]")
     time_limit = positive("time_limit", d.get("time_limit", DEFAULT_TIME_LIMIT), where=source)
     salt = string("salt", d.get("salt", ""), where=source, nonempty=False)
+    sprt = None
+    if "sprt" in d:
+        sprt = _sprt(d["sprt"], f"{source} [sprt]", {"pursuer": pursuers, "evader": evaders})
     spec = Spec(
         name=name,
         description=description,
@@ -292,6 +306,7 @@ def spec_from_dict(
         variants=variants,
         time_limit=time_limit,
         salt=salt,
+        sprt=sprt,
     )
     seen: dict[str, str] = {}
     fast: list[str] = []
@@ -319,6 +334,35 @@ def spec_from_dict(
             stacklevel=2,
         )
     return spec
+
+
+def _sprt(value: Any, where: str, rosters: Mapping[str, tuple[PolicyEntry, ...]]) -> dict:
+    d = mapping("sprt", value, where=where)
+    unknown = sorted(set(d) - _SPRT_KEYS)
+    if unknown:
+        raise InvalidConfigError(
+            f"{where}: unknown field(s) {unknown}; [sprt] has {sorted(_SPRT_KEYS)}"
+        )
+    for required in ("role", "candidate", "baseline"):
+        if required not in d:
+            raise InvalidConfigError(f"{where}: missing field {required!r}")
+    role = choice("role", d["role"], ("pursuer", "evader"), where=where)
+    labels = [p.label for p in rosters[role]]
+    out: dict[str, Any] = {"role": role}
+    for key in ("candidate", "baseline"):
+        label = string(key, d[key], where=where)
+        if label not in labels:
+            raise InvalidConfigError(
+                f"{where}: {key} = {label!r}: expected a label of the {role} roster {labels}"
+            )
+        out[key] = label
+    if out["candidate"] == out["baseline"]:
+        raise InvalidConfigError(f"{where}: candidate and baseline are both {out['candidate']!r}")
+    for key, default in (("p1", 0.65), ("alpha", 0.05), ("beta", 0.05)):
+        out[key] = unit_interval(key, d.get(key, default), where=where)
+    if out["p1"] <= 0.5:
+        raise InvalidConfigError(f"{where}: p1 = {out['p1']!r}: expected a number in (0.5, 1)")
+    return out
 
 
 def _list(name: str, value: Any, where: str) -> list[Any]:

@@ -28,6 +28,45 @@ def test_serial_and_process_backends_store_the_same_results(tmp_path, small_spec
         assert comparable(x.rows(a.run_id)) == comparable(y.rows(b.run_id))
 
 
+def test_sprt_stops_a_decided_run_and_a_rerun_keeps_the_decision(tmp_path):
+    import analysis.tournament.statistics as st
+
+    d = {
+        "maps": ["open_room"],
+        "pursuers": ["pursuer/greedy", "pursuer/random"],
+        "evaders": ["evader/straight", "evader/random"],
+        "seeds": 40,
+        "start": "valid",
+        "env": {"max_cycles": 60},
+        "sprt": {"role": "pursuer", "candidate": "pursuer/greedy", "baseline": "pursuer/random"},
+    }
+    d["sprt"]["p1"] = 0.9  # decided after 5 discordant starts won by the candidate alone
+    spec = spec_from_dict(d)
+    s = run_tournament(spec, tmp_path / "s.sqlite", backend="serial", progress=False)
+    assert s.decided == "a better" and s.complete and s.played < s.planned
+    assert "'pursuer/greedy' is better than 'pursuer/random'" in s.describe()
+    with Store(tmp_path / "s.sqlite") as db:
+        rows = db.rows(s.run_id)
+        assert db.run(s.run_id)["status"] == "decided"
+    (pc,) = [c for c in st.paired_comparisons(rows) if c.role == "pursuer"]
+    a_only, b_only = (pc.a_only, pc.b_only) if pc.a == "pursuer/greedy" else (pc.b_only, pc.a_only)
+    assert st.sprt(a_only, b_only, p1=0.9) == "a better"
+    # the run stopped at its first decision: without the last seed's pairs it was undecided
+    last = max(r["seed"] for r in rows)
+    earlier = [r for r in rows if r["seed"] < last]
+    (pc,) = [c for c in st.paired_comparisons(earlier) if c.role == "pursuer"]
+    a_only, b_only = (pc.a_only, pc.b_only) if pc.a == "pursuer/greedy" else (pc.b_only, pc.a_only)
+    assert st.sprt(a_only, b_only, p1=0.9) == "undecided"
+    again = run_tournament(spec, tmp_path / "s.sqlite", backend="serial", progress=False)
+    assert again.played == 0 and again.reused == len(rows) and again.decided == "a better"
+    # without [sprt] the same matches are reused and the rest is played
+    del d["sprt"]
+    full = run_tournament(
+        spec_from_dict(d), tmp_path / "s.sqlite", backend="serial", progress=False
+    )
+    assert full.reused == len(rows) and full.reused + full.played == full.planned == 160
+
+
 @pytest.mark.parametrize("backend", ["serial", "process"])
 def test_raising_and_hanging_policies_forfeit_and_the_run_goes_on(tmp_path, test_policies, backend):
     d = {

@@ -41,6 +41,23 @@ from .conftest import comparable
         ({"time_limit": 0}, r"time_limit = 0"),
         ({"colour": "red"}, r"unknown field.*colour"),
         ({"evaders": [{"model": "zoo:no_such_model"}]}, r"no zoo model 'no_such_model'"),
+        ({"sprt": {"role": "pursuer", "candidate": "pursuer/greedy"}}, r"\[sprt\].*baseline"),
+        (
+            {"sprt": {"role": "pursuer", "candidate": "pursuer/greedy", "baseline": "x"}},
+            r"\[sprt\]: baseline = 'x': expected a label of the pursuer roster",
+        ),
+        (
+            {
+                "sprt": {
+                    "role": "pursuer",
+                    "candidate": "pursuer/greedy",
+                    "baseline": "pursuer/tractrix",
+                    "p1": 0.5,
+                }
+            },
+            r"\[sprt\]: p1 = 0.5: expected a number in \(0.5, 1\)",
+        ),
+        ({"sprt": {"role": "both", "candidate": "a", "baseline": "b"}}, r"\[sprt\].*role = 'both'"),
     ],
 )
 def test_bad_specs_name_the_field(small_spec, patch, message):

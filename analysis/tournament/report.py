@@ -475,6 +475,11 @@ def write_report(
 def _header(a: Analysis) -> list[str]:
     run, spec = a.run, a.run["spec"]
     statuses = {s: sum(r["status"] == s for r in a.rows) for s in ("ok", "forfeit", "error")}
+    sequential = []
+    if spec.get("sprt"):
+        from analysis.tournament.driver import Sequential
+
+        sequential = [Sequential(spec["sprt"], a.rows).describe()]
     return [
         f"run `{run['run_id']}` ({run['status']}): {run['done']} of {run['planned']} matches "
         f"stored; {statuses['forfeit']} forfeits, {statuses['error']} errors",
@@ -482,6 +487,7 @@ def _header(a: Analysis) -> list[str]:
         f"starts: {', '.join(spec['starts'])}; time limit {spec['time_limit']:g} s per match",
         f"env: {json.dumps(spec['env'])}; grid: "
         f"{', '.join(v['label'] for v in spec['variants'] if v['label']) or 'none'}",
+        *sequential,
     ]
 
 

@@ -57,6 +57,10 @@ def test_sprt_stops_a_decided_run_and_a_rerun_keeps_the_decision(tmp_path):
     (pc,) = [c for c in st.paired_comparisons(earlier) if c.role == "pursuer"]
     a_only, b_only = (pc.a_only, pc.b_only) if pc.a == "pursuer/greedy" else (pc.b_only, pc.a_only)
     assert st.sprt(a_only, b_only, p1=0.9) == "undecided"
+    from analysis.tournament.report import write_report
+
+    files = write_report(tmp_path / "s.sqlite", tmp_path / "rep", run_id=s.run_id, replays=False)
+    assert "'pursuer/greedy' is better than" in files["markdown"].read_text()
     again = run_tournament(spec, tmp_path / "s.sqlite", backend="serial", progress=False)
     assert again.played == 0 and again.reused == len(rows) and again.decided == "a better"
     # without [sprt] the same matches are reused and the rest is played

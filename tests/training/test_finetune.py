@@ -1,0 +1,71 @@
+"""PPO fine-tuning after cloning: the critic warms up with the actor frozen, the BC term decays."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import torch
+
+from envs.errors import InvalidConfigError
+from strategies.policies import make_policy
+from strategies.runner import run_episode
+from training.dagger import DaggerConfig, _Rollout, dagger
+from training.finetune import BCRegularisedPPO, from_cloned
+from training.single_agent import SingleAgentEnv
+
+
+def _actor(model):
+    p = model.policy
+    params = [*p.mlp_extractor.policy_net.parameters(), *p.action_net.parameters(), p.log_std]
+    return [t.detach().clone() for t in params]
+
+
+def _critic(model):
+    p = model.policy
+    params = [*p.mlp_extractor.value_net.parameters(), *p.value_net.parameters()]
+    return [t.detach().clone() for t in params]
+
+
+def test_finetune_warms_the_critic_then_decays_the_bc_term(tmp_path):
+    torch.set_num_threads(1)
+    cfg = DaggerConfig(role="pursuer", expert="pursuer/greedy", opponent="evader/straight",
+                       iterations=1, episodes=2, max_cycles=60, epochs=200,
+                       output_dir=str(tmp_path / "d"))  # fmt: skip
+    r = dagger(cfg)
+    # the cloning dataset: one expert-played episode, labelled by the expert
+    learner = from_cloned(r.model_path, SingleAgentEnv("pursuer", "evader/straight",
+                          map="open_room", observation="state"))  # fmt: skip
+    roll = _Rollout(make_policy("pursuer/greedy"), learner, beta=1.0, seed=1)
+    run_episode("open_room", roll, "evader/straight", 1, max_cycles=60, start="valid")
+    X, Y = np.asarray(roll.obs), np.clip(np.asarray(roll.labels), -1, 1)
+
+    env = SingleAgentEnv("pursuer", "evader/straight", map="open_room", observation="state")
+    model = from_cloned(r.model_path, env, bc_obs=X, bc_act=Y, bc_coef=2.0, bc_decay=0.5,
+                        critic_warmup=1, n_steps=64, batch_size=32, n_epochs=2, seed=0)  # fmt: skip
+    before = model.predict(X, deterministic=True)[0]
+    actor0, critic0 = _actor(model), _critic(model)
+    model.learn(total_timesteps=64)  # one rollout: the warm-up
+    assert all(torch.equal(a, b) for a, b in zip(actor0, _actor(model), strict=True))
+    assert not all(torch.equal(a, b) for a, b in zip(critic0, _critic(model), strict=True))
+    assert np.array_equal(model.predict(X, deterministic=True)[0], before)
+    model.learn(total_timesteps=3 * 64, reset_num_timesteps=False)
+    assert model.bc_weights == [0.0, 2.0, 1.0, 0.5]
+    # the BC term keeps the fine-tuned actor close to the expert on the cloning states
+    after = np.clip(model.predict(X, deterministic=True)[0], -1, 1)
+    assert np.linalg.norm(after - Y, axis=1).mean() < 0.2
+    path = tmp_path / "ft.zip"
+    model.save(str(path))
+    from stable_baselines3 import PPO
+
+    assert np.array_equal(
+        PPO.load(str(path)).predict(X, deterministic=True)[0],
+        model.predict(X, deterministic=True)[0],
+    )  # an ordinary PPO zip
+    env.close()
+
+
+@pytest.mark.parametrize("bad", [{"bc_decay": 1.5}, {"bc_coef": -1.0}, {"critic_warmup": -1}])
+def test_bad_finetune_arguments_name_the_field(bad):
+    env = SingleAgentEnv("pursuer", "evader/straight", map="open_room", observation="state")
+    with pytest.raises(InvalidConfigError, match=next(iter(bad))):
+        BCRegularisedPPO("MlpPolicy", env, **bad)

@@ -39,9 +39,18 @@ def test_finetune_warms_the_critic_then_decays_the_bc_term(tmp_path):
     run_episode("open_room", roll, "evader/straight", 1, max_cycles=60, start="valid")
     X, Y = np.asarray(roll.obs), np.clip(np.asarray(roll.labels), -1, 1)
 
-    env = SingleAgentEnv("pursuer", "evader/straight", map="open_room", observation="state")
-    model = from_cloned(r.model_path, env, bc_obs=X, bc_act=Y, bc_coef=2.0, bc_decay=0.5,
-                        critic_warmup=1, n_steps=64, batch_size=32, n_epochs=2, seed=0)  # fmt: skip
+    def tuned(bc_coef):
+        env = SingleAgentEnv("pursuer", "evader/straight", map="open_room", observation="state")
+        return from_cloned(r.model_path, env, bc_obs=X, bc_act=Y, bc_coef=bc_coef, bc_decay=0.5,
+                           critic_warmup=1, n_steps=64, batch_size=32, n_epochs=2, seed=0,
+                           learning_rate=3e-3)  # fmt: skip
+
+    def distance(m):
+        return np.linalg.norm(
+            np.clip(m.predict(X, deterministic=True)[0], -1, 1) - Y, axis=1
+        ).mean()
+
+    model, plain = tuned(2.0), tuned(0.0)
     before = model.predict(X, deterministic=True)[0]
     actor0, critic0 = _actor(model), _critic(model)
     model.learn(total_timesteps=64)  # one rollout: the warm-up
@@ -49,10 +58,10 @@ def test_finetune_warms_the_critic_then_decays_the_bc_term(tmp_path):
     assert not all(torch.equal(a, b) for a, b in zip(critic0, _critic(model), strict=True))
     assert np.array_equal(model.predict(X, deterministic=True)[0], before)
     model.learn(total_timesteps=3 * 64, reset_num_timesteps=False)
+    plain.learn(total_timesteps=4 * 64)
     assert model.bc_weights == [0.0, 2.0, 1.0, 0.5]
-    # the BC term keeps the fine-tuned actor close to the expert on the cloning states
-    after = np.clip(model.predict(X, deterministic=True)[0], -1, 1)
-    assert np.linalg.norm(after - Y, axis=1).mean() < 0.2
+    # measured: cloned 0.023; after 3 PPO updates at lr 3e-3, 0.039 with BC, 0.091 without
+    assert distance(model) < 0.06 < distance(plain)
     path = tmp_path / "ft.zip"
     model.save(str(path))
     from stable_baselines3 import PPO
@@ -61,7 +70,6 @@ def test_finetune_warms_the_critic_then_decays_the_bc_term(tmp_path):
         PPO.load(str(path)).predict(X, deterministic=True)[0],
         model.predict(X, deterministic=True)[0],
     )  # an ordinary PPO zip
-    env.close()
 
 
 @pytest.mark.parametrize("bad", [{"bc_decay": 1.5}, {"bc_coef": -1.0}, {"critic_warmup": -1}])

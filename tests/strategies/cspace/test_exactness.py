@@ -212,3 +212,18 @@ def test_office_is_exact():
 
     dec = decompose(builtin_map("office"), 2.0)
     assert dec.exact, dec.stats
+
+
+def test_two_triangles_type5_birth_keeps_the_verdict_monotone():
+    """Figures finding: a lower triangle's apex under an upper one's base (type-5 curves
+    appear near L = 1.5625). An earlier build left one boundary piece unmatched there and
+    declared every cell escapable; the pursuer holds on both sides and at the birth."""
+    w = Map(
+        [(0, 0), (16, 0), (16, 12), (0, 12)],
+        [[(6, 7), (8, 7), (7, 9)], [(8, 3), (10, 3), (9, 5.8)]],
+        name="apex_under_base",
+    )
+    for L in (1.5615, 1.5625, 1.565):
+        d = decompose(w, L)
+        assert d.exact and not d.unresolved, (L, d.summary())
+        assert not d.evader_wins, (L, d.summary())

@@ -227,3 +227,23 @@ def test_two_triangles_type5_birth_keeps_the_verdict_monotone():
         d = decompose(w, L)
         assert d.exact and not d.unresolved, (L, d.summary())
         assert not d.evader_wins, (L, d.summary())
+
+
+def test_two_pillars_evader_wins_once_the_rod_outgrows_the_gap():
+    """Figures finding (decomposition: evader at L = 1.6; grid oracle: pursuer). Checked by
+    brute force (free arcs sampled on both sides of every boundary piece agree with the
+    recorded adjacencies): for L just above the 1.5 gap, a diagonal arc through the gap
+    (body on a pillar corner, tip on the facing pillar) closes in four small pockets (reason
+    "a") and the escapes cascade; the grid oracle misses them (its pursuer verdict is only a
+    lower bound)."""
+    x = 6.5
+    w = Map(
+        [(0, 0), (12, 0), (12, 8), (0, 8)],
+        [[(3, 3), (5, 3), (5, 5), (3, 5)], [(x, 3), (x + 2, 3), (x + 2, 5), (x, 5)]],
+        name="two_pillars_1.5",
+    )
+    assert not decompose(w, 1.49).evader_wins
+    d = decompose(w, 1.6)
+    assert d.exact and d.evader_wins
+    pockets = [c for c in d.cells if c.reason == "a" and 2.5 < d.regions[c.region].point[1] < 5.5]
+    assert len(pockets) == 4

@@ -9,7 +9,7 @@
 | Agents               | `agents = ["pursuer_0", "evader_0"]`                        |
 | Action shape         | (2,)                                                        |
 | Action values        | Box(-1, 1, (2,), float32): velocity / speed bound           |
-| Observation shape    | `"state"`: (13,); `"lidar"`: (n_rays + 6,)                  |
+| Observation shape    | `"state"`: (13,); `"lidar"`: (n_rays + 6,); `"lidar_track"`: (n_rays + 8,) |
 | Observation values   | float32 Box, finite bounds (see `observations.py`)          |
 | State shape          | (13,), the `"state"` observation                            |
 
@@ -44,6 +44,11 @@ evader to pursuer, distance / l_max, the visibility bit, steps / max_cycles. Dec
 agent's relative position / l_max (zeros and a 0 mask bit when surveillance does not
 hold), the agent's realised velocity, the visibility bit, the time fraction
 (`envs.surveillance.lidar_layout(n_rays)`).
+
+`observation="lidar_track"`: the lidar plus the other agent's realised velocity / its speed
+bound, after the relative position (zeros when surveillance does not hold), as a tracker
+locked on the target reports it (`lidar_layout(n_rays, track=True)`). Added in v0 without
+changing the other kinds.
 
 ### Rewards
 
@@ -97,7 +102,7 @@ new version.
 
 `dt`: step duration. `max_cycles`: steps before truncation.
 
-`observation`: `"state"` or `"lidar"`. `n_rays` (at most 4096), `lidar_range` (default
+`observation`: `"state"`, `"lidar"` or `"lidar_track"`. `n_rays` (at most 4096), `lidar_range` (default
 `l_max`): lidar.
 
 `reward`: `"zero_sum"` or `"sparse"`.

@@ -339,14 +339,15 @@ class _Observer:
             return self.env.state()
         p, e = self.env.world.positions()
         if self.prev is None:
-            vel = (0.0, 0.0)
-        else:  # the realised velocity, as the env computes it
+            vp = ve = (0.0, 0.0)
+        else:  # the realised velocities, as the env computes them
             p0, e0 = self.prev
-            a0, a1 = (p0, p) if self.role == "pursuer" else (e0, e)
-            vel = ((a1[0] - a0[0]) * self.inv_dt, (a1[1] - a0[1]) * self.inv_dt)
+            vp = ((p[0] - p0[0]) * self.inv_dt, (p[1] - p0[1]) * self.inv_dt)
+            ve = ((e[0] - e0[0]) * self.inv_dt, (e[1] - e0[1]) * self.inv_dt)
         self.prev = (p, e)
-        me, other = (p, e) if self.role == "pursuer" else (e, p)
-        return self.encoder.encode(me, vel, other, visible, step)
+        if self.role == "pursuer":
+            return self.encoder.encode(p, vp, e, visible, step, ve)
+        return self.encoder.encode(e, ve, p, visible, step, vp)
 
 
 def _make(policy: Any, role: str):

@@ -10,9 +10,24 @@ which plain behaviour cloning never shows it.
 Rollouts go through the shared episode runner (:func:`strategies.runner.run_episode`); the
 learner is the policy network of an SB3 PPO model (``MlpPolicy``), fitted by mean squared
 error between its action mean and the expert's action, so the result loads and plays like
-any trained model (``ROLE/sb3:PATH``) and can be fine-tuned by PPO. Both read the
-``"state"`` observation (the analytic experts need it; a lidar learner needs the expert to
-label from the env's state, which this first version does not do).
+any trained model (``ROLE/sb3:PATH``) and can be fine-tuned by PPO
+(:mod:`training.finetune`).
+
+**Learners that see lidar.** The analytic experts read the ``"state"`` vector; a learner
+meant for maps it has never seen reads ``"lidar"`` (ray distances plus the relative
+vector, normalised by the ranges, so nothing in it names the map or its size). Each
+visited state is then labelled by the expert from the state and shown to the learner as
+the lidar vector the env would have given it at that instant
+(:meth:`envs.surveillance.observations.LidarEncoder.encode_state`).
+
+**Many maps, many opponents.** ``maps`` cycles through built-ins, map files and seeded
+random maps (``"random:SEED"``); ``opponent`` is one policy or a pool
+(:class:`training.pool.OpponentPool`, one drawn per episode).
+
+**Nothing is lost.** After every iteration the model, the dataset and the curves are
+written to ``output_dir``; a rerun with the same config continues from the last finished
+iteration and ends with the same model, bit for bit, as an uninterrupted run (every
+random draw of an iteration is seeded by ``(seed, iteration)``).
 
 The disagreement, the mean distance between the learner's and the expert's actions on the
 states the learner's own rollouts visit, is recorded per iteration: DAgger's progress
@@ -22,47 +37,70 @@ Example::
 
     from training.dagger import DaggerConfig, dagger
     result = dagger(DaggerConfig(role="pursuer", expert="pursuer/decomposition",
-                                 opponent="evader/shooting", maps=("corridor",),
+                                 opponent=("evader/shooting", "evader/straight"),
+                                 maps=("corridor", "random:1"),
+                                 observation={"observation": "lidar", "n_rays": 32},
                                  output_dir="out/dagger/pursuer"))
     print(result.disagreement)  # one value per iteration, falling
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
+import sys
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10 reads TOML with the tomli backport
+    import tomli as tomllib
+
 from envs import validation
 from envs.errors import InvalidConfigError
 from strategies.policies import make_policy
 from strategies.policies.base import check_role
-from strategies.runner import run_episode
+from strategies.runner import check_observation_options, run_episode
 
-__all__ = ["DaggerConfig", "DaggerResult", "dagger"]
+__all__ = ["DaggerConfig", "DaggerResult", "dagger", "load_dagger_config"]
+
+_FILES = ("model.zip", "dataset.npz", "progress.json")
 
 
 @dataclass(frozen=True)
 class DaggerConfig:
-    """One DAgger run: a role imitating an expert against a fixed opponent."""
+    """One DAgger run: a role imitating an expert against an opponent or a pool."""
 
     role: str
+    """The learner's role."""
     expert: str
-    opponent: str
+    """The analytic policy that labels states (``"pursuer/decomposition"``...)."""
+    opponent: str | tuple[str, ...]
+    """The other role's policy, or several: a pool, one drawn per episode."""
+    opponent_weights: tuple[float, ...] = ()
+    """Weights of the pool's members (empty: uniform)."""
     maps: tuple[str, ...] = ("open_room",)
+    """Worlds, used in turn: built-in names, map files, ``random:SEED`` names."""
     env: dict[str, Any] = field(default_factory=dict)
+    """Env overrides for every episode (a built-in's recommendations fill the rest)."""
+    observation: dict[str, Any] = field(default_factory=lambda: {"observation": "state"})
+    """What the learner sees: ``{"observation": "lidar", "n_rays": 32}`` or the state."""
     iterations: int = 5
     episodes: int = 4
+    """Episodes per iteration."""
     max_cycles: int = 300
     beta: float = 0.5
+    """The expert acts with probability ``beta ** iteration``."""
     start: str = "valid"
     net_arch: tuple[int, ...] = (64, 64)
     epochs: int = 30
+    """Passes over the whole dataset per fit."""
     batch_size: int = 256
     learning_rate: float = 1e-3
     seed: int = 0
@@ -70,23 +108,126 @@ class DaggerConfig:
 
     def __post_init__(self) -> None:
         where = "DaggerConfig"
+        put = lambda name, value: object.__setattr__(self, name, value)
         check_role(self.role)
-        for name in ("expert", "opponent", "output_dir", "start"):
+        for name in ("expert", "output_dir", "start"):
             validation.string(name, getattr(self, name), where=where)
         if not self.expert.startswith(self.role + "/"):
             raise InvalidConfigError(
                 f"{where}: expert = {self.expert!r} does not play the {self.role}"
             )
+        other = "evader" if self.role == "pursuer" else "pursuer"
+        pool = (self.opponent,) if isinstance(self.opponent, str) else tuple(self.opponent)
+        if not pool or not all(isinstance(o, str) and o.startswith(other + "/") for o in pool):
+            raise InvalidConfigError(
+                f"{where}: opponent = {self.opponent!r}: expected one or more "
+                f"'{other}/KIND' policy names"
+            )
+        put("opponent", pool[0] if len(pool) == 1 else pool)
+        put("opponent_weights", tuple(float(w) for w in self.opponent_weights))
+        if self.opponent_weights:
+            from training.pool import OpponentPool
+
+            OpponentPool(list(pool), list(self.opponent_weights))  # checks the weights
+        put("maps", (self.maps,) if isinstance(self.maps, str) else tuple(self.maps))
         if not self.maps or not all(isinstance(m, str) and m for m in self.maps):
             raise InvalidConfigError(f"{where}: maps = {self.maps!r}: expected map names or files")
         validation.mapping("env", self.env, where=where)
+        put("observation", check_observation_options(self.observation, f"{where}: observation"))
         for name, lo in (("iterations", 1), ("episodes", 1), ("max_cycles", 1), ("epochs", 1),
                          ("batch_size", 1), ("seed", 0)):  # fmt: skip
             validation.integer(name, getattr(self, name), minimum=lo, where=where)
         validation.unit_interval("beta", self.beta, where=where, open=False)
         validation.positive("learning_rate", self.learning_rate, where=where)
+        put("net_arch", tuple(self.net_arch))
         for i, n in enumerate(self.net_arch):
             validation.integer(f"net_arch[{i}]", n, minimum=1, where=where)
+
+    @property
+    def pool(self) -> tuple[str, ...]:
+        """The opponent(s) as a tuple."""
+        return (self.opponent,) if isinstance(self.opponent, str) else tuple(self.opponent)
+
+    def opponent_policy(self) -> Any:
+        """The opponent to play: a name, or an :class:`~training.pool.OpponentPool`."""
+        if isinstance(self.opponent, str) and not self.opponent_weights:
+            return self.opponent
+        from training.pool import OpponentPool
+
+        return OpponentPool(list(self.pool), list(self.opponent_weights) or None)
+
+    def to_dict(self) -> dict[str, Any]:
+        """A JSON/TOML-ready dict (``method = "dagger"``) that :meth:`from_dict` reads back."""
+        d: dict[str, Any] = {"method": "dagger"}
+        for f in dataclasses.fields(self):
+            v = getattr(self, f.name)
+            d[f.name] = list(v) if isinstance(v, tuple) else (dict(v) if isinstance(v, dict) else v)
+        return d
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> DaggerConfig:
+        """Build a config from a mapping (a parsed TOML file).
+
+        Raises:
+            InvalidConfigError: an unknown or missing key, or a bad value (named).
+        """
+        data = dict(data)
+        method = data.pop("method", "dagger")
+        if method != "dagger":
+            raise InvalidConfigError(f"config: method = {method!r}: expected 'dagger'")
+        names = [f.name for f in dataclasses.fields(cls)]
+        unknown = sorted(set(data) - set(names))
+        if unknown:
+            raise InvalidConfigError(f"config: unknown field(s) {unknown}; fields are {names}")
+        missing = [n for n in ("role", "expert", "opponent") if n not in data]
+        if missing:
+            raise InvalidConfigError(f"config: missing required field(s) {missing}")
+        for key in ("maps", "net_arch", "opponent_weights"):
+            if isinstance(data.get(key), list):
+                data[key] = tuple(data[key])
+        if isinstance(data.get("opponent"), list):
+            data["opponent"] = tuple(data["opponent"])
+        return cls(**data)
+
+    def to_toml(self) -> str:
+        """This config as TOML text (loadable by :func:`load_dagger_config`)."""
+        from training.config import _toml_value
+
+        d = self.to_dict()
+        tables = {k: d.pop(k) for k in ("env", "observation")}
+        if not d["opponent_weights"]:
+            del d["opponent_weights"]
+        lines = [f"{k} = {_toml_value(v)}" for k, v in d.items()]
+        for name, items in tables.items():
+            if items:
+                lines += ["", f"[{name}]"] + [f"{k} = {_toml_value(v)}" for k, v in items.items()]
+        return "\n".join(lines) + "\n"
+
+    def replace(self, **changes: Any) -> DaggerConfig:
+        """A copy with some fields changed (validated again)."""
+        return dataclasses.replace(self, **changes)
+
+
+def load_dagger_config(path: str | os.PathLike[str], **overrides: Any) -> DaggerConfig:
+    """Load a :class:`DaggerConfig` from a TOML file (``method = "dagger"``).
+
+    Raises:
+        InvalidConfigError: the file is missing or not valid TOML, or a field is bad
+            (the message names the file).
+    """
+    p = Path(path)
+    try:
+        with p.open("rb") as fh:
+            data = tomllib.load(fh)
+    except FileNotFoundError:
+        raise InvalidConfigError(f"config: no such file {str(p)!r}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise InvalidConfigError(f"config: {str(p)!r} is not valid TOML ({exc})") from exc
+    data.update(overrides)
+    try:
+        return DaggerConfig.from_dict(data)
+    except InvalidConfigError as exc:
+        raise InvalidConfigError(f"{p}: {exc}") from None
 
 
 @dataclass
@@ -99,9 +240,11 @@ class DaggerResult:
             states visited that iteration (measured before refitting).
         samples: dataset size after each iteration.
         held: per iteration, the share of episodes the learner's role won.
-        wall_seconds: total time.
+        wall_seconds: total time (of this call; a resumed run adds to the stored one in
+            ``provenance.json``).
         fit_error: per iteration, the mean |learner - expert| on the whole dataset after
             the fit (how well the network imitates what it was shown).
+        episodes: per iteration, one record per episode (map, opponent, winner, steps).
     """
 
     model_path: Path
@@ -110,6 +253,7 @@ class DaggerResult:
     held: list[float]
     wall_seconds: float
     fit_error: list[float] = field(default_factory=list)
+    episodes: list[list[dict[str, Any]]] = field(default_factory=list)
 
 
 class _Rollout:
@@ -117,15 +261,19 @@ class _Rollout:
 
     Both see every step (the expert keeps its internal state in sync); the action taken is
     the expert's with probability ``beta``; every observation is stored with the expert's
-    action (its label) and the learner's (for the disagreement).
+    action (its label) and the learner's (for the disagreement). With ``learner_obs``
+    options other than the state, the learner's observation is the lidar vector of the
+    same instant (built from the state the expert reads).
     """
 
     uses_state = True
 
-    def __init__(self, expert, model, beta: float, seed: int) -> None:
+    def __init__(self, expert, model, beta: float, seed: int, learner_obs=None) -> None:
         self.expert, self.model, self.beta = expert, model, beta
         self.rng = np.random.default_rng(seed)
         self.name = f"dagger({expert.name})"
+        self.learner_obs = dict(learner_obs or {"observation": "state"})
+        self.encoder = None
         self.obs: list[np.ndarray] = []
         self.labels: list[np.ndarray] = []
         self.learned: list[np.ndarray] = []
@@ -138,14 +286,24 @@ class _Rollout:
     def role(self):
         return self.expert.role
 
-    def reset(self, **kwargs):
-        return self.expert.reset(**kwargs)
+    def reset(self, *, role, map, config, seed):
+        self._role, self._state_config = role, config
+        if self.learner_obs.get("observation", "state") != "state":
+            from envs.geometry import kernel_for
+            from envs.surveillance.observations import LidarEncoder
+
+            lidar = dataclasses.replace(config, **self.learner_obs)
+            self.encoder = LidarEncoder(lidar, role, kernel_for(config.map))
+        return self.expert.reset(role=role, map=map, config=config, seed=seed)
 
     def act(self, observation):
         label = np.asarray(self.expert.act(observation), dtype=np.float32)
-        own, _ = self.model.predict(np.asarray(observation), deterministic=True)
+        seen = np.asarray(observation, dtype=np.float32)
+        if self.encoder is not None:
+            seen = self.encoder.encode_state(seen, self._state_config, self._role)
+        own, _ = self.model.predict(seen, deterministic=True)
         own = np.clip(np.asarray(own, dtype=np.float32), -1.0, 1.0)
-        self.obs.append(np.asarray(observation, dtype=np.float32))
+        self.obs.append(seen)
         self.labels.append(label)
         self.learned.append(own)
         return label if self.rng.random() < self.beta else own
@@ -176,79 +334,164 @@ def _fit(model, obs: np.ndarray, act: np.ndarray, cfg: DaggerConfig, rng) -> flo
     return loss_value
 
 
-def dagger(cfg: DaggerConfig) -> DaggerResult:
-    """Run DAgger; writes ``model.zip`` and ``provenance.json`` to ``cfg.output_dir``.
+def _learner_env(cfg: DaggerConfig):
+    from training.single_agent import SingleAgentEnv
+
+    return SingleAgentEnv(cfg.role, cfg.pool[0], map=cfg.maps[0], **{**cfg.env, **cfg.observation})
+
+
+def _resume(cfg: DaggerConfig, out: Path, env) -> tuple[Any, dict[str, Any], list, list] | None:
+    """The model, curves and dataset of the last finished iteration in ``out``, if any."""
+    from stable_baselines3 import PPO
+
+    prog_path = out / "progress.json"
+    if not prog_path.is_file():
+        return None
+    try:
+        progress = json.loads(prog_path.read_text())
+        stored = DaggerConfig.from_dict(progress["config"])
+    except (ValueError, KeyError, InvalidConfigError) as exc:
+        raise InvalidConfigError(
+            f"output_dir {str(out)!r}: unreadable {prog_path.name} ({exc}); delete it to start over"
+        ) from None
+    before = stored.replace(output_dir=cfg.output_dir).to_dict()
+    now = cfg.to_dict()
+    diff = sorted(k for k in now if k not in ("iterations", "output_dir") and before[k] != now[k])
+    if diff:
+        raise InvalidConfigError(
+            f"output_dir {str(out)!r} holds a DAgger run with a different config (fields "
+            f"{diff}: {[before[k] for k in diff]} there, {[now[k] for k in diff]} now); "
+            "use another output_dir or delete that one"
+        )
+    try:
+        model = PPO.load(str(out / "model.zip"), env=env, device="cpu")
+        with np.load(out / "dataset.npz") as data:
+            obs, act = list(data["obs"]), list(data["act"])
+    except Exception as exc:  # a damaged file: say which, do not guess
+        raise InvalidConfigError(
+            f"output_dir {str(out)!r}: cannot resume ({type(exc).__name__}: {exc}); "
+            "delete the directory to start over"
+        ) from None
+    if len(obs) != progress["samples"][-1]:
+        raise InvalidConfigError(
+            f"output_dir {str(out)!r}: dataset.npz holds {len(obs)} samples, "
+            f"progress.json {progress['samples'][-1]}; delete the directory to start over"
+        )
+    return model, progress, obs, act
+
+
+def _write_iteration(out: Path, model, obs, act, progress: dict[str, Any]) -> None:
+    """Model, dataset and curves of a finished iteration, each replaced atomically."""
+    tmp = out / "model.zip.tmp"
+    model.save(str(tmp))
+    os.replace(tmp, out / "model.zip")
+    tmp_npz = out / "dataset.tmp.npz"
+    np.savez_compressed(tmp_npz, obs=np.asarray(obs), act=np.asarray(act))
+    os.replace(tmp_npz, out / "dataset.npz")
+    tmp_json = out / "progress.json.tmp"
+    tmp_json.write_text(json.dumps(progress, indent=2) + "\n")
+    os.replace(tmp_json, out / "progress.json")
+
+
+def dagger(cfg: DaggerConfig, *, verbose: bool = False) -> DaggerResult:
+    """Run DAgger; writes ``model.zip``, ``provenance.json`` and the curves to ``output_dir``.
+
+    Resumes from the last finished iteration found in ``output_dir`` (see the module
+    docstring); raising ``iterations`` continues a finished run.
+
+    Args:
+        cfg: the run.
+        verbose: print one line per iteration (and the episodes as they end).
 
     Raises:
-        InvalidConfigError: bad names, maps or env parameters (before any rollout).
+        InvalidConfigError: bad names, maps or env parameters (before any rollout), or an
+            ``output_dir`` holding a different run.
     """
     import torch
     from stable_baselines3 import PPO
 
-    from training.single_agent import SingleAgentEnv
+    from training.train import _git_state, _versions
 
     t0 = time.perf_counter()
-    torch.manual_seed(cfg.seed)
     torch.set_num_threads(1)
-    other = "evader" if cfg.role == "pursuer" else "pursuer"
-    if not cfg.opponent.startswith(other + "/"):
-        raise InvalidConfigError(f"DaggerConfig: opponent = {cfg.opponent!r} must play the {other}")
-    env = SingleAgentEnv(cfg.role, cfg.opponent, map=cfg.maps[0], observation="state", **cfg.env)
-    model = PPO(
-        "MlpPolicy",
-        env,
-        policy_kwargs={"net_arch": list(cfg.net_arch)},
-        seed=cfg.seed,
-        device="cpu",
-        verbose=0,
-    )
-    rng = np.random.default_rng(cfg.seed)
-    data_obs: list[np.ndarray] = []
-    data_act: list[np.ndarray] = []
-    disagreement, samples, held, fit_loss = [], [], [], []
-    for it in range(cfg.iterations):
+    out = Path(cfg.output_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    env = _learner_env(cfg)
+    resumed = _resume(cfg, out, env)
+    if resumed is None:
+        torch.manual_seed(cfg.seed)
+        model = PPO("MlpPolicy", env, policy_kwargs={"net_arch": list(cfg.net_arch)},
+                    seed=cfg.seed, device="cpu", verbose=0)  # fmt: skip
+        progress: dict[str, Any] = {
+            "config": cfg.to_dict(),
+            "disagreement": [], "samples": [], "held": [], "fit_error": [], "episodes": [],
+            "wall_seconds": 0.0,
+        }  # fmt: skip
+        data_obs: list[np.ndarray] = []
+        data_act: list[np.ndarray] = []
+    else:
+        model, progress, data_obs, data_act = resumed
+        progress["config"] = cfg.to_dict()
+    opponent = cfg.opponent_policy()
+    for it in range(len(progress["samples"]), cfg.iterations):
+        t_it = time.perf_counter()
         beta = cfg.beta**it
-        wins, seen_l, seen_e = 0, [], []
+        wins, seen_l, seen_e, records = 0, [], [], []
         for ep in range(cfg.episodes):
             seed = cfg.seed * 100_003 + it * 1_009 + ep
             world = cfg.maps[(it * cfg.episodes + ep) % len(cfg.maps)]
-            roll = _Rollout(make_policy(cfg.expert), model, beta, seed)
-            pair = {cfg.role: roll, other: cfg.opponent}
+            roll = _Rollout(make_policy(cfg.expert), model, beta, seed, cfg.observation)
+            other = "evader" if cfg.role == "pursuer" else "pursuer"
+            pair = {cfg.role: roll, other: opponent}
             r = run_episode(world, pair["pursuer"], pair["evader"], seed, max_cycles=cfg.max_cycles,
                             overrides=cfg.env, start=cfg.start)  # fmt: skip
             wins += r.winner == cfg.role
+            records.append({"map": world, "opponent": r.evader if other == "evader" else r.pursuer,
+                            "winner": r.winner, "steps": r.steps})  # fmt: skip
             data_obs.extend(roll.obs)
             data_act.extend(roll.labels)
             seen_l.extend(roll.learned)
             seen_e.extend(roll.labels)
         d = np.linalg.norm(np.asarray(seen_l) - np.asarray(seen_e), axis=1)
-        disagreement.append(float(d.mean()) if len(d) else float("nan"))
-        held.append(wins / cfg.episodes)
         X, Y = np.asarray(data_obs), np.clip(np.asarray(data_act), -1, 1)
-        _fit(model, X, Y, cfg, rng)
+        _fit(model, X, Y, cfg, np.random.default_rng([cfg.seed, it]))
         pred, _ = model.predict(X, deterministic=True)
-        fit_loss.append(float(np.linalg.norm(np.clip(pred, -1, 1) - Y, axis=1).mean()))
-        samples.append(len(data_obs))
-    out = Path(cfg.output_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    model_path = out / "model.zip"
-    tmp = out / "model.zip.tmp"
-    model.save(str(tmp))
-    os.replace(tmp, model_path)
-    wall = time.perf_counter() - t0
+        progress["disagreement"].append(float(d.mean()) if len(d) else float("nan"))
+        progress["held"].append(wins / cfg.episodes)
+        progress["fit_error"].append(float(np.linalg.norm(np.clip(pred, -1, 1) - Y, axis=1).mean()))
+        progress["samples"].append(len(data_obs))
+        progress["episodes"].append(records)
+        progress["wall_seconds"] = round(progress["wall_seconds"] + time.perf_counter() - t_it, 3)
+        _write_iteration(out, model, data_obs, data_act, progress)
+        if verbose:
+            print(f"dagger {cfg.role} iteration {it}: beta {beta:.3f}, samples {len(data_obs)}, "
+                  f"disagreement {progress['disagreement'][-1]:.3f}, fit error "
+                  f"{progress['fit_error'][-1]:.3f}, won {wins}/{cfg.episodes}, "
+                  f"{time.perf_counter() - t_it:.0f} s", flush=True)  # fmt: skip
     provenance = {
         "role": cfg.role,
-        "opponent": cfg.opponent,
+        "opponent": cfg.opponent if isinstance(cfg.opponent, str) else list(cfg.opponent),
         "algo": "ppo",
         "method": "dagger",
         "expert": cfg.expert,
-        "config": {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(cfg).items()},
+        "config": cfg.to_dict(),
         "env_config": env.config.to_dict(),
-        "disagreement": disagreement,
-        "samples": samples,
-        "held": held,
-        "wall_seconds": round(wall, 3),
+        "maps": list(cfg.maps),
+        "net_arch": list(cfg.net_arch),
+        "parameters": int(sum(p.numel() for p in model.policy.parameters())),
+        "disagreement": progress["disagreement"],
+        "samples": progress["samples"],
+        "held": progress["held"],
+        "fit_error": progress["fit_error"],
+        "wall_seconds": progress["wall_seconds"],
+        **_git_state(),
+        "versions": _versions(),
     }
-    (out / "provenance.json").write_text(json.dumps(provenance, indent=2) + "\n")
+    (out / "config.toml").write_text(cfg.to_toml())
+    tmp = out / "provenance.json.tmp"
+    tmp.write_text(json.dumps(provenance, indent=2) + "\n")
+    os.replace(tmp, out / "provenance.json")
     env.close()
-    return DaggerResult(model_path, disagreement, samples, held, wall, fit_loss)
+    return DaggerResult(out / "model.zip", progress["disagreement"], progress["samples"],
+                        progress["held"], time.perf_counter() - t0, progress["fit_error"],
+                        progress["episodes"])  # fmt: skip

@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import dataclasses
 import json
-import os
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -30,7 +29,6 @@ import numpy as np
 
 from envs import surveillance_v0
 from envs.errors import InvalidConfigError
-from envs.maps import Map
 from envs.surveillance.env import EVADER, PURSUER
 from strategies.policies import Policy, make_policy
 from strategies.policies.base import check_role
@@ -107,8 +105,14 @@ class SingleAgentEnv(gym.Env):
     Args:
         role: ``"pursuer"`` or ``"evader"``, the role the learner plays.
         opponent: the other role's policy: a name for
-            :func:`strategies.policies.make_policy` or a Policy object.
-        map: the world (a :class:`Map`, a built-in name or a map file path).
+            :func:`strategies.policies.make_policy`, a Policy object, or a mixture
+            (anything with ``select(seed) -> Policy``, e.g.
+            :class:`training.pool.OpponentPool`) from which each episode draws one.
+        map: the world (a :class:`Map`, a built-in name, a map file path or a
+            ``random:SEED`` name), or a list of worlds: each episode is played on one
+            drawn uniformly from this env's generator. A built-in named by a string
+            brings its recommended ranges and speeds unless ``env_kwargs`` sets them,
+            and observations are normalised by each world's own ranges.
         start: ``"env"`` (the env's random start), ``"valid"`` or ``"safe"``
             (:func:`strategies.policies.starts.sample_start`).
         render_mode: ``None``, ``"human"`` or ``"rgb_array"``.
@@ -132,8 +136,8 @@ class SingleAgentEnv(gym.Env):
     def __init__(
         self,
         role: str,
-        opponent: str | Policy,
-        map: Map | str | os.PathLike[str] = "corridor",
+        opponent: Any,
+        map: Any = "corridor",
         *,
         start: str = "env",
         render_mode: str | None = None,
@@ -143,25 +147,50 @@ class SingleAgentEnv(gym.Env):
         if start not in START_CHOICES:
             raise InvalidConfigError(f"start: expected one of {START_CHOICES}, got {start!r}")
         self.start = start
-        self.opponent = make_opponent(opponent, role)
+        self.pool = opponent if hasattr(opponent, "select") else None
+        if self.pool is not None and getattr(self.pool, "role", _other(role)) != _other(role):
+            raise InvalidConfigError(
+                f"opponent: a {role} learner needs a pool of {_other(role)} policies, "
+                f"got {self.pool!r}"
+            )
+        self.opponent = (
+            self.pool.select(0) if self.pool is not None else make_opponent(opponent, role)
+        )
         self.opponent_role = _other(role)
         self.agent = AGENT_OF_ROLE[role]
         self.opponent_agent = AGENT_OF_ROLE[self.opponent_role]
-        try:
-            self.env = surveillance_v0.parallel_env(map=map, render_mode=render_mode, **env_kwargs)
-        except TypeError as exc:  # a misspelt env argument
-            raise InvalidConfigError(f"env: {exc}") from exc
-        self.config = self.env.config
+        maps = list(map) if isinstance(map, (list, tuple)) else [map]
+        if not maps:
+            raise InvalidConfigError("map: expected a map or a non-empty list of maps, got []")
+        self.envs = []
+        for world in maps:
+            try:
+                self.envs.append(
+                    surveillance_v0.parallel_env(map=world, render_mode=render_mode, **env_kwargs)
+                )
+            except TypeError as exc:  # a misspelt env argument
+                raise InvalidConfigError(f"env: {exc}") from exc
+        self._select(0)
         self.render_mode = self.env.render_mode
         self.metadata = {**type(self).metadata, "render_fps": 1.0 / self.config.dt}
-        self.observation_space = self.env.observation_space(self.agent)
+        self.observation_space = _union_space(
+            [e.observation_space(self.agent) for e in self.envs], maps
+        )
         self.action_space = self.env.action_space(self.agent)
+        self._opponent_obs: np.ndarray | None = None
+
+    def _select(self, i: int) -> None:
+        """Play the next episode on map ``i`` (of the list given)."""
+        self.env = self.envs[i]
+        self.config = self.env.config
+        self._bind_opponent()
+
+    def _bind_opponent(self) -> None:
         # analytic opponents read the "state" vector even when the learner sees lidar
         self._opponent_reads_state = bool(getattr(self.opponent, "uses_state", True))
         self._opponent_config = self.config
         if self._opponent_reads_state and self.config.observation != "state":
             self._opponent_config = dataclasses.replace(self.config, observation="state")
-        self._opponent_obs: np.ndarray | None = None
 
     # ------------------------------------------------------------------ episode
     def reset(
@@ -182,6 +211,12 @@ class SingleAgentEnv(gym.Env):
         env_seed, start_seed, opp_seed = (
             int(s) for s in self.np_random.integers(_SEED_BOUND, size=3)
         )
+        if len(self.envs) > 1:  # a draw only when there is a choice: one-map streams unchanged
+            self.env = None
+            self._select(int(self.np_random.integers(len(self.envs))))
+        if self.pool is not None:
+            self.opponent = self.pool.select(int(self.np_random.integers(_SEED_BOUND)))
+            self._bind_opponent()
         if options and ("pursuer" in options or "evader" in options):
             placement = dict(options)
         elif self.start == "env":
@@ -240,5 +275,22 @@ class SingleAgentEnv(gym.Env):
         return self.env.render()
 
     def close(self) -> None:
-        """Close the env's renderer (idempotent)."""
-        self.env.close()
+        """Close the envs' renderers (idempotent)."""
+        for env in self.envs:
+            env.close()
+
+
+def _union_space(spaces: list[gym.spaces.Box], maps: list[Any]) -> gym.spaces.Box:
+    """One Box holding the observations of every map (bounds may differ: ``"state"``)."""
+    first = spaces[0]
+    for world, space in zip(maps[1:], spaces[1:], strict=True):
+        if space.shape != first.shape:
+            raise InvalidConfigError(
+                f"map: {world!r} gives observations of shape {space.shape}, the first map "
+                f"{first.shape}; maps trained together need one observation shape"
+            )
+    if len(spaces) == 1:
+        return first
+    low = np.minimum.reduce([s.low for s in spaces])
+    high = np.maximum.reduce([s.high for s in spaces])
+    return gym.spaces.Box(low=low, high=high, dtype=first.dtype)

@@ -58,6 +58,7 @@ from envs.maps.map import Map
 
 __all__ = [
     "FORMATS",
+    "RANDOM_PREFIX",
     "MapDocument",
     "load_map",
     "map_from_dict",
@@ -494,23 +495,50 @@ def read_map(path: str | os.PathLike[str], *, merge: bool | None = None) -> MapD
     return map_from_dict(obj, source=source, merge=merge)
 
 
+RANDOM_PREFIX = "random:"
+"""Map names ``random:SEED`` and ``random:KIND:SEED`` are seeded random maps."""
+
+
+def _random_by_name(name: str) -> Map:
+    from envs.maps.random_maps import KINDS, random_map
+
+    parts = name[len(RANDOM_PREFIX) :].split(":")
+    kind, seed_text = ("polygons", parts[0]) if len(parts) == 1 else (parts[0], parts[-1])
+    if len(parts) > 2 or kind not in KINDS or not seed_text.isdigit():
+        raise InvalidConfigError(
+            f"map: {name!r} is not a random map name; expected 'random:SEED' or "
+            f"'random:KIND:SEED' with SEED an integer >= 0 and KIND one of {list(KINDS)}"
+        )
+    return random_map(int(seed_text), kind=kind)
+
+
 def load_map(path_or_name: str | os.PathLike[str], *, merge: bool | None = None) -> Map:
-    """Load a map from a file (by suffix) or a built-in map by name.
+    """Load a map from a file (by suffix), a built-in map by name, or a seeded random map.
 
     Args:
-        path_or_name: a ``.json``, ``.geojson`` or ``.wkt`` file, or a name from
-            :func:`envs.maps.builtin.builtin_names`.
+        path_or_name: a ``.json``, ``.geojson`` or ``.wkt`` file, a name from
+            :func:`envs.maps.builtin.builtin_names`, or ``"random:SEED"`` /
+            ``"random:KIND:SEED"`` for :func:`envs.maps.random_maps.random_map` with its
+            defaults (``KIND`` one of its ``KINDS``, default ``"polygons"``): a whole
+            family of worlds by name, for training on many maps and testing on held-out
+            seeds.
         merge: for files, override the file's merge flag (see :func:`read_map`).
 
     Raises:
         UnknownNameError: for a name that is neither a built-in nor a map file.
         InvalidMapError: naming the file and the problem (a missing file included).
+        InvalidConfigError: a malformed ``random:`` name.
 
     Examples:
         >>> load_map("corridor").n_vertices
         8
+        >>> load_map("random:3").name
+        'random_polygons_3'
     """
     from envs.maps.builtin import builtin_map, builtin_names
+
+    if isinstance(path_or_name, str) and path_or_name.startswith(RANDOM_PREFIX):
+        return _random_by_name(path_or_name)
 
     if not isinstance(path_or_name, (str, os.PathLike)):
         raise UnknownNameError(

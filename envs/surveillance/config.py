@@ -36,8 +36,9 @@ __all__ = [
     "resolve_map",
 ]
 
-OBSERVATION_KINDS = ("state", "lidar")
-"""``"state"``: the full normalised state; ``"lidar"``: egocentric ray distances."""
+OBSERVATION_KINDS = ("state", "lidar", "lidar_track")
+"""``"state"``: the full normalised state; ``"lidar"``: egocentric ray distances;
+``"lidar_track"``: the lidar plus the tracked other agent's velocity."""
 
 REWARD_KINDS = ("zero_sum", "sparse")
 """See :mod:`envs.surveillance.rules` for both reward schemes."""
@@ -108,8 +109,8 @@ class EnvConfig:
             but warned about: the evader then wins by charging (Sec. 5).
         dt: duration of one env step (> 0).
         max_cycles: steps before the episode is truncated (>= 1).
-        observation: ``"state"`` or ``"lidar"`` (see :mod:`.observations`).
-        n_rays: lidar rays per agent (in [1, MAX_RAYS]; used by ``"lidar"`` only).
+        observation: ``"state"``, ``"lidar"`` or ``"lidar_track"`` (see :mod:`.observations`).
+        n_rays: lidar rays per agent (in [1, MAX_RAYS]; used by the lidar kinds only).
         lidar_range: range at which lidar rays saturate (> 0); ``None`` means ``l_max``.
         reward: ``"zero_sum"`` or ``"sparse"`` (see :mod:`.rules`).
         body_radius: radius of both agents' discs, in (0, l_min / 2).

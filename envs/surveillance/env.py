@@ -335,10 +335,10 @@ class parallel_env(ParallelEnv, EzPickle):
             return {PURSUER: obs, EVADER: obs.copy()}
         return {
             PURSUER: self._lidar[PURSUER].encode(
-                self._pursuer, self._vp, self._evader, self._visible, self._step
+                self._pursuer, self._vp, self._evader, self._visible, self._step, self._ve
             ),
             EVADER: self._lidar[EVADER].encode(
-                self._evader, self._ve, self._pursuer, self._visible, self._step
+                self._evader, self._ve, self._pursuer, self._visible, self._step, self._vp
             ),
         }
 

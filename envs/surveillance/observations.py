@@ -30,6 +30,13 @@ realised velocity divided by its speed bound; the visibility bit (surveillance h
 the time fraction. The relative vector is zero padded *and* masked by the explicit bit,
 since a zero vector alone would be ambiguous.
 
+``"lidar_track"`` -- the lidar plus what a tracker locked on the other agent reports:
+its realised velocity divided by *its* speed bound (``other_vel``, after ``other_rel``;
+zeros when not visible), :func:`lidar_layout` with ``track=True``. Still egocentric and
+free of map coordinates, and it carries what the analytic policies act on (the
+decomposition pursuer matches the evader's velocity, eq. 5), so a learner imitating them
+can see it.
+
 ``state()`` (for centralised critics) is the ``"state"`` vector whatever the agents see.
 """
 
@@ -70,14 +77,25 @@ STATE_LAYOUT: dict[str, slice] = {
 STATE_SIZE = 13
 
 
-def lidar_layout(n_rays: int) -> dict[str, slice]:
-    """Where each field lives in a ``"lidar"`` observation with ``n_rays`` rays.
+def lidar_layout(n_rays: int, track: bool = False) -> dict[str, slice]:
+    """Where each field lives in a ``"lidar"`` (``"lidar_track"``: ``track``) observation.
 
     Examples:
         >>> lidar_layout(4)["other_rel"]
         slice(4, 6, None)
+        >>> lidar_layout(4, track=True)["other_vel"], lidar_layout(4, track=True)["time"]
+        (slice(6, 8, None), slice(11, 12, None))
     """
     n = int(n_rays)
+    if track:
+        return {
+            "rays": slice(0, n),
+            "other_rel": slice(n, n + 2),
+            "other_vel": slice(n + 2, n + 4),
+            "self_vel": slice(n + 4, n + 6),
+            "visible": slice(n + 6, n + 7),
+            "time": slice(n + 7, n + 8),
+        }
     return {
         "rays": slice(0, n),
         "other_rel": slice(n, n + 2),
@@ -105,8 +123,8 @@ def state_space(config: EnvConfig) -> Box:
 
 
 def lidar_space(config: EnvConfig) -> Box:
-    """The Box of ``"lidar"`` observations (a new object each call: store it)."""
-    layout = lidar_layout(config.n_rays)
+    """The Box of ``"lidar"`` / ``"lidar_track"`` observations (a new object each call)."""
+    layout = lidar_layout(config.n_rays, track=config.observation == "lidar_track")
     size = layout["time"].stop
     low = np.full(size, -1.0, dtype=np.float32)
     high = np.full(size, 1.0, dtype=np.float32)
@@ -234,7 +252,7 @@ def decode_state(obs: np.ndarray, config: EnvConfig) -> StateView:
 
 
 class LidarEncoder:
-    """Builds ``"lidar"`` vectors for one agent.
+    """Builds ``"lidar"`` (or ``"lidar_track"``, by ``config.observation``) vectors.
 
     Args:
         config: the env configuration.
@@ -250,6 +268,9 @@ class LidarEncoder:
         self.max_range = config.lidar_max_range
         self.inv_range = 1.0 / self.max_range
         self.inv_speed = 1.0 / config.speed(role)
+        self.track = config.observation == "lidar_track"
+        self.inv_other_speed = 1.0 / config.speed("evader" if role == "pursuer" else "pursuer")
+        self.size = self.n + (8 if self.track else 6)
         self.inv_lmax = 1.0 / config.l_max
         self.inv_cycles = 1.0 / config.max_cycles
 
@@ -260,19 +281,62 @@ class LidarEncoder:
         other: tuple[float, float],
         visible: bool,
         step: int,
+        other_vel: tuple[float, float] = (0.0, 0.0),
     ) -> np.ndarray:
-        """The ``"lidar"`` vector of the agent at ``me`` looking for ``other``."""
-        out = np.empty(self.n + 6, dtype=np.float32)
+        """The vector of the agent at ``me`` looking for ``other`` (moving at ``other_vel``,
+        read by ``"lidar_track"`` only)."""
+        n = self.n
+        out = np.empty(self.size, dtype=np.float32)
         rays = self.kernel.ray_distances(np.array(me), self.angles, self.max_range)
-        np.minimum(np.asarray(rays) * self.inv_range, 1.0, out=out[: self.n], casting="unsafe")
+        np.minimum(np.asarray(rays) * self.inv_range, 1.0, out=out[:n], casting="unsafe")
         if visible:
-            out[self.n] = _clip1((other[0] - me[0]) * self.inv_lmax)
-            out[self.n + 1] = _clip1((other[1] - me[1]) * self.inv_lmax)
+            out[n] = _clip1((other[0] - me[0]) * self.inv_lmax)
+            out[n + 1] = _clip1((other[1] - me[1]) * self.inv_lmax)
         else:
-            out[self.n] = 0.0
-            out[self.n + 1] = 0.0
-        out[self.n + 2] = _clip1(my_vel[0] * self.inv_speed)
-        out[self.n + 3] = _clip1(my_vel[1] * self.inv_speed)
-        out[self.n + 4] = 1.0 if visible else 0.0
-        out[self.n + 5] = step * self.inv_cycles
+            out[n] = 0.0
+            out[n + 1] = 0.0
+        if self.track:
+            if visible:
+                out[n + 2] = _clip1(other_vel[0] * self.inv_other_speed)
+                out[n + 3] = _clip1(other_vel[1] * self.inv_other_speed)
+            else:
+                out[n + 2] = 0.0
+                out[n + 3] = 0.0
+            n += 2
+        out[n + 2] = _clip1(my_vel[0] * self.inv_speed)
+        out[n + 3] = _clip1(my_vel[1] * self.inv_speed)
+        out[n + 4] = 1.0 if visible else 0.0
+        out[n + 5] = step * self.inv_cycles
         return out
+
+    def encode_state(self, state: np.ndarray, state_config: EnvConfig, role: str) -> np.ndarray:
+        """The lidar vector ``role`` would see in the state ``state``.
+
+        For learners that see lidar while a teacher reads the ``"state"`` vector of the
+        same instant (DAgger labels with an analytic expert): the rays are cast from the
+        decoded position, the relative vector and the visibility bit come from the state,
+        and ``self_vel`` is the state's velocity of ``role`` (both are the realised
+        velocity over the speed bound, clipped). Equal to the env's own ``"lidar"``
+        observation up to the float32 rounding of the positions in ``state``.
+
+        Args:
+            state: a ``"state"`` vector (:data:`STATE_LAYOUT`).
+            state_config: the config of the env that produced it (its map bounds
+                de-normalise the positions).
+            role: ``"pursuer"`` or ``"evader"``: whose lidar.
+        """
+        view = decode_state(state, state_config)
+        if role == "pursuer":
+            me, other = view.pursuer_pos, view.evader_pos
+            vel, ovel = view.pursuer_vel, view.evader_vel
+        else:
+            me, other = view.evader_pos, view.pursuer_pos
+            vel, ovel = view.evader_vel, view.pursuer_vel
+        return self.encode(
+            (float(me[0]), float(me[1])),
+            (float(vel[0]), float(vel[1])),
+            (float(other[0]), float(other[1])),
+            view.visible,
+            view.step,
+            (float(ovel[0]), float(ovel[1])),
+        )

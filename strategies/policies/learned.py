@@ -100,7 +100,7 @@ class SB3Policy(BasePolicy):
         if "observation" not in env:
             return None
         opts = {"observation": env["observation"]}
-        if env["observation"] == "lidar":
+        if env["observation"] != "state":
             opts["n_rays"] = env.get("n_rays", 32)
             if env.get("lidar_range") is not None:
                 opts["lidar_range"] = env["lidar_range"]

@@ -137,3 +137,35 @@ def test_step_before_reset_raises():
     env = SingleAgentEnv("pursuer", "evader/straight", map="open_room")
     with pytest.raises(InvalidConfigError, match="reset"):
         env.step(np.zeros(2))
+
+
+def test_a_list_of_maps_plays_each_episode_on_one_of_them() -> None:
+    """Each reset draws a world; a built-in keeps its recommended ranges; the lidar
+    observation has one shape everywhere; the same seed replays the same sequence."""
+    from envs.maps import builtin_info
+
+    maps = ["corridor", "l_hall", "random:2"]
+    env = SingleAgentEnv("pursuer", "evader/straight", map=maps, observation="lidar_track",
+                         n_rays=16, max_cycles=5)  # fmt: skip
+    names = []
+    env.reset(seed=1)
+    for _ in range(20):
+        names.append(env.config.map.name)
+        obs, _ = env.reset()
+        assert env.observation_space.contains(obs)
+    assert set(names) == {"corridor", "l_hall", "random_polygons_2"}
+    env.reset(seed=1)
+    again = [env.config.map.name]
+    for _ in range(19):
+        env.reset()
+        again.append(env.config.map.name)
+    assert again == names
+    while env.config.map.name != "corridor":
+        env.reset()
+    assert env.config.l_min == builtin_info("corridor").l_min
+    env.close()
+
+
+def test_an_empty_list_of_maps_is_refused() -> None:
+    with pytest.raises(InvalidConfigError, match="map"):
+        SingleAgentEnv("pursuer", "evader/straight", map=[])

@@ -216,3 +216,29 @@ def test_generated_maps_are_valid_against_shapely():
     pts = np.random.default_rng(0).uniform(-1, m.bounds[2] + 1, size=(2000, 2))
     expect = shapely.covers(m.free_region, shapely.points(pts))
     np.testing.assert_array_equal(m.contains(pts), expect)
+
+
+# ------------------------------------------------------------------ random:SEED names
+def test_random_names_load_the_seeded_random_map() -> None:
+    from envs.maps import load_map
+
+    assert load_map("random:7") == random_map(7)
+    assert load_map("random:rectangles:2") == random_map(2, kind="rectangles")
+    assert load_map("random:7").digest != load_map("random:8").digest
+
+
+def test_random_names_work_wherever_a_map_name_does() -> None:
+    from envs import surveillance_v0
+
+    env = surveillance_v0.parallel_env(map="random:star:4")
+    assert env.config.map == random_map(4, kind="star")
+    env.close()
+
+
+@pytest.mark.parametrize("bad", ["random:", "random:x", "random:-1", "random:blobs:3", "random:1:2:3"])
+def test_malformed_random_names_say_what_is_expected(bad: str) -> None:
+    from envs.errors import InvalidConfigError
+    from envs.maps import load_map
+
+    with pytest.raises(InvalidConfigError, match="random:SEED"):
+        load_map(bad)

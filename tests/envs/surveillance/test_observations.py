@@ -143,3 +143,69 @@ def test_lidar_masks_the_other_agent_when_surveillance_breaks() -> None:
         assert obs[agent][layout["visible"]][0] == 0.0
         assert np.all(obs[agent][layout["other_rel"]] == 0.0)
         assert env.observation_space(agent).contains(obs[agent])
+
+
+# ------------------------------------------------------------------ "lidar_track"
+def test_lidar_track_layout_tiles_and_keeps_the_lidar_fields_in_order() -> None:
+    for n in (1, 8, 32):
+        layout = lidar_layout(n, track=True)
+        assert _tiles(layout, n + 8)
+        plain = lidar_layout(n)
+        assert [k for k in layout if k != "other_vel"] == list(plain)
+
+
+def test_lidar_track_reports_the_other_agents_realised_velocity() -> None:
+    """After one step in open space each agent moved at its command: the tracker reports
+    the other's velocity over the other's speed bound; the rest equals the plain lidar."""
+    kw = dict(map=pillar_room(), n_rays=12, l_min=1.0, l_max=4.0, v_pursuer=2.0, v_evader=0.5)
+    place = {"pursuer": (2.0, 1.0), "evader": (2.0, 3.0)}
+    act = {P: np.array([0.6, 0.0]), E: np.array([-0.5, 0.4])}
+    out = {}
+    for kind in ("lidar", "lidar_track"):
+        env = surveillance_v0.parallel_env(observation=kind, **kw)
+        env.reset(options=place)
+        out[kind], *_ = env.step(act)
+        assert all(env.observation_space(a).contains(out[kind][a]) for a in (P, E))
+    t, plain = lidar_layout(12, track=True), lidar_layout(12)
+    for agent, other in ((P, E), (E, P)):
+        o = out["lidar_track"][agent]
+        assert o[t["visible"]][0] == 1.0
+        # realised velocity / own bound = the command (in open space, no wall contact)
+        assert o[t["other_vel"]] == pytest.approx(act[other], abs=1e-4)
+        for name, s in plain.items():
+            assert np.array_equal(o[t[name]], out["lidar"][agent][s]), name
+
+
+def test_lidar_track_masks_the_velocity_when_surveillance_breaks() -> None:
+    env = surveillance_v0.parallel_env(map=l_room(), observation="lidar_track", n_rays=8,
+                                       l_min=1.0, l_max=5.0, v_evader=2.0, v_pursuer=2.0)  # fmt: skip
+    env.reset(options={"pursuer": (6.2, 2.0), "evader": (4.5, 6.0)})
+    obs, _, term, _, _ = env.step({P: np.zeros(2), E: np.array([1.0, 1.0])})
+    assert term[P]
+    t = lidar_layout(8, track=True)
+    for agent in (P, E):
+        assert np.all(obs[agent][t["other_vel"]] == 0.0) and obs[agent][t["visible"]][0] == 0.0
+
+
+@pytest.mark.parametrize("kind", ["lidar", "lidar_track"])
+def test_encode_state_rebuilds_the_envs_lidar_from_the_state_vector(kind: str) -> None:
+    """What a lidar learner is shown while an expert reads the state (DAgger labels)."""
+    import dataclasses
+
+    from envs.surveillance.observations import LidarEncoder
+
+    env = surveillance_v0.parallel_env(map="l_hall", observation=kind, n_rays=16, max_cycles=80)
+    obs, _ = env.reset(seed=5)
+    state_cfg = dataclasses.replace(env.config, observation="state")
+    enc = {r: LidarEncoder(env.config, r, env.kernel) for r in ("pursuer", "evader")}
+    rng = np.random.default_rng(0)
+    steps = 0
+    while env.agents:
+        s = env.state()
+        for role, agent in (("pursuer", P), ("evader", E)):
+            got = enc[role].encode_state(s, state_cfg, role)
+            assert got.shape == obs[agent].shape
+            assert np.max(np.abs(got - obs[agent])) < 1e-5  # float32 rounding of positions
+        obs, *_ = env.step({a: rng.uniform(-1, 1, 2) for a in env.agents})
+        steps += 1
+    assert steps > 5

@@ -9,7 +9,7 @@
 | Agents               | `agents = ["pursuer_0", "evader_0"]`                        |
 | Action shape         | (2,)                                                        |
 | Action values        | Box(-1, 1, (2,), float32): velocity / speed bound           |
-| Observation shape    | `"state"`: (13,); `"lidar"`: (n_rays + 6,); `"lidar_track"`: (n_rays + 8,) |
+| Observation shape    | `"state"`: (13,); `"lidar"`: (n_rays + 6,); `"lidar_track"`: +2 |
 | Observation values   | float32 Box, finite bounds (see `observations.py`)          |
 | State shape          | (13,), the `"state"` observation                            |
 
@@ -102,8 +102,8 @@ new version.
 
 `dt`: step duration. `max_cycles`: steps before truncation.
 
-`observation`: `"state"`, `"lidar"` or `"lidar_track"`. `n_rays` (at most 4096), `lidar_range` (default
-`l_max`): lidar.
+`observation`: `"state"`, `"lidar"` or `"lidar_track"`. `n_rays` (at most 4096),
+`lidar_range` (default `l_max`): lidar.
 
 `reward`: `"zero_sum"` or `"sparse"`.
 

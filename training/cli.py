@@ -11,8 +11,8 @@ import math
 import sys
 from collections.abc import Callable, Sequence
 
-from envs.errors import SurveilValueError
-from training.config import load_config
+from envs.errors import InvalidConfigError, SurveilValueError
+from training.config import TrainConfig, load_any_config
 from training.selfplay import self_play
 from training.train import TrainResult, train
 
@@ -45,11 +45,23 @@ def run_train(args: argparse.Namespace) -> int:
     overrides = {}
     if args.output_dir is not None:
         overrides["output_dir"] = args.output_dir
-    if args.timesteps is not None:
-        overrides["total_timesteps"] = args.timesteps
     if args.seed is not None:
         overrides["seed"] = args.seed
-    config = load_config(args.config, **overrides)
+    config = load_any_config(args.config, **overrides)
+    if not isinstance(config, TrainConfig):  # a DAgger recipe
+        if args.timesteps is not None or args.self_play:
+            raise InvalidConfigError(
+                f"{args.config}: --timesteps and --self-play apply to RL configs; this is a "
+                "DAgger config (set iterations and episodes in the file)"
+            )
+        from training.dagger import dagger
+
+        r = dagger(config, verbose=True)
+        print(f"dagger {config.role}: {r.samples[-1]} labelled states, disagreement "
+              f"{r.disagreement[0]:.3f} -> {r.disagreement[-1]:.3f} -> {r.model_path}")  # fmt: skip
+        return 0
+    if args.timesteps is not None:
+        config = config.replace(total_timesteps=args.timesteps)
     if args.self_play:
         results = self_play(config, args.self_play, progress_bar=args.progress).stages
     else:

@@ -44,7 +44,7 @@ from envs.surveillance.config import EnvConfig, env_parameters
 from strategies.policies.base import check_role
 from training.single_agent import START_CHOICES
 
-__all__ = ["ALGORITHMS", "TrainConfig", "load_config"]
+__all__ = ["ALGORITHMS", "TrainConfig", "load_any_config", "load_config"]
 
 ALGORITHMS = ("ppo", "sac")
 """The SB3 algorithms :func:`training.train` runs (continuous actions)."""
@@ -267,12 +267,36 @@ def load_config(path: str | os.PathLike[str], **overrides: Any) -> TrainConfig:
     except tomllib.TOMLDecodeError as exc:
         raise InvalidConfigError(f"config: {str(p)!r} is not valid TOML ({exc})") from exc
     data.update(overrides)
+    if data.get("method") == "rl":  # written by load_any_config users for clarity
+        del data["method"]
     try:
         return TrainConfig.from_dict(data)
     except InvalidConfigError as exc:  # name the file the value came from
         msg = str(exc)
         msg = msg[len("config.toml: ") :] if msg.startswith("config.toml: ") else msg
         raise InvalidConfigError(f"{p}: {msg}") from None
+
+
+def load_any_config(path: str | os.PathLike[str], **overrides: Any):
+    """A :class:`TrainConfig` or, for a file with ``method = "dagger"``, a
+    :class:`~training.dagger.DaggerConfig`.
+
+    Raises:
+        InvalidConfigError: as :func:`load_config` (the file is named).
+    """
+    p = Path(path)
+    try:
+        with p.open("rb") as fh:
+            method = tomllib.load(fh).get("method", "rl")
+    except (OSError, tomllib.TOMLDecodeError):
+        method = "rl"  # load_config reports the problem
+    if method == "dagger":
+        from training.dagger import load_dagger_config
+
+        return load_dagger_config(p, **overrides)
+    if method != "rl":
+        raise InvalidConfigError(f"{p}: method = {method!r}: expected 'rl' (default) or 'dagger'")
+    return load_config(p, **overrides)
 
 
 def _toml_value(v: Any) -> str:

@@ -83,6 +83,8 @@ class DaggerConfig:
     """The analytic policy that labels states (``"pursuer/decomposition"``...)."""
     opponent: str | tuple[str, ...]
     """The other role's policy, or several: a pool, one drawn per episode."""
+    expert_params: dict[str, Any] = field(default_factory=dict)
+    """Parameters of the expert (``{"range_margin": 0.15}``...)."""
     opponent_weights: tuple[float, ...] = ()
     """Weights of the pool's members (empty: uniform)."""
     maps: tuple[str, ...] = ("open_room",)
@@ -133,6 +135,8 @@ class DaggerConfig:
         if not self.maps or not all(isinstance(m, str) and m for m in self.maps):
             raise InvalidConfigError(f"{where}: maps = {self.maps!r}: expected map names or files")
         validation.mapping("env", self.env, where=where)
+        validation.mapping("expert_params", self.expert_params, where=where)
+        make_policy(self.expert, **self.expert_params)  # unknown names and parameters fail here
         put("observation", check_observation_options(self.observation, f"{where}: observation"))
         for name, lo in (("iterations", 1), ("episodes", 1), ("max_cycles", 1), ("epochs", 1),
                          ("batch_size", 1), ("seed", 0)):  # fmt: skip
@@ -194,7 +198,7 @@ class DaggerConfig:
         from training.config import _toml_value
 
         d = self.to_dict()
-        tables = {k: d.pop(k) for k in ("env", "observation")}
+        tables = {k: d.pop(k) for k in ("env", "observation", "expert_params")}
         if not d["opponent_weights"]:
             del d["opponent_weights"]
         lines = [f"{k} = {_toml_value(v)}" for k, v in d.items()]
@@ -440,7 +444,8 @@ def dagger(cfg: DaggerConfig, *, verbose: bool = False) -> DaggerResult:
         for ep in range(cfg.episodes):
             seed = cfg.seed * 100_003 + it * 1_009 + ep
             world = cfg.maps[(it * cfg.episodes + ep) % len(cfg.maps)]
-            roll = _Rollout(make_policy(cfg.expert), model, beta, seed, cfg.observation)
+            expert = make_policy(cfg.expert, **cfg.expert_params)
+            roll = _Rollout(expert, model, beta, seed, cfg.observation)
             other = "evader" if cfg.role == "pursuer" else "pursuer"
             pair = {cfg.role: roll, other: opponent}
             r = run_episode(world, pair["pursuer"], pair["evader"], seed, max_cycles=cfg.max_cycles,

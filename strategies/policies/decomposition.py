@@ -55,6 +55,11 @@ class DecompositionPursuer(BasePolicy):
         probe_every: use every k-th grid sample along a ray as a probe.
         hysteresis: weight of the rotation needed to reach a target, in units of V.
         distance_gain: rate (1/s) of the correction of L toward L_min.
+        range_margin: extra distance held above the minimal one, as a fraction of
+            ``L_max - L_min`` (default 0: ride at L_min plus a one-step buffer, as the
+            paper). A margin trades some of the rod's freedom (a longer rod has fewer
+            free orientations, Prop. 3) for slack against imprecise execution, e.g. for
+            a learner imitating this policy.
         turn_rate: the rotation rate the evader is assumed to impose (eq. 6, Sec. 6.1):
             ``"both"``, ``(V_p / L) sqrt(1 - rho^2)``, the least rate when the rod may
             turn either way; ``"one"``, ``(V_p / L)(1 - rho)``, the least rate in one
@@ -78,6 +83,7 @@ class DecompositionPursuer(BasePolicy):
         probe_every: int = 3,
         hysteresis: float = 0.25,
         distance_gain: float = 3.0,
+        range_margin: float = 0.0,
         turn_rate: str = "both",
         table: str = "auto",
         name: str | None = None,
@@ -89,12 +95,13 @@ class DecompositionPursuer(BasePolicy):
         self.probe_every = count_param("probe_every", probe_every, 1, MAX_RAYS)
         self.hysteresis = nonnegative_param("hysteresis", hysteresis)
         self.distance_gain = positive_param("distance_gain", distance_gain)
+        self.range_margin = validation.unit_interval("range_margin", range_margin, open=False)
         self.turn_rate = validation.choice("turn_rate", turn_rate, ("both", "one"))
         self.table_kind = validation.choice("table", table, ("auto", "eager", "lazy"))
 
     def _reset(self) -> None:
         c = self.config
-        self.L_target = distance_target(c)
+        self.L_target = distance_target(c) + self.range_margin * (c.l_max - c.l_min)
         # the pursuer's disc keeps its centre body_radius off the walls, so the rod tip
         # meets a wall as if the rod were that much longer (Prop. 3: fewer free arcs)
         self.table_length = round(self.L_target + c.body_radius, 6)

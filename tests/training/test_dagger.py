@@ -75,3 +75,60 @@ def test_rollout_labels_every_visited_observation_with_the_expert():
 def test_bad_dagger_configs_name_the_field(tmp_path, bad):
     with pytest.raises(InvalidConfigError):
         _cfg(tmp_path, **bad)
+
+
+# ------------------------------------------------------------------ lidar learners, pools, resume
+def _lidar_cfg(tmp_path, name="run", **kw):
+    base = dict(role="pursuer", expert="pursuer/greedy",
+                opponent=("evader/straight", "evader/random"), maps=("open_room", "random:3"),
+                observation={"observation": "lidar_track", "n_rays": 8}, iterations=2,
+                episodes=2, max_cycles=40, epochs=20, output_dir=str(tmp_path / name))  # fmt: skip
+    return DaggerConfig(**{**base, **kw})
+
+
+def test_a_lidar_learner_is_shown_the_envs_lidar_and_plays_from_it(tmp_path):
+    r = dagger(_lidar_cfg(tmp_path))
+    with np.load(r.model_path.parent / "dataset.npz") as data:
+        assert data["obs"].shape == (r.samples[-1], 8 + 8)  # lidar_track with 8 rays
+        assert data["act"].shape == (r.samples[-1], 2)
+    # both maps and both opponents were played
+    played = [e for it in r.episodes for e in it]
+    assert {e["map"] for e in played} == {"open_room", "random:3"}
+    p = make_policy(f"pursuer/sb3:{r.model_path}")
+    assert p.observation_options == {"observation": "lidar_track", "n_rays": 8}
+    from strategies.runner import run_episode
+
+    res = run_episode("random:5", p, "evader/straight", 0, max_cycles=10)  # a map never seen
+    assert res.observations["pursuer"]["observation"] == "lidar_track"
+
+
+def test_an_interrupted_run_resumes_to_the_same_model_bit_for_bit(tmp_path):
+    import torch
+    from stable_baselines3 import PPO
+
+    whole = dagger(_lidar_cfg(tmp_path, "whole"))
+    dagger(_lidar_cfg(tmp_path, "parts", iterations=1))  # "interrupted" after iteration 0
+    parts = dagger(_lidar_cfg(tmp_path, "parts"))  # same config: continues at iteration 1
+    assert parts.disagreement == whole.disagreement and parts.samples == whole.samples
+    a = PPO.load(whole.model_path, device="cpu").policy.state_dict()
+    b = PPO.load(parts.model_path, device="cpu").policy.state_dict()
+    assert all(torch.equal(a[k], b[k]) for k in a)
+
+
+def test_a_different_config_in_the_same_directory_is_refused(tmp_path):
+    dagger(_lidar_cfg(tmp_path, iterations=1))
+    with pytest.raises(InvalidConfigError, match="different config"):
+        dagger(_lidar_cfg(tmp_path, iterations=1, learning_rate=0.5))
+
+
+def test_dagger_configs_round_trip_through_toml(tmp_path):
+    from training.config import load_any_config
+
+    cfg = _lidar_cfg(tmp_path, expert_params={"hysteresis": 0.5}, expert="pursuer/decomposition",
+                     opponent_weights=(2.0, 1.0))  # fmt: skip
+    path = tmp_path / "recipe.toml"
+    path.write_text(cfg.to_toml())
+    assert load_any_config(path) == cfg
+    path.write_text(cfg.to_toml().replace("hysteresis", "hysteresys"))
+    with pytest.raises(InvalidConfigError, match="hysteresys"):
+        load_any_config(path)

@@ -33,9 +33,7 @@ def test_a_zero_weight_member_is_never_drawn_and_draws_are_seeded() -> None:
 def test_nash_weights_from_a_payoff_matrix() -> None:
     # rows: the learner's population; columns: the pool. The column player mixes 50/50
     # (0.9 y + 0.2 (1 - y) = 0.5 y + 0.6 (1 - y)); a dominated column gets nothing.
-    pool = OpponentPool.from_payoffs(
-        EVADERS, [[0.9, 0.2, 0.95], [0.5, 0.6, 0.9]]
-    )
+    pool = OpponentPool.from_payoffs(EVADERS, [[0.9, 0.2, 0.95], [0.5, 0.6, 0.9]])
     assert pool.probabilities == pytest.approx((0.5, 0.5, 0.0), abs=1e-9)
     mixed = OpponentPool.from_payoffs(EVADERS, [[0.9, 0.2, 0.95], [0.5, 0.6, 0.9]], floor=0.3)
     assert mixed.probabilities == pytest.approx((0.45, 0.45, 0.1), abs=1e-9)

@@ -27,7 +27,8 @@ from typing import Any
 
 from envs.errors import UnknownNameError
 from strategies.policies import Policy
-from training.config import TrainConfig, load_config
+from training.config import TrainConfig, load_any_config
+from training.dagger import DaggerConfig, DaggerResult, dagger
 from training.train import TrainResult, load_policy, read_provenance, train
 
 __all__ = [
@@ -77,9 +78,9 @@ def info(name: str) -> dict[str, Any]:
     return read_provenance(_dir(name))
 
 
-def config(name: str) -> TrainConfig:
-    """The training config of ``name``."""
-    return load_config(_dir(name) / "config.toml")
+def config(name: str) -> TrainConfig | DaggerConfig:
+    """The training config of ``name`` (RL or DAgger, by its ``method``)."""
+    return load_any_config(_dir(name) / "config.toml")
 
 
 def policy_name(name: str) -> str:
@@ -102,8 +103,11 @@ def reproduce(
     *,
     install_result: bool = False,
     progress_bar: bool = False,
-) -> TrainResult:
+) -> TrainResult | DaggerResult:
     """Retrain ``name`` from its stored config (same seed, same hyperparameters).
+
+    The result is the same model, bit for bit, on the same package versions and CPU
+    (torch runs one thread; every random draw is seeded by the config).
 
     Args:
         name: a zoo model.
@@ -112,6 +116,11 @@ def reproduce(
         progress_bar: show SB3's progress bar.
     """
     cfg = config(name).replace(output_dir=os.fspath(output_dir or Path("out/zoo") / name))
+    if isinstance(cfg, DaggerConfig):
+        result = dagger(cfg, verbose=progress_bar)
+        if install_result:
+            install(name, cfg.output_dir)
+        return result
     result = train(cfg, progress_bar=progress_bar)
     if install_result:
         install(name, result.output_dir)

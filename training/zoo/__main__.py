@@ -38,13 +38,19 @@ def _main(argv: list[str] | None) -> int:
     if args.command == "list":
         for name in zoo.list_models():
             prov = zoo.info(name)
-            print(f"{name}\t{prov['role']} vs {prov['opponent']} on {prov['config']['map']}")
+            maps = prov.get("maps") or [prov["config"].get("map")]
+            how = prov.get("method", "rl")
+            print(f"{name}\t{prov['role']} ({how}) vs {prov['opponent']} on {', '.join(maps)}")
     elif args.command == "info":
         print(json.dumps(zoo.info(args.name), indent=2))
     elif args.command == "reproduce":
         r = zoo.reproduce(
             args.name, args.output_dir, install_result=args.install, progress_bar=args.progress
         )
+        if not hasattr(r, "timesteps"):  # a DAgger recipe
+            print(f"dagger: {r.samples[-1]} labelled states in {r.wall_seconds:.1f} s "
+                  f"-> {r.model_path}")  # fmt: skip
+            return 0
         print(f"trained {r.timesteps} timesteps in {r.wall_time:.1f} s -> {r.model_path}")
         if r.evaluation is not None:
             print(_line(r.evaluation))

@@ -235,7 +235,9 @@ def test_random_names_work_wherever_a_map_name_does() -> None:
     env.close()
 
 
-@pytest.mark.parametrize("bad", ["random:", "random:x", "random:-1", "random:blobs:3", "random:1:2:3"])
+@pytest.mark.parametrize(
+    "bad", ["random:", "random:x", "random:-1", "random:blobs:3", "random:1:2:3"]
+)
 def test_malformed_random_names_say_what_is_expected(bad: str) -> None:
     from envs.errors import InvalidConfigError
     from envs.maps import load_map

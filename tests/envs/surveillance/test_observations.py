@@ -177,8 +177,8 @@ def test_lidar_track_reports_the_other_agents_realised_velocity() -> None:
 
 
 def test_lidar_track_masks_the_velocity_when_surveillance_breaks() -> None:
-    env = surveillance_v0.parallel_env(map=l_room(), observation="lidar_track", n_rays=8,
-                                       l_min=1.0, l_max=5.0, v_evader=2.0, v_pursuer=2.0)  # fmt: skip
+    kw = dict(l_min=1.0, l_max=5.0, v_evader=2.0, v_pursuer=2.0)
+    env = surveillance_v0.parallel_env(map=l_room(), observation="lidar_track", n_rays=8, **kw)
     env.reset(options={"pursuer": (6.2, 2.0), "evader": (4.5, 6.0)})
     obs, _, term, _, _ = env.step({P: np.zeros(2), E: np.array([1.0, 1.0])})
     assert term[P]

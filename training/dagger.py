@@ -105,6 +105,8 @@ class DaggerConfig:
     """Passes over the whole dataset per fit."""
     batch_size: int = 256
     learning_rate: float = 1e-3
+    radial_weight: float = 1.0
+    """Weight of the action error along the line of sight (1: plain MSE); see :func:`_fit`."""
     seed: int = 0
     output_dir: str = "out/dagger"
 
@@ -143,6 +145,7 @@ class DaggerConfig:
             validation.integer(name, getattr(self, name), minimum=lo, where=where)
         validation.unit_interval("beta", self.beta, where=where, open=False)
         validation.positive("learning_rate", self.learning_rate, where=where)
+        validation.positive("radial_weight", self.radial_weight, where=where)
         put("net_arch", tuple(self.net_arch))
         for i, n in enumerate(self.net_arch):
             validation.integer(f"net_arch[{i}]", n, minimum=1, where=where)
@@ -316,21 +319,48 @@ class _Rollout:
         return self.act(observation), state
 
 
+def _line_of_sight(obs: np.ndarray, observation: dict[str, Any]) -> np.ndarray:
+    """Unit vectors along the line of sight in each observation (zeros where unseen)."""
+    from envs.surveillance.observations import STATE_LAYOUT, lidar_layout
+
+    if observation.get("observation", "state") == "state":
+        return np.asarray(obs[:, STATE_LAYOUT["theta"]], dtype=np.float32)
+    kind = observation["observation"]
+    rel = obs[
+        :, lidar_layout(int(observation.get("n_rays", 32)), kind == "lidar_track")["other_rel"]
+    ]
+    n = np.linalg.norm(rel, axis=1, keepdims=True)
+    return np.where(n > 0, rel / np.maximum(n, 1e-12), 0.0).astype(np.float32)
+
+
 def _fit(model, obs: np.ndarray, act: np.ndarray, cfg: DaggerConfig, rng) -> float:
-    """Regress the policy's action mean onto the expert's actions (MSE); returns the loss."""
+    """Regress the policy's action mean onto the expert's actions; returns the last loss.
+
+    The loss is the squared error with its component along the line of sight weighted by
+    ``radial_weight``: an error along the line of sight changes L, and L leaving
+    ``[L_min, L_max]`` ends the episode, while an error across it only turns the rod a
+    little. Plain regression shrinks the actions it is unsure of toward their mean, which
+    for a pursuer imitating one that holds L just above L_min means drifting into
+    ``"too_close"``.
+    """
     import torch
 
     policy = model.policy
     opt = torch.optim.Adam(policy.parameters(), lr=cfg.learning_rate)
     x_all = torch.as_tensor(obs)
     y_all = torch.as_tensor(act)
+    u_all = torch.as_tensor(_line_of_sight(obs, cfg.observation))
+    extra = cfg.radial_weight - 1.0
     loss_value = float("nan")
     for _ in range(cfg.epochs):
         order = rng.permutation(len(obs))
         for s in range(0, len(order), cfg.batch_size):
             idx = torch.as_tensor(order[s : s + cfg.batch_size])
             dist = policy.get_distribution(x_all[idx])
-            loss = torch.nn.functional.mse_loss(dist.distribution.mean, y_all[idx])
+            err = dist.distribution.mean - y_all[idx]
+            loss = (err * err).sum(dim=1).mean()
+            if extra:
+                loss = loss + extra * ((err * u_all[idx]).sum(dim=1) ** 2).mean()
             opt.zero_grad()
             loss.backward()
             opt.step()

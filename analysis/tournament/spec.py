@@ -5,7 +5,7 @@ seeds::
 
     name = "quick"                      # the run's name (default: the file's stem)
     description = "greedy vs baselines"
-    maps = ["corridor", "two_rooms", "worlds/office.json"]   # built-ins or map files
+    maps = ["corridor", "two_rooms", "worlds/office.json", "random:7"]  # built-ins, files, seeds
     seeds = 10                          # seeds 0..9, or a list [3, 5, 8]
     start = "safe"                      # "safe", "valid", or a list of both
     time_limit = 120                    # wall-clock seconds per match (forfeit beyond)
@@ -383,6 +383,11 @@ def _maps(value: Any, source: str, base: Path) -> tuple[MapEntry, ...]:
         if text in builtin_names():
             info = builtin_info(text)
             entry = MapEntry(text, f"builtin:{text}", info.map, dict(info.params()))
+        elif text.startswith("random:"):  # a seeded random map, named by its seed
+            try:
+                entry = MapEntry(text, text, load_map(text), {})
+            except ValueError as exc:
+                raise InvalidConfigError(f"{where}: {exc}") from exc
         else:
             path = (base / text).resolve()
             if not path.is_file():

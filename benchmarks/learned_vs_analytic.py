@@ -54,6 +54,73 @@ def _fmt(rate, lo, hi, n):
     return f"{rate:5.2f} [{lo:.2f}, {hi:.2f}] n={n}"
 
 
+def card(name: str, role: str, rows, args) -> str:
+    """The model card of zoo model ``name``: recipe, training curves, measured rates."""
+    prov = zoo.info(name)
+    cfg = prov["config"]
+    size = zoo.model_path(name).stat().st_size
+    seen = [m for m in cfg.get("maps", [cfg.get("map")]) if any(r["map"] == m for r in rows)]
+    how = (
+        f"imitating `{prov['expert']}` {cfg.get('expert_params') or ''} "
+        if "expert" in prov
+        else ""
+    )
+    obs = prov["env_config"]
+    lines = [
+        f"# {name}",
+        "",
+        f"A {role} trained by {prov.get('method', 'rl')} {how}against {prov['opponent']}, "
+        f"observing `{obs['observation']}` ({obs.get('n_rays')} rays). Retrain it bit for bit "
+        f"with `python -m training.zoo reproduce {name}`; its recipe is `config.toml` beside "
+        "this card.",
+        "",
+        f"- training maps: {', '.join(cfg.get('maps', [cfg.get('map')]))}",
+        f"- network: {prov.get('net_arch')} ({prov.get('parameters')} parameters), "
+        f"model file {size / 1024:.0f} KiB",
+        f"- labelled states: {prov['samples'][-1] if 'samples' in prov else '-'}; "
+        f"wall time {prov.get('wall_seconds', prov.get('wall_time', float('nan'))):.0f} s on "
+        "2 cores",
+        f"- code: {prov.get('git_sha')} (dirty: {prov.get('git_dirty')}); "
+        f"versions {prov.get('versions')}",
+        "",
+    ]
+    if "disagreement" in prov:
+        lines += ["## DAgger curve", "", "| iteration | samples | disagreement | fit error | won |",
+                  "|---|---|---|---|---|"]  # fmt: skip
+        curves = zip(prov["samples"], prov["disagreement"], prov["fit_error"], prov["held"],
+                     strict=False)  # fmt: skip
+        for i, (n, d, f, h) in enumerate(curves):
+            lines.append(f"| {i} | {n} | {d:.3f} | {f:.3f} | {h:.2f} |")
+        lines.append("")
+    lines += [
+        f"## Measured ({args.seeds} seeded safe starts per map, max_cycles {args.max_cycles}, "
+        "`benchmarks/learned_vs_analytic.py`)",
+        "",
+        "Rates are the model's wins (a pursuer holds, an evader escapes) with Wilson 95 % "
+        "intervals; the analytic policy of the model's role is measured in its place on the "
+        "same starts.",
+        "",
+        "| maps | opponent | this model | analytic in its place |",
+        "|---|---|---|---|",
+    ]
+    ref = "pursuer/decomposition" if role == "pursuer" else "evader/shooting"
+    opponents = EVADERS if role == "pursuer" else PURSUERS
+    for label, maps in (("seen: " + ", ".join(seen), seen), ("held out: " + ", ".join(HELD_OUT),
+                        HELD_OUT)):  # fmt: skip
+        if not maps:
+            continue
+        for o in opponents:
+            pair = (name, o) if role == "pursuer" else (o, name)
+            pair_ref = (ref, o) if role == "pursuer" else (o, ref)
+            r, lo, hi, n = _rate(rows, *pair, maps)
+            q, qlo, qhi, qn = _rate(rows, *pair_ref, maps)
+            if role == "evader":
+                r, lo, hi = 1 - r, 1 - hi, 1 - lo
+                q, qlo, qhi = 1 - q, 1 - qhi, 1 - qlo
+            lines.append(f"| {label} | {o} | {_fmt(r, lo, hi, n)} | {_fmt(q, qlo, qhi, qn)} |")
+    return "\n".join(lines) + "\n"
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=20, help="seeded safe starts per map")
@@ -61,6 +128,8 @@ def main(argv=None) -> int:
     ap.add_argument("--store", default="out/bench/learned.sqlite")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--max-cycles", type=int, default=300)
+    ap.add_argument("--cards", action="store_true",
+                    help="write each model's CARD.md into the zoo from this run")  # fmt: skip
     args = ap.parse_args(argv)
     names = args.models or zoo.list_models()
     learned = {"pursuer": [], "evader": []}
@@ -129,6 +198,12 @@ def main(argv=None) -> int:
             if t_ref and t_m:
                 a_ms, b_ms = 1e3 * sum(t_m) / len(t_m), 1e3 * sum(t_ref) / len(t_ref)
                 print(f"  {m:<44} {a_ms:7.3f} ms vs {ref} {b_ms:7.3f} ms ({b_ms / a_ms:5.2f}x)")
+    if args.cards:
+        for role in ("pursuer", "evader"):
+            for m in learned[role]:
+                path = zoo.MODELS_DIR / m / "CARD.md"
+                path.write_text(card(m, role, rows, args))
+                print(f"card: {path}")
     out = write_report(args.store, Path(args.store).with_suffix("") / "report", replays=False)
     print(f"\nreport: {out.get('html', out)}")
     return 0

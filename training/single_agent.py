@@ -222,9 +222,10 @@ class SingleAgentEnv(gym.Env):
         elif self.start == "env":
             placement = None
         else:
-            placement = sample_start(
-                self.config, np.random.default_rng(start_seed), kind=self.start
-            )
+            judge = self.config  # the start sampler's judge reads the state
+            if judge.observation != "state":
+                judge = dataclasses.replace(judge, observation="state")
+            placement = sample_start(judge, np.random.default_rng(start_seed), kind=self.start)
         self.opponent.reset(
             role=self.opponent_role,
             map=self.config.map,

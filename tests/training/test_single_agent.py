@@ -169,3 +169,13 @@ def test_a_list_of_maps_plays_each_episode_on_one_of_them() -> None:
 def test_an_empty_list_of_maps_is_refused() -> None:
     with pytest.raises(InvalidConfigError, match="map"):
         SingleAgentEnv("pursuer", "evader/straight", map=[])
+
+
+@pytest.mark.parametrize("start", ["safe", "valid"])
+def test_sampled_starts_work_for_a_lidar_learner(start) -> None:
+    """The start sampler judges with the state; the learner still sees its lidar."""
+    env = SingleAgentEnv("pursuer", "evader/straight", map="corridor", start=start,
+                         observation="lidar_track", n_rays=8, max_cycles=5)  # fmt: skip
+    obs, info = env.reset(seed=0)
+    assert obs.shape == (16,) and info["surveillance"]
+    env.close()

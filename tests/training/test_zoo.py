@@ -9,15 +9,18 @@ from envs import surveillance_v0
 from envs.errors import UnknownNameError
 from training import zoo
 from training.config import TrainConfig
+from training.dagger import DaggerConfig
 
-SHIPPED = ["ppo_evader_vs_greedy_open_room", "ppo_pursuer_vs_straight_open_room"]
+RL = ["ppo_evader_vs_greedy_open_room", "ppo_pursuer_vs_straight_open_room"]
+DAGGER = ["dagger_evader_generalist", "dagger_pursuer_generalist"]
+SHIPPED = RL + DAGGER
 
 
 def test_list_models():
     assert set(SHIPPED) <= set(zoo.list_models())
 
 
-@pytest.mark.parametrize("name", SHIPPED)
+@pytest.mark.parametrize("name", RL)
 def test_model_files_and_provenance(name):
     assert zoo.model_path(name).stat().st_size < 1_000_000
     prov = zoo.info(name)
@@ -29,12 +32,28 @@ def test_model_files_and_provenance(name):
     assert zoo.policy_name(name) == f"{cfg.role}/sb3:{zoo.model_path(name)}"
 
 
+@pytest.mark.parametrize("name", DAGGER)
+def test_dagger_models_files_card_and_provenance(name):
+    assert zoo.model_path(name).stat().st_size < 1_000_000
+    prov = zoo.info(name)
+    cfg = zoo.config(name)
+    assert isinstance(cfg, DaggerConfig)
+    assert prov["config"] == cfg.to_dict() and prov["role"] == cfg.role
+    assert prov["method"] == "dagger" and len(prov["samples"]) == cfg.iterations
+    # generalists: they see no map coordinates, and were trained on several maps
+    assert prov["env_config"]["observation"] == "lidar_track" and len(cfg.maps) > 2
+    card = (zoo.MODELS_DIR / name / "CARD.md").read_text()
+    assert name in card and "held out" in card
+
+
 @pytest.mark.parametrize("name", SHIPPED)
 @pytest.mark.parametrize("observation_seed", [0, 1])
 def test_loads_and_acts(name, observation_seed):
     cfg = zoo.config(name)
     policy = zoo.load(name)
-    env = surveillance_v0.parallel_env(map=cfg.map, **cfg.env)
+    obs_kw = {k: v for k, v in (policy.observation_options or {}).items()}
+    world = cfg.map if isinstance(cfg, TrainConfig) else cfg.maps[0]
+    env = surveillance_v0.parallel_env(map=world, **{**cfg.env, **obs_kw})
     agent = f"{cfg.role}_0"
     obs, _ = env.reset(seed=observation_seed)
     policy.reset(role=cfg.role, map=env.config.map, config=env.config, seed=0)
@@ -59,3 +78,41 @@ def test_cli_list(capsys):
     assert main(["list"]) == 0
     out = capsys.readouterr().out
     assert all(name in out for name in SHIPPED)
+
+
+def _weights(path):
+    from stable_baselines3 import PPO
+
+    return PPO.load(str(path), device="cpu").policy.state_dict()
+
+
+def _same(a, b) -> bool:
+    import torch
+
+    return a.keys() == b.keys() and all(torch.equal(a[k], b[k]) for k in a)
+
+
+@pytest.mark.parametrize("method", ["dagger", "rl"])
+def test_reproduce_is_bit_for_bit(tmp_path, monkeypatch, method):
+    """Install a tiny run as a zoo model, reproduce it elsewhere: the same weights."""
+    from training.dagger import dagger
+    from training.train import train
+
+    run = tmp_path / "run"
+    if method == "dagger":
+        cfg = DaggerConfig(role="pursuer", expert="pursuer/greedy",
+                           opponent=("evader/straight", "evader/random"),
+                           maps=("open_room", "random:4"), iterations=2, episodes=2, max_cycles=30,
+                           epochs=5, observation={"observation": "lidar_track", "n_rays": 8},
+                           output_dir=str(run))  # fmt: skip
+        dagger(cfg)
+    else:
+        cfg = TrainConfig(role="pursuer", opponent="evader/straight", total_timesteps=256,
+                          n_steps=128, batch_size=64, eval_episodes=0, checkpoint_freq=10_000,
+                          env={"max_cycles": 40}, output_dir=str(run))  # fmt: skip
+        train(cfg)
+    monkeypatch.setattr(zoo, "MODELS_DIR", tmp_path / "zoo")
+    zoo.install("tiny", run)
+    assert zoo.list_models() == ["tiny"]
+    again = zoo.reproduce("tiny", tmp_path / "again")
+    assert _same(_weights(run / "model.zip"), _weights(again.model_path))

@@ -13,9 +13,9 @@ floats of exact data and a parameter ``t``:
 
 Besides points, tangents and curvatures, each shape has an *implicit* signed function
 ``F`` that vanishes on the curve and measures distance to first order (exactly for
-segments and arcs; along the rod through ``v`` for conchoids), and a *projection* that
-maps a point of the curve back to its parameter. Intersections and tangencies are found
-with them (:mod:`strategies.cspace._intersect`).
+segments and arcs), finite and continuous everywhere but at a conchoid's vertex, and a
+*projection* that maps a point of the curve back to its parameter. Intersections and
+tangencies are found with them (:mod:`strategies.cspace._intersect`).
 """
 
 from __future__ import annotations
@@ -134,8 +134,8 @@ def implicit(kind, data, x, L: float) -> np.ndarray:
     """Signed function of points ``x`` (k, 2) vanishing on curve ``k``'s support.
 
     Segment: signed distance to the line (positive on the left of ``d``). Arc: distance
-    to the centre minus R. Conchoid: along the line through ``x`` and ``v``, the distance
-    from the edge's line to ``x`` minus L (``inf`` where that line is parallel to the edge).
+    to the centre minus R. Conchoid: see :func:`_conchoid_implicit` (``inf`` only at
+    ``v``).
     """
     x = np.asarray(x, dtype=float).reshape(-1, 2)
     kind, data, _ = _broadcast(kind, data, np.zeros(len(x)))
@@ -149,11 +149,37 @@ def implicit(kind, data, x, L: float) -> np.ndarray:
         out[m] = np.hypot(*(x[m] - data[m, 0:2]).T) - data[m, 2]
     m = kind == CONCHOID
     if m.any():
-        s = project(CONCHOID, data[m], x[m])
-        Q, wh, _, _, _ = _conchoid_frame(data[m], s)
-        f = ((x[m] - Q) * wh).sum(axis=1) - L
-        out[m] = np.where(np.isfinite(f), f, np.inf)
+        out[m] = _conchoid_implicit(data[m], x[m], L)
     return out
+
+
+def _conchoid_implicit(data: np.ndarray, x: np.ndarray, L: float) -> np.ndarray:
+    """The conchoids' implicit function, without a pole: ``H / |grad H|``.
+
+    With ``n`` the edge's unit normal, ``h(x) = n . (x - a)`` the height above the edge's
+    line (signed positive on ``v``'s side) and ``alpha`` the angle between ``x - v`` and
+    ``n``, a point is on the conchoid iff its height is the rod's rise,
+    ``H(x) = h(x) - L |cos alpha| = 0``. The distance along the rod from the edge's line,
+    ``h / |cos alpha| - L = H / |cos alpha|``, has the same sign but a pole on the line
+    through ``v`` parallel to the edge (there the rod never reaches the edge's line):
+    a curve ending or sampled on that line (a wall's end cap parallel to the edge, as in
+    every rectilinear map) read ``inf`` there and lost its crossing with the conchoid.
+    ``H`` is continuous everywhere but at ``v``; divided by its gradient's norm (in closed
+    form) it measures distance to first order.
+    """
+    v, a, u = data[:, 0:2], data[:, 2:4], data[:, 4:6]
+    n = np.stack([-u[:, 1], u[:, 0]], axis=1)
+    side = np.where(((v - a) * n).sum(axis=1) < 0.0, -1.0, 1.0)
+    r = x - v
+    rn = np.hypot(r[:, 0], r[:, 1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rh = r / rn[:, None]
+        cos = (rh * n).sum(axis=1)
+        H = side * ((x - a) * n).sum(axis=1) - L * np.abs(cos)
+        # grad |cos alpha| = sign(cos) (n - cos r^) / |r|
+        grad = side[:, None] * n - (np.sign(cos) * L / rn)[:, None] * (n - cos[:, None] * rh)
+        f = H / np.maximum(np.hypot(grad[:, 0], grad[:, 1]), np.finfo(float).tiny)
+    return np.where(np.isfinite(f), f, np.inf)
 
 
 def gradient(kind, data, x, L: float) -> np.ndarray:

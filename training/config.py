@@ -75,8 +75,9 @@ class TrainConfig:
 
     role: str
     """The learner's role: ``"pursuer"`` or ``"evader"``."""
-    opponent: str
-    """The other role's policy name (``"evader/straight"``, ``"pursuer/sb3:PATH"``...)."""
+    opponent: str | tuple[str, ...]
+    """The other role's policy name (``"evader/straight"``, ``"pursuer/sb3:PATH"``...), or
+    several: a pool (:class:`training.pool.OpponentPool`), one drawn per episode."""
     map: str = "open_room"
     """Built-in map name or map file path."""
     env: dict[str, Any] = field(default_factory=dict)
@@ -113,18 +114,29 @@ class TrainConfig:
     """Starts of the final evaluation (``"env"``, ``"valid"``, ``"safe"``)."""
     output_dir: str = "out/training/run"
     """Directory for checkpoints, ``model.zip`` and ``provenance.json``."""
+    opponent_weights: tuple[float, ...] = ()
+    """Weights of the pool's members (empty: uniform), e.g. a Nash mixture (PSRO)."""
 
     def __post_init__(self) -> None:
         put = lambda name, value: object.__setattr__(self, name, value)
         check = _Checker()
         check.role(self.role)
-        put("opponent", check.string("opponent", self.opponent))
         other = "evader" if self.role == "pursuer" else "pursuer"
-        if self.opponent.partition("/")[0] != other:
-            raise InvalidConfigError(
-                f"opponent: a {self.role} learner needs an '{other}/KIND' policy, "
-                f"got {self.opponent!r}"
-            )
+        pool = (self.opponent,) if isinstance(self.opponent, str) else tuple(self.opponent)
+        if not pool:
+            raise InvalidConfigError("opponent: expected a policy name or a non-empty list")
+        for name in pool:
+            check.string("opponent", name)
+            if name.partition("/")[0] != other:
+                raise InvalidConfigError(
+                    f"opponent: a {self.role} learner needs an '{other}/KIND' policy, got {name!r}"
+                )
+        put("opponent", pool[0] if len(pool) == 1 and isinstance(self.opponent, str) else pool)
+        put("opponent_weights", tuple(self.opponent_weights))
+        if self.opponent_weights:
+            from training.pool import OpponentPool
+
+            OpponentPool(list(pool), list(self.opponent_weights))  # checks the weights
         put("map", check.string("map", self.map))
         put("env", check.table("env", self.env, allowed=_ENV_KEYS))
         try:  # the env's own validation, so a bad [env] value fails here, not mid-run
@@ -222,12 +234,32 @@ class TrainConfig:
         missing = [n for n in ("role", "opponent") if n not in data]
         if missing:
             raise InvalidConfigError(f"config: missing required field(s) {missing}")
+        data = dict(data)
+        for key in ("opponent", "opponent_weights", "net_arch"):
+            if isinstance(data.get(key), list):
+                data[key] = tuple(data[key])
         return cls(**data)
+
+    def opponent_policy(self) -> Any:
+        """The opponent to build envs with: a name, or a new :class:`OpponentPool`
+        (a new one per call: each env needs its own stateful policies)."""
+        if isinstance(self.opponent, str) and not self.opponent_weights:
+            return self.opponent
+        from training.pool import OpponentPool
+
+        pool = (self.opponent,) if isinstance(self.opponent, str) else self.opponent
+        return OpponentPool(list(pool), list(self.opponent_weights) or None)
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON/TOML-ready dict that :meth:`from_dict` turns back into this config."""
         d = dataclasses.asdict(self)
         d["net_arch"] = list(self.net_arch)
+        if not isinstance(self.opponent, str):
+            d["opponent"] = list(self.opponent)
+        if self.opponent_weights:
+            d["opponent_weights"] = list(self.opponent_weights)
+        else:  # absent unless used: configs written before pools load and compare equal
+            del d["opponent_weights"]
         d["env"] = dict(self.env)
         d["algo_kwargs"] = dict(self.algo_kwargs)
         d["policy_kwargs"] = dict(self.policy_kwargs)

@@ -262,7 +262,7 @@ def _make_vec_env(config: TrainConfig):
     from stable_baselines3.common.vec_env import DummyVecEnv
 
     def factory():
-        return Monitor(SingleAgentEnv(config.role, config.opponent, **config.env_kwargs()))
+        return Monitor(SingleAgentEnv(config.role, config.opponent_policy(), **config.env_kwargs()))
 
     return DummyVecEnv([factory] * config.n_envs)
 
@@ -445,7 +445,7 @@ def train(
         learner = make_policy(f"{config.role}/sb3:{model_path}", algo=config.algo.upper())
         evaluation = evaluate_model(
             learner,
-            config.opponent,
+            config.opponent_policy(),
             episodes=config.eval_episodes,
             seed=config.seed + EVAL_SEED_OFFSET,
             role=config.role,
@@ -458,11 +458,11 @@ def train(
         "env_id": ENV_NAME,
         "registry_id": ENV_ID,
         "role": config.role,
-        "opponent": config.opponent,
+        "opponent": config.opponent if isinstance(config.opponent, str) else list(config.opponent),
         "algo": config.algo,
         "config": config.to_dict(),
         "env_config": SingleAgentEnv(
-            config.role, config.opponent, **config.env_kwargs()
+            config.role, config.opponent_policy(), **config.env_kwargs()
         ).config.to_dict(),
         **_git_state(),
         "packages": _versions(),

@@ -19,11 +19,28 @@ def test_example_configs_exist():
 
 @pytest.mark.parametrize("path", CONFIGS, ids=lambda p: p.stem)
 def test_example_configs_load_and_round_trip(path, tmp_path):
-    config = load_config(path)
+    from training.config import load_any_config
+
+    config = load_any_config(path)
     out = tmp_path / "again.toml"
     out.write_text(config.to_toml())
-    assert load_config(out) == config
-    assert TrainConfig.from_dict(config.to_dict()) == config
+    assert load_any_config(out) == config
+    assert type(config).from_dict(config.to_dict()) == config
+
+
+def test_a_pool_of_opponents_round_trips_and_is_checked(tmp_path):
+    cfg = TrainConfig(role="pursuer", opponent=("evader/straight", "evader/shooting"),
+                      opponent_weights=(3.0, 1.0))  # fmt: skip
+    out = tmp_path / "pool.toml"
+    out.write_text(cfg.to_toml())
+    assert load_config(out) == cfg
+    pool = cfg.opponent_policy()
+    assert pool.probabilities == pytest.approx((0.75, 0.25))
+    assert cfg.opponent_policy() is not pool  # one per env: their policies keep state
+    with pytest.raises(InvalidConfigError, match="pursuer/greedy"):
+        TrainConfig(role="pursuer", opponent=("evader/straight", "pursuer/greedy"))
+    with pytest.raises(InvalidConfigError, match="opponent pool"):
+        TrainConfig(role="pursuer", opponent=("evader/straight",), opponent_weights=(1.0, 2.0))
 
 
 def test_overrides_and_defaults(tmp_path):

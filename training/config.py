@@ -78,8 +78,8 @@ class TrainConfig:
     opponent: str | tuple[str, ...]
     """The other role's policy name (``"evader/straight"``, ``"pursuer/sb3:PATH"``...), or
     several: a pool (:class:`training.pool.OpponentPool`), one drawn per episode."""
-    map: str = "open_room"
-    """Built-in map name or map file path."""
+    map: str | tuple[str, ...] = "open_room"
+    """Built-in map name, map file path or ``random:SEED``; or several, one per episode."""
     env: dict[str, Any] = field(default_factory=dict)
     """Overrides of ``surveillance_v0.parallel_env`` arguments (``max_cycles``, ...)."""
     start: str = "env"
@@ -137,10 +137,16 @@ class TrainConfig:
             from training.pool import OpponentPool
 
             OpponentPool(list(pool), list(self.opponent_weights))  # checks the weights
-        put("map", check.string("map", self.map))
+        if isinstance(self.map, (list, tuple)):  # several maps: one drawn per episode
+            if not self.map:
+                raise InvalidConfigError("map: expected a map name or a non-empty list")
+            put("map", tuple(check.string("map", m) for m in self.map))
+        else:
+            put("map", check.string("map", self.map))
         put("env", check.table("env", self.env, allowed=_ENV_KEYS))
         try:  # the env's own validation, so a bad [env] value fails here, not mid-run
-            EnvConfig(map=self.map, **self.env)
+            for world in self.maps:
+                EnvConfig(map=world, **self.env)
         except InvalidConfigError as exc:
             if str(exc).startswith("map:"):
                 raise
@@ -235,10 +241,15 @@ class TrainConfig:
         if missing:
             raise InvalidConfigError(f"config: missing required field(s) {missing}")
         data = dict(data)
-        for key in ("opponent", "opponent_weights", "net_arch"):
+        for key in ("opponent", "opponent_weights", "net_arch", "map"):
             if isinstance(data.get(key), list):
                 data[key] = tuple(data[key])
         return cls(**data)
+
+    @property
+    def maps(self) -> tuple[str, ...]:
+        """The map(s) as a tuple."""
+        return (self.map,) if isinstance(self.map, str) else tuple(self.map)
 
     def opponent_policy(self) -> Any:
         """The opponent to build envs with: a name, or a new :class:`OpponentPool`
@@ -256,6 +267,8 @@ class TrainConfig:
         d["net_arch"] = list(self.net_arch)
         if not isinstance(self.opponent, str):
             d["opponent"] = list(self.opponent)
+        if not isinstance(self.map, str):
+            d["map"] = list(self.map)
         if self.opponent_weights:
             d["opponent_weights"] = list(self.opponent_weights)
         else:  # absent unless used: configs written before pools load and compare equal
@@ -277,7 +290,8 @@ class TrainConfig:
 
     def env_kwargs(self) -> dict[str, Any]:
         """Keyword arguments of :class:`~training.single_agent.SingleAgentEnv` (no opponent)."""
-        return {"map": self.map, "start": self.start, **self.env}
+        return {"map": self.map if isinstance(self.map, str) else list(self.map),
+                "start": self.start, **self.env}  # fmt: skip
 
     def replace(self, **changes: Any) -> TrainConfig:
         """A copy with some fields changed (validated again)."""

@@ -107,6 +107,12 @@ class DaggerConfig:
     learning_rate: float = 1e-3
     radial_weight: float = 1.0
     """Weight of the action error along the line of sight (1: plain MSE); see :func:`_fit`."""
+    curriculum: tuple[dict[str, Any], ...] = ()
+    """Stages played first, in order: ``{"iterations": n, "start": ..., "maps": [...],
+    "env": {...}}`` (each key but ``iterations`` optional, overriding the top-level
+    value for those iterations), e.g. escapable starts, then safe ones; a wide sensor range,
+    then the narrow one; simple maps, then cluttered ones. The top-level settings apply
+    after the last stage."""
     seed: int = 0
     output_dir: str = "out/dagger"
 
@@ -146,9 +152,44 @@ class DaggerConfig:
         validation.unit_interval("beta", self.beta, where=where, open=False)
         validation.positive("learning_rate", self.learning_rate, where=where)
         validation.positive("radial_weight", self.radial_weight, where=where)
+        from strategies.policies.starts import START_KINDS
+
+        validation.choice("start", self.start, START_KINDS, where=where)
+        stages = []
+        for i, stage in enumerate(self.curriculum):
+            at = f"{where}: curriculum[{i}]"
+            stage = dict(validation.mapping("curriculum stage", stage, where=at))
+            unknown = sorted(set(stage) - {"iterations", "start", "maps", "env"})
+            if unknown or "iterations" not in stage:
+                raise InvalidConfigError(
+                    f"{at} = {stage!r}: expected 'iterations' and optionally 'start', 'maps', "
+                    f"'env'" + (f"; unknown {unknown}" if unknown else "")
+                )
+            validation.integer("iterations", stage["iterations"], minimum=1, where=at)
+            if "start" in stage:
+                validation.choice("start", stage["start"], START_KINDS, where=at)
+            if "maps" in stage:
+                m = stage["maps"]
+                stage["maps"] = (m,) if isinstance(m, str) else tuple(m)
+                if not stage["maps"] or not all(isinstance(x, str) and x for x in stage["maps"]):
+                    raise InvalidConfigError(f"{at}: maps = {m!r}: expected map names")
+            if "env" in stage:
+                stage["env"] = dict(validation.mapping("env", stage["env"], where=at))
+            stages.append(stage)
+        put("curriculum", tuple(stages))
         put("net_arch", tuple(self.net_arch))
         for i, n in enumerate(self.net_arch):
             validation.integer(f"net_arch[{i}]", n, minimum=1, where=where)
+
+    def stage(self, iteration: int) -> tuple[tuple[str, ...], str, dict[str, Any]]:
+        """The maps, start kind and env overrides of ``iteration`` (curriculum first)."""
+        first = 0
+        for stage in self.curriculum:
+            if iteration < first + stage["iterations"]:
+                env = {**self.env, **stage.get("env", {})}
+                return stage.get("maps", self.maps), stage.get("start", self.start), env
+            first += stage["iterations"]
+        return self.maps, self.start, dict(self.env)
 
     @property
     def pool(self) -> tuple[str, ...]:
@@ -169,6 +210,10 @@ class DaggerConfig:
         for f in dataclasses.fields(self):
             v = getattr(self, f.name)
             d[f.name] = list(v) if isinstance(v, tuple) else (dict(v) if isinstance(v, dict) else v)
+        d["curriculum"] = [
+            {k: (list(x) if isinstance(x, tuple) else x) for k, x in s.items()}
+            for s in self.curriculum
+        ]
         return d
 
     @classmethod
@@ -189,7 +234,7 @@ class DaggerConfig:
         missing = [n for n in ("role", "expert", "opponent") if n not in data]
         if missing:
             raise InvalidConfigError(f"config: missing required field(s) {missing}")
-        for key in ("maps", "net_arch", "opponent_weights"):
+        for key in ("maps", "net_arch", "opponent_weights", "curriculum"):
             if isinstance(data.get(key), list):
                 data[key] = tuple(data[key])
         if isinstance(data.get("opponent"), list):
@@ -202,12 +247,21 @@ class DaggerConfig:
 
         d = self.to_dict()
         tables = {k: d.pop(k) for k in ("env", "observation", "expert_params")}
+        stages = d.pop("curriculum")
         if not d["opponent_weights"]:
             del d["opponent_weights"]
         lines = [f"{k} = {_toml_value(v)}" for k, v in d.items()]
         for name, items in tables.items():
             if items:
                 lines += ["", f"[{name}]"] + [f"{k} = {_toml_value(v)}" for k, v in items.items()]
+        for stage in stages:
+            lines += ["", "[[curriculum]]"]
+            for k, v in stage.items():
+                if isinstance(v, dict):
+                    inner = ", ".join(f"{a} = {_toml_value(b)}" for a, b in v.items())
+                    lines.append(f"{k} = {{{inner}}}")
+                else:
+                    lines.append(f"{k} = {_toml_value(v)}")
         return "\n".join(lines) + "\n"
 
     def replace(self, **changes: Any) -> DaggerConfig:
@@ -471,17 +525,19 @@ def dagger(cfg: DaggerConfig, *, verbose: bool = False) -> DaggerResult:
         t_it = time.perf_counter()
         beta = cfg.beta**it
         wins, seen_l, seen_e, records = 0, [], [], []
+        maps, start, env_overrides = cfg.stage(it)
         for ep in range(cfg.episodes):
             seed = cfg.seed * 100_003 + it * 1_009 + ep
-            world = cfg.maps[(it * cfg.episodes + ep) % len(cfg.maps)]
+            world = maps[(it * cfg.episodes + ep) % len(maps)]
             expert = make_policy(cfg.expert, **cfg.expert_params)
             roll = _Rollout(expert, model, beta, seed, cfg.observation)
             other = "evader" if cfg.role == "pursuer" else "pursuer"
             pair = {cfg.role: roll, other: opponent}
             r = run_episode(world, pair["pursuer"], pair["evader"], seed, max_cycles=cfg.max_cycles,
-                            overrides=cfg.env, start=cfg.start)  # fmt: skip
+                            overrides=env_overrides, start=start)  # fmt: skip
             wins += r.winner == cfg.role
-            records.append({"map": world, "opponent": r.evader if other == "evader" else r.pursuer,
+            records.append({"map": world, "start": start, "l_max": r.config.l_max,
+                            "opponent": r.evader if other == "evader" else r.pursuer,
                             "winner": r.winner, "steps": r.steps})  # fmt: skip
             data_obs.extend(roll.obs)
             data_act.extend(roll.labels)

@@ -40,7 +40,7 @@ from strategies.policies.base import (
     positive_param,
 )
 from strategies.policies.lazy_table import LazySafetyTable
-from strategies.policies.safety import NO_PATH, safety_table
+from strategies.policies.safety import NO_PATH, SafetyTable, safety_table
 
 __all__ = ["DecompositionPursuer"]
 
@@ -138,6 +138,15 @@ class DecompositionPursuer(BasePolicy):
         lut[NO_PATH] = math.pi / self.omega  # no safe orientation: half a turn
         lut[0] = -1e9
         self._turn_lut = lut.astype(np.float32)
+        nb = self.table.n_bins
+        # the eager table's fast path (:meth:`_probe_values`) takes the largest rotation
+        # need over the probes at one radius before the lookup: exact when the lookup is
+        # non-decreasing over the needs a table holds (0 .. n_bins // 2, the shorter way
+        # round, or NO_PATH), which it is unless rounding says otherwise
+        held = self._turn_lut[np.r_[np.arange(nb // 2 + 1), NO_PATH]]
+        self._fast = isinstance(self.table, SafetyTable) and bool(np.all(np.diff(held) >= 0))
+        # the penalty of turning k bins, as _target's score needs it (same float ops)
+        self._turn_penalty = self.hysteresis * np.arange(nb + 1.0) * self._bw / self.omega
         self.last_target: int | None = None
 
     # ------------------------------------------------------------------ decision
@@ -148,10 +157,14 @@ class DecompositionPursuer(BasePolicy):
         ``p`` where ``theta`` is not safe; the horizon where no probe threatens ``theta``,
         and ``-turn / omega`` (negative) where ``theta`` is not safe at ``evader`` itself.
         """
-        tab = self.table
-        row = tab.row(evader)
+        row = self.table.row(evader)
         if row < 0:
-            return np.zeros(tab.n_bins)
+            return np.zeros(self.table.n_bins)
+        return self._values(evader, row)
+
+    def _values(self, evader: np.ndarray, row: int) -> np.ndarray:
+        """:meth:`orientation_values` at a free grid row ``row`` of ``evader``."""
+        tab = self.table
         value = np.full(tab.n_bins, self.horizon)
         value = np.minimum(value, self._probe_values(evader))
         need0 = tab.need[row]
@@ -161,6 +174,22 @@ class DecompositionPursuer(BasePolicy):
         """The least margin over the probes on rays from ``origin`` (see above)."""
         tab = self.table
         points = origin + self._offsets
+        if self._fast:
+            # eager table: one lookup of every ray sample serves as the wall test and
+            # as the probes' rows
+            rows = tab.rows(points).reshape(self.rays, self._n_r)
+            reach = np.logical_and.accumulate(rows >= 0, axis=1)  # stop at the first wall
+            sub_ok = reach[:, self._probe_cols]
+            if not sub_ok.any():
+                return np.full(tab.n_bins, self.horizon)
+            # the probes of one radius share t_e, and t_e - lut[k] falls as k grows (the
+            # lookup is non-decreasing, rounding is monotone), so per radius only the
+            # largest need over its reached probes counts; an unreached probe counts as
+            # safe (need 0: t_e + 1e9, never below the first radius's value)
+            need = tab.need[rows[:, self._probe_cols]]  # (rays, radii, bins)
+            need = (need * sub_ok[:, :, None]).max(axis=0)
+            v = self._t_e[:, None] - self._turn_lut[need]
+            return v.min(axis=0)
         inside = tab.inside(points).reshape(self.rays, self._n_r)
         reach = np.cumsum(~inside, axis=1) == 0  # a ray stops at the first wall
         sub_ok = reach[:, self._probe_cols]
@@ -180,7 +209,7 @@ class DecompositionPursuer(BasePolicy):
         b0 = tab.bin_of(snap.theta)
         if row < 0:
             return 0.0, b0
-        value = self.orientation_values(snap.evader)
+        value = self._values(snap.evader, row)
         free = tab.free[row]
         nb = tab.n_bins
         # bins reachable by turning through free orientations, each way round. The table
@@ -189,8 +218,9 @@ class DecompositionPursuer(BasePolicy):
         # the current bin as blocked, so each scan starts from the nearest orientation
         # the table calls free on its side (the bins in between are crossed, not
         # targeted): otherwise no candidate is left and the pursuer stops turning.
-        ccw_run = np.roll(free, -b0)  # ccw_run[k]: bin b0 + k is free
-        cw_run = np.roll(free[::-1], b0 + 1)  # cw_run[k]: bin b0 - k is free
+        twice = np.concatenate((free, free))
+        ccw_run = twice[b0 : b0 + nb].copy()  # ccw_run[k]: bin b0 + k is free
+        cw_run = twice[b0 + nb : b0 : -1].copy()  # cw_run[k]: bin b0 - k is free
         ccw_run[0] = cw_run[0] = True
         blocked = not free[b0] and free.any()
         gap_ccw = gap_cw = 0  # table-blocked bins crossed before the first free one
@@ -201,14 +231,15 @@ class DecompositionPursuer(BasePolicy):
             cw_run[1 : gap_cw + 1] = True
         n_ccw = int(np.argmin(ccw_run)) if not ccw_run.all() else nb
         n_cw = int(np.argmin(cw_run)) if not cw_run.all() else nb
-        steps = np.arange(nb)
-        ccw_steps = steps[gap_ccw + 1 if blocked else 0 : n_ccw]
-        cw_steps = steps[gap_cw + 1 : n_cw]
-        cand_bins = np.concatenate([(b0 + ccw_steps) % nb, (b0 - cw_steps) % nb])
-        cand_rot = np.concatenate([ccw_steps, -cw_steps]).astype(float)
-        if cand_bins.size == 0:
+        ccw_from = gap_ccw + 1 if blocked else 0
+        cw_from = gap_cw + 1
+        ccw_steps = np.arange(ccw_from, max(n_ccw, ccw_from))
+        cw_steps = np.arange(cw_from, max(n_cw, cw_from))
+        if not ccw_steps.size and not cw_steps.size:
             return 0.0, b0
-        score = value[cand_bins] - self.hysteresis * np.abs(cand_rot) * self._bw / self.omega
+        cand_bins = np.concatenate([(b0 + ccw_steps) % nb, (b0 - cw_steps) % nb])
+        steps = np.concatenate([ccw_steps, cw_steps])
+        score = value[cand_bins] - self._turn_penalty[steps]
         if self.last_target is not None:  # prefer keeping the previous goal on ties
             score = score + 1e-9 * (cand_bins == self.last_target)
         k = int(np.argmax(score))
@@ -216,7 +247,7 @@ class DecompositionPursuer(BasePolicy):
         self.last_target = target
         if target == b0:
             return 0.0, target
-        rot = cand_rot[k] * self._bw
+        rot = (1 if k < ccw_steps.size else -1) * float(steps[k]) * self._bw
         # aim at the bin centre, measured from the current angle
         centre = float(tab.bin_centre(target))
         offset = math.remainder(centre - snap.theta, 2.0 * math.pi)

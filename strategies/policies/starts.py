@@ -11,6 +11,11 @@ the bounded-speed sense of Sec. 5 as the decomposition pursuer estimates it (val
 the evader does; for rho >= 1 nothing is admissible and only the safe cell is
 required). On maps where no safe cell exists (Prop. 2 holds) it falls back to a
 valid start at L_min, since no safe start exists to draw.
+
+``kind="escapable"``: the opposite, for curricula that teach escapes (and pursuits that
+must recover): a valid start with L just above L_min whose orientation lies in an
+*escapable* cell of the exact decomposition at L_min (or in a free arc at a point where
+no cell is safe). On maps with no escapable orientation it raises ``InfeasibleError``.
 """
 
 from __future__ import annotations
@@ -25,7 +30,7 @@ from envs.surveillance.placement import random_start, spawn_margins
 
 __all__ = ["START_KINDS", "sample_start"]
 
-START_KINDS = ("valid", "safe")
+START_KINDS = ("valid", "safe", "escapable")
 BATCH = 256
 MAX_BATCHES = 100
 
@@ -38,7 +43,7 @@ def sample_start(
     Args:
         config: the env's ``EnvConfig``.
         rng: the generator to draw from (the only source of randomness).
-        kind: ``"valid"`` or ``"safe"`` (see the module docstring).
+        kind: ``"valid"``, ``"safe"`` or ``"escapable"`` (see the module docstring).
         angle_margin: for ``"safe"``, radians the orientation keeps from the safe set's edge.
 
     Raises:
@@ -59,13 +64,31 @@ def sample_start(
     judge = DecompositionPursuer(turn_rate="one")
     judge.reset(role="pursuer", map=config.map, config=config, seed=0)
     tab = judge.table
+    if kind == "escapable":
+        return _near_l_min(config, kernel, rng, judge, tab, None, escapable=True)
     if not tab.guaranteed.any():  # Prop. 2: nothing is safe anywhere
         return _near_l_min(config, kernel, rng, judge, tab, None)
     return _near_l_min(config, kernel, rng, judge, tab, angle_margin)
 
 
-def _near_l_min(config, kernel, rng, judge, tab, angle_margin):
+def _escapable(dec, e, theta: float) -> bool:
+    """The rod at ``theta`` lies in an escapable cell of the exact decomposition (or in a
+    free arc at a point where no cell is known to be safe)."""
+    arcs = dec.free_arcs(e)
+    if not any(ca.escapable is False for ca in arcs):
+        return True
+    for ca in arcs:
+        if ca.arc.is_full or (theta - ca.arc.lo) % (2.0 * math.pi) <= ca.arc.width:
+            return ca.escapable is True
+    return False
+
+
+def _near_l_min(config, kernel, rng, judge, tab, angle_margin, escapable=False):
     m = config.map
+    if escapable:  # judged exactly, at L_min (the paper's cells), not on the table's grid
+        from strategies.cspace import decompose
+
+        dec = decompose(m, config.l_min)
     admissible = config.rho < 1.0  # for rho >= 1 no configuration is admissible (Sec. 5)
     range_margin, rod_clearance = spawn_margins(config)
     # near L_min (the pursuer's target), but inside the sensor range even when it is
@@ -95,6 +118,8 @@ def _near_l_min(config, kernel, rng, judge, tab, angle_margin):
                 kernel, e[i], length + r, float(theta[i]), angle_margin
             ):
                 continue
+            if escapable and not _escapable(dec, e[i], float(theta[i])):
+                continue
             if angle_margin is not None:
                 row = tab.row(e[i])
                 if row < 0 or not tab.guaranteed[row]:
@@ -109,8 +134,9 @@ def _near_l_min(config, kernel, rng, judge, tab, angle_margin):
                 "pursuer": (float(p[i, 0]), float(p[i, 1])),
                 "evader": (float(e[i, 0]), float(e[i, 1])),
             }
+    what = "escapable" if escapable else ("safe" if angle_margin is not None else "valid")
     raise InfeasibleError(
-        f"no {'safe' if angle_margin is not None else 'valid'} start at L = {length:.4g} found "
+        f"no {what} start at L = {length:.4g} found "
         f"on map {m.name!r} in {MAX_BATCHES * BATCH} proposals"
     )
 

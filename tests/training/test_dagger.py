@@ -132,3 +132,23 @@ def test_dagger_configs_round_trip_through_toml(tmp_path):
     path.write_text(cfg.to_toml().replace("hysteresis", "hysteresys"))
     with pytest.raises(InvalidConfigError, match="hysteresys"):
         load_any_config(path)
+
+
+def test_a_curriculum_plays_its_stages_in_order_then_the_top_level_settings(tmp_path):
+    """Escapable starts on a wide sensor range first, then safe starts at the map's own."""
+    from training.config import load_any_config
+
+    cfg = _lidar_cfg(tmp_path, maps=("corridor",), iterations=3, episodes=1, epochs=2,
+                     curriculum=({"iterations": 1, "start": "escapable", "env": {"l_max": 6.0}},
+                                 {"iterations": 1, "maps": ["open_room"]}),
+                     start="safe")  # fmt: skip
+    r = dagger(cfg)
+    (a,), (b,), (c,) = r.episodes
+    assert (a["map"], a["start"], a["l_max"]) == ("corridor", "escapable", 6.0)
+    assert (b["map"], b["start"]) == ("open_room", "safe") and b["l_max"] != 6.0
+    assert (c["map"], c["start"]) == ("corridor", "safe")
+    path = tmp_path / "curriculum.toml"
+    path.write_text(cfg.to_toml())
+    assert load_any_config(path) == cfg
+    with pytest.raises(InvalidConfigError, match="curriculum"):
+        _lidar_cfg(tmp_path, curriculum=({"start": "safe"},))

@@ -32,3 +32,27 @@ def test_same_generator_state_same_start():
     a = sample_start(env.config, np.random.default_rng(3), kind="safe")
     b = sample_start(env.config, np.random.default_rng(3), kind="safe")
     assert a == b
+
+
+@pytest.mark.parametrize("map_name", ["corridor", "two_rooms"])
+def test_escapable_starts_put_the_rod_in_an_escapable_cell(map_name):
+    """Checked against the exact decomposition at L_min: the orientation of the start's
+    rod lies in a cell the evader can escape from (or where no cell is classified safe)."""
+    import math
+
+    from strategies.cspace import decompose
+
+    env = surveillance_v0.parallel_env(map=map_name)
+    cfg = env.config
+    dec = decompose(cfg.map, cfg.l_min)
+    rng = np.random.default_rng(3)
+    for _ in range(4):
+        start = sample_start(cfg, rng, kind="escapable")
+        p, e = np.asarray(start["pursuer"]), np.asarray(start["evader"])
+        assert cfg.l_min <= np.linalg.norm(p - e) <= cfg.l_max
+        env.reset(seed=0, options=start)
+        theta = math.atan2(p[1] - e[1], p[0] - e[0])
+        cell = dec.cell_at(float(e[0]), float(e[1]), theta)
+        safe_here = [ca for ca in dec.free_arcs(e) if ca.escapable is False]
+        assert cell is None or cell.escapable or not safe_here
+    env.close()

@@ -85,7 +85,10 @@ def card(name: str, role: str, rows, args) -> str:
         "",
     ]
     if "disagreement" in prov:
-        lines += ["## DAgger curve", "", "| iteration | samples | disagreement | fit error | won |",
+        lines += ["## DAgger curve", "",
+                  "won: episodes won by the rollout policy, the expert acting with "
+                  "probability beta^i (so iteration 0 is the expert alone).", "",
+                  "| iteration | samples | disagreement | fit error | won |",
                   "|---|---|---|---|---|"]  # fmt: skip
         curves = zip(prov["samples"], prov["disagreement"], prov["fit_error"], prov["held"],
                      strict=False)  # fmt: skip

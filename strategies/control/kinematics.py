@@ -96,10 +96,16 @@ def theta_dot(alpha, theta, *, L: float, v_p: float, rho: float):
     v_p = validation.positive("v_p", v_p)
     rho = validation.nonnegative("rho", rho)
     phi = validation.finite_array("alpha", alpha) - validation.finite_array("theta", theta)
+    plus, minus = _theta_dot_rates(phi, L, v_p, rho)
+    return _scalar_or_array(plus), _scalar_or_array(minus)
+
+
+def _theta_dot_rates(phi, L: float, v_p: float, rho: float):
+    """:func:`theta_dot` at ``phi = alpha - theta`` on checked inputs (per-step callers)."""
     root = np.sqrt(np.maximum(1.0 - (rho * np.cos(phi)) ** 2, 0.0))
     base = -rho * np.sin(phi)
     k = v_p / L
-    return _scalar_or_array(k * (base + root)), _scalar_or_array(k * (base - root))
+    return k * (base + root), k * (base - root)
 
 
 def max_abs_theta_dot(alpha, theta, *, L: float, v_p: float, rho: float):
@@ -238,6 +244,13 @@ def pursuer_velocity_holding_range(
     L_target = validation.positive("L_target", L_target)
     v_p = validation.positive("v_p", v_p)
     gain = validation.nonnegative("gain", gain)
+    return _holding_range(ev, th, td, L, L_target, v_p, gain)
+
+
+def _holding_range(
+    ev: np.ndarray, th: float, td: float, L: float, L_target: float, v_p: float, gain: float
+) -> PursuerCommand:
+    """:func:`pursuer_velocity_holding_range` on checked inputs (per-step callers)."""
     u = np.array([math.cos(th), math.sin(th)])
     n = np.array([-math.sin(th), math.cos(th)])
     perp = float(ev @ n) + L * td  # pursuer's own perpendicular speed

@@ -29,7 +29,7 @@ import math
 import numpy as np
 
 from envs import validation
-from strategies.control.kinematics import pursuer_velocity_holding_range, theta_dot
+from strategies.control.kinematics import _holding_range, _theta_dot_rates
 from strategies.policies.base import (
     MAX_RAYS,
     BasePolicy,
@@ -187,7 +187,8 @@ class DecompositionPursuer(BasePolicy):
             # largest need over its reached probes counts; an unreached probe counts as
             # safe (need 0: t_e + 1e9, never below the first radius's value)
             need = tab.need[rows[:, self._probe_cols]]  # (rays, radii, bins)
-            need = (need * sub_ok[:, :, None]).max(axis=0)
+            need[~sub_ok] = 0
+            need = need.max(axis=0)
             v = self._t_e[:, None] - self._turn_lut[need]
             return v.min(axis=0)
         inside = tab.inside(points).reshape(self.rays, self._n_r)
@@ -265,16 +266,18 @@ class DecompositionPursuer(BasePolicy):
         rot, _ = self._target(snap)
         alpha = math.atan2(float(ve[1]), float(ve[0])) if speed > 0 else snap.theta
         rate = min(speed / c.v_pursuer, 1.0)
-        hi, lo = theta_dot(alpha, snap.theta, L=L, v_p=c.v_pursuer, rho=rate)  # eq. (6)
+        # eq. (6) and the command, on inputs checked already (theta_dot and
+        # pursuer_velocity_holding_range without their argument checks)
+        hi, lo = _theta_dot_rates(alpha - snap.theta, L, float(c.v_pursuer), rate)
         want = rot / (2.0 * c.dt)
-        cmd_rate = min(max(want, lo), hi)
-        cmd = pursuer_velocity_holding_range(
-            ve,
+        cmd_rate = min(max(want, float(lo)), float(hi))
+        cmd = _holding_range(
+            np.asarray(ve, dtype=np.float64),
             snap.theta,
             cmd_rate,
-            L=L,
-            L_target=self.L_target,
-            v_p=c.v_pursuer,
-            gain=self.distance_gain,
+            L,
+            self.L_target,
+            float(c.v_pursuer),
+            self.distance_gain,
         )
         return cmd.velocity

@@ -61,7 +61,7 @@ class LazySafetyTable:
     bin_width = SafetyTable.bin_width
     bin_of = SafetyTable.bin_of
     bin_centre = SafetyTable.bin_centre
-    row = SafetyTable.row
+    row = SafetyTable._row_search  # classifies through rows()
     grid_index = SafetyTable.grid_index
 
     def __init__(self, world: Map, L: float, resolution: float, n_bins: int) -> None:

@@ -118,10 +118,15 @@ class SafetyTable:
 
     def rows(self, points: np.ndarray) -> np.ndarray:
         """Table rows of the grid points nearest to (k, 2) points (-1 outside)."""
-        idx, ok = self.grid_index(points)
-        out = np.full(len(idx), -1, dtype=np.int64)
-        out[ok] = self.cell[idx[ok, 0], idx[ok, 1]]
-        return out
+        # grid_index's nodes, looked up flat (the policies call this every step)
+        idx = np.rint((np.asarray(points, dtype=float) - self.origin) / self.resolution).astype(
+            np.int64
+        )
+        ix, iy = idx[:, 0], idx[:, 1]
+        nx, ny = self.shape
+        ok = (ix.view(np.uint64) < nx) & (iy.view(np.uint64) < ny)  # negatives wrap high
+        flat = self.cell.reshape(-1).take(np.where(ok, ix * ny + iy, 0))
+        return np.where(ok, flat, -1).astype(np.int64)
 
     def inside(self, points: np.ndarray) -> np.ndarray:
         """Whether the grid points nearest to (k, 2) points lie in the free region."""
@@ -129,6 +134,18 @@ class SafetyTable:
 
     def row(self, point: np.ndarray) -> int:
         """Table row of the grid point nearest to ``point``, or of the nearest in free space."""
+        # rows() of one point in scalar arithmetic (the same IEEE operations; Python's
+        # round, like np.rint, rounds half to even)
+        i = round((float(point[0]) - float(self.origin[0])) / self.resolution)
+        j = round((float(point[1]) - float(self.origin[1])) / self.resolution)
+        if 0 <= i < self.shape[0] and 0 <= j < self.shape[1]:
+            r = int(self.cell[i, j])
+            if r >= 0:
+                return r
+        return self._row_search(point)
+
+    def _row_search(self, point: np.ndarray) -> int:
+        """:meth:`row` through :meth:`rows`, looking around when ``point`` is just outside."""
         r = int(self.rows(np.asarray(point, dtype=float)[None])[0])
         if r >= 0:
             return r

@@ -119,45 +119,101 @@ class ShootingEvader(BasePolicy):
         self.mode = "start"
 
     # ------------------------------------------------------------------ candidates
-    def _candidates(self, e: np.ndarray) -> np.ndarray:
+    def _candidates(self, e: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Probes on rays from ``e`` up to the first wall and their table rows, and the
+        corner points in range (their line of sight from ``e`` not checked yet: see
+        :meth:`_best_candidate`)."""
         tab = self.table
         pts = e + self._offsets
         rows = tab.rows(pts).reshape(self.rays, self._n_r)
         reach = np.cumsum(rows < 0, axis=1) == 0
-        cand = pts.reshape(self.rays, self._n_r, 2)[:, self._cols][reach[:, self._cols]]
+        sub = reach[:, self._cols]
+        cand = pts.reshape(self.rays, self._n_r, 2)[:, self._cols][sub]
         near = np.linalg.norm(self._corner_points - e, axis=1) <= self._n_r * tab.resolution
-        corners = [q for q in self._corner_points[near] if self.kernel.line_of_sight(e, q)]
-        return np.concatenate([cand, np.asarray(corners).reshape(-1, 2)])
+        return cand, rows[:, self._cols][sub], self._corner_points[near]
 
-    def _margins(self, e: np.ndarray, theta: float, cand: np.ndarray):
-        """Escape margin (radians) per candidate, and which way the pursuer would turn."""
+    def _best_candidate(self, e: np.ndarray, theta: float) -> tuple[np.ndarray, str] | None:
+        """The candidate endpoint with the largest positive escape margin (the first such
+        in the order rays, then visible corners), and the pursuer's branch there.
+
+        Corners are candidates only in line of sight of ``e``. The margins do not depend
+        on the other candidates, so only a corner that would beat every probe (and 0)
+        needs its line of sight checked.
+        """
+        rays, ray_rows, corners = self._candidates(e)
+        n = len(rays)
+        rows = np.concatenate([ray_rows, self.table.rows(corners)])
+        margin, branch = self._margins(e, theta, np.concatenate([rays, corners]), rows)
+        top = max(float(margin[:n].max()) if n else -math.inf, 0.0)
+        ex, ey = float(e[0]), float(e[1])
+        best = -1
+        for i in np.flatnonzero(margin[n:] > top).tolist():
+            q = corners[i]
+            if (best < 0 or margin[n + i] > margin[best]) and self.kernel.line_of_sight(
+                (ex, ey), (float(q[0]), float(q[1]))
+            ):
+                best = n + i
+        if best < 0 and n and margin[:n].max() > 0:
+            best = int(np.argmax(margin[:n]))
+        if best < 0:
+            return None
+        return np.concatenate([rays, corners])[best], str(branch[best])
+
+    def _margins(self, e: np.ndarray, theta: float, cand: np.ndarray, rows=None):
+        """Escape margin (radians) per candidate, and which way the pursuer would turn.
+
+        The margin is ``-inf`` (and the branch meaningless) where it cannot be positive:
+        the current orientation is safe at the candidate, the candidate is off the grid,
+        or the pursuer turns far enough either way at its least rate (eq. 6 at
+        ``alpha - theta = +-pi/2``: ``(V_p / L)(1 - rho)``, a lower bound of every
+        rate of its branch) while the evader gets there.
+
+        Args:
+            rows: the candidates' table rows, if known.
+        """
         c, tab = self.config, self.table
-        rows = tab.rows(cand)
+        rows = tab.rows(cand) if rows is None else rows
         ok = rows >= 0
         b = tab.bin_of(theta)
         need_ccw = np.where(ok, tab.ccw[np.maximum(rows, 0), b], 0).astype(float)
         need_cw = np.where(ok, tab.cw[np.maximum(rows, 0), b], 0).astype(float)
         need_ccw = np.where(need_ccw >= NO_PATH, 2 * math.pi, need_ccw * tab.bin_width)
         need_cw = np.where(need_cw >= NO_PATH, 2 * math.pi, need_cw * tab.bin_width)
-        d = cand - e
+        margin = np.full(len(cand), -np.inf)
+        branch = np.full(len(cand), "-")
+        live = np.flatnonzero(ok & ((need_ccw > 0) | (need_cw > 0)))
+        if not len(live):
+            return margin, branch
+        d = cand[live] - e
         dist = np.linalg.norm(d, axis=1)
-        alpha = np.arctan2(d[:, 1], d[:, 0])
-        dt = dist / c.v_evader / _EULER
         rho = min(self.rho, 1.0)
         k = c.v_pursuer / c.l_min
-        turned = []
-        for s in (1.0, -1.0):  # eq. (6): the pursuer turns at its best rate each way
-            th = np.full(len(cand), theta)
-            for _ in range(_EULER):
-                phi = alpha - th
-                rate = k * (
-                    -rho * np.sin(phi) + s * np.sqrt(np.maximum(1 - (rho * np.cos(phi)) ** 2, 0))
-                )
-                th = th + rate * dt
-            turned.append(np.abs(th - theta))
-        margin = np.minimum(need_ccw - turned[0], need_cw - turned[1])
-        margin = np.where(ok & ((need_ccw > 0) | (need_cw > 0)), margin, -np.inf)
-        branch = np.where(need_ccw - turned[0] < need_cw - turned[1], "+", "-")
+        # the Euler rotation below is at least k (1 - rho) dist / V_e each way (up to
+        # rounding, ~1e-14 rad): a candidate needing no more than that has no margin
+        least = k * (1.0 - rho) * dist / c.v_evader
+        up = np.minimum(need_ccw[live], need_cw[live]) - least + 1e-9 > 0
+        if not up.any():
+            return margin, branch
+        live, d, dist = live[up], d[up], dist[up]
+        need_ccw, need_cw = need_ccw[live], need_cw[live]
+        alpha = np.arctan2(d[:, 1], d[:, 0])
+        dt = dist / c.v_evader / _EULER
+        # eq. (6): the pursuer turns at its best rate each way (both ways in one array:
+        # the first half counter-clockwise, the second clockwise)
+        m = len(live)
+        alpha2, dt2 = np.concatenate([alpha, alpha]), np.concatenate([dt, dt])
+        sign = np.repeat([1.0, -1.0], m)
+        th = np.full(2 * m, theta)
+        for _ in range(_EULER):
+            phi = alpha2 - th
+            rate = k * (
+                -rho * np.sin(phi) + sign * np.sqrt(np.maximum(1 - (rho * np.cos(phi)) ** 2, 0))
+            )
+            th = th + rate * dt2
+        turned = np.abs(th - theta)
+        left, right = need_ccw - turned[:m], need_cw - turned[m:]
+        margin[live] = np.minimum(left, right)
+        branch[live] = np.where(left < right, "+", "-")
         return margin, branch
 
     # ------------------------------------------------------------------ decision
@@ -180,13 +236,10 @@ class ShootingEvader(BasePolicy):
         if self._arc is not None and self._arc_age < self.replan:
             self._arc_age += 1
             return c.v_evader * self._arc_heading(e)
-        cand = self._candidates(e)
-        if len(cand):
-            margin, branch = self._margins(e, theta, cand)
-            best = int(np.argmax(margin))
-            if margin[best] > 0:
-                self.mode = "shoot"
-                return c.v_evader * self._start_arc(e, theta, cand[best], branch[best])
+        best = self._best_candidate(e, theta)
+        if best is not None:
+            self.mode = "shoot"
+            return c.v_evader * self._start_arc(e, theta, *best)
         if row >= 0 and self.plan.region.any() and not self.plan.region[row]:
             nxt = self.plan.region_next[row]
             if nxt >= 0:

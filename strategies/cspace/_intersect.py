@@ -9,7 +9,10 @@
   implicit function is followed along it; sign changes are bisected to double precision,
   and so are the zeros of its derivative between samples of one sign (local extrema):
   an extremum that crosses zero brackets two roots, one closer than ``touch`` to zero is
-  a tangency.
+  a tangency. When the other curve is a conchoid too, its implicit function is angular
+  about its vertex (the curve passes through the vertex along two lines, see
+  :func:`refine_about`): the samples are refined there until each interval turns by
+  less than the angle between those lines, so no two roots share an interval.
 
 Each routine returns flat arrays ``(pair, tA, tB)``: pair index, the parameter on the
 first curve and on the second (unclamped: the caller checks them against the pieces'
@@ -22,10 +25,21 @@ import numpy as np
 
 from strategies.cspace._shapes import derivatives, gradient, implicit, points
 
-__all__ = ["arc_arc", "conchoid_samples", "sampled_roots", "seg_arc", "seg_seg"]
+__all__ = [
+    "arc_arc",
+    "conchoid_samples",
+    "node_sweep",
+    "refine_about",
+    "sampled_roots",
+    "seg_arc",
+    "seg_seg",
+]
 
 _PARALLEL = 1e-12  # |sin| of the angle below which two segments are parallel
 _BISECT = 64  # halvings of a bracket: below double precision on any interval
+_MAX_SWEEP = np.pi / 8  # largest turn about a conchoid's vertex of one sample interval
+_MIN_SWEEP = np.pi / 256  # ... even when the conchoid's two lines there nearly coincide
+_REFINE = 48  # halvings of a sample interval, at most
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -120,6 +134,69 @@ def conchoid_samples(data: np.ndarray, lo: np.ndarray, hi: np.ndarray, n: int):
     t.sort(axis=1)
     owner = np.repeat(np.arange(k), t.shape[1])
     return owner, t.ravel()
+
+
+def node_sweep(data: np.ndarray, L: float) -> np.ndarray:
+    """Per conchoid ``(v, a, u)``: the largest turn about ``v`` a sample interval may make.
+
+    Near its vertex ``v`` a conchoid's implicit function (:mod:`strategies.cspace._shapes`)
+    has the sign of ``h - L |cos alpha|`` (``h``: the height of ``v`` above the edge's
+    line, ``alpha``: the direction from ``v``, measured from the edge's normal): it
+    changes sign on the two lines through ``v`` at ``cos alpha = +-h / L``, whatever the
+    distance to ``v``. A curve passing close to ``v`` crosses both within a short stretch;
+    an interval turning by less than half the angle between neighbouring rays of those
+    lines (``2 phi0`` and ``pi - 2 phi0``, ``cos phi0 = h / L``) holds at most one of
+    those crossings.
+    """
+    v, a, u = data[:, 0:2], data[:, 2:4], data[:, 4:6]
+    h = np.abs(u[:, 0] * (v[:, 1] - a[:, 1]) - u[:, 1] * (v[:, 0] - a[:, 0]))
+    phi0 = np.arccos(np.clip(h / L, 0.0, 1.0))
+    return np.clip(0.5 * np.minimum(2.0 * phi0, np.pi - 2.0 * phi0), _MIN_SWEEP, _MAX_SWEEP)
+
+
+def refine_about(kind_a, data_a, owner, t, centre, sweep, L: float, floor: float):
+    """Samples of curves A refined until each interval turns by at most ``sweep`` about
+    ``centre`` (per pair: the vertex of the conchoid whose implicit function is followed
+    along A, see :func:`node_sweep`).
+
+    An interval is halved while the directions from ``centre`` to its two ends differ by
+    more than ``sweep`` and both ends are farther than ``floor`` from ``centre`` (closer,
+    they are ``centre``: a vertex). Only intervals near ``centre`` are split: far from it,
+    the sampling already turns little.
+
+    Args:
+        kind_a, data_a: per pair, the sampled curve A.
+        owner, t: samples as for :func:`sampled_roots` (sorted by pair, then parameter).
+        centre: (k, 2) per pair, the point to resolve (``nan``: none).
+        sweep: (k,) per pair, the largest turn of an interval (``inf``: no refinement).
+        L: rod length.
+        floor: distance to ``centre`` below which a sample is at it.
+
+    Returns:
+        ``(owner, t)``, refined.
+    """
+    kind_a = np.asarray(kind_a)
+    rel = points(kind_a[owner], data_a[owner], t, L) - centre[owner]
+    r = np.hypot(rel[:, 0], rel[:, 1])
+    ang = np.arctan2(rel[:, 1], rel[:, 0])
+    k = np.flatnonzero(owner[1:] == owner[:-1])  # intervals to check: (k, k + 1)
+    for _ in range(_REFINE):
+        turn = np.abs((ang[k + 1] - ang[k] + np.pi) % (2.0 * np.pi) - np.pi)
+        split = (turn > sweep[owner[k]]) & (r[k] > floor) & (r[k + 1] > floor)
+        split &= t[k + 1] - t[k] > 1e-12 * (np.abs(t[k + 1]) + np.abs(t[k]) + L)
+        k = k[split]
+        if len(k) == 0:
+            break
+        tm = 0.5 * (t[k] + t[k + 1])
+        rm = points(kind_a[owner[k]], data_a[owner[k]], tm, L) - centre[owner[k]]
+        t = np.insert(t, k + 1, tm)
+        owner = np.insert(owner, k + 1, owner[k])
+        r = np.insert(r, k + 1, np.hypot(rm[:, 0], rm[:, 1]))
+        ang = np.insert(ang, k + 1, np.arctan2(rm[:, 1], rm[:, 0]))
+        left = k + np.arange(len(k))  # where each split interval's left end is now
+        k = np.concatenate([left, left + 1])
+        k.sort()
+    return owner, t
 
 
 def sampled_roots(

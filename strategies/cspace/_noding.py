@@ -27,7 +27,15 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from strategies.cspace._intersect import arc_arc, conchoid_samples, sampled_roots, seg_arc, seg_seg
+from strategies.cspace._intersect import (
+    arc_arc,
+    conchoid_samples,
+    node_sweep,
+    refine_about,
+    sampled_roots,
+    seg_arc,
+    seg_seg,
+)
 from strategies.cspace._shapes import ARC, CONCHOID, SEGMENT, points, project
 from strategies.cspace.tolerances import Tolerances
 
@@ -163,6 +171,15 @@ def _records(cv: Curves, L: float, tol: Tolerances, i, j):
         a_ = np.where(ki[m] == CONCHOID, i[m], j[m])
         b_ = np.where(ki[m] == CONCHOID, j[m], i[m])
         owner, ts = conchoid_samples(cv.data[a_], cv.t0[a_], cv.t1[a_], _CONCHOID_SAMPLES)
+        # a conchoid's implicit function turns about its vertex: resolve it there
+        both = np.flatnonzero(cv.kind[b_] == CONCHOID)
+        if len(both):
+            sweep = np.full(len(m), np.inf)
+            sweep[both] = node_sweep(cv.data[b_[both]], L)
+            centre = cv.data[b_, 0:2]
+            owner, ts = refine_about(
+                cv.kind[a_], cv.data[a_], owner, ts, centre, sweep, L, tol.merge
+            )
         pair, tr, _ = sampled_roots(
             cv.kind[a_], cv.data[a_], owner, ts, cv.kind[b_], cv.data[b_], L, tol.touch
         )

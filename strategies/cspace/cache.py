@@ -46,7 +46,7 @@ __all__ = [
     "write_cache_file",
 ]
 
-FORMAT_VERSION = 4  # 4: conchoid-conchoid crossings no longer lost at the pole (53fcd50)
+FORMAT_VERSION = 5  # 5: conchoid-conchoid crossings near a vertex kept (4: at the pole)
 """Bump when the decomposition's content or the file layout changes."""
 
 MAGIC = b"SURVEIL-CSPACE-DECOMPOSITION\n"

@@ -73,6 +73,7 @@ class DecompositionPursuer(BasePolicy):
 
     roles = ("pursuer",)
     EAGER_TABLE_POINTS = 50_000  # grid points above which "auto" fills the table lazily
+    CLOSING = 0.3  # share of V_p kept for closing in while L exceeds its target
 
     def __init__(
         self,
@@ -269,8 +270,23 @@ class DecompositionPursuer(BasePolicy):
         # eq. (6) and the command, on inputs checked already (theta_dot and
         # pursuer_velocity_holding_range without their argument checks)
         hi, lo = _theta_dot_rates(alpha - snap.theta, L, float(c.v_pursuer), rate)
+        hi, lo = float(hi), float(lo)
+        closing = min(self.distance_gain * (L - self.L_target), self.CLOSING * c.v_pursuer)
+        if closing > 0.0:
+            # the rod is longer than the table's (fewer free orientations, Prop. 3: the
+            # table may call an orientation clear that is not): keep part of the speed
+            # for closing in instead of spending it all on the rotation, which would let
+            # L drift with the evader's radial motion. Eq. (6)'s interval and this one
+            # are both centred on the rate that matches the evader's motion across the
+            # rod; the narrower wins (this one when the evader is not charging)
+            u = (math.cos(snap.theta), math.sin(snap.theta))
+            along = float(ve[0]) * u[0] + float(ve[1]) * u[1]
+            across = float(ve[1]) * u[0] - float(ve[0]) * u[1]
+            budget = math.sqrt(max(c.v_pursuer**2 - (along - closing) ** 2, 0.0))
+            hi = min(hi, (budget - across) / L)
+            lo = max(lo, (-budget - across) / L)
         want = rot / (2.0 * c.dt)
-        cmd_rate = min(max(want, float(lo)), float(hi))
+        cmd_rate = min(max(want, lo), hi)
         cmd = _holding_range(
             np.asarray(ve, dtype=np.float64),
             snap.theta,

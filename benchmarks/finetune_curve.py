@@ -29,10 +29,10 @@ from strategies.runner import run_episode
 from training import zoo
 
 
-def _held(model_zip: Path, prov_dir: Path, maps, opponent: str, episodes: int) -> int:
+def _held(model_zip: Path, prov_dir: Path, maps, opponent: str, episodes: int, tmp: str) -> int:
     import shutil
 
-    d = model_zip.parent / "eval"
+    d = Path(tmp) / "eval"  # the model beside the zoo's provenance (its observation)
     d.mkdir(exist_ok=True)
     shutil.copyfile(model_zip, d / "model.zip")
     shutil.copyfile(prov_dir / "provenance.json", d / "provenance.json")
@@ -72,7 +72,7 @@ def main(argv=None) -> int:
         "plain PPO (same weights)": dict(critic_warmup=0, bc_coef=0.0, bc_decay=1.0),
     }
     with tempfile.TemporaryDirectory() as tmp:
-        base = _held(zoo.model_path(args.model), prov_dir, maps, args.opponent, args.episodes)
+        base = _held(zoo.model_path(args.model), prov_dir, maps, args.opponent, args.episodes, tmp)
         for arm, kw in arms.items():
             print(f"\n== {arm}")
             blo, bhi = wilson_interval(base, args.episodes)
@@ -93,7 +93,7 @@ def main(argv=None) -> int:
                 model.learn(args.every, reset_num_timesteps=False)
                 path = Path(tmp) / f"{len(arm)}_{done}.zip"
                 model.save(str(path))
-                w = _held(path, prov_dir, maps, args.opponent, args.episodes)
+                w = _held(path, prov_dir, maps, args.opponent, args.episodes, tmp)
                 lo, hi = wilson_interval(w, args.episodes)
                 print(f"  step {done:>7}: held {w:>3}/{args.episodes} [{lo:.2f}, {hi:.2f}] "
                       f"({time.perf_counter() - t0:.0f} s)", flush=True)  # fmt: skip

@@ -32,7 +32,10 @@ from tests.envs.surveillance._worlds import open_room
         ({"max_cycles": 0}, r"^max_cycles = 0: expected an integer >= 1$"),
         ({"max_cycles": 10.0}, r"^max_cycles = 10.0: expected an integer >= 1$"),
         ({"max_cycles": True}, r"^max_cycles = True: expected an integer >= 1, got bool$"),
-        ({"observation": "pixels"}, r"^observation = 'pixels': expected one of 'state', 'lidar', 'lidar_track'$"),
+        (
+            {"observation": "pixels"},
+            r"^observation = 'pixels': expected one of 'state', 'lidar', 'lidar_track'$",
+        ),
         ({"n_rays": 0}, r"^n_rays = 0: expected an integer in \[1, 4096\]$"),
         ({"n_rays": 10**9}, r"^n_rays = 1000000000: expected an integer in \[1, 4096\]$"),
         ({"lidar_range": -2.0}, r"^lidar_range = -2.0: expected a finite number > 0$"),

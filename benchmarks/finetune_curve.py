@@ -11,7 +11,7 @@ measured in the same run.
 
 Usage::
 
-    python benchmarks/finetune_curve.py [--model dagger_pursuer_specialist]
+    python benchmarks/finetune_curve.py [--model dagger_pursuer_generalist]
         [--steps 40000] [--every 10000] [--episodes 24] [--opponent evader/shooting]
 """
 
@@ -53,7 +53,7 @@ def main(argv=None) -> int:
     from training.single_agent import SingleAgentEnv
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--model", default="dagger_pursuer_specialist")
+    ap.add_argument("--model", default="dagger_pursuer_generalist")
     ap.add_argument("--steps", type=int, default=40_000)
     ap.add_argument("--every", type=int, default=10_000)
     ap.add_argument("--episodes", type=int, default=24)

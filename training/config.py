@@ -298,6 +298,22 @@ class TrainConfig:
         return dataclasses.replace(self, **changes)
 
 
+def read_toml(path: str | os.PathLike[str]) -> dict[str, Any]:
+    """The table of a TOML config file.
+
+    Raises:
+        InvalidConfigError: the file is missing or not valid TOML (naming it).
+    """
+    p = Path(path)
+    try:
+        with p.open("rb") as fh:
+            return tomllib.load(fh)
+    except FileNotFoundError:
+        raise InvalidConfigError(f"config: no such file {str(p)!r}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise InvalidConfigError(f"config: {str(p)!r} is not valid TOML ({exc})") from exc
+
+
 def load_config(path: str | os.PathLike[str], **overrides: Any) -> TrainConfig:
     """Load a :class:`TrainConfig` from a TOML file, with optional field overrides.
 
@@ -305,13 +321,7 @@ def load_config(path: str | os.PathLike[str], **overrides: Any) -> TrainConfig:
         InvalidConfigError: the file is missing or not valid TOML, or a field is bad.
     """
     p = Path(path)
-    try:
-        with p.open("rb") as fh:
-            data = tomllib.load(fh)
-    except FileNotFoundError:
-        raise InvalidConfigError(f"config: no such file {str(p)!r}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise InvalidConfigError(f"config: {str(p)!r} is not valid TOML ({exc})") from exc
+    data = read_toml(p)
     data.update(overrides)
     if data.get("method") == "rl":  # written by load_any_config users for clarity
         del data["method"]

@@ -58,9 +58,9 @@ from typing import Any
 import numpy as np
 
 if sys.version_info >= (3, 11):
-    import tomllib
+    pass
 else:  # pragma: no cover - Python 3.10 reads TOML with the tomli backport
-    import tomli as tomllib
+    pass
 
 from envs import validation
 from envs.errors import InvalidConfigError
@@ -276,14 +276,10 @@ def load_dagger_config(path: str | os.PathLike[str], **overrides: Any) -> Dagger
         InvalidConfigError: the file is missing or not valid TOML, or a field is bad
             (the message names the file).
     """
+    from training.config import read_toml
+
     p = Path(path)
-    try:
-        with p.open("rb") as fh:
-            data = tomllib.load(fh)
-    except FileNotFoundError:
-        raise InvalidConfigError(f"config: no such file {str(p)!r}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise InvalidConfigError(f"config: {str(p)!r} is not valid TOML ({exc})") from exc
+    data = read_toml(p)
     data.update(overrides)
     try:
         return DaggerConfig.from_dict(data)

@@ -49,18 +49,12 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
-import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-
-if sys.version_info >= (3, 11):
-    pass
-else:  # pragma: no cover - Python 3.10 reads TOML with the tomli backport
-    pass
 
 from envs import validation
 from envs.errors import InvalidConfigError

@@ -116,3 +116,32 @@ def test_reproduce_is_bit_for_bit(tmp_path, monkeypatch, method):
     assert zoo.list_models() == ["tiny"]
     again = zoo.reproduce("tiny", tmp_path / "again")
     assert _same(_weights(run / "model.zip"), _weights(again.model_path))
+
+
+def test_reproduce_warns_when_the_code_has_changed_since_training(tmp_path, monkeypatch):
+    """The provenance names the commit; code changed since then may train another model."""
+    from training.train import _git
+
+    first = _git("rev-list", "--max-parents=0", "HEAD")
+    if first is None:
+        pytest.skip("not a git checkout")
+    changed = zoo.code_changed_since(first.splitlines()[0])
+    assert any(p.startswith("envs/") for p in changed)
+    assert zoo.code_changed_since(None) == [] and zoo.code_changed_since("0" * 40) == []
+    monkeypatch.setattr(zoo, "MODELS_DIR", tmp_path / "zoo")
+    run = tmp_path / "run"
+    cfg = DaggerConfig(role="pursuer", expert="pursuer/greedy", opponent="evader/straight",
+                       maps=("open_room",), iterations=1, episodes=1, max_cycles=10, epochs=1,
+                       output_dir=str(run))  # fmt: skip
+    from training.dagger import dagger
+
+    dagger(cfg)
+    prov = run / "provenance.json"
+    import json
+
+    record = json.loads(prov.read_text())
+    record["git_sha"] = first.splitlines()[0]
+    prov.write_text(json.dumps(record))
+    zoo.install("old", run)
+    with pytest.warns(zoo.ReproducibilityWarning, match="check that commit out"):
+        zoo.reproduce("old", tmp_path / "again")

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -33,6 +34,8 @@ from training.train import TrainResult, load_policy, read_provenance, train
 
 __all__ = [
     "MODELS_DIR",
+    "ReproducibilityWarning",
+    "code_changed_since",
     "config",
     "info",
     "install",
@@ -116,6 +119,16 @@ def reproduce(
         progress_bar: show SB3's progress bar.
     """
     cfg = config(name).replace(output_dir=os.fspath(output_dir or Path("out/zoo") / name))
+    changed = code_changed_since(info(name).get("git_sha"))
+    if changed:
+        warnings.warn(
+            f"{name} was trained at {info(name)['git_sha'][:12]}; the code it trains with "
+            f"has changed since ({', '.join(changed[:5])}{', ...' if len(changed) > 5 else ''}), "
+            "so the retrained model may differ: check that commit out to reproduce it bit "
+            "for bit",
+            ReproducibilityWarning,
+            stacklevel=2,
+        )
     if isinstance(cfg, DaggerConfig):
         result = dagger(cfg, verbose=progress_bar)
         if install_result:
@@ -125,6 +138,23 @@ def reproduce(
     if install_result:
         install(name, result.output_dir)
     return result
+
+
+class ReproducibilityWarning(UserWarning):
+    """``reproduce`` runs code that differs from the code the model was trained with."""
+
+
+def code_changed_since(sha: str | None) -> list[str]:
+    """Files under envs/, strategies/ and training/ (models excluded) that differ between
+    commit ``sha`` and the working tree; ``[]`` when they are the same or git cannot tell
+    (no git, or an unknown commit)."""
+    from training.train import _git
+
+    if not sha:
+        return []
+    out = _git("diff", "--name-only", sha, "--", "envs", "strategies", "training",
+               ":(exclude)training/zoo/models")  # fmt: skip
+    return [] if not out else out.splitlines()
 
 
 def install(name: str, run_dir: str | os.PathLike[str]) -> Path:

@@ -64,8 +64,6 @@ from strategies.runner import check_observation_options, run_episode
 
 __all__ = ["DaggerConfig", "DaggerResult", "dagger", "load_dagger_config"]
 
-_FILES = ("model.zip", "dataset.npz", "progress.json")
-
 
 @dataclass(frozen=True)
 class DaggerConfig:
@@ -101,6 +99,12 @@ class DaggerConfig:
     learning_rate: float = 1e-3
     radial_weight: float = 1.0
     """Weight of the action error along the line of sight (1: plain MSE); see :func:`_fit`."""
+    validation_episodes: int = 0
+    """Episodes the learner plays *alone* after each fit (fixed seeds, the top-level maps,
+    start and env, the opponent or pool): a learner-only learning curve. With more than 0,
+    ``model.zip`` is the iteration that won most of them (ties: the later one) and
+    ``model_last.zip`` the last iteration, from which a resumed run continues: DAgger's
+    last iteration is not always its best."""
     curriculum: tuple[dict[str, Any], ...] = ()
     """Stages played first, in order: ``{"iterations": n, "start": ..., "maps": [...],
     "env": {...}}`` (each key but ``iterations`` optional, overriding the top-level
@@ -141,7 +145,7 @@ class DaggerConfig:
         make_policy(self.expert, **self.expert_params)  # unknown names and parameters fail here
         put("observation", check_observation_options(self.observation, f"{where}: observation"))
         for name, lo in (("iterations", 1), ("episodes", 1), ("max_cycles", 1), ("epochs", 1),
-                         ("batch_size", 1), ("seed", 0)):  # fmt: skip
+                         ("batch_size", 1), ("seed", 0), ("validation_episodes", 0)):  # fmt: skip
             validation.integer(name, getattr(self, name), minimum=lo, where=where)
         validation.unit_interval("beta", self.beta, where=where, open=False)
         validation.positive("learning_rate", self.learning_rate, where=where)
@@ -208,6 +212,8 @@ class DaggerConfig:
             {k: (list(x) if isinstance(x, tuple) else x) for k, x in s.items()}
             for s in self.curriculum
         ]
+        if not self.validation_episodes:  # absent unless used: older records compare equal
+            del d["validation_episodes"]
         return d
 
     @classmethod
@@ -296,6 +302,9 @@ class DaggerResult:
         fit_error: per iteration, the mean |learner - expert| on the whole dataset after
             the fit (how well the network imitates what it was shown).
         episodes: per iteration, one record per episode (map, opponent, winner, steps).
+        validation: per iteration, the share of the validation episodes the learner won
+            alone (empty without ``validation_episodes``).
+        best_iteration: the iteration ``model_path`` holds.
     """
 
     model_path: Path
@@ -305,6 +314,8 @@ class DaggerResult:
     wall_seconds: float
     fit_error: list[float] = field(default_factory=list)
     episodes: list[list[dict[str, Any]]] = field(default_factory=list)
+    validation: list[float] = field(default_factory=list)
+    best_iteration: int = -1
 
 
 class _Rollout:
@@ -442,7 +453,8 @@ def _resume(cfg: DaggerConfig, out: Path, env) -> tuple[Any, dict[str, Any], lis
             "use another output_dir or delete that one"
         )
     try:
-        model = PPO.load(str(out / "model.zip"), env=env, device="cpu")
+        last = out / "model_last.zip"
+        model = PPO.load(str(last if last.is_file() else out / "model.zip"), env=env, device="cpu")
         with np.load(out / "dataset.npz") as data:
             obs, act = list(data["obs"]), list(data["act"])
     except Exception as exc:  # a damaged file: say which, do not guess
@@ -458,17 +470,38 @@ def _resume(cfg: DaggerConfig, out: Path, env) -> tuple[Any, dict[str, Any], lis
     return model, progress, obs, act
 
 
-def _write_iteration(out: Path, model, obs, act, progress: dict[str, Any]) -> None:
-    """Model, dataset and curves of a finished iteration, each replaced atomically."""
-    tmp = out / "model.zip.tmp"
+def _write_iteration(out: Path, model, obs, act, progress: dict[str, Any], best: bool) -> None:
+    """Model, dataset and curves of a finished iteration, each replaced atomically;
+    ``model.zip`` too when this iteration is the best so far (or there is no validation)."""
+    import shutil
+
+    tmp = out / "model_last.zip.tmp"
     model.save(str(tmp))
-    os.replace(tmp, out / "model.zip")
+    os.replace(tmp, out / "model_last.zip")
+    if best:
+        shutil.copyfile(out / "model_last.zip", out / "model.zip.tmp")
+        os.replace(out / "model.zip.tmp", out / "model.zip")
     tmp_npz = out / "dataset.tmp.npz"
     np.savez_compressed(tmp_npz, obs=np.asarray(obs), act=np.asarray(act))
     os.replace(tmp_npz, out / "dataset.npz")
     tmp_json = out / "progress.json.tmp"
     tmp_json.write_text(json.dumps(progress, indent=2) + "\n")
     os.replace(tmp_json, out / "progress.json")
+
+
+def _validate(cfg: DaggerConfig, model, opponent) -> float:
+    """The share of ``cfg.validation_episodes`` fixed-seed episodes the learner wins alone."""
+    wins = 0
+    other = "evader" if cfg.role == "pursuer" else "pursuer"
+    for k in range(cfg.validation_episodes):
+        seed = 10_000_019 + cfg.seed * 1_003 + k
+        learner = _Rollout(make_policy(cfg.expert, **cfg.expert_params), model, 0.0, seed,
+                           cfg.observation)  # fmt: skip
+        pair = {cfg.role: learner, other: opponent}
+        r = run_episode(cfg.maps[k % len(cfg.maps)], pair["pursuer"], pair["evader"], seed,
+                        max_cycles=cfg.max_cycles, overrides=cfg.env, start=cfg.start)  # fmt: skip
+        wins += r.winner == cfg.role
+    return wins / cfg.validation_episodes
 
 
 def dagger(cfg: DaggerConfig, *, verbose: bool = False) -> DaggerResult:
@@ -542,12 +575,22 @@ def dagger(cfg: DaggerConfig, *, verbose: bool = False) -> DaggerResult:
         progress["fit_error"].append(float(np.linalg.norm(np.clip(pred, -1, 1) - Y, axis=1).mean()))
         progress["samples"].append(len(data_obs))
         progress["episodes"].append(records)
+        best = True
+        if cfg.validation_episodes:
+            won = _validate(cfg, model, opponent)
+            curve = progress.setdefault("validation", [])
+            curve.append(won)
+            best = won >= max(curve)
+            if best:
+                progress["best_iteration"] = it
         progress["wall_seconds"] = round(progress["wall_seconds"] + time.perf_counter() - t_it, 3)
-        _write_iteration(out, model, data_obs, data_act, progress)
+        _write_iteration(out, model, data_obs, data_act, progress, best)
         if verbose:
             print(f"dagger {cfg.role} iteration {it}: beta {beta:.3f}, samples {len(data_obs)}, "
                   f"disagreement {progress['disagreement'][-1]:.3f}, fit error "
-                  f"{progress['fit_error'][-1]:.3f}, won {wins}/{cfg.episodes}, "
+                  f"{progress['fit_error'][-1]:.3f}, won {wins}/{cfg.episodes}"
+                  + (f", learner alone won {progress['validation'][-1]:.2f}"
+                     if cfg.validation_episodes else "") + ", "
                   f"{time.perf_counter() - t_it:.0f} s", flush=True)  # fmt: skip
     provenance = {
         "role": cfg.role,
@@ -564,6 +607,8 @@ def dagger(cfg: DaggerConfig, *, verbose: bool = False) -> DaggerResult:
         "samples": progress["samples"],
         "held": progress["held"],
         "fit_error": progress["fit_error"],
+        "validation": progress.get("validation", []),
+        "best_iteration": progress.get("best_iteration", len(progress["samples"]) - 1),
         "wall_seconds": progress["wall_seconds"],
         **_git_state(),
         "versions": _versions(),
@@ -575,4 +620,5 @@ def dagger(cfg: DaggerConfig, *, verbose: bool = False) -> DaggerResult:
     env.close()
     return DaggerResult(out / "model.zip", progress["disagreement"], progress["samples"],
                         progress["held"], time.perf_counter() - t0, progress["fit_error"],
-                        progress["episodes"])  # fmt: skip
+                        progress["episodes"], progress.get("validation", []),
+                        provenance["best_iteration"])  # fmt: skip

@@ -152,3 +152,21 @@ def test_a_curriculum_plays_its_stages_in_order_then_the_top_level_settings(tmp_
     assert load_any_config(path) == cfg
     with pytest.raises(InvalidConfigError, match="curriculum"):
         _lidar_cfg(tmp_path, curriculum=({"start": "safe"},))
+
+
+def test_validation_keeps_the_best_iteration_and_a_resumable_last_one(tmp_path):
+    """The learner plays alone after each fit; model.zip is the iteration that won most
+    (the later on ties), model_last.zip the last, and both load as ordinary models."""
+    import torch
+    from stable_baselines3 import PPO
+
+    r = dagger(_lidar_cfg(tmp_path, iterations=3, validation_episodes=3))
+    assert len(r.validation) == 3 and all(0.0 <= v <= 1.0 for v in r.validation)
+    best = max(i for i, v in enumerate(r.validation) if v == max(r.validation))
+    assert r.best_iteration == best
+    kept = PPO.load(r.model_path, device="cpu").policy.state_dict()
+    last = PPO.load(r.model_path.parent / "model_last.zip", device="cpu").policy.state_dict()
+    same = all(torch.equal(kept[k], last[k]) for k in kept)
+    assert same == (best == 2)
+    prov = json.loads((r.model_path.parent / "provenance.json").read_text())
+    assert prov["validation"] == r.validation and prov["best_iteration"] == best

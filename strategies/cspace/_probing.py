@@ -6,9 +6,11 @@ the exact middle of one of its edges, along the exact normal, a small offset to 
 side; the free arcs there (all probes of a round at once,
 :func:`~strategies.cspace._batch_arcs.free_arcs_batch`) must carry exactly the stop
 pairs of the region on that side, which identifies each arc's cell. A side whose probe
-does not match tries a smaller offset, then other edges of the piece (longest first);
-across a sliver (a face too thin to probe) it steps over the sliver and takes whichever
-region lies beyond. Sides are matched independently, round after round, until each is
+does not match tries a smaller offset, then other edges of the piece (longest first),
+then other points of those edges (``PROBE_AT``: the kernel's stops are not the exact ones
+in cusps near some curve ends, which can cover a short piece's middle); across a sliver
+(a face too thin to probe) it steps over the sliver and takes whichever region lies
+beyond. Sides are matched independently, round after round, until each is
 matched or out of attempts; a piece whose sides never match falls back to matching
 arcs by overlap and is counted as unresolved (never silently).
 
@@ -29,13 +31,17 @@ from strategies.cspace._arcs import OVERLAP_TOL
 from strategies.cspace._batch_arcs import ArcBatch, free_arcs_batch
 from strategies.cspace.arrangement import Arrangement
 
-__all__ = ["PROBE_EDGES", "PROBE_SHRINK", "Probed", "probe_pieces", "signature_hashes"]
+__all__ = ["PROBE_AT", "PROBE_EDGES", "PROBE_SHRINK", "Probed", "probe_pieces", "signature_hashes"]
 
 PROBE_EDGES = 4
 """Edges of a piece tried (longest first)."""
 
 PROBE_SHRINK = (1.0, 0.1, 0.01, 1e-3)
 """Probe offsets tried on an edge, times the first one."""
+
+PROBE_AT = (0.5, 0.25, 0.75, 0.1, 0.9)
+"""Points of an edge probed, as fractions of its parameter interval: the middle first
+(every edge and offset), then the others, nearer and nearer to its ends."""
 
 _THIN_STEPS = (2.0, 4.0, 10.0, 30.0)  # offsets past a sliver, times the sliver tolerance
 _TWO_PI = 2.0 * math.pi
@@ -85,12 +91,16 @@ def signature_hashes(batch: ArcBatch) -> np.ndarray:
     return out
 
 
-def _offsets(tol, length: np.ndarray, width: np.ndarray, over: np.ndarray) -> np.ndarray:
-    """(k, 7) offsets to try on one side of an edge (NaN: none): a fraction of the edge
-    and of the regions (``width``) shrinking to the kernel's resolution, then a few
-    sliver widths; across a sliver (``over``) only the sliver widths."""
+def _offsets(
+    tol, length: np.ndarray, width: np.ndarray, over: np.ndarray, at: float = 0.5
+) -> np.ndarray:
+    """(k, 7) offsets to try on one side of an edge probed at fraction ``at`` of it (NaN:
+    none): a fraction of the edge (half the distance to its nearer end) and of the
+    regions (``width``) shrinking to the kernel's resolution, then a few sliver widths;
+    across a sliver (``over``) only the sliver widths."""
     floor = 4.0 * tol.kernel
-    eps0 = np.maximum(np.minimum(np.minimum(tol.probe, 0.25 * length), 0.25 * width), floor)
+    reach = 0.5 * min(at, 1.0 - at) * length
+    eps0 = np.maximum(np.minimum(np.minimum(tol.probe, reach), 0.25 * width), floor)
     shrink = np.maximum(eps0[:, None] * np.asarray(PROBE_SHRINK)[None, :], floor)
     shrink[:, 1:][shrink[:, 1:] == shrink[:, :-1]] = np.nan  # clamped to the floor: once
     thin = np.asarray(_THIN_STEPS[:3]) * tol.thin
@@ -165,21 +175,35 @@ def probe_pieces(
     edge_tab[owner, rank], sign_tab[owner, rank] = e_all, s_all
     regs = np.stack([ra[job], rb[job]], axis=1)
     real_w = np.where(regs >= 0, width[np.maximum(regs, 0)], np.inf).min(axis=1)
-    # attempts per (job, side): PROBE_EDGES edges x 7 offsets, in order
+    # attempts per (job, side), in order: per point along the edges (PROBE_AT), per edge
+    # (PROBE_EDGES), 7 offsets. A probe must land where the kernel's stop labels are
+    # those of the exact arrangement: not always so near a curve's end, where the kernel
+    # takes a block narrower than ANGLE_TOL for a mere contact (e.g. beside a type-2 arc
+    # near the end of a type-4 segment on it, a cusp about ANGLE_TOL * L**2 / d wide at
+    # distance d from the end); on a piece a few 1e-6 L short (a wall edge within a few
+    # 1e-6 L of L) that cusp can cover the side at the middle at every offset, so the
+    # other points of the edge are tried before giving up.
     length = np.where(edge_tab >= 0, arr.edge_length[np.maximum(edge_tab, 0)], np.nan)
     offs = np.stack(
         [
-            _offsets(
-                tol,
-                length.ravel(),
-                np.repeat(real_w, PROBE_EDGES),
-                np.repeat(regs[:, side] < 0, PROBE_EDGES),
-            ).reshape(n_jobs, PROBE_EDGES, -1)
+            np.stack(
+                [
+                    _offsets(
+                        tol,
+                        length.ravel(),
+                        np.repeat(real_w, PROBE_EDGES),
+                        np.repeat(regs[:, side] < 0, PROBE_EDGES),
+                        at,
+                    ).reshape(n_jobs, PROBE_EDGES, -1)
+                    for at in PROBE_AT
+                ],
+                axis=1,
+            ).reshape(n_jobs, -1)
             for side in (0, 1)
         ],
         axis=1,
-    )  # (job, side, edge, offset)
-    n_off = offs.shape[3]
+    )  # (job, side, attempt): attempt = (at * PROBE_EDGES + edge) * n_off + offset
+    n_off = offs.shape[2] // (len(PROBE_AT) * PROBE_EDGES)
     found = np.full((n_jobs, 2), -2, dtype=np.intp)  # region matched, -1: a wall, -2: none
     inside = np.zeros((n_jobs, 2), dtype=bool)  # a probe stayed inside the sliver
     own = np.zeros((n_jobs, 2), dtype=np.uint64)
@@ -194,15 +218,15 @@ def probe_pieces(
     sig_regions: dict[int, list[int]] = {}
     for r, h in enumerate(sig_hash.tolist()):
         sig_regions.setdefault(h, []).append(r)
-    for attempt in range(PROBE_EDGES * n_off):
-        k, o = divmod(attempt, n_off)
-        eps = offs[:, :, k, o]
+    for attempt in range(offs.shape[2]):
+        a, k = divmod(attempt // n_off, PROBE_EDGES)
+        eps = offs[:, :, attempt]
         todo_j, todo_s = np.nonzero((found == -2) & np.isfinite(eps) & (edge_tab[:, k, None] >= 0))
         if len(todo_j) == 0:
-            if not ((found == -2) & np.isfinite(offs[:, :, k:, :]).any(axis=(2, 3))).any():
+            if not ((found == -2) & np.isfinite(offs[:, :, attempt:]).any(axis=2)).any():
                 break
             continue
-        p, n = arr.probes(edge_tab[todo_j, k], sign_tab[todo_j, k])
+        p, n = arr.probes(edge_tab[todo_j, k], sign_tab[todo_j, k], PROBE_AT[a])
         fresh = np.isnan(first_p[todo_j, 0])
         first_p[todo_j[fresh]], first_n[todo_j[fresh]] = p[fresh], n[fresh]
         side_sign = np.where(todo_s == 0, 1.0, -1.0)

@@ -107,12 +107,16 @@ class Arrangement:
     tol: Tolerances = field(repr=False)
     stats: dict[str, int] = field(default_factory=dict)
 
-    def probes(self, edges: np.ndarray, signs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The exact middles of edges and the unit normals there, pointing to the left
-        (``signs`` +1) or right (-1) of each edge's growing parameter."""
+    def probes(
+        self, edges: np.ndarray, signs: np.ndarray, at: float = 0.5
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The exact points of edges at fraction ``at`` of their parameter interval (the
+        middles by default) and the unit normals there, pointing to the left (``signs``
+        +1) or right (-1) of each edge's growing parameter."""
         edges = np.asarray(edges, dtype=np.intp)
         k = self.noded.curve[edges]
-        t = 0.5 * (self.noded.ta[edges] + self.noded.tb[edges])
+        ta, tb = self.noded.ta[edges], self.noded.tb[edges]
+        t = 0.5 * (ta + tb) if at == 0.5 else ta + at * (tb - ta)
         kind, data = self.curves.kind[k], self.curves.data[k]
         p = points(kind, data, t, self.tol.L)
         d1, _ = derivatives(kind, data, t, self.tol.L)

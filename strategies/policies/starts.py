@@ -12,6 +12,32 @@ the evader does; for rho >= 1 nothing is admissible and only the safe cell is
 required). On maps where no safe cell exists (Prop. 2 holds) it falls back to a
 valid start at L_min, since no safe start exists to draw.
 
+For rho < 1 a safe start must also leave the pursuer room to *retreat* (issue 13): the
+cell test is about orientations, not about the pursuer's body, and a start at L_0 (just
+above L_min) with the pursuer's back to a wall was lost in about a second to an evader
+charging straight at it (maze, seed 5: the pursuer is pinned, "too_close", before its
+rod has turned). The criterion, conservative and simple:
+
+* Charged along the rod at V_e, the pursuer keeps L constant only by moving with a
+  component V_e along the rod direction u (away from the evader); its remaining speed
+  V_p sqrt(1 - rho^2) goes sideways and turns the rod at V_p sqrt(1 - rho^2) / L.
+* It must turn until it can slide along the wall behind it while holding L: for a wall
+  met square-on that is an angle asin(rho) off the wall's normal (sliding then gives
+  dL/dt = V_p sin(angle) - V_e >= 0). So the turn takes
+  T_turn = L_0 asin(rho) / (V_p sqrt(1 - rho^2)), and during it the pursuer recedes
+  along u by V_e T_turn.
+* Required: the pursuer's disc (radius ``body_radius``) can move
+  ``c_req = V_e T_turn = rho L_0 asin(rho) / sqrt(1 - rho^2)`` straight along u from its
+  start without touching a wall (checked exactly with the kernel: the segment has line
+  of sight and keeps ``body_radius`` from every wall vertex and edge).
+
+It is conservative because it spends none of the range margin L_0 - L_min (left as a
+reserve for the policy's reaction lag and for walls that are not flat), and credits the
+pursuer no sideways room. At the built-ins' rho = 0.5 and L_0 = 2.45 it asks for 0.74 of
+clearance; the lost maze start had 0.18, and starts with 0.24 to 0.31 already held in
+the runs that motivated it. At rho >= 1 no turn holds L against a charge and the
+criterion is not applied (like admissibility, Sec. 5).
+
 ``kind="escapable"``: the opposite, for curricula that teach escapes (and pursuits that
 must recover): a valid start with L just above L_min whose orientation lies in an
 *escapable* cell of the exact decomposition at L_min (or in a free arc at a point where
@@ -28,7 +54,7 @@ from envs.errors import InfeasibleError, InvalidConfigError
 from envs.geometry import kernel_for
 from envs.surveillance.placement import random_start, spawn_margins
 
-__all__ = ["START_KINDS", "sample_start"]
+__all__ = ["START_KINDS", "has_retreat_clearance", "retreat_clearance_required", "sample_start"]
 
 START_KINDS = ("valid", "safe", "escapable")
 BATCH = 256
@@ -98,6 +124,7 @@ def _near_l_min(config, kernel, rng, judge, tab, angle_margin, escapable=False):
     r = config.body_radius
     convex = m.vertices[m.vertex_convex]
     margin_bins = 0 if angle_margin is None else math.ceil(angle_margin / tab.bin_width)
+    retreat = retreat_clearance_required(config, length) if admissible else 0.0
     for _ in range(MAX_BATCHES):
         e = rng.uniform((xmin, ymin), (xmax, ymax), size=(BATCH, 2))
         theta = rng.uniform(-math.pi, math.pi, size=BATCH)
@@ -130,6 +157,8 @@ def _near_l_min(config, kernel, rng, judge, tab, angle_margin, escapable=False):
                     continue
                 if admissible and judge.orientation_values(e[i])[b] < 0.0:
                     continue
+                if admissible and not has_retreat_clearance(m, kernel, p[i], e[i], retreat, r):
+                    continue
             return {
                 "pursuer": (float(p[i, 0]), float(p[i, 1])),
                 "evader": (float(e[i, 0]), float(e[i, 1])),
@@ -149,3 +178,30 @@ def _free_with_margin(kernel, e, L: float, theta: float, margin: float) -> bool:
         if (theta - margin - arc.lo) % (2.0 * math.pi) + 2.0 * margin <= arc.width:
             return True
     return False
+
+
+def retreat_clearance_required(config, length: float) -> float:
+    """Distance ``rho L asin(rho) / sqrt(1 - rho^2)`` the pursuer must be able to retreat
+    along the rod from a safe start at rod length ``length`` (module docstring); ``inf``
+    for rho >= 1."""
+    rho = config.rho
+    if rho >= 1.0:
+        return math.inf
+    return rho * length * math.asin(rho) / math.sqrt(1.0 - rho * rho)
+
+
+def has_retreat_clearance(m, kernel, p, e, distance: float, radius: float) -> bool:
+    """The disc of ``radius`` at the pursuer ``p`` can move ``distance`` straight away from
+    the evader ``e`` (along e -> p) in free space, touching no wall."""
+    p = np.asarray(p, dtype=float)
+    d = p - np.asarray(e, dtype=float)
+    q = p + distance * d / np.linalg.norm(d)
+    if not m.contains(q[None])[0] or not kernel.line_of_sight(p, q):
+        return False
+    # no crossing, so the segment's distance to the walls is the least of its ends' and
+    # the wall vertices' distance to it
+    if np.min(m.distance_to_walls(np.stack([p, q]))) < radius:
+        return False
+    seg = q - p
+    t = np.clip((m.vertices - p) @ seg / (seg @ seg), 0.0, 1.0)
+    return bool(np.min(np.linalg.norm(m.vertices - (p + t[:, None] * seg), axis=1)) >= radius)

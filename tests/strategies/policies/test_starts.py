@@ -56,3 +56,54 @@ def test_escapable_starts_put_the_rod_in_an_escapable_cell(map_name):
         safe_here = [ca for ca in dec.free_arcs(e) if ca.escapable is False]
         assert cell is None or cell.escapable or not safe_here
     env.close()
+
+
+@pytest.mark.parametrize("map_name", ["corner", "maze"])
+def test_safe_starts_leave_retreat_clearance_and_survive_a_charge(map_name):
+    """Issue 13: a safe start leaves the pursuer room to back away from an evader charging
+    along the rod (maze seed 5 used to put its back to a wall, lost "too_close" at 1.1 s),
+    and a charging toward_away evader at rho = 0.5 does not win within 2 s."""
+    from envs.maps import builtin_info
+    from strategies.policies.starts import has_retreat_clearance, retreat_clearance_required
+    from strategies.runner import episode_seeds, run_episode
+
+    params = dict(builtin_info(map_name).params())
+    params["v_evader"] = 0.5 * params["v_pursuer"]
+    env = surveillance_v0.parallel_env(map=map_name, **params)
+    cfg = env.config
+    kernel = kernel_for(cfg.map)
+    for seed in (5, 6, 10):
+        start = sample_start(cfg, np.random.default_rng(episode_seeds(seed)[1]), kind="safe")
+        p, e = np.asarray(start["pursuer"]), np.asarray(start["evader"])
+        need = retreat_clearance_required(cfg, float(np.linalg.norm(p - e)))
+        assert 0.5 < need < 1.0  # rho = 0.5, L just above L_min = 2
+        assert has_retreat_clearance(cfg.map, kernel, p, e, need, cfg.body_radius)
+        r = run_episode(
+            map_name,
+            "pursuer/decomposition",
+            "evader/toward_away",
+            seed,
+            start="safe",
+            max_cycles=20,
+            overrides=params,
+        )
+        assert r.start == {"pursuer": list(p), "evader": list(e)}
+        assert r.winner == "pursuer", (seed, r.cause, r.escape_time)
+    env.close()
+
+
+def test_retreat_clearance_rejects_a_pursuer_backed_against_a_wall():
+    """The maze start of issue 13 (seed 5 before the fix): 0.18 of room behind the pursuer."""
+    from strategies.policies.starts import has_retreat_clearance
+
+    env = surveillance_v0.parallel_env(map="open_room")
+    cfg = env.config
+    kernel = kernel_for(cfg.map)
+    _, ymin, xmax, ymax = cfg.map.bounds
+    y = 0.5 * (ymin + ymax)
+    p = np.array([xmax - 0.3, y])  # 0.3 from the right wall, facing away from it
+    e = p - np.array([2.45, 0.0])
+    assert has_retreat_clearance(cfg.map, kernel, p, e, 0.19, cfg.body_radius)
+    assert not has_retreat_clearance(cfg.map, kernel, p, e, 0.21, cfg.body_radius)
+    assert has_retreat_clearance(cfg.map, kernel, e, p, 0.74, cfg.body_radius)  # turned round
+    env.close()

@@ -7,6 +7,7 @@ region covers it), so it shares no code with the geometry kernel or the curve cl
 from __future__ import annotations
 
 import math
+import warnings
 from collections import Counter
 
 import numpy as np
@@ -188,3 +189,27 @@ def stops_constant(dec, rng, per_region: int = 6, inset: float | None = None) ->
             if stop_pairs(kernel.free_arcs(p, dec.L)) != want:
                 bad.append((r.id, tuple(p)))
     return n, bad
+
+
+def fingerprint(dec) -> tuple:
+    """What must not change under a similarity: region, cell and escapable counts, verdict."""
+    return (len(dec.regions), len(dec.cells), len(dec.escapable), dec.evader_wins)
+
+
+def exact_decomposition(world: Map, L: float):
+    """``decompose(world, L)`` with every warning an error, asserted exact (no dangling or
+    unresolved piece)."""
+    from strategies.cspace import decompose
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        dec = decompose(world, L)
+    assert dec.exact, dec.stats
+    assert dec.stats["dangling"] == 0 and dec.unresolved == 0, dec.stats
+    return dec
+
+
+def similar(world: Map, angle: float, scale: float, offset) -> Map:
+    """``world`` rotated by ``angle``, scaled by ``scale`` and moved by ``offset``."""
+    c, s = scale * math.cos(angle), scale * math.sin(angle)
+    return world.transformed([[c, -s], [s, c]], offset)

@@ -15,16 +15,14 @@ vertex until each interval turns less than the angle between those lines.
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 import pytest
 
 from envs.maps import Map
-from strategies.cspace import decompose
 from strategies.cspace._intersect import node_sweep, refine_about, sampled_roots
 from strategies.cspace._shapes import CONCHOID, points
-from tests.strategies.cspace._oracle import stops_constant
+from tests.strategies.cspace._oracle import exact_decomposition, fingerprint, stops_constant
 
 ROOM = [(0.0, 0.0), (11.10604969912589, 0.0), (11.10604969912589, 10.906834875630896),
         (0.0, 10.906834875630896)]  # fmt: skip
@@ -43,27 +41,14 @@ def _turned(angle: float, scale: float = 1.0, offset=(0.0, 0.0)) -> Map:
     return Map(ROOM, TRIANGLES, name="two_triangles").transformed([[c, -s], [s, c]], offset)
 
 
-def _fingerprint(dec):
-    return (len(dec.regions), len(dec.cells), len(dec.escapable), dec.evader_wins)
-
-
-def _exact(world: Map, L: float):
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        dec = decompose(world, L)
-    assert dec.exact, dec.stats
-    assert dec.stats["dangling"] == 0 and dec.unresolved == 0, dec.stats
-    return dec
-
-
 @pytest.fixture(scope="module")
 def base():
-    return _exact(_turned(0.0), L)
+    return exact_decomposition(_turned(0.0), L)
 
 
 def test_the_turned_world_is_exact(base):
-    dec = _exact(_turned(ANGLE), L)
-    assert _fingerprint(dec) == _fingerprint(base)
+    dec = exact_decomposition(_turned(ANGLE), L)
+    assert fingerprint(dec) == fingerprint(base)
     n, bad = stops_constant(dec, np.random.default_rng(7), per_region=3)
     assert not bad, bad[:5]
     assert n > 2 * len(dec.regions)
@@ -75,8 +60,8 @@ def test_the_turned_world_is_exact(base):
      (ANGLE + math.pi, 1.0, (0.0, 0.0)), (0.5 * math.pi, 1.0, (0.0, 0.0))],
 )  # fmt: skip
 def test_counts_are_invariant(base, angle, scale, offset):
-    dec = _exact(_turned(angle, scale, offset), L * scale)
-    assert _fingerprint(dec) == _fingerprint(base)
+    dec = exact_decomposition(_turned(angle, scale, offset), L * scale)
+    assert fingerprint(dec) == fingerprint(base)
 
 
 def test_both_crossings_near_the_vertex_are_found():

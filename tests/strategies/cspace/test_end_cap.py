@@ -14,15 +14,13 @@ the doorway cropped to eight vertices; it reproduced at every translation and sc
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 import pytest
 
 from envs.maps import Map
-from strategies.cspace import decompose
 from strategies.cspace._shapes import CONCHOID, implicit, points
-from tests.strategies.cspace._oracle import stops_constant
+from tests.strategies.cspace._oracle import exact_decomposition, fingerprint, stops_constant
 
 END_CAP = [
     (1.5, 2.75), (1.5, -3.5), (-0.26, -3.5), (-0.26, 0),
@@ -37,22 +35,9 @@ def end_cap() -> Map:
     return Map(END_CAP, name="end_cap")
 
 
-def _exact(world: Map, L: float):
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        dec = decompose(world, L)
-    assert dec.exact, dec.stats
-    assert dec.stats["dangling"] == 0 and dec.unresolved == 0, dec.stats
-    return dec
-
-
-def _fingerprint(dec):
-    return (len(dec.regions), len(dec.cells), len(dec.escapable), dec.evader_wins)
-
-
 @pytest.fixture(scope="module")
 def base():
-    return _exact(end_cap(), L)
+    return exact_decomposition(end_cap(), L)
 
 
 def test_the_end_cap_is_exact(base):
@@ -67,15 +52,17 @@ def test_the_end_cap_is_exact(base):
      (1e-3, (0.0, 0.0)), (7.0, (-3.0, 2.0)), (1e3, (0.0, 0.0))],
 )  # fmt: skip
 def test_counts_are_invariant_under_translation_and_scaling(base, scale, offset):
-    moved = _exact(end_cap().transformed([[scale, 0.0], [0.0, scale]], offset), L * scale)
-    assert _fingerprint(moved) == _fingerprint(base)
+    moved = exact_decomposition(
+        end_cap().transformed([[scale, 0.0], [0.0, scale]], offset), L * scale
+    )
+    assert fingerprint(moved) == fingerprint(base)
 
 
 @pytest.mark.parametrize("angle", [0.5 * math.pi, 0.7137])
 def test_counts_are_invariant_under_rotation(base, angle):
     c, s = math.cos(angle), math.sin(angle)
-    moved = _exact(end_cap().transformed([[c, -s], [s, c]]), L)
-    assert _fingerprint(moved) == _fingerprint(base)
+    moved = exact_decomposition(end_cap().transformed([[c, -s], [s, c]]), L)
+    assert fingerprint(moved) == fingerprint(base)
 
 
 def test_conchoid_implicit_is_finite_on_its_pole_line():

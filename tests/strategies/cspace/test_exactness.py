@@ -19,9 +19,11 @@ from strategies.cspace import decompose
 from tests.strategies.cspace._oracle import (
     brute_free,
     circular_runs,
+    fingerprint,
     hexagons,
     resolvable,
     rotated_room,
+    similar,
     skew_corridor,
     slanted_corridor,
     stars,
@@ -41,15 +43,6 @@ WORLDS = {
     "random_star": (lambda: random_map(2, n_vertices=16, kind="star"), 1.7),
     "random_convex": (lambda: random_map(4, n_vertices=12, kind="convex"), 1.0),
 }
-
-
-def _fingerprint(dec):
-    return (len(dec.regions), len(dec.cells), len(dec.escapable), dec.evader_wins)
-
-
-def _similar(world: Map, angle: float, scale: float, offset) -> Map:
-    c, s = math.cos(angle), math.sin(angle)
-    return world.transformed([[scale * c, -scale * s], [scale * s, scale * c]], offset)
 
 
 @pytest.fixture(scope="module")
@@ -76,8 +69,8 @@ def test_translating_a_slanted_corridor_keeps_every_count(offset):
     """Issue 10: translating the slanted corridor by (0.5, 0) changed 67 regions to 66."""
     for L in (1.7, 2.5, 3.3):
         base = decompose(slanted_corridor(), L)
-        moved = decompose(_similar(slanted_corridor(), 0.0, 1.0, offset), L)
-        assert _fingerprint(moved) == _fingerprint(base), (L, offset)
+        moved = decompose(similar(slanted_corridor(), 0.0, 1.0, offset), L)
+        assert fingerprint(moved) == fingerprint(base), (L, offset)
         assert base.exact and moved.exact
 
 
@@ -118,8 +111,8 @@ def test_cells_are_the_brute_force_free_arcs(name, decs):
 def test_counts_and_verdicts_are_invariant_under_similarities(angle, scale, offset, decs):
     for name in ("tilted_block", "stars", "triangles", "random_star"):
         make, L = WORLDS[name]
-        moved = decompose(_similar(make(), angle, scale, offset), L * scale)
-        assert _fingerprint(moved) == _fingerprint(decs[name]), name
+        moved = decompose(similar(make(), angle, scale, offset), L * scale)
+        assert fingerprint(moved) == fingerprint(decs[name]), name
         assert moved.exact, (name, moved.stats)
 
 
@@ -179,8 +172,8 @@ def test_degenerate_worlds_are_exact_and_invariant(name):
     assert not bad, bad[:5]
     assert n > 2 * len(dec.regions)
     for angle, scale, offset in ((0.9431, 1.0, (0.0, 0.0)), (0.0, 1e3, (1e6, 0.0))):
-        moved = decompose(_similar(world, angle, scale, offset), L * scale)
-        assert _fingerprint(moved) == _fingerprint(dec), (angle, scale, offset)
+        moved = decompose(similar(world, angle, scale, offset), L * scale)
+        assert fingerprint(moved) == fingerprint(dec), (angle, scale, offset)
 
 
 def test_a_rod_longer_than_the_map_is_said_not_to_fit():

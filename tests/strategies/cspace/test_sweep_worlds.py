@@ -10,14 +10,17 @@ verdict is monotone in L) on a fine grid of L.
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 import pytest
 
 from envs.maps import Map, builtin_map, random_map
-from strategies.cspace import decompose
-from tests.strategies.cspace._oracle import stops_constant
+from tests.strategies.cspace._oracle import (
+    exact_decomposition,
+    fingerprint,
+    similar,
+    stops_constant,
+)
 
 
 def _regular(n: int, r: float, c, phase: float) -> np.ndarray:
@@ -64,29 +67,11 @@ CASES = {
 }
 
 
-def _fingerprint(dec):
-    return (len(dec.regions), len(dec.cells), len(dec.escapable), dec.evader_wins)
-
-
-def _exact(world: Map, L: float):
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        dec = decompose(world, L)
-    assert dec.exact, dec.stats
-    assert dec.stats["dangling"] == 0 and dec.unresolved == 0, dec.stats
-    return dec
-
-
-def _similar(world: Map, angle: float, scale: float, offset) -> Map:
-    c, s = scale * math.cos(angle), scale * math.sin(angle)
-    return world.transformed([[c, -s], [s, c]], offset)
-
-
 @pytest.mark.parametrize("name", list(CASES))
 def test_sweep_world_is_exact_and_invariant(name):
     make, L = CASES[name]
     world = make()
-    dec = _exact(world, L)
+    dec = exact_decomposition(world, L)
     n, bad = stops_constant(dec, np.random.default_rng(5), per_region=2)
     assert not bad, bad[:5]
     assert n > len(dec.regions)
@@ -96,8 +81,8 @@ def test_sweep_world_is_exact_and_invariant(name):
         (0.0, 1e3, (0.0, 0.0)),
         (0.0, 1.0, (1e6, -1e6)),
     ):
-        moved = _exact(_similar(world, angle, scale, offset), L * scale)
-        assert _fingerprint(moved) == _fingerprint(dec), (angle, scale, offset)
+        moved = exact_decomposition(similar(world, angle, scale, offset), L * scale)
+        assert fingerprint(moved) == fingerprint(dec), (angle, scale, offset)
 
 
 @pytest.mark.parametrize("make", [hexagon_hall, trapezoid_room])
@@ -106,7 +91,7 @@ def test_prop3_the_verdict_is_monotone_along_L(make):
     Ls = np.round(np.arange(1.0, 4.01, 0.25), 2)
     wins = []
     for L in Ls:
-        dec = _exact(world, float(L))
+        dec = exact_decomposition(world, float(L))
         wins.append(dec.evader_wins)
     assert wins == sorted(wins), dict(zip(Ls.tolist(), wins, strict=True))
     assert not wins[0] and wins[-1]

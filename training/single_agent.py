@@ -212,7 +212,6 @@ class SingleAgentEnv(gym.Env):
             int(s) for s in self.np_random.integers(_SEED_BOUND, size=3)
         )
         if len(self.envs) > 1:  # a draw only when there is a choice: one-map streams unchanged
-            self.env = None
             self._select(int(self.np_random.integers(len(self.envs))))
         if self.pool is not None:
             self.opponent = self.pool.select(int(self.np_random.integers(_SEED_BOUND)))

@@ -104,7 +104,7 @@ def _escapable(dec, e, theta: float) -> bool:
     if not any(ca.escapable is False for ca in arcs):
         return True
     for ca in arcs:
-        if ca.arc.is_full or (theta - ca.arc.lo) % (2.0 * math.pi) <= ca.arc.width:
+        if ca.arc.contains(theta):
             return ca.escapable is True
     return False
 

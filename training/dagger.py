@@ -105,6 +105,12 @@ class DaggerConfig:
     ``model.zip`` is the iteration that won most of them (ties: the later one) and
     ``model_last.zip`` the last iteration, from which a resumed run continues: DAgger's
     last iteration is not always its best."""
+    validation_opponent: str | tuple[str, ...] = ()
+    """Whom the validation episodes are played against (empty: the training opponent or
+    pool). Select against the opponent the model is meant to beat, e.g. the
+    ``evader/shooting`` of issue 9's target, while training against a wider pool."""
+    validation_maps: tuple[str, ...] = ()
+    """The worlds of the validation episodes, used in turn (empty: ``maps``)."""
     curriculum: tuple[dict[str, Any], ...] = ()
     """Stages played first, in order: ``{"iterations": n, "start": ..., "maps": [...],
     "env": {...}}`` (each key but ``iterations`` optional, overriding the top-level
@@ -140,6 +146,19 @@ class DaggerConfig:
         put("maps", (self.maps,) if isinstance(self.maps, str) else tuple(self.maps))
         if not self.maps or not all(isinstance(m, str) and m for m in self.maps):
             raise InvalidConfigError(f"{where}: maps = {self.maps!r}: expected map names or files")
+        vm = self.validation_maps
+        put("validation_maps", (vm,) if isinstance(vm, str) else tuple(vm))
+        if not all(isinstance(m, str) and m for m in self.validation_maps):
+            raise InvalidConfigError(
+                f"{where}: validation_maps = {vm!r}: expected map names or files"
+            )
+        vo = self.validation_opponent
+        vpool = (vo,) if isinstance(vo, str) else tuple(vo)
+        if not all(isinstance(o, str) and o.startswith(other + "/") for o in vpool):
+            raise InvalidConfigError(
+                f"{where}: validation_opponent = {vo!r}: expected '{other}/KIND' policy names"
+            )
+        put("validation_opponent", vpool[0] if len(vpool) == 1 else vpool)
         validation.mapping("env", self.env, where=where)
         validation.mapping("expert_params", self.expert_params, where=where)
         make_policy(self.expert, **self.expert_params)  # unknown names and parameters fail here
@@ -212,8 +231,9 @@ class DaggerConfig:
             {k: (list(x) if isinstance(x, tuple) else x) for k, x in s.items()}
             for s in self.curriculum
         ]
-        if not self.validation_episodes:  # absent unless used: older records compare equal
-            del d["validation_episodes"]
+        for name in ("validation_episodes", "validation_opponent", "validation_maps"):
+            if not getattr(self, name):  # absent unless used: older records compare equal
+                del d[name]
         return d
 
     @classmethod
@@ -234,11 +254,12 @@ class DaggerConfig:
         missing = [n for n in ("role", "expert", "opponent") if n not in data]
         if missing:
             raise InvalidConfigError(f"config: missing required field(s) {missing}")
-        for key in ("maps", "net_arch", "opponent_weights", "curriculum"):
+        for key in ("maps", "net_arch", "opponent_weights", "curriculum", "validation_maps"):
             if isinstance(data.get(key), list):
                 data[key] = tuple(data[key])
-        if isinstance(data.get("opponent"), list):
-            data["opponent"] = tuple(data["opponent"])
+        for key in ("opponent", "validation_opponent"):
+            if isinstance(data.get(key), list):
+                data[key] = tuple(data[key])
         return cls(**data)
 
     def to_toml(self) -> str:
@@ -490,15 +511,28 @@ def _write_iteration(out: Path, model, obs, act, progress: dict[str, Any], best:
 
 
 def _validate(cfg: DaggerConfig, model, opponent) -> float:
-    """The share of ``cfg.validation_episodes`` fixed-seed episodes the learner wins alone."""
+    """The share of ``cfg.validation_episodes`` fixed-seed episodes the learner wins alone.
+
+    Against ``cfg.validation_opponent`` on ``cfg.validation_maps`` when they are set,
+    else against ``opponent`` (the training one) on ``cfg.maps``.
+    """
     wins = 0
     other = "evader" if cfg.role == "pursuer" else "pursuer"
+    maps = cfg.validation_maps or cfg.maps
+    if cfg.validation_opponent:
+        vo = cfg.validation_opponent
+        if isinstance(vo, str):
+            opponent = vo
+        else:
+            from training.pool import OpponentPool
+
+            opponent = OpponentPool(list(vo))
     for k in range(cfg.validation_episodes):
         seed = 10_000_019 + cfg.seed * 1_003 + k
         learner = _Rollout(make_policy(cfg.expert, **cfg.expert_params), model, 0.0, seed,
                            cfg.observation)  # fmt: skip
         pair = {cfg.role: learner, other: opponent}
-        r = run_episode(cfg.maps[k % len(cfg.maps)], pair["pursuer"], pair["evader"], seed,
+        r = run_episode(maps[k % len(maps)], pair["pursuer"], pair["evader"], seed,
                         max_cycles=cfg.max_cycles, overrides=cfg.env, start=cfg.start)  # fmt: skip
         wins += r.winner == cfg.role
     return wins / cfg.validation_episodes

@@ -170,3 +170,35 @@ def test_validation_keeps_the_best_iteration_and_a_resumable_last_one(tmp_path):
     assert same == (best == 2)
     prov = json.loads((r.model_path.parent / "provenance.json").read_text())
     assert prov["validation"] == r.validation and prov["best_iteration"] == best
+
+
+def test_validation_plays_the_named_opponent_on_the_named_maps(tmp_path, monkeypatch):
+    """Selection against the opponent a model is meant to beat (issue 9's target is the
+    shooting evader) while it trains against a wider pool; the fields round-trip in TOML
+    and bad values are named."""
+    import training.dagger as dagger_module
+    from training.config import load_any_config
+
+    played = []
+    real = dagger_module.run_episode
+
+    def spy(world, pursuer, evader, seed, **kw):
+        played.append((world, evader))
+        return real(world, pursuer, evader, seed, **kw)
+
+    cfg = _lidar_cfg(tmp_path, iterations=1, validation_episodes=3,
+                     validation_opponent="evader/toward_away",
+                     validation_maps=("corridor", "l_hall"))  # fmt: skip
+    monkeypatch.setattr(dagger_module, "run_episode", spy)
+    dagger(cfg)
+    assert played[-3:] == [("corridor", "evader/toward_away"), ("l_hall", "evader/toward_away"),
+                           ("corridor", "evader/toward_away")]  # fmt: skip
+    # the training episodes drew from the pool (an OpponentPool), not the named opponent
+    assert len(played) == 2 + 3 and all(not isinstance(e, str) for _, e in played[:2])
+    path = tmp_path / "validation.toml"
+    path.write_text(cfg.to_toml())
+    assert load_any_config(path) == cfg
+    with pytest.raises(InvalidConfigError, match="validation_opponent"):
+        _lidar_cfg(tmp_path, validation_opponent="pursuer/greedy")
+    with pytest.raises(InvalidConfigError, match="validation_maps"):
+        _lidar_cfg(tmp_path, validation_maps=("",))

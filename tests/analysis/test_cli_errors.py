@@ -17,7 +17,7 @@ from analysis.cli import main
 FAST = ["--pursuer", "pursuer/greedy", "--evader", "evader/straight", "--max-cycles", "5"]
 
 
-def _fails(capsys, argv: list[str], *needles: str) -> str:
+def assert_fails(capsys, argv: list[str], *needles: str) -> str:
     """Run ``surveil ARGV``: exit code 2, one ``surveil: error:`` line naming each needle."""
     assert main(argv) == 2
     out, err = capsys.readouterr()
@@ -43,15 +43,17 @@ def map_file(tmp_path) -> Path:
 # ---------------------------------------------------------------------- map files
 def test_missing_map_file(capsys, tmp_path):
     missing = str(tmp_path / "nowhere.json")
-    _fails(capsys, ["play", "--map", missing, "--no-gif"], "--map", missing, "no such map file")
-    _fails(capsys, ["analyze", missing], "map", missing, "no such map file")
+    assert_fails(
+        capsys, ["play", "--map", missing, "--no-gif"], "--map", missing, "no such map file"
+    )
+    assert_fails(capsys, ["analyze", missing], "map", missing, "no such map file")
 
 
 def test_a_directory_given_as_a_map(capsys, tmp_path):
     folder = tmp_path / "maps.json"
     folder.mkdir()
-    _fails(capsys, ["play", "--map", str(folder), "--no-gif"], "--map", "is a directory")
-    _fails(capsys, ["analyze", str(tmp_path)], "is a directory")
+    assert_fails(capsys, ["play", "--map", str(folder), "--no-gif"], "--map", "is a directory")
+    assert_fails(capsys, ["analyze", str(tmp_path)], "is a directory")
 
 
 @pytest.mark.parametrize(
@@ -69,7 +71,7 @@ def test_a_directory_given_as_a_map(capsys, tmp_path):
 def test_a_broken_map_file_of_each_kind(capsys, tmp_path, content, needle):
     path = tmp_path / "room.json"
     path.write_bytes(content)
-    _fails(capsys, ["play", "--map", str(path), "--no-gif"], "--map", str(path), needle)
+    assert_fails(capsys, ["play", "--map", str(path), "--no-gif"], "--map", str(path), needle)
 
 
 # ---------------------------------------------------------------------- outputs
@@ -77,13 +79,13 @@ def test_an_output_under_a_file_is_refused_before_the_episode(capsys, tmp_path):
     blocker = tmp_path / "file.txt"
     blocker.write_text("x")
     out = str(blocker / "sub" / "replay.gif")
-    _fails(capsys, ["play", *FAST, "--out", out], "--out", "is a file, not a directory")
-    _fails(capsys, ["figure", "tractrix", "--out", out.replace(".gif", ".png")], "--out")
-    _fails(capsys, ["maps", "--plot", str(blocker)], "--plot", "is a file")
+    assert_fails(capsys, ["play", *FAST, "--out", out], "--out", "is a file, not a directory")
+    assert_fails(capsys, ["figure", "tractrix", "--out", out.replace(".gif", ".png")], "--out")
+    assert_fails(capsys, ["maps", "--plot", str(blocker)], "--plot", "is a file")
 
 
 def test_an_output_with_a_wrong_suffix(capsys, tmp_path):
-    _fails(capsys, ["play", *FAST, "--out", str(tmp_path / "r.mp4")], "--out", ".gif or .png")
+    assert_fails(capsys, ["play", *FAST, "--out", str(tmp_path / "r.mp4")], "--out", ".gif or .png")
 
 
 def test_a_directory_as_the_output_holds_the_default_name(capsys, tmp_path):
@@ -113,7 +115,7 @@ def test_a_directory_as_the_output_holds_the_default_name(capsys, tmp_path):
     ],
 )
 def test_bad_config(capsys, text, needles):
-    _fails(capsys, ["play", *FAST, "--no-gif", "--config", text], *needles)
+    assert_fails(capsys, ["play", *FAST, "--no-gif", "--config", text], *needles)
 
 
 @pytest.mark.parametrize(
@@ -145,18 +147,18 @@ def test_bad_config(capsys, text, needles):
     ],
 )
 def test_bad_policies_and_parameters(capsys, argv, needles):
-    _fails(capsys, ["play", "--max-cycles", "5", "--no-gif", *argv], *needles)
+    assert_fails(capsys, ["play", "--max-cycles", "5", "--no-gif", *argv], *needles)
 
 
 def test_unknown_figure_parameter(capsys):
-    _fails(
+    assert_fails(
         capsys,
         ["figure", "shooting", "--params", '{"bogus": 1}'],
         "--params",
         "no parameter(s) ['bogus']",
         "rho (default 0.5)",
     )
-    _fails(capsys, ["figure", "shooting", "--params", '{"rho": "half"}'], "--params", "rho")
+    assert_fails(capsys, ["figure", "shooting", "--params", '{"rho": "half"}'], "--params", "rho")
 
 
 # ---------------------------------------------------------------------- numbers
@@ -174,15 +176,17 @@ def test_unknown_figure_parameter(capsys):
     ],
 )
 def test_bad_numbers_and_flags_name_the_flag(capsys, argv, needles):
-    _fails(capsys, argv, *needles)
+    assert_fails(capsys, argv, *needles)
 
 
 def test_analyze_needs_a_length_for_a_map_file(capsys, map_file):
-    _fails(capsys, ["analyze", str(map_file)], "--length is required", str(map_file))
+    assert_fails(capsys, ["analyze", str(map_file)], "--length is required", str(map_file))
 
 
 def test_analyze_refuses_a_rod_that_fits_nowhere(capsys):
-    _fails(capsys, ["analyze", "corridor", "--length", "1e9"], "--length = 1e+09", "fits nowhere")
+    assert_fails(
+        capsys, ["analyze", "corridor", "--length", "1e9"], "--length = 1e+09", "fits nowhere"
+    )
 
 
 def test_rho_above_one_is_played_with_one_warning_line(capsys):

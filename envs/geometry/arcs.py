@@ -23,6 +23,11 @@ Degenerate cases, decided with the kernel's length tolerance ``eps``:
   occupies there. The arcs next to it end in ("body", edge) stops, the rod lying along
   the wall. Edges through E are not clipped (their angle at E is undefined).
 * E outside the closed free region: no free orientation (an empty tuple).
+* A wall vertex inside the disk ends the blocks of both its edges: its angle is computed
+  once, from the vertex's own coordinates, for both. The end of an edge computed as
+  ``start + length * direction`` rounds an ulp or so away from the vertex, which seen
+  from a point within ~1e-4 of it is more than ``ANGLE_TOL`` and opened a spurious free
+  arc between the two blocks, one that depended on the frame (issue 10).
 """
 
 from __future__ import annotations
@@ -166,11 +171,16 @@ def _blocked_scalar(kernel: Kernel, cand, ex: float, ey: float, L: float) -> Blo
         t0 = s - sq
         t1 = s + sq
         t0 = 0.0 if t0 < 0.0 else t0
-        t1 = length if t1 > length else t1
+        inside_b = t1 >= length  # the edge's end vertex lies in the disk
+        t1 = length if inside_b else t1
         if t0 > t1:
             continue
         ang_a = math.atan2(wy + t0 * uy, wx + t0 * ux)
-        ang_b = math.atan2(wy + t1 * uy, wx + t1 * ux)
+        if inside_b:  # from the vertex itself, as the next edge's start
+            vb = int(ev[e, 1])
+            ang_b = math.atan2(vxy[vb][1] - ey, vxy[vb][0] - ex)
+        else:
+            ang_b = math.atan2(wy + t1 * uy, wx + t1 * ux)
         w = (ang_b - ang_a) % TWO_PI
         flip = w > math.pi  # E behind the edge's line: the short arc runs b' -> a'
         if flip:
@@ -227,7 +237,13 @@ def _blocked_numpy(
     t1 = np.minimum(s + sq, length)
     ok &= t0 <= t1
     ang_a = np.arctan2(wy + t0 * u[:, 1], wx + t0 * u[:, 0])
-    ang_b = np.arctan2(wy + t1 * u[:, 1], wx + t1 * u[:, 0])
+    vb_all = m.edge_vertices[idx, 1]
+    end = m.vertices[vb_all]
+    ang_b = np.where(  # an end vertex in the disk: from the vertex itself (see above)
+        t1 == length,
+        np.arctan2(end[:, 1] - ey, end[:, 0] - ex),
+        np.arctan2(wy + t1 * u[:, 1], wx + t1 * u[:, 0]),
+    )
     w = (ang_b - ang_a) % TWO_PI
     flip = w > math.pi
     w = np.where(flip, TWO_PI - w, w)
@@ -235,8 +251,7 @@ def _blocked_numpy(
     sel = np.flatnonzero(ok & (w > ANGLE_TOL))
     if len(sel) == 0:
         return lo, wid, lab_lo, lab_hi
-    ev = m.edge_vertices
-    vb = ev[idx[sel], 1]
+    vb = vb_all[sel]
     db = np.hypot(m.vertices[vb, 0] - ex, m.vertices[vb, 1] - ey)
     for k, j in enumerate(sel.tolist()):
         e = int(idx[j])

@@ -124,7 +124,14 @@ def _blocks(world: Map, P: np.ndarray, L: float, eps: float, pid: np.ndarray, e:
     t1 = np.minimum(s + sq, length)
     ok &= t0 <= t1
     ang_a = np.arctan2(wy + t0 * u[:, 1], wx + t0 * u[:, 0])
-    ang_b = np.arctan2(wy + t1 * u[:, 1], wx + t1 * u[:, 0])
+    # an end vertex inside the disk: its angle from the vertex itself, as the kernel
+    # (the same float as the next edge's start, in every frame)
+    end = world.vertices[world.edge_vertices[e, 1]]
+    ang_b = np.where(
+        t1 == length,
+        np.arctan2(end[:, 1] - P[pid, 1], end[:, 0] - P[pid, 0]),
+        np.arctan2(wy + t1 * u[:, 1], wx + t1 * u[:, 0]),
+    )
     w = (ang_b - ang_a) % TWO_PI
     flip = w > math.pi
     w = np.where(flip, TWO_PI - w, w)

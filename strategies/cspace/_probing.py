@@ -10,7 +10,8 @@ does not match tries a smaller offset, then other edges of the piece (longest fi
 then other points of those edges (``PROBE_AT``: the kernel's stops are not the exact ones
 in cusps near some curve ends, which can cover a short piece's middle); across a sliver
 (a face too thin to probe) it steps over the sliver and takes whichever region lies
-beyond. Sides are matched independently, round after round, until each is
+beyond; a piece along a speck (a face collapsed to a point) is not probed: it separates
+nothing. Sides are matched independently, round after round, until each is
 matched or out of attempts; a piece whose sides never match falls back to matching
 arcs by overlap and is counted as unresolved (never silently).
 
@@ -158,7 +159,9 @@ def probe_pieces(
     fa = np.array([p.faces[0] for p in arr.pieces], dtype=np.intp)
     fb = np.array([p.faces[1] for p in arr.pieces], dtype=np.intp)
     ra, rb = region_of_face[fa], region_of_face[fb]
-    job = np.flatnonzero(~((ra < 0) & (rb < 0)) & (ra != rb))
+    # (a piece of a speck separates nothing: the faces around it meet at a point)
+    speck = arr.speck[fa] | arr.speck[fb]
+    job = np.flatnonzero(~((ra < 0) & (rb < 0)) & (ra != rb) & ~speck)
     n_jobs = len(job)
     # each job's edges, longest first (at most PROBE_EDGES)
     n_e = np.array([len(arr.pieces[i].edges) for i in job.tolist()], dtype=np.intp)

@@ -14,7 +14,10 @@ Built from the exact curves, not from their polylines:
    holes (assigned to the smallest face around them);
 5. a face narrower than the sliver tolerance (twice its area over its perimeter) is a
    sliver of a near-degeneracy the geometry kernel cannot resolve: it is marked, and the
-   decomposition steps over it (:mod:`strategies.cspace._build`).
+   decomposition steps over it (:mod:`strategies.cspace._build`); a face of perimeter
+   below twice the collapse tolerance is a speck, a point pulled apart by a
+   near-degeneracy: it is marked too (a sliver and a speck), and its boundary pieces
+   separate nothing.
 
 Polylines (within the chord tolerance) only draw the faces' polygons; the topology, the
 probe points and the normals across boundaries come from the exact curves.
@@ -89,10 +92,14 @@ class Arrangement:
         sliver: (F,) faces narrower than the sliver tolerance (twice their area over
             their perimeter): a near-degeneracy the kernel cannot resolve; they carry no
             cells and the boundaries across them are found by stepping over them.
+        speck: (F,) faces whose perimeter is below twice the collapse tolerance (so
+            their diameter is below it; also slivers): the faces around one meet at a
+            point, its boundary pieces separate nothing.
         stats: counts for diagnostics: ``vertices``, ``edges``, ``dangling`` (edges with
             the same face on both sides: a curve end that lies on no other curve),
-            ``slivers`` (faces too thin to probe), ``orphan_holes`` (clockwise
-            cycles inside no face), ``wide_vertices`` (see :class:`Noded`).
+            ``slivers`` (faces too thin to probe), ``specks`` (faces collapsed to a
+            point), ``orphan_holes`` (clockwise cycles inside no face),
+            ``wide_vertices`` (see :class:`Noded`).
     """
 
     faces: tuple[Polygon, ...]
@@ -102,6 +109,7 @@ class Arrangement:
     edge_length: np.ndarray = field(repr=False)
     origin: np.ndarray = field(repr=False)
     sliver: np.ndarray = field(repr=False)
+    speck: np.ndarray = field(repr=False)
     face_of_half_edge: np.ndarray = field(repr=False)
     bridge: np.ndarray = field(repr=False)
     tol: Tolerances = field(repr=False)
@@ -234,7 +242,8 @@ def _rotation(cv: Curves, nd: Noded, L: float, e_len: np.ndarray) -> np.ndarray:
     """``next`` of every half-edge (2k: u -> v, 2k + 1: v -> u) for faces on the left.
 
     At each vertex the half-edges leave in the order of the directions from the vertex
-    to their points a quarter of the shortest incident edge along (never the tangents:
+    to their points a quarter of the shortest incident edge along, or 16 times the
+    vertex's distance to its edges' curves if that is farther (never the tangents:
     a vertex stands for every point within the merge tolerance, and two curves merged
     there may pass each other in an order their tangents do not tell). No two incident
     edges cross that close to the vertex, so that order is the arrangement's.
@@ -249,7 +258,13 @@ def _rotation(cv: Curves, nd: Noded, L: float, e_len: np.ndarray) -> np.ndarray:
     np.minimum.at(short, origin, e_len[k])
     d1, _ = derivatives(kind, data, t, L)
     speed = np.maximum(np.hypot(d1[:, 0], d1[:, 1]), 1e-300)
-    dt = np.minimum(0.25 * short[origin] / speed, 0.5 * (nd.tb - nd.ta)[k])
+    # a vertex merged from points up to the merge tolerance apart lies that far off its
+    # edges' curves: the chords must be much longer than that to give their directions
+    off = np.hypot(*(points(kind, data, t, L) - nd.vertices[origin]).T)
+    spread = np.zeros(len(nd.vertices))
+    np.maximum.at(spread, origin, off)
+    reach = np.maximum(0.25 * short[origin], 16.0 * spread[origin])
+    dt = np.minimum(reach / speed, 0.5 * (nd.tb - nd.ta)[k])
     chord = points(kind, data, np.where(fwd, t + dt, t - dt), L) - nd.vertices[origin]
     ang = np.arctan2(chord[:, 1], chord[:, 0])
     order = np.lexsort((ang, origin))
@@ -375,9 +390,14 @@ def arrange(world: Map, curves: tuple[CriticalCurve, ...], tol: Tolerances) -> A
     has = face_h >= 0
     f_perim = np.bincount(face_h[has], weights=e_len[h_edge[has]], minlength=nf)
     sliver = 2.0 * f_area < tol.thin * f_perim
+    # specks: faces of half-perimeter (at least their diameter) below the collapse
+    # tolerance, a length along the edges' polylines, the same in every frame
+    speck = f_perim < 2.0 * tol.collapse
     faces = list(shapely.transform(np.array(faces, dtype=object), lambda x: x + c0))
     pieces = _pieces(cv, nd, curves, face_h, offsets, pts + c0)
-    arr = Arrangement(tuple(faces), pieces, cv, nd, e_len, c0, sliver, face_h, bridge, tol, {})
+    arr = Arrangement(
+        tuple(faces), pieces, cv, nd, e_len, c0, sliver, speck, face_h, bridge, tol, {}
+    )
     # the polygons are exact only to the chord tolerance (two short curved edges between
     # the same vertices are one chord twice): a face thin on its polygon is a sliver only
     # if it is thin on the exact curves too (twice the depth of its exact sample point)
@@ -385,15 +405,19 @@ def arrange(world: Map, curves: tuple[CriticalCurve, ...], tol: Tolerances) -> A
     if len(cand):
         _, depth = arr.exact_samples(cand)
         sliver[cand[np.isfinite(depth) & (2.0 * depth > tol.thin)]] = False
+    sliver |= speck
     stats = {
         "vertices": len(nd.vertices),
         "edges": ne,
         "dangling": int(np.count_nonzero(bridge & ~blocked[cyc[0::2]])),
         "slivers": int(np.count_nonzero(sliver)),
+        "specks": int(np.count_nonzero(speck)),
         "orphan_holes": orphans,
         "wide_vertices": nd.n_clusters_wide,
     }
-    return Arrangement(tuple(faces), pieces, cv, nd, e_len, c0, sliver, face_h, bridge, tol, stats)
+    return Arrangement(
+        tuple(faces), pieces, cv, nd, e_len, c0, sliver, speck, face_h, bridge, tol, stats
+    )
 
 
 def _face_samples(arr: Arrangement, sel: np.ndarray):

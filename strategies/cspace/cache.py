@@ -46,7 +46,7 @@ __all__ = [
     "write_cache_file",
 ]
 
-FORMAT_VERSION = 6  # 6: probes also off the middle of an edge (5: conchoid crossings near a vertex)
+FORMAT_VERSION = 7  # 7: specks, vertex angles (6: probes off the middle of an edge)
 """Bump when the decomposition's content or the file layout changes."""
 
 MAGIC = b"SURVEIL-CSPACE-DECOMPOSITION\n"

@@ -23,7 +23,18 @@ The decomposition is exact up to these tolerances:
   near-degeneracy: it carries no cells, and a boundary piece along it is resolved by
   probing across it, to whichever region lies beyond;
 * the two **probes** that decide adjacency across a boundary piece sit ``probe`` to each
-  side of it (less on short pieces).
+  side of it (less on short pieces);
+* a face whose perimeter is below twice ``collapse`` (so its diameter is below it) is a
+  **speck**: a point where curves meet in exact arithmetic, pulled apart by a
+  near-degeneracy (e.g. a wall edge within 1e-5 L of L, where type-4 segment ends,
+  type-2 arcs and a type-3 segment come within ``|L - length|`` of one another). The
+  kernel cannot resolve it: it compares angles to ``ANGLE_TOL``, so near the end of a
+  type-4 segment on a type-2 arc its stops are not the exact ones in a cusp about
+  ``ANGLE_TOL * L**2 / d`` wide at distance d from that end, i.e. within about
+  ``sqrt(ANGLE_TOL) * L`` (1e-6 L) of it. A speck carries no cells and its boundary
+  pieces separate nothing: the faces around it meet at a point, as they do when the
+  degeneracy is exact. The rule reads a length (the face's perimeter) against L, never
+  a coordinate, so it does not depend on the frame.
 
 Example:
     >>> from envs.maps import Map
@@ -51,6 +62,7 @@ from envs.tolerances import REL_LENGTH_TOL
 
 __all__ = [
     "CHORD_TOL_REL",
+    "COLLAPSE_REL",
     "KERNEL_FLOOR",
     "MERGE_REL",
     "PROBE_REL",
@@ -75,7 +87,11 @@ THIN_REL = 1e-7
 PROBE_REL = 1e-5
 """Offset (times L) of the probe points on each side of a boundary piece."""
 
-KERNEL_FLOOR = {"touch": 2.0, "merge": 20.0, "thin": 20.0, "probe": 200.0}
+COLLAPSE_REL = 1e-5
+"""Faces of a smaller half-perimeter (times L) are specks (collapsed to a point): ten
+times the kernel's resolution ``sqrt(ANGLE_TOL)`` near a type-4 end (module docstring)."""
+
+KERNEL_FLOOR = {"touch": 2.0, "merge": 20.0, "thin": 20.0, "probe": 200.0, "collapse": 200.0}
 """Each tolerance is at least this many times ``REL_LENGTH_TOL * sqrt(2) * diameter``, a
 rotation-invariant bound on the kernel's tolerance ``REL_LENGTH_TOL * scale``."""
 
@@ -91,6 +107,7 @@ class Tolerances:
         touch: tangency (touch) distance.
         thin: sliver width.
         probe: probe offset across a boundary piece.
+        collapse: faces of a smaller half-perimeter are specks (a point).
         kernel: the geometry kernel's length tolerance (``REL_LENGTH_TOL * scale``).
     """
 
@@ -100,6 +117,7 @@ class Tolerances:
     touch: float
     thin: float
     probe: float
+    collapse: float
     kernel: float
 
     @classmethod
@@ -113,6 +131,7 @@ class Tolerances:
             touch=max(TOUCH_REL * L, KERNEL_FLOOR["touch"] * k),
             thin=max(THIN_REL * L, KERNEL_FLOOR["thin"] * k),
             probe=max(PROBE_REL * L, KERNEL_FLOOR["probe"] * k),
+            collapse=max(COLLAPSE_REL * L, KERNEL_FLOOR["collapse"] * k),
             kernel=REL_LENGTH_TOL * world.scale,
         )
 

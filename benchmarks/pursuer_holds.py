@@ -12,7 +12,9 @@ the same run).
 Usage::
 
     python benchmarks/pursuer_holds.py [--seeds 10] [--rho 0.3 0.5] [--workers 2]
-        [--max-cycles 600] [--worlds corridor corner ...]
+        [--max-cycles 600] [--worlds corridor corner ...] [--no-greedy]
+
+``--no-greedy`` skips the greedy reference (half the time; no decision-time ratio).
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ EVADERS = [
     "evader/random",
 ]
 WORLDS = ["corridor", "corner", "l_hall", "open_room"]
+PURSUERS = ("pursuer/decomposition", "pursuer/greedy")
 # (label, rotation in radians, scale, offset)
 VARIANTS = [
     ("as is", 0.0, 1.0, (0.0, 0.0)),
@@ -67,13 +70,13 @@ def _evader(label: str):
 
 
 def _play(job):
-    world, variant, rho, evader, seed, max_cycles = job
+    world, variant, rho, evader, seed, max_cycles, pursuers = job
     label, rot, scale, offset = variant
     m, params = _world(world, rot, scale, offset)
     params["v_evader"] = rho * params["v_pursuer"]
     params["body_radius"] = 0.2 * scale
     out = {}
-    for pursuer in ("pursuer/decomposition", "pursuer/greedy"):
+    for pursuer in pursuers:
         r = run_episode(
             m, pursuer, _evader(evader), seed, max_cycles=max_cycles, overrides=params, start="safe"
         )
@@ -89,11 +92,13 @@ def main(argv=None) -> int:
     ap.add_argument("--max-cycles", type=int, default=600)
     ap.add_argument("--worlds", nargs="+", default=WORLDS)
     ap.add_argument("--variants", nargs="+", default=[v[0] for v in VARIANTS])
+    ap.add_argument("--no-greedy", action="store_true", help="skip the greedy reference")
     args = ap.parse_args(argv)
+    pursuers = ("pursuer/decomposition",) if args.no_greedy else PURSUERS
     print(f"load average: {os.getloadavg()}")
     variants = [v for v in VARIANTS if v[0] in args.variants]
     jobs = [
-        (w, v, rho, e, s, args.max_cycles)
+        (w, v, rho, e, s, args.max_cycles, pursuers)
         for w in args.worlds
         for v in variants
         for rho in args.rho
@@ -106,7 +111,7 @@ def main(argv=None) -> int:
     wall = time.perf_counter() - t0
     held: dict[tuple, list[int]] = {}
     losses = []
-    decide = {p: [] for p in ("pursuer/decomposition", "pursuer/greedy")}
+    decide = {p: [] for p in pursuers}
     for world, label, rho, evader, seed, out in results:
         for p in decide:
             decide[p].append(out[p][3])
@@ -115,20 +120,25 @@ def main(argv=None) -> int:
         h = held.setdefault(key, [0, 0, 0])
         h[0] += winner == "pursuer"
         h[1] += 1
-        h[2] += out["pursuer/greedy"][0] == "pursuer"
+        h[2] += "pursuer/greedy" in out and out["pursuer/greedy"][0] == "pursuer"
         if winner != "pursuer":
             losses.append((world, label, rho, evader, seed, cause, t))
-    print(f"{len(jobs)} x 2 episodes in {wall:.0f} s ({args.workers} workers)")
+    print(f"{len(jobs)} x {len(pursuers)} episodes in {wall:.0f} s ({args.workers} workers)")
     print(f"{'world':<10}{'evader':<26}{'decomposition held':>20}{'greedy held':>14}")
     for (world, evader), (h, n, g) in sorted(held.items()):
-        print(f"{world:<10}{evader:<26}{f'{h}/{n}':>20}{f'{g}/{n}':>14}")
+        greedy = f"{g}/{n}" if len(pursuers) > 1 else "-"
+        print(f"{world:<10}{evader:<26}{f'{h}/{n}':>20}{greedy:>14}")
     total = sum(v[0] for v in held.values()), sum(v[1] for v in held.values())
     print(f"decomposition pursuer held {total[0]}/{total[1]} from safe starts")
-    d, g = (float(np.mean(decide[p])) for p in ("pursuer/decomposition", "pursuer/greedy"))
-    print(
-        f"decision time per step: decomposition {1e3 * d:.3f} ms, greedy {1e3 * g:.3f} ms "
-        f"(ratio {d / g:.1f}x)"
-    )
+    d = float(np.mean(decide["pursuer/decomposition"]))
+    if len(pursuers) > 1:
+        g = float(np.mean(decide["pursuer/greedy"]))
+        print(
+            f"decision time per step: decomposition {1e3 * d:.3f} ms, greedy {1e3 * g:.3f} ms "
+            f"(ratio {d / g:.1f}x)"
+        )
+    else:
+        print(f"decision time per step: decomposition {1e3 * d:.3f} ms")
     for loss in losses:
         world, label, rho, evader, seed, cause, t = loss
         print(f"  lost: {world} [{label}] rho={rho} {evader} seed={seed}: {cause} at {t}")

@@ -20,10 +20,17 @@ Per step (a table lookup plus a little arithmetic, no geometry kernel call):
 3. The velocity is the evader's velocity plus the perpendicular component that realises the
    commanded rotation rate (eq. 5), plus a radial correction of L toward L_min, all within
    V_p (:func:`strategies.control.kinematics.pursuer_velocity_holding_range`).
+4. While the evader closes in along the rod, the rotation keeps room to circle it
+   (issue 13): charged, the pursuer holds L only by backing off, and turning as fast as
+   it can it runs on a circle of radius ``L / sqrt(1 - rho^2)``. Where going on would
+   leave no such circle free of walls, it turns hard round one that is (or nearly is),
+   instead of being pushed into a wall or down a dead end and pinned closer than L_min
+   (:meth:`DecompositionPursuer._keep_orbit`).
 """
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -43,6 +50,22 @@ from strategies.policies.lazy_table import LazySafetyTable
 from strategies.policies.safety import NO_PATH, SafetyTable, safety_table
 
 __all__ = ["DecompositionPursuer"]
+
+
+@functools.lru_cache(maxsize=16)
+def _clearance_grid(world, table: SafetyTable) -> np.ndarray:
+    """(nx, ny) wall distance of each node ``origin + resolution (i, j)`` of an eager
+    table's grid (0 off the free region), for the orbit test of
+    :meth:`DecompositionPursuer._orbit_margins` (a lazy table fills the same values in
+    as they are needed)."""
+    nodes = np.argwhere(table.cell >= 0)
+    clear = np.zeros(table.shape)
+    for k in range(0, len(nodes), 4096):  # bounded memory: points x edges per chunk
+        chunk = nodes[k : k + 4096]
+        clear[chunk[:, 0], chunk[:, 1]] = world.distance_to_walls(
+            table.origin + table.resolution * chunk
+        )
+    return clear
 
 
 class DecompositionPursuer(BasePolicy):
@@ -74,6 +97,8 @@ class DecompositionPursuer(BasePolicy):
     roles = ("pursuer",)
     EAGER_TABLE_POINTS = 50_000  # grid points above which "auto" fills the table lazily
     CLOSING = 0.3  # share of V_p kept for closing in while L exceeds its target
+    ORBIT_LOOKAHEAD = 1.0  # seconds of the charge a candidate rate is followed for
+    ORBIT_REACH = 0.3  # a circle short of room by less than this x L is worth turning for
 
     def __init__(
         self,
@@ -149,6 +174,18 @@ class DecompositionPursuer(BasePolicy):
         # the penalty of turning k bins, as _target's score needs it (same float ops)
         self._turn_penalty = self.hysteresis * np.arange(nb + 1.0) * self._bw / self.omega
         self.last_target: int | None = None
+        # the orbit test (:meth:`_orbit_margins`), for rho < 1
+        self._clear = None  # (nx, ny) wall distances of the grid nodes (eager tables)
+        self._clear_memo: dict[tuple[int, int], float] | None = None  # the lazy ones'
+        if rho < 1.0:
+            if isinstance(self.table, SafetyTable):
+                self._clear = _clearance_grid(c.map, self.table)
+            else:
+                self._clear_memo = {}
+        root = math.sqrt(max(1.0 - rho * rho, 1e-12))
+        self._orbit_k = rho / root  # radius of the evader's circle, per unit of L
+        self._orbit_R = 1.0 / root  # radius of the pursuer's circle, per unit of L
+        self._orbit_pad = c.body_radius + h  # + a grid step: the margin is read on the grid
 
     # ------------------------------------------------------------------ decision
     def orientation_values(self, evader: np.ndarray) -> np.ndarray:
@@ -259,6 +296,81 @@ class DecompositionPursuer(BasePolicy):
             offset -= 2.0 * math.pi
         return offset, target
 
+    def _orbit_margins(self, ex: float, ey: float, theta: float, L: float) -> tuple[float, float]:
+        """How much room the orbit about the evader has, turning ccw and cw (negative: none).
+
+        Charged along the rod at V_e, the pursuer holds L by backing off at V_e and turns
+        the rod with the rest of its speed at ``omega = V_p sqrt(1 - rho^2) / L`` (eq. 6,
+        Sec. 6.1). Turning at that rate one way round, the evader runs on a circle of
+        radius ``rho L / sqrt(1 - rho^2)`` and the pursuer on a concentric one of radius
+        ``R = L / sqrt(1 - rho^2)``, centred beside the evader; the rod is a chord of the
+        pursuer's circle. If the disc of radius ``R`` plus the pursuer's body is free, the
+        pursuer can keep circling forever and is never pinned against a wall. The margin
+        is the wall distance of the centre (at the nearest node of the table's grid) minus
+        that radius and one grid step.
+        """
+        tab = self.table
+        k = self._orbit_k * L
+        nx, ny = -math.sin(theta) * k, math.cos(theta) * k
+        need = self._orbit_R * L + self._orbit_pad
+        ox, oy = float(tab.origin[0]), float(tab.origin[1])
+        h = tab.resolution
+        out = []
+        for s in (1.0, -1.0):
+            i = round((ex + s * nx - ox) / h)
+            j = round((ey + s * ny - oy) / h)
+            if not (0 <= i < tab.shape[0] and 0 <= j < tab.shape[1]):
+                d = 0.0
+            elif self._clear is not None:
+                d = float(self._clear[i, j])
+            else:
+                d = self._clear_memo.get((i, j))
+                if d is None:  # the eager grid's value: same node, same arithmetic
+                    node = np.array([[i, j]])
+                    inside = bool(tab.inside(tab.origin + h * node)[0])
+                    world = self.config.map
+                    d = float(world.distance_to_walls(tab.origin + h * node)[0]) if inside else 0.0
+                    self._clear_memo[(i, j)] = d
+            out.append(d - need)
+        return out[0], out[1]
+
+    def _keep_orbit(self, snap: Snapshot, rate: float, hi: float, lo: float, L: float) -> float:
+        """The rotation rate against a charge, overridden to keep or reach an orbit.
+
+        Each candidate (``rate``, the decomposition's turn; ``hi`` and ``lo``, hard round
+        either way) is followed for ``ORBIT_LOOKAHEAD`` seconds of the charge along the
+        turning rod, and scored by the best margin of :meth:`_orbit_margins` there.
+        ``rate`` stands if it keeps an orbit with room; otherwise the hard turn with the
+        best margin wins if it beats ``rate``'s, and is not short of room by more than
+        ``ORBIT_REACH`` x L. A hard turn keeps its own circle where it is, so this turns
+        hard just before going on would lose the last circle with room, and circles a
+        nearly free one rather than being pushed on toward a wall or down a dead end.
+        """
+        ex, ey = float(snap.evader[0]), float(snap.evader[1])
+        ve = snap.evader_velocity
+        v = math.hypot(float(ve[0]), float(ve[1]))
+        T = self.ORBIT_LOOKAHEAD
+        th = snap.theta
+
+        def after(r: float) -> float:
+            # the charge along the turning rod for T seconds, in closed form
+            if abs(r) * T < 1e-6:
+                x, y = ex + v * T * math.cos(th), ey + v * T * math.sin(th)
+            else:
+                x = ex + v / r * (math.sin(th + r * T) - math.sin(th))
+                y = ey - v / r * (math.cos(th + r * T) - math.cos(th))
+            return max(self._orbit_margins(x, y, th + r * T, L))
+
+        base = after(rate)
+        if base >= 0.0:
+            return rate
+        best, pick = max(-self.ORBIT_REACH * L, base), rate
+        for r in (hi, lo):
+            m = after(r)
+            if m > best + 0.01 * L:
+                best, pick = m, r
+        return pick
+
     def _decide(self, snap: Snapshot) -> np.ndarray:
         c = self.config
         L = max(snap.L, 1e-9)
@@ -287,6 +399,10 @@ class DecompositionPursuer(BasePolicy):
             lo = max(lo, (-budget - across) / L)
         want = rot / (2.0 * c.dt)
         cmd_rate = min(max(want, lo), hi)
+        if self._clear is not None or self._clear_memo is not None:
+            u = (math.cos(snap.theta), math.sin(snap.theta))
+            if float(ve[0]) * u[0] + float(ve[1]) * u[1] > 0.5 * speed:  # it closes in
+                cmd_rate = self._keep_orbit(snap, cmd_rate, hi, lo, L)
         cmd = _holding_range(
             np.asarray(ve, dtype=np.float64),
             snap.theta,

@@ -1,0 +1,77 @@
+"""The decomposition pursuer keeps room to circle a charging evader (issue 13).
+
+Charged along the rod, the pursuer holds L only by backing off at V_e; turning the rod
+as fast as it can, both agents run on concentric circles (the pursuer's of radius
+L / sqrt(1 - rho^2)). Before, nothing in the policy looked at that room: in the corner
+world a charger pushed the pursuer down an arm to its dead end, or into a wall while it
+swung the rod the long way round, and won by "too_close" after 13-25 s. Now the
+pursuer turns hard where going on would lose the last circle it has room for (or would
+move it further from one it nearly has).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from strategies.policies import make_policy
+from strategies.policies.base import Snapshot
+from strategies.runner import build_env, run_episode
+
+
+def _pursuer(world: str):
+    config = build_env(world, {}).config
+    policy = make_policy("pursuer/decomposition")
+    policy.reset(role="pursuer", map=config.map, config=config, seed=0)
+    return policy
+
+
+def test_orbit_margins_in_the_open_room():
+    p = _pursuer("open_room")  # 10 x 10, rho = 0.5, body radius 0.1
+    L = 2.0
+    ccw, cw = p._orbit_margins(5.0, 5.0, 0.0, L)
+    # the evader's circle has radius rho L / sqrt(1 - rho^2), the pursuer's L / sqrt(...)
+    r_e, r_p = L * 0.5 / math.sqrt(0.75), L / math.sqrt(0.75)
+    want = (5.0 - r_e) - (r_p + p.config.body_radius + p.table.resolution)
+    h = p.table.resolution
+    assert ccw == pytest.approx(want, abs=h) and cw == pytest.approx(want, abs=h)
+    # beside the south wall only the circle on the north side fits
+    ccw, cw = p._orbit_margins(5.0, 2.6, 0.0, L)
+    assert ccw > 0.0 > cw
+
+
+def _charge(evader, theta: float, L: float) -> Snapshot:
+    u = np.array([math.cos(theta), math.sin(theta)])
+    e = np.asarray(evader, dtype=float)
+    return Snapshot(e, e + L * u, 0.5 * u, 0.5 * u, 0.0)
+
+
+def test_the_pursuer_turns_before_it_loses_its_last_orbit():
+    p = _pursuer("open_room")
+    L = p.L_target
+    # a charge heading east toward the east wall: the circles' centres move with it;
+    # find the last position where a circle still fits
+    x = 5.0
+    while max(p._orbit_margins(x + 0.05, 5.0, 0.0, L)) >= 0.0:
+        x += 0.05
+    hi, lo = 0.4, -0.4
+    assert p._keep_orbit(_charge((x, 5.0), 0.0, L), 0.0, hi, lo, L) in (hi, lo)  # turn hard
+    # in the middle of the room nothing is overridden
+    assert p._keep_orbit(_charge((5.0, 5.0), 0.0, L), 0.0, hi, lo, L) == 0.0
+    # and the policy's own command turns the rod there
+    p.last_target = None
+    v = p._decide(_charge((x, 5.0), 0.0, L))
+    assert abs(float(v[1])) > 0.5  # mostly sideways (a straight retreat would be (0.5, 0))
+
+
+@pytest.mark.parametrize(
+    ("world", "seed", "cycles"),
+    [("corner", 5, 200), ("maze", 4, 150)],  # lost to the charge at 18.7 s and 13.7 s before
+)
+def test_the_pursuer_outlasts_a_charger(world, seed, cycles):
+    r = run_episode(
+        world, "pursuer/decomposition", "evader/toward_away", seed, start="safe", max_cycles=cycles
+    )
+    assert r.winner == "pursuer", r.summary()

@@ -282,10 +282,14 @@ class ShootingEvader(BasePolicy):
             self._plan_lost = False
         step = self.config.v_evader * self.config.dt
         if cell != last:
-            if last >= 0 and self._witness is not None:
-                # crossed from `last` through its witness piece: never straight back
-                self._came_through = (last, self._witness.boundary)
-                self._trail.append((last, self._witness.boundary))
+            if last >= 0:
+                # crossed from `last` through its witness piece: never straight back. Left
+                # without a witness (no reachable crossing) it is on the trail too, so that
+                # a cell whose plan only leads into such a cell and back is caught (A -> B
+                # -> A) rather than alternated with for the whole episode (issue 13)
+                piece = -1 if self._witness is None else self._witness.boundary
+                self._came_through = (last, piece)
+                self._trail.append((last, piece))
                 if len(self._trail) >= 2 and self._trail[-2][0] == cell:
                     # back in the cell of two crossings ago (A -> B -> A: two pieces at a
                     # junction, or either side of a region thinner than a step): neither

@@ -290,11 +290,13 @@ class ShootingEvader(BasePolicy):
                 piece = -1 if self._witness is None else self._witness.boundary
                 self._came_through = (last, piece)
                 self._trail.append((last, piece))
-                if len(self._trail) >= 2 and self._trail[-2][0] == cell:
-                    # back in the cell of two crossings ago (A -> B -> A: two pieces at a
-                    # junction, or either side of a region thinner than a step): neither
-                    # crossing made progress, so both are out
-                    for c_, b_ in self._trail[-2:]:
+                back = [i for i, (c_, _) in enumerate(self._trail[:-1]) if c_ == cell]
+                if back:
+                    # back in a cell left a few crossings ago (A -> B -> A: two pieces at a
+                    # junction, or either side of a region thinner than a step; or A -> B
+                    # -> C -> A round witness-less cells, office x10 vs the referee): no
+                    # crossing of the cycle made progress, so all of them are out
+                    for c_, b_ in self._trail[back[-1] :]:
                         self._excluded.setdefault(c_, set()).add(b_)
                 del self._trail[:-4]
             self._plan_cell = cell

@@ -8,6 +8,11 @@ pieces in turn. Leaving a cell without a witness was not put on the trail of
 crossings, so the A -> B -> A check never fired and the evader alternated between the
 two cells for the whole horizon (8 D / V_e). Now such a departure is on the trail, the
 two crossings are excluded, and it escapes within 2 D / V_e.
+
+Against the referee pursuer (seed 0) the same corner made a three-cell cycle (a rank-6
+cell's plan into a rank-0 cell without a reachable crossing, on to another, and back;
+about 6 D / V_e at HEAD before, held for 8 D / V_e after the first fix): a return to
+any cell still on the trail now excludes every crossing of the cycle.
 """
 
 from __future__ import annotations
@@ -15,6 +20,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 from envs.maps import builtin_info
 from strategies.runner import run_episode
@@ -30,10 +36,13 @@ def _office_x10_rot():
     return m, params
 
 
-def test_escapes_where_it_alternated_between_two_cells():
+@pytest.mark.parametrize(
+    ("pursuer", "seed"), [("pursuer/corner_rounding", 2), ("pursuer/referee", 0)]
+)
+def test_escapes_where_it_cycled_between_cells(pursuer, seed):
     m, params = _office_x10_rot()
     x0, y0, x1, y1 = m.bounds
     horizon = 2.0 * math.hypot(x1 - x0, y1 - y0) / params["v_evader"]  # seconds
-    r = run_episode(m, "pursuer/corner_rounding", "evader/shooting", 2, start="safe",
+    r = run_episode(m, pursuer, "evader/shooting", seed, start="safe",
                     max_cycles=math.ceil(horizon / 0.1), overrides=params)  # fmt: skip
     assert r.winner == "evader", r.summary()

@@ -151,7 +151,7 @@ def _play(job):
     for e in simple:
         s = run_episode(m, _policy(pursuer), _policy(e), seed, max_cycles=max_cycles,
                         overrides=params, start=start)  # fmt: skip
-        out[e] = (s.winner, s.escape_time, s.decide_seconds["evader"])
+        out[e] = (s.winner, s.escape_time, s.decide_seconds["evader"], s.steps)
     return name, variant, pursuer, seed, out
 
 
@@ -223,9 +223,9 @@ def main(argv=None) -> int:
         for e in simple:
             if e not in out:
                 continue
-            w, _, d = out[e]
-            if e == "evader/straight":
-                pair.append((dec, d))
+            w, _, d, n_steps = out[e]
+            if e == "evader/straight":  # seconds and steps of each, weighted by steps
+                pair.append((dec * out["steps"], out["steps"], d * n_steps, n_steps))
             for acc in (row[3][e], simple_rate[e]):
                 acc[0] += w == "evader"
                 acc[1] += 1
@@ -249,7 +249,8 @@ def main(argv=None) -> int:
     spent, steps = np.sum(decide, axis=0)
     line = f"decision time per step: shooting {1e3 * spent / steps:.3f} ms (all steps)"
     if pair:
-        d, s = np.mean(pair, axis=0)
+        a, na, b, nb = np.sum(pair, axis=0)
+        d, s = a / na, b / nb
         line += f"; same starts: shooting {1e3 * d:.3f} ms, straight {1e3 * s:.4f} ms"
         line += f" (ratio {d / s:.0f}x)"
     print(line)

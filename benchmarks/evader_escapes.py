@@ -50,6 +50,7 @@ import time
 import numpy as np
 
 from envs.maps import Map, builtin_info, load_map
+from envs.maps.junctions import crossroads, t_junction
 from strategies.policies.base import BasePolicy
 from strategies.runner import run_episode
 
@@ -77,28 +78,13 @@ class StandStill(BasePolicy):
         return np.zeros(2)
 
 
-def plus(arm: float = 4.0, width: float = 1.6) -> Map:
-    h = width / 2
-    r = h + arm
-    pts = [(h, -r), (h, -h), (r, -h), (r, h), (h, h), (h, r), (-h, r), (-h, h), (-r, h),
-           (-r, -h), (-h, -h), (-h, -r)]  # fmt: skip
-    return Map(pts, name="plus")
-
-
-def tee(arm: float = 3.0, width: float = 1.6) -> Map:
-    h = width / 2
-    pts = [(-arm - h, -h), (arm + h, -h), (arm + h, h), (h, h), (h, arm + h), (-h, arm + h),
-           (-h, h), (-arm - h, h)]  # fmt: skip
-    return Map(pts, name="tee")
-
-
 def world(name: str, variant: str = "as is") -> tuple[Map, dict]:
     """The map and env overrides of a world variant (lengths and speeds scaled with it)."""
     rot, scale, offset = VARIANTS[variant]
     if name == "plus":
-        m, params = plus(), dict(BASE)
+        m, params = crossroads(), dict(BASE)
     elif name == "tee":
-        m, params = tee(), dict(BASE)
+        m, params = t_junction(), dict(BASE)
     elif name.startswith("random:"):
         m, params = load_map(name), dict(BASE)
     else:

@@ -17,7 +17,7 @@ import math
 import numpy as np
 import pytest
 
-from envs.maps import Map
+from envs.maps.junctions import crossroads, t_junction
 from strategies.cspace import decompose
 from strategies.policies.base import BasePolicy
 from strategies.runner import run_episode
@@ -34,27 +34,12 @@ class StandStill(BasePolicy):
         return np.zeros(2)
 
 
-def plus(arm: float = 4.0, width: float = 1.6) -> Map:
-    h = width / 2
-    r = h + arm
-    pts = [(h, -r), (h, -h), (r, -h), (r, h), (h, h), (h, r), (-h, r), (-h, h), (-r, h),
-           (-r, -h), (-h, -h), (-h, -r)]  # fmt: skip
-    return Map(pts, name="plus")
-
-
-def tee(arm: float = 3.0, width: float = 1.6) -> Map:
-    h = width / 2
-    pts = [(-arm - h, -h), (arm + h, -h), (arm + h, h), (h, h), (h, arm + h), (-h, arm + h),
-           (-h, h), (-arm - h, h)]  # fmt: skip
-    return Map(pts, name="tee")
-
-
-@pytest.mark.parametrize("world", [plus(), tee()], ids=lambda m: m.name)
+@pytest.mark.parametrize("world", [crossroads(), t_junction()], ids=lambda m: m.name)
 def test_prop2_holds_on_these_worlds(world):
     assert decompose(world, 2.2).evader_wins  # L_min + body radius
 
 
-@pytest.mark.parametrize("world", [plus(), tee()], ids=lambda m: m.name)
+@pytest.mark.parametrize("world", [crossroads(), t_junction()], ids=lambda m: m.name)
 @pytest.mark.parametrize("pursuer", ["still", "pursuer/greedy", "pursuer/decomposition"])
 def test_the_shooting_evader_escapes_every_episode(world, pursuer):
     x0, y0, x1, y1 = world.bounds

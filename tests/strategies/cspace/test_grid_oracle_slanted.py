@@ -22,20 +22,11 @@ from __future__ import annotations
 
 import pytest
 
-from envs.maps import Map
 from tests.oracles import grid_oracle as go
-from tests.strategies.cspace._oracle import exact_decomposition
+from tests.strategies.cspace._oracle import exact_decomposition, tilted_block
 from tests.strategies.cspace.test_sweep_worlds import trapezoid_room
 
-TILTED_BLOCK = [(6.924, 4.301), (4.916, 3.676), (5.431, 2.022), (7.438, 2.647)]
-
-
-def tilted_block_room() -> Map:
-    """A 12 x 8 room with one block turned by about 17 degrees."""
-    return Map([(0, 0), (12, 0), (12, 8), (0, 8)], [TILTED_BLOCK], name="tilted_block")
-
-
-STABLE = [(tilted_block_room, 2.5), (tilted_block_room, 3.6)]
+STABLE = [(tilted_block, 2.5), (tilted_block, 3.6)]
 
 
 @pytest.mark.parametrize(("world", "L"), STABLE, ids=[f"{w.__name__}-L{L:g}" for w, L in STABLE])

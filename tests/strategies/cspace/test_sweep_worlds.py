@@ -16,21 +16,13 @@ import pytest
 
 from envs.maps import Map, builtin_map, random_map
 from tests.strategies.cspace._oracle import (
+    _regular,
+    _rotated,
     exact_decomposition,
     fingerprint,
     similar,
     stops_constant,
 )
-
-
-def _regular(n: int, r: float, c, phase: float) -> np.ndarray:
-    a = phase + 2 * math.pi * np.arange(n) / n
-    return np.c_[c[0] + r * np.cos(a), c[1] + r * np.sin(a)]
-
-
-def _turn(points, angle: float) -> np.ndarray:
-    c, s = math.cos(angle), math.sin(angle)
-    return np.asarray(points, dtype=float) @ np.array([[c, s], [-s, c]])
 
 
 def hexagon_hall() -> Map:
@@ -44,7 +36,9 @@ def hexagon_hall() -> Map:
 
 def trapezoid_room() -> Map:
     """A room whose side walls lean (a trapezoid) with one tilted block."""
-    block = _turn([(-1.6, -0.7), (1.6, -0.7), (1.6, 0.7), (-1.6, 0.7)], 0.83) + np.array([5.6, 4.3])
+    block = _rotated([(-1.6, -0.7), (1.6, -0.7), (1.6, 0.7), (-1.6, 0.7)], 0.83) + np.array(
+        [5.6, 4.3]
+    )
     return Map([(0, 0), (11.5, 0), (10.2, 8.6), (1.9, 8.6)], [block], name="trapezoid_room")
 
 

@@ -100,8 +100,9 @@ class DaggerConfig:
     radial_weight: float = 1.0
     """Weight of the action error along the line of sight (1: plain MSE); see :func:`_fit`."""
     validation_episodes: int = 0
-    """Episodes the learner plays *alone* after each fit (fixed seeds, the top-level maps,
-    start and env, the opponent or pool): a learner-only learning curve. With more than 0,
+    """Episodes the learner plays *alone* after each fit (fixed seeds, the top-level start
+    and env; ``validation_maps`` and ``validation_opponent`` when set, else the top-level
+    maps and the opponent or pool): a learner-only learning curve. With more than 0,
     ``model.zip`` is the iteration that won most of them (ties: the later one) and
     ``model_last.zip`` the last iteration, from which a resumed run continues: DAgger's
     last iteration is not always its best."""

@@ -26,6 +26,9 @@ Per step (a table lookup plus a little arithmetic, no geometry kernel call):
    leave no such circle free of walls, it turns hard round one that is (or nearly is),
    instead of being pushed into a wall or down a dead end and pinned closer than L_min
    (:meth:`DecompositionPursuer._keep_orbit`).
+5. Near a wall that faces it along the rod, it holds the distance longer by the
+   evader's overlap with that wall, which the physics gives back in one step when the
+   evader turns away (:meth:`DecompositionPursuer._wall_push`).
 """
 
 from __future__ import annotations
@@ -46,6 +49,7 @@ from strategies.policies.base import (
     nonnegative_param,
     positive_param,
 )
+from strategies.policies.baselines import nearest_wall_point
 from strategies.policies.lazy_table import LazySafetyTable
 from strategies.policies.safety import NO_PATH, SafetyTable, safety_table
 
@@ -371,6 +375,35 @@ class DecompositionPursuer(BasePolicy):
                 best, pick = m, r
         return pick
 
+    def _wall_push(self, snap: Snapshot) -> float:
+        """How far the physics may push the evader toward the pursuer in one step.
+
+        A disc driven into a wall overlaps it (by up to half its radius,
+        :data:`envs.surveillance.physics.MAX_SUBSTEP_TRAVEL`) and is pushed back out when
+        it turns away; an evader that walks into a wall and bounces back along the rod
+        thus closes its overlap on top of ``V_e dt`` in one step, more than the
+        one-step buffer of the held distance allows. The overlap times the share of the
+        wall's normal along the rod (0 when the wall does not face the pursuer).
+        """
+        r = self.config.body_radius
+        e = snap.evader
+        if self._clear is not None:  # the grid's wall distance rules most steps out
+            tab = self.table
+            i = round((float(e[0]) - float(tab.origin[0])) / tab.resolution)
+            j = round((float(e[1]) - float(tab.origin[1])) / tab.resolution)
+            if 0 <= i < tab.shape[0] and 0 <= j < tab.shape[1]:
+                if self._clear[i, j] > r + tab.resolution:  # nearest node within h / sqrt 2
+                    return 0.0
+        q, _ = nearest_wall_point(self.config.map, np.asarray(e, dtype=np.float64))
+        dx, dy = float(e[0]) - float(q[0]), float(e[1]) - float(q[1])
+        d = math.hypot(dx, dy)
+        if d >= r or d == 0.0:
+            return 0.0
+        L = max(snap.L, 1e-9)
+        rod = snap.pursuer - snap.evader
+        facing = (dx * float(rod[0]) + dy * float(rod[1])) / (d * L)
+        return (r - d) * max(facing, 0.0)
+
     def _decide(self, snap: Snapshot) -> np.ndarray:
         c = self.config
         L = max(snap.L, 1e-9)
@@ -383,7 +416,8 @@ class DecompositionPursuer(BasePolicy):
         # pursuer_velocity_holding_range without their argument checks)
         hi, lo = _theta_dot_rates(alpha - snap.theta, L, float(c.v_pursuer), rate)
         hi, lo = float(hi), float(lo)
-        closing = min(self.distance_gain * (L - self.L_target), self.CLOSING * c.v_pursuer)
+        L_target = self.L_target + self._wall_push(snap)
+        closing = min(self.distance_gain * (L - L_target), self.CLOSING * c.v_pursuer)
         if closing > 0.0:
             # the rod is longer than the table's (fewer free orientations, Prop. 3: the
             # table may call an orientation clear that is not): keep part of the speed
@@ -408,7 +442,7 @@ class DecompositionPursuer(BasePolicy):
             snap.theta,
             cmd_rate,
             L,
-            self.L_target,
+            L_target,
             float(c.v_pursuer),
             self.distance_gain,
         )

@@ -1,0 +1,65 @@
+"""The decomposition pursuer keeps its distance from an evader that bounces off a wall.
+
+A disc driven into a wall overlaps it (by up to half its radius) and the physics pushes
+it back out when it turns away: an evader that walks into a wall, the pursuer following
+at L_min plus the one-step buffer, and bounces straight back along the rod closes that
+overlap on top of ``V_e dt`` in one step. The straight-line evader beat the pursuer this
+way on every built-in Fig. 3 world (``too_close`` as it left the wall: open room 8.2 s,
+corridor 52 s, corner 37 s and 38 s, maze 20 s, rho = 0.5, body radius 0.2); the
+pursuer now adds the overlap, where the wall faces it along the rod, to the distance it
+holds (issue 13).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from strategies.policies import make_policy
+from strategies.policies.base import Snapshot
+from strategies.runner import build_env, run_episode
+
+OVERRIDES = {"v_evader": 0.5, "body_radius": 0.2}  # rho = 0.5, as benchmarks/pursuer_holds.py
+
+
+def _pursuer():
+    config = build_env("open_room", dict(OVERRIDES)).config  # 10 x 10, V_p = 1
+    policy = make_policy("pursuer/decomposition")
+    policy.reset(role="pursuer", map=config.map, config=config, seed=0)
+    return policy
+
+
+def _snap(evader, theta: float, L: float = 2.12) -> Snapshot:
+    e = np.asarray(evader, dtype=float)
+    u = np.array([math.cos(theta), math.sin(theta)])
+    return Snapshot(e, e + L * u, np.zeros(2), np.zeros(2), 0.0)
+
+
+def test_wall_push_is_the_overlap_along_the_rod():
+    p = _pursuer()
+    r = p.config.body_radius
+    # pressed 0.08 into the west wall, the pursuer due east: all of the overlap
+    assert p._wall_push(_snap((0.12, 5.0), 0.0)) == pytest.approx(r - 0.12)
+    # the pursuer at 60 degrees: the share of the wall's normal along the rod
+    assert p._wall_push(_snap((0.12, 5.0), math.pi / 3)) == pytest.approx(0.5 * (r - 0.12))
+    # the wall behind the pursuer's side, or no overlap: nothing
+    assert p._wall_push(_snap((0.12, 5.0), math.pi / 2 + 0.1)) == 0.0
+    assert p._wall_push(_snap((0.25, 5.0), 0.0)) == 0.0
+    assert p._wall_push(_snap((5.0, 5.0), 0.0)) == 0.0
+
+
+def test_the_pursuer_outlasts_a_wall_bounce():
+    # before: the evader walked into the west wall, turned back at the pursuer and won
+    # by "too_close" at 8.2 s
+    r = run_episode(
+        "open_room",
+        "pursuer/decomposition",
+        "evader/straight",
+        0,
+        overrides=dict(OVERRIDES),
+        start="safe",
+        max_cycles=120,
+    )
+    assert r.winner == "pursuer", r.summary()

@@ -128,49 +128,67 @@ class EscapePlan:
     region_next: np.ndarray
 
     @functools.cached_property
-    def _pieces(self) -> list[tuple[np.ndarray, ...]]:
-        """Per boundary: segment starts, directions, lengths, left normals (into A), and
-        cands samples along the piece with their segment and wall clearance."""
-        out = []
-        step_min = self.dec.chord_tol
-        for b in self.dec.boundaries:
-            p0, p1 = b.segments[:, 0], b.segments[:, 1]
-            d = p1 - p0
-            ln = np.hypot(d[:, 0], d[:, 1])
-            keep = ln > 0
-            p0, d, ln = p0[keep], d[keep], ln[keep]
-            u = d / ln[:, None]
-            step = max(step_min, float(ln.sum()) / _SAMPLES)
-            m = np.maximum(1, np.ceil(ln / step).astype(int))
-            seg = np.repeat(np.arange(len(ln)), m)
-            frac = (np.arange(int(m.sum())) - np.repeat(np.cumsum(m) - m, m) + 0.5) / m[seg]
-            s = p0[seg] + frac[:, None] * d[seg]
-            clear = self.dec.map.distance_to_walls(s) if len(s) else np.zeros(0)
-            out.append((p0, d, ln, np.stack([-u[:, 1], u[:, 0]], axis=1), s, seg, clear))
-        return out
+    def _pieces(self) -> dict[int, tuple[np.ndarray, ...]]:
+        return {}
+
+    def _piece(self, b: int) -> tuple[np.ndarray, ...]:
+        """Boundary ``b``'s segment starts, directions, lengths, left normals (into A),
+        and samples along the piece with their segment and wall clearance (computed on
+        first use: a plan crosses few of the pieces)."""
+        got = self._pieces.get(b)
+        if got is not None:
+            return got
+        p0, p1 = self.dec.boundaries[b].segments[:, 0], self.dec.boundaries[b].segments[:, 1]
+        d = p1 - p0
+        ln = np.hypot(d[:, 0], d[:, 1])
+        keep = ln > 0
+        p0, d, ln = p0[keep], d[keep], ln[keep]
+        u = d / ln[:, None]
+        step = max(self.dec.chord_tol, float(ln.sum()) / _SAMPLES)
+        m = np.maximum(1, np.ceil(ln / step).astype(int))
+        seg = np.repeat(np.arange(len(ln)), m)
+        frac = (np.arange(int(m.sum())) - np.repeat(np.cumsum(m) - m, m) + 0.5) / m[seg]
+        s = p0[seg] + frac[:, None] * d[seg]
+        clear = self.dec.map.distance_to_walls(s) if len(s) else np.zeros(0)
+        got = (p0, d, ln, np.stack([-u[:, 1], u[:, 0]], axis=1), s, seg, clear)
+        self._pieces[b] = got
+        return got
 
     @functools.cached_property
-    def _inside(self) -> list:
-        """Region polygons grown by a few polyline tolerances, prepared for line tests."""
-        tol = 4.0 * self.dec.chord_tol + CROSS_REL * self.dec.L
-        polys = [r.polygon.buffer(tol) for r in self.dec.regions]
-        shapely.prepare(polys)
-        return polys
+    def _polygons(self) -> dict:
+        return {}
+
+    def _polygon(self, region: int, offset: float = 0.0):
+        """``region``'s polygon grown by ``offset`` (shrunk if negative), prepared for
+        point and line tests (made on first use)."""
+        poly = self._polygons.get((region, offset))
+        if poly is None:
+            poly = self.dec.regions[region].polygon
+            poly = poly.buffer(offset) if offset else poly
+            shapely.prepare(poly)
+            self._polygons[(region, offset)] = poly
+        return poly
+
+    def _inside(self, region: int):
+        """The region's polygon grown by a few polyline tolerances (for line tests)."""
+        return self._polygon(region, 4.0 * self.dec.chord_tol + CROSS_REL * self.dec.L)
+
+    def inside(self, region: int, point: np.ndarray) -> bool:
+        """Whether ``point`` lies in ``region``'s polygon."""
+        return bool(shapely.contains_xy(self._polygon(region), float(point[0]), float(point[1])))
 
     def well_inside(self, region: int, point: np.ndarray) -> bool:
         """Whether ``point`` lies in ``region`` farther than a few polyline tolerances from
         its boundary (then the configuration's cell cannot have changed since it was
-        identified in that region: the rod cannot cross a wall)."""
-        poly = self._shrunk.get(region)
-        if poly is None:
-            poly = self.dec.regions[region].polygon.buffer(-4.0 * self.dec.chord_tol)
-            shapely.prepare(poly)
-            self._shrunk[region] = poly
+        identified in that region: the rod cannot cross a wall; nearer, the exact curve
+        may lie on either side of the polyline)."""
+        poly = self._polygon(region, -4.0 * self.dec.chord_tol)
         return bool(shapely.contains_xy(poly, float(point[0]), float(point[1])))
 
-    @functools.cached_property
-    def _shrunk(self) -> dict:
-        return {}
+    def well_inside_many(self, region: int, points: np.ndarray) -> np.ndarray:
+        """(n,) bool: :meth:`well_inside` for each of ``points`` (n, 2)."""
+        poly = self._polygon(region, -4.0 * self.dec.chord_tol)
+        return shapely.contains_xy(poly, points[:, 0], points[:, 1])
 
     def cell_at(self, point: np.ndarray, theta: float) -> int:
         """The cell holding configuration ``(point, theta)``, -1 if none is identified."""
@@ -183,14 +201,18 @@ class EscapePlan:
         point: np.ndarray,
         clearance: float = 0.0,
         exclude: frozenset[int] = frozenset(),
+        margin: float = 0.0,
     ) -> Witness | None:
         """The crossing of one of ``cell``'s vias nearest to ``point``.
 
         Candidates are the point of each via piece nearest to ``point`` (projection onto
         the piece's polyline) and samples along the pieces, nearest first; a crossing
-        must keep ``clearance`` from the walls (the evader's disc). The first candidate
-        reachable in a straight line inside the cell's region is taken, else the
-        nearest one.
+        must keep ``clearance`` from the walls (the evader's disc) and should land in the
+        region across its piece (the point ``CROSS_REL * L`` across: near a piece's end
+        it can lie across another piece, in a cell of any rank). The first candidate
+        that lands across and is reachable in a straight line inside the cell's region
+        is taken, else the first that lands across, else (none does) the first in a
+        straight line, else the nearest one.
 
         Args:
             cell: the configuration's cell.
@@ -198,6 +220,8 @@ class EscapePlan:
             clearance: the least distance from the walls of a usable crossing.
             exclude: via pieces not to use (ones the evader could not reach, or that
                 would take it back where it came from).
+            margin: the least arc length along the piece between a crossing and the
+                piece's ends (the midpoint of a piece shorter than two margins).
 
         Returns:
             The :class:`Witness`, or ``None`` if the cell is not escapable or no crossing
@@ -212,17 +236,34 @@ class EscapePlan:
         for b in self.vias[cell]:
             if b in exclude:
                 continue
-            p0, d, ln, nrm, s, seg, clear = self._pieces[b]
+            p0, d, ln, nrm, s, seg, clear = self._piece(b)
             if not len(ln):
                 continue
             sign = 1.0 if dec.boundaries[b].regions[1] == reg else -1.0  # left normal -> A
-            t = np.clip(np.einsum("ij,ij->i", p - p0, d) / ln**2, 0.0, 1.0)
+            lo, hi = 0.0, 1.0
+            ok = clear >= clearance
+            if margin > 0.0:
+                # keep `margin` (arc length) from the piece's ends, where it meets other
+                # pieces: a step across near an end can cross one of those instead (into
+                # a cell of any rank). A piece shorter than 2 margins: its midpoint only.
+                cum = np.r_[0.0, np.cumsum(ln)]  # the piece is a chain of its segments
+                arc_lo, arc_hi = margin, cum[-1] - margin
+                if arc_hi < arc_lo:
+                    arc_lo = arc_hi = 0.5 * cum[-1]
+                lo = np.clip((arc_lo - cum[:-1]) / ln, 0.0, 1.0)
+                hi = np.clip((arc_hi - cum[:-1]) / ln, 0.0, 1.0)
+                pos = cum[seg] + np.einsum("ij,ij->i", s - p0[seg], d[seg]) / ln[seg]
+                ok &= (pos >= arc_lo - 1e-12) & (pos <= arc_hi + 1e-12)
+            t = np.clip(np.einsum("ij,ij->i", p - p0, d) / ln**2, lo, hi)
             q = p0 + t[:, None] * d
             dist = np.hypot(q[:, 0] - p[0], q[:, 1] - p[1])
+            if margin > 0.0:
+                # none on segments wholly within a margin of an end
+                dist = np.where((cum[:-1] <= arc_hi) & (cum[1:] >= arc_lo), dist, np.inf)
             k = int(np.argmin(dist))
             cand = (float(dist[k]), b, q[k], sign * nrm[k])
             ds = np.hypot(s[:, 0] - p[0], s[:, 1] - p[1])
-            ok = np.flatnonzero(clear >= clearance)
+            ok = np.flatnonzero(ok)
             cands.append(cand)
             cands.extend(
                 (float(ds[i]), b, s[i], sign * nrm[seg[i]]) for i in ok[np.argsort(ds[ok])[:8]]
@@ -234,17 +275,31 @@ class EscapePlan:
         cands = [c for c, cl in zip(cands, clear, strict=True) if cl >= clearance]
         if not cands:
             return None  # every crossing is closer to a wall than the evader's disc allows
-        poly = self._inside[reg]
-        choice = next(
-            (
-                c
-                for c in cands
-                if c[0] == 0.0 or shapely.covers(poly, shapely.LineString([p, c[2]]))
-            ),
-            cands[0],
-        )
-        _, b, q, n = choice
-        return Witness(int(b), q, n, q + CROSS_REL * dec.L * n)
+        poly = self._inside(reg)
+        step = CROSS_REL * dec.L
+
+        def lands(c) -> bool:
+            # the point just across lies in the region across the piece: near the
+            # piece's ends (a junction of critical curves) it can lie across another
+            # piece, in a cell of any rank (issue 13)
+            pair = dec.boundaries[c[1]].regions
+            return self.inside(pair[0] if pair[1] == reg else pair[1], c[2] + step * c[3])
+
+        def direct(c) -> bool:
+            return c[0] == 0.0 or shapely.covers(poly, shapely.LineString([p, c[2]]))
+
+        # nearest first: one that lands across and is in a straight line, else the
+        # nearest that lands across, else (none lands) the first in a straight line
+        fallback = None
+        for c in cands:
+            if lands(c):
+                if direct(c):
+                    break
+                fallback = fallback or c
+        else:
+            c = fallback or next((c for c in cands if direct(c)), cands[0])
+        _, b, q, n = c
+        return Witness(int(b), q, n, q + step * n)
 
 
 def _region_next(world: Map, cell: np.ndarray, pts: np.ndarray, h: float, region: np.ndarray):

@@ -4,9 +4,11 @@ Each step, with the rod of length L_eff = L_min + body radius (the most capable 
 Sec. 5 "minimax": its tip meets walls as if the rod were that long):
 
 1. **Escapable cell** (the configuration lies in an escapable cell of the exact
-   decomposition K_L): walk to the nearest crossing of one of the cell's via pieces and
-   step across (:mod:`strategies.policies.escape_plan`); the rank falls at every
-   crossing whatever the pursuer does, until condition (a) breaks surveillance.
+   decomposition K_L): walk, inside the cell's region, to the nearest crossing of one of
+   the cell's via pieces (a step from the piece's ends where it can, and landing in the
+   region across) and land just across it (:mod:`strategies.policies.escape_plan`); the
+   rank falls at every crossing whatever the pursuer does, until condition (a) breaks
+   surveillance.
 2. **Shooting escape**: candidate endpoints (Fig. 13) are points the evader can reach in
    a straight line (probes on rays, and points just past each convex obstacle vertex in
    reach) where the current orientation is not safe. For each, the rotation the pursuer
@@ -49,6 +51,11 @@ from strategies.policies.safety import NO_PATH, safety_table
 __all__ = ["ShootingEvader"]
 
 _EULER = 8  # sub-steps of the straight-path rotation estimate
+# the moves tried, in order, to keep a walk inside a region: the heading turned by 0, 5,
+# ... 90 degrees either way, at a whole, half or quarter step, most progress first
+_TURN_DEG = np.array([s * d for d in range(0, 91, 5) for s in ((1, -1) if d else (1,))])
+_TURNS = np.array([(math.radians(a), f) for f in (1.0, 0.5, 0.25) for a in _TURN_DEG])
+_TURNS = _TURNS[np.argsort(-_TURNS[:, 1] * np.cos(_TURNS[:, 0]), kind="stable")]
 
 
 class ShootingEvader(BasePolicy):
@@ -227,7 +234,6 @@ class ShootingEvader(BasePolicy):
             # (Straight away, as the paper says, can end in a room corner.)
             self.mode = "toward"
             return c.v_evader * unit(snap.rod)
-        row = self.table.row(e)
         heading = self._plan_heading(e, theta)
         if heading is not None:
             self.mode = "plan"
@@ -240,6 +246,7 @@ class ShootingEvader(BasePolicy):
         if best is not None:
             self.mode = "shoot"
             return c.v_evader * self._start_arc(e, theta, *best)
+        row = self.table.row(e)
         if row >= 0 and self.plan.region.any() and not self.plan.region[row]:
             nxt = self.plan.region_next[row]
             if nxt >= 0:
@@ -298,7 +305,9 @@ class ShootingEvader(BasePolicy):
                     # crossing of the cycle made progress, so all of them are out
                     for c_, b_ in self._trail[back[-1] :]:
                         self._excluded.setdefault(c_, set()).add(b_)
-                del self._trail[:-4]
+                # (16 crossings, not 4: random:polygons:0 vs the decomposition pursuer
+                # went round longer cycles for the whole horizon, issue 13)
+                del self._trail[:-16]
             self._plan_cell = cell
             self._new_witness(cell, e)
         elif self._witness is not None:
@@ -314,8 +323,27 @@ class ShootingEvader(BasePolicy):
         if w is None:
             return None
         if np.linalg.norm(w.cross - e) <= step:
+            # land just across the piece (slower if need be), not a step past it: the
+            # region across can be thinner than a step (office: 0.03), and a step past
+            # it lands in the next one, whose plan leads back (issue 13)
+            to = w.target - e
+            gap = float(np.linalg.norm(to))
+            if gap > 1e-3 * step and float(to @ w.normal) > 0.0:  # not past it yet
+                return to / max(gap, step)
             return w.normal.copy()
-        return unit(w.target - e)
+        u = unit(w.target - e)
+        # keep the walk inside the region: a straight one can leave it across another
+        # piece, into a cell of any rank (a sliver along the piece just crossed, or a
+        # crossing out of sight, issue 13); turn the heading as little as keeps the next
+        # step inside
+        reg = self.plan.dec.cells[cell].region
+        if self.plan.well_inside(reg, e + step * u):
+            return u
+        a, f = _TURNS[:, 0], _TURNS[:, 1]
+        h = np.stack([np.cos(a) * u[0] - np.sin(a) * u[1], np.sin(a) * u[0] + np.cos(a) * u[1]], 1)
+        move = f[:, None] * h
+        ok = np.flatnonzero(self.plan.well_inside_many(reg, e + step * move))
+        return move[ok[0]] if len(ok) else u
 
     def _new_witness(self, cell: int, e: np.ndarray) -> None:
         """Choose the crossing for ``cell``, leaving out excluded pieces and the way back."""
@@ -323,9 +351,14 @@ class ShootingEvader(BasePolicy):
         if self._came_through is not None:
             # the piece just crossed, seen from the new side, leads back: skip it
             exclude.add(self._came_through[1])
+        c = self.config
+        # a crossing at least a step from the piece's ends if there is one: the last step,
+        # from up to a step away, must cross that piece, not a neighbour (issue 13:
+        # random:convex:1, along the normal from a piece's end into a rank-39 cell)
+        exclude = frozenset(exclude)
         self._witness = self.plan.witness(
-            cell, e, self.config.body_radius, exclude=frozenset(exclude)
-        )
+            cell, e, c.body_radius, exclude=exclude, margin=c.v_evader * c.dt
+        ) or self.plan.witness(cell, e, c.body_radius, exclude=exclude)
         self._best_gap, self._stall = math.inf, 0
 
     def _start_arc(

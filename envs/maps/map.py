@@ -317,7 +317,7 @@ class Map:
         """Number of wall edges."""
         return len(self.edge_start)
 
-    @property
+    @functools.cached_property
     def bounds(self) -> tuple[float, float, float, float]:
         """``(xmin, ymin, xmax, ymax)`` of the boundary."""
         lo = self.rings[0].min(axis=0)

@@ -232,20 +232,21 @@ def decode_state(obs: np.ndarray, config: EnvConfig) -> StateView:
         raise ValueError(
             f"decode_state: expected a state vector of shape ({STATE_SIZE},), got {o.shape}"
         )
+    # Python floats: the same IEEE operations in the same order as the vectorised form
+    # (lo + (o + 1) * half), a few times faster on 13 numbers (analytic policies decode
+    # every step)
+    px, py, pvx, pvy, ex, ey, evx, evy, c, s, d, vis, t = o.tolist()
     xmin, ymin, xmax, ymax = config.map.bounds
-    lo = np.array([xmin, ymin])
-    half = 0.5 * np.array([xmax - xmin, ymax - ymin])
-    pos = lambda name: lo + (o[STATE_LAYOUT[name]] + 1.0) * half
-    c, s = o[STATE_LAYOUT["theta"]]
-    step = round(float(o[STATE_LAYOUT["time"]][0]) * config.max_cycles)
+    hx, hy = 0.5 * (xmax - xmin), 0.5 * (ymax - ymin)
+    step = round(t * config.max_cycles)
     return StateView(
-        pursuer_pos=pos("pursuer_pos"),
-        pursuer_vel=o[STATE_LAYOUT["pursuer_vel"]] * config.v_pursuer,
-        evader_pos=pos("evader_pos"),
-        evader_vel=o[STATE_LAYOUT["evader_vel"]] * config.v_evader,
+        pursuer_pos=np.array((xmin + (px + 1.0) * hx, ymin + (py + 1.0) * hy)),
+        pursuer_vel=np.array((pvx * config.v_pursuer, pvy * config.v_pursuer)),
+        evader_pos=np.array((xmin + (ex + 1.0) * hx, ymin + (ey + 1.0) * hy)),
+        evader_vel=np.array((evx * config.v_evader, evy * config.v_evader)),
         theta=math.atan2(s, c),
-        distance=float(o[STATE_LAYOUT["distance"]][0]) * config.l_max,
-        visible=bool(o[STATE_LAYOUT["visible"]][0] >= 0.5),
+        distance=d * config.l_max,
+        visible=bool(vis >= 0.5),
         step=step,
         time=step * config.dt,
     )

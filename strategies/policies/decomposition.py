@@ -25,7 +25,9 @@ Per step (a table lookup plus a little arithmetic, no geometry kernel call):
    it can it runs on a circle of radius ``L / sqrt(1 - rho^2)``. Where going on would
    leave no such circle free of walls, it turns hard round one that is (or nearly is),
    instead of being pushed into a wall or down a dead end and pinned closer than L_min
-   (:meth:`DecompositionPursuer._keep_orbit`).
+   (:meth:`DecompositionPursuer._keep_orbit`). Where no circle is even nearly free, it
+   at least turns the way whose path stays clear of walls for a while, if the one it
+   settled on meets one.
 5. Near a wall that faces it along the rod, it holds the distance longer by the
    evader's overlap with that wall, which the physics gives back in one step when the
    evader turns away (:meth:`DecompositionPursuer._wall_push`).
@@ -103,6 +105,8 @@ class DecompositionPursuer(BasePolicy):
     CLOSING = 0.3  # share of V_p kept for closing in while L exceeds its target
     ORBIT_LOOKAHEAD = 1.0  # seconds of the charge a candidate rate is followed for
     ORBIT_REACH = 0.3  # a circle short of room by less than this x L is worth turning for
+    WALL_HORIZON = 2.0  # seconds the pursuer's path is checked for walls (no circle in reach)
+    WALL_STEP = 0.1  # spacing in seconds of the points checked on that path
 
     def __init__(
         self,
@@ -190,6 +194,9 @@ class DecompositionPursuer(BasePolicy):
         self._orbit_k = rho / root  # radius of the evader's circle, per unit of L
         self._orbit_R = 1.0 / root  # radius of the pursuer's circle, per unit of L
         self._orbit_pad = c.body_radius + h  # + a grid step: the margin is read on the grid
+        self._wall_times = np.arange(1, round(self.WALL_HORIZON / self.WALL_STEP) + 1) * (
+            self.WALL_STEP
+        )
 
     # ------------------------------------------------------------------ decision
     def orientation_values(self, evader: np.ndarray) -> np.ndarray:
@@ -328,15 +335,59 @@ class DecompositionPursuer(BasePolicy):
             elif self._clear is not None:
                 d = float(self._clear[i, j])
             else:
-                d = self._clear_memo.get((i, j))
-                if d is None:  # the eager grid's value: same node, same arithmetic
-                    node = np.array([[i, j]])
-                    inside = bool(tab.inside(tab.origin + h * node)[0])
-                    world = self.config.map
-                    d = float(world.distance_to_walls(tab.origin + h * node)[0]) if inside else 0.0
-                    self._clear_memo[(i, j)] = d
+                d = self._memo_clearance(i, j)
             out.append(d - need)
         return out[0], out[1]
+
+    def _memo_clearance(self, i: int, j: int) -> float:
+        """Wall distance of grid node (i, j) of a lazy table (the eager grid's value: same
+        node, same arithmetic), memoised."""
+        d = self._clear_memo.get((i, j))
+        if d is None:
+            tab = self.table
+            node = tab.origin + tab.resolution * np.array([[i, j]])
+            inside = bool(tab.inside(node)[0])
+            d = float(self.config.map.distance_to_walls(node)[0]) if inside else 0.0
+            self._clear_memo[(i, j)] = d
+        return d
+
+    def _time_to_wall(self, snap: Snapshot, r: float, L: float, follow: bool = True) -> float:
+        """When the pursuer's body first meets a wall if the rod turns at ``r`` (``inf``:
+        not within ``WALL_HORIZON`` seconds).
+
+        The evader either runs along the turning rod at its speed (``follow``: the charge
+        of :meth:`_keep_orbit`) or keeps its velocity (the straight-line evader of eqs.
+        2-3), and the pursuer keeps L from it; its centre is checked every ``WALL_STEP``
+        seconds against the wall distances of the table's grid (nearest node).
+        """
+        ex, ey = float(snap.evader[0]), float(snap.evader[1])
+        ve = snap.evader_velocity
+        v = math.hypot(float(ve[0]), float(ve[1]))
+        th = snap.theta
+        ts = self._wall_times
+        a = th + r * ts
+        if not follow:  # the evader keeps its velocity
+            x = ex + float(ve[0]) * ts
+            y = ey + float(ve[1]) * ts
+        elif abs(r) * self.WALL_HORIZON < 1e-6:
+            x = ex + v * ts * math.cos(th)
+            y = ey + v * ts * math.sin(th)
+        else:
+            x = ex + v / r * (np.sin(a) - math.sin(th))
+            y = ey - v / r * (np.cos(a) - math.cos(th))
+        tab = self.table
+        h = tab.resolution
+        i = np.rint((x + L * np.cos(a) - float(tab.origin[0])) / h).astype(np.int64)
+        j = np.rint((y + L * np.sin(a) - float(tab.origin[1])) / h).astype(np.int64)
+        ok = (i >= 0) & (i < tab.shape[0]) & (j >= 0) & (j < tab.shape[1])
+        d = np.zeros(ts.size)
+        if self._clear is not None:
+            d[ok] = self._clear[i[ok], j[ok]]
+        else:
+            for k in np.flatnonzero(ok):
+                d[k] = self._memo_clearance(int(i[k]), int(j[k]))
+        hit = np.flatnonzero(d < self.config.body_radius)
+        return float(ts[hit[0]]) if hit.size else math.inf
 
     def _keep_orbit(self, snap: Snapshot, rate: float, hi: float, lo: float, L: float) -> float:
         """The rotation rate against a charge, overridden to keep or reach an orbit.
@@ -349,6 +400,17 @@ class DecompositionPursuer(BasePolicy):
         ``ORBIT_REACH`` x L. A hard turn keeps its own circle where it is, so this turns
         hard just before going on would lose the last circle with room, and circles a
         nearly free one rather than being pushed on toward a wall or down a dead end.
+
+        Where no candidate has a circle within reach (between pillars, with a wall
+        behind), the circles say nothing about which way to go; the pick's path is then
+        checked for walls over ``WALL_HORIZON`` seconds (:meth:`_time_to_wall`), with the
+        evader following the rod and with it keeping its velocity. If the body would
+        meet a wall in both, a hard turn whose path stays clear of walls in both wins.
+        Where a circle is within reach the pick stands: a path clear for a while can
+        still lead down a dead end, away from the swing that reaches the circle (a
+        clear-path override there lost 2 corner episodes the circles hold); and an
+        override judged on the charge alone undid the decomposition's turns against
+        evaders that do not follow the rod (5 maze and pillar episodes lost).
         """
         ex, ey = float(snap.evader[0]), float(snap.evader[1])
         ve = snap.evader_velocity
@@ -368,11 +430,24 @@ class DecompositionPursuer(BasePolicy):
         base = after(rate)
         if base >= 0.0:
             return rate
-        best, pick = max(-self.ORBIT_REACH * L, base), rate
+        reach = -self.ORBIT_REACH * L
+        best, pick = max(reach, base), rate
+        near = base >= reach  # some circle is within reach
         for r in (hi, lo):
             m = after(r)
+            near = near or m >= reach
             if m > best + 0.01 * L:
                 best, pick = m, r
+        if near:
+            return pick
+        for follow in (True, False):
+            if self._time_to_wall(snap, pick, L, follow) == math.inf:
+                return pick
+        for r in (hi, lo):
+            if r != pick and all(
+                self._time_to_wall(snap, r, L, follow) == math.inf for follow in (True, False)
+            ):
+                return r
         return pick
 
     def _wall_push(self, snap: Snapshot) -> float:

@@ -1,13 +1,17 @@
-"""The decomposition pursuer keeps its distance from an evader that bounces off a wall.
+"""The decomposition pursuer near walls (issue 13).
 
-A disc driven into a wall overlaps it (by up to half its radius) and the physics pushes
-it back out when it turns away: an evader that walks into a wall, the pursuer following
-at L_min plus the one-step buffer, and bounces straight back along the rod closes that
-overlap on top of ``V_e dt`` in one step. The straight-line evader beat the pursuer this
-way on every built-in Fig. 3 world (``too_close`` as it left the wall: open room 8.2 s,
-corridor 52 s, corner 37 s and 38 s, maze 20 s, rho = 0.5, body radius 0.2); the
-pursuer now adds the overlap, where the wall faces it along the rod, to the distance it
-holds (issue 13).
+It keeps its distance from an evader that bounces off a wall: a disc driven into a wall
+overlaps it (by up to half its radius) and the physics pushes it back out when it turns
+away: an evader that walks into a wall, the pursuer following at L_min plus the one-step
+buffer, and bounces straight back along the rod closes that overlap on top of
+``V_e dt`` in one step. The straight-line evader beat the pursuer this way on every
+built-in Fig. 3 world (``too_close`` as it left the wall: open room 8.2 s, corridor
+52 s, corner 37 s and 38 s, maze 20 s, rho = 0.5, body radius 0.2); the pursuer now adds
+the overlap, where the wall faces it along the rod, to the distance it holds.
+
+And where a charger leaves it no circle to run on, it turns the way that keeps it off
+the walls: in the pillar room, from a safe start 1.15 from the north wall, the charge
+pinned it there in 2 s while it turned the short way, toward the wall.
 """
 
 from __future__ import annotations
@@ -61,5 +65,29 @@ def test_the_pursuer_outlasts_a_wall_bounce():
         overrides=dict(OVERRIDES),
         start="safe",
         max_cycles=120,
+    )
+    assert r.winner == "pursuer", r.summary()
+
+
+@pytest.mark.parametrize(
+    ("world", "evader", "seed", "cycles"),
+    [
+        # before: "too_close" at 2.0 s and 2.1 s
+        ("pillars", "evader/toward_away", 2, 60),
+        ("pillars", "evader/shooting", 2, 60),
+        # held before; lost at 5.0 s to an override that assumed the evader follows the
+        # rod (a straight-line evader does not)
+        ("maze", "evader/straight", 1, 80),
+    ],
+)
+def test_the_pursuer_keeps_off_the_walls_with_no_circle_in_reach(world, evader, seed, cycles):
+    r = run_episode(
+        world,
+        "pursuer/decomposition",
+        evader,
+        seed,
+        overrides=dict(OVERRIDES),
+        start="safe",
+        max_cycles=cycles,
     )
     assert r.winner == "pursuer", r.summary()

@@ -9,7 +9,9 @@ rate with its Wilson 95 % interval, and each target of issue 9 as a ratio measur
 this run:
 
 * learned pursuer vs ``evader/shooting``: held rate / the decomposition pursuer's, on
-  corridor, open_room and l_hall (target >= 0.9); on held-out maps, minus greedy's (>= 0);
+  corridor, open_room and l_hall (target >= 0.9); on held-out maps, minus greedy's (>= 0).
+  A map specialist (a model trained on one map) is judged on its own map, and when every
+  target map has one, the specialists as a team (each on its own map);
 * learned evader vs ``pursuer/decomposition``: escape rate minus ``evader/shooting``'s on
   two_rooms and office (>= 0); on held-out maps minus ``evader/straight``'s (>= 0);
 * the per-step decision time of each model against the analytic policy of its role.
@@ -20,7 +22,7 @@ store.
 Usage::
 
     python benchmarks/learned_vs_analytic.py [--seeds 20] [--models NAME ...]
-        [--store out/bench/learned.sqlite] [--workers 2]
+        [--store out/bench/learned.sqlite] [--workers 2] [--maps MAP ...]
 """
 
 from __future__ import annotations
@@ -50,6 +52,11 @@ def _rate(rows, pursuer, evader, maps):
     return (held / len(got) if got else float("nan")), lo, hi, len(got)
 
 
+def _training_maps(name: str) -> list[str]:
+    cfg = zoo.info(name)["config"]
+    return list(cfg.get("maps", [cfg.get("map")]))
+
+
 def _fmt(rate, lo, hi, n):
     return f"{rate:5.2f} [{lo:.2f}, {hi:.2f}] n={n}"
 
@@ -66,11 +73,12 @@ def card(name: str, role: str, rows, args) -> str:
         else ""
     )
     obs = prov["env_config"]
+    rays = f" ({obs.get('n_rays')} rays)" if obs["observation"] != "state" else ""
     lines = [
         f"# {name}",
         "",
         f"A {role} trained by {prov.get('method', 'rl')} {how}against {prov['opponent']}, "
-        f"observing `{obs['observation']}` ({obs.get('n_rays')} rays). Retrain it bit for bit "
+        f"observing `{obs['observation']}`{rays}. Retrain it bit for bit "
         f"with `python -m training.zoo reproduce {name}`; its recipe is `config.toml` beside "
         "this card.",
         "",
@@ -85,15 +93,20 @@ def card(name: str, role: str, rows, args) -> str:
         "",
     ]
     if "disagreement" in prov:
+        alone = prov.get("validation") or []
         lines += ["## DAgger curve", "",
                   "won: episodes won by the rollout policy, the expert acting with "
-                  "probability beta^i (so iteration 0 is the expert alone).", "",
-                  "| iteration | samples | disagreement | fit error | won |",
-                  "|---|---|---|---|---|"]  # fmt: skip
+                  "probability beta^i (so iteration 0 is the expert alone); alone: won by "
+                  "the learner alone in the validation episodes (against "
+                  f"`{cfg.get('validation_opponent') or 'the training pool'}`), which pick "
+                  f"the shipped iteration ({prov.get('best_iteration', '-')}).", "",
+                  "| iteration | samples | disagreement | fit error | won | alone |",
+                  "|---|---|---|---|---|---|"]  # fmt: skip
         curves = zip(prov["samples"], prov["disagreement"], prov["fit_error"], prov["held"],
                      strict=False)  # fmt: skip
         for i, (n, d, f, h) in enumerate(curves):
-            lines.append(f"| {i} | {n} | {d:.3f} | {f:.3f} | {h:.2f} |")
+            v = f"{alone[i]:.2f}" if i < len(alone) and alone[i] is not None else "-"
+            lines.append(f"| {i} | {n} | {d:.3f} | {f:.3f} | {h:.2f} | {v} |")
         lines.append("")
     lines += [
         f"## Measured ({args.seeds} seeded safe starts per map, max_cycles {args.max_cycles}, "
@@ -110,7 +123,7 @@ def card(name: str, role: str, rows, args) -> str:
     opponents = EVADERS if role == "pursuer" else PURSUERS
     for label, maps in (("seen: " + ", ".join(seen), seen), ("held out: " + ", ".join(HELD_OUT),
                         HELD_OUT)):  # fmt: skip
-        if not maps:
+        if not any(r["map"] in maps for r in rows):
             continue
         for o in opponents:
             pair = (name, o) if role == "pursuer" else (o, name)
@@ -131,6 +144,8 @@ def main(argv=None) -> int:
     ap.add_argument("--store", default="out/bench/learned.sqlite")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--max-cycles", type=int, default=300)
+    ap.add_argument("--maps", nargs="*", default=None,
+                    help="play only these maps (default: the seen and held-out maps)")  # fmt: skip
     ap.add_argument("--cards", action="store_true",
                     help="write each model's CARD.md into the zoo from this run")  # fmt: skip
     args = ap.parse_args(argv)
@@ -142,7 +157,7 @@ def main(argv=None) -> int:
     spec = spec_from_dict(
         {
             "name": "learned_vs_analytic",
-            "maps": sorted(set(SEEN_PURSUER + SEEN_EVADER + HELD_OUT), key=str),
+            "maps": args.maps or sorted(set(SEEN_PURSUER + SEEN_EVADER + HELD_OUT), key=str),
             "seeds": args.seeds,
             "start": "safe",
             "time_limit": 300,
@@ -158,7 +173,10 @@ def main(argv=None) -> int:
     groups = {"seen (pursuer maps)": SEEN_PURSUER, "seen (evader maps)": SEEN_EVADER,
               "held out": HELD_OUT}  # fmt: skip
     print("\nheld rate of the pursuer [Wilson 95%], per map group")
+    played = {r["map"] for r in rows}
     for gname, maps in groups.items():
+        if not played & set(maps):
+            continue
         print(f"\n== {gname}: {', '.join(maps)}")
         for p in PURSUERS + learned["pursuer"]:
             for e in EVADERS + learned["evader"]:
@@ -171,14 +189,31 @@ def main(argv=None) -> int:
                 print(f"  {p:<44} {e:<40} {_fmt(*_rate(rows, p, e, maps))}")
     print("\ntargets (ratios measured in this run)")
     for m in learned["pursuer"]:
-        r_l = _rate(rows, m, "evader/shooting", SEEN_PURSUER)[0]
-        r_d = _rate(rows, "pursuer/decomposition", "evader/shooting", SEEN_PURSUER)[0]
+        # a map specialist is judged on the target maps it trained on
+        own = [x for x in SEEN_PURSUER if x in _training_maps(m)] or SEEN_PURSUER
+        r_l = _rate(rows, m, "evader/shooting", own)[0]
+        r_d = _rate(rows, "pursuer/decomposition", "evader/shooting", own)[0]
         h_l = _rate(rows, m, "evader/shooting", HELD_OUT)[0]
         h_g = _rate(rows, "pursuer/greedy", "evader/shooting", HELD_OUT)[0]
         ratio = r_l / r_d if r_d else float("nan")
-        print(f"  {m}: seen held {r_l:.2f} / decomposition {r_d:.2f} = {ratio:.2f} (target >= 0.9: "
-              f"{'met' if ratio >= 0.9 else 'NOT met'}); held out {h_l:.2f} vs greedy {h_g:.2f} "
-              f"({'met' if h_l >= h_g else 'NOT met'})")  # fmt: skip
+        held_out = (
+            (f"; held out {h_l:.2f} vs greedy {h_g:.2f} ({'met' if h_l >= h_g else 'NOT met'})")
+            if played & set(HELD_OUT)
+            else ""
+        )
+        verdict = "met" if ratio >= 0.9 else "NOT met"
+        print(f"  {m}: seen ({', '.join(own)}) held {r_l:.2f} / decomposition {r_d:.2f} = "
+              f"{ratio:.2f} (target >= 0.9: {verdict}){held_out}")  # fmt: skip
+    team = {x: [m for m in learned["pursuer"] if _training_maps(m) == [x]] for x in SEEN_PURSUER}
+    if all(team.values()):  # one specialist per target map: the target for the team
+        got = [_rate(rows, team[x][0], "evader/shooting", [x]) for x in SEEN_PURSUER]
+        held = sum(r * n for r, _, _, n in got)
+        n = sum(n for *_, n in got)
+        r_d = _rate(rows, "pursuer/decomposition", "evader/shooting", SEEN_PURSUER)[0]
+        ratio = held / n / r_d if n and r_d else float("nan")
+        print(f"  specialists ({', '.join(team[x][0] for x in SEEN_PURSUER)}), each on its own "
+              f"map: held {held / n:.2f} / decomposition {r_d:.2f} = {ratio:.2f} (target >= 0.9: "
+              f"{'met' if ratio >= 0.9 else 'NOT met'})")  # fmt: skip
     for m in learned["evader"]:
         e_l = 1 - _rate(rows, "pursuer/decomposition", m, SEEN_EVADER)[0]
         e_s = 1 - _rate(rows, "pursuer/decomposition", "evader/shooting", SEEN_EVADER)[0]

@@ -13,7 +13,8 @@ from training.dagger import DaggerConfig
 
 RL = ["ppo_evader_vs_greedy_open_room", "ppo_pursuer_vs_straight_open_room"]
 DAGGER = ["dagger_evader_generalist", "dagger_pursuer_generalist"]
-SHIPPED = RL + DAGGER
+SPECIALISTS = ["dagger_pursuer_corridor", "dagger_pursuer_l_hall", "dagger_pursuer_open_room"]
+SHIPPED = RL + DAGGER + SPECIALISTS
 
 
 def test_list_models():
@@ -44,6 +45,20 @@ def test_dagger_models_files_card_and_provenance(name):
     assert prov["env_config"]["observation"] == "lidar_track" and len(cfg.maps) > 2
     card = (zoo.MODELS_DIR / name / "CARD.md").read_text()
     assert name in card and "held out" in card
+
+
+@pytest.mark.parametrize("name", SPECIALISTS)
+def test_specialists_files_card_and_provenance(name):
+    assert zoo.model_path(name).stat().st_size < 1_000_000
+    prov = zoo.info(name)
+    cfg = zoo.config(name)
+    assert isinstance(cfg, DaggerConfig) and prov["config"] == cfg.to_dict()
+    assert prov["method"] == "dagger" and len(prov["samples"]) == cfg.iterations
+    # one map each, seen through map coordinates, selected against the shooting evader
+    assert prov["env_config"]["observation"] == "state" and len(cfg.maps) == 1
+    assert name.endswith(cfg.maps[0]) and cfg.validation_opponent == "evader/shooting"
+    card = (zoo.MODELS_DIR / name / "CARD.md").read_text()
+    assert name in card and f"seen: {cfg.maps[0]}" in card
 
 
 @pytest.mark.parametrize("name", SHIPPED)

@@ -18,6 +18,7 @@ rays and range) is what the shared runner gives it (:attr:`SB3Policy.observation
 from __future__ import annotations
 
 import json
+import warnings
 import zipfile
 from pathlib import Path
 from typing import Any
@@ -27,7 +28,7 @@ import numpy as np
 from envs.errors import InvalidConfigError, InvalidObservationError
 from strategies.policies.base import BasePolicy
 
-__all__ = ["SB3_ALGORITHMS", "SB3Policy"]
+__all__ = ["SB3_ALGORITHMS", "SB3Policy", "UnseenMapWarning"]
 
 SB3_ALGORITHMS = ("A2C", "DDPG", "PPO", "SAC", "TD3")
 """Algorithms :class:`SB3Policy` can load (continuous actions)."""
@@ -35,6 +36,10 @@ SB3_ALGORITHMS = ("A2C", "DDPG", "PPO", "SAC", "TD3")
 
 _PLAY_ONLY = {"lr_schedule": 0.0, "learning_rate": 0.0, "clip_range": 0.0}
 """SB3 ``custom_objects`` for a model that only acts (its training schedules unused)."""
+
+
+class UnseenMapWarning(UserWarning):
+    """A model that sees map coordinates plays a map it was not trained on."""
 
 
 def _algo_from_zip(path: Path) -> str:
@@ -85,6 +90,7 @@ class SB3Policy(BasePolicy):
         self.algo = algo.upper() if algo else None
         self.deterministic = bool(deterministic)
         self.model: Any = None
+        self._warned: set[str] = set()
         self.provenance = _provenance(self.path)
         trained = None if self.provenance is None else self.provenance.get("role")
         if trained is not None and trained != role:
@@ -126,6 +132,28 @@ class SB3Policy(BasePolicy):
                 ) from exc
         seed = int(self.rng.integers(2**31 - 1))
         self.model.set_random_seed(seed)
+        self._warn_unseen_map()
+
+    def _warn_unseen_map(self) -> None:
+        """Warn (once per map) when a model that sees map coordinates plays a map it did
+        not train on: a ``"state"`` observation places both agents in the map's bounds,
+        so what it learned belongs to its training maps (a map specialist)."""
+        prov = self.provenance or {}
+        if (prov.get("env_config") or {}).get("observation") != "state":
+            return
+        cfg = prov.get("config") or {}
+        trained = cfg.get("maps") or ([cfg["map"]] if cfg.get("map") else [])
+        here = getattr(self.map, "name", None)
+        if not trained or here is None or here in trained or here in self._warned:
+            return
+        self._warned.add(here)
+        warnings.warn(
+            f"{self.name}: this model sees map coordinates (observation 'state') and was "
+            f"trained on {', '.join(map(str, trained))}; it plays {here!r}, a map it has "
+            "not seen",
+            UnseenMapWarning,
+            stacklevel=3,
+        )
 
     def act(self, observation: np.ndarray) -> np.ndarray:
         """The model's action for one observation, clipped to [-1, 1].

@@ -82,6 +82,30 @@ def test_loads_and_acts(name, observation_seed):
             break
 
 
+def test_a_specialist_warns_on_a_map_it_has_not_seen():
+    import warnings
+
+    from envs.maps import load_map
+    from strategies.policies.learned import UnseenMapWarning
+
+    policy = zoo.load("dagger_pursuer_l_hall")
+    for world, warns in (("l_hall", False), ("corridor", True)):
+        env = surveillance_v0.parallel_env(map=world)
+        with warnings.catch_warnings(record=True) as got:
+            warnings.simplefilter("always")
+            policy.reset(role="pursuer", map=load_map(world), config=env.config, seed=0)
+            policy.reset(role="pursuer", map=load_map(world), config=env.config, seed=1)
+        said = [w for w in got if issubclass(w.category, UnseenMapWarning)]
+        assert len(said) == (1 if warns else 0), [str(w.message) for w in said]  # once a map
+        assert all("l_hall" in str(w.message) and world in str(w.message) for w in said)
+    # a lidar generalist sees no map coordinates: no warning anywhere
+    general = zoo.load("dagger_pursuer_generalist")
+    env = surveillance_v0.parallel_env(map="corridor", **general.observation_options)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UnseenMapWarning)
+        general.reset(role="pursuer", map=load_map("pillars"), config=env.config, seed=0)
+
+
 def test_unknown_model():
     with pytest.raises(UnknownNameError, match="ppo_pursuer_vs_straight_open_room"):
         zoo.load("no_such_model")

@@ -320,24 +320,24 @@ class DecompositionPursuer(BasePolicy):
         is the wall distance of the centre (at the nearest node of the table's grid) minus
         that radius and one grid step.
         """
-        tab = self.table
         k = self._orbit_k * L
         nx, ny = -math.sin(theta) * k, math.cos(theta) * k
         need = self._orbit_R * L + self._orbit_pad
-        ox, oy = float(tab.origin[0]), float(tab.origin[1])
-        h = tab.resolution
-        out = []
-        for s in (1.0, -1.0):
-            i = round((ex + s * nx - ox) / h)
-            j = round((ey + s * ny - oy) / h)
-            if not (0 <= i < tab.shape[0] and 0 <= j < tab.shape[1]):
-                d = 0.0
-            elif self._clear is not None:
-                d = float(self._clear[i, j])
-            else:
-                d = self._memo_clearance(i, j)
-            out.append(d - need)
-        return out[0], out[1]
+        return (
+            self._clearance_at(ex + nx, ey + ny) - need,
+            self._clearance_at(ex - nx, ey - ny) - need,
+        )
+
+    def _clearance_at(self, x: float, y: float) -> float:
+        """Wall distance at the table's grid node nearest ``(x, y)`` (0 off the grid)."""
+        tab = self.table
+        i = round((x - float(tab.origin[0])) / tab.resolution)
+        j = round((y - float(tab.origin[1])) / tab.resolution)
+        if not (0 <= i < tab.shape[0] and 0 <= j < tab.shape[1]):
+            return 0.0
+        if self._clear is not None:
+            return float(self._clear[i, j])
+        return self._memo_clearance(i, j)
 
     def _memo_clearance(self, i: int, j: int) -> float:
         """Wall distance of grid node (i, j) of a lazy table (the eager grid's value: same
@@ -463,12 +463,9 @@ class DecompositionPursuer(BasePolicy):
         r = self.config.body_radius
         e = snap.evader
         if self._clear is not None:  # the grid's wall distance rules most steps out
-            tab = self.table
-            i = round((float(e[0]) - float(tab.origin[0])) / tab.resolution)
-            j = round((float(e[1]) - float(tab.origin[1])) / tab.resolution)
-            if 0 <= i < tab.shape[0] and 0 <= j < tab.shape[1]:
-                if self._clear[i, j] > r + tab.resolution:  # nearest node within h / sqrt 2
-                    return 0.0
+            # (the nearest node lies within h / sqrt 2)
+            if self._clearance_at(float(e[0]), float(e[1])) > r + self.table.resolution:
+                return 0.0
         q, _ = nearest_wall_point(self.config.map, np.asarray(e, dtype=np.float64))
         dx, dy = float(e[0]) - float(q[0]), float(e[1]) - float(q[1])
         d = math.hypot(dx, dy)

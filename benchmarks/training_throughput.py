@@ -27,6 +27,8 @@ import time
 import gymnasium as gym
 import numpy as np
 
+from envs.surveillance.config import OBSERVATION_KINDS
+
 
 class Timed(gym.Wrapper):
     """Accumulates the wall time spent in ``step`` and ``reset``."""
@@ -90,9 +92,7 @@ def main(argv=None) -> int:
     ap.add_argument("--steps", type=int, default=8192)
     ap.add_argument("--opponent", default="evader/straight")
     ap.add_argument("--map", default="corridor")
-    ap.add_argument(
-        "--observation", default="lidar_track", choices=["state", "lidar", "lidar_track"]
-    )
+    ap.add_argument("--observation", default="lidar_track", choices=OBSERVATION_KINDS)
     args = ap.parse_args(argv)
     print(f"load average: {os.getloadavg()}; cores: {os.cpu_count()}; {args.steps} env steps "
           f"vs {args.opponent} on {args.map}, observation {args.observation}")  # fmt: skip

@@ -11,6 +11,10 @@ and at rank 0 the rod has no continuation: surveillance breaks (Sec. 4: "a guara
 escape path"). The cell keeps its identity while the evader stays in R (the rod cannot
 jump across a wall), so the rank only falls.
 
+The evader has a body: a via piece that runs closer to a wall than its radius everywhere
+cannot be crossed. With a ``clearance`` the plan keeps the point evader's escapable cells
+but ranks the routes round such pieces first (:func:`escape_ranks`'s ``narrow``).
+
 Where some region carries only escapable cells (Prop. 2, ``Decomposition.witness_regions``)
 an evader in a non-escapable cell first walks there: :attr:`EscapePlan.region_next` gives
 the next grid point on a shortest grid walk.
@@ -19,6 +23,7 @@ the next grid point on a shortest grid walk.
 from __future__ import annotations
 
 import functools
+import heapq
 import math
 from dataclasses import dataclass
 
@@ -39,7 +44,9 @@ CROSS_REL = 1e-3
 _SAMPLES = 64  # cands crossing points per boundary piece
 
 
-def escape_ranks(dec: Decomposition) -> tuple[np.ndarray, tuple[tuple[int, ...], ...]]:
+def escape_ranks(
+    dec: Decomposition, narrow: frozenset[int] = frozenset()
+) -> tuple[np.ndarray, tuple[tuple[int, ...], ...]]:
     """Rank and vias of every cell: the least fixed point of Sec. 4, by rounds.
 
     A pair (cell kappa, boundary piece b of kappa's region) is *satisfied* at round 0 if
@@ -47,11 +54,21 @@ def escape_ranks(dec: Decomposition) -> tuple[np.ndarray, tuple[tuple[int, ...],
     adjacent across b has rank <= r (condition (b)). A cell's rank is the first round at
     which one of its pairs is satisfied; its vias are the pieces satisfied then.
 
+    Pieces in ``narrow`` (ones the evader's disc cannot cross; Sec. 4's evader is a
+    point) cost more than any route of other crossings: a pair across one is satisfied
+    ``n_cells + 1`` rounds after its last adjacent cell (condition (a): ``n_cells``), a
+    weighted least fixed point (Knuth's generalisation of Dijkstra's algorithm to
+    min-max costs). The escapable set is the same and every crossing of a via still
+    lowers the rank; a rank below ``n_cells`` means a route round every narrow piece
+    whatever the pursuer does, and then the vias take it. Without ``narrow`` the ranks
+    are the rounds above.
+
     Returns:
         ``(rank, vias)``: (n_cells,) int64 ranks (-1 for a non-escapable cell) and, per
         cell, the ids of its via pieces (empty if not escapable).
     """
     n = len(dec.cells)
+    big = n + 1
     across: dict[tuple[int, int], set[int]] = {}
     for c in dec.cells:
         for b in dec.regions[c.region].boundaries:
@@ -66,26 +83,49 @@ def escape_ranks(dec: Decomposition) -> tuple[np.ndarray, tuple[tuple[int, ...],
         for x in nbrs:
             watchers.setdefault(x, []).append(key)
     rank = np.full(n, -1, dtype=np.int64)
+    sat: dict[tuple[int, int], int] = {}  # pair -> round at which it is satisfied
+    heap: list[tuple[int, int]] = []
+
+    def ready(key: tuple[int, int], after: int) -> None:
+        r = after + (big if key[1] in narrow else 1)
+        sat[key] = r
+        heapq.heappush(heap, (r, key[0]))
+
+    for key in sorted(k for k, m in count.items() if m == 0):  # condition (a)
+        ready(key, -1)
+    while heap:
+        r, c = heapq.heappop(heap)
+        if rank[c] >= 0:
+            continue
+        rank[c] = r
+        # condition (b): pairs whose last adjacent cell just became escapable (cells
+        # become escapable in rank order, so that cell has the highest rank across)
+        for key in watchers.get(c, ()):
+            count[key] -= 1
+            if count[key] == 0 and rank[key[0]] < 0:
+                ready(key, r)
     vias: list[list[int]] = [[] for _ in range(n)]
-    ready = sorted(k for k, m in count.items() if m == 0)  # condition (a)
-    r = 0
-    while ready:
-        fresh = []
-        for c, b in ready:
-            if rank[c] < 0 or rank[c] == r:
-                if rank[c] < 0:
-                    rank[c] = r
-                    fresh.append(c)
-                vias[c].append(b)
-        ready = []
-        for x in fresh:  # condition (b): pairs whose last adjacent cell just became escapable
-            for key in watchers.get(x, ()):
-                count[key] -= 1
-                if count[key] == 0 and rank[key[0]] < 0:
-                    ready.append(key)
-        ready.sort()
-        r += 1
+    for (c, b), r in sorted(sat.items()):
+        if r == rank[c]:
+            vias[c].append(b)
     return rank, tuple(tuple(v) for v in vias)
+
+
+def _samples(segments: np.ndarray, chord_tol: float) -> tuple[np.ndarray, ...]:
+    """A piece's (m, 2, 2) ``segments`` without the empty ones: their starts,
+    directions, lengths, unit directions, and samples along them (about ``_SAMPLES``,
+    no closer than ``chord_tol``) with each sample's segment."""
+    p0, p1 = segments[:, 0], segments[:, 1]
+    d = p1 - p0
+    ln = np.hypot(d[:, 0], d[:, 1])
+    keep = ln > 0
+    p0, d, ln = p0[keep], d[keep], ln[keep]
+    u = d / ln[:, None]
+    step = max(chord_tol, float(ln.sum()) / _SAMPLES)
+    m = np.maximum(1, np.ceil(ln / step).astype(int))
+    seg = np.repeat(np.arange(len(ln)), m)
+    frac = (np.arange(int(m.sum())) - np.repeat(np.cumsum(m) - m, m) + 0.5) / m[seg]
+    return p0, d, ln, u, p0[seg] + frac[:, None] * d[seg], seg
 
 
 @dataclass(frozen=True)
@@ -112,7 +152,7 @@ class EscapePlan:
     Attributes:
         dec: the decomposition.
         rank: (n_cells,) round of the fixed point at which the cell became escapable, -1
-            if not escapable.
+            if not escapable (with a clearance: :func:`escape_ranks`'s weighted rounds).
         vias: per cell, the boundary pieces that make it escapable at its rank.
         points: (n, 2) grid points (the rows of the matching ``SafetyTable``).
         region: (n,) bool, the grid point lies in a witness region (Prop. 2).
@@ -138,17 +178,7 @@ class EscapePlan:
         got = self._pieces.get(b)
         if got is not None:
             return got
-        p0, p1 = self.dec.boundaries[b].segments[:, 0], self.dec.boundaries[b].segments[:, 1]
-        d = p1 - p0
-        ln = np.hypot(d[:, 0], d[:, 1])
-        keep = ln > 0
-        p0, d, ln = p0[keep], d[keep], ln[keep]
-        u = d / ln[:, None]
-        step = max(self.dec.chord_tol, float(ln.sum()) / _SAMPLES)
-        m = np.maximum(1, np.ceil(ln / step).astype(int))
-        seg = np.repeat(np.arange(len(ln)), m)
-        frac = (np.arange(int(m.sum())) - np.repeat(np.cumsum(m) - m, m) + 0.5) / m[seg]
-        s = p0[seg] + frac[:, None] * d[seg]
+        p0, d, ln, u, s, seg = _samples(self.dec.boundaries[b].segments, self.dec.chord_tol)
         clear = self.dec.map.distance_to_walls(s) if len(s) else np.zeros(0)
         got = (p0, d, ln, np.stack([-u[:, 1], u[:, 0]], axis=1), s, seg, clear)
         self._pieces[b] = got
@@ -333,15 +363,42 @@ def _region_next(world: Map, cell: np.ndarray, pts: np.ndarray, h: float, region
     return nxt
 
 
+def _narrow(dec: Decomposition, clearance: float) -> frozenset[int]:
+    """The boundary pieces no crossing of which keeps ``clearance`` from the walls: no
+    sample along the piece (:meth:`EscapePlan.witness`'s samples) does.
+
+    A piece whose middle vertex keeps ``clearance`` is not narrow: only the others are
+    sampled (a few percent of them).
+    """
+    if clearance <= 0.0 or not dec.boundaries:
+        return frozenset()
+    world = dec.map
+    mid = np.array([b.segments[len(b.segments) // 2, 0] for b in dec.boundaries])
+    near = np.flatnonzero(world.distance_to_walls(mid) < clearance)
+    out = []
+    for i in near.tolist():
+        b = dec.boundaries[i]
+        s = _samples(b.segments, dec.chord_tol)[4]
+        if not len(s) or world.distance_to_walls(s).max() < clearance:
+            out.append(b.id)
+    return frozenset(out)
+
+
 @functools.lru_cache(maxsize=8)
-def escape_plan(world: Map, L: float, resolution: float = 0.1) -> EscapePlan:
+def escape_plan(
+    world: Map, L: float, resolution: float = 0.1, clearance: float = 0.0
+) -> EscapePlan:
     """The :class:`EscapePlan` of ``world`` for a rod of length ``L`` (cached in memory).
 
     The decomposition comes from :func:`strategies.cspace.decompose` (cached on disk);
-    the grid is the safety table's at the same ``resolution``.
+    the grid is the safety table's at the same ``resolution``. With ``clearance`` (the
+    evader's body radius) the vias avoid the pieces no crossing of which keeps that
+    distance from the walls wherever a route without them exists
+    (:func:`escape_ranks`'s ``narrow``; issue 13: a rank-1 cell of random:polygons:0
+    whose only via runs within 0.094 of a wall, where the pursuer pinned the evader).
     """
     dec = decompose(world, L, cache=True)
-    rank, vias = escape_ranks(dec)
+    rank, vias = escape_ranks(dec, _narrow(dec, clearance))
     _origin, cell, pts = grid_points(world, resolution)
     region = np.zeros(len(pts), dtype=bool)
     for r in dec.witness_regions:

@@ -8,7 +8,8 @@ Sec. 5 "minimax": its tip meets walls as if the rod were that long):
    the cell's via pieces (a step from the piece's ends where it can, and landing in the
    region across) and land just across it (:mod:`strategies.policies.escape_plan`); the
    rank falls at every crossing whatever the pursuer does, until condition (a) breaks
-   surveillance.
+   surveillance. The plan goes round the pieces the evader's disc cannot cross (closer
+   to a wall than its body radius all along) wherever a route without them exists.
 2. **Shooting escape**: candidate endpoints (Fig. 13) are points the evader can reach in
    a straight line (probes on rays, and points just past each convex obstacle vertex in
    reach) where the current orientation is not safe. For each, the rotation the pursuer
@@ -95,7 +96,7 @@ class ShootingEvader(BasePolicy):
         self.L_eff = round(c.l_min + c.body_radius, 6)
         res = self.resolution if self.resolution is not None else c.l_min / 20.0
         self.table = safety_table(c.map, self.L_eff, res)
-        self.plan = escape_plan(c.map, self.L_eff, res)
+        self.plan = escape_plan(c.map, self.L_eff, res, c.body_radius)
         self.kernel = kernel_for(c.map)
         self.rho = c.rho
         omega_max = c.v_pursuer * (1.0 + min(self.rho, 1.0)) / c.l_min  # Sec. 6.1 maximum

@@ -8,6 +8,11 @@
   the target just across it lies outside the region, and at the target the configuration
   has no continuation in a cell adjacent to the cell (condition (a)) or only in cells of
   lower rank (condition (b)), checked with ``dec.free_arcs`` and the kernel's arcs.
+* An evader with a body: the pieces its disc cannot cross (shapely distances to the
+  walls) cost more than any route without one; the escapable set is the same, every via
+  still lowers the rank, the plan of a cell that has a route without them takes none,
+  and on random:polygons:0 cells whose every point-plan via is too close to a wall get
+  a crossing the disc can make (issue 13).
 * The witness-region walk: every hop is a grid neighbour joined by a wall-free segment
   (shapely) and the walk is a shortest one (networkx breadth first search).
 """
@@ -22,11 +27,13 @@ import pytest
 import shapely
 from shapely.geometry import LineString, Point
 
-from envs.maps import builtin_map
+from envs.maps import builtin_map, load_map
 from strategies.cspace._arcs import overlap
 from strategies.policies.escape_plan import (
     CROSS_REL,
+    _narrow,
     _region_next,
+    _samples,
     escape_plan,
     escape_ranks,
 )
@@ -157,6 +164,48 @@ def test_witness_keeps_clearance_from_walls():
             assert walls.distance(Point(w.cross)) >= 0.1 - 1e-9, (c, w)
         seen[w is None] += 1
     assert seen[False] > 20
+
+
+def test_disc_plan_avoids_the_pieces_its_disc_cannot_cross():
+    world, radius = load_map("random:polygons:0"), 0.1
+    point = escape_plan(world, L, 0.1)
+    disc = escape_plan(world, L, 0.1, radius)
+    dec = disc.dec
+    n = len(dec.cells)
+    walls = world.free_region.boundary
+    narrow = _narrow(dec, radius)
+    for b in dec.boundaries:  # no sample of a narrow piece keeps the radius (shapely)
+        s = _samples(b.segments, dec.chord_tol)[4]
+        far = shapely.distance(shapely.points(s), walls).max() >= radius
+        assert far != (b.id in narrow), b.id
+    assert narrow
+    assert np.array_equal(point.rank >= 0, disc.rank >= 0)
+    across = {}
+    for b in dec.boundaries:
+        for i, j in b.adjacent:
+            across.setdefault((i, b.id), []).append(j)
+            across.setdefault((j, b.id), []).append(i)
+    for c in np.flatnonzero(disc.rank >= 0).tolist():
+        assert disc.vias[c]
+        for b in disc.vias[c]:  # every crossing of a via still lowers the rank
+            assert all(0 <= disc.rank[x] < disc.rank[c] for x in across.get((c, b), ()))
+            # ranks below n_cells: a route round every narrow piece, whatever the pursuer
+            assert disc.rank[c] >= n or b not in narrow, (c, b)
+    # cells the point plan leaves to a disc without a crossing (every via narrow) that
+    # the disc plan routes round them (cell 568, rank 0 -> 2, took the evader out of
+    # the loop against the decomposition pursuer, seed 0)
+    fixed = [
+        c
+        for c in np.flatnonzero(point.rank >= 0).tolist()
+        if set(point.vias[c]) <= narrow and disc.rank[c] < n
+    ]
+    assert len(fixed) >= 5, fixed
+    for c in fixed:
+        start = dec.regions[dec.cells[c].region].point
+        assert point.witness(c, start, radius) is None
+        w = disc.witness(c, start, radius)
+        assert w is not None and w.boundary not in narrow
+        assert shapely.distance(shapely.Point(w.cross), walls) >= radius
 
 
 def test_plan_grid_is_the_safety_tables():

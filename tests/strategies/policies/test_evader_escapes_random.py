@@ -25,7 +25,12 @@ turns away from walls it cannot circle clear of (issue 13, the pillar room), it 
 for the whole 8 D / V_e. The cycle passes that rank-1 cell, whose only via the evader's
 disc (radius 0.1) cannot cross: the plan is made for a point evader (Sec. 4), and ranking
 only the crossings a disc can make left too few escapable cells (1197 -> 196 on this map).
-An open problem of issue 13, measured by ``benchmarks/evader_escapes.py`` (510 of 512).
+Now the plan keeps every escapable cell but ranks the routes round such pieces first
+(``escape_plan(..., clearance)``, tested in ``test_escape_plan.py``): both escape, but
+late (6.6 and 6.2 D / V_e, over 2,500 steps: too long for a test here; every route from
+their starts crosses one of those pieces in the worst case, and the evader wanders until
+the pursuer's side lets it into a cell with a route round them). Measured by
+``benchmarks/evader_escapes.py`` (512 of 512).
 """
 
 from __future__ import annotations

@@ -363,6 +363,24 @@ def _region_next(world: Map, cell: np.ndarray, pts: np.ndarray, h: float, region
     return nxt
 
 
+def _inside_any(pts: np.ndarray, polygons: list) -> np.ndarray:
+    """(n,) bool: the point lies inside one of ``polygons`` (``shapely.contains_xy``),
+    testing each polygon only on the points within its bounding box (found by
+    bisection on x: on an evader-win map every region can be a witness, and testing
+    all of them at every grid point took seconds at reset)."""
+    out = np.zeros(len(pts), dtype=bool)
+    if not polygons:
+        return out
+    order = np.argsort(pts[:, 0], kind="stable")
+    xs, ys = pts[order, 0], pts[order, 1]
+    for poly in polygons:
+        x0, y0, x1, y1 = poly.bounds
+        lo, hi = np.searchsorted(xs, x0, "left"), np.searchsorted(xs, x1, "right")
+        k = lo + np.flatnonzero((ys[lo:hi] >= y0) & (ys[lo:hi] <= y1))
+        out[order[k[shapely.contains_xy(poly, xs[k], ys[k])]]] = True
+    return out
+
+
 def _narrow(dec: Decomposition, clearance: float) -> frozenset[int]:
     """The boundary pieces no crossing of which keeps ``clearance`` from the walls: no
     sample along the piece (:meth:`EscapePlan.witness`'s samples) does.
@@ -400,9 +418,7 @@ def escape_plan(
     dec = decompose(world, L, cache=True)
     rank, vias = escape_ranks(dec, _narrow(dec, clearance))
     _origin, cell, pts = grid_points(world, resolution)
-    region = np.zeros(len(pts), dtype=bool)
-    for r in dec.witness_regions:
-        region |= shapely.contains_xy(dec.regions[r].polygon, pts[:, 0], pts[:, 1])
+    region = _inside_any(pts, [dec.regions[r].polygon for r in dec.witness_regions])
     if region.any():
         nxt = _region_next(world, cell, pts, resolution, region)
     else:

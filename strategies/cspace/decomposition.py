@@ -23,6 +23,7 @@ The tolerances the result is exact up to are stated in :mod:`strategies.cspace.t
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import networkx as nx
@@ -220,10 +221,19 @@ class Decomposition:
             nb[c].add(a)
         self._neighbours = [tuple(sorted(s)) for s in nb]
         self._kernel = kernel_for(self.map)
+        self._grid: _RegionGrid | None = None
+
+    def region_grid(self) -> _RegionGrid:
+        """The uniform grid that answers most :meth:`locate` queries without the tree
+        (built on first use, a few tens of ms on the largest built-in maps; see
+        :class:`_RegionGrid`)."""
+        if self._grid is None:
+            self._grid = _RegionGrid.build(self)
+        return self._grid
 
     def __getstate__(self) -> dict:
         state = self.__dict__.copy()
-        for k in ("_tree", "_cell_of", "_neighbours", "_kernel", "_graph"):
+        for k in ("_tree", "_cell_of", "_neighbours", "_kernel", "_graph", "_grid"):
             state.pop(k, None)
         return state
 
@@ -276,6 +286,11 @@ class Decomposition:
             InvalidConfigError: ``point`` is not a finite (x, y) pair.
         """
         p = _point(point)
+        r = self.region_grid().region(float(p[0]), float(p[1]))
+        return self._locate_tree(p) if r < 0 else r
+
+    def _locate_tree(self, p: np.ndarray) -> int | None:
+        """:meth:`locate` of a checked point through the region tree (no grid)."""
         pt = shapely.Point(p)
         hits = self._tree.query(pt, predicate="intersects")
         if len(hits):
@@ -375,6 +390,133 @@ class Decomposition:
             f"Decomposition(map={self.map.name!r}, L={self.L:g}, regions={len(self.regions)}, "
             f"cells={len(self.cells)}, evader_wins={self.evader_wins})"
         )
+
+
+_GRID_PER_REGION = 16  # grid squares per region, on average, of the locate grid
+_GRID_MAX = 1 << 20  # at most this many squares
+
+
+@dataclass(frozen=True, eq=False)
+class _RegionGrid:
+    """A uniform grid over the regions for :meth:`Decomposition.locate`.
+
+    Every square (grown by ``pad`` on every side, which covers the rounding of a
+    point's square index) keeps the regions whose polygons may meet it: those whose
+    boundary segments pass within ``2 pad`` of it, and those holding its centre (a
+    polygon whose boundary misses the square and which holds its centre holds all of
+    it; one that holds neither misses it). A square that no boundary meets is labelled
+    with the region holding its centre, if exactly one does.
+
+    :meth:`region` answers only what the region tree would
+    (:meth:`Decomposition._locate_tree`: the first polygon intersecting the point): a
+    labelled square's region, else the one candidate whose polygon intersects the point
+    if exactly one does (then no other polygon does: it would be a candidate). Where
+    none or several do, or an invalid polygon is near, it answers -1 and ``locate`` asks
+    the tree.
+
+    Attributes:
+        origin: (x0, y0) corner of square (0, 0).
+        h: side of a square.
+        labels: (nx, ny) int32 region of each square, -1 if not labelled, -2 near an
+            invalid polygon (ask the tree).
+        start, cand: the candidates of flat square k are ``cand[start[k]:start[k + 1]]``.
+        polygons: the regions' polygons (prepared).
+    """
+
+    origin: tuple[float, float]
+    h: float
+    labels: np.ndarray
+    start: np.ndarray
+    cand: np.ndarray
+    polygons: np.ndarray
+
+    @classmethod
+    def build(cls, dec: Decomposition) -> _RegionGrid:
+        from scipy import ndimage
+
+        polys = np.array([r.polygon for r in dec.regions], dtype=object)
+        if not len(polys):
+            z = np.zeros(0, dtype=np.int64)
+            return cls((0.0, 0.0), 1.0, np.full((0, 0), -1, dtype=np.int32), z, z, polys)
+        x0, y0, x1, y1 = (float(v) for v in shapely.total_bounds(polys))
+        w, ht = max(x1 - x0, 1e-9), max(y1 - y0, 1e-9)
+        h = math.sqrt(w * ht / min(_GRID_PER_REGION * len(polys), _GRID_MAX))
+        nx, ny = math.ceil(w / h) + 1, math.ceil(ht / h) + 1
+        pad = 1e-9 * max(w, ht, abs(x0), abs(y0), abs(x1), abs(y1), 1.0)
+
+        def squares(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+            # flat indices of the squares meeting the boxes [lo, hi] grown by 2 pad
+            # (each box at most two squares wide: its corners' squares are all of them)
+            i0 = np.floor((lo[:, 0] - 2 * pad - x0) / h).astype(np.int64)
+            j0 = np.floor((lo[:, 1] - 2 * pad - y0) / h).astype(np.int64)
+            i1 = np.floor((hi[:, 0] + 2 * pad - x0) / h).astype(np.int64)
+            j1 = np.floor((hi[:, 1] + 2 * pad - y0) / h).astype(np.int64)
+            i0, i1 = np.clip(i0, 0, nx - 1), np.clip(i1, 0, nx - 1)
+            j0, j1 = np.clip(j0, 0, ny - 1), np.clip(j1, 0, ny - 1)
+            return np.stack([i * ny + j for i in (i0, i1) for j in (j0, j1)], axis=1)
+
+        valid = shapely.is_valid(polys)
+        ids = np.flatnonzero(valid)
+        rings, owner = shapely.get_rings(polys[valid], return_index=True)
+        rings = shapely.segmentize(rings, 0.25 * h)
+        xy, ring = shapely.get_coordinates(rings, return_index=True)
+        same = ring[1:] == ring[:-1]
+        a, b = xy[:-1][same], xy[1:][same]
+        sq = squares(np.minimum(a, b), np.maximum(a, b))
+        m = len(polys)  # (square, region) pairs as square * m + region
+        pairs = np.unique(sq * m + ids[owner[ring[:-1][same]]][:, None])
+        hit = np.zeros(nx * ny, dtype=bool)
+        hit[pairs // m] = True
+        lost = np.zeros(nx * ny, dtype=bool)  # near an invalid polygon: ask the tree
+        for p in polys[~valid]:
+            bx0, by0, bx1, by1 = p.bounds
+            i0, j0 = (max(0, math.floor((v - 2 * pad - o) / h)) for v, o in ((bx0, x0), (by0, y0)))
+            i1, j1 = (math.floor((v + 2 * pad - o) / h) for v, o in ((bx1, x0), (by1, y0)))
+            lost.reshape(nx, ny)[i0 : i1 + 1, j0 : j1 + 1] = True
+        # squares joined by a side, none met by a boundary: inside the same polygons
+        comp, n = ndimage.label(~(hit | lost).reshape(nx, ny))
+        comp = comp.ravel()
+        rep = np.full(n + 1, -1, dtype=np.int64)
+        free = np.flatnonzero(comp)
+        rep[comp[free[::-1]]] = free[::-1]  # the first square of each component
+        # the centres of the met squares and of one square per component
+        asked = np.concatenate([np.flatnonzero(hit), rep[1:]])
+        ci, cj = np.divmod(asked, ny)
+        centres = shapely.points(x0 + (ci + 0.5) * h, y0 + (cj + 0.5) * h)
+        pt, reg = dec._tree.query(centres, predicate="intersects")
+        n_hit = int(hit.sum())
+        held = np.bincount(pt, minlength=len(asked))[n_hit:]
+        labels_c = np.full(n + 1, -1, dtype=np.int32)
+        one = pt >= n_hit
+        one &= held[np.maximum(pt - n_hit, 0)] == 1
+        labels_c[pt[one] - n_hit + 1] = reg[one]
+        labels = labels_c[comp]
+        labels[comp == 0] = -1
+        labels[lost] = -2
+        # candidates of the met squares: their boundaries' regions and centres' holders
+        inner = pt < n_hit
+        both = np.unique(np.concatenate([pairs, asked[pt[inner]] * m + reg[inner]]))
+        start = np.searchsorted(both // m, np.arange(nx * ny + 1)).astype(np.int64)
+        shapely.prepare(polys)
+        return cls((x0, y0), h, labels.reshape(nx, ny), start, both % m, polys)
+
+    def region(self, x: float, y: float) -> int:
+        """The region the tree would answer for ``(x, y)``, or -1 (then ask the tree)."""
+        i = math.floor((x - self.origin[0]) / self.h)
+        j = math.floor((y - self.origin[1]) / self.h)
+        nx, ny = self.labels.shape
+        if not (0 <= i < nx and 0 <= j < ny):
+            return -1
+        r = int(self.labels[i, j])
+        if r != -1:
+            return max(r, -1)  # -2: near an invalid polygon
+        k = i * ny + j
+        s, e = int(self.start[k]), int(self.start[k + 1])
+        if s == e:
+            return -1
+        c = self.cand[s:e]
+        got = np.flatnonzero(shapely.intersects_xy(self.polygons[c], x, y))
+        return int(c[got[0]]) if len(got) == 1 else -1
 
 
 _CHECKS = ("dangling", "orphan_holes", "noncritical_violations", "slivers_unresolved")

@@ -416,6 +416,7 @@ def escape_plan(
     whose only via runs within 0.094 of a wall, where the pursuer pinned the evader).
     """
     dec = decompose(world, L, cache=True)
+    dec.region_grid()  # the point-location grid of cell_at, built here rather than mid-episode
     rank, vias = escape_ranks(dec, _narrow(dec, clearance))
     _origin, cell, pts = grid_points(world, resolution)
     region = _inside_any(pts, [dec.regions[r].polygon for r in dec.witness_regions])

@@ -27,7 +27,8 @@ Per step (a table lookup plus a little arithmetic, no geometry kernel call):
    instead of being pushed into a wall or down a dead end and pinned closer than L_min
    (:meth:`DecompositionPursuer._keep_orbit`). Where no circle is even nearly free, it
    at least turns the way whose path stays clear of walls for a while, if the one it
-   settled on meets one.
+   settled on meets one. An evader walking at the wall behind the pursuer without
+   charging gets the same check (:meth:`DecompositionPursuer._avoid_pin`).
 5. Near a wall that faces it along the rod, it holds the distance longer by the
    evader's overlap with that wall, which the physics gives back in one step when the
    evader turns away (:meth:`DecompositionPursuer._wall_push`).
@@ -450,6 +451,34 @@ class DecompositionPursuer(BasePolicy):
                 return r
         return pick
 
+    def _avoid_pin(self, snap: Snapshot, rate: float, hi: float, lo: float, L: float) -> float:
+        """The rotation rate when the evader is not charging, overridden against a pin.
+
+        An evader walking at the wall behind the pursuer, though not along the rod,
+        squeezes the pursuer against it unless the rod turns away in time; turning one
+        given way, the evader can hold the rate down to ``(V_p / L)(1 - rho)`` (eq. 6),
+        too slow for a long swing past the wall's normal (pillar room, seed 2: 90 deg at
+        about 0.25 rad/s, pinned at L_min in 4.6 s). So where the pursuer is between the
+        evader and its nearest wall (the rod points at it), the evader walks toward that
+        wall, and the path of ``rate`` meets a wall within ``WALL_HORIZON`` seconds with
+        the evader keeping its velocity (:meth:`_time_to_wall`), the hard turn nearer to
+        ``rate`` whose path stays clear wins (else ``rate`` stands). Without the two
+        conditions the override fired in the maze's narrow corridors, where the wall the
+        path meets is no pin, and lost an episode (maze, straight evader, seed 1).
+        """
+        if self._time_to_wall(snap, rate, L, False) == math.inf:
+            return rate
+        q, _ = nearest_wall_point(self.config.map, np.asarray(snap.pursuer, dtype=np.float64))
+        nx, ny = float(snap.pursuer[0]) - float(q[0]), float(snap.pursuer[1]) - float(q[1])
+        ve = snap.evader_velocity
+        u = (math.cos(snap.theta), math.sin(snap.theta))
+        if nx * u[0] + ny * u[1] >= 0.0 or nx * float(ve[0]) + ny * float(ve[1]) >= 0.0:
+            return rate  # the rod or the evader heads away from that wall: no pin
+        for r in sorted((hi, lo), key=lambda r: abs(r - rate)):
+            if self._time_to_wall(snap, r, L, False) == math.inf:
+                return r
+        return rate
+
     def _wall_push(self, snap: Snapshot) -> float:
         """How far the physics may push the evader toward the pursuer in one step.
 
@@ -509,6 +538,8 @@ class DecompositionPursuer(BasePolicy):
             u = (math.cos(snap.theta), math.sin(snap.theta))
             if float(ve[0]) * u[0] + float(ve[1]) * u[1] > 0.5 * speed:  # it closes in
                 cmd_rate = self._keep_orbit(snap, cmd_rate, hi, lo, L)
+            elif speed > 0.0:
+                cmd_rate = self._avoid_pin(snap, cmd_rate, hi, lo, L)
         cmd = _holding_range(
             np.asarray(ve, dtype=np.float64),
             snap.theta,

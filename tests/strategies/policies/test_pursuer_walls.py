@@ -78,6 +78,9 @@ def test_the_pursuer_outlasts_a_wall_bounce():
         # held before; lost at 5.0 s to an override that assumed the evader follows the
         # rod (a straight-line evader does not)
         ("maze", "evader/straight", 1, 80),
+        # before: "too_close" at 4.6 s, pinned on the north wall while it turned the
+        # short way toward it at the one-way rate of eq. (6) (the evader not charging)
+        ("pillars", "evader/straight", 2, 80),
     ],
 )
 def test_the_pursuer_keeps_off_the_walls_with_no_circle_in_reach(world, evader, seed, cycles):

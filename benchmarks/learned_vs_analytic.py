@@ -67,17 +67,15 @@ def card(name: str, role: str, rows, args) -> str:
     cfg = prov["config"]
     size = zoo.model_path(name).stat().st_size
     seen = [m for m in cfg.get("maps", [cfg.get("map")]) if any(r["map"] == m for r in rows)]
-    how = (
-        f"imitating `{prov['expert']}` {cfg.get('expert_params') or ''} "
-        if "expert" in prov
-        else ""
-    )
+    params = f"{cfg['expert_params']} " if cfg.get("expert_params") else ""
+    how = f"imitating `{prov['expert']}` {params}" if "expert" in prov else ""
+    article = "An" if role == "evader" else "A"
     obs = prov["env_config"]
     rays = f" ({obs.get('n_rays')} rays)" if obs["observation"] != "state" else ""
     lines = [
         f"# {name}",
         "",
-        f"A {role} trained by {prov.get('method', 'rl')} {how}against {prov['opponent']}, "
+        f"{article} {role} trained by {prov.get('method', 'rl')} {how}against {prov['opponent']}, "
         f"observing `{obs['observation']}`{rays}. Retrain it bit for bit "
         f"with `python -m training.zoo reproduce {name}`; its recipe is `config.toml` beside "
         "this card.",
@@ -215,13 +213,20 @@ def main(argv=None) -> int:
               f"map: held {held / n:.2f} / decomposition {r_d:.2f} = {ratio:.2f} (target >= 0.9: "
               f"{'met' if ratio >= 0.9 else 'NOT met'})")  # fmt: skip
     for m in learned["evader"]:
-        e_l = 1 - _rate(rows, "pursuer/decomposition", m, SEEN_EVADER)[0]
-        e_s = 1 - _rate(rows, "pursuer/decomposition", "evader/shooting", SEEN_EVADER)[0]
+        # a map specialist is judged on the target maps it trained on, as for the pursuer
+        own = [x for x in SEEN_EVADER if x in _training_maps(m)] or SEEN_EVADER
+        e_l = 1 - _rate(rows, "pursuer/decomposition", m, own)[0]
+        e_s = 1 - _rate(rows, "pursuer/decomposition", "evader/shooting", own)[0]
         h_l = 1 - _rate(rows, "pursuer/decomposition", m, HELD_OUT)[0]
         h_s = 1 - _rate(rows, "pursuer/decomposition", "evader/straight", HELD_OUT)[0]
-        print(f"  {m}: seen escape {e_l:.2f} vs shooting {e_s:.2f} "
-              f"({'met' if e_l >= e_s else 'NOT met'}); held out {h_l:.2f} vs straight "
-              f"{h_s:.2f} ({'met' if h_l >= h_s else 'NOT met'})")  # fmt: skip
+        verdict = "met" if h_l >= h_s else "NOT met"
+        held_out = (
+            f"; held out {h_l:.2f} vs straight {h_s:.2f} ({verdict})"
+            if played & set(HELD_OUT)
+            else ""
+        )
+        print(f"  {m}: seen ({', '.join(own)}) escape {e_l:.2f} vs shooting {e_s:.2f} "
+              f"({'met' if e_l >= e_s else 'NOT met'}){held_out}")  # fmt: skip
     decide = defaultdict(list)
     for r in rows:
         for role in ("pursuer", "evader"):

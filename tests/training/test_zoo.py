@@ -13,7 +13,12 @@ from training.dagger import DaggerConfig
 
 RL = ["ppo_evader_vs_greedy_open_room", "ppo_pursuer_vs_straight_open_room"]
 DAGGER = ["dagger_evader_generalist", "dagger_pursuer_generalist"]
-SPECIALISTS = ["dagger_pursuer_corridor", "dagger_pursuer_l_hall", "dagger_pursuer_open_room"]
+SPECIALISTS = [
+    "dagger_evader_two_rooms",
+    "dagger_pursuer_corridor",
+    "dagger_pursuer_l_hall",
+    "dagger_pursuer_open_room",
+]
 SHIPPED = RL + DAGGER + SPECIALISTS
 
 
@@ -54,9 +59,11 @@ def test_specialists_files_card_and_provenance(name):
     cfg = zoo.config(name)
     assert isinstance(cfg, DaggerConfig) and prov["config"] == cfg.to_dict()
     assert prov["method"] == "dagger" and len(prov["samples"]) == cfg.iterations
-    # one map each, seen through map coordinates, selected against the shooting evader
+    # one map each, seen through map coordinates, selected against the other role's
+    # analytic policy
     assert prov["env_config"]["observation"] == "state" and len(cfg.maps) == 1
-    assert name.endswith(cfg.maps[0]) and cfg.validation_opponent == "evader/shooting"
+    analytic = {"pursuer": "evader/shooting", "evader": "pursuer/decomposition"}
+    assert name.endswith(cfg.maps[0]) and cfg.validation_opponent == analytic[cfg.role]
     card = (zoo.MODELS_DIR / name / "CARD.md").read_text()
     assert name in card and f"seen: {cfg.maps[0]}" in card
 

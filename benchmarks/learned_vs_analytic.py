@@ -52,11 +52,6 @@ def _rate(rows, pursuer, evader, maps):
     return (held / len(got) if got else float("nan")), lo, hi, len(got)
 
 
-def _training_maps(name: str) -> list[str]:
-    cfg = zoo.info(name)["config"]
-    return list(cfg.get("maps", [cfg.get("map")]))
-
-
 def _fmt(rate, lo, hi, n):
     return f"{rate:5.2f} [{lo:.2f}, {hi:.2f}] n={n}"
 
@@ -66,7 +61,8 @@ def card(name: str, role: str, rows, args) -> str:
     prov = zoo.info(name)
     cfg = prov["config"]
     size = zoo.model_path(name).stat().st_size
-    seen = [m for m in cfg.get("maps", [cfg.get("map")]) if any(r["map"] == m for r in rows)]
+    trained = zoo.training_maps(name)
+    seen = [m for m in trained if any(r["map"] == m for r in rows)]
     params = f"{cfg['expert_params']} " if cfg.get("expert_params") else ""
     how = f"imitating `{prov['expert']}` {params}" if "expert" in prov else ""
     article = "An" if role == "evader" else "A"
@@ -80,7 +76,7 @@ def card(name: str, role: str, rows, args) -> str:
         f"with `python -m training.zoo reproduce {name}`; its recipe is `config.toml` beside "
         "this card.",
         "",
-        f"- training maps: {', '.join(cfg.get('maps', [cfg.get('map')]))}",
+        f"- training maps: {', '.join(trained)}",
         f"- network: {prov.get('net_arch')} ({prov.get('parameters')} parameters), "
         f"model file {size / 1024:.0f} KiB",
         f"- labelled states: {prov['samples'][-1] if 'samples' in prov else '-'}; "
@@ -188,7 +184,7 @@ def main(argv=None) -> int:
     print("\ntargets (ratios measured in this run)")
     for m in learned["pursuer"]:
         # a map specialist is judged on the target maps it trained on
-        own = [x for x in SEEN_PURSUER if x in _training_maps(m)] or SEEN_PURSUER
+        own = [x for x in SEEN_PURSUER if x in zoo.training_maps(m)] or SEEN_PURSUER
         r_l = _rate(rows, m, "evader/shooting", own)[0]
         r_d = _rate(rows, "pursuer/decomposition", "evader/shooting", own)[0]
         h_l = _rate(rows, m, "evader/shooting", HELD_OUT)[0]
@@ -202,7 +198,7 @@ def main(argv=None) -> int:
         verdict = "met" if ratio >= 0.9 else "NOT met"
         print(f"  {m}: seen ({', '.join(own)}) held {r_l:.2f} / decomposition {r_d:.2f} = "
               f"{ratio:.2f} (target >= 0.9: {verdict}){held_out}")  # fmt: skip
-    team = {x: [m for m in learned["pursuer"] if _training_maps(m) == [x]] for x in SEEN_PURSUER}
+    team = {x: [m for m in learned["pursuer"] if zoo.training_maps(m) == [x]] for x in SEEN_PURSUER}
     if all(team.values()):  # one specialist per target map: the target for the team
         got = [_rate(rows, team[x][0], "evader/shooting", [x]) for x in SEEN_PURSUER]
         held = sum(r * n for r, _, _, n in got)
@@ -214,7 +210,7 @@ def main(argv=None) -> int:
               f"{'met' if ratio >= 0.9 else 'NOT met'})")  # fmt: skip
     for m in learned["evader"]:
         # a map specialist is judged on the target maps it trained on, as for the pursuer
-        own = [x for x in SEEN_EVADER if x in _training_maps(m)] or SEEN_EVADER
+        own = [x for x in SEEN_EVADER if x in zoo.training_maps(m)] or SEEN_EVADER
         e_l = 1 - _rate(rows, "pursuer/decomposition", m, own)[0]
         e_s = 1 - _rate(rows, "pursuer/decomposition", "evader/shooting", own)[0]
         h_l = 1 - _rate(rows, "pursuer/decomposition", m, HELD_OUT)[0]

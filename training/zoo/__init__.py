@@ -44,6 +44,7 @@ __all__ = [
     "model_path",
     "policy_name",
     "reproduce",
+    "training_maps",
 ]
 
 MODELS_DIR = Path(__file__).resolve().parent / "models"
@@ -84,6 +85,12 @@ def info(name: str) -> dict[str, Any]:
 def config(name: str) -> TrainConfig | DaggerConfig:
     """The training config of ``name`` (RL or DAgger, by its ``method``)."""
     return load_any_config(_dir(name) / "config.toml")
+
+
+def training_maps(name: str) -> list[str]:
+    """The maps ``name`` trained on (a DAgger recipe's ``maps``, an RL recipe's ``map``)."""
+    cfg = config(name)
+    return list(getattr(cfg, "maps", None) or [cfg.map])
 
 
 def policy_name(name: str) -> str:

@@ -62,7 +62,7 @@ def test_specialists_files_card_and_provenance(name):
     # one map each, seen through map coordinates, selected against the other role's
     # analytic policy
     assert prov["env_config"]["observation"] == "state" and len(cfg.maps) == 1
-    assert zoo.training_maps(name) == cfg.maps
+    assert zoo.training_maps(name) == list(cfg.maps)
     analytic = {"pursuer": "evader/shooting", "evader": "pursuer/decomposition"}
     assert name.endswith(cfg.maps[0]) and cfg.validation_opponent == analytic[cfg.role]
     card = (zoo.MODELS_DIR / name / "CARD.md").read_text()

@@ -60,6 +60,7 @@ from envs import validation
 from envs.errors import InvalidConfigError
 from strategies.policies import make_policy
 from strategies.policies.base import check_role
+from strategies.policies.learner_inputs import LearnerInputs, check_features
 from strategies.runner import check_observation_options, run_episode
 
 __all__ = ["DaggerConfig", "DaggerResult", "dagger", "load_dagger_config"]
@@ -85,6 +86,12 @@ class DaggerConfig:
     """Env overrides for every episode (a built-in's recommendations fill the rest)."""
     observation: dict[str, Any] = field(default_factory=lambda: {"observation": "state"})
     """What the learner sees: ``{"observation": "lidar", "n_rays": 32}`` or the state."""
+    features: tuple[str, ...] = ()
+    """Analytic features appended to what the learner sees
+    (:data:`strategies.policies.learner_inputs.LEARNER_FEATURES`), computed with
+    ``expert_params``: ``("safety_table",)`` gives a decomposition learner the pursuer's
+    turn choice. A model trained with features plays only through
+    :class:`~strategies.policies.learned.SB3Policy`, which computes them from the state."""
     iterations: int = 5
     episodes: int = 4
     """Episodes per iteration."""
@@ -164,6 +171,8 @@ class DaggerConfig:
         validation.mapping("expert_params", self.expert_params, where=where)
         make_policy(self.expert, **self.expert_params)  # unknown names and parameters fail here
         put("observation", check_observation_options(self.observation, f"{where}: observation"))
+        put("features", check_features(self.features, role=self.role, expert=self.expert,
+                                        where=where))  # fmt: skip
         for name, lo in (("iterations", 1), ("episodes", 1), ("max_cycles", 1), ("epochs", 1),
                          ("batch_size", 1), ("seed", 0), ("validation_episodes", 0)):  # fmt: skip
             validation.integer(name, getattr(self, name), minimum=lo, where=where)
@@ -232,7 +241,7 @@ class DaggerConfig:
             {k: (list(x) if isinstance(x, tuple) else x) for k, x in s.items()}
             for s in self.curriculum
         ]
-        for name in ("validation_episodes", "validation_opponent", "validation_maps"):
+        for name in ("validation_episodes", "validation_opponent", "validation_maps", "features"):
             if not getattr(self, name):  # absent unless used: older records compare equal
                 del d[name]
         return d
@@ -255,7 +264,8 @@ class DaggerConfig:
         missing = [n for n in ("role", "expert", "opponent") if n not in data]
         if missing:
             raise InvalidConfigError(f"config: missing required field(s) {missing}")
-        for key in ("maps", "net_arch", "opponent_weights", "curriculum", "validation_maps"):
+        for key in ("maps", "net_arch", "opponent_weights", "curriculum", "validation_maps",
+                    "features"):  # fmt: skip
             if isinstance(data.get(key), list):
                 data[key] = tuple(data[key])
         for key in ("opponent", "validation_opponent"):
@@ -347,17 +357,19 @@ class _Rollout:
     the expert's with probability ``beta``; every observation is stored with the expert's
     action (its label) and the learner's (for the disagreement). With ``learner_obs``
     options other than the state, the learner's observation is the lidar vector of the
-    same instant (built from the state the expert reads).
+    same instant (built from the state the expert reads), followed by any analytic
+    ``features`` (:class:`~strategies.policies.learner_inputs.LearnerInputs`).
     """
 
     uses_state = True
 
-    def __init__(self, expert, model, beta: float, seed: int, learner_obs=None) -> None:
+    def __init__(
+        self, expert, model, beta: float, seed: int, learner_obs=None, features=()
+    ) -> None:
         self.expert, self.model, self.beta = expert, model, beta
         self.rng = np.random.default_rng(seed)
         self.name = f"dagger({expert.name})"
-        self.learner_obs = dict(learner_obs or {"observation": "state"})
-        self.encoder = None
+        self.inputs = LearnerInputs(learner_obs, features)
         self.obs: list[np.ndarray] = []
         self.labels: list[np.ndarray] = []
         self.learned: list[np.ndarray] = []
@@ -371,20 +383,14 @@ class _Rollout:
         return self.expert.role
 
     def reset(self, *, role, map, config, seed):
-        self._role, self._state_config = role, config
-        if self.learner_obs.get("observation", "state") != "state":
-            from envs.geometry import kernel_for
-            from envs.surveillance.observations import LidarEncoder
-
-            lidar = dataclasses.replace(config, **self.learner_obs)
-            self.encoder = LidarEncoder(lidar, role, kernel_for(config.map))
-        return self.expert.reset(role=role, map=map, config=config, seed=seed)
+        out = self.expert.reset(role=role, map=map, config=config, seed=seed)
+        # the features reuse the expert's own table (same parameters, same map)
+        self.inputs.reset(config, role, pursuer=self.expert if self.inputs.features else None)
+        return out
 
     def act(self, observation):
         label = np.asarray(self.expert.act(observation), dtype=np.float32)
-        seen = np.asarray(observation, dtype=np.float32)
-        if self.encoder is not None:
-            seen = self.encoder.encode_state(seen, self._state_config, self._role)
+        seen = self.inputs(observation)
         own, _ = self.model.predict(seen, deterministic=True)
         own = np.clip(np.asarray(own, dtype=np.float32), -1.0, 1.0)
         self.obs.append(seen)
@@ -446,9 +452,14 @@ def _fit(model, obs: np.ndarray, act: np.ndarray, cfg: DaggerConfig, rng) -> flo
 
 
 def _learner_env(cfg: DaggerConfig):
+    """The env whose observation space the learner's network is built for (never stepped)."""
     from training.single_agent import SingleAgentEnv
 
-    return SingleAgentEnv(cfg.role, cfg.pool[0], map=cfg.maps[0], **{**cfg.env, **cfg.observation})
+    env = SingleAgentEnv(cfg.role, cfg.pool[0], map=cfg.maps[0], **{**cfg.env, **cfg.observation})
+    env.observation_space = LearnerInputs(cfg.observation, cfg.features).space(
+        env.observation_space
+    )
+    return env
 
 
 def _resume(cfg: DaggerConfig, out: Path, env) -> tuple[Any, dict[str, Any], list, list] | None:
@@ -531,7 +542,7 @@ def _validate(cfg: DaggerConfig, model, opponent) -> float:
     for k in range(cfg.validation_episodes):
         seed = 10_000_019 + cfg.seed * 1_003 + k
         learner = _Rollout(make_policy(cfg.expert, **cfg.expert_params), model, 0.0, seed,
-                           cfg.observation)  # fmt: skip
+                           cfg.observation, cfg.features)  # fmt: skip
         pair = {cfg.role: learner, other: opponent}
         r = run_episode(maps[k % len(maps)], pair["pursuer"], pair["evader"], seed,
                         max_cycles=cfg.max_cycles, overrides=cfg.env, start=cfg.start)  # fmt: skip
@@ -588,7 +599,7 @@ def dagger(cfg: DaggerConfig, *, verbose: bool = False) -> DaggerResult:
             seed = cfg.seed * 100_003 + it * 1_009 + ep
             world = maps[(it * cfg.episodes + ep) % len(maps)]
             expert = make_policy(cfg.expert, **cfg.expert_params)
-            roll = _Rollout(expert, model, beta, seed, cfg.observation)
+            roll = _Rollout(expert, model, beta, seed, cfg.observation, cfg.features)
             other = "evader" if cfg.role == "pursuer" else "pursuer"
             pair = {cfg.role: roll, other: opponent}
             r = run_episode(world, pair["pursuer"], pair["evader"], seed, max_cycles=cfg.max_cycles,

@@ -56,7 +56,7 @@ from strategies.policies.baselines import nearest_wall_point
 from strategies.policies.lazy_table import LazySafetyTable
 from strategies.policies.safety import NO_PATH, SafetyTable, safety_table
 
-__all__ = ["DecompositionPursuer"]
+__all__ = ["DecompositionPursuer", "reachable_steps"]
 
 
 @functools.lru_cache(maxsize=16)
@@ -263,29 +263,7 @@ class DecompositionPursuer(BasePolicy):
         value = self._values(snap.evader, row)
         free = tab.free[row]
         nb = tab.n_bins
-        # bins reachable by turning through free orientations, each way round. The table
-        # is built for the rod L_target + body radius; the real rod (shorter, e.g. with
-        # the pursuer pressed to a wall) is clear right now even where the table reads
-        # the current bin as blocked, so each scan starts from the nearest orientation
-        # the table calls free on its side (the bins in between are crossed, not
-        # targeted): otherwise no candidate is left and the pursuer stops turning.
-        twice = np.concatenate((free, free))
-        ccw_run = twice[b0 : b0 + nb].copy()  # ccw_run[k]: bin b0 + k is free
-        cw_run = twice[b0 + nb : b0 : -1].copy()  # cw_run[k]: bin b0 - k is free
-        ccw_run[0] = cw_run[0] = True
-        blocked = not free[b0] and free.any()
-        gap_ccw = gap_cw = 0  # table-blocked bins crossed before the first free one
-        if blocked:
-            gap_ccw = int(np.argmax(ccw_run[1:]))
-            gap_cw = int(np.argmax(cw_run[1:]))
-            ccw_run[1 : gap_ccw + 1] = True
-            cw_run[1 : gap_cw + 1] = True
-        n_ccw = int(np.argmin(ccw_run)) if not ccw_run.all() else nb
-        n_cw = int(np.argmin(cw_run)) if not cw_run.all() else nb
-        ccw_from = gap_ccw + 1 if blocked else 0
-        cw_from = gap_cw + 1
-        ccw_steps = np.arange(ccw_from, max(n_ccw, ccw_from))
-        cw_steps = np.arange(cw_from, max(n_cw, cw_from))
+        ccw_steps, cw_steps = reachable_steps(free, b0)
         if not ccw_steps.size and not cw_steps.size:
             return 0.0, b0
         cand_bins = np.concatenate([(b0 + ccw_steps) % nb, (b0 - cw_steps) % nb])
@@ -550,3 +528,39 @@ class DecompositionPursuer(BasePolicy):
             self.distance_gain,
         )
         return cmd.velocity
+
+
+def reachable_steps(free: np.ndarray, b0: int) -> tuple[np.ndarray, np.ndarray]:
+    """Rotations (in bins) the decomposition pursuer weighs from bin ``b0``, each way round.
+
+    The bins reachable by turning through free orientations. The table is built for the
+    rod L_target + body radius; the real rod (shorter, e.g. with the pursuer pressed to a
+    wall) is clear right now even where the table reads the current bin as blocked, so
+    each scan starts from the nearest orientation the table calls free on its side (the
+    bins in between are crossed, not targeted): otherwise no candidate is left and the
+    pursuer stops turning. ``b0`` itself is a candidate only when free (counter-clockwise).
+
+    Args:
+        free: the table's free orientations for the evader's row, ``(n_bins,)`` bool.
+        b0: the rod's current bin.
+
+    Returns:
+        ``(ccw, cw)``: step counts k such that bin ``b0 + k`` (``b0 - k``) is a candidate.
+    """
+    nb = len(free)
+    twice = np.concatenate((free, free))
+    ccw_run = twice[b0 : b0 + nb].copy()  # ccw_run[k]: bin b0 + k is free
+    cw_run = twice[b0 + nb : b0 : -1].copy()  # cw_run[k]: bin b0 - k is free
+    ccw_run[0] = cw_run[0] = True
+    blocked = not free[b0] and free.any()
+    gap_ccw = gap_cw = 0  # table-blocked bins crossed before the first free one
+    if blocked:
+        gap_ccw = int(np.argmax(ccw_run[1:]))
+        gap_cw = int(np.argmax(cw_run[1:]))
+        ccw_run[1 : gap_ccw + 1] = True
+        cw_run[1 : gap_cw + 1] = True
+    n_ccw = int(np.argmin(ccw_run)) if not ccw_run.all() else nb
+    n_cw = int(np.argmin(cw_run)) if not cw_run.all() else nb
+    ccw_from = gap_ccw + 1 if blocked else 0
+    cw_from = gap_cw + 1
+    return np.arange(ccw_from, max(n_ccw, ccw_from)), np.arange(cw_from, max(n_cw, cw_from))

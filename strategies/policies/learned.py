@@ -13,6 +13,9 @@ When a ``provenance.json`` written by :mod:`training` sits beside the zip, the p
 checks it on load: a model trained as a pursuer refuses to play the evader (and the
 reverse), and the observation the model was trained on (``state`` or ``lidar`` with its
 rays and range) is what the shared runner gives it (:attr:`SB3Policy.observation_options`).
+A model trained with analytic features (``features`` in its DAgger config) reads the
+state and builds its input as in training
+(:class:`~strategies.policies.learner_inputs.LearnerInputs`).
 """
 
 from __future__ import annotations
@@ -27,6 +30,7 @@ import numpy as np
 
 from envs.errors import InvalidConfigError, InvalidObservationError
 from strategies.policies.base import BasePolicy
+from strategies.policies.learner_inputs import LearnerInputs, check_features
 
 __all__ = ["SB3_ALGORITHMS", "SB3Policy", "UnseenMapWarning"]
 
@@ -98,10 +102,26 @@ class SB3Policy(BasePolicy):
                 f"{self.name}: this model was trained as the {trained} (its provenance.json "
                 f"says role = {trained!r}); it cannot play the {role}"
             )
+        self._inputs = self._learner_inputs()
+        if self._inputs is not None:
+            self.uses_state = True  # the runner gives it the state; act() builds the input
 
-    @property
-    def observation_options(self) -> dict[str, Any] | None:
-        """The observation the model was trained on (from its provenance), if known."""
+    def _learner_inputs(self) -> LearnerInputs | None:
+        """How to build the model's input from the state, for a model trained with
+        analytic features (its provenance's ``config.features``); ``None`` otherwise."""
+        prov = self.provenance or {}
+        cfg = prov.get("config") or {}
+        features = cfg.get("features") or ()
+        if not features:
+            return None
+        where = f"{self.name}: provenance"
+        features = check_features(
+            features, role=self.roles[0], expert=cfg.get("expert"), where=where
+        )
+        return LearnerInputs(self._trained_observation(), features, cfg.get("expert_params"))
+
+    def _trained_observation(self) -> dict[str, Any] | None:
+        """The env observation options the model was trained with, from its provenance."""
         env = (self.provenance or {}).get("env_config") or {}
         if "observation" not in env:
             return None
@@ -111,6 +131,15 @@ class SB3Policy(BasePolicy):
             if env.get("lidar_range") is not None:
                 opts["lidar_range"] = env["lidar_range"]
         return opts
+
+    @property
+    def observation_options(self) -> dict[str, Any] | None:
+        """The observation the runner should give the model (from its provenance), if
+        known: the one it was trained on, or the state for a model with analytic
+        features (it builds its input from the state, as in training)."""
+        if self._inputs is not None:
+            return {"observation": "state"}
+        return self._trained_observation()
 
     def _reset(self) -> None:
         if self.model is None:
@@ -132,6 +161,8 @@ class SB3Policy(BasePolicy):
                 ) from exc
         seed = int(self.rng.integers(2**31 - 1))
         self.model.set_random_seed(seed)
+        if self._inputs is not None:
+            self._inputs.reset(self.config, self.role)
         self._warn_unseen_map()
 
     def _warn_unseen_map(self) -> None:
@@ -165,6 +196,8 @@ class SB3Policy(BasePolicy):
         if self.role is None:
             raise InvalidConfigError(f"policy {self.name!r}: call reset() before act()")
         obs = np.asarray(observation)
+        if self._inputs is not None:
+            obs = self._inputs(obs)
         want = self.model.observation_space.shape
         if obs.shape != want:
             raise InvalidObservationError(

@@ -202,3 +202,56 @@ def test_validation_plays_the_named_opponent_on_the_named_maps(tmp_path, monkeyp
         _lidar_cfg(tmp_path, validation_opponent="pursuer/greedy")
     with pytest.raises(InvalidConfigError, match="validation_maps"):
         _lidar_cfg(tmp_path, validation_maps=("",))
+
+
+# ------------------------------------------------------------------ analytic features
+def test_a_learner_with_table_features_sees_in_play_what_it_was_fitted_on(tmp_path, monkeypatch):
+    """The rollout's stored inputs are the lidar vector plus the 5 table features, and the
+    SB3Policy built from the zip computes the same vectors from the state: same seed, same
+    opponent, the learner alone (beta 0) plays the same episode in training and in play."""
+    from strategies.policies.learned import SB3Policy
+    from strategies.runner import run_episode
+
+    cfg = _lidar_cfg(tmp_path, expert="pursuer/decomposition", features=("safety_table",),
+                     expert_params={"range_margin": 0.3}, maps=("corridor",),
+                     opponent="evader/straight", iterations=1, episodes=1, epochs=5,
+                     max_cycles=30)  # fmt: skip
+    r = dagger(cfg)
+    with np.load(r.model_path.parent / "dataset.npz") as data:
+        obs = data["obs"]
+    assert obs.shape == (r.samples[-1], 8 + 8 + 5)
+    assert np.all(np.abs(obs[:, 16:]) <= 1.5) and np.any(obs[:, 16] != obs[:, 18])
+    p = make_policy(f"pursuer/sb3:{r.model_path}")
+    assert p.observation_options == {"observation": "state"} and p.uses_state
+    seen = []
+    act = SB3Policy.act
+    monkeypatch.setattr(
+        SB3Policy, "act", lambda self, o: seen.append(self._inputs(o)) or act(self, o)
+    )
+    roll = _Rollout(make_policy("pursuer/decomposition", range_margin=0.3), _load(r), 0.0, 5,
+                    cfg.observation, cfg.features)  # fmt: skip
+    a = run_episode("corridor", roll, "evader/straight", 7, max_cycles=30, start="safe")
+    b = run_episode("corridor", p, "evader/straight", 7, max_cycles=30, start="safe")
+    assert a.steps == b.steps and a.winner == b.winner
+    assert np.array_equal(a.trajectory, b.trajectory)
+    assert np.array_equal(np.asarray(seen), np.asarray(roll.obs))
+
+
+def _load(r):
+    from stable_baselines3 import PPO
+
+    return PPO.load(str(r.model_path), device="cpu")
+
+
+@pytest.mark.parametrize(
+    "bad",
+    [
+        {"features": ("no_such",)},
+        {"features": "safety_table"},  # a string, not a list
+        {"features": ("safety_table",)},  # the greedy expert has no table
+        {"features": ("safety_table", "safety_table"), "expert": "pursuer/decomposition"},
+    ],
+)
+def test_bad_features_are_refused_naming_them(tmp_path, bad):
+    with pytest.raises(InvalidConfigError, match="feature"):
+        _lidar_cfg(tmp_path, **bad)

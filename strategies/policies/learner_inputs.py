@@ -1,0 +1,160 @@
+"""What a learned policy sees when it is built from the ``"state"`` observation.
+
+A learner trained by imitation (:mod:`training.dagger`) is labelled by an analytic expert
+that reads the ``"state"`` vector, while the learner itself may see something else: the
+lidar vector the env would have given it at that instant, plus, optionally, *analytic
+features*, numbers an analytic policy computes from the map that no observation of the
+env carries. :class:`LearnerInputs` builds that input from the state, the same way in
+training (the DAgger rollout) and in play (:class:`~strategies.policies.learned.SB3Policy`),
+so a model sees in play exactly what it was fitted on.
+
+Features (``LEARNER_FEATURES``):
+
+``"safety_table"``
+    The decomposition pursuer's turn choice, digested into 5 numbers
+    (:mod:`strategies.policies.table_features`). A pursuer-only feature: it needs the map's
+    safety table (built once per map, as the decomposition pursuer builds it) and the
+    evader's position in map coordinates. A model fed it is a learned policy *with
+    analytic features*, not a replacement for the analytic one.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+from gymnasium.spaces import Box
+
+from envs.errors import InvalidConfigError
+from strategies.policies.table_features import FLOOR, TABLE_FEATURES, TableFeatures
+
+__all__ = ["LEARNER_FEATURES", "LearnerInputs", "check_features"]
+
+LEARNER_FEATURES: dict[str, int] = {"safety_table": len(TABLE_FEATURES)}
+"""Analytic features a learner may be given, and how many numbers each adds."""
+
+_EXPERT = {"safety_table": "pursuer/decomposition"}
+"""The analytic policy whose parameters each feature is computed with."""
+
+
+def check_features(features: Any, *, role: str, expert: str | None, where: str) -> tuple[str, ...]:
+    """Validate a learner's ``features`` list; returns it as a tuple.
+
+    Args:
+        features: a sequence of names from :data:`LEARNER_FEATURES`.
+        role: the learner's role.
+        expert: the expert the features take their parameters from (``None``: no
+            expert, e.g. PPO from scratch, where no feature applies).
+        where: what to name in the error.
+
+    Raises:
+        InvalidConfigError: not a list of known names, a repeated name, or a feature
+            that does not fit the role or the expert.
+    """
+    if isinstance(features, str) or not isinstance(features, Sequence):
+        raise InvalidConfigError(
+            f"{where}: features = {features!r}: expected a list of names from "
+            f"{sorted(LEARNER_FEATURES)}"
+        )
+    out = tuple(features)
+    for name in out:
+        if name not in LEARNER_FEATURES:
+            raise InvalidConfigError(
+                f"{where}: features: unknown feature {name!r}; expected one of "
+                f"{sorted(LEARNER_FEATURES)}"
+            )
+        need = _EXPERT[name]
+        if expert != need or role != need.partition("/")[0]:
+            raise InvalidConfigError(
+                f"{where}: feature {name!r} is computed by the {need!r} expert for a "
+                f"{need.partition('/')[0]} learner; this run has role = {role!r}, "
+                f"expert = {expert!r}"
+            )
+    if len(set(out)) != len(out):
+        raise InvalidConfigError(f"{where}: features = {list(out)!r} repeats a name")
+    return out
+
+
+class LearnerInputs:
+    """Build a learner's input vector from the ``"state"`` observation.
+
+    Args:
+        observation: the learner's observation options (``{"observation": "state"}``,
+            ``{"observation": "lidar_track", "n_rays": 32}``...), as the env takes them.
+        features: names from :data:`LEARNER_FEATURES`, appended in this order.
+        expert_params: the expert's parameters (the features are computed with them).
+    """
+
+    def __init__(
+        self,
+        observation: Mapping[str, Any] | None = None,
+        features: Sequence[str] = (),
+        expert_params: Mapping[str, Any] | None = None,
+    ) -> None:
+        self.observation = dict(observation or {"observation": "state"})
+        self.features = tuple(features)
+        self.expert_params = dict(expert_params or {})
+        self._encoder: Any = None
+        self._table: TableFeatures | None = None
+        self._config: Any = None
+        self._role: str | None = None
+
+    @property
+    def from_state(self) -> bool:
+        """Whether the input differs from the ``"state"`` vector itself."""
+        return self.observation.get("observation", "state") != "state" or bool(self.features)
+
+    @property
+    def n_features(self) -> int:
+        """How many numbers the features add."""
+        return sum(LEARNER_FEATURES[f] for f in self.features)
+
+    def reset(self, config: Any, role: str, pursuer: Any = None) -> None:
+        """Prepare for an episode on ``config``'s map (a ``"state"`` env's config).
+
+        Args:
+            config: the env's config.
+            role: the learner's role.
+            pursuer: a decomposition pursuer already reset on this map with the expert's
+                parameters, whose table the ``"safety_table"`` features then reuse.
+        """
+        if config is not self._config or role != self._role:
+            self._encoder = None
+            if self.observation.get("observation", "state") != "state":
+                from envs.geometry import kernel_for
+                from envs.surveillance.observations import LidarEncoder
+
+                lidar = dataclasses.replace(config, **self.observation)
+                self._encoder = LidarEncoder(lidar, role, kernel_for(config.map))
+            self._config, self._role = config, role
+            self._table = None
+        if "safety_table" in self.features:
+            if pursuer is not None:
+                self._table = TableFeatures(config, pursuer=pursuer)
+            elif self._table is None:
+                self._table = TableFeatures(config, **self.expert_params)
+
+    def __call__(self, state: np.ndarray) -> np.ndarray:
+        """The learner's input (float32) at the ``"state"`` vector ``state``."""
+        if self._config is None:
+            raise InvalidConfigError("LearnerInputs: call reset() before encoding a state")
+        seen = np.asarray(state, dtype=np.float32)
+        out = seen
+        if self._encoder is not None:
+            out = self._encoder.encode_state(seen, self._config, self._role)
+        if self._table is not None:
+            out = np.concatenate([out, self._table(seen)])
+        return out
+
+    def space(self, base: Box) -> Box:
+        """``base`` (the learner's env observation space) with the features' bounds added."""
+        if not self.features:
+            return base
+        n = self.n_features
+        return Box(
+            np.concatenate([base.low, np.full(n, FLOOR, np.float32)]),
+            np.concatenate([base.high, np.full(n, -FLOOR, np.float32)]),
+            dtype=np.float32,
+        )

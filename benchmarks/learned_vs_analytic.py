@@ -68,6 +68,12 @@ def card(name: str, role: str, rows, args) -> str:
     article = "An" if role == "evader" else "A"
     obs = prov["env_config"]
     rays = f" ({obs.get('n_rays')} rays)" if obs["observation"] != "state" else ""
+    if cfg.get("features"):  # computed from the state by SB3Policy, as in training
+        rays += (
+            f" plus the analytic features {', '.join(f'`{f}`' for f in cfg['features'])} "
+            "(a learned policy with analytic features: each step it reads the state and "
+            "computes them from the map, see `strategies/policies/learner_inputs.py`)"
+        )
     lines = [
         f"# {name}",
         "",

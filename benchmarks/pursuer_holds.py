@@ -15,6 +15,14 @@ Usage::
         [--max-cycles 600] [--worlds corridor corner ...] [--no-greedy]
 
 ``--no-greedy`` skips the greedy reference (half the time; no decision-time ratio).
+
+``--referee CPL`` asks the referee (:mod:`strategies.referee`, the bounded-speed ground
+truth) about every loss: the start, mapped back to the as-is world (a rotation and a
+uniform scaling of lengths and speeds leave the game unchanged), is classified on the
+as-is world's referee at CPL cells per L_min, with a fine evader lattice (2 cells, 1
+spacing a step). A loss from a certified *evader* start is one no pursuer can avoid; from
+a certified *pursuer* start, a weakness of the policy (its regret); "unknown" is the
+referee's resolution gap. Solutions are cached on disk (minutes per world the first time).
 """
 
 from __future__ import annotations
@@ -80,8 +88,30 @@ def _play(job):
         r = run_episode(
             m, pursuer, _evader(evader), seed, max_cycles=max_cycles, overrides=params, start="safe"
         )
-        out[pursuer] = (r.winner, r.cause, r.escape_time, r.decide_seconds["pursuer"])
+        out[pursuer] = (r.winner, r.cause, r.escape_time, r.decide_seconds["pursuer"], r.start)
     return world, label, rho, evader, seed, out
+
+
+def _referee_label(world: str, variant_label: str, rho: float, start, cpl: float) -> str:
+    """The referee's label of a variant's start, on the as-is world (see the docstring)."""
+    from envs.errors import InvalidPlacementError
+    from envs.surveillance.config import EnvConfig
+    from strategies.referee import referee_for
+
+    _, rot, scale, offset = next(v for v in VARIANTS if v[0] == variant_label)
+    m, params = _world(world, 0.0, 1.0, (0.0, 0.0))
+    c, s = math.cos(rot), math.sin(rot)
+    back = lambda q: (
+        (np.asarray(q, float) - np.asarray(offset)) / scale @ np.array([[c, -s], [s, c]])
+    )
+    cfg = EnvConfig(map=m, l_min=params["l_min"], l_max=params["l_max"],
+                    v_pursuer=params["v_pursuer"], v_evader=rho * params["v_pursuer"],
+                    body_radius=0.2)  # fmt: skip
+    ref = referee_for(cfg, cpl, evader_coarse=2, evader_steps=1)
+    try:
+        return ref.classify(back(start["pursuer"]), back(start["evader"]))
+    except InvalidPlacementError:
+        return "not a start"
 
 
 def main(argv=None) -> int:
@@ -93,6 +123,13 @@ def main(argv=None) -> int:
     ap.add_argument("--worlds", nargs="+", default=WORLDS)
     ap.add_argument("--variants", nargs="+", default=[v[0] for v in VARIANTS])
     ap.add_argument("--no-greedy", action="store_true", help="skip the greedy reference")
+    ap.add_argument(
+        "--referee",
+        type=float,
+        metavar="CPL",
+        default=None,
+        help="label each lost start with the referee at CPL cells per L_min",
+    )
     args = ap.parse_args(argv)
     pursuers = ("pursuer/decomposition",) if args.no_greedy else PURSUERS
     print(f"load average: {os.getloadavg()}")
@@ -115,14 +152,14 @@ def main(argv=None) -> int:
     for world, label, rho, evader, seed, out in results:
         for p in decide:
             decide[p].append(out[p][3])
-        winner, cause, t, _ = out["pursuer/decomposition"]
+        winner, cause, t, _, start = out["pursuer/decomposition"]
         key = (world, evader)
         h = held.setdefault(key, [0, 0, 0])
         h[0] += winner == "pursuer"
         h[1] += 1
         h[2] += "pursuer/greedy" in out and out["pursuer/greedy"][0] == "pursuer"
         if winner != "pursuer":
-            losses.append((world, label, rho, evader, seed, cause, t))
+            losses.append((world, label, rho, evader, seed, cause, t, start))
     print(f"{len(jobs)} x {len(pursuers)} episodes in {wall:.0f} s ({args.workers} workers)")
     print(f"{'world':<10}{'evader':<26}{'decomposition held':>20}{'greedy held':>14}")
     for (world, evader), (h, n, g) in sorted(held.items()):
@@ -139,9 +176,22 @@ def main(argv=None) -> int:
         )
     else:
         print(f"decision time per step: decomposition {1e3 * d:.3f} ms")
+    verdicts: dict[str, int] = {}
     for loss in losses:
-        world, label, rho, evader, seed, cause, t = loss
-        print(f"  lost: {world} [{label}] rho={rho} {evader} seed={seed}: {cause} at {t}")
+        world, label, rho, evader, seed, cause, t, start = loss
+        ref = ""
+        if args.referee:
+            v = _referee_label(world, label, rho, start, args.referee)
+            verdicts[v] = verdicts.get(v, 0) + 1
+            ref = f"; referee: {v}"
+        print(f"  lost: {world} [{label}] rho={rho} {evader} seed={seed}: {cause} at {t}{ref}")
+    if args.referee and losses:
+        meaning = {"evader": "unavoidable", "pursuer": "the policy's regret",
+                   "unknown": "the referee's resolution gap"}  # fmt: skip
+        print(
+            f"referee (cpl {args.referee:g}) on the {len(losses)} lost starts: "
+            + ", ".join(f"{n} {v} ({meaning.get(v, v)})" for v, n in sorted(verdicts.items()))
+        )
     return 0
 
 

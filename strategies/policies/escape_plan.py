@@ -42,6 +42,7 @@ CROSS_REL = 1e-3
 """How far past a boundary piece (relative to L) a witness point lies."""
 
 _SAMPLES = 64  # cands crossing points per boundary piece
+_CLEAR_TOL = 1e-9  # beyond the rounding of a distance to the walls
 
 
 def escape_ranks(
@@ -185,6 +186,49 @@ class EscapePlan:
         return got
 
     @functools.cached_property
+    def _spans(self) -> dict[tuple[int, float, float], tuple | None]:
+        return {}
+
+    def _span(self, b: int, clearance: float, margin: float) -> tuple | None:
+        """What :meth:`witness` needs of piece ``b`` that does not depend on the evader's
+        position (computed on first use): the segments' starts, directions, squared
+        lengths, the bounds of the projection parameter that keep ``margin`` from the
+        piece's ends (and which segments have such points, ``None`` without a margin),
+        their left normals, per segment [room at its start, room at its end, length]
+        (room: distance to the walls beyond ``clearance``), and the samples that keep
+        ``clearance`` from the walls and ``margin`` from the ends, with their segments'
+        normals. ``None`` for an empty piece."""
+        key = (b, clearance, margin)
+        if key in self._spans:
+            return self._spans[key]
+        p0, d, ln, nrm, s, seg, clear = self._piece(b)
+        got = None
+        if len(ln):
+            lo, hi, live = 0.0, 1.0, None
+            ok = clear >= clearance
+            if margin > 0.0:
+                # keep `margin` (arc length) from the piece's ends, where it meets other
+                # pieces: a step across near an end can cross one of those instead (into
+                # a cell of any rank). A piece shorter than 2 margins: its midpoint only.
+                cum = np.r_[0.0, np.cumsum(ln)]  # the piece is a chain of its segments
+                arc_lo, arc_hi = margin, cum[-1] - margin
+                if arc_hi < arc_lo:
+                    arc_lo = arc_hi = 0.5 * cum[-1]
+                lo = np.clip((arc_lo - cum[:-1]) / ln, 0.0, 1.0)
+                hi = np.clip((arc_hi - cum[:-1]) / ln, 0.0, 1.0)
+                pos = cum[seg] + np.einsum("ij,ij->i", s - p0[seg], d[seg]) / ln[seg]
+                ok &= (pos >= arc_lo - 1e-12) & (pos <= arc_hi + 1e-12)
+                # none on segments wholly within a margin of an end
+                live = (cum[:-1] <= arc_hi) & (cum[1:] >= arc_lo)
+            ok = np.flatnonzero(ok)
+            # the segments' ends' distances to the walls, less `clearance`, and lengths
+            ends = self.dec.map.distance_to_walls(np.concatenate([p0, p0 + d])) - clearance
+            room = np.stack([ends[: len(p0)], ends[len(p0) :], ln], axis=1).tolist()
+            got = (p0, d, ln**2, lo, hi, live, nrm, room, s[ok], nrm[seg[ok]])
+        self._spans[key] = got
+        return got
+
+    @functools.cached_property
     def _polygons(self) -> dict:
         return {}
 
@@ -262,49 +306,48 @@ class EscapePlan:
         dec = self.dec
         reg = dec.cells[cell].region
         p = np.asarray(point, dtype=float)
-        cands = []  # (distance, boundary, point, normal out of the region)
+        px, py = p[0], p[1]
+        # (distance, boundary, points, normals, index, sign): the crossing is
+        # points[index], the normal out of the region sign * normals[index]
+        cands = []
+        nearest = []  # the projections that may lie nearer the walls than `clearance`
+        # (the samples keep it)
         for b in self.vias[cell]:
             if b in exclude:
                 continue
-            p0, d, ln, nrm, s, seg, clear = self._piece(b)
-            if not len(ln):
+            span = self._span(b, clearance, margin)
+            if span is None:
                 continue
+            p0, d, ln2, lo, hi, live, nrm, room, s, s_nrm = span
             sign = 1.0 if dec.boundaries[b].regions[1] == reg else -1.0  # left normal -> A
-            lo, hi = 0.0, 1.0
-            ok = clear >= clearance
-            if margin > 0.0:
-                # keep `margin` (arc length) from the piece's ends, where it meets other
-                # pieces: a step across near an end can cross one of those instead (into
-                # a cell of any rank). A piece shorter than 2 margins: its midpoint only.
-                cum = np.r_[0.0, np.cumsum(ln)]  # the piece is a chain of its segments
-                arc_lo, arc_hi = margin, cum[-1] - margin
-                if arc_hi < arc_lo:
-                    arc_lo = arc_hi = 0.5 * cum[-1]
-                lo = np.clip((arc_lo - cum[:-1]) / ln, 0.0, 1.0)
-                hi = np.clip((arc_hi - cum[:-1]) / ln, 0.0, 1.0)
-                pos = cum[seg] + np.einsum("ij,ij->i", s - p0[seg], d[seg]) / ln[seg]
-                ok &= (pos >= arc_lo - 1e-12) & (pos <= arc_hi + 1e-12)
-            t = np.clip(np.einsum("ij,ij->i", p - p0, d) / ln**2, lo, hi)
+            t = np.clip(np.einsum("ij,ij->i", p - p0, d) / ln2, lo, hi)
             q = p0 + t[:, None] * d
-            dist = np.hypot(q[:, 0] - p[0], q[:, 1] - p[1])
-            if margin > 0.0:
-                # none on segments wholly within a margin of an end
-                dist = np.where((cum[:-1] <= arc_hi) & (cum[1:] >= arc_lo), dist, np.inf)
+            dist = np.hypot(q[:, 0] - px, q[:, 1] - py)
+            if live is not None:
+                dist = np.where(live, dist, np.inf)
             k = int(np.argmin(dist))
-            cand = (float(dist[k]), b, q[k], sign * nrm[k])
-            ds = np.hypot(s[:, 0] - p[0], s[:, 1] - p[1])
-            ok = np.flatnonzero(ok)
-            cands.append(cand)
+            # the distance to the walls is 1-Lipschitz: q[k] keeps `clearance` if its
+            # distance along the segment from either end is less than that end's room
+            a, z, n = room[k]
+            tk = float(t[k])
+            if max(a - tk * n, z - (1.0 - tk) * n) <= _CLEAR_TOL:
+                nearest.append(len(cands))
+            cands.append((float(dist[k]), b, q, nrm, k, sign))
+            ds = np.hypot(s[:, 0] - px, s[:, 1] - py)
+            order = np.argsort(ds)[:8]
             cands.extend(
-                (float(ds[i]), b, s[i], sign * nrm[seg[i]]) for i in ok[np.argsort(ds[ok])[:8]]
+                (dj, b, s, s_nrm, j, sign)
+                for dj, j in zip(ds[order].tolist(), order.tolist(), strict=True)
             )
         if not cands:
             return None
+        if nearest:
+            clear = dec.map.distance_to_walls(np.array([cands[i][2][cands[i][4]] for i in nearest]))
+            for i in reversed(np.flatnonzero(clear < clearance).tolist()):
+                del cands[nearest[i]]
+            if not cands:
+                return None  # every crossing is closer to a wall than the evader's disc allows
         cands.sort(key=lambda c: c[0])
-        clear = dec.map.distance_to_walls(np.array([c[2] for c in cands]))
-        cands = [c for c, cl in zip(cands, clear, strict=True) if cl >= clearance]
-        if not cands:
-            return None  # every crossing is closer to a wall than the evader's disc allows
         poly = self._inside(reg)
         step = CROSS_REL * dec.L
 
@@ -313,10 +356,11 @@ class EscapePlan:
             # piece's ends (a junction of critical curves) it can lie across another
             # piece, in a cell of any rank (issue 13)
             pair = dec.boundaries[c[1]].regions
-            return self.inside(pair[0] if pair[1] == reg else pair[1], c[2] + step * c[3])
+            q, n = c[2][c[4]], c[5] * c[3][c[4]]
+            return self.inside(pair[0] if pair[1] == reg else pair[1], q + step * n)
 
         def direct(c) -> bool:
-            return c[0] == 0.0 or shapely.covers(poly, shapely.LineString([p, c[2]]))
+            return c[0] == 0.0 or shapely.covers(poly, shapely.LineString([p, c[2][c[4]]]))
 
         # nearest first: one that lands across and is in a straight line, else the
         # nearest that lands across, else (none lands) the first in a straight line
@@ -328,7 +372,8 @@ class EscapePlan:
                 fallback = fallback or c
         else:
             c = fallback or next((c for c in cands if direct(c)), cands[0])
-        _, b, q, n = c
+        _, b, pts, nrms, i, sign = c
+        q, n = pts[i], sign * nrms[i]
         return Witness(int(b), q, n, q + step * n)
 
 

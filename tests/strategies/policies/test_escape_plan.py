@@ -248,3 +248,95 @@ def test_region_walk_is_a_shortest_wall_free_grid_walk():
             j = int(nxt[i])
             assert j >= 0 and dist[j] == dist[i] - 1
             assert free.covers(LineString([pts[i], pts[j]]))
+
+
+def _witness_direct(plan, cell, p, clearance, exclude, margin):
+    """:meth:`EscapePlan.witness` computed directly: every via's projection and samples
+    from scratch, each candidate's clearance by ``distance_to_walls`` (the method caches
+    the per-piece part and skips the distances the 1-Lipschitz bound settles)."""
+    dec = plan.dec
+    reg = dec.cells[cell].region
+    cands = []
+    for b in plan.vias[cell]:
+        if b in exclude:
+            continue
+        p0, d, ln, u, s, seg = _samples(dec.boundaries[b].segments, dec.chord_tol)
+        if not len(ln):
+            continue
+        nrm = np.stack([-u[:, 1], u[:, 0]], axis=1)
+        sign = 1.0 if dec.boundaries[b].regions[1] == reg else -1.0
+        lo, hi = 0.0, 1.0
+        ok = dec.map.distance_to_walls(s) >= clearance
+        if margin > 0.0:
+            cum = np.r_[0.0, np.cumsum(ln)]
+            arc_lo, arc_hi = margin, cum[-1] - margin
+            if arc_hi < arc_lo:
+                arc_lo = arc_hi = 0.5 * cum[-1]
+            lo = np.clip((arc_lo - cum[:-1]) / ln, 0.0, 1.0)
+            hi = np.clip((arc_hi - cum[:-1]) / ln, 0.0, 1.0)
+            pos = cum[seg] + np.einsum("ij,ij->i", s - p0[seg], d[seg]) / ln[seg]
+            ok &= (pos >= arc_lo - 1e-12) & (pos <= arc_hi + 1e-12)
+        t = np.clip(np.einsum("ij,ij->i", p - p0, d) / ln**2, lo, hi)
+        q = p0 + t[:, None] * d
+        dist = np.hypot(q[:, 0] - p[0], q[:, 1] - p[1])
+        if margin > 0.0:
+            dist = np.where((cum[:-1] <= arc_hi) & (cum[1:] >= arc_lo), dist, np.inf)
+        k = int(np.argmin(dist))
+        cands.append((float(dist[k]), b, q[k], sign * nrm[k]))
+        ds = np.hypot(s[:, 0] - p[0], s[:, 1] - p[1])
+        ok = np.flatnonzero(ok)
+        cands.extend(
+            (float(ds[i]), b, s[i], sign * nrm[seg[i]]) for i in ok[np.argsort(ds[ok])[:8]]
+        )
+    cands.sort(key=lambda c: c[0])
+    clear = dec.map.distance_to_walls(np.array([c[2] for c in cands])) if cands else []
+    cands = [c for c, cl in zip(cands, clear, strict=True) if cl >= clearance]
+    if plan.rank[cell] < 0 or not cands:
+        return None
+    step = CROSS_REL * dec.L
+    poly = plan._inside(reg)
+
+    def lands(c):
+        pair = dec.boundaries[c[1]].regions
+        return plan.inside(pair[0] if pair[1] == reg else pair[1], c[2] + step * c[3])
+
+    def direct(c):
+        return c[0] == 0.0 or shapely.covers(poly, LineString([p, c[2]]))
+
+    fallback = None
+    for c in cands:
+        if lands(c):
+            if direct(c):
+                break
+            fallback = fallback or c
+    else:
+        c = fallback or next((c for c in cands if direct(c)), cands[0])
+    return c[1], c[2], c[3]
+
+
+@pytest.mark.parametrize("name", ["two_rooms", "maze"])
+def test_witness_is_the_direct_computation(name):
+    # bit for bit (the shooting evader's actions must not change), also where a
+    # projection lies nearer the walls than the clearance or within a margin of an end
+    plan = escape_plan(builtin_map(name), L)
+    rng = np.random.default_rng(3)
+    cells = np.flatnonzero(plan.rank >= 0)
+    dropped = 0
+    for _ in range(400):
+        c = int(rng.choice(cells))
+        reg = plan.dec.regions[plan.dec.cells[c].region]
+        x0, y0, x1, y1 = reg.polygon.bounds
+        p = rng.uniform([x0, y0], [x1, y1])
+        clearance = float(rng.choice([0.0, 0.1, 0.3]))
+        margin = float(rng.choice([0.0, 0.05, 0.2]))
+        exclude = frozenset(b for b in plan.vias[c] if rng.random() < 0.3)
+        got = plan.witness(c, p, clearance, exclude=exclude, margin=margin)
+        want = _witness_direct(plan, c, p, clearance, exclude, margin)
+        if want is None:
+            assert got is None
+            dropped += 1
+            continue
+        assert got.boundary == want[0]
+        assert got.cross.tobytes() == want[1].tobytes()
+        assert got.normal.tobytes() == want[2].tobytes()
+    assert dropped < 200

@@ -62,9 +62,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
 
 def run(args: argparse.Namespace) -> int:
     """Run ``surveil referee``."""
+    import warnings
+
     import numpy as np
 
-    from envs.errors import SurveilValueError
+    from envs.errors import SurveilValueError, VacuousBoundWarning
     from envs.surveillance.config import EnvConfig
     from strategies.referee import referee_for
     from strategies.runner import map_parameters
@@ -81,7 +83,9 @@ def run(args: argparse.Namespace) -> int:
         raise type(exc)(f"map: {exc}") from None
     cfg = EnvConfig(map=world, **{**params, **overrides})
     t = time.perf_counter()
-    ref = referee_for(cfg, args.cells_per_lmin, cache=not args.no_cache)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", VacuousBoundWarning)  # the summary says it below
+        ref = referee_for(cfg, args.cells_per_lmin, cache=not args.no_cache)
     s = ref.summary()
     print(
         f"{world.name}: rho = {cfg.rho:g}, L in [{cfg.l_min:g}, {cfg.l_max:g}], "
@@ -98,6 +102,9 @@ def run(args: argparse.Namespace) -> int:
             f"{b['tau']:.4g} s, {b['states']} states, {b['iterations']} sweeps, "
             f"{b['seconds']['build'] + b['seconds']['solve']:.1f} s"
         )
+    vacuous = s["pursuer_bound"]["vacuous"]
+    if vacuous is not None:
+        print(f"  the pursuer wins above say nothing: {vacuous}")
     if args.classify is not None:
         px, py, ex, ey = args.classify
         label = ref.classify((px, py), (ex, ey))

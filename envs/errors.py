@@ -18,6 +18,7 @@ __all__ = [
     "RhoAboveOneWarning",
     "SurveilValueError",
     "UnknownNameError",
+    "VacuousBoundWarning",
 ]
 
 
@@ -65,3 +66,9 @@ class UnknownNameError(SurveilValueError, KeyError):
 
 class RhoAboveOneWarning(UserWarning):
     """V_e > V_p: legal, but escape is trivial for the evader (Sec. 5 of the paper)."""
+
+
+class VacuousBoundWarning(UserWarning):
+    """A referee bound that certifies nothing, or that is in the regime where it was measured
+    to certify nothing: its 0 % means "unknown", not a win for the other player
+    (:mod:`strategies.referee.pursuer_bound`)."""

@@ -24,10 +24,50 @@ game (continuous time, any evader, and the env at any step that divides ``tau``)
 The pursuer's winning set is the greatest fixed point ``W = {x : exists a safe move whose
 every evader successor is in W}``, computed by iterating from the safe states, with a
 worklist of the windows that changed.
+
+**When it certifies nothing (issue 13).** Favouring the evader costs the pursuer twice per
+step: the evader foresees the whole committed step of length V_p tau, and its position is
+forgotten down to its cell, so it gains ``g = V_e tau`` plus up to ``h sqrt(2)`` of centre
+displacement every step. Two regimes follow (:func:`vacuity` names them, and
+:func:`~strategies.referee.referee.solve` raises a
+:class:`~envs.errors.VacuousBoundWarning`):
+
+* **The range band is used up** (a priori, a necessary condition checked exactly on the
+  window, :func:`range_band`): after a step the evader's successor cells must all be in
+  range of the pursuer's new point, which leaves a band of distances of width about
+  ``(l_max - l_min) - 2 g - 3 sqrt(2) h`` (an estimate: it counts every successor
+  centre as ``g + h sqrt(2)`` away). When no window offset passes both the end-of-step
+  range test and the successors' range test, no start with the evader in open space can
+  be certified (L in [2, 4], rho = 0.5, 8 cells per L_min, the default lattice: tau =
+  1.5 s, estimate -0.56).
+* **Measured to certify nothing** (empirical): then the evader herds the pursuer into a
+  wall in the abstraction, from the walls inward, although a real pursuer keeps its range
+  against a charging evader there by circling at ``L_min / sqrt(1 - rho^2)`` (whether it
+  wins against every evader is what the referee cannot say). On the empty 10 m room with
+  L in [2, 4] (fraction of (point, cell) states certified):
+
+  ============  ===================================  ===========================
+  rho           cells per L_min, coarse, tau          certified
+  ============  ===================================  ===========================
+  0.2 / 0.25    16, 4, 1.5 s (the default lattice)    99.1 / 98.6 %
+  0.265 - 0.4   16, 4, 1.5 s                          0 %
+  0.3 / 0.33    24, 6, 1.5 s (the default lattice)    0 %
+  0.15 - 0.3    16, 2, 0.8 s                          98.2 - 99.8 %
+  0.35          16, 2, 0.8 s; 16, 2, 0.5 s; 16, 1,    0 %
+                0.5 s; 24, 2, 0.5 s (0.4: 16, 2, 0.5 s)
+  0.5           12 lattices, tau 0.4 to 1.5 s         0 % (the open plane: 100 %
+                                                      at some of them)
+  ============  ===================================  ===========================
+
+  So from ``rho >=`` :data:`VACUOUS_RHO` the bound is vacuous at every resolution
+  tried; below it, it can be vacuous at some lattices (solve() also warns when the solved
+  bound certifies no state at all). Its 0 % then means "unknown", not "the evader wins":
+  only the evader bound certifies evader wins.
 """
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 from typing import Any, ClassVar
@@ -41,7 +81,11 @@ from strategies.referee.lattice import Lattice, segment_wall_distance
 from strategies.referee.robust import convex_corners, sweep_hits_vertex, sweep_range_ok
 from strategies.referee.spec import GameSpec, Resolution
 
-__all__ = ["PursuerBound", "solve_pursuer_bound"]
+__all__ = ["VACUOUS_RHO", "PursuerBound", "range_band", "solve_pursuer_bound", "vacuity"]
+
+VACUOUS_RHO = 0.35
+"""From this rho on, the pursuer bound certified nothing in an empty room the pursuer wins,
+at every resolution tried (the module docstring's table)."""
 
 
 @dataclass
@@ -151,6 +195,25 @@ class PursuerBound(SolvedBound):
             return False
         return self.plan(p, e) is not None
 
+    def vacuity(self) -> str | None:
+        """Why this bound's pursuer wins say nothing (:func:`vacuity`, or it won no state
+        at all), None when it is informative."""
+        reason = vacuity(self.spec, self.res)
+        if reason is None and not self.win.any():
+            spec, res = self.spec, self.res
+            ratio = (spec.v_evader * res.tau + math.sqrt(2.0) * res.cell) / (
+                spec.v_pursuer * res.tau
+            )
+            reason = (
+                f"pursuer bound at rho = {spec.rho:.3g} (cell h = {res.cell:.4g}, step tau = "
+                f"{res.tau:.4g} s) certified no state (the evader foresees each committed "
+                f"step and is re-localised in its cell, covering {ratio:.2f} of the pursuer's "
+                f"step per step; such bounds certified nothing even in rooms the pursuer "
+                f"wins, see strategies.referee.pursuer_bound); its 0 % pursuer wins mean "
+                f"'unknown', not 'evader wins'"
+            )
+        return reason
+
     def fraction(self) -> float:
         """Fraction of the states (pursuer point, open evader cell in range) that win."""
         dom = self._domain()
@@ -167,6 +230,82 @@ def _range0(lat: Lattice, spec: GameSpec) -> np.ndarray:
     R0 = lat.delta + spec.margin
     dist = np.hypot(lat.offsets[..., 0], lat.offsets[..., 1])
     return (dist - R0 >= spec.l_min) & (dist + R0 <= spec.l_max)
+
+
+def range_band(spec: GameSpec, res: Resolution) -> tuple[float, bool]:
+    """The range band a step of the pursuer bound leaves, approximate and exact.
+
+    Returns:
+        ``(width, open)``: ``width = (l_max - l_min) - 2 g - 3 sqrt(2) h`` (g = V_e tau),
+        an estimate of the band of pursuer-evader distances from which every evader
+        successor cell is still in range (counting every successor centre as ``g + h
+        sqrt(2)`` away, so it is pessimistic by up to about ``2 h``); and whether
+        some window offset passes both tests the solver makes (the end-of-step range test
+        of :func:`~strategies.referee.robust.sweep_range_ok` and every successor cell of
+        the evader's one-step stencil in range). When ``open`` is False, no state whose
+        evader successors are all open cells can be won.
+
+    Examples:
+        The default lattice of the 10 m room at L in [2, 4] and 8 cells per L_min
+        (coarse 2, three spacings per step, tau = 1.5 s): open at rho = 0.2, used up at
+        rho = 0.5. At 16 cells per L_min (coarse 4, tau = 1.5 s) the estimate is -0.03
+        at rho = 0.5 but the exact test finds offsets: the band is open (and the bound
+        still certifies nothing there, the second regime).
+
+        >>> from envs.maps import Map
+        >>> room = Map([(0, 0), (10, 0), (10, 10), (0, 10)])
+        >>> for rho, cell, coarse in ((0.2, 0.25, 2), (0.5, 0.25, 2), (0.5, 0.125, 4)):
+        ...     spec = GameSpec(room, 2.0, 4.0, 1.0, rho, body_radius=0.2)
+        ...     w, ok = range_band(spec, Resolution(cell=cell, coarse=coarse, tau=1.5))
+        ...     print(f"{w:+.2f} {ok}")
+        +0.34 True
+        -0.56 False
+        -0.03 True
+    """
+    h, delta, m = res.cell, res.cell_radius, spec.margin
+    g = spec.v_evader * res.tau
+    width = (spec.l_max - spec.l_min) - 2.0 * g - 3.0 * math.sqrt(2.0) * h
+    hw = math.ceil((spec.l_max + delta) / h) + 1  # the pursuer lattice's window
+    w = np.arange(-hw, hw + 1) * h
+    dist = np.hypot(*np.meshgrid(w, w, indexing="ij"))
+    R0 = delta + m
+    in_range = (dist - R0 >= spec.l_min) & (dist + R0 <= spec.l_max)
+    successors = erode(in_range[None], reach_rectangles(g + m, h), border=False)[0]
+    end = (dist - R0 - g >= spec.l_min) & (dist + R0 + g <= spec.l_max)
+    return width, bool((successors & end).any())
+
+
+def vacuity(spec: GameSpec, res: Resolution) -> str | None:
+    """Why the pursuer bound of ``spec`` at ``res`` cannot certify a start, or was measured
+    not to (see the module docstring), with the numbers; None when neither applies. Known
+    before solving: :meth:`PursuerBound.vacuity` adds the solved bound's own emptiness."""
+    h, tau, rho = res.cell, res.tau, spec.rho
+    g = spec.v_evader * tau
+    ratio = (g + math.sqrt(2.0) * h) / (spec.v_pursuer * tau)
+    where = (
+        f"pursuer bound at rho = {rho:.3g} (cell h = {h:.4g}, step tau = {tau:.4g} s, the "
+        f"evader's step g = V_e tau = {g:.4g})"
+    )
+    unknown = (
+        "its 0 % pursuer wins mean 'unknown', not 'evader wins' (only the evader bound "
+        "certifies those)"
+    )
+    width, band_open = range_band(spec, res)
+    if not band_open:
+        return (
+            f"{where}: the range band is used up ((l_max - l_min) - 2 g - 3 sqrt(2) h = "
+            f"{width:+.3g}; no offset keeps every evader successor cell in [{spec.l_min:g}, "
+            f"{spec.l_max:g}] after a step), so it certifies no start with the evader in open "
+            f"space; {unknown}. A shorter step (pursuer_steps, pursuer_coarse) reopens it"
+        )
+    if rho >= VACUOUS_RHO:
+        return (
+            f"{where}: rho >= {VACUOUS_RHO:g}, where it was measured to certify nothing at "
+            f"every resolution tried, even in an empty room the pursuer wins (the evader "
+            f"foresees each committed step and is re-localised in its cell: it covers "
+            f"{ratio:.2f} of the pursuer's step per step); {unknown}"
+        )
+    return None
 
 
 def _sweep_hits_any(spec, p, d, c, R0, g, pieces) -> np.ndarray:

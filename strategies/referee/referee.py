@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -23,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from envs import validation as V
-from envs.errors import InvalidConfigError, InvalidPlacementError
+from envs.errors import InvalidConfigError, InvalidPlacementError, VacuousBoundWarning
 from envs.geometry import kernel_for
 from strategies.referee.cache import load_arrays, save_arrays
 from strategies.referee.evader_bound import EvaderBound, solve_evader_bound
@@ -278,6 +279,9 @@ class Referee:
         """Sizes, timings and the label fractions over all lattice starts.
 
         ``gap`` is the fraction of starts neither bound certifies: the resolution error.
+        ``pursuer_bound["vacuous"]`` says why the pursuer wins say nothing here (the range
+        band is used up, rho is in the regime where the bound was measured to certify
+        nothing, or it certified no state; :meth:`PursuerBound.vacuity`), None otherwise.
         """
         starts = self.lattice_starts(margin=margin)
         fr = starts.fractions()
@@ -296,6 +300,7 @@ class Referee:
                 "states": int(pb.win.size),
                 "iterations": pb.iterations,
                 "seconds": dict(pb.seconds),
+                "vacuous": pb.vacuity(),
             },
             "evader_bound": {
                 "cell": eb.res.cell,
@@ -369,6 +374,13 @@ def solve(
     sensor range ``l_max - l_min``. Both share the cells' anchor, so a start with each
     player on its lattice can be certified either way.
 
+    The pursuer bound is vacuous (it certifies nothing, although the real game may well be a
+    pursuer win) when its range band is used up, from rho = 0.35 at every resolution
+    tried, and at some lattices below that (the empty 10 m room at rho = 0.3: 0 % at the
+    default lattice, tau = 1.5 s; 98 % with ``pursuer_coarse=2``, tau = 0.8 s); see
+    :mod:`strategies.referee.pursuer_bound`. Then its pursuer wins mean "unknown", and
+    :class:`~envs.errors.VacuousBoundWarning` says so, with the numbers.
+
     Args:
         spec: the game.
         cells_per_lmin: opponent cells per L_min (the resolution; the gap shrinks as it
@@ -383,6 +395,10 @@ def solve(
         cache: read and write the on-disk cache.
         cache_dir: cache directory (default ``$SURVEIL_CACHE_DIR`` or ``~/.cache/surveil``).
         progress: print the fixed points' progress.
+
+    Warns:
+        VacuousBoundWarning: the pursuer bound's wins say nothing about the game
+            (:meth:`PursuerBound.vacuity`, the reason and its numbers in the message).
     """
     if not isinstance(spec, GameSpec):
         raise InvalidConfigError(f"solve: expected a GameSpec, got {type(spec).__name__}")
@@ -399,11 +415,15 @@ def solve(
                              steps=pursuer_steps, **kw)  # fmt: skip
     re = Resolution.for_role(spec, "evader", cells_per_lmin, coarse=evader_coarse,
                              steps=evader_steps, **kw)  # fmt: skip
-    return Referee(
+    ref = Referee(
         spec=spec,
         pursuer=cached_pursuer_bound(spec, rp, cache=cache, cache_dir=cache_dir, progress=progress),
         evader=cached_evader_bound(spec, re, cache=cache, cache_dir=cache_dir, progress=progress),
     )
+    reason = ref.pursuer.vacuity()
+    if reason is not None:
+        warnings.warn(f"map {spec.map.name!r}: {reason}", VacuousBoundWarning, stacklevel=2)
+    return ref
 
 
 def referee_for(config: Any, cells_per_lmin: float = 24.0, **kwargs: Any) -> Referee:

@@ -20,6 +20,7 @@ import dataclasses
 import json
 import math
 import os
+import warnings
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -28,7 +29,7 @@ import numpy as np
 from scipy.stats import binomtest
 
 from envs import validation as V
-from envs.errors import InvalidConfigError, InvalidPlacementError
+from envs.errors import InvalidConfigError, InvalidPlacementError, VacuousBoundWarning
 from envs.maps import Map
 from strategies.referee.referee import Referee, solve
 from strategies.referee.spec import GameSpec
@@ -215,7 +216,11 @@ def tournament_regret(
             says how many and why, so a report still renders.
 
     Returns:
-        :func:`regret_table`'s rows (only matches played out, status ``"ok"``).
+        :func:`regret_table`'s rows (only matches played out, status ``"ok"``), then a
+        note row when a game's pursuer bound is vacuous (a
+        :class:`~envs.errors.VacuousBoundWarning`: at rho = 0.5 its pursuer rows count no
+        certified start because the bound certifies none, not because none is winnable),
+        then one when matches were left out.
 
     Raises:
         InvalidConfigError: with ``strict``, a match whose game cannot be rebuilt.
@@ -234,9 +239,20 @@ def tournament_regret(
             if strict:
                 raise
             skipped.append(str(exc))
-    table = regret_table(
-        regret(matches, cells_per_lmin=cells_per_lmin, cache=cache, cache_dir=cache_dir)
-    )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", VacuousBoundWarning)
+        results = regret(matches, cells_per_lmin=cells_per_lmin, cache=cache, cache_dir=cache_dir)
+    for w in caught:  # other warnings go on as they came
+        if not issubclass(w.category, VacuousBoundWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    table = regret_table(results)
+    vacuous = sorted({str(w.message) for w in caught
+                      if issubclass(w.category, VacuousBoundWarning)})  # fmt: skip
+    if vacuous:
+        note = (f"pursuer regret: in {len(vacuous)} game(s) the pursuer bound certifies "
+                f"nothing informative, so their starts count as unknown, not as winnable: "
+                f"{vacuous[0]}")  # fmt: skip
+        table.append(["-", note, *[""] * (len(table[0]) - 2)])
     if skipped:
         note = f"{len(skipped)} matches not counted: {skipped[0]}"
         table.append(["-", note, *[""] * (len(table[0]) - 2)])
@@ -313,8 +329,6 @@ def _map_of(source, digest, maps, geometry) -> Map:
 def _config(world: Map, params: Mapping[str, Any], rho):
     """The env config of a match (``rho`` sets v_evader = rho v_pursuer, as a spec's
     variant does)."""
-    import warnings
-
     from envs.errors import RhoAboveOneWarning
     from envs.surveillance.config import EnvConfig
 

@@ -20,11 +20,25 @@ def test_referee_summary_classify_sample_and_picture(tmp_path, capsys, monkeypat
     text = capsys.readouterr().out.splitlines()
     assert text[0].startswith("open_room: rho = 1.5, L in [2, 4], 8 cells per L_min")
     assert "evader wins 100.0%" in text[1]
-    assert text[4].startswith("start pursuer (5, 8), evader (5, 5): evader (surveillance breaks")
-    starts = [json.loads(line) for line in text[5:7]]
+    # a long step of a fast evader: the pursuer bound's 0 % is flagged, with the numbers
+    assert text[4].startswith("  the pursuer wins above say nothing: pursuer bound at rho = 1.5")
+    assert "the range band is used up" in text[4] and "= -3.56;" in text[4]
+    assert text[5].startswith("start pursuer (5, 8), evader (5, 5): evader (surveillance breaks")
+    starts = [json.loads(line) for line in text[6:8]]
     assert all(set(s) == {"pursuer", "evader"} for s in starts)
     assert out.stat().st_size > 10_000
     assert any((tmp_path / "cache" / "referee").iterdir())  # solved once, cached
+
+
+def test_referee_summary_flags_a_pursuer_bound_that_certified_nothing(capsys, monkeypatch):
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", "/nonexistent")
+    base = ["referee", "open_room", "--config", '{"v_evader": 0.2}', "--no-cache"]
+    assert main([*base, "--cells-per-lmin", "12"]) == 0  # 88 % certified: no note
+    text = capsys.readouterr().out
+    assert "pursuer wins 8" in text and "say nothing" not in text
+    assert main([*base, "--cells-per-lmin", "8"]) == 0  # too coarse: 0 %, and a note
+    text = capsys.readouterr().out
+    assert "pursuer wins 0.0%" in text and "say nothing" in text and "certified no state" in text
 
 
 @pytest.mark.parametrize(

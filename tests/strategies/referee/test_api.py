@@ -21,6 +21,9 @@ from strategies.referee import (
 from strategies.referee.cache import cache_path
 from tests.strategies.referee.conftest import RADIUS, open_room, spec
 
+# rho = 0.5 and 0.9 on purpose: the pursuer bound's own warning is tested in test_vacuity
+pytestmark = pytest.mark.filterwarnings("ignore::envs.errors.VacuousBoundWarning")
+
 
 def test_classify_and_label_starts(open_slow, corridor_half):
     assert open_slow.classify((2.5, 4.0), (2.5, 2.5)) == "pursuer"

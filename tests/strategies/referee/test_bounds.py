@@ -13,6 +13,9 @@ from strategies.cspace import decompose, surveillance_verdict
 from strategies.referee import Referee, Resolution, solve, solve_evader_bound, solve_pursuer_bound
 from tests.strategies.referee.conftest import L_MAX, L_MIN, dead_end, open_room, spec
 
+# rho = 0.5 on purpose: the pursuer bound's own warning is tested in test_vacuity
+pytestmark = pytest.mark.filterwarnings("ignore::envs.errors.VacuousBoundWarning")
+
 
 def _clearances(ref, starts):
     m = ref.spec.map

@@ -19,6 +19,9 @@ from strategies.referee import RefereeEvader, RefereePursuer
 from strategies.runner import run_episode
 from tests.strategies.referee.conftest import DT, play
 
+# rho = 0.5 on purpose: the pursuer bound's own warning is tested in test_vacuity
+pytestmark = pytest.mark.filterwarnings("ignore::envs.errors.VacuousBoundWarning")
+
 
 def _registered(role: str) -> list[str]:
     """The registered policies of ``role`` but the referee's own, which these tests add

@@ -13,6 +13,9 @@ from strategies.referee import Regret, regret, regret_table, tournament_regret
 from strategies.runner import run_episode
 from tests.strategies.referee.conftest import DT, L_MAX, L_MIN, RADIUS
 
+# rho = 0.5 on purpose: the pursuer bound's own warning is tested in test_vacuity
+pytestmark = pytest.mark.filterwarnings("ignore::envs.errors.VacuousBoundWarning")
+
 
 def _match(ref, start, pursuer, evader, winner, max_cycles=200):
     s = ref.spec
@@ -83,6 +86,11 @@ def test_tournament_regret_from_runner_records(corridor_half):
     spec = {"maps": [{"label": world.name, "source": "<inline>", "digest": world.digest}]}
     table = tournament_regret(json.dumps(spec), rows, geometry={world.digest: world.to_dict()},
                               cells_per_lmin=12, cache=False)  # fmt: skip
+    # rho = 0.5: the last row says the pursuer bound certifies nothing informative
+    *table, note = table
+    assert note[0] == "-" and len(note) == len(table[0])
+    assert note[1].startswith("pursuer regret: in 1 game(s) the pursuer bound certifies")
+    assert "rho = 0.5" in note[1] and "'unknown'" in note[1]
     by_policy = {row[1]: row for row in table[1:]}
     assert set(by_policy) == {"pursuer/greedy", "evader/shooting"}
     assert by_policy["evader/shooting"][3] == "2"  # both starts certified for the evader
@@ -116,7 +124,8 @@ def test_tournament_regret_redraws_the_runners_start_from_the_seed(monkeypatch):
         assert np.allclose(m["start"]["pursuer"], s["pursuer"])
         assert np.allclose(m["start"]["evader"], s["evader"])
     assert all(m["v_evader"] == 0.25 and m["max_cycles"] == 50 for m in seen)
-    assert len(table) == 3
+    # 6 cells per L_min is too coarse for the pursuer bound (tau = 2 s): a note says so
+    assert len(table) == 4 and "certified no state" in table[3][1]
 
 
 def test_tournament_regret_refuses_a_changed_map(corridor_half):

@@ -241,9 +241,11 @@ class Referee:
         starts = self.lattice_starts(margin=margin)
         idx = np.flatnonzero(starts.label == kind)
         if len(idx) == 0:
+            why = self.pursuer.vacuity() if kind == "pursuer" else None
             raise InvalidConfigError(
                 f"sample_starts: no {kind!r}-labelled start on map {self.spec.map.name!r} "
                 f"at this resolution (counts {starts.counts()})"
+                + ("" if why is None else f"; which says nothing about the game: {why}")
             )
         pick = rng.choice(idx, size=n, replace=n > len(idx))
         out = []

@@ -80,12 +80,21 @@ def test_sample_starts_are_valid_labelled_and_reproducible(kind, open_slow, corr
 
 def test_sample_starts_errors(open_slow):
     rng = np.random.default_rng(0)
-    with pytest.raises(InvalidConfigError, match="no 'evader'-labelled start"):
+    with pytest.raises(InvalidConfigError, match="no 'evader'-labelled start") as err:
         open_slow.sample_starts(1, rng, kind="evader")
+    assert "says nothing" not in str(err.value)
     with pytest.raises(InvalidConfigError, match="kind = 'both'"):
         open_slow.sample_starts(1, rng, kind="both")
     with pytest.raises(InvalidConfigError, match="n = -1"):
         open_slow.sample_starts(-1, rng)
+
+
+def test_sample_starts_says_when_no_pursuer_start_says_nothing(corridor_half):
+    # rho = 0.5: the pursuer bound is vacuous, and the error says so rather than suggest
+    # that no start is winnable for the pursuer
+    with pytest.raises(InvalidConfigError, match="no 'pursuer'-labelled start") as err:
+        corridor_half.sample_starts(1, np.random.default_rng(0), kind="pursuer")
+    assert "which says nothing about the game: pursuer bound at rho = 0.5" in str(err.value)
 
 
 def test_summary_reports_fractions_sizes_and_timings(open_slow):

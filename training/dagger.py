@@ -90,7 +90,8 @@ class DaggerConfig:
     """Analytic features appended to what the learner sees
     (:data:`strategies.policies.learner_inputs.LEARNER_FEATURES`), computed with
     ``expert_params``: ``("safety_table",)`` gives a decomposition learner the pursuer's
-    turn choice. A model trained with features plays only through
+    turn choice, ``("escape_plan",)`` a shooting learner the evader's plan. A model
+    trained with features plays only through
     :class:`~strategies.policies.learned.SB3Policy`, which computes them from the state."""
     iterations: int = 5
     episodes: int = 4
@@ -384,8 +385,8 @@ class _Rollout:
 
     def reset(self, *, role, map, config, seed):
         out = self.expert.reset(role=role, map=map, config=config, seed=seed)
-        # the features reuse the expert's own table (same parameters, same map)
-        self.inputs.reset(config, role, pursuer=self.expert if self.inputs.features else None)
+        # the features reuse the expert's own tables (same parameters, same map)
+        self.inputs.reset(config, role, expert=self.expert if self.inputs.features else None)
         return out
 
     def act(self, observation):

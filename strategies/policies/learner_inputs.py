@@ -16,6 +16,15 @@ Features (``LEARNER_FEATURES``):
     safety table (built once per map, as the decomposition pursuer builds it) and the
     evader's position in map coordinates. A model fed it is a learned policy *with
     analytic features*, not a replacement for the analytic one.
+
+``"escape_plan"``
+    The shooting evader's plan, digested into 11 numbers
+    (:mod:`strategies.policies.plan_features`): whether the configuration's cell is
+    escapable and its rank, the direction and distance to the crossing of its nearest via,
+    the walk to a witness region and the best shooting candidate, in the frame of the line
+    of sight. An evader-only feature: it needs the map's exact decomposition and the
+    shooting evader's safety table (built once per map) and both positions in map
+    coordinates.
 """
 
 from __future__ import annotations
@@ -28,15 +37,25 @@ import numpy as np
 from gymnasium.spaces import Box
 
 from envs.errors import InvalidConfigError
+from strategies.policies.plan_features import PLAN_FEATURES, PlanFeatures
 from strategies.policies.table_features import FLOOR, TABLE_FEATURES, TableFeatures
 
 __all__ = ["LEARNER_FEATURES", "LearnerInputs", "check_features"]
 
-LEARNER_FEATURES: dict[str, int] = {"safety_table": len(TABLE_FEATURES)}
+LEARNER_FEATURES: dict[str, int] = {
+    "safety_table": len(TABLE_FEATURES),
+    "escape_plan": len(PLAN_FEATURES),
+}
 """Analytic features a learner may be given, and how many numbers each adds."""
 
-_EXPERT = {"safety_table": "pursuer/decomposition"}
+_EXPERT = {"safety_table": "pursuer/decomposition", "escape_plan": "evader/shooting"}
 """The analytic policy whose parameters each feature is computed with."""
+
+_BOUNDS = {"safety_table": (FLOOR, -FLOOR), "escape_plan": (-1.0, 1.0)}
+"""The range of each feature's numbers (the learner's observation space)."""
+
+_MAKERS = {"safety_table": (TableFeatures, "pursuer"), "escape_plan": (PlanFeatures, "evader")}
+"""Each feature's class and the keyword under which it takes an expert to reuse."""
 
 
 def check_features(features: Any, *, role: str, expert: str | None, where: str) -> tuple[str, ...]:
@@ -97,7 +116,7 @@ class LearnerInputs:
         self.features = tuple(features)
         self.expert_params = dict(expert_params or {})
         self._encoder: Any = None
-        self._table: TableFeatures | None = None
+        self._made: dict[str, Any] = {}  # feature name -> its TableFeatures / PlanFeatures
         self._config: Any = None
         self._role: str | None = None
 
@@ -111,14 +130,16 @@ class LearnerInputs:
         """How many numbers the features add."""
         return sum(LEARNER_FEATURES[f] for f in self.features)
 
-    def reset(self, config: Any, role: str, pursuer: Any = None) -> None:
+    def reset(self, config: Any, role: str, expert: Any = None) -> None:
         """Prepare for an episode on ``config``'s map (a ``"state"`` env's config).
 
         Args:
             config: the env's config.
             role: the learner's role.
-            pursuer: a decomposition pursuer already reset on this map with the expert's
-                parameters, whose table the ``"safety_table"`` features then reuse.
+            expert: the features' expert (a decomposition pursuer for ``"safety_table"``,
+                a shooting evader for ``"escape_plan"``) already reset on this map with
+                the expert's parameters, whose tables the features then reuse (only
+                stateless methods: its actions are unchanged).
         """
         if config is not self._config or role != self._role:
             self._encoder = None
@@ -129,12 +150,13 @@ class LearnerInputs:
                 lidar = dataclasses.replace(config, **self.observation)
                 self._encoder = LidarEncoder(lidar, role, kernel_for(config.map))
             self._config, self._role = config, role
-            self._table = None
-        if "safety_table" in self.features:
-            if pursuer is not None:
-                self._table = TableFeatures(config, pursuer=pursuer)
-            elif self._table is None:
-                self._table = TableFeatures(config, **self.expert_params)
+            self._made = {}
+        for name in self.features:
+            make, keyword = _MAKERS[name]
+            if expert is not None:
+                self._made[name] = make(config, **{keyword: expert})
+            elif name not in self._made:
+                self._made[name] = make(config, **self.expert_params)
 
     def __call__(self, state: np.ndarray) -> np.ndarray:
         """The learner's input (float32) at the ``"state"`` vector ``state``."""
@@ -144,17 +166,16 @@ class LearnerInputs:
         out = seen
         if self._encoder is not None:
             out = self._encoder.encode_state(seen, self._config, self._role)
-        if self._table is not None:
-            out = np.concatenate([out, self._table(seen)])
+        if self._made:
+            out = np.concatenate([out, *(self._made[name](seen) for name in self.features)])
         return out
 
     def space(self, base: Box) -> Box:
         """``base`` (the learner's env observation space) with the features' bounds added."""
         if not self.features:
             return base
-        n = self.n_features
+        lo = [np.full(LEARNER_FEATURES[f], _BOUNDS[f][0], np.float32) for f in self.features]
+        hi = [np.full(LEARNER_FEATURES[f], _BOUNDS[f][1], np.float32) for f in self.features]
         return Box(
-            np.concatenate([base.low, np.full(n, FLOOR, np.float32)]),
-            np.concatenate([base.high, np.full(n, -FLOOR, np.float32)]),
-            dtype=np.float32,
+            np.concatenate([base.low, *lo]), np.concatenate([base.high, *hi]), dtype=np.float32
         )

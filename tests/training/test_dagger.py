@@ -205,33 +205,49 @@ def test_validation_plays_the_named_opponent_on_the_named_maps(tmp_path, monkeyp
 
 
 # ------------------------------------------------------------------ analytic features
-def test_a_learner_with_table_features_sees_in_play_what_it_was_fitted_on(tmp_path, monkeypatch):
-    """The rollout's stored inputs are the lidar vector plus the 5 table features, and the
-    SB3Policy built from the zip computes the same vectors from the state: same seed, same
-    opponent, the learner alone (beta 0) plays the same episode in training and in play."""
+@pytest.mark.parametrize(
+    "role, expert, feature, n, params, world, opponent",
+    [
+        ("pursuer", "pursuer/decomposition", "safety_table", 5, {"range_margin": 0.3},
+         "corridor", "evader/straight"),
+        ("evader", "evader/shooting", "escape_plan", 11, {}, "two_rooms", "pursuer/greedy"),
+    ],
+    ids=["safety_table", "escape_plan"],
+)  # fmt: skip
+def test_a_learner_with_features_sees_in_play_what_it_was_fitted_on(
+    tmp_path, monkeypatch, role, expert, feature, n, params, world, opponent
+):
+    """The rollout's stored inputs are the lidar vector plus the features, and the SB3Policy
+    built from the zip computes the same vectors from the state: same seed, same opponent,
+    the learner alone (beta 0) plays the same episode in training and in play."""
     from strategies.policies.learned import SB3Policy
     from strategies.runner import run_episode
 
-    cfg = _lidar_cfg(tmp_path, expert="pursuer/decomposition", features=("safety_table",),
-                     expert_params={"range_margin": 0.3}, maps=("corridor",),
-                     opponent="evader/straight", iterations=1, episodes=1, epochs=5,
+    cfg = _lidar_cfg(tmp_path, role=role, expert=expert, features=(feature,), expert_params=params,
+                     maps=(world,), opponent=opponent, iterations=1, episodes=1, epochs=5,
                      max_cycles=30)  # fmt: skip
     r = dagger(cfg)
     with np.load(r.model_path.parent / "dataset.npz") as data:
         obs = data["obs"]
-    assert obs.shape == (r.samples[-1], 8 + 8 + 5)
-    assert np.all(np.abs(obs[:, 16:]) <= 1.5) and np.any(obs[:, 16] != obs[:, 18])
-    p = make_policy(f"pursuer/sb3:{r.model_path}")
+    assert obs.shape == (r.samples[-1], 8 + 8 + n)
+    if feature == "safety_table":
+        assert np.all(np.abs(obs[:, 16:]) <= 1.5) and np.any(obs[:, 16] != obs[:, 18])
+    else:  # every cell of two_rooms is escapable: a crossing to head for
+        assert np.all(np.abs(obs[:, 16:]) <= 1.0) and np.any(obs[:, 18:20] != 0)
+    p = make_policy(f"{role}/sb3:{r.model_path}")
     assert p.observation_options == {"observation": "state"} and p.uses_state
     seen = []
     act = SB3Policy.act
     monkeypatch.setattr(
         SB3Policy, "act", lambda self, o: seen.append(self._inputs(o)) or act(self, o)
     )
-    roll = _Rollout(make_policy("pursuer/decomposition", range_margin=0.3), _load(r), 0.0, 5,
-                    cfg.observation, cfg.features)  # fmt: skip
-    a = run_episode("corridor", roll, "evader/straight", 7, max_cycles=30, start="safe")
-    b = run_episode("corridor", p, "evader/straight", 7, max_cycles=30, start="safe")
+    roll = _Rollout(make_policy(expert, **params), _load(r), 0.0, 5, cfg.observation, cfg.features)
+
+    def play(learner):
+        pair = (learner, opponent) if role == "pursuer" else (opponent, learner)
+        return run_episode(world, *pair, 7, max_cycles=30, start="safe")
+
+    a, b = play(roll), play(p)
     assert a.steps == b.steps and a.winner == b.winner
     assert np.array_equal(a.trajectory, b.trajectory)
     assert np.array_equal(np.asarray(seen), np.asarray(roll.obs))
@@ -250,6 +266,7 @@ def _load(r):
         {"features": "safety_table"},  # a string, not a list
         {"features": ("safety_table",)},  # the greedy expert has no table
         {"features": ("safety_table", "safety_table"), "expert": "pursuer/decomposition"},
+        {"features": ("escape_plan",), "expert": "pursuer/decomposition"},  # an evader's
     ],
 )
 def test_bad_features_are_refused_naming_them(tmp_path, bad):

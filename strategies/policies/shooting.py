@@ -52,6 +52,7 @@ from strategies.policies.safety import NO_PATH, safety_table
 __all__ = ["ShootingEvader"]
 
 _EULER = 8  # sub-steps of the straight-path rotation estimate
+_WALL_TOL = 1e-9  # beyond the rounding of a distance to the walls
 # the moves tried, in order, to keep a walk inside a region: the heading turned by 0, 5,
 # ... 90 degrees either way, at a whole, half or quarter step, most progress first
 _TURN_DEG = np.array([s * d for d in range(0, 91, 5) for s in ((1, -1) if d else (1,))])
@@ -107,13 +108,22 @@ class ShootingEvader(BasePolicy):
         ang = 2.0 * math.pi * np.arange(self.rays) / self.rays
         dirs = np.stack([np.cos(ang), np.sin(ang)], axis=1)
         self._offsets = (dirs[:, None, :] * radii[None, :, None]).reshape(-1, 2)
+        # the probes' x and y offsets apart: e + offsets one coordinate at a time (the
+        # same sums, without broadcasting a (2,) point over (n, 2) rows)
+        self._off_x = self._offsets[:, 0].copy()
+        self._off_y = self._offsets[:, 1].copy()
         self._n_r = n_r
         self._cols = np.arange(self.probe_every - 1, n_r, self.probe_every)
+        # flat probe index of every candidate column of every ray, (rays, len(cols))
+        self._col_index = np.arange(self.rays)[:, None] * n_r + self._cols[None, :]
+        self._has_region = bool(self.plan.region.any())
+        self._wall_last: tuple[float, float, float] | None = None  # (x, y, distance)
         m = c.map
         idx = m.convex_vertices
         bis = m.edge_normal[m.vertex_prev_edge[idx]] + m.edge_normal[m.vertex_next_edge[idx]]
         bis = bis / np.maximum(np.linalg.norm(bis, axis=1, keepdims=True), 1e-12)
         self._corner_points = m.vertices[idx] + (c.body_radius + 2.0 * h) * bis
+        self._corner_rows = self.table.rows(self._corner_points)
         self._arc: tuple[np.ndarray, float, np.ndarray] | None = None  # (start, frame, path)
         self._arc_age = 0
         self._plan_cell, self._plan_lost, self._witness = -1, False, None
@@ -127,18 +137,26 @@ class ShootingEvader(BasePolicy):
         self.mode = "start"
 
     # ------------------------------------------------------------------ candidates
-    def _candidates(self, e: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _candidates(self, e: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Probes on rays from ``e`` up to the first wall and their table rows, and the
         corner points in range (their line of sight from ``e`` not checked yet: see
-        :meth:`_best_candidate`)."""
+        :meth:`_best_candidate`) and their rows."""
         tab = self.table
-        pts = e + self._offsets
-        rows = tab.rows(pts).reshape(self.rays, self._n_r)
-        reach = np.cumsum(rows < 0, axis=1) == 0
-        sub = reach[:, self._cols]
-        cand = pts.reshape(self.rays, self._n_r, 2)[:, self._cols][sub]
+        # tab.rows(e + self._offsets), one coordinate at a time (the same operations)
+        x = float(e[0]) + self._off_x
+        y = float(e[1]) + self._off_y
+        ix = np.rint((x - tab.origin[0]) / tab.resolution).astype(np.int64)
+        iy = np.rint((y - tab.origin[1]) / tab.resolution).astype(np.int64)
+        nx, ny = tab.shape
+        ok = (ix.view(np.uint64) < nx) & (iy.view(np.uint64) < ny)  # negatives wrap high
+        rows = np.where(ok, tab.cell.reshape(-1).take(np.where(ok, ix * ny + iy, 0)), -1)
+        reach = np.cumsum(rows.reshape(self.rays, self._n_r) < 0, axis=1) == 0
+        pick = self._col_index[reach[:, self._cols]]
+        cand = np.empty((len(pick), 2))
+        cand[:, 0] = x[pick]
+        cand[:, 1] = y[pick]
         near = np.linalg.norm(self._corner_points - e, axis=1) <= self._n_r * tab.resolution
-        return cand, rows[:, self._cols][sub], self._corner_points[near]
+        return cand, rows[pick].astype(np.int64), self._corner_points[near], self._corner_rows[near]
 
     def _best_candidate(self, e: np.ndarray, theta: float) -> tuple[np.ndarray, str] | None:
         """The candidate endpoint with the largest positive escape margin (the first such
@@ -148,9 +166,9 @@ class ShootingEvader(BasePolicy):
         on the other candidates, so only a corner that would beat every probe (and 0)
         needs its line of sight checked.
         """
-        rays, ray_rows, corners = self._candidates(e)
+        rays, ray_rows, corners, corner_rows = self._candidates(e)
         n = len(rays)
-        rows = np.concatenate([ray_rows, self.table.rows(corners)])
+        rows = np.concatenate([ray_rows, corner_rows])
         margin, branch = self._margins(e, theta, np.concatenate([rays, corners]), rows)
         top = max(float(margin[:n].max()) if n else -math.inf, 0.0)
         ex, ey = float(e[0]), float(e[1])
@@ -248,7 +266,7 @@ class ShootingEvader(BasePolicy):
             self.mode = "shoot"
             return c.v_evader * self._start_arc(e, theta, *best)
         row = self.table.row(e)
-        if row >= 0 and self.plan.region.any() and not self.plan.region[row]:
+        if row >= 0 and self._has_region and not self.plan.region[row]:
             nxt = self.plan.region_next[row]
             if nxt >= 0:
                 self.mode = "region"
@@ -260,11 +278,26 @@ class ShootingEvader(BasePolicy):
         # or away by the best candidate's side, as before, flipped every step and left the
         # evader in place.)
         u = unit(snap.rod)
-        if self.map.distance_to_walls(e[None])[0] <= c.body_radius + 2.0 * c.v_evader * c.dt:
+        if self._near_wall(e, c.body_radius + 2.0 * c.v_evader * c.dt):
             # against a wall the push is lost: slide along it, perpendicular to the rod
             # (which turns the rod fastest)
             return c.v_evader * np.array([-u[1], u[0]])
         return c.v_evader * u
+
+    def _near_wall(self, e: np.ndarray, r: float) -> bool:
+        """Whether ``e`` lies within ``r`` of a wall (``Map.distance_to_walls``), from the
+        last distance computed when it settles the answer (the distance is 1-Lipschitz:
+        it changed by at most the distance moved since)."""
+        if self._wall_last is not None:
+            x, y, dist = self._wall_last
+            moved = math.hypot(float(e[0]) - x, float(e[1]) - y)
+            if dist - moved > r + _WALL_TOL:
+                return False
+            if dist + moved < r - _WALL_TOL:
+                return True
+        dist = float(self.map.distance_to_walls(e[None])[0])
+        self._wall_last = (float(e[0]), float(e[1]), dist)
+        return dist <= r
 
     def _plan_heading(self, e: np.ndarray, theta: float) -> np.ndarray | None:
         """Heading of the guaranteed escape plan, or ``None`` if the cell is not escapable

@@ -384,9 +384,7 @@ def _region_next(world: Map, cell: np.ndarray, pts: np.ndarray, h: float, region
     the walls: the two discs of that radius are free and cover the segment between them.
     """
     n = len(pts)
-    clear = np.zeros(n)
-    for s in range(0, n, 65536):
-        clear[s : s + 65536] = world.distance_to_walls(pts[s : s + 65536])
+    clear = _clear_within(world, pts, 0.5 * h * math.hypot(1, 1))
     rows, cols = [], []
     nx, ny = cell.shape
     for di, dj in ((1, 0), (0, 1), (1, 1), (1, -1)):
@@ -406,6 +404,34 @@ def _region_next(world: Map, cell: np.ndarray, pts: np.ndarray, h: float, region
     nxt[(nxt == n) | (nxt < 0)] = -1
     nxt[region] = -1
     return nxt
+
+
+def _clear_within(world: Map, pts: np.ndarray, reach: float) -> np.ndarray:
+    """(n,) distance from each point to the walls (``Map.distance_to_walls``) where it
+    may be at most ``reach``, ``inf`` elsewhere.
+
+    Only the points within ``reach`` of a wall edge's bounding box (found by bisection on
+    x) are measured: the others lie farther than ``reach`` from every edge. On office
+    measuring every grid point was a third of the reset.
+    """
+    out = np.full(len(pts), np.inf)
+    if not len(pts):
+        return out
+    reach += _CLEAR_TOL * world.scale
+    order = np.argsort(pts[:, 0], kind="stable")
+    xs, ys = pts[order, 0], pts[order, 1]
+    lo = np.minimum(world.edge_start, world.edge_end) - reach
+    hi = np.maximum(world.edge_start, world.edge_end) + reach
+    first = np.searchsorted(xs, lo[:, 0], "left")
+    last = np.searchsorted(xs, hi[:, 0], "right")
+    near = np.zeros(len(pts), dtype=bool)
+    for k in range(len(lo)):
+        y = ys[first[k] : last[k]]
+        near[first[k] : last[k]] |= (y >= lo[k, 1]) & (y <= hi[k, 1])
+    idx = np.sort(order[near])
+    for s in range(0, len(idx), 65536):
+        out[idx[s : s + 65536]] = world.distance_to_walls(pts[idx[s : s + 65536]])
+    return out
 
 
 def _inside_any(pts: np.ndarray, polygons: list) -> np.ndarray:

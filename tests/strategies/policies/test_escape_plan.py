@@ -31,6 +31,7 @@ from envs.maps import builtin_map, load_map
 from strategies.cspace._arcs import overlap
 from strategies.policies.escape_plan import (
     CROSS_REL,
+    _clear_within,
     _narrow,
     _region_next,
     _samples,
@@ -340,3 +341,16 @@ def test_witness_is_the_direct_computation(name):
         assert got.cross.tobytes() == want[1].tobytes()
         assert got.normal.tobytes() == want[2].tobytes()
     assert dropped < 200
+
+
+@pytest.mark.parametrize("name", ["maze", "pillars"])
+def test_clear_within_measures_every_point_near_a_wall(name):
+    world = builtin_map(name)
+    _origin, _cell, pts = grid_points(world, 0.1)
+    reach = 0.3
+    got = _clear_within(world, pts, reach)
+    want = world.distance_to_walls(pts)
+    measured = np.isfinite(got)
+    assert np.array_equal(got[measured], want[measured])  # the same values
+    assert (want[~measured] > reach).all()
+    assert measured.any() and not measured.all()

@@ -27,6 +27,7 @@ from __future__ import annotations
 import argparse
 import os
 import time
+import warnings
 
 import numpy as np
 
@@ -47,6 +48,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--rho", type=float, default=0.5)
     args = parser.parse_args(argv)
 
+    from envs.errors import VacuousBoundWarning
     from envs.surveillance.config import EnvConfig
     from strategies.cspace import decompose, surveillance_verdict
     from strategies.policies.registry import policy_names
@@ -71,11 +73,15 @@ def main(argv: list[str] | None = None) -> int:
     ref = None
     for cpl in args.cpl:
         t = time.perf_counter()
-        ref = referee_for(cfg, cpl)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", VacuousBoundWarning)  # printed below
+            ref = referee_for(cfg, cpl)
         s = ref.summary()
         print(f"\ncells per L_min {cpl:g} ({time.perf_counter() - t:.0f} s): {s['starts']} "
               f"lattice starts, pursuer {s['pursuer']:.1%}, evader {s['evader']:.1%}, "
               f"unknown {s['gap']:.1%}")  # fmt: skip
+        if s["pursuer_bound"]["vacuous"] is not None:
+            print(f"  the pursuer share says nothing: {s['pursuer_bound']['vacuous']}")
         for i, st in enumerate(starts):
             label = ref.classify(st["pursuer"], st["evader"])
             extra = ""

@@ -208,9 +208,10 @@ class PursuerBound(SolvedBound):
                 f"pursuer bound at rho = {spec.rho:.3g} (cell h = {res.cell:.4g}, step tau = "
                 f"{res.tau:.4g} s) certified no state (the evader foresees each committed "
                 f"step and is re-localised in its cell, covering {ratio:.2f} of the pursuer's "
-                f"step per step; such bounds certified nothing even in rooms the pursuer "
-                f"wins, see strategies.referee.pursuer_bound); its 0 % pursuer wins mean "
-                f"'unknown', not 'evader wins'"
+                f"step per step; such bounds certified nothing even in an empty room they "
+                f"certify at a lower rho or another lattice, see "
+                f"strategies.referee.pursuer_bound); its 0 % pursuer wins mean 'unknown', "
+                f"not 'evader wins'"
             )
         return reason
 
@@ -301,9 +302,10 @@ def vacuity(spec: GameSpec, res: Resolution) -> str | None:
     if rho >= VACUOUS_RHO:
         return (
             f"{where}: rho >= {VACUOUS_RHO:g}, where it was measured to certify nothing at "
-            f"every resolution tried, even in an empty room the pursuer wins (the evader "
-            f"foresees each committed step and is re-localised in its cell: it covers "
-            f"{ratio:.2f} of the pursuer's step per step); {unknown}"
+            f"every resolution tried, even in the empty 10 m room (L in [2, 4]) it "
+            f"certifies at rho = 0.2 (the evader foresees each committed step and is "
+            f"re-localised in its cell: it covers {ratio:.2f} of the pursuer's step per "
+            f"step); {unknown}"
         )
     return None
 

@@ -97,6 +97,9 @@ class ShootingEvader(BasePolicy):
         self.L_eff = round(c.l_min + c.body_radius, 6)
         res = self.resolution if self.resolution is not None else c.l_min / 20.0
         self.table = safety_table(c.map, self.L_eff, res)
+        # a rotation table entry (uint8 bins) in radians, the whole turn for NO_PATH
+        bins = np.arange(256).astype(float)
+        self._radians = np.where(bins >= NO_PATH, 2 * math.pi, bins * self.table.bin_width)
         self.plan = escape_plan(c.map, self.L_eff, res, c.body_radius)
         self.kernel = kernel_for(c.map)
         self.rho = c.rho
@@ -201,17 +204,19 @@ class ShootingEvader(BasePolicy):
         rows = tab.rows(cand) if rows is None else rows
         ok = rows >= 0
         b = tab.bin_of(theta)
-        need_ccw = np.where(ok, tab.ccw[np.maximum(rows, 0), b], 0).astype(float)
-        need_cw = np.where(ok, tab.cw[np.maximum(rows, 0), b], 0).astype(float)
-        need_ccw = np.where(need_ccw >= NO_PATH, 2 * math.pi, need_ccw * tab.bin_width)
-        need_cw = np.where(need_cw >= NO_PATH, 2 * math.pi, need_cw * tab.bin_width)
+        # bins to turn each way (0 off the grid), in radians through a lookup of the
+        # 256 uint8 values: 2 pi for NO_PATH, else bins * bin width
+        bins_ccw, bins_cw = tab.ccw[np.maximum(rows, 0), b], tab.cw[np.maximum(rows, 0), b]
+        if not ok.all():
+            bins_ccw, bins_cw = np.where(ok, bins_ccw, 0), np.where(ok, bins_cw, 0)
+        need_ccw, need_cw = self._radians[bins_ccw], self._radians[bins_cw]
         margin = np.full(len(cand), -np.inf)
         branch = np.full(len(cand), "-")
-        live = np.flatnonzero(ok & ((need_ccw > 0) | (need_cw > 0)))
+        live = np.flatnonzero((bins_ccw > 0) | (bins_cw > 0))
         if not len(live):
             return margin, branch
         d = cand[live] - e
-        dist = np.linalg.norm(d, axis=1)
+        dist = np.sqrt(np.add.reduce(d * d, axis=1))  # np.linalg.norm(d, axis=1)
         rho = min(self.rho, 1.0)
         k = c.v_pursuer / c.l_min
         # the Euler rotation below is at least k (1 - rho) dist / V_e each way (up to
@@ -232,9 +237,9 @@ class ShootingEvader(BasePolicy):
         th = np.full(2 * m, theta)
         for _ in range(_EULER):
             phi = alpha2 - th
-            rate = k * (
-                -rho * np.sin(phi) + sign * np.sqrt(np.maximum(1 - (rho * np.cos(phi)) ** 2, 0))
-            )
+            # (rho <= 1: |rho cos phi| <= 1 after rounding too, so the root's argument is
+            # never negative)
+            rate = k * (-rho * np.sin(phi) + sign * np.sqrt(1 - (rho * np.cos(phi)) ** 2))
             th = th + rate * dt2
         turned = np.abs(th - theta)
         left, right = need_ccw - turned[:m], need_cw - turned[m:]

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from strategies.policies import make_policy
-from strategies.policies.safety import SafetyTable
+from strategies.policies.safety import NO_PATH, SafetyTable
 from strategies.runner import build_env
 
 
@@ -89,3 +89,67 @@ def test_shooting_wall_test_is_the_distance_to_the_walls(shooter):
         assert shooter._near_wall(e, r) == bool(dist[i] <= r), i
         computed += shooter._wall_last is not before
     assert computed < len(walk)  # the bound settled some
+
+
+def _margins_direct(policy, e, theta, cand):
+    """ShootingEvader._margins as first written: every candidate through eq. (6)."""
+    c, tab = policy.config, policy.table
+    rows = tab.rows(cand)
+    ok = rows >= 0
+    b = tab.bin_of(theta)
+    need = []
+    for t in (tab.ccw, tab.cw):
+        n = np.where(ok, t[np.maximum(rows, 0), b], 0).astype(float)
+        need.append(np.where(n >= NO_PATH, 2 * np.pi, n * tab.bin_width))
+    margin, branch = np.full(len(cand), -np.inf), np.full(len(cand), "-")
+    rho, k = min(policy.rho, 1.0), c.v_pursuer / c.l_min
+    d = cand - e
+    dist = np.linalg.norm(d, axis=1)
+    least = k * (1.0 - rho) * dist / c.v_evader
+    live = np.flatnonzero(
+        ok & ((need[0] > 0) | (need[1] > 0)) & (np.minimum(*need) - least + 1e-9 > 0)
+    )
+    if not len(live):
+        return margin, branch
+    alpha = np.arctan2(d[live, 1], d[live, 0])
+    dt = dist[live] / c.v_evader / 8
+    for i, sign in ((0, 1.0), (1, -1.0)):
+        th = np.full(len(live), theta)
+        for _ in range(8):
+            phi = alpha - th
+            th = (
+                th
+                + k
+                * (-rho * np.sin(phi) + sign * np.sqrt(np.maximum(1 - (rho * np.cos(phi)) ** 2, 0)))
+                * dt
+            )
+        need[i] = need[i][live] - np.abs(th - theta)
+    margin[live] = np.minimum(need[0], need[1])
+    branch[live] = np.where(need[0] < need[1], "+", "-")
+    return margin, branch
+
+
+@pytest.mark.parametrize("rho", [0.5, 0.9, 1.0])
+def test_shooting_margins_are_the_direct_computation(shooter, rho):
+    # bit for bit, off the grid and on NO_PATH entries too, and at rho = 1 (where the
+    # root's argument reaches 0)
+    rng = np.random.default_rng(5)
+    saved = shooter.rho
+    shooter.rho = rho
+    try:
+        finite = 0
+        for e in _free_points(shooter, 60, seed=6):
+            theta = float(rng.uniform(-np.pi, np.pi))
+            cand = e + rng.uniform(-4.0, 4.0, (int(rng.integers(1, 200)), 2))
+            margin, branch = shooter._margins(e, theta, cand)
+            want_margin, want_branch = _margins_direct(shooter, e, theta, cand)
+            assert margin.tobytes() == want_margin.tobytes()
+            assert np.array_equal(branch, want_branch)
+            finite += int(np.isfinite(margin).sum())
+        assert finite > 100
+    finally:
+        shooter.rho = saved
+    # every table entry, NO_PATH too (the maps above have none)
+    n = np.arange(256, dtype=np.uint8)
+    want = np.where(n >= NO_PATH, 2 * np.pi, n.astype(float) * shooter.table.bin_width)
+    assert shooter._radians[n].tobytes() == want.tobytes()

@@ -323,3 +323,31 @@ def test_solve_escape_refuses_runaway_integrations(theta0, x_e, L, rho):
     sol = solve_escape(theta0, x_e, L=L, rho=rho)
     assert not sol.success
     assert "RK4 steps" in sol.reason and repr(x_e) in sol.reason
+
+
+def test_rk4_step_is_the_rhs_at_four_stages():
+    # _step writes _rhs out inline (the shooting's inner loop): the same floats, bit for
+    # bit, as the classical composition of _rhs
+    from strategies.control._integrators import _rhs, _step
+
+    def composed(state, d, s, L, rho, q):
+        th, a = state[2], state[3]
+        k1 = _rhs(th, a, s, L, rho, q)
+        k2 = _rhs(th + 0.5 * d * k1[2], a + 0.5 * d * k1[3], s, L, rho, q)
+        k3 = _rhs(th + 0.5 * d * k2[2], a + 0.5 * d * k2[3], s, L, rho, q)
+        k4 = _rhs(th + d * k3[2], a + d * k3[3], s, L, rho, q)
+        return tuple(
+            v + d / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]) for i, v in enumerate(state)
+        )
+
+    rng = np.random.default_rng(7)
+    for _ in range(2000):
+        state = tuple(float(v) for v in rng.uniform(-3.0, 3.0, 5))
+        d, L, rho = (
+            float(rng.uniform(1e-4, 0.1)),
+            float(rng.uniform(0.5, 3.0)),
+            float(rng.uniform(0.05, 0.95)),
+        )
+        s = int(rng.choice([-1, 1]))
+        q = 1.0 / (1.0 - rho * rho)
+        assert _step(state, d, s, L, rho, q) == composed(state, d, s, L, rho, q)

@@ -69,6 +69,12 @@ class ShootingEvader(BasePolicy):
         probe_every: every k-th grid sample along a ray is a candidate.
         replan: steps between shooting re-plans.
         shoot: refine the chosen straight path with the optimal arc of Sec. 6.
+        memory: keep what the evader learnt on the way (crossings excluded after a stall
+            or a cycle, the piece it came through, the arc it follows). ``False``: decide
+            each step from the state alone, as a fresh evader would (what
+            :mod:`strategies.policies.plan_features` describes; a DAgger labeller whose
+            labels do not depend on who steered before). It can loop where the evader
+            with memory does not (issue 13).
     """
 
     roles = ("evader",)
@@ -81,6 +87,7 @@ class ShootingEvader(BasePolicy):
         probe_every: int = 3,
         replan: int = 5,
         shoot: bool = True,
+        memory: bool = True,
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
@@ -89,6 +96,7 @@ class ShootingEvader(BasePolicy):
         self.probe_every = count_param("probe_every", probe_every, 1, MAX_RAYS)
         self.replan = validation.integer("replan", replan, minimum=1)
         self.shoot = flag_param("shoot", shoot)
+        self.memory = flag_param("memory", memory)
 
     STALL_STEPS = 10  # steps without getting closer to a crossing before giving it up
 
@@ -127,6 +135,11 @@ class ShootingEvader(BasePolicy):
         bis = bis / np.maximum(np.linalg.norm(bis, axis=1, keepdims=True), 1e-12)
         self._corner_points = m.vertices[idx] + (c.body_radius + 2.0 * h) * bis
         self._corner_rows = self.table.rows(self._corner_points)
+        self._forget()
+        self.mode = "start"
+
+    def _forget(self) -> None:
+        """Clear what the evader learnt on the way (its memory)."""
         self._arc: tuple[np.ndarray, float, np.ndarray] | None = None  # (start, frame, path)
         self._arc_age = 0
         self._plan_cell, self._plan_lost, self._witness = -1, False, None
@@ -137,7 +150,6 @@ class ShootingEvader(BasePolicy):
         self._best_gap, self._stall = math.inf, 0
         self._came_through: tuple[int, int] | None = None  # (cell left, piece crossed)
         self._trail: list[tuple[int, int]] = []  # the last crossings (cell left, piece)
-        self.mode = "start"
 
     # ------------------------------------------------------------------ candidates
     def _candidates(self, e: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -251,6 +263,8 @@ class ShootingEvader(BasePolicy):
     def _decide(self, snap: Snapshot) -> np.ndarray:
         c = self.config
         e, theta = snap.evader, snap.theta
+        if not self.memory:
+            self._forget()
         if c.rho > 1.0:
             # footnote 4's trivial escape, in a bounded world: straight at the pursuer. The
             # rod is free (surveillance holds), so nothing blocks the way, and whatever

@@ -127,3 +127,22 @@ def test_the_features_carry_a_fresh_shooting_evaders_decision(feats):
             assert f[9] == 0.0 and not f[2:4].any() and not f[5:7].any()
     # corridor: mostly pressure and shooting; pillar_box: mostly the plan
     assert len(modes) >= 2 and modes.get("plan", 0) + modes.get("shoot", 0) > 20, modes
+
+
+def test_an_evader_without_memory_decides_each_step_as_a_fresh_one(feats):
+    """memory=False (the DAgger labeller): over a run of states each action is a fresh
+    evader's at that state; the evader with memory keeps its arcs and differs."""
+    c = feats.config
+    states = [s for s, _, _ in _states(feats, 60, seed=2)]
+    acts = {}
+    for memory in (False, True):
+        ev = ShootingEvader(memory=memory)
+        ev.reset(role="evader", map=c.map, config=c, seed=0)
+        acts[memory] = np.array([ev.act(s) for s in states])
+    fresh = []
+    for s in states:
+        ev = ShootingEvader()
+        ev.reset(role="evader", map=c.map, config=c, seed=0)
+        fresh.append(ev.act(s))
+    assert np.array_equal(acts[False], np.array(fresh))
+    assert not np.array_equal(acts[True], acts[False])

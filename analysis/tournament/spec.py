@@ -486,6 +486,19 @@ def _entry(item: Any, role: str, where: str, base: Path) -> PolicyEntry:
         from envs.validation import boolean
 
         params["deterministic"] = boolean("deterministic", d["deterministic"], where=where)
+    from strategies.policies.learned import learner_inputs_spec
+
+    inputs = learner_inputs_spec(provenance)
+    if inputs is not None:
+        # trained with analytic features: it reads the state and builds its input itself
+        # (the copy of the zip a worker loads has no provenance beside it)
+        params["inputs"] = _canonical(inputs)
+        if observation is not None and observation.get("observation") != "state":
+            raise InvalidConfigError(
+                f"{where}: model {text!r} computes analytic features {inputs['features']} "
+                f"from the state; it cannot be given observation {observation!r}"
+            )
+        observation = {"observation": "state"}
     if observation is None:
         env_cfg = provenance.get("env_config") or {}
         if isinstance(env_cfg, Mapping) and env_cfg.get("observation"):

@@ -23,6 +23,7 @@ from __future__ import annotations
 import json
 import warnings
 import zipfile
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -32,7 +33,13 @@ from envs.errors import InvalidConfigError, InvalidObservationError
 from strategies.policies.base import BasePolicy
 from strategies.policies.learner_inputs import LearnerInputs, check_features
 
-__all__ = ["SB3_ALGORITHMS", "SB3Policy", "UnseenMapWarning"]
+__all__ = [
+    "SB3_ALGORITHMS",
+    "SB3Policy",
+    "UnseenMapWarning",
+    "learner_inputs_spec",
+    "trained_observation",
+]
 
 SB3_ALGORITHMS = ("A2C", "DDPG", "PPO", "SAC", "TD3")
 """Algorithms :class:`SB3Policy` can load (continuous actions)."""
@@ -73,6 +80,10 @@ class SB3Policy(BasePolicy):
         role: the role the model was trained for.
         algo: ``"PPO"``, ``"SAC"``... (``None``: read from the zip).
         deterministic: use the deterministic action.
+        inputs: how to build the model's input from the state, for a model trained with
+            analytic features (:func:`learner_inputs_spec`); ``None``: from the
+            ``provenance.json`` beside the zip (a copy of the zip without it, e.g. a
+            tournament's, needs this passed).
     """
 
     uses_state = False
@@ -85,6 +96,7 @@ class SB3Policy(BasePolicy):
         algo: str | None = None,
         deterministic: bool = True,
         name: str | None = None,
+        inputs: Mapping[str, Any] | None = None,
     ) -> None:
         super().__init__(name=name or f"{role}/sb3:{path}")
         self.path = Path(path)
@@ -102,35 +114,29 @@ class SB3Policy(BasePolicy):
                 f"{self.name}: this model was trained as the {trained} (its provenance.json "
                 f"says role = {trained!r}); it cannot play the {role}"
             )
-        self._inputs = self._learner_inputs()
+        if inputs is None:
+            inputs = learner_inputs_spec(self.provenance)
+        self._inputs = None if inputs is None else self._learner_inputs(inputs)
         if self._inputs is not None:
             self.uses_state = True  # the runner gives it the state; act() builds the input
 
-    def _learner_inputs(self) -> LearnerInputs | None:
-        """How to build the model's input from the state, for a model trained with
-        analytic features (its provenance's ``config.features``); ``None`` otherwise."""
-        prov = self.provenance or {}
-        cfg = prov.get("config") or {}
-        features = cfg.get("features") or ()
-        if not features:
-            return None
-        where = f"{self.name}: provenance"
+    def _learner_inputs(self, inputs: Mapping[str, Any]) -> LearnerInputs:
+        """The input builder of a model trained with analytic features (see
+        :func:`learner_inputs_spec`)."""
+        where = f"{self.name}: inputs"
+        if not isinstance(inputs, Mapping) or not inputs.get("features"):
+            raise InvalidConfigError(
+                f"{where} = {inputs!r}: expected a mapping with 'features' (a list of names), "
+                "'observation', 'expert' and 'expert_params' (see learner_inputs_spec)"
+            )
         features = check_features(
-            features, role=self.roles[0], expert=cfg.get("expert"), where=where
+            inputs["features"], role=self.roles[0], expert=inputs.get("expert"), where=where
         )
-        return LearnerInputs(self._trained_observation(), features, cfg.get("expert_params"))
+        return LearnerInputs(inputs.get("observation"), features, inputs.get("expert_params"))
 
     def _trained_observation(self) -> dict[str, Any] | None:
         """The env observation options the model was trained with, from its provenance."""
-        env = (self.provenance or {}).get("env_config") or {}
-        if "observation" not in env:
-            return None
-        opts = {"observation": env["observation"]}
-        if env["observation"] != "state":
-            opts["n_rays"] = env.get("n_rays", 32)
-            if env.get("lidar_range") is not None:
-                opts["lidar_range"] = env["lidar_range"]
-        return opts
+        return trained_observation(self.provenance)
 
     @property
     def observation_options(self) -> dict[str, Any] | None:
@@ -206,6 +212,36 @@ class SB3Policy(BasePolicy):
             )
         action, _ = self.model.predict(obs, deterministic=self.deterministic)
         return np.clip(np.asarray(action, dtype=np.float32), -1.0, 1.0)
+
+
+def trained_observation(provenance: Mapping[str, Any] | None) -> dict[str, Any] | None:
+    """The env observation options a model was trained with, from its provenance."""
+    env = (provenance or {}).get("env_config") or {}
+    if "observation" not in env:
+        return None
+    opts = {"observation": env["observation"]}
+    if env["observation"] != "state":
+        opts["n_rays"] = env.get("n_rays", 32)
+        if env.get("lidar_range") is not None:
+            opts["lidar_range"] = env["lidar_range"]
+    return opts
+
+
+def learner_inputs_spec(provenance: Mapping[str, Any] | None) -> dict[str, Any] | None:
+    """The ``inputs`` of a model trained with analytic features, from its provenance.
+
+    ``{"observation": ..., "features": [...], "expert": ..., "expert_params": {...}}``
+    (JSON-ready), or ``None`` for a model that reads the env's own observation.
+    """
+    cfg = (provenance or {}).get("config") or {}
+    if not cfg.get("features"):
+        return None
+    return {
+        "observation": trained_observation(provenance),
+        "features": list(cfg["features"]),
+        "expert": cfg.get("expert"),
+        "expert_params": dict(cfg.get("expert_params") or {}),
+    }
 
 
 def _provenance(path: Path) -> dict[str, Any] | None:

@@ -56,8 +56,12 @@ def _fmt(rate, lo, hi, n):
     return f"{rate:5.2f} [{lo:.2f}, {hi:.2f}] n={n}"
 
 
-def card(name: str, role: str, rows, args) -> str:
-    """The model card of zoo model ``name``: recipe, training curves, measured rates."""
+def card(name: str, role: str, rows, args, decide=None) -> str:
+    """The model card of zoo model ``name``: recipe, training curves, measured rates.
+
+    ``decide``: per-step decision times by ``(role, label)`` from the same run, for the
+    model's line beside the analytic policy of its role.
+    """
     prov = zoo.info(name)
     cfg = prov["config"]
     size = zoo.model_path(name).stat().st_size
@@ -134,6 +138,12 @@ def card(name: str, role: str, rows, args) -> str:
                 r, lo, hi = 1 - r, 1 - hi, 1 - lo
                 q, qlo, qhi = 1 - q, 1 - qhi, 1 - qlo
             lines.append(f"| {label} | {o} | {_fmt(r, lo, hi, n)} | {_fmt(q, qlo, qhi, qn)} |")
+    t_m, t_ref = (decide or {}).get((role, name)), (decide or {}).get((role, ref))
+    if t_m and t_ref:
+        a_ms, b_ms = 1e3 * sum(t_m) / len(t_m), 1e3 * sum(t_ref) / len(t_ref)
+        lines += ["", "Decision time per step in the same run (mean over matches, wall "
+                  f"clock): {a_ms:.3f} ms against `{ref}`'s {b_ms:.3f} ms "
+                  f"({a_ms / b_ms:.2f}x)."]  # fmt: skip
     return "\n".join(lines) + "\n"
 
 
@@ -247,7 +257,7 @@ def main(argv=None) -> int:
         for role in ("pursuer", "evader"):
             for m in learned[role]:
                 path = zoo.MODELS_DIR / m / "CARD.md"
-                path.write_text(card(m, role, rows, args))
+                path.write_text(card(m, role, rows, args, decide))
                 print(f"card: {path}")
     out = write_report(args.store, Path(args.store).with_suffix("") / "report", replays=False)
     print(f"\nreport: {out.get('html', out)}")

@@ -16,10 +16,13 @@ The result is an ordinary SB3 ``PPO`` model (saved and loaded as one).
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 from stable_baselines3 import PPO
 
 from envs import validation
+from envs.errors import InvalidConfigError
 
 __all__ = ["BCRegularisedPPO", "from_cloned"]
 
@@ -119,6 +122,14 @@ def from_cloned(path, env, **kwargs) -> BCRegularisedPPO:
     :class:`BCRegularisedPPO` (``bc_obs``, ``bc_act``, ``n_steps``, ``learning_rate``...).
     """
     old = PPO.load(str(path), device="cpu")
+    want, got = old.observation_space.shape, env.observation_space.shape
+    if want != got:
+        raise InvalidConfigError(
+            f"from_cloned: the model {os.fspath(path)!r} reads observations of shape {want}, "
+            f"the env gives {got}; fine-tune on an env with the observation the model was "
+            "trained on (a model trained with analytic features, DaggerConfig.features, "
+            "reads more than any env observation and cannot be fine-tuned by PPO here)"
+        )
     kwargs.setdefault("policy_kwargs", old.policy_kwargs)
     new = BCRegularisedPPO("MlpPolicy", env, device="cpu", **kwargs)
     new.policy.load_state_dict(old.policy.state_dict())

@@ -77,3 +77,12 @@ def test_bad_finetune_arguments_name_the_field(bad):
     env = SingleAgentEnv("pursuer", "evader/straight", map="open_room", observation="state")
     with pytest.raises(InvalidConfigError, match=next(iter(bad))):
         BCRegularisedPPO("MlpPolicy", env, **bad)
+
+
+def test_a_model_that_reads_another_observation_is_refused_naming_both_shapes():
+    from training import zoo
+
+    env = SingleAgentEnv("pursuer", "evader/straight", map="corridor", observation="lidar_track")
+    # the table-feature generalist reads lidar_track (40) plus 5 analytic features
+    with pytest.raises(InvalidConfigError, match=r"shape \(45,\).*\(40,\)"):
+        from_cloned(zoo.model_path("dagger_pursuer_table"), env)

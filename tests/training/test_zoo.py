@@ -12,7 +12,7 @@ from training.config import TrainConfig
 from training.dagger import DaggerConfig
 
 RL = ["ppo_evader_vs_greedy_open_room", "ppo_pursuer_vs_straight_open_room"]
-DAGGER = ["dagger_evader_generalist", "dagger_pursuer_generalist"]
+DAGGER = ["dagger_evader_generalist", "dagger_pursuer_generalist", "dagger_pursuer_table"]
 SPECIALISTS = [
     "dagger_evader_two_rooms",
     "dagger_pursuer_corridor",
@@ -192,3 +192,25 @@ def test_reproduce_warns_when_the_code_has_changed_since_training(tmp_path, monk
     zoo.install("old", run)
     with pytest.warns(zoo.ReproducibilityWarning, match="check that commit out"):
         zoo.reproduce("old", tmp_path / "again")
+
+
+def test_a_model_with_analytic_features_plays_a_tournament_as_it_plays_alone(tmp_path):
+    """A tournament worker loads a copy of the zip without its provenance: the spec carries
+    how the model builds its input (features from the state), so it plays the match as
+    ``zoo.load`` plays it, instead of forfeiting on an observation of the wrong shape."""
+    from analysis.tournament import Store, run_tournament, spec_from_dict
+    from strategies.runner import run_episode
+
+    spec = spec_from_dict({"name": "features", "maps": ["corridor"], "seeds": 2, "start": "safe",
+                           "pursuers": [{"model": "zoo:dagger_pursuer_table", "label": "table"}],
+                           "evaders": ["evader/straight"], "env": {"max_cycles": 40}})  # fmt: skip
+    entry = spec.policies()["pursuer:table"]
+    assert entry.observation == {"observation": "state"}
+    assert entry.params["inputs"]["features"] == ["safety_table"]
+    s = run_tournament(spec, tmp_path / "t.sqlite", backend="serial", progress=False)
+    assert s.played == 2 and s.forfeits == 0 and s.errors == 0
+    rows = Store(tmp_path / "t.sqlite").rows(s.run_id)
+    for row in rows:
+        alone = run_episode("corridor", zoo.load("dagger_pursuer_table"), "evader/straight",
+                            row["seed"], max_cycles=40, start="safe")  # fmt: skip
+        assert (row["winner"], row["steps"]) == (alone.winner, alone.steps)

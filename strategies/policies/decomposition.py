@@ -6,7 +6,9 @@ Per step (a table lookup plus a little arithmetic, no geometry kernel call):
    escapable cell at L_min, Sec. 4), the rotation each orientation bin needs to reach a
    safe orientation at every probe point the evader can reach soon: probes lie on rays
    from the evader, up to ``V_e T`` with ``T = pi / omega`` (the time to turn the rod half
-   way round), and a ray stops at the first wall it meets.
+   way round), and a ray stops at the first wall it meets. An evader hugging a wall
+   toward a convex corner is probed round that corner too, on rays from where it rounds
+   it (:meth:`DecompositionPursuer._corners_in_reach`).
 2. The value of each orientation (eqs. 2-3 with a straight-line evader and the pursuer
    turning at ``omega = (V_p / L_min) sqrt(1 - rho^2)``, the least rate the evader can
    impose, Sec. 6.1)::
@@ -108,6 +110,8 @@ class DecompositionPursuer(BasePolicy):
     ORBIT_REACH = 0.3  # a circle short of room by less than this x L is worth turning for
     WALL_HORIZON = 2.0  # seconds the pursuer's path is checked for walls (no circle in reach)
     WALL_STEP = 0.1  # spacing in seconds of the points checked on that path
+    CORNER_HUG = 2  # grid steps of clearance beyond its body within which the evader hugs a wall
+    CORNER_HEADING = 0.9  # least cosine between the evader's heading and a corner it rounds
 
     def __init__(
         self,
@@ -165,6 +169,7 @@ class DecompositionPursuer(BasePolicy):
         ang = 2.0 * math.pi * np.arange(self.rays) / self.rays
         dirs = np.stack([np.cos(ang), np.sin(ang)], axis=1)
         self._offsets = (dirs[:, None, :] * radii[None, :, None]).reshape(-1, 2)
+        self._dirs = dirs
         self._n_r = n_r
         self._probe_cols = np.arange(self.probe_every - 1, n_r, self.probe_every)
         self._t_e = (radii[self._probe_cols] / c.v_evader).astype(np.float32)
@@ -198,6 +203,8 @@ class DecompositionPursuer(BasePolicy):
         self._wall_times = np.arange(1, round(self.WALL_HORIZON / self.WALL_STEP) + 1) * (
             self.WALL_STEP
         )
+        # probes round the corners (issue 13, :meth:`_corners_in_reach`)
+        self._corners, self._corner_vertex = _corner_starts(c.map, c.body_radius)
 
     # ------------------------------------------------------------------ decision
     def orientation_values(self, evader: np.ndarray) -> np.ndarray:
@@ -212,24 +219,93 @@ class DecompositionPursuer(BasePolicy):
             return np.zeros(self.table.n_bins)
         return self._values(evader, row)
 
-    def _values(self, evader: np.ndarray, row: int) -> np.ndarray:
-        """:meth:`orientation_values` at a free grid row ``row`` of ``evader``."""
+    def _values(
+        self, evader: np.ndarray, row: int, velocity: np.ndarray | None = None
+    ) -> np.ndarray:
+        """:meth:`orientation_values` at a free grid row ``row`` of ``evader``; given the
+        evader's ``velocity`` (the decision, :meth:`_target`), with the probes round the
+        corners it is about to round (:meth:`_corners_in_reach`). Without it (the start
+        sampler's judge, the learners' table features) the values are as before."""
         tab = self.table
         value = np.full(tab.n_bins, self.horizon)
         value = np.minimum(value, self._probe_values(evader))
+        if velocity is not None:
+            for start, delay, shadow in self._corners_in_reach(evader, velocity):
+                value = np.minimum(value, self._probe_values(start, delay, shadow))
         need0 = tab.need[row]
         return np.where(need0 > 0, -self._turn_lut[need0], value)
 
-    def _probe_values(self, origin: np.ndarray) -> np.ndarray:
-        """The least margin over the probes on rays from ``origin`` (see above)."""
+    def _corners_in_reach(
+        self, evader: np.ndarray, velocity: np.ndarray
+    ) -> list[tuple[np.ndarray, float, np.ndarray]]:
+        """The convex corners a wall-hugging evader is about to round, for :meth:`_target`.
+
+        Straight probe rays stop at the first wall, so an evader walking along a wall
+        toward a convex vertex threatens orientations behind that vertex (the rod would
+        sweep it) that no probe sees until the evader is there, too late to swing the rod
+        round: the pillar room's triangle, the L-hall's pillar, maze walls (issue 13).
+        Where the evader touches a wall (its clearance within ``CORNER_HUG`` grid steps
+        of its body radius) and walks toward a corner (cosine at least
+        ``CORNER_HEADING``) it reaches in a straight free line within the horizon, the
+        nearest such corner is probed too: rays from the point where the evader's centre
+        rounds it, only those turning round it (into the shadow of the walk), with
+        ``t_e = (|corner - e| + r) / V_e``, a path the evader can walk (eq. 2's
+        straight-line times, with one bend). Without the two conditions the corners'
+        threats turned the rod against evaders that do not round them (maze, straight
+        evader, seed 1) and cost more decision time.
+
+        Returns:
+            ``[(start, delay, rays)]`` for that corner (or ``[]``): the rays' origin, the
+            evader's time to it, and which of the probe rays (bool) count.
+        """
+        starts = self._corners
+        if not len(starts) or (self._clear is None and self._clear_memo is None):
+            return []
+        c = self.config
+        vx, vy = float(velocity[0]), float(velocity[1])
+        speed = math.hypot(vx, vy)
+        ex, ey = float(evader[0]), float(evader[1])
+        h = self.table.resolution
+        if speed == 0.0 or self._clearance_at(ex, ey) > c.body_radius + self.CORNER_HUG * h:
+            return []
+        dx, dy = starts[:, 0] - ex, starts[:, 1] - ey
+        d = np.hypot(dx, dy)
+        reach = c.v_evader * (self.horizon - float(self._t_e[0]))
+        ahead = (d < reach) & (dx * vx + dy * vy >= self.CORNER_HEADING * speed * d)
+        for k in np.flatnonzero(ahead)[np.argsort(d[ahead], kind="stable")]:
+            n = max(2, math.ceil(float(d[k]) / h))
+            seg = evader + (np.arange(1, n + 1)[:, None] / n) * (starts[k] - evader)
+            if not bool(np.all(self.table.rows(seg) >= 0)):  # no straight free walk
+                continue
+            wx = float(self._corner_vertex[k, 0] - starts[k, 0])
+            wy = float(self._corner_vertex[k, 1] - starts[k, 1])
+            side = float(dx[k]) * wy - float(dy[k]) * wx  # > 0: the wall left of the walk
+            cross = float(dx[k]) * self._dirs[:, 1] - float(dy[k]) * self._dirs[:, 0]
+            return [(starts[k], float(d[k]) / c.v_evader, cross * side > 0.0)]
+        return []
+
+    def _probe_values(
+        self, origin: np.ndarray, delay: float = 0.0, rays: np.ndarray | None = None
+    ) -> np.ndarray:
+        """The least margin over the probes on rays from ``origin`` (see above); the
+        evader reaches ``origin`` itself after ``delay`` seconds (probes beyond the horizon
+        then drop out), and only the rays ``rays`` (bool, per ray) count if given."""
         tab = self.table
-        points = origin + self._offsets
+        offsets, n_rays = self._offsets, self.rays
+        if rays is not None:  # only those rays' samples (the others would count as safe)
+            n_rays = int(rays.sum())
+            offsets = offsets.reshape(self.rays, self._n_r, 2)[rays].reshape(-1, 2)
+        points = origin + offsets
+        t_e = self._t_e + np.float32(delay) if delay else self._t_e
+        late = t_e > self.horizon if delay else None
         if self._fast:
             # eager table: one lookup of every ray sample serves as the wall test and
             # as the probes' rows
-            rows = tab.rows(points).reshape(self.rays, self._n_r)
+            rows = tab.rows(points).reshape(n_rays, self._n_r)
             reach = np.logical_and.accumulate(rows >= 0, axis=1)  # stop at the first wall
             sub_ok = reach[:, self._probe_cols]
+            if late is not None:
+                sub_ok[:, late] = False
             if not sub_ok.any():
                 return np.full(tab.n_bins, self.horizon)
             # the probes of one radius share t_e, and t_e - lut[k] falls as k grows (the
@@ -239,16 +315,18 @@ class DecompositionPursuer(BasePolicy):
             need = tab.need[rows[:, self._probe_cols]]  # (rays, radii, bins)
             need[~sub_ok] = 0
             need = need.max(axis=0)
-            v = self._t_e[:, None] - self._turn_lut[need]
+            v = t_e[:, None] - self._turn_lut[need]
             return v.min(axis=0)
-        inside = tab.inside(points).reshape(self.rays, self._n_r)
+        inside = tab.inside(points).reshape(n_rays, self._n_r)
         reach = np.cumsum(~inside, axis=1) == 0  # a ray stops at the first wall
         sub_ok = reach[:, self._probe_cols]
+        if late is not None:
+            sub_ok[:, late] = False
         if not sub_ok.any():
             return np.full(tab.n_bins, self.horizon)
-        probes = points.reshape(self.rays, self._n_r, 2)[:, self._probe_cols][sub_ok]
+        probes = points.reshape(n_rays, self._n_r, 2)[:, self._probe_cols][sub_ok]
         r = tab.rows(probes)  # only the probes' orientations are looked up
-        t_e = np.broadcast_to(self._t_e, sub_ok.shape)[sub_ok]
+        t_e = np.broadcast_to(t_e, sub_ok.shape)[sub_ok]
         # lut: seconds to turn by a number of bins; a safe bin (0) never threatens
         v = t_e[:, None] - self._turn_lut[tab.need[r]]
         return v.min(axis=0)
@@ -260,7 +338,7 @@ class DecompositionPursuer(BasePolicy):
         b0 = tab.bin_of(snap.theta)
         if row < 0:
             return 0.0, b0
-        value = self._values(snap.evader, row)
+        value = self._values(snap.evader, row, snap.evader_velocity)
         free = tab.free[row]
         nb = tab.n_bins
         ccw_steps, cw_steps = reachable_steps(free, b0)
@@ -528,6 +606,27 @@ class DecompositionPursuer(BasePolicy):
             self.distance_gain,
         )
         return cmd.velocity
+
+
+def _corner_starts(world, pad: float) -> tuple[np.ndarray, np.ndarray]:
+    """(k, 2) points ``pad`` off the convex obstacle vertices of ``world``, along the
+    bisector of their walls' normals (where the centre of an evader of radius ``pad``
+    rounding one passes), and (k, 2) those vertices."""
+    out, vert = [], []
+    for i in world.convex_vertices:
+        n1 = world.edge_normal[world.vertex_prev_edge[i]]
+        n2 = world.edge_normal[world.vertex_next_edge[i]]
+        b = n1 + n2
+        nb = float(np.hypot(b[0], b[1]))
+        if nb < 1e-9:
+            continue
+        b = b / nb
+        out.append(world.vertices[i] + b * pad)
+        vert.append(world.vertices[i])
+    return (
+        np.asarray(out, dtype=np.float64).reshape(-1, 2),
+        np.asarray(vert, dtype=np.float64).reshape(-1, 2),
+    )
 
 
 def reachable_steps(free: np.ndarray, b0: int) -> tuple[np.ndarray, np.ndarray]:

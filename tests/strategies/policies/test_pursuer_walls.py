@@ -94,3 +94,72 @@ def test_the_pursuer_keeps_off_the_walls_with_no_circle_in_reach(world, evader, 
         max_cycles=cycles,
     )
     assert r.winner == "pursuer", r.summary()
+
+
+def _pillars_pursuer():
+    config = build_env("pillars", dict(OVERRIDES)).config
+    policy = make_policy("pursuer/decomposition")
+    policy.reset(role="pursuer", map=config.map, config=config, seed=0)
+    return policy
+
+
+def test_the_corner_ahead_of_a_wall_hugger_is_probed():
+    # the evader hugs the bottom edge (y = 2.5) of the pillar room's triangle
+    # (13, 2.5) - (16, 2.5) - (14.5, 5.1), its centre a body radius below it
+    p = _pillars_pursuer()
+    e = np.array([14.35, 2.3])
+    west = p._corners_in_reach(e, np.array([-0.5, 0.0]))
+    assert len(west) == 1
+    start, delay, rays = west[0]
+    assert start[0] < 13.0 and abs(start[1] - 2.5) < 0.2  # the west vertex, not the east one
+    assert delay == pytest.approx(np.hypot(*(start - e)) / 0.5)
+    assert rays.any() and not rays.all()
+    assert np.all(p._dirs[rays][:, 1] >= -1e-9)  # round the vertex: up its west face
+    east = p._corners_in_reach(e, np.array([0.5, 0.0]))
+    assert len(east) == 1 and east[0][0][0] > 16.0
+    assert p._corners_in_reach(e, np.array([0.0, -0.5])) == []  # walking away from the wall
+    assert p._corners_in_reach(np.array([14.35, 1.5]), np.array([-0.5, 0.0])) == []  # off it
+    # with the corner, the rod pointing east (the pursuer behind the vertex) is worth less;
+    # without the velocity (the start sampler's judge) the values are as before
+    row = p.table.row(e)
+    b = p.table.bin_of(0.0)
+    assert p._values(e, row, np.array([-0.5, 0.0]))[b] < p._values(e, row)[b] - 1.0
+    assert np.array_equal(p._values(e, row), p.orientation_values(e))
+
+
+def _variant_map(world: str, rot: float, scale: float):
+    from envs.maps import builtin_info
+
+    info = builtin_info(world)
+    c, s = math.cos(rot), math.sin(rot)
+    m = info.map.transformed(scale * np.array([[c, -s], [s, c]]), (0.0, 0.0))
+    params = dict(info.params())
+    for k in ("l_min", "l_max", "v_pursuer"):
+        params[k] = params[k] * scale
+    params["v_evader"] = 0.5 * params["v_pursuer"]
+    params["body_radius"] = 0.2 * scale
+    return m, params
+
+
+@pytest.mark.parametrize(
+    ("world", "rot", "scale", "seed", "cycles"),
+    [
+        # before: "occluded" at 8.4 s: the evader walked west under the triangle's bottom
+        # edge and rounded its vertex (13, 2.5), the rod swung too late to follow
+        ("pillars", 0.0, 1.0, 4, 110),
+        # before: "occluded" at 6.7 s rounding the pillar's south-west corner (3, 3)
+        ("l_hall", 1.1, 10.0, 1, 90),
+    ],
+)
+def test_the_pursuer_swings_before_a_wall_hugger_rounds_a_corner(world, rot, scale, seed, cycles):
+    m, params = _variant_map(world, rot, scale)
+    r = run_episode(
+        m,
+        "pursuer/decomposition",
+        "evader/wall_hugging",
+        seed,
+        overrides=params,
+        start="safe",
+        max_cycles=cycles,
+    )
+    assert r.winner == "pursuer", r.summary()

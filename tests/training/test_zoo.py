@@ -12,7 +12,12 @@ from training.config import TrainConfig
 from training.dagger import DaggerConfig
 
 RL = ["ppo_evader_vs_greedy_open_room", "ppo_pursuer_vs_straight_open_room"]
-DAGGER = ["dagger_evader_generalist", "dagger_pursuer_generalist", "dagger_pursuer_table"]
+DAGGER = [
+    "dagger_evader_generalist",
+    "dagger_evader_plan",
+    "dagger_pursuer_generalist",
+    "dagger_pursuer_table",
+]
 SPECIALISTS = [
     "dagger_evader_two_rooms",
     "dagger_pursuer_corridor",

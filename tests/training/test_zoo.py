@@ -130,6 +130,9 @@ def test_cli_list(capsys):
     assert main(["list"]) == 0
     out = capsys.readouterr().out
     assert all(name in out for name in SHIPPED)
+    lines = {line.split("\t")[0]: line for line in out.splitlines()}
+    assert "features safety_table" in lines["dagger_pursuer_table"]
+    assert "features" not in lines["dagger_pursuer_generalist"]
 
 
 def _weights(path):

@@ -40,6 +40,9 @@ def _main(argv: list[str] | None) -> int:
             prov = zoo.info(name)
             maps = prov.get("maps") or [prov["config"].get("map")]
             how = prov.get("method", "rl")
+            features = (prov.get("config") or {}).get("features")
+            if features:  # a learned policy with analytic features: say which
+                how += f" + features {', '.join(features)}"
             print(f"{name}\t{prov['role']} ({how}) vs {prov['opponent']} on {', '.join(maps)}")
     elif args.command == "info":
         print(json.dumps(zoo.info(args.name), indent=2))

@@ -137,6 +137,14 @@ def _cmd_export(args: argparse.Namespace) -> int:
     return 0
 
 
+def _roster_entry(item: str) -> str | dict[str, str]:
+    """A ``--pursuers``/``--evaders`` item as a spec entry: ``zoo:NAME`` and ``*.zip`` are
+    learned models (``{"model": ...}``), anything else a registered policy name."""
+    if item.startswith("zoo:") or item.lower().endswith(".zip"):
+        return {"model": item}
+    return item
+
+
 def _cmd_evaluate(args: argparse.Namespace) -> int:
     import json
 
@@ -156,8 +164,8 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         {
             "name": "evaluate",
             "maps": args.maps,
-            "pursuers": args.pursuers,
-            "evaders": args.evaders,
+            "pursuers": [_roster_entry(x) for x in args.pursuers],
+            "evaders": [_roster_entry(x) for x in args.evaders],
             "seeds": args.seeds,
             "start": args.start,
             "env": env,
@@ -230,8 +238,11 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
         "evaluate", help="quick matchup table from flags (a one-off tournament spec)"
     )
     p.add_argument("--maps", nargs="+", default=["corridor", "two_rooms"])
-    p.add_argument("--pursuers", nargs="+", default=["pursuer/decomposition", "pursuer/greedy"])
-    p.add_argument("--evaders", nargs="+", default=["evader/shooting", "evader/straight"])
+    roster = "policy names, zoo:NAME (a shipped model) or a model .zip"
+    p.add_argument("--pursuers", nargs="+", default=["pursuer/decomposition", "pursuer/greedy"],
+                   help=roster)  # fmt: skip
+    p.add_argument("--evaders", nargs="+", default=["evader/shooting", "evader/straight"],
+                   help=roster)  # fmt: skip
     p.add_argument("--seeds", type=int, default=10, help="number of seeded starts per match")
     p.add_argument("--max-cycles", type=int, default=None)
     p.add_argument("--config", help="env overrides as JSON, e.g. '{\"v_evader\": 0.8}'")

@@ -120,3 +120,13 @@ def test_evaluate_is_a_one_off_tournament_without_double_counting(tmp_path, caps
     assert (tmp_path / "t.png").stat().st_size > 1000
     with Store(store) as db:
         assert db.conn.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 3
+
+
+def test_evaluate_takes_zoo_models_by_name(tmp_path, capsys):
+    """`--pursuers zoo:NAME` is a learned model, as `zoo:NAME` is in a spec's roster."""
+    argv = ["evaluate", "--maps", "corridor", "--pursuers", "zoo:ppo_pursuer_vs_straight_open_room",
+            "--evaders", "evader/straight", "--seeds", "1", "--max-cycles", "10",
+            "--results", str(tmp_path / "z.sqlite"), "--no-progress"]  # fmt: skip
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "1 of 1 matches stored" in out and "zoo:ppo_pursuer_vs_straight_open_room" in out

@@ -42,20 +42,24 @@ from strategies.policies.table_features import FLOOR, TABLE_FEATURES, TableFeatu
 
 __all__ = ["LEARNER_FEATURES", "LearnerInputs", "check_features"]
 
-LEARNER_FEATURES: dict[str, int] = {
-    "safety_table": len(TABLE_FEATURES),
-    "escape_plan": len(PLAN_FEATURES),
-}
+
+@dataclasses.dataclass(frozen=True)
+class _Feature:
+    make: Any  # the class computing it: make(config, <role>=expert) or make(config, **params)
+    expert: str  # the analytic policy whose parameters (and tables) it is computed with
+    low: float  # the range of its numbers (the learner's observation space)
+    high: float
+    size: int
+
+
+_FEATURES = {
+    "safety_table": _Feature(TableFeatures, "pursuer/decomposition", FLOOR, -FLOOR,
+                             len(TABLE_FEATURES)),
+    "escape_plan": _Feature(PlanFeatures, "evader/shooting", -1.0, 1.0, len(PLAN_FEATURES)),
+}  # fmt: skip
+
+LEARNER_FEATURES: dict[str, int] = {name: f.size for name, f in _FEATURES.items()}
 """Analytic features a learner may be given, and how many numbers each adds."""
-
-_EXPERT = {"safety_table": "pursuer/decomposition", "escape_plan": "evader/shooting"}
-"""The analytic policy whose parameters each feature is computed with."""
-
-_BOUNDS = {"safety_table": (FLOOR, -FLOOR), "escape_plan": (-1.0, 1.0)}
-"""The range of each feature's numbers (the learner's observation space)."""
-
-_MAKERS = {"safety_table": (TableFeatures, "pursuer"), "escape_plan": (PlanFeatures, "evader")}
-"""Each feature's class and the keyword under which it takes an expert to reuse."""
 
 
 def check_features(features: Any, *, role: str, expert: str | None, where: str) -> tuple[str, ...]:
@@ -84,7 +88,7 @@ def check_features(features: Any, *, role: str, expert: str | None, where: str) 
                 f"{where}: features: unknown feature {name!r}; expected one of "
                 f"{sorted(LEARNER_FEATURES)}"
             )
-        need = _EXPERT[name]
+        need = _FEATURES[name].expert
         if expert != need or role != need.partition("/")[0]:
             raise InvalidConfigError(
                 f"{where}: feature {name!r} is computed by the {need!r} expert for a "
@@ -121,11 +125,6 @@ class LearnerInputs:
         self._role: str | None = None
 
     @property
-    def from_state(self) -> bool:
-        """Whether the input differs from the ``"state"`` vector itself."""
-        return self.observation.get("observation", "state") != "state" or bool(self.features)
-
-    @property
     def n_features(self) -> int:
         """How many numbers the features add."""
         return sum(LEARNER_FEATURES[f] for f in self.features)
@@ -152,11 +151,11 @@ class LearnerInputs:
             self._config, self._role = config, role
             self._made = {}
         for name in self.features:
-            make, keyword = _MAKERS[name]
-            if expert is not None:
-                self._made[name] = make(config, **{keyword: expert})
+            f = _FEATURES[name]
+            if expert is not None:  # TableFeatures(config, pursuer=...), PlanFeatures(evader=)
+                self._made[name] = f.make(config, **{f.expert.partition("/")[0]: expert})
             elif name not in self._made:
-                self._made[name] = make(config, **self.expert_params)
+                self._made[name] = f.make(config, **self.expert_params)
 
     def __call__(self, state: np.ndarray) -> np.ndarray:
         """The learner's input (float32) at the ``"state"`` vector ``state``."""
@@ -174,8 +173,9 @@ class LearnerInputs:
         """``base`` (the learner's env observation space) with the features' bounds added."""
         if not self.features:
             return base
-        lo = [np.full(LEARNER_FEATURES[f], _BOUNDS[f][0], np.float32) for f in self.features]
-        hi = [np.full(LEARNER_FEATURES[f], _BOUNDS[f][1], np.float32) for f in self.features]
+        feats = [_FEATURES[name] for name in self.features]
+        lo = [np.full(f.size, f.low, np.float32) for f in feats]
+        hi = [np.full(f.size, f.high, np.float32) for f in feats]
         return Box(
             np.concatenate([base.low, *lo]), np.concatenate([base.high, *hi]), dtype=np.float32
         )

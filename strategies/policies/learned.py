@@ -134,10 +134,6 @@ class SB3Policy(BasePolicy):
         )
         return LearnerInputs(inputs.get("observation"), features, inputs.get("expert_params"))
 
-    def _trained_observation(self) -> dict[str, Any] | None:
-        """The env observation options the model was trained with, from its provenance."""
-        return trained_observation(self.provenance)
-
     @property
     def observation_options(self) -> dict[str, Any] | None:
         """The observation the runner should give the model (from its provenance), if
@@ -145,7 +141,7 @@ class SB3Policy(BasePolicy):
         features (it builds its input from the state, as in training)."""
         if self._inputs is not None:
             return {"observation": "state"}
-        return self._trained_observation()
+        return trained_observation(self.provenance)
 
     def _reset(self) -> None:
         if self.model is None:

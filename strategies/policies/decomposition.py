@@ -8,7 +8,8 @@ Per step (a table lookup plus a little arithmetic, no geometry kernel call):
    from the evader, up to ``V_e T`` with ``T = pi / omega`` (the time to turn the rod half
    way round), and a ray stops at the first wall it meets. An evader hugging a wall
    toward a convex corner is probed round that corner too, on rays from where it rounds
-   it (:meth:`DecompositionPursuer._corners_in_reach`).
+   it, and round the next corner if the wall it rounds onto ends in one
+   (:meth:`DecompositionPursuer._corners_in_reach`).
 2. The value of each orientation (eqs. 2-3 with a straight-line evader and the pursuer
    turning at ``omega = (V_p / L_min) sqrt(1 - rho^2)``, the least rate the evader can
    impose, Sec. 6.1)::
@@ -205,6 +206,7 @@ class DecompositionPursuer(BasePolicy):
         )
         # probes round the corners (issue 13, :meth:`_corners_in_reach`)
         self._corners, self._corner_vertex = _corner_starts(c.map, c.body_radius)
+        self._corner_next, self._corner_in = _corner_neighbours(c.map, c.body_radius)
 
     # ------------------------------------------------------------------ decision
     def orientation_values(self, evader: np.ndarray) -> np.ndarray:
@@ -230,14 +232,14 @@ class DecompositionPursuer(BasePolicy):
         value = np.full(tab.n_bins, self.horizon)
         value = np.minimum(value, self._probe_values(evader))
         if velocity is not None:
-            for start, delay, shadow in self._corners_in_reach(evader, velocity):
-                value = np.minimum(value, self._probe_values(start, delay, shadow))
+            for start, delay, shadow, sense in self._corners_in_reach(evader, velocity):
+                value = np.minimum(value, self._probe_values(start, delay, shadow, sense))
         need0 = tab.need[row]
         return np.where(need0 > 0, -self._turn_lut[need0], value)
 
     def _corners_in_reach(
         self, evader: np.ndarray, velocity: np.ndarray
-    ) -> list[tuple[np.ndarray, float, np.ndarray]]:
+    ) -> list[tuple[np.ndarray, float, np.ndarray, int]]:
         """The convex corners a wall-hugging evader is about to round, for :meth:`_target`.
 
         Straight probe rays stop at the first wall, so an evader walking along a wall
@@ -254,9 +256,22 @@ class DecompositionPursuer(BasePolicy):
         threats turned the rod against evaders that do not round them (maze, straight
         evader, seed 1) and cost more decision time.
 
+        If the wall it rounds onto ends in another convex corner within reach in a
+        straight free line (the end of a thin maze wall), that corner is probed as well,
+        on the walk's far side, with ``t_e`` over both legs; so is the far corner of an
+        evader rounding a corner now (within ``CORNER_HUG`` steps of its body from it),
+        whose heading no longer points at either. Behind that second corner the rod
+        cannot take the shorter way round to a safe orientation (it would sweep the wall
+        the evader walked round); it has to turn the way the walk turns, so its probes
+        count the table's rotation that way (``ccw`` or ``cw``, not ``need``). With the
+        shorter way the rod swung too late (maze, wall hugger, seeds 6 and 7); counting
+        the turn's way for the first corner too lost the maze's wall-hugger seeds 0, 1
+        and 5.
+
         Returns:
-            ``[(start, delay, rays)]`` for that corner (or ``[]``): the rays' origin, the
-            evader's time to it, and which of the probe rays (bool) count.
+            ``[(start, delay, rays, sense)]`` (or ``[]``): the rays' origin, the
+            evader's time to it, which of the probe rays (bool) count, and the way the
+            rod must turn there (+1 ccw, -1 cw; 0: the shorter way).
         """
         starts = self._corners
         if not len(starts) or (self._clear is None and self._clear_memo is None):
@@ -271,25 +286,68 @@ class DecompositionPursuer(BasePolicy):
         dx, dy = starts[:, 0] - ex, starts[:, 1] - ey
         d = np.hypot(dx, dy)
         reach = c.v_evader * (self.horizon - float(self._t_e[0]))
+        near = np.flatnonzero(d <= c.body_radius + self.CORNER_HUG * h)
+        for k in near[np.argsort(d[near], kind="stable")]:
+            # rounding corner k now: probe round the one at the far end of the wall it
+            # rounds onto, if any (the nearest corner at hand only)
+            j = self._corner_after(k, vx, vy)
+            nxt = self._corner_probe(j, evader, 0.0, reach) if j >= 0 else None
+            if nxt is not None:
+                return [nxt]
+            break
         ahead = (d < reach) & (dx * vx + dy * vy >= self.CORNER_HEADING * speed * d)
         for k in np.flatnonzero(ahead)[np.argsort(d[ahead], kind="stable")]:
-            n = max(2, math.ceil(float(d[k]) / h))
-            seg = evader + (np.arange(1, n + 1)[:, None] / n) * (starts[k] - evader)
-            if not bool(np.all(self.table.rows(seg) >= 0)):  # no straight free walk
+            first = self._corner_probe(k, evader, 0.0, reach)
+            if first is None:  # no straight free walk
                 continue
-            wx = float(self._corner_vertex[k, 0] - starts[k, 0])
-            wy = float(self._corner_vertex[k, 1] - starts[k, 1])
-            side = float(dx[k]) * wy - float(dy[k]) * wx  # > 0: the wall left of the walk
-            cross = float(dx[k]) * self._dirs[:, 1] - float(dy[k]) * self._dirs[:, 0]
-            return [(starts[k], float(d[k]) / c.v_evader, cross * side > 0.0)]
+            out = [(*first[:3], 0)]
+            j = self._corner_after(k, float(dx[k]), float(dy[k]))
+            nxt = self._corner_probe(j, starts[k], float(d[k]), reach) if j >= 0 else None
+            if nxt is not None:
+                out.append(nxt)
+            return out
         return []
 
+    def _corner_after(self, k: int, vx: float, vy: float) -> int:
+        """The corner at the far end of the wall an evader walking ``(vx, vy)`` along a
+        wall of corner ``k`` rounds onto (-1: that end is no corner)."""
+        din = self._corner_in[k]
+        forward = vx * din[0, 0] + vy * din[0, 1] >= vx * din[1, 0] + vy * din[1, 1]
+        return int(self._corner_next[k, 0 if forward else 1])
+
+    def _corner_probe(
+        self, k: int, origin: np.ndarray, walked: float, reach: float
+    ) -> tuple[np.ndarray, float, np.ndarray] | None:
+        """Probe rays round corner ``k`` for an evader at ``origin`` having walked
+        ``walked`` already: (start, delay, shadow rays), or None if it cannot walk there
+        straight within ``reach``."""
+        start = self._corners[k]
+        fx, fy = float(start[0] - origin[0]), float(start[1] - origin[1])
+        f = math.hypot(fx, fy)
+        if walked + f >= reach:
+            return None
+        n = max(2, math.ceil(f / self.table.resolution))
+        seg = origin + (np.arange(1, n + 1)[:, None] / n) * (start - origin)
+        if not bool(np.all(self.table.rows(seg) >= 0)):
+            return None
+        wx = float(self._corner_vertex[k, 0] - start[0])
+        wy = float(self._corner_vertex[k, 1] - start[1])
+        side = fx * wy - fy * wx  # > 0: the wall left of the walk
+        cross = fx * self._dirs[:, 1] - fy * self._dirs[:, 0]
+        sense = 1 if side > 0 else -1  # the walk turns ccw round it (wall on the left)
+        return start, (walked + f) / self.config.v_evader, cross * side > 0.0, sense
+
     def _probe_values(
-        self, origin: np.ndarray, delay: float = 0.0, rays: np.ndarray | None = None
+        self,
+        origin: np.ndarray,
+        delay: float = 0.0,
+        rays: np.ndarray | None = None,
+        sense: int = 0,
     ) -> np.ndarray:
         """The least margin over the probes on rays from ``origin`` (see above); the
         evader reaches ``origin`` itself after ``delay`` seconds (probes beyond the horizon
-        then drop out), and only the rays ``rays`` (bool, per ray) count if given."""
+        then drop out), only the rays ``rays`` (bool, per ray) count if given, and the
+        rotation is counted ccw (``sense`` > 0) or cw (< 0) only if given."""
         tab = self.table
         offsets, n_rays = self._offsets, self.rays
         if rays is not None:  # only those rays' samples (the others would count as safe)
@@ -312,7 +370,8 @@ class DecompositionPursuer(BasePolicy):
             # lookup is non-decreasing, rounding is monotone), so per radius only the
             # largest need over its reached probes counts; an unreached probe counts as
             # safe (need 0: t_e + 1e9, never below the first radius's value)
-            need = tab.need[rows[:, self._probe_cols]]  # (rays, radii, bins)
+            needs = tab.need if not sense else (tab.ccw if sense > 0 else tab.cw)
+            need = needs[rows[:, self._probe_cols]]  # (rays, radii, bins)
             need[~sub_ok] = 0
             need = need.max(axis=0)
             v = t_e[:, None] - self._turn_lut[need]
@@ -328,7 +387,8 @@ class DecompositionPursuer(BasePolicy):
         r = tab.rows(probes)  # only the probes' orientations are looked up
         t_e = np.broadcast_to(t_e, sub_ok.shape)[sub_ok]
         # lut: seconds to turn by a number of bins; a safe bin (0) never threatens
-        v = t_e[:, None] - self._turn_lut[tab.need[r]]
+        needs = tab.need if not sense else (tab.ccw if sense > 0 else tab.cw)
+        v = t_e[:, None] - self._turn_lut[needs[r]]
         return v.min(axis=0)
 
     def _target(self, snap: Snapshot) -> tuple[float, int]:
@@ -627,6 +687,34 @@ def _corner_starts(world, pad: float) -> tuple[np.ndarray, np.ndarray]:
         np.asarray(out, dtype=np.float64).reshape(-1, 2),
         np.asarray(vert, dtype=np.float64).reshape(-1, 2),
     )
+
+
+def _corner_neighbours(world, pad: float) -> tuple[np.ndarray, np.ndarray]:
+    """For the corners of :func:`_corner_starts` (same order): (k, 2) the indices of the
+    corners at the far ends of their two walls (-1: that end is not a corner), and
+    (k, 2, 2) the directions in which a walk along each wall arrives at the corner (the
+    walk then goes on toward the neighbour over the other wall)."""
+    conv = list(world.convex_vertices)
+    keep = []
+    for i in conv:
+        b = (
+            world.edge_normal[world.vertex_prev_edge[i]]
+            + world.edge_normal[world.vertex_next_edge[i]]
+        )
+        if float(np.hypot(b[0], b[1])) >= 1e-9:
+            keep.append(int(i))
+    index = {v: k for k, v in enumerate(keep)}
+    nxt = np.full((len(keep), 2), -1, dtype=np.int64)
+    din = np.zeros((len(keep), 2, 2))
+    for k, i in enumerate(keep):
+        e_in, e_out = int(world.vertex_prev_edge[i]), int(world.vertex_next_edge[i])
+        # arriving along the wall before it (forward): go on to the next vertex
+        din[k, 0] = world.edge_dir[e_in]
+        nxt[k, 0] = index.get(int(world.edge_vertices[e_out, 1]), -1)
+        # arriving along the wall after it (backward): go on to the previous vertex
+        din[k, 1] = -world.edge_dir[e_out]
+        nxt[k, 1] = index.get(int(world.edge_vertices[e_in, 0]), -1)
+    return nxt, din
 
 
 def reachable_steps(free: np.ndarray, b0: int) -> tuple[np.ndarray, np.ndarray]:

@@ -109,14 +109,14 @@ def test_the_corner_ahead_of_a_wall_hugger_is_probed():
     p = _pillars_pursuer()
     e = np.array([14.35, 2.3])
     west = p._corners_in_reach(e, np.array([-0.5, 0.0]))
-    assert len(west) == 1
-    start, delay, rays = west[0]
+    start, delay, rays, sense = west[0]
+    assert sense == 0  # the first corner: the shorter way round, as the straight probes
     assert start[0] < 13.0 and abs(start[1] - 2.5) < 0.2  # the west vertex, not the east one
     assert delay == pytest.approx(np.hypot(*(start - e)) / 0.5)
     assert rays.any() and not rays.all()
     assert np.all(p._dirs[rays][:, 1] >= -1e-9)  # round the vertex: up its west face
     east = p._corners_in_reach(e, np.array([0.5, 0.0]))
-    assert len(east) == 1 and east[0][0][0] > 16.0
+    assert east[0][0][0] > 16.0
     assert p._corners_in_reach(e, np.array([0.0, -0.5])) == []  # walking away from the wall
     assert p._corners_in_reach(np.array([14.35, 1.5]), np.array([-0.5, 0.0])) == []  # off it
     # with the corner, the rod pointing east (the pursuer behind the vertex) is worth less;
@@ -125,6 +125,27 @@ def test_the_corner_ahead_of_a_wall_hugger_is_probed():
     b = p.table.bin_of(0.0)
     assert p._values(e, row, np.array([-0.5, 0.0]))[b] < p._values(e, row)[b] - 1.0
     assert np.array_equal(p._values(e, row), p.orientation_values(e))
+
+
+def test_the_far_side_of_a_thin_wall_is_probed_round_both_corners():
+    # the maze's wall (8.75 .. 9.25, y 2.75 .. 3.25) seen from its north face: an evader
+    # walking east along it rounds its end (two corners) and walks back west beneath it
+    config = build_env("maze", dict(OVERRIDES)).config
+    p = make_policy("pursuer/decomposition")
+    p.reset(role="pursuer", map=config.map, config=config, seed=0)
+    e, v = np.array([8.82, 3.46]), np.array([0.5, 0.0])
+    probes = p._corners_in_reach(e, v)
+    assert len(probes) == 2
+    (s1, d1, _, sense1), (s2, d2, rays2, sense2) = probes
+    assert d1 == pytest.approx(np.hypot(*(s1 - e)) / 0.5)
+    assert s1[0] > 9.25 and s1[1] > 3.25 and sense1 == 0  # north-east corner
+    assert s2[0] > 9.25 and s2[1] < 2.75  # then the south-east one
+    assert d2 == pytest.approx((np.hypot(*(s1 - e)) + np.hypot(*(s2 - s1))) / 0.5)
+    assert sense2 == -1  # the walk turns clockwise round the end, so must the rod
+    assert rays2.any() and np.all(p._dirs[rays2][:, 0] <= 1e-9)  # back west, beneath it
+    # at the end (past the first corner's heading), the far corner is still probed
+    at = p._corners_in_reach(np.array([9.41, 3.39]), np.array([0.39, -0.32]))
+    assert len(at) == 1 and np.array_equal(at[0][0], s2) and at[0][3] == -1
 
 
 def _variant_map(world: str, rot: float, scale: float):
@@ -149,6 +170,10 @@ def _variant_map(world: str, rot: float, scale: float):
         ("pillars", 0.0, 1.0, 4, 110),
         # before: "occluded" at 6.7 s rounding the pillar's south-west corner (3, 3)
         ("l_hall", 1.1, 10.0, 1, 90),
+        # before: "occluded" at 27.1 s and 48.2 s: the evader rounded the end of a thin
+        # wall and came back along its far side; the rod swung the short way, across it
+        ("maze", 0.0, 1.0, 7, 300),
+        ("maze", 0.0, 1.0, 6, 500),
     ],
 )
 def test_the_pursuer_swings_before_a_wall_hugger_rounds_a_corner(world, rot, scale, seed, cycles):

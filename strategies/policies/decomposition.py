@@ -205,8 +205,9 @@ class DecompositionPursuer(BasePolicy):
             self.WALL_STEP
         )
         # probes round the corners (issue 13, :meth:`_corners_in_reach`)
-        self._corners, self._corner_vertex = _corner_starts(c.map, c.body_radius)
-        self._corner_next, self._corner_in = _corner_neighbours(c.map, c.body_radius)
+        corners = _rounding_corners(c.map)
+        self._corners, self._corner_vertex = _corner_starts(c.map, corners, c.body_radius)
+        self._corner_next, self._corner_in = _corner_neighbours(c.map, corners)
 
     # ------------------------------------------------------------------ decision
     def orientation_values(self, evader: np.ndarray) -> np.ndarray:
@@ -668,19 +669,32 @@ class DecompositionPursuer(BasePolicy):
         return cmd.velocity
 
 
-def _corner_starts(world, pad: float) -> tuple[np.ndarray, np.ndarray]:
-    """(k, 2) points ``pad`` off the convex obstacle vertices of ``world``, along the
-    bisector of their walls' normals (where the centre of an evader of radius ``pad``
-    rounding one passes), and (k, 2) those vertices."""
-    out, vert = [], []
+def _rounding_corners(world) -> list[int]:
+    """The convex obstacle vertices an evader can round: those whose walls' normals do
+    not cancel (their bisector is defined). The corners of :func:`_corner_starts` and
+    :func:`_corner_neighbours`, in this order."""
+    keep = []
     for i in world.convex_vertices:
-        n1 = world.edge_normal[world.vertex_prev_edge[i]]
-        n2 = world.edge_normal[world.vertex_next_edge[i]]
-        b = n1 + n2
-        nb = float(np.hypot(b[0], b[1]))
-        if nb < 1e-9:
-            continue
-        b = b / nb
+        b = (
+            world.edge_normal[world.vertex_prev_edge[i]]
+            + world.edge_normal[world.vertex_next_edge[i]]
+        )
+        if float(np.hypot(b[0], b[1])) >= 1e-9:
+            keep.append(int(i))
+    return keep
+
+
+def _corner_starts(world, corners: list[int], pad: float) -> tuple[np.ndarray, np.ndarray]:
+    """(k, 2) points ``pad`` off the ``corners`` of ``world``, along the bisector of their
+    walls' normals (where the centre of an evader of radius ``pad`` rounding one passes),
+    and (k, 2) those vertices."""
+    out, vert = [], []
+    for i in corners:
+        b = (
+            world.edge_normal[world.vertex_prev_edge[i]]
+            + world.edge_normal[world.vertex_next_edge[i]]
+        )
+        b = b / float(np.hypot(b[0], b[1]))
         out.append(world.vertices[i] + b * pad)
         vert.append(world.vertices[i])
     return (
@@ -689,24 +703,15 @@ def _corner_starts(world, pad: float) -> tuple[np.ndarray, np.ndarray]:
     )
 
 
-def _corner_neighbours(world, pad: float) -> tuple[np.ndarray, np.ndarray]:
-    """For the corners of :func:`_corner_starts` (same order): (k, 2) the indices of the
-    corners at the far ends of their two walls (-1: that end is not a corner), and
-    (k, 2, 2) the directions in which a walk along each wall arrives at the corner (the
-    walk then goes on toward the neighbour over the other wall)."""
-    conv = list(world.convex_vertices)
-    keep = []
-    for i in conv:
-        b = (
-            world.edge_normal[world.vertex_prev_edge[i]]
-            + world.edge_normal[world.vertex_next_edge[i]]
-        )
-        if float(np.hypot(b[0], b[1])) >= 1e-9:
-            keep.append(int(i))
-    index = {v: k for k, v in enumerate(keep)}
-    nxt = np.full((len(keep), 2), -1, dtype=np.int64)
-    din = np.zeros((len(keep), 2, 2))
-    for k, i in enumerate(keep):
+def _corner_neighbours(world, corners: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """For the ``corners`` (indices into them): (k, 2) the corners at the far ends of
+    their two walls (-1: that end is not one of them), and (k, 2, 2) the directions in
+    which a walk along each wall arrives at the corner (the walk then goes on toward the
+    neighbour over the other wall)."""
+    index = {v: k for k, v in enumerate(corners)}
+    nxt = np.full((len(corners), 2), -1, dtype=np.int64)
+    din = np.zeros((len(corners), 2, 2))
+    for k, i in enumerate(corners):
         e_in, e_out = int(world.vertex_prev_edge[i]), int(world.vertex_next_edge[i])
         # arriving along the wall before it (forward): go on to the next vertex
         din[k, 0] = world.edge_dir[e_in]

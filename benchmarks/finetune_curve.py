@@ -1,9 +1,11 @@
-"""Does PPO fine-tuning keep what DAgger taught? The held rate along the fine-tuning run.
+"""Does PPO fine-tuning keep what DAgger taught? The win rate along the fine-tuning run.
 
 Starts :class:`training.finetune.BCRegularisedPPO` from a DAgger zoo model (its weights,
-its DAgger dataset for the decaying behaviour-cloning term when ``out/training/NAME``
-still holds ``dataset.npz``, else no BC term) and evaluates the policy every ``--every``
-env steps on the same seeded safe starts against ``--opponent`` (Wilson 95 % intervals).
+its DAgger dataset for the decaying behaviour-cloning term when ``--dataset`` or
+``out/training/NAME/dataset.npz`` holds one, else no BC term) and evaluates the policy
+every ``--every`` env steps on the same seeded safe starts against ``--opponent`` (Wilson
+95 % intervals): the pursuer's held rate, the evader's escape rate. A model trained with
+analytic features is fine-tuned on the input it was fitted on (``SingleAgentEnv(inputs=)``).
 Step 0 is the cloned model itself; a collapse shows as a drop after the critic warm-up.
 Two arms are run from the same start: with the remedies (critic warm-up, BC term, small
 initial action noise) and plain PPO from the same weights, so the remedies' effect is
@@ -13,6 +15,7 @@ Usage::
 
     python benchmarks/finetune_curve.py [--model dagger_pursuer_generalist]
         [--steps 40000] [--every 10000] [--episodes 24] [--opponent evader/shooting]
+        [--maps two_rooms office] [--dataset PATH] [--arms remedies plain]
 """
 
 from __future__ import annotations
@@ -29,19 +32,29 @@ from strategies.runner import run_episode
 from training import zoo
 
 
-def _held(model_zip: Path, prov_dir: Path, maps, opponent: str, episodes: int, tmp: str) -> int:
+def _wins(model_zip: Path, prov_dir: Path, role: str, maps, opponent: str, episodes: int,
+          tmp: str) -> int:  # fmt: skip
     import shutil
 
-    d = Path(tmp) / "eval"  # the model beside the zoo's provenance (its observation)
+    d = Path(tmp) / "eval"  # the model beside the zoo's provenance (its observation, features)
     d.mkdir(exist_ok=True)
     shutil.copyfile(model_zip, d / "model.zip")
     shutil.copyfile(prov_dir / "provenance.json", d / "provenance.json")
+    me = f"{role}/sb3:{d / 'model.zip'}"
     wins = 0
     for s in range(episodes):
-        r = run_episode(maps[s % len(maps)], f"pursuer/sb3:{d / 'model.zip'}", opponent,
-                        70_000 + s, start="safe", max_cycles=300)  # fmt: skip
-        wins += r.winner == "pursuer"
+        world = maps[s % len(maps)]
+        players = (me, opponent) if role == "pursuer" else (opponent, me)
+        r = run_episode(world, *players, 70_000 + s, start="safe", max_cycles=300)
+        wins += r.winner == role
     return wins
+
+
+ARMS = {
+    # critic warm-up, a decaying BC term and a small initial action noise (log_std -1.6)
+    "remedies": dict(critic_warmup=3, bc_coef=1.0, bc_decay=0.95),
+    "plain": dict(critic_warmup=0, bc_coef=0.0, bc_decay=1.0),  # plain PPO, same weights
+}
 
 
 def main(argv=None) -> int:
@@ -49,7 +62,7 @@ def main(argv=None) -> int:
 
     import torch
 
-    from training.finetune import from_cloned
+    from training.finetune import from_cloned, model_inputs
     from training.single_agent import SingleAgentEnv
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -57,28 +70,42 @@ def main(argv=None) -> int:
     ap.add_argument("--steps", type=int, default=40_000)
     ap.add_argument("--every", type=int, default=10_000)
     ap.add_argument("--episodes", type=int, default=24)
-    ap.add_argument("--opponent", default="evader/shooting")
+    ap.add_argument("--opponent", default=None,
+                    help="default: evader/shooting for a pursuer, pursuer/decomposition for an "
+                    "evader")  # fmt: skip
+    ap.add_argument("--maps", nargs="+", default=None,
+                    help="fine-tune and evaluate on these (default: the recipe's)")  # fmt: skip
+    ap.add_argument("--dataset", default=None,
+                    help="the DAgger dataset.npz for the BC term (default: the recipe's "
+                    "output_dir)")  # fmt: skip
+    ap.add_argument("--arms", nargs="+", choices=sorted(ARMS), default=sorted(ARMS))
+    ap.add_argument("--save", default=None, help="directory to keep each arm's last model in")
     args = ap.parse_args(argv)
     torch.set_num_threads(1)
     cfg = zoo.config(args.model)
+    role = cfg.role
+    opponent = args.opponent or (
+        "evader/shooting" if role == "pursuer" else "pursuer/decomposition"
+    )
     prov_dir = zoo.MODELS_DIR / args.model
-    maps = list(cfg.maps)
+    maps = list(args.maps or cfg.maps)
     obs = dict(cfg.observation)
-    data = Path(cfg.output_dir) / "dataset.npz"
-    print(f"load average: {os.getloadavg()}; {args.model} on {maps} vs {args.opponent}; "
+    inputs = model_inputs(zoo.model_path(args.model), role)
+    data = Path(args.dataset) if args.dataset else Path(cfg.output_dir) / "dataset.npz"
+    verb = "held" if role == "pursuer" else "escaped"
+    print(f"load average: {os.getloadavg()}; {args.model} ({role}) on {maps} vs {opponent}; "
+          f"features: {list(inputs.features) if inputs else 'none'}; "
           f"BC dataset: {data if data.is_file() else 'none'}")  # fmt: skip
-    arms = {
-        "warm-up + BC + log_std -1.6": dict(critic_warmup=3, bc_coef=1.0, bc_decay=0.95),
-        "plain PPO (same weights)": dict(critic_warmup=0, bc_coef=0.0, bc_decay=1.0),
-    }
     with tempfile.TemporaryDirectory() as tmp:
-        base = _held(zoo.model_path(args.model), prov_dir, maps, args.opponent, args.episodes, tmp)
-        for arm, kw in arms.items():
-            print(f"\n== {arm}")
+        base = _wins(zoo.model_path(args.model), prov_dir, role, maps, opponent, args.episodes,
+                     tmp)  # fmt: skip
+        for arm in args.arms:
+            kw = ARMS[arm]
+            print(f"\n== {arm}: {kw}")
             blo, bhi = wilson_interval(base, args.episodes)
-            print(f"  step {0:>7}: held {base:>3}/{args.episodes} [{blo:.2f}, {bhi:.2f}]")
-            env = SingleAgentEnv("pursuer", args.opponent, map=maps, start="safe",
-                                 max_cycles=300, **obs)  # fmt: skip
+            print(f"  step {0:>7}: {verb} {base:>3}/{args.episodes} [{blo:.2f}, {bhi:.2f}]")
+            env = SingleAgentEnv(role, opponent, map=maps, start="safe", max_cycles=300,
+                                 inputs=inputs, **obs)  # fmt: skip
             extra = {}
             if data.is_file() and kw["bc_coef"] > 0:
                 with np.load(data) as z:
@@ -91,12 +118,15 @@ def main(argv=None) -> int:
             t0 = time.perf_counter()
             for done in range(args.every, args.steps + 1, args.every):
                 model.learn(args.every, reset_num_timesteps=False)
-                path = Path(tmp) / f"{len(arm)}_{done}.zip"
+                path = Path(tmp) / f"{arm}_{done}.zip"
                 model.save(str(path))
-                w = _held(path, prov_dir, maps, args.opponent, args.episodes, tmp)
+                w = _wins(path, prov_dir, role, maps, opponent, args.episodes, tmp)
                 lo, hi = wilson_interval(w, args.episodes)
-                print(f"  step {done:>7}: held {w:>3}/{args.episodes} [{lo:.2f}, {hi:.2f}] "
+                print(f"  step {done:>7}: {verb} {w:>3}/{args.episodes} [{lo:.2f}, {hi:.2f}] "
                       f"({time.perf_counter() - t0:.0f} s)", flush=True)  # fmt: skip
+            if args.save:
+                Path(args.save).mkdir(parents=True, exist_ok=True)
+                model.save(str(Path(args.save) / f"{arm}.zip"))
             env.close()
     return 0
 

@@ -24,7 +24,7 @@ from stable_baselines3 import PPO
 from envs import validation
 from envs.errors import InvalidConfigError
 
-__all__ = ["BCRegularisedPPO", "from_cloned"]
+__all__ = ["BCRegularisedPPO", "from_cloned", "model_inputs"]
 
 
 class BCRegularisedPPO(PPO):
@@ -128,9 +128,24 @@ def from_cloned(path, env, **kwargs) -> BCRegularisedPPO:
             f"from_cloned: the model {os.fspath(path)!r} reads observations of shape {want}, "
             f"the env gives {got}; fine-tune on an env with the observation the model was "
             "trained on (a model trained with analytic features, DaggerConfig.features, "
-            "reads more than any env observation and cannot be fine-tuned by PPO here)"
+            "reads more than any env observation: pass SingleAgentEnv(..., "
+            "inputs=model_inputs(path, role)))"
         )
     kwargs.setdefault("policy_kwargs", old.policy_kwargs)
     new = BCRegularisedPPO("MlpPolicy", env, device="cpu", **kwargs)
     new.policy.load_state_dict(old.policy.state_dict())
     return new
+
+
+def model_inputs(path, role: str):
+    """The :class:`~strategies.policies.learner_inputs.LearnerInputs` of the model zip at
+    ``path`` (from the ``provenance.json`` beside it), or ``None`` for a model that reads
+    the env's own observation. Give them to :class:`training.single_agent.SingleAgentEnv`
+    (``inputs=``) to fine-tune or evaluate a model trained with analytic features.
+
+    Raises:
+        InvalidConfigError: the provenance names another role or unknown features.
+    """
+    from strategies.policies.learned import SB3Policy
+
+    return SB3Policy(path, role=role).inputs

@@ -15,6 +15,12 @@ Opponents that read the ``"state"`` observation (every analytic policy) still pl
 the learner sees ``"lidar"``: they receive ``env.state()`` (the ``"state"`` vector) and a
 copy of the config with ``observation="state"``, so they are as strong as in a
 ``"state"`` env. Learned opponents (``uses_state = False``) get their own observation.
+
+A learner trained with analytic features (``DaggerConfig.features``) reads more than any
+env observation: pass its :class:`~strategies.policies.learner_inputs.LearnerInputs` as
+``inputs`` and the learner's observation is built from the state by them, the same code as
+in the DAgger rollout and in :class:`~strategies.policies.learned.SB3Policy`, so PPO
+fine-tunes (or evaluates) such a model on the input it was fitted on and plays with.
 """
 
 from __future__ import annotations
@@ -32,6 +38,7 @@ from envs.errors import InvalidConfigError
 from envs.surveillance.env import EVADER, PURSUER
 from strategies.policies import Policy, make_policy
 from strategies.policies.base import check_role
+from strategies.policies.learner_inputs import LearnerInputs
 from strategies.policies.starts import START_KINDS, sample_start
 
 __all__ = ["AGENT_OF_ROLE", "START_CHOICES", "SingleAgentEnv", "make_opponent", "sb3_params"]
@@ -43,6 +50,7 @@ START_CHOICES = ("env", *START_KINDS)
 """``"env"``: the env's own random start; ``"valid"``/``"safe"``: ``sample_start``."""
 
 _SEED_BOUND = 2**31 - 1
+_OBSERVATION_KEYS = ("observation", "n_rays", "lidar_range")
 
 
 def _other(role: str) -> str:
@@ -116,6 +124,12 @@ class SingleAgentEnv(gym.Env):
         start: ``"env"`` (the env's random start), ``"valid"`` or ``"safe"``
             (:func:`strategies.policies.starts.sample_start`).
         render_mode: ``None``, ``"human"`` or ``"rgb_array"``.
+        inputs: the learner's input built from the state (a
+            :class:`~strategies.policies.learner_inputs.LearnerInputs`, e.g. of a model
+            trained with analytic features) instead of the env's observation; its
+            ``observation`` options replace ``env_kwargs``' observation. The features are
+            built once per map (from the features' expert parameters) and reset every
+            episode.
         **env_kwargs: the other arguments of :func:`envs.surveillance_v0.parallel_env`
             (``max_cycles``, ``observation``, ``v_evader``...).
 
@@ -141,9 +155,16 @@ class SingleAgentEnv(gym.Env):
         *,
         start: str = "env",
         render_mode: str | None = None,
+        inputs: LearnerInputs | None = None,
         **env_kwargs: Any,
     ) -> None:
         self.role = check_role(role)
+        if inputs is not None and not isinstance(inputs, LearnerInputs):
+            raise InvalidConfigError(
+                f"inputs: expected a LearnerInputs or None, got {type(inputs).__name__} {inputs!r}"
+            )
+        if inputs is not None:  # the env computes the state; the inputs encode it
+            env_kwargs = {k: v for k, v in env_kwargs.items() if k not in _OBSERVATION_KEYS}
         if start not in START_CHOICES:
             raise InvalidConfigError(f"start: expected one of {START_CHOICES}, got {start!r}")
         self.start = start
@@ -176,11 +197,23 @@ class SingleAgentEnv(gym.Env):
         self.observation_space = _union_space(
             [e.observation_space(self.agent) for e in self.envs], maps
         )
+        self._inputs: list[LearnerInputs] = []
+        if inputs is not None:
+            # one per map: the features' tables are built once per map, not per episode
+            self._inputs = [
+                LearnerInputs(inputs.observation, inputs.features, inputs.expert_params)
+                for _ in self.envs
+            ]
+            base = SingleAgentEnv(role, self.opponent, maps[0], **env_kwargs,
+                                  **inputs.observation)  # fmt: skip
+            self.observation_space = inputs.space(base.observation_space)
+            base.close()
         self.action_space = self.env.action_space(self.agent)
         self._opponent_obs: np.ndarray | None = None
 
     def _select(self, i: int) -> None:
         """Play the next episode on map ``i`` (of the list given)."""
+        self._map_index = i
         self.env = self.envs[i]
         self.config = self.env.config
         self._bind_opponent()
@@ -233,7 +266,14 @@ class SingleAgentEnv(gym.Env):
         )
         obs, infos = self.env.reset(seed=env_seed, options=placement)
         self._opponent_obs = self._opponent_view(obs)
-        return obs[self.agent], dict(infos[self.agent])
+        if self._inputs:
+            self._inputs[self._map_index].reset(self.config, self.role)
+        return self._learner_view(obs), dict(infos[self.agent])
+
+    def _learner_view(self, obs: dict[str, np.ndarray]) -> np.ndarray:
+        if self._inputs:
+            return self._inputs[self._map_index](self.env.state())
+        return obs[self.agent]
 
     def _opponent_view(self, obs: dict[str, np.ndarray]) -> np.ndarray:
         if self._opponent_config is not self.config:
@@ -263,7 +303,7 @@ class SingleAgentEnv(gym.Env):
         truncated = bool(truncs[self.agent])
         self._opponent_obs = None if terminated or truncated else self._opponent_view(obs)
         return (
-            obs[self.agent],
+            self._learner_view(obs),
             float(rewards[self.agent]),
             terminated,
             truncated,

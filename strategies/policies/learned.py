@@ -120,6 +120,12 @@ class SB3Policy(BasePolicy):
         if self._inputs is not None:
             self.uses_state = True  # the runner gives it the state; act() builds the input
 
+    @property
+    def inputs(self) -> LearnerInputs | None:
+        """How the model's input is built from the state (a model trained with analytic
+        features), or ``None`` for a model that reads the env's own observation."""
+        return self._inputs
+
     def _learner_inputs(self, inputs: Mapping[str, Any]) -> LearnerInputs:
         """The input builder of a model trained with analytic features (see
         :func:`learner_inputs_spec`)."""

@@ -86,3 +86,34 @@ def test_a_model_that_reads_another_observation_is_refused_naming_both_shapes():
     # the table-feature generalist reads lidar_track (40) plus 5 analytic features
     with pytest.raises(InvalidConfigError, match=r"shape \(45,\).*\(40,\)"):
         from_cloned(zoo.model_path("dagger_pursuer_table"), env)
+
+
+def test_a_feature_model_fine_tunes_on_the_input_it_plays_with():
+    from training import zoo
+    from training.finetune import model_inputs
+
+    torch.set_num_threads(1)
+    path = zoo.model_path("dagger_pursuer_table")
+    inputs = model_inputs(path, "pursuer")
+    assert inputs is not None and inputs.features == ("safety_table",)
+    env = SingleAgentEnv("pursuer", "evader/straight", map=["corridor", "l_hall"], start="safe",
+                         max_cycles=40, observation="lidar_track", n_rays=32,
+                         inputs=inputs)  # fmt: skip
+    assert env.observation_space.shape == (45,)
+    model = from_cloned(path, env, n_steps=32, batch_size=32, n_epochs=1, seed=0)
+    player = make_policy(f"pursuer/sb3:{path}")
+    for seed in (5, 6):
+        obs, _ = env.reset(seed=seed)
+        player.reset(role="pursuer", map=env.config.map, config=env.config, seed=0)
+        for _ in range(25):  # the same action as the model playing from the state
+            action = np.clip(model.predict(obs, deterministic=True)[0], -1, 1)
+            np.testing.assert_allclose(action, player.act(env.env.state()), atol=1e-6)
+            obs, _, term, trunc, _ = env.step(action)
+            if term or trunc:
+                break
+    model.learn(total_timesteps=32)  # and PPO trains on it
+
+
+def test_bad_inputs_are_refused_naming_the_value():
+    with pytest.raises(InvalidConfigError, match="inputs: expected a LearnerInputs"):
+        SingleAgentEnv("pursuer", "evader/straight", map="corridor", inputs=["safety_table"])

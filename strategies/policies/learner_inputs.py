@@ -25,6 +25,16 @@ Features (``LEARNER_FEATURES``):
     of sight. An evader-only feature: it needs the map's exact decomposition and the
     shooting evader's safety table (built once per map) and both positions in map
     coordinates.
+
+``"escape_memory"``
+    What the shooting evader with memory holds, digested into 11 numbers
+    (:mod:`strategies.policies.memory_features`): the crossing it keeps and how long it
+    has stalled, whether every crossing of its cell is excluded, the mode it decides in
+    and the escape arc it follows. An evader-only feature, and *stateful*: a shadow
+    shooting evader fed the episode's states decides at each. :meth:`LearnerInputs.reset`
+    restarts it at each episode start, and the learner must then be called **once per
+    step, in order** (as the DAgger rollout and :class:`~strategies.policies.learned.SB3Policy`
+    do): a state skipped or repeated changes what follows.
 """
 
 from __future__ import annotations
@@ -37,6 +47,7 @@ import numpy as np
 from gymnasium.spaces import Box
 
 from envs.errors import InvalidConfigError
+from strategies.policies.memory_features import MEMORY_FEATURES, MemoryFeatures
 from strategies.policies.plan_features import PLAN_FEATURES, PlanFeatures
 from strategies.policies.table_features import FLOOR, TABLE_FEATURES, TableFeatures
 
@@ -50,12 +61,15 @@ class _Feature:
     low: float  # the range of its numbers (the learner's observation space)
     high: float
     size: int
+    stateful: bool = False  # restart()ed at each episode start, called once per step
 
 
 _FEATURES = {
     "safety_table": _Feature(TableFeatures, "pursuer/decomposition", FLOOR, -FLOOR,
                              len(TABLE_FEATURES)),
     "escape_plan": _Feature(PlanFeatures, "evader/shooting", -1.0, 1.0, len(PLAN_FEATURES)),
+    "escape_memory": _Feature(MemoryFeatures, "evader/shooting", -1.0, 1.0,
+                              len(MEMORY_FEATURES), stateful=True),
 }  # fmt: skip
 
 LEARNER_FEATURES: dict[str, int] = {name: f.size for name, f in _FEATURES.items()}
@@ -156,9 +170,15 @@ class LearnerInputs:
                 self._made[name] = f.make(config, **{f.expert.partition("/")[0]: expert})
             elif name not in self._made:
                 self._made[name] = f.make(config, **self.expert_params)
+            elif f.stateful:  # made for an earlier episode on this map: forget it
+                self._made[name].restart()
 
     def __call__(self, state: np.ndarray) -> np.ndarray:
-        """The learner's input (float32) at the ``"state"`` vector ``state``."""
+        """The learner's input (float32) at the ``"state"`` vector ``state``.
+
+        With a stateful feature (``"escape_memory"``) call it once per step of the
+        episode, in order: each call feeds the state to the feature's shadow policy.
+        """
         if self._config is None:
             raise InvalidConfigError("LearnerInputs: call reset() before encoding a state")
         seen = np.asarray(state, dtype=np.float32)

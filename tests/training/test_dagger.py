@@ -211,19 +211,22 @@ def test_validation_plays_the_named_opponent_on_the_named_maps(tmp_path, monkeyp
         ("pursuer", "pursuer/decomposition", "safety_table", 5, {"range_margin": 0.3},
          "corridor", "evader/straight"),
         ("evader", "evader/shooting", "escape_plan", 11, {}, "two_rooms", "pursuer/greedy"),
+        ("evader", "evader/shooting", "escape_plan+escape_memory", 22, {}, "office",
+         "pursuer/decomposition"),
     ],
-    ids=["safety_table", "escape_plan"],
+    ids=["safety_table", "escape_plan", "escape_memory"],
 )  # fmt: skip
 def test_a_learner_with_features_sees_in_play_what_it_was_fitted_on(
-    tmp_path, monkeypatch, role, expert, feature, n, params, world, opponent
+    tmp_path, role, expert, feature, n, params, world, opponent
 ):
     """The rollout's stored inputs are the lidar vector plus the features, and the SB3Policy
     built from the zip computes the same vectors from the state: same seed, same opponent,
     the learner alone (beta 0) plays the same episode in training and in play."""
-    from strategies.policies.learned import SB3Policy
+    from strategies.policies.learner_inputs import LearnerInputs
     from strategies.runner import run_episode
 
-    cfg = _lidar_cfg(tmp_path, role=role, expert=expert, features=(feature,), expert_params=params,
+    cfg = _lidar_cfg(tmp_path, role=role, expert=expert, features=tuple(feature.split("+")),
+                     expert_params=params,
                      maps=(world,), opponent=opponent, iterations=1, episodes=1, epochs=5,
                      max_cycles=30)  # fmt: skip
     r = dagger(cfg)
@@ -232,15 +235,20 @@ def test_a_learner_with_features_sees_in_play_what_it_was_fitted_on(
     assert obs.shape == (r.samples[-1], 8 + 8 + n)
     if feature == "safety_table":
         assert np.all(np.abs(obs[:, 16:]) <= 1.5) and np.any(obs[:, 16] != obs[:, 18])
-    else:  # every cell of two_rooms is escapable: a crossing to head for
+    else:  # two_rooms: every cell escapable, office: most; a crossing to head for
         assert np.all(np.abs(obs[:, 16:]) <= 1.0) and np.any(obs[:, 18:20] != 0)
+    if n == 22:  # the shadow decides in one mode at each step
+        assert np.all(obs[:, 32:36].sum(axis=1) == 1.0)
     p = make_policy(f"{role}/sb3:{r.model_path}")
     assert p.observation_options == {"observation": "state"} and p.uses_state
     seen = []
-    act = SB3Policy.act
-    monkeypatch.setattr(
-        SB3Policy, "act", lambda self, o: seen.append(self._inputs(o)) or act(self, o)
-    )
+
+    class Spy(LearnerInputs):  # records what the policy builds, calling it once a step
+        def __call__(self, state):
+            seen.append(super().__call__(state))
+            return seen[-1]
+
+    p._inputs.__class__ = Spy
     roll = _Rollout(make_policy(expert, **params), _load(r), 0.0, 5, cfg.observation, cfg.features)
 
     def play(learner):
@@ -250,6 +258,12 @@ def test_a_learner_with_features_sees_in_play_what_it_was_fitted_on(
     a, b = play(roll), play(p)
     assert a.steps == b.steps and a.winner == b.winner
     assert np.array_equal(a.trajectory, b.trajectory)
+    assert np.array_equal(np.asarray(seen), np.asarray(roll.obs))
+    # a second episode in play: the stateful features start afresh (not from the first
+    # episode's memory), so it plays the same again
+    seen.clear()
+    c = play(p)
+    assert np.array_equal(c.trajectory, b.trajectory)
     assert np.array_equal(np.asarray(seen), np.asarray(roll.obs))
 
 
@@ -267,6 +281,19 @@ def _load(r):
         {"features": ("safety_table",)},  # the greedy expert has no table
         {"features": ("safety_table", "safety_table"), "expert": "pursuer/decomposition"},
         {"features": ("escape_plan",), "expert": "pursuer/decomposition"},  # an evader's
+        {"features": ("escape_memory",), "expert": "pursuer/decomposition"},  # an evader's
+        {
+            "features": ("escape_memory", "escape_memory"),
+            "role": "evader",
+            "expert": "evader/shooting",
+            "opponent": "pursuer/greedy",
+        },
+        {
+            "features": ("escape_memry",),
+            "role": "evader",
+            "expert": "evader/shooting",
+            "opponent": "pursuer/greedy",
+        },
     ],
 )
 def test_bad_features_are_refused_naming_them(tmp_path, bad):

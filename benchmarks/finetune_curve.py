@@ -14,8 +14,8 @@ measured in the same run.
 Usage::
 
     python benchmarks/finetune_curve.py [--model dagger_pursuer_generalist]
-        [--steps 40000] [--every 10000] [--episodes 24] [--opponent evader/shooting]
-        [--maps two_rooms office] [--dataset PATH] [--arms remedies plain]
+        [--steps 40000] [--every 10000] [--episodes 24] [--opponent evader/shooting ...]
+        [--maps two_rooms office] [--dataset PATH] [--arms remedies plain] [--save DIR]
 """
 
 from __future__ import annotations
@@ -30,10 +30,12 @@ import numpy as np
 from analysis.evaluate import wilson_interval
 from strategies.runner import run_episode
 from training import zoo
+from training.pool import OpponentPool
 
 
-def _wins(model_zip: Path, prov_dir: Path, role: str, maps, opponent: str, episodes: int,
-          tmp: str) -> int:  # fmt: skip
+def _wins(model_zip: Path, prov_dir: Path, role: str, maps, opponents, episodes: int,
+          tmp: str) -> dict[str, int]:  # fmt: skip
+    """Wins against each opponent over ``episodes`` seeded safe starts (maps in turn)."""
     import shutil
 
     d = Path(tmp) / "eval"  # the model beside the zoo's provenance (its observation, features)
@@ -41,13 +43,23 @@ def _wins(model_zip: Path, prov_dir: Path, role: str, maps, opponent: str, episo
     shutil.copyfile(model_zip, d / "model.zip")
     shutil.copyfile(prov_dir / "provenance.json", d / "provenance.json")
     me = f"{role}/sb3:{d / 'model.zip'}"
-    wins = 0
-    for s in range(episodes):
-        world = maps[s % len(maps)]
-        players = (me, opponent) if role == "pursuer" else (opponent, me)
-        r = run_episode(world, *players, 70_000 + s, start="safe", max_cycles=300)
-        wins += r.winner == role
+    wins = {}
+    for opponent in opponents:
+        wins[opponent] = 0
+        for s in range(episodes):
+            players = (me, opponent) if role == "pursuer" else (opponent, me)
+            r = run_episode(maps[s % len(maps)], *players, 70_000 + s, start="safe",
+                            max_cycles=300)  # fmt: skip
+            wins[opponent] += r.winner == role
     return wins
+
+
+def _line(step: int, wins: dict[str, int], episodes: int, verb: str, extra: str = "") -> str:
+    parts = []
+    for opponent, w in wins.items():
+        lo, hi = wilson_interval(w, episodes)
+        parts.append(f"{opponent} {w:>3}/{episodes} [{lo:.2f}, {hi:.2f}]")
+    return f"  step {step:>7}: {verb} " + "; ".join(parts) + extra
 
 
 ARMS = {
@@ -70,48 +82,51 @@ def main(argv=None) -> int:
     ap.add_argument("--steps", type=int, default=40_000)
     ap.add_argument("--every", type=int, default=10_000)
     ap.add_argument("--episodes", type=int, default=24)
-    ap.add_argument("--opponent", default=None,
-                    help="default: evader/shooting for a pursuer, pursuer/decomposition for an "
-                    "evader")  # fmt: skip
+    ap.add_argument("--opponent", nargs="+", default=None,
+                    help="fine-tune against these (a uniform pool) and evaluate against each "
+                    "(default: evader/shooting for a pursuer, pursuer/decomposition for an "
+                    "evader)")  # fmt: skip
     ap.add_argument("--maps", nargs="+", default=None,
                     help="fine-tune and evaluate on these (default: the recipe's)")  # fmt: skip
     ap.add_argument("--dataset", default=None,
                     help="the DAgger dataset.npz for the BC term (default: the recipe's "
                     "output_dir)")  # fmt: skip
     ap.add_argument("--arms", nargs="+", choices=sorted(ARMS), default=sorted(ARMS))
+    ap.add_argument("--learning-rate", type=float, default=1e-4)
     ap.add_argument("--save", default=None, help="directory to keep each arm's last model in")
     args = ap.parse_args(argv)
     torch.set_num_threads(1)
     cfg = zoo.config(args.model)
     role = cfg.role
-    opponent = args.opponent or (
+    opponents = args.opponent or [
         "evader/shooting" if role == "pursuer" else "pursuer/decomposition"
-    )
+    ]
     prov_dir = zoo.MODELS_DIR / args.model
     maps = list(args.maps or cfg.maps)
     obs = dict(cfg.observation)
     inputs = model_inputs(zoo.model_path(args.model), role)
     data = Path(args.dataset) if args.dataset else Path(cfg.output_dir) / "dataset.npz"
     verb = "held" if role == "pursuer" else "escaped"
-    print(f"load average: {os.getloadavg()}; {args.model} ({role}) on {maps} vs {opponent}; "
+    print(f"load average: {os.getloadavg()}; {args.model} ({role}) on {maps} vs {opponents}; "
           f"features: {list(inputs.features) if inputs else 'none'}; "
           f"BC dataset: {data if data.is_file() else 'none'}")  # fmt: skip
+    n = args.episodes
     with tempfile.TemporaryDirectory() as tmp:
-        base = _wins(zoo.model_path(args.model), prov_dir, role, maps, opponent, args.episodes,
-                     tmp)  # fmt: skip
+        base = _wins(zoo.model_path(args.model), prov_dir, role, maps, opponents, n, tmp)
         for arm in args.arms:
             kw = ARMS[arm]
-            print(f"\n== {arm}: {kw}")
-            blo, bhi = wilson_interval(base, args.episodes)
-            print(f"  step {0:>7}: {verb} {base:>3}/{args.episodes} [{blo:.2f}, {bhi:.2f}]")
-            env = SingleAgentEnv(role, opponent, map=maps, start="safe", max_cycles=300,
+            print(f"\n== {arm}: {kw}, learning rate {args.learning_rate}")
+            print(_line(0, base, n, verb))
+            pool = OpponentPool(opponents) if len(opponents) > 1 else opponents[0]
+            env = SingleAgentEnv(role, pool, map=maps, start="safe", max_cycles=300,
                                  inputs=inputs, **obs)  # fmt: skip
             extra = {}
             if data.is_file() and kw["bc_coef"] > 0:
                 with np.load(data) as z:
                     extra = {"bc_obs": z["obs"], "bc_act": z["act"]}
             model = from_cloned(zoo.model_path(args.model), env, n_steps=1024, batch_size=256,
-                                learning_rate=1e-4, n_epochs=5, seed=0, **kw, **extra)  # fmt: skip
+                                learning_rate=args.learning_rate, n_epochs=5, seed=0, **kw,
+                                **extra)  # fmt: skip
             if kw["critic_warmup"]:
                 with torch.no_grad():
                     model.policy.log_std.fill_(-1.6)
@@ -120,10 +135,9 @@ def main(argv=None) -> int:
                 model.learn(args.every, reset_num_timesteps=False)
                 path = Path(tmp) / f"{arm}_{done}.zip"
                 model.save(str(path))
-                w = _wins(path, prov_dir, role, maps, opponent, args.episodes, tmp)
-                lo, hi = wilson_interval(w, args.episodes)
-                print(f"  step {done:>7}: {verb} {w:>3}/{args.episodes} [{lo:.2f}, {hi:.2f}] "
-                      f"({time.perf_counter() - t0:.0f} s)", flush=True)  # fmt: skip
+                wins = _wins(path, prov_dir, role, maps, opponents, n, tmp)
+                print(_line(done, wins, n, verb, f" ({time.perf_counter() - t0:.0f} s)"),
+                      flush=True)  # fmt: skip
             if args.save:
                 Path(args.save).mkdir(parents=True, exist_ok=True)
                 model.save(str(Path(args.save) / f"{arm}.zip"))

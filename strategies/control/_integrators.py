@@ -40,50 +40,6 @@ def _rhs(th: float, a: float, s: int, L: float, rho: float, q: float):
     )  # d ln μ/dσ = cos α · (-∂f2/∂θ), μ = 1 + s λ2 (E3b)
 
 
-def _step(state, d: float, s: int, L: float, rho: float, q: float):
-    """One RK4 step of length ``d``: :func:`_rhs` written out at the four stages (the same
-    operations, without the calls: this is the shooting's inner loop)."""
-    x, y, th, a, lm = state
-    cos, sin, sqrt = math.cos, math.sin, math.sqrt
-    srho, Lrho = s * rho, L * rho
-    h2 = 0.5 * d
-    # stage 1 at (th, a)
-    phi = a - th
-    c, sp = cos(phi), sin(phi)
-    h = sqrt(1.0 - rho * rho * c * c)
-    n = h - srho * sp
-    x1, y1, t1, a1, m1 = cos(a), sin(a), s * n / Lrho, n * n * sp * q / L, -c * n / (h * L)
-    # stage 2
-    th2, aa2 = th + h2 * t1, a + h2 * a1
-    phi = aa2 - th2
-    c, sp = cos(phi), sin(phi)
-    h = sqrt(1.0 - rho * rho * c * c)
-    n = h - srho * sp
-    x2, y2, t2, a2, m2 = cos(aa2), sin(aa2), s * n / Lrho, n * n * sp * q / L, -c * n / (h * L)
-    # stage 3
-    th3, aa3 = th + h2 * t2, a + h2 * a2
-    phi = aa3 - th3
-    c, sp = cos(phi), sin(phi)
-    h = sqrt(1.0 - rho * rho * c * c)
-    n = h - srho * sp
-    x3, y3, t3, a3, m3 = cos(aa3), sin(aa3), s * n / Lrho, n * n * sp * q / L, -c * n / (h * L)
-    # stage 4
-    th4, aa4 = th + d * t3, a + d * a3
-    phi = aa4 - th4
-    c, sp = cos(phi), sin(phi)
-    h = sqrt(1.0 - rho * rho * c * c)
-    n = h - srho * sp
-    x4, y4, t4, a4, m4 = cos(aa4), sin(aa4), s * n / Lrho, n * n * sp * q / L, -c * n / (h * L)
-    w = d / 6.0
-    return (
-        x + w * (x1 + 2.0 * (x2 + x3) + x4),
-        y + w * (y1 + 2.0 * (y2 + y3) + y4),
-        th + w * (t1 + 2.0 * (t2 + t3) + t4),
-        a + w * (a1 + 2.0 * (a2 + a3) + a4),
-        lm + w * (m1 + 2.0 * (m2 + m3) + m4),
-    )
-
-
 def integrate_reduced(
     theta0: float,
     alpha0: float,
@@ -100,34 +56,93 @@ def integrate_reduced(
     Returns ``(rows, status)``: rows are ``(σ, x, y, θ, α, ln(μ/μ0))``; only the last row is
     kept when ``store`` is False. ``status`` is 0 (reached), +1/-1 (α reached ±π/2 going
     up/down: the arc turned back in x) or 2 (``max_steps`` exhausted).
+
+    Each RK4 step of length ``d`` is :func:`_rhs` at the four classical stages written out
+    (the same operations, without the calls: this is the shooting's inner loop), the state
+    in locals; once a step passes ``x_target``, the same code runs the shortened steps from
+    the last state: three Newton passes on their length ``d`` (dx/dσ = cos α), then the
+    step of the final length.
     """
+    cos, sin, sqrt = math.cos, math.sin, math.sqrt
     q = 1.0 / (1.0 - rho * rho)
-    state = (0.0, 0.0, theta0, alpha0, 0.0)
+    # (rho * rho * c * c is (rho * rho) * c * c; s * n with s = ±1.0 is the product with the
+    # int s, exactly, and a float product is faster)
+    rr, srho, Lrho = rho * rho, s * rho, L * rho
+    s = float(s)
+    x, y, th, a, lm = 0.0, 0.0, theta0, alpha0, 0.0
     sig = 0.0
-    rows = [(sig, *state)]
-    for _ in range(max_steps):
-        new = _step(state, step, s, L, rho, q)
-        if not abs(new[3]) < _HALF_PI:  # also catches NaN
-            return rows, (1 if new[3] > 0 else -1)
-        if new[0] >= x_target:
-            # shorten the step: solve x(δ) = x_target, dx/dσ = cos α (Newton, 3 passes)
-            d = step * (x_target - state[0]) / (new[0] - state[0])
-            for _ in range(3):
-                new = _step(state, d, s, L, rho, q)
-                d += (x_target - new[0]) / math.cos(new[3])
-            new = _step(state, d, s, L, rho, q)
-            row = (sig + d, x_target, *new[1:])
+    rows = [(sig, x, y, th, a, lm)]
+    d = step
+    newton = 0  # 0: whole steps; 1-3: Newton passes on the last step's length; 4: final
+    taken = 0
+    while newton or taken < max_steps:
+        h2 = 0.5 * d
+        # stage 1 at (th, a)
+        phi = a - th
+        c, sp = cos(phi), sin(phi)
+        h = sqrt(1.0 - rr * c * c)
+        n = h - srho * sp
+        x1, y1, t1, a1, m1 = cos(a), sin(a), s * n / Lrho, n * n * sp * q / L, -c * n / (h * L)
+        # stage 2
+        th2, aa2 = th + h2 * t1, a + h2 * a1
+        phi = aa2 - th2
+        c, sp = cos(phi), sin(phi)
+        h = sqrt(1.0 - rr * c * c)
+        n = h - srho * sp
+        x2, y2, t2, a2, m2 = cos(aa2), sin(aa2), s * n / Lrho, n * n * sp * q / L, -c * n / (h * L)
+        # stage 3
+        th3, aa3 = th + h2 * t2, a + h2 * a2
+        phi = aa3 - th3
+        c, sp = cos(phi), sin(phi)
+        h = sqrt(1.0 - rr * c * c)
+        n = h - srho * sp
+        x3, y3, t3, a3, m3 = cos(aa3), sin(aa3), s * n / Lrho, n * n * sp * q / L, -c * n / (h * L)
+        # stage 4
+        th4, aa4 = th + d * t3, a + d * a3
+        phi = aa4 - th4
+        c, sp = cos(phi), sin(phi)
+        h = sqrt(1.0 - rr * c * c)
+        n = h - srho * sp
+        x4, y4, t4, a4, m4 = cos(aa4), sin(aa4), s * n / Lrho, n * n * sp * q / L, -c * n / (h * L)
+        w = d / 6.0
+        nx = x + w * (x1 + 2.0 * (x2 + x3) + x4)
+        na = a + w * (a1 + 2.0 * (a2 + a3) + a4)
+        if newton:
+            if newton < 4:  # solve x(d) = x_target
+                d += (x_target - nx) / cos(na)
+                newton += 1
+                continue
+            row = (
+                sig + d,
+                x_target,
+                y + w * (y1 + 2.0 * (y2 + y3) + y4),
+                th + w * (t1 + 2.0 * (t2 + t3) + t4),
+                na,
+                lm + w * (m1 + 2.0 * (m2 + m3) + m4),
+            )
             if store:
                 rows.append(row)
             else:
                 rows[0] = row
             return rows, REACHED
-        state = new
+        if not abs(na) < _HALF_PI:  # also catches NaN
+            if not store:
+                rows[0] = (sig, x, y, th, a, lm)
+            return rows, (1 if na > 0 else -1)
+        if nx >= x_target:  # shorten this step, from the same state
+            d = step * (x_target - x) / (nx - x)
+            newton = 1
+            continue
+        y = y + w * (y1 + 2.0 * (y2 + y3) + y4)
+        th = th + w * (t1 + 2.0 * (t2 + t3) + t4)
+        lm = lm + w * (m1 + 2.0 * (m2 + m3) + m4)
+        x, a = nx, na
         sig += step
+        taken += 1
         if store:
-            rows.append((sig, *state))
-        else:
-            rows[0] = (sig, *state)
+            rows.append((sig, x, y, th, a, lm))
+    if not store:
+        rows[0] = (sig, x, y, th, a, lm)
     return rows, TOO_LONG
 
 

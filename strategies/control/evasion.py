@@ -57,6 +57,7 @@ __all__ = [
     "GreedyHeading",
     "ShootResult",
     "default_step",
+    "escape_path",
     "greedy_heading",
     "shoot",
     "solve_escape",
@@ -324,48 +325,11 @@ def solve_escape(
     Raises:
         SurveilValueError: non-finite input, ``x_e <= 0``, ``L <= 0``, ``rho <= 0``.
     """
-    th0 = validation.real("theta0", theta0)
-    x_e = validation.positive("x_e", x_e)
-    L = validation.positive("L", L)
-    rho_v = validation.positive("rho", rho)
-    s = branch_sign(branch)
-    if rho_v >= 1.0:
-        return EscapeSolution(
-            success=False,
-            reason=f"rho = {rho_v!r} >= 1: the evader escapes trivially by moving away "
-            "from the pursuer (footnote 4); at rho = 1, θ̇⁺ can vanish (E1)",
-        )
-    h = default_step(x_e, L, rho_v) if step is None else validation.positive("step", step)
-    if step is None and x_e / h > _MAX_DEFAULT_STEPS:
-        return EscapeSolution(
-            success=False,
-            reason=f"x_e = {x_e!r} with L = {L!r}, rho = {rho_v!r} needs {x_e / h:.3g} RK4 "
-            f"steps of the default step {h:.3g} (budget {_MAX_DEFAULT_STEPS}); pass step= "
-            "to integrate anyway",
-        )
-    coarse = 8.0 * h  # bracket and first root on an 8x coarser grid, then polish
-
-    def residual(a0: float, hh: float = h) -> float:
-        rows, status = integrate_reduced(
-            th0, a0, s, L, rho_v, hh, x_e, False, _max_steps(x_e, L, hh)
-        )
-        if status != REACHED:  # turned back going up (+1) / down (-1), or wandered (2)
-            return 10.0 * (status if status != 2 else math.copysign(1.0, rows[0][2]))
-        return rows[0][2] / x_e
-
-    grid = [(a, residual(a, coarse)) for a in _ALPHA_GRID]
-    roots = []
-    for (a_lo, r_lo), (a_hi, r_hi) in itertools.pairwise(grid):
-        if r_lo * r_hi < 0.0 or r_lo == 0.0:
-            root = _polished_root(residual, a_lo, a_hi, coarse)
-            if root is not None:
-                roots.append(root)
-    best = None
-    for a0 in roots:
-        rows, status = integrate_reduced(th0, a0, s, L, rho_v, h, x_e, True, _max_steps(x_e, L, h))
-        J = rows[-1][3] - th0
-        if status == REACHED and (best is None or abs(J) < abs(best[1])):
-            best = (a0, J, rows)
+    args, reason = _escape_inputs(theta0, x_e, L, rho, branch, step)
+    if reason:
+        return EscapeSolution(success=False, reason=reason)
+    th0, x_e, L, rho_v, s, _ = args
+    roots, best = _shoot_escape(*args)
     if best is None:
         return EscapeSolution(
             success=False,
@@ -390,6 +354,87 @@ def solve_escape(
         arc=arc,
         candidates=len(roots),
     )
+
+
+def escape_path(
+    theta0: float, x_e: float, *, L: float, rho: float, branch="+", step: float | None = None
+) -> np.ndarray | None:
+    """``solve_escape(...).arc.evader_path()``, or None where it fails, without the rest of
+    the solution (multipliers, H, first return: the shooting evader follows the path only).
+
+    Same arguments and errors as :func:`solve_escape`.
+    """
+    args, reason = _escape_inputs(theta0, x_e, L, rho, branch, step)
+    if reason:
+        return None
+    best = _shoot_escape(*args)[1]
+    if best is None:
+        return None
+    arr = np.asarray(best[2], dtype=float).reshape(-1, 6)  # as _build_result reads the rows
+    return np.column_stack([arr[:, 1], arr[:, 2]])
+
+
+def _escape_inputs(theta0, x_e, L, rho, branch, step):
+    """Validated ``(theta0, x_e, L, rho, s, h)`` of :func:`solve_escape`, and why it does
+    not shoot ("" if it does)."""
+    th0 = validation.real("theta0", theta0)
+    x_e = validation.positive("x_e", x_e)
+    L = validation.positive("L", L)
+    rho_v = validation.positive("rho", rho)
+    s = branch_sign(branch)
+    if rho_v >= 1.0:
+        return None, (
+            f"rho = {rho_v!r} >= 1: the evader escapes trivially by moving away "
+            "from the pursuer (footnote 4); at rho = 1, θ̇⁺ can vanish (E1)"
+        )
+    h = default_step(x_e, L, rho_v) if step is None else validation.positive("step", step)
+    if step is None and x_e / h > _MAX_DEFAULT_STEPS:
+        return None, (
+            f"x_e = {x_e!r} with L = {L!r}, rho = {rho_v!r} needs {x_e / h:.3g} RK4 "
+            f"steps of the default step {h:.3g} (budget {_MAX_DEFAULT_STEPS}); pass step= "
+            "to integrate anyway"
+        )
+    return (th0, x_e, L, rho_v, s, h), ""
+
+
+def _shoot_escape(th0: float, x_e: float, L: float, rho: float, s: int, h: float):
+    """The roots of ``y(x_e) = 0`` in α(0) (step ``h``) and the least-|J| extremal among
+    them as ``(alpha0, J, rows)`` (None if no root reaches ``x_e``)."""
+    coarse = 8.0 * h  # bracket and first root on an 8x coarser grid, then polish
+    # Brent and the polish evaluate some headings twice (a bracket's ends, the coarse
+    # root), and the winner is integrated once more with its rows: each integration is
+    # run once, by its exact inputs (the sign of a zero heading too), the fine ones with
+    # their rows
+    done: dict[tuple[float, float, float], tuple[float, list, int]] = {}
+
+    def residual(a0: float, hh: float = h) -> float:
+        key = (a0, math.copysign(1.0, a0), hh)
+        if key in done:
+            return done[key][0]
+        fine = hh == h
+        rows, status = integrate_reduced(th0, a0, s, L, rho, hh, x_e, fine, _max_steps(x_e, L, hh))
+        if status != REACHED:  # turned back going up (+1) / down (-1), or wandered (2)
+            r = 10.0 * (status if status != 2 else math.copysign(1.0, rows[-1][2]))
+        else:
+            r = rows[-1][2] / x_e
+        done[key] = (r, rows if fine else [], status)
+        return r
+
+    grid = [(a, residual(a, coarse)) for a in _ALPHA_GRID]
+    roots = []
+    for (a_lo, r_lo), (a_hi, r_hi) in itertools.pairwise(grid):
+        if r_lo * r_hi < 0.0 or r_lo == 0.0:
+            root = _polished_root(residual, a_lo, a_hi, coarse)
+            if root is not None:
+                roots.append(root)
+    best = None
+    for a0 in roots:
+        residual(a0)  # (every root was evaluated on the fine grid: a lookup)
+        _, rows, status = done[(a0, math.copysign(1.0, a0), h)]
+        J = rows[-1][3] - th0
+        if status == REACHED and (best is None or abs(J) < abs(best[1])):
+            best = (a0, J, rows)
+    return roots, best
 
 
 def _polished_root(residual, a_lo: float, a_hi: float, coarse: float) -> float | None:

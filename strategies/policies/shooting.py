@@ -36,7 +36,7 @@ import numpy as np
 
 from envs import validation
 from envs.geometry import kernel_for
-from strategies.control.evasion import solve_escape
+from strategies.control.evasion import escape_path
 from strategies.policies.base import (
     MAX_RAYS,
     BasePolicy,
@@ -423,11 +423,10 @@ class ShootingEvader(BasePolicy):
         dist = math.hypot(d[0], d[1])
         self._arc, self._arc_age = None, 0
         if self.shoot and 0.0 < self.rho < 1.0:
-            sol = solve_escape(
+            path = escape_path(
                 theta - frame, dist, L=self.config.l_min, rho=self.rho, branch=branch
             )
-            if sol.success and sol.arc is not None:
-                path = sol.arc.evader_path()
+            if path is not None:
                 rot = np.array(
                     [[math.cos(frame), -math.sin(frame)], [math.sin(frame), math.cos(frame)]]
                 )

@@ -12,7 +12,7 @@ from scipy.interpolate import CubicSpline
 from scipy.optimize import minimize, minimize_scalar
 
 from envs.errors import InfeasibleError, SurveilValueError
-from strategies.control.evasion import greedy_heading, shoot, solve_escape
+from strategies.control.evasion import escape_path, greedy_heading, shoot, solve_escape
 from strategies.control.hamiltonian import f2
 
 FIG11A = {"theta0": math.pi, "lambda1": -1.0, "lambda2_0": 0.41}
@@ -325,12 +325,15 @@ def test_solve_escape_refuses_runaway_integrations(theta0, x_e, L, rho):
     assert "RK4 steps" in sol.reason and repr(x_e) in sol.reason
 
 
-def test_rk4_step_is_the_rhs_at_four_stages():
-    # _step writes _rhs out inline (the shooting's inner loop): the same floats, bit for
-    # bit, as the classical composition of _rhs
-    from strategies.control._integrators import _rhs, _step
+def _reference_integrate(theta0, alpha0, s, L, rho, step, x_target, store, max_steps):
+    """integrate_reduced as first written: classical RK4 steps composed of _rhs, the step
+    that passes x_target redone from the same state with its length from three Newton
+    passes."""
+    from strategies.control._integrators import _HALF_PI, REACHED, TOO_LONG, _rhs
 
-    def composed(state, d, s, L, rho, q):
+    q = 1.0 / (1.0 - rho * rho)
+
+    def rk4(state, d):
         th, a = state[2], state[3]
         k1 = _rhs(th, a, s, L, rho, q)
         k2 = _rhs(th + 0.5 * d * k1[2], a + 0.5 * d * k1[3], s, L, rho, q)
@@ -340,14 +343,87 @@ def test_rk4_step_is_the_rhs_at_four_stages():
             v + d / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]) for i, v in enumerate(state)
         )
 
+    state, sig = (0.0, 0.0, theta0, alpha0, 0.0), 0.0
+    rows = [(sig, *state)]
+    for _ in range(max_steps):
+        new = rk4(state, step)
+        if not abs(new[3]) < _HALF_PI:
+            return rows, (1 if new[3] > 0 else -1)
+        if new[0] >= x_target:
+            d = step * (x_target - state[0]) / (new[0] - state[0])
+            for _ in range(3):
+                new = rk4(state, d)
+                d += (x_target - new[0]) / math.cos(new[3])
+            new = rk4(state, d)
+            row = (sig + d, x_target, *new[1:])
+            if store:
+                rows.append(row)
+            else:
+                rows[0] = row
+            return rows, REACHED
+        state, sig = new, sig + step
+        if store:
+            rows.append((sig, *state))
+        else:
+            rows[0] = (sig, *state)
+    return rows, TOO_LONG
+
+
+def test_integrate_reduced_is_rk4_of_the_rhs_bit_for_bit():
+    # integrate_reduced writes _rhs out inline at the four stages, in locals (the shooting's
+    # inner loop): the same floats, bit for bit, as RK4 composed of _rhs; every outcome
+    # (reached, turned back either way, out of steps), rows kept or not
+    from strategies.control._integrators import integrate_reduced
+
     rng = np.random.default_rng(7)
-    for _ in range(2000):
-        state = tuple(float(v) for v in rng.uniform(-3.0, 3.0, 5))
-        d, L, rho = (
-            float(rng.uniform(1e-4, 0.1)),
-            float(rng.uniform(0.5, 3.0)),
-            float(rng.uniform(0.05, 0.95)),
+    seen = set()
+    for _ in range(400):
+        th0, a0 = float(rng.uniform(-4.0, 4.0)), float(rng.uniform(-1.57, 1.57))
+        L, rho = float(rng.uniform(0.5, 3.0)), float(rng.uniform(0.05, 0.95))
+        step, x_t = float(rng.uniform(0.005, 0.2)), float(rng.uniform(0.05, 2.0))
+        s, store = int(rng.choice([-1, 1])), bool(rng.integers(2))
+        budget = (
+            int(rng.integers(1, 40)) if rng.random() < 0.2 else math.ceil(10 * (x_t + L) / step)
         )
-        s = int(rng.choice([-1, 1]))
-        q = 1.0 / (1.0 - rho * rho)
-        assert _step(state, d, s, L, rho, q) == composed(state, d, s, L, rho, q)
+        args = (th0, a0, s, L, rho, step, x_t, store, budget)
+        got = integrate_reduced(*args)
+        assert repr(got) == repr(_reference_integrate(*args))  # (repr: -0.0 too)
+        seen.add(got[1])
+    assert seen == {-1, 0, 1, 2}
+
+
+@pytest.mark.parametrize(
+    ("theta0", "x_e", "L", "rho", "branch"),
+    [
+        (-4.283643770806559, 0.2999999999999998, 2.0, 0.5, "+"),  # office, the evader's
+        (-5.756916611522011, 1.2000000000000002, 2.0, 0.5, "-"),  # corner
+        (0.3, 1.0, 1.0, 1.3, "+"),  # rho > 1: no arc
+        (0.0, 1e4, 1.0, 0.5, "+"),  # over the step budget: no arc
+    ],
+)
+def test_escape_path_is_the_solutions_evader_path(theta0, x_e, L, rho, branch):
+    sol = solve_escape(theta0, x_e, L=L, rho=rho, branch=branch)
+    path = escape_path(theta0, x_e, L=L, rho=rho, branch=branch)
+    if not sol.success:
+        assert path is None
+        return
+    ref = sol.arc.evader_path()
+    assert path.tobytes() == ref.tobytes() and path.flags.c_contiguous
+
+
+def test_solve_escape_integrates_each_heading_once(monkeypatch):
+    # Brent and the polish ask for some headings twice (a bracket's ends, the coarse root)
+    # and the winner's rows were integrated again: each (heading, step) is integrated once
+    from strategies.control import evasion
+
+    runs = []
+    real = evasion.integrate_reduced
+
+    def counted(theta0, alpha0, s, L, rho, step, *rest):
+        runs.append((alpha0.hex(), step))
+        return real(theta0, alpha0, s, L, rho, step, *rest)
+
+    monkeypatch.setattr(evasion, "integrate_reduced", counted)
+    sol = solve_escape(-4.29821055010567, 0.9, L=2.0, rho=0.5, branch="+")
+    assert sol.success and sol.candidates == 1
+    assert len(runs) == len(set(runs)) == 18  # (it was 23: 18 coarse, 4 fine, 1 stored)

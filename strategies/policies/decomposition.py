@@ -179,13 +179,22 @@ class DecompositionPursuer(BasePolicy):
         lut[NO_PATH] = math.pi / self.omega  # no safe orientation: half a turn
         lut[0] = -1e9
         self._turn_lut = lut.astype(np.float32)
+        # one way round (the corner probes' ccw or cw counts, up to n_bins - 1 bins): no
+        # safe orientation is a full turn, more than any turn that way, as NO_PATH is
+        # more than any shorter-way turn above
+        lut[NO_PATH] = 2.0 * math.pi / self.omega
+        self._way_lut = lut.astype(np.float32)
         nb = self.table.n_bins
         # the eager table's fast path (:meth:`_probe_values`) takes the largest rotation
-        # need over the probes at one radius before the lookup: exact when the lookup is
-        # non-decreasing over the needs a table holds (0 .. n_bins // 2, the shorter way
-        # round, or NO_PATH), which it is unless rounding says otherwise
+        # over the probes at one radius before the lookup: exact when each lookup is
+        # non-decreasing over the counts a table holds (0 .. n_bins // 2 the shorter way
+        # round, 0 .. n_bins - 1 one way, or NO_PATH), which it is unless rounding says
+        # otherwise
         held = self._turn_lut[np.r_[np.arange(nb // 2 + 1), NO_PATH]]
-        self._fast = isinstance(self.table, SafetyTable) and bool(np.all(np.diff(held) >= 0))
+        way = self._way_lut[np.r_[np.arange(nb), NO_PATH]]
+        self._fast = isinstance(self.table, SafetyTable) and bool(
+            np.all(np.diff(held) >= 0) and np.all(np.diff(way) >= 0)
+        )
         # the penalty of turning k bins, as _target's score needs it (same float ops)
         self._turn_penalty = self.hysteresis * np.arange(nb + 1.0) * self._bw / self.omega
         self.last_target: int | None = None
@@ -348,7 +357,8 @@ class DecompositionPursuer(BasePolicy):
         """The least margin over the probes on rays from ``origin`` (see above); the
         evader reaches ``origin`` itself after ``delay`` seconds (probes beyond the horizon
         then drop out), only the rays ``rays`` (bool, per ray) count if given, and the
-        rotation is counted ccw (``sense`` > 0) or cw (< 0) only if given."""
+        rotation is counted ccw (``sense`` > 0) or cw (< 0) only if given (a probe with
+        no safe orientation then counts as a full turn, more than any turn that way)."""
         tab = self.table
         offsets, n_rays = self._offsets, self.rays
         if rays is not None:  # only those rays' samples (the others would count as safe)
@@ -375,7 +385,7 @@ class DecompositionPursuer(BasePolicy):
             need = needs[rows[:, self._probe_cols]]  # (rays, radii, bins)
             need[~sub_ok] = 0
             need = need.max(axis=0)
-            v = t_e[:, None] - self._turn_lut[need]
+            v = t_e[:, None] - (self._way_lut if sense else self._turn_lut)[need]
             return v.min(axis=0)
         inside = tab.inside(points).reshape(n_rays, self._n_r)
         reach = np.cumsum(~inside, axis=1) == 0  # a ray stops at the first wall
@@ -389,7 +399,7 @@ class DecompositionPursuer(BasePolicy):
         t_e = np.broadcast_to(t_e, sub_ok.shape)[sub_ok]
         # lut: seconds to turn by a number of bins; a safe bin (0) never threatens
         needs = tab.need if not sense else (tab.ccw if sense > 0 else tab.cw)
-        v = t_e[:, None] - self._turn_lut[needs[r]]
+        v = t_e[:, None] - (self._way_lut if sense else self._turn_lut)[needs[r]]
         return v.min(axis=0)
 
     def _target(self, snap: Snapshot) -> tuple[float, int]:

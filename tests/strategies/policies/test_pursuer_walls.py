@@ -148,6 +148,34 @@ def test_the_far_side_of_a_thin_wall_is_probed_round_both_corners():
     assert len(at) == 1 and np.array_equal(at[0][0], s2) and at[0][3] == -1
 
 
+def test_no_safe_orientation_counts_as_a_full_turn_one_way_round():
+    # the second corner's probes count the rod's turn one way round (up to n_bins - 1
+    # bins); a probe with no safe orientation (NO_PATH) must not count as less than a
+    # turn of more than half way at another probe of the same radius (the eager table's
+    # fast path takes the largest count per radius: NO_PATH, read as half a turn, hid it)
+    import dataclasses
+
+    from strategies.policies.safety import NO_PATH
+
+    p = _pursuer()
+    tab = p.table
+    e = np.array([5.0, 5.0])
+    k = 2  # the third probe radius
+    radius = p.table.resolution * (p._probe_cols[k] + 1)
+    ccw = np.zeros_like(tab.ccw)
+    far = tab.n_bins * 2 // 3  # two thirds of a turn, ccw
+    ccw[tab.row(e + radius * p._dirs[0])] = NO_PATH
+    ccw[tab.row(e + radius * p._dirs[4])] = far
+    p.table = dataclasses.replace(tab, ccw=ccw, cw=np.zeros_like(tab.cw))
+    assert p._fast
+    v = p._probe_values(e, 0.0, None, sense=1)
+    t_e = float(p._t_e[k])
+    assert np.all(v <= t_e - far * tab.bin_width / p.omega + 1e-4)
+    assert v == pytest.approx(t_e - 2.0 * math.pi / p.omega, abs=1e-4)
+    # the shorter way round (need = min(ccw, cw) = 0 here): no threat at all
+    assert np.all(p._probe_values(e) >= p.horizon)
+
+
 def _variant_map(world: str, rot: float, scale: float):
     from envs.maps import builtin_info
 

@@ -58,17 +58,17 @@ def integrate_reduced(
     up/down: the arc turned back in x) or 2 (``max_steps`` exhausted).
 
     Each RK4 step of length ``d`` is :func:`_rhs` at the four classical stages written out
-    (the same operations, without the calls: this is the shooting's inner loop), the state
-    in locals; once a step passes ``x_target``, the same code runs the shortened steps from
+    (the same floats, without the calls: this is the shooting's inner loop), the state in
+    locals; once a step passes ``x_target``, the same code runs the shortened steps from
     the last state: three Newton passes on their length ``d`` (dx/dσ = cos α), then the
     step of the final length.
     """
     cos, sin, sqrt = math.cos, math.sin, math.sqrt
     q = 1.0 / (1.0 - rho * rho)
-    # (rho * rho * c * c is (rho * rho) * c * c; s * n with s = ±1.0 is the product with the
-    # int s, exactly, and a float product is faster)
-    rr, srho, Lrho = rho * rho, s * rho, L * rho
-    s = float(s)
+    # the same floats as _rhs with fewer operations: rho * rho * c * c is (rho * rho) * c * c;
+    # s * n / (L rho) = n / (s L rho) and -c * n / (h L) = c * n / (h (-L)) exactly (s = ±1,
+    # and IEEE rounding is symmetric: a sign moves freely through products and quotients)
+    rr, srho, sLrho, nL = rho * rho, s * rho, s * (L * rho), -L
     x, y, th, a, lm = 0.0, 0.0, theta0, alpha0, 0.0
     sig = 0.0
     rows = [(sig, x, y, th, a, lm)]
@@ -79,31 +79,47 @@ def integrate_reduced(
         h2 = 0.5 * d
         # stage 1 at (th, a)
         phi = a - th
-        c, sp = cos(phi), sin(phi)
+        c = cos(phi)
+        sp = sin(phi)
         h = sqrt(1.0 - rr * c * c)
         n = h - srho * sp
-        x1, y1, t1, a1, m1 = cos(a), sin(a), s * n / Lrho, n * n * sp * q / L, -c * n / (h * L)
+        x1, y1 = cos(a), sin(a)
+        t1 = n / sLrho
+        a1 = n * n * sp * q / L
+        m1 = c * n / (h * nL)
         # stage 2
         th2, aa2 = th + h2 * t1, a + h2 * a1
         phi = aa2 - th2
-        c, sp = cos(phi), sin(phi)
+        c = cos(phi)
+        sp = sin(phi)
         h = sqrt(1.0 - rr * c * c)
         n = h - srho * sp
-        x2, y2, t2, a2, m2 = cos(aa2), sin(aa2), s * n / Lrho, n * n * sp * q / L, -c * n / (h * L)
+        x2, y2 = cos(aa2), sin(aa2)
+        t2 = n / sLrho
+        a2 = n * n * sp * q / L
+        m2 = c * n / (h * nL)
         # stage 3
         th3, aa3 = th + h2 * t2, a + h2 * a2
         phi = aa3 - th3
-        c, sp = cos(phi), sin(phi)
+        c = cos(phi)
+        sp = sin(phi)
         h = sqrt(1.0 - rr * c * c)
         n = h - srho * sp
-        x3, y3, t3, a3, m3 = cos(aa3), sin(aa3), s * n / Lrho, n * n * sp * q / L, -c * n / (h * L)
+        x3, y3 = cos(aa3), sin(aa3)
+        t3 = n / sLrho
+        a3 = n * n * sp * q / L
+        m3 = c * n / (h * nL)
         # stage 4
         th4, aa4 = th + d * t3, a + d * a3
         phi = aa4 - th4
-        c, sp = cos(phi), sin(phi)
+        c = cos(phi)
+        sp = sin(phi)
         h = sqrt(1.0 - rr * c * c)
         n = h - srho * sp
-        x4, y4, t4, a4, m4 = cos(aa4), sin(aa4), s * n / Lrho, n * n * sp * q / L, -c * n / (h * L)
+        x4, y4 = cos(aa4), sin(aa4)
+        t4 = n / sLrho
+        a4 = n * n * sp * q / L
+        m4 = c * n / (h * nL)
         w = d / 6.0
         nx = x + w * (x1 + 2.0 * (x2 + x3) + x4)
         na = a + w * (a1 + 2.0 * (a2 + a3) + a4)

@@ -141,6 +141,7 @@ class ShootingEvader(BasePolicy):
     def _forget(self) -> None:
         """Clear what the evader learnt on the way (its memory)."""
         self._arc: tuple[np.ndarray, float, np.ndarray] | None = None  # (start, frame, path)
+        self._arc_length: np.ndarray | None = None  # along the arc's path, from its start
         self._arc_age = 0
         self._plan_cell, self._plan_lost, self._witness = -1, False, None
         # progress toward the witness: a crossing the evader cannot reach (its disc
@@ -228,7 +229,7 @@ class ShootingEvader(BasePolicy):
         if not len(live):
             return margin, branch
         d = cand[live] - e
-        dist = np.sqrt(np.add.reduce(d * d, axis=1))  # np.linalg.norm(d, axis=1)
+        dist = _row_norms(d)
         rho = min(self.rho, 1.0)
         k = c.v_pursuer / c.l_min
         # the Euler rotation below is at least k (1 - rho) dist / V_e each way (up to
@@ -431,6 +432,7 @@ class ShootingEvader(BasePolicy):
                     [[math.cos(frame), -math.sin(frame)], [math.sin(frame), math.cos(frame)]]
                 )
                 self._arc = (e.copy(), frame, path @ rot.T + e)
+                self._arc_length = _arc_lengths(self._arc[2])
                 self._arc_age = 1
                 return self._arc_heading(e)
         return unit(d)
@@ -438,11 +440,22 @@ class ShootingEvader(BasePolicy):
     def _arc_heading(self, e: np.ndarray) -> np.ndarray:
         """Heading toward the stored arc's point one step ahead of the evader's progress."""
         _, _, path = self._arc
-        k = int(np.argmin(np.linalg.norm(path - e, axis=1)))
+        k = int(np.argmin(_row_norms(path - e)))
         ahead = self.config.v_evader * self.config.dt
-        s = np.cumsum(np.r_[0.0, np.linalg.norm(np.diff(path, axis=0), axis=1)])
+        s = self._arc_length  # of this arc (_start_arc)
         j = int(np.searchsorted(s, s[k] + ahead))
         if j >= len(path):
             self._arc = None
             return unit(path[-1] - e)
         return unit(path[j] - e)
+
+
+def _row_norms(d: np.ndarray) -> np.ndarray:
+    """``np.linalg.norm(d, axis=1)`` of real (n, 2) rows: the same floats (it computes
+    ``sqrt(add.reduce(d * d, axis=1))``), without its dispatch."""
+    return np.sqrt(np.add.reduce(d * d, axis=1))
+
+
+def _arc_lengths(path: np.ndarray) -> np.ndarray:
+    """Arc length along ``path`` at each of its points (0 at the first)."""
+    return np.cumsum(np.concatenate(([0.0], _row_norms(np.diff(path, axis=0)))))

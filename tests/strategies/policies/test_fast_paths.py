@@ -153,3 +153,17 @@ def test_shooting_margins_are_the_direct_computation(shooter, rho):
     n = np.arange(256, dtype=np.uint8)
     want = np.where(n >= NO_PATH, 2 * np.pi, n.astype(float) * shooter.table.bin_width)
     assert shooter._radians[n].tobytes() == want.tobytes()
+
+
+def test_shooting_arc_lengths_are_the_norm_formula():
+    # the arc's lengths, once per arc, and the nearest point's distances without
+    # np.linalg.norm's dispatch: the same floats as the formula _arc_heading used
+    from strategies.policies.shooting import _arc_lengths, _row_norms
+
+    rng = np.random.default_rng(3)
+    for n in (2, 5, 40, 300):
+        path = np.cumsum(rng.normal(scale=0.05, size=(n, 2)), axis=0) + rng.uniform(-9, 9, 2)
+        e = path[rng.integers(n)] + rng.normal(scale=1e-3, size=2)
+        assert _row_norms(path - e).tobytes() == np.linalg.norm(path - e, axis=1).tobytes()
+        want = np.cumsum(np.r_[0.0, np.linalg.norm(np.diff(path, axis=0), axis=1)])
+        assert _arc_lengths(path).tobytes() == want.tobytes()

@@ -403,7 +403,18 @@ class DecompositionPursuer(BasePolicy):
         return v.min(axis=0)
 
     def _target(self, snap: Snapshot) -> tuple[float, int]:
-        """Signed rotation (radians) toward the best reachable orientation, and its bin."""
+        """Signed rotation (radians) toward the best reachable orientation, and its bin.
+
+        Where the table leaves the rod no room to turn one way at the evader's grid row,
+        the orientations free at its row one step ahead (``E + v dt``) count as free too:
+        the rod turns during the step while the evader walks on. Rounding a wall's end the
+        evader opens the far side a row later, and the rod idled that step (maze, wall
+        hugger, seed 4: at 9.0 s the clockwise arc was shut by the wall behind the
+        pursuer and 82 bins open a step later; the swing over the end came about a degree
+        short, occluded at 11.7 s). The row ahead at every step (alone, or added to the
+        current one) changed other episodes: two pillar-room losses, or four escapes of
+        the shooting evader on random:convex:1 that no longer happened.
+        """
         tab = self.table
         row = tab.row(snap.evader)
         b0 = tab.bin_of(snap.theta)
@@ -413,6 +424,12 @@ class DecompositionPursuer(BasePolicy):
         free = tab.free[row]
         nb = tab.n_bins
         ccw_steps, cw_steps = reachable_steps(free, b0)
+        # ccw_steps holds 0 (b0 itself) when b0 is free: no turn
+        if not cw_steps.size or ccw_steps.size == int(ccw_steps.size > 0 and ccw_steps[0] == 0):
+            ahead = tab.row(snap.evader + self.config.dt * snap.evader_velocity)
+            if ahead >= 0 and ahead != row:  # pinned one way here: the row ahead as well
+                free = free | tab.free[ahead]
+                ccw_steps, cw_steps = reachable_steps(free, b0)
         if not ccw_steps.size and not cw_steps.size:
             return 0.0, b0
         cand_bins = np.concatenate([(b0 + ccw_steps) % nb, (b0 - cw_steps) % nb])

@@ -202,6 +202,10 @@ def _variant_map(world: str, rot: float, scale: float):
         # wall and came back along its far side; the rod swung the short way, across it
         ("maze", 0.0, 1.0, 7, 300),
         ("maze", 0.0, 1.0, 6, 500),
+        # before: "occluded" at 11.7 s, the rod a degree short over the end of the thin
+        # wall (8.75 .. 9.25, y 8.75 .. 12.25): at 9.0 s it idled a step while its
+        # clockwise arc was shut at the evader's row and open at the next
+        ("maze", 0.0, 1.0, 4, 130),
     ],
 )
 def test_the_pursuer_swings_before_a_wall_hugger_rounds_a_corner(world, rot, scale, seed, cycles):

@@ -14,9 +14,11 @@ from training.dagger import DaggerConfig
 RL = ["ppo_evader_vs_greedy_open_room", "ppo_pursuer_vs_straight_open_room"]
 DAGGER = [
     "dagger_evader_generalist",
+    "dagger_evader_memory",
     "dagger_evader_plan",
     "dagger_pursuer_generalist",
     "dagger_pursuer_table",
+    "dagger_pursuer_table_balanced",
 ]
 SPECIALISTS = [
     "dagger_evader_two_rooms",
@@ -132,6 +134,7 @@ def test_cli_list(capsys):
     assert all(name in out for name in SHIPPED)
     lines = {line.split("\t")[0]: line for line in out.splitlines()}
     assert "features safety_table" in lines["dagger_pursuer_table"]
+    assert "features escape_plan, escape_memory" in lines["dagger_evader_memory"]
     assert "features" not in lines["dagger_pursuer_generalist"]
 
 

@@ -52,6 +52,7 @@ import numpy as np
 
 from envs.errors import InvalidConfigError
 from strategies.policies.observe import read_state
+from strategies.policies.plan_features import line_of_sight_frame
 from strategies.policies.shooting import ShootingEvader
 
 __all__ = ["MEMORY_FEATURES", "MemoryFeatures"]
@@ -124,24 +125,15 @@ class MemoryFeatures:
             return out
         u = rod / dist
 
-        def frame(d: np.ndarray) -> tuple[float, float]:
-            n = math.hypot(float(d[0]), float(d[1]))
-            if n <= 0.0:
-                return 0.0, 0.0
-            return (
-                float(d[0] * u[0] + d[1] * u[1]) / n,
-                float(-d[0] * u[1] + d[1] * u[0]) / n,
-            )
-
         w = sh._witness
         if w is not None:
             to = w.target - e
-            out[0], out[1] = frame(to)
+            out[0], out[1] = line_of_sight_frame(to, u)
             out[2] = min(math.hypot(float(to[0]), float(to[1])) / self.config.l_max, 1.0)
             out[3] = min(sh._stall / sh.STALL_STEPS, 1.0)
         cell = sh._plan_cell
         if w is None and cell >= 0 and int(sh.plan.rank[cell]) >= 0:
             out[4] = 1.0
         if sh._arc is not None and sh._arc_age < sh.replan:
-            out[9], out[10] = frame(sh._arc[2][-1] - e)
+            out[9], out[10] = line_of_sight_frame(sh._arc[2][-1] - e, u)
         return out

@@ -49,7 +49,7 @@ from envs.errors import InvalidConfigError
 from strategies.policies.observe import read_state
 from strategies.policies.shooting import ShootingEvader
 
-__all__ = ["PLAN_FEATURES", "PlanFeatures"]
+__all__ = ["PLAN_FEATURES", "PlanFeatures", "line_of_sight_frame"]
 
 PLAN_FEATURES = (
     "escapable",
@@ -65,6 +65,19 @@ PLAN_FEATURES = (
     "shot_branch",
 )
 """The features, in order (all in [-1, 1])."""
+
+
+def line_of_sight_frame(d: np.ndarray, u: np.ndarray) -> tuple[float, float]:
+    """``(d . u, d . n) / |d|``: the unit direction of ``d`` in the frame of the line of
+    sight ``u`` (a unit vector) and ``n``, ``u`` turned a quarter counter-clockwise;
+    ``(0, 0)`` for ``d = 0``."""
+    n = math.hypot(float(d[0]), float(d[1]))
+    if n <= 0.0:
+        return 0.0, 0.0
+    return (
+        float(d[0] * u[0] + d[1] * u[1]) / n,
+        float(-d[0] * u[1] + d[1] * u[0]) / n,
+    )
 
 
 class PlanFeatures:
@@ -103,15 +116,6 @@ class PlanFeatures:
         theta = math.atan2(float(u[1]), float(u[0]))
         ev, plan, c = self.evader, self.evader.plan, self.config
 
-        def frame(d: np.ndarray) -> tuple[float, float]:
-            n = math.hypot(float(d[0]), float(d[1]))
-            if n <= 0.0:
-                return 0.0, 0.0
-            return (
-                float(d[0] * u[0] + d[1] * u[1]) / n,
-                float(-d[0] * u[1] + d[1] * u[0]) / n,
-            )
-
         cell = plan.cell_at(e, theta)
         if cell >= 0:
             rank = int(plan.rank[cell])
@@ -124,18 +128,18 @@ class PlanFeatures:
                 )
                 if w is not None:
                     to = w.target - e
-                    out[2], out[3] = frame(to)
+                    out[2], out[3] = line_of_sight_frame(to, u)
                     out[4] = min(math.hypot(float(to[0]), float(to[1])) / c.l_max, 1.0)
         row = ev.table.row(e)
         if row >= 0 and plan.region.any() and not plan.region[row]:
             nxt = int(plan.region_next[row])
             if nxt >= 0:
-                out[5], out[6] = frame(plan.points[nxt] - e)
+                out[5], out[6] = line_of_sight_frame(plan.points[nxt] - e, u)
         best = ev._best_candidate(e, theta)
         if best is not None:
             q, branch = best
             margin, _ = ev._margins(e, theta, q[None])
-            out[7], out[8] = frame(q - e)
+            out[7], out[8] = line_of_sight_frame(q - e, u)
             out[9] = min(max(float(margin[0]) / math.pi, 0.0), 1.0)
             out[10] = 1.0 if branch == "+" else -1.0
         return out

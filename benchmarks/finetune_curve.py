@@ -96,7 +96,10 @@ def main(argv=None) -> int:
     ap.add_argument("--save", default=None, help="directory to keep each arm's last model in")
     args = ap.parse_args(argv)
     torch.set_num_threads(1)
-    cfg = zoo.config(args.model)
+    try:
+        cfg = zoo.config(args.model)
+    except ValueError as exc:  # UnknownNameError: say it without a traceback
+        ap.error(str(exc))
     role = cfg.role
     opponents = args.opponent or [
         "evader/shooting" if role == "pursuer" else "pursuer/decomposition"

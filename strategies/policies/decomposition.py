@@ -424,8 +424,9 @@ class DecompositionPursuer(BasePolicy):
         free = tab.free[row]
         nb = tab.n_bins
         ccw_steps, cw_steps = reachable_steps(free, b0)
-        # ccw_steps holds 0 (b0 itself) when b0 is free: no turn
-        if not cw_steps.size or ccw_steps.size == int(ccw_steps.size > 0 and ccw_steps[0] == 0):
+        # pinned one way: no clockwise step, or no counter-clockwise one (ccw_steps also
+        # holds 0, staying at b0, when b0 is free)
+        if not cw_steps.size or not (ccw_steps > 0).any():
             ahead = tab.row(snap.evader + self.config.dt * snap.evader_velocity)
             if ahead >= 0 and ahead != row:  # pinned one way here: the row ahead as well
                 free = free | tab.free[ahead]

@@ -204,9 +204,9 @@ class SingleAgentEnv(gym.Env):
                 LearnerInputs(inputs.observation, inputs.features, inputs.expert_params)
                 for _ in self.envs
             ]
-            base = SingleAgentEnv(role, self.opponent, maps[0], **env_kwargs,
-                                  **inputs.observation)  # fmt: skip
-            self.observation_space = inputs.space(base.observation_space)
+            # the space of the observation the inputs encode (lidar: the same on every map)
+            base = surveillance_v0.parallel_env(map=maps[0], **env_kwargs, **inputs.observation)
+            self.observation_space = inputs.space(base.observation_space(self.agent))
             base.close()
         self.action_space = self.env.action_space(self.agent)
         self._opponent_obs: np.ndarray | None = None

@@ -104,10 +104,7 @@ class MemoryFeatures:
 
     def restart(self) -> None:
         """Forget the episode: the shadow as :meth:`ShootingEvader.reset` leaves it."""
-        sh = self.shadow
-        sh._prev, sh._steps, sh._wall_last = None, 0, None
-        sh._forget()
-        sh.mode = "start"
+        self.shadow.restart()
 
     def __call__(self, state: np.ndarray) -> np.ndarray:
         """The (11,) float32 features after the shadow's decision at ``state`` (the next

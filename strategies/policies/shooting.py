@@ -128,13 +128,20 @@ class ShootingEvader(BasePolicy):
         # flat probe index of every candidate column of every ray, (rays, len(cols))
         self._col_index = np.arange(self.rays)[:, None] * n_r + self._cols[None, :]
         self._has_region = bool(self.plan.region.any())
-        self._wall_last: tuple[float, float, float] | None = None  # (x, y, distance)
         m = c.map
         idx = m.convex_vertices
         bis = m.edge_normal[m.vertex_prev_edge[idx]] + m.edge_normal[m.vertex_next_edge[idx]]
         bis = bis / np.maximum(np.linalg.norm(bis, axis=1, keepdims=True), 1e-12)
         self._corner_points = m.vertices[idx] + (c.body_radius + 2.0 * h) * bis
         self._corner_rows = self.table.rows(self._corner_points)
+        self.restart()
+
+    def restart(self) -> None:
+        """Forget the episode and keep the map's tables: the evader as :meth:`reset`
+        leaves it (for a copy fed another episode's states,
+        :class:`~strategies.policies.memory_features.MemoryFeatures`)."""
+        self._prev, self._steps = None, 0
+        self._wall_last: tuple[float, float, float] | None = None  # (x, y, distance)
         self._forget()
         self.mode = "start"
 

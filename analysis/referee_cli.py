@@ -6,6 +6,7 @@
     surveil referee corner --cells-per-lmin 24 --out out/referee_corner.png
     surveil referee my_map.json --config '{"v_evader": 0.25}' --classify 3 1 4.5 1
     surveil referee open_room --sample 5 --kind pursuer   # certified starts, as JSON lines
+    surveil referee corner --estimate 6 8             # and the estimate (not a certificate)
 
 The game is the one ``surveil play`` plays on that world (a built-in map's recommended
 range and speeds, then ``--config``). The solution is cached on disk (``$SURVEIL_CACHE_DIR``),
@@ -55,6 +56,15 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     p.add_argument("--sample", type=integer(1), help="print this many certified starts")
     p.add_argument("--kind", choices=["pursuer", "evader", "unknown"], default="pursuer")
     p.add_argument("--seed", type=integer(0), default=0, help="seed of --sample (>= 0)")
+    p.add_argument(
+        "--estimate",
+        nargs="*",
+        type=real(0.0),
+        metavar="CPL",
+        help="also solve the plain discrete game (an estimate, not a certificate) at these "
+        "cells per L_min (default 6 8) and print its shares and its contested share (the "
+        "resolution error); with --classify, the start's estimated label too",
+    )
     p.add_argument("--no-cache", action="store_true", help="neither read nor write the cache")
     p.set_defaults(func=run)
     return p
@@ -112,6 +122,8 @@ def run(args: argparse.Namespace) -> int:
         if label == "evader":
             extra = f" (surveillance breaks within {ref.escape_time((px, py), (ex, ey)):.1f} s)"
         print(f"start pursuer ({px:g}, {py:g}), evader ({ex:g}, {ey:g}): {label}{extra}")
+    if args.estimate is not None:
+        _print_estimate(ref.spec, args)
     if args.sample:
         rng = np.random.default_rng(args.seed)
         for start in ref.sample_starts(args.sample, rng, kind=args.kind):
@@ -122,3 +134,34 @@ def run(args: argparse.Namespace) -> int:
         draw_referee(ref, path=Path(out))
         print(f"wrote {out}")
     return 0
+
+
+def _print_estimate(spec, args: argparse.Namespace) -> None:
+    """The estimate's shares beside the certificates (never mixed with them)."""
+    from strategies.referee import estimate
+
+    cpls = tuple(args.estimate) or (6.0, 8.0)
+    t = time.perf_counter()
+    est = estimate(spec, cpls, cache=not args.no_cache)
+    s = est.summary()
+    print(
+        f"estimate (the plain discrete game at {', '.join(f'{c:g}' for c in est.cpls)} cells "
+        f"per L_min, both information orders; not a certificate; "
+        f"{time.perf_counter() - t:.1f} s):"
+    )
+    print(
+        f"  {s['starts']} lattice starts: pursuer {s['pursuer']:.1%}, evader "
+        f"{s['evader']:.1%}, contested {s['contested']:.1%} (the resolution error)"
+    )
+    for sol in s["solutions"]:
+        print(
+            f"  {sol['cells_per_lmin']:g} cells per L_min: cell {sol['cell']:.4g}, step "
+            f"{sol['tau']:.4g} s, {sol['states']} states, pursuer wins "
+            f"{sol['evader_first']:.1%} (evader moves first) / {sol['pursuer_first']:.1%} "
+            f"(pursuer first), {sol['iterations']} sweeps, "
+            f"{sol['seconds']['build'] + sol['seconds']['solve']:.1f} s"
+        )
+    if args.classify is not None:
+        px, py, ex, ey = args.classify
+        print(f"  start pursuer ({px:g}, {py:g}), evader ({ex:g}, {ey:g}): estimated "
+              f"{est.classify((px, py), (ex, ey))}")  # fmt: skip

@@ -12,7 +12,11 @@ body radius 0.1. For each resolution the script prints:
   episodes use: ``strategies.policies.starts.sample_start``, seeds 0..n-1), with the
   certified time within which the evader breaks surveillance;
 * and, from those starts, every registered pursuer against the referee's own certified
-  evader (``RefereeEvader``) through the shared runner: who won, and when.
+  evader (``RefereeEvader``) through the shared runner: who won, and when;
+* then the *estimate* (``strategies.referee.estimates``: the plain discrete game at the
+  ``--estimate-cpl`` resolutions, both information orders; not a certificate): its shares
+  over the lattice starts, its contested share (the resolution error), and the estimated
+  label of each safe start.
 
 ``--world centered`` moves the pillar to the middle of the room (5..7, 3..5), where the
 gaps are wider than L_max and Prop. 2 no longer decides.
@@ -20,6 +24,7 @@ gaps are wider than L_max and Prop. 2 no longer decides.
 Usage::
 
     python benchmarks/referee_pillar.py [--cpl 24 32] [--starts 6] [--world box|centered]
+        [--estimate-cpl 6 8]
 """
 
 from __future__ import annotations
@@ -46,6 +51,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--starts", type=int, default=6)
     parser.add_argument("--world", choices=["box", "centered"], default="box")
     parser.add_argument("--rho", type=float, default=0.5)
+    parser.add_argument("--estimate-cpl", type=float, nargs="*", default=[6.0, 8.0],
+                        help="resolutions of the estimate (none: skip it)")  # fmt: skip
     args = parser.parse_args(argv)
 
     from envs.errors import VacuousBoundWarning
@@ -106,7 +113,29 @@ def main(argv: list[str] | None = None) -> int:
             t = "-" if r.escape_time is None else f"{r.escape_time:.1f}"
             row.append(f"{name.split('/')[1]} {r.winner} {t}")
         print(f"  start {i} (bound {bound:.1f} s): " + "; ".join(row))
+    if len(set(args.estimate_cpl)) >= 2:
+        _print_estimate(cfg, starts, args.estimate_cpl)
     return 0
+
+
+def _print_estimate(cfg, starts, cpls) -> None:
+    from strategies.referee import GameSpec, estimate
+
+    t = time.perf_counter()
+    est = estimate(GameSpec.from_config(cfg), cpls)
+    s = est.summary()
+    print(f"\nthe estimate (the plain discrete game at {', '.join(f'{c:g}' for c in est.cpls)} "
+          f"cells per L_min, both information orders; not a certificate; "
+          f"{time.perf_counter() - t:.0f} s): {s['starts']} lattice starts, pursuer "
+          f"{s['pursuer']:.1%}, evader {s['evader']:.1%}, contested {s['contested']:.1%} "
+          "(the resolution error)")  # fmt: skip
+    for sol in s["solutions"]:
+        print(f"  {sol['cells_per_lmin']:g} cells per L_min (step {sol['tau']:.3g} s, "
+              f"{sol['states']} states, {sol['seconds']['build'] + sol['seconds']['solve']:.0f}"
+              f" s): pursuer wins {sol['evader_first']:.1%} when the evader moves first, "
+              f"{sol['pursuer_first']:.1%} when the pursuer does")  # fmt: skip
+    for i, st in enumerate(starts):
+        print(f"  safe start {i}: estimated {est.classify(st['pursuer'], st['evader'])}")
 
 
 if __name__ == "__main__":

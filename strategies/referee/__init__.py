@@ -21,6 +21,12 @@ curricula; :func:`regret` and :func:`tournament_regret` report how often each po
 loses a start the referee certifies winnable; :func:`strategies.referee.draw.draw_referee`
 draws the winning sets.
 
+Beside the certificates, :func:`estimate` solves issue 13's plain discrete game (both
+players on one lattice, finite headings, the env's losing set checked at each half-step's
+end and continuously during it) at several resolutions and both information orders: an
+*estimate*, not a certificate, whose labels are ``"pursuer"``, ``"evader"`` or
+``"contested"`` (the solutions disagree: the resolution error) (:mod:`.estimates`).
+
 Example::
 
     spec = GameSpec(world, l_min=1.0, l_max=2.0, v_pursuer=1.0, v_evader=0.5)
@@ -29,6 +35,13 @@ Example::
     ref.summary()["gap"]                       # share of lattice starts left unknown
 """
 
+from strategies.referee.estimates import (
+    ESTIMATE_LABELS,
+    Estimate,
+    EstimateSolution,
+    estimate,
+    solve_estimate,
+)
 from strategies.referee.evader_bound import EvaderBound, solve_evader_bound
 from strategies.referee.policy import RefereeEvader, RefereePursuer
 from strategies.referee.pursuer_bound import PursuerBound, solve_pursuer_bound
@@ -47,8 +60,11 @@ from strategies.referee.regrets import Regret, regret, regret_table, tournament_
 from strategies.referee.spec import MARGIN_REL, GameSpec, Resolution
 
 __all__ = [
+    "ESTIMATE_LABELS",
     "LABELS",
     "MARGIN_REL",
+    "Estimate",
+    "EstimateSolution",
     "EvaderBound",
     "GameSpec",
     "PursuerBound",
@@ -60,12 +76,14 @@ __all__ = [
     "StartSet",
     "cached_evader_bound",
     "cached_pursuer_bound",
+    "estimate",
     "label_starts",
     "referee_for",
     "regret",
     "regret_table",
     "sample_starts",
     "solve",
+    "solve_estimate",
     "solve_evader_bound",
     "solve_pursuer_bound",
     "tournament_regret",

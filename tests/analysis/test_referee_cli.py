@@ -41,6 +41,23 @@ def test_referee_summary_flags_a_pursuer_bound_that_certified_nothing(capsys, mo
     assert "pursuer wins 0.0%" in text and "say nothing" in text and "certified no state" in text
 
 
+def test_referee_estimate_is_printed_beside_the_certificates(capsys, monkeypatch):
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", "/nonexistent")
+    argv = ["referee", "open_room", "--config", '{"v_evader": 0.2}', "--cells-per-lmin", "8",
+            "--no-cache", "--classify", "5", "8", "5", "5", "--estimate", "3", "4"]  # fmt: skip
+    assert main(argv) == 0
+    text = capsys.readouterr().out.splitlines()
+    head = [i for i, line in enumerate(text) if line.startswith("estimate (the plain discrete")]
+    assert len(head) == 1 and "at 3, 4 cells per L_min" in text[head[0]]
+    assert "not a certificate" in text[head[0]]
+    i = head[0]
+    assert "contested" in text[i + 1] and "(the resolution error)" in text[i + 1]
+    assert text[i + 2].startswith("  3 cells per L_min:") and "(evader moves first)" in text[i + 2]
+    assert text[i + 3].startswith("  4 cells per L_min:")
+    assert text[i + 4].startswith("  start pursuer (5, 8), evader (5, 5): estimated ")
+    assert text[i + 4].split()[-1] in ("pursuer", "evader", "contested")
+
+
 @pytest.mark.parametrize(
     ("argv", "message"),
     [

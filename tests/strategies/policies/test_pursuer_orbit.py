@@ -16,6 +16,7 @@ import math
 import numpy as np
 import pytest
 
+from envs.maps import Map
 from strategies.policies import make_policy
 from strategies.policies.base import Snapshot
 from strategies.runner import build_env, run_episode
@@ -74,4 +75,18 @@ def test_the_pursuer_outlasts_a_charger(world, seed, cycles):
     r = run_episode(
         world, "pursuer/decomposition", "evader/toward_away", seed, start="safe", max_cycles=cycles
     )
+    assert r.winner == "pursuer", r.summary()
+
+
+def test_no_swing_for_a_circle_through_a_pillar():
+    # a 10 x 10 room with a 2 x 2 pillar in the middle: the ring round it is 4 wide, no
+    # orbit circle (radius 2.45 + body) fits, but the hard ccw turn's reaches within
+    # ORBIT_REACH of one. Before, _keep_orbit swung for it along a path into the
+    # pillar's top face (wall in 1.6 s, then 1.5, ... 0.1 s) while the decomposition's
+    # own cw turn stayed clear; a straight evader walking at the pillar pinned the
+    # pursuer there, "too_close" at 33.3 s
+    room = Map([(0, 0), (10, 0), (10, 10), (0, 10)], [[(4, 4), (6, 4), (6, 6), (4, 6)]])
+    params = {"l_min": 2.0, "l_max": 4.0, "v_pursuer": 1.0, "v_evader": 0.5, "body_radius": 0.1}
+    r = run_episode(room, "pursuer/decomposition", "evader/straight", 101, start="safe",
+                    max_cycles=345, overrides=params)  # fmt: skip
     assert r.winner == "pursuer", r.summary()

@@ -155,8 +155,9 @@ def _print_estimate(spec, args: argparse.Namespace) -> None:
     )
     for sol in s["solutions"]:
         print(
-            f"  {sol['cells_per_lmin']:g} cells per L_min: cell {sol['cell']:.4g}, step "
-            f"{sol['tau']:.4g} s, {sol['states']} states, pursuer wins "
+            f"  {sol['cells_per_lmin']:g} cells per L_min, {sol['steps']:.3g} cells a step: "
+            f"cell {sol['cell']:.4g}, step {sol['tau']:.4g} s, {sol['states']} states, "
+            f"pursuer wins "
             f"{sol['evader_first']:.1%} (evader moves first) / {sol['pursuer_first']:.1%} "
             f"(pursuer first), {sol['iterations']} sweeps, "
             f"{sol['seconds']['build'] + sol['seconds']['solve']:.1f} s"

@@ -130,7 +130,8 @@ def _print_estimate(cfg, starts, cpls) -> None:
           f"{s['pursuer']:.1%}, evader {s['evader']:.1%}, contested {s['contested']:.1%} "
           "(the resolution error)")  # fmt: skip
     for sol in s["solutions"]:
-        print(f"  {sol['cells_per_lmin']:g} cells per L_min (step {sol['tau']:.3g} s, "
+        print(f"  {sol['cells_per_lmin']:g} cells per L_min ({sol['steps']:.3g} cells a step of "
+              f"{sol['tau']:.3g} s, "
               f"{sol['states']} states, {sol['seconds']['build'] + sol['seconds']['solve']:.0f}"
               f" s): pursuer wins {sol['evader_first']:.1%} when the evader moves first, "
               f"{sol['pursuer_first']:.1%} when the pursuer does")  # fmt: skip

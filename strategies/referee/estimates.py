@@ -45,22 +45,26 @@ disagree (*contested*) is how wrong it may be, and nothing proves even that.
 share of the finest lattice's starts is the resolution error. Its solutions are cached
 on disk like the bounds' (:mod:`.cache`, kind ``"estimate<headings>"``).
 
-**Measured** (L in [2, 4], rho = 0.5, body 0.1, 4 cells per step, 16 headings; states
-where surveillance holds, seconds to build + solve both orders, load ~3 on 2 cores):
+**Measured** (L in [2, 4], rho = 0.5, body 0.1, 16 headings, the default steps: tau =
+1.33 s, the pursuer 4, 5.33 and 8 cells a step at 6, 8 and 12 cells per L_min; states where
+surveillance holds, seconds to build + solve both orders, load ~2.5 on 2 cores):
 
 =================  ===============  ===============  ================  ============
 world              6 cells / L_min  8                12                contested
 =================  ===============  ===============  ================  ============
-open_room 10 x 10  176 k, 7 s       579 k, 19 s      2.99 M, 91 s      97.8 %
-pillar room 12x8   138 k, 21 s      456 k, 49 s      2.37 M, 187 s     0 % (evader)
-corner 14 x 14     169 k, 18 s      562 k, 51 s      -                 0 % (evader)
+open_room 10 x 10  176 k, 7 s       579 k, 12 s      2.99 M, 61 s      97.7 %
+pillar room 12x8   138 k, 21 s      456 k, 56 s      2.37 M, 217 s     0 % (evader)
+corner 14 x 14     169 k, 18 s      562 k, 37 s      -                 0 % (evader)
 =================  ===============  ===============  ================  ============
 
-The states grow as the fourth power of the resolution (cpl^4), the sweeps about
-linearly. In the open room the pursuer wins 97 % of the states when it moves second and
-none when it moves first, at every resolution: at rho = 0.5 a pursuer that commits a step
-of V_p tau before the evader answers loses the whole room at these resolutions, so the
-estimate can only say ``"evader"`` or ``"contested"`` there.
+The states grow as the fourth power of the resolution (cpl^4). In the open room the
+pursuer wins 97 % of the states when it moves second and none when it moves first, at
+every resolution: at rho = 0.5 a pursuer that commits its step before the evader answers
+loses the whole room at these resolutions, so the estimate can only say ``"evader"`` or
+``"contested"`` there. The snapping alone can decide a solution: the open room at rho =
+0.4 is won by the pursuer moving first from 98 % of the states at 6 cells per L_min (the
+evader's 1.6-cell moves snap to at most 2.24 cells) and from none at 8 (2.13 cells snap
+to up to 2.83 on the diagonals): 98.5 % contested.
 """
 
 from __future__ import annotations
@@ -231,6 +235,7 @@ class EstimateSolution:
         n = max(1, self.states)
         return {
             "cells_per_lmin": self.cells_per_lmin,
+            "steps": self.steps,
             "cell": self.lattice.h,
             "tau": self.tau,
             "points": self.lattice.n_points,
@@ -597,7 +602,7 @@ def estimate(
     spec: GameSpec,
     cpls: Sequence[float] = (6.0, 8.0),
     *,
-    steps: float = 4.0,
+    steps: float | Sequence[float] | None = None,
     headings: int = 16,
     cache: bool = True,
     cache_dir: str | os.PathLike | None = None,
@@ -607,10 +612,20 @@ def estimate(
 
     Args:
         spec: the game.
-        cpls: cells per L_min of each resolution (at least two, each > 0).
-        steps: cells the pursuer covers per step (``tau = steps l_min / (cpl V_p)``). The
-            evader covers ``rho steps`` cells; below 2 its snapped moves are coarse (a move
-            of one cell is 1 or sqrt(2) cells long: up to 41 % too fast).
+        cpls: cells per L_min of each resolution (at least two, each > 0, all different).
+        steps: cells the pursuer covers per step at each resolution (one number for all,
+            or one per entry of ``cpls``; ``tau = steps l_min / (cpl V_p)``); the evader
+            covers ``rho steps`` cells. None: 4 at the coarsest resolution and
+            proportionally more at the others (``4 cpl / min(cpls)``), so every solution
+            has the same step ``tau = 4 l_min / (min(cpls) V_p)`` and the finer ones refine
+            space and the snapping of the moves: at rho = 0.5 the evader's 16 headings of 2
+            cells snap to lengths 1.41, 2 and 2.24, of 2.67 cells to 2.24, 2.83 and 3. With
+            the same ``steps`` at every resolution every solution snaps alike and the
+            contested share misses that error (an empty 12 x 8 room at rho = 0.5, 8 cells
+            per L_min: the pursuer moving second wins 0 % of the states at 4 cells a step,
+            49 % at 6); a longer step costs the pursuer that moves first (the evader
+            answers a longer committed move). Below 2 evader cells a step the snapped moves
+            are coarse (a move of one cell is 1 or sqrt(2) cells long: up to 41 % fast).
         headings: directions of the moves.
         cache: read and write the on-disk cache (:mod:`.cache`).
         cache_dir: cache directory (default ``$SURVEIL_CACHE_DIR`` or ``~/.cache/surveil``).
@@ -619,13 +634,24 @@ def estimate(
     if not isinstance(spec, GameSpec):
         raise InvalidConfigError(f"estimate: expected a GameSpec, got {type(spec).__name__}")
     values = [V.positive("cpls", c) for c in cpls]
-    if len(set(values)) < 2:
+    if len(set(values)) < 2 or len(set(values)) < len(values):
         raise InvalidConfigError(
             f"cpls = {tuple(cpls)!r}: expected at least two different resolutions (the "
             "resolution error is their disagreement)"
         )
-    steps = V.positive("steps", steps)
+    order = np.argsort(values, kind="stable")
+    if steps is None:
+        per = [4.0 * values[i] / values[order[0]] for i in order]
+    elif isinstance(steps, Sequence):
+        if len(steps) != len(values):
+            raise InvalidConfigError(
+                f"steps = {tuple(steps)!r}: expected one number, or one per resolution in "
+                f"cpls = {tuple(cpls)!r}"
+            )
+        per = [V.positive("steps", steps[i]) for i in order]
+    else:
+        per = [V.positive("steps", steps)] * len(values)
     headings = V.integer("headings", headings, minimum=4)
-    sols = [_cached_solution(spec, c, steps, headings, cache, cache_dir, progress)
-            for c in sorted(set(values))]  # fmt: skip
+    sols = [_cached_solution(spec, values[i], s, headings, cache, cache_dir, progress)
+            for i, s in zip(order, per, strict=True)]  # fmt: skip
     return Estimate(spec, sols)

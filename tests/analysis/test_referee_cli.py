@@ -52,8 +52,9 @@ def test_referee_estimate_is_printed_beside_the_certificates(capsys, monkeypatch
     assert "not a certificate" in text[head[0]]
     i = head[0]
     assert "contested" in text[i + 1] and "(the resolution error)" in text[i + 1]
-    assert text[i + 2].startswith("  3 cells per L_min:") and "(evader moves first)" in text[i + 2]
-    assert text[i + 3].startswith("  4 cells per L_min:")
+    assert text[i + 2].startswith("  3 cells per L_min, 4 cells a step:")
+    assert "(evader moves first)" in text[i + 2]
+    assert text[i + 3].startswith("  4 cells per L_min, 5.33 cells a step:")
     assert text[i + 4].startswith("  start pursuer (5, 8), evader (5, 5): estimated ")
     assert text[i + 4].split()[-1] in ("pursuer", "evader", "contested")
 

@@ -68,6 +68,9 @@ def test_estimate_api_labels_cache_and_bad_input(tmp_path):
     s = spec(open_room(), 1.5)
     first = estimate(s, cpls=(3, 4), cache_dir=tmp_path)
     assert first.cpls == (3.0, 4.0)
+    # the same step tau, the finer lattice's moves snap differently
+    assert [s.steps for s in first.solutions] == pytest.approx([4.0, 16 / 3])
+    assert first.solutions[0].tau == pytest.approx(first.solutions[1].tau)
     assert any((tmp_path / "referee").iterdir())
     again = estimate(s, cpls=(4, 3), cache_dir=tmp_path)  # loaded, same arrays
     for x, y in zip(first.solutions, again.solutions, strict=True):
@@ -81,5 +84,7 @@ def test_estimate_api_labels_cache_and_bad_input(tmp_path):
         estimate(s, cpls=(4, 4))
     with pytest.raises(InvalidConfigError, match="cpls"):
         estimate(s, cpls=(4, -1))
+    with pytest.raises(InvalidConfigError, match="steps = \\(4,\\): expected one number"):
+        estimate(s, cpls=(3, 4), steps=(4,))
     with pytest.raises(InvalidConfigError, match="expected a GameSpec"):
         estimate(open_room(), cpls=(3, 4))

@@ -99,6 +99,7 @@ class ShootingEvader(BasePolicy):
         self.memory = flag_param("memory", memory)
 
     STALL_STEPS = 10  # steps without getting closer to a crossing before giving it up
+    FORGIVE_STEPS = 20  # steps without a crossing in an escapable cell before a retry
 
     def _reset(self) -> None:
         c = self.config
@@ -158,6 +159,8 @@ class ShootingEvader(BasePolicy):
         self._best_gap, self._stall = math.inf, 0
         self._came_through: tuple[int, int] | None = None  # (cell left, piece crossed)
         self._trail: list[tuple[int, int]] = []  # the last crossings (cell left, piece)
+        self._no_way = 0  # steps in an escapable cell whose crossings are all excluded
+        self._forgiven = 0  # retries so far (each waits twice as long as the last)
 
     # ------------------------------------------------------------------ candidates
     def _candidates(self, e: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -380,6 +383,26 @@ class ShootingEvader(BasePolicy):
             if self._stall >= self.STALL_STEPS:  # not getting closer: that crossing is out
                 self._excluded.setdefault(cell, set()).add(self._witness.boundary)
                 self._new_witness(cell, e)
+        if (
+            self._witness is None
+            and plan.rank[cell] >= 0
+            and (cell in self._excluded or self._came_through)
+        ):
+            # an escapable cell whose every usable crossing is excluded (stalls and cycles
+            # add up over an episode): the fallback alone made no progress there for the
+            # whole horizon (issue 13: two_rooms turned by 2.2 rad at L_min 1, L_max 1.5,
+            # rho 0.5: 4,600 steps of pressure). After FORGIVE_STEPS of it, forget this
+            # cell's exclusions and the way back and try its plan again; the trail and the
+            # other cells' exclusions stay (a cycle it re-enters is caught again), and each
+            # retry waits twice as long as the last (a fallback that escapes keeps its time)
+            self._no_way += 1
+            if self._no_way >= self.FORGIVE_STEPS << self._forgiven:
+                self._excluded.pop(cell, None)
+                self._came_through = None
+                self._new_witness(cell, e)
+                self._no_way, self._forgiven = 0, self._forgiven + 1
+        else:
+            self._no_way = 0
         w = self._witness
         if w is None:
             return None

@@ -20,7 +20,13 @@ pursuer's mean in the same run (the machine-independent figures).
 Usage::
 
     python benchmarks/decision_time.py [--maps corridor two_rooms ...] [--seeds 2]
-        [--max-cycles 300] [--reps 3] [--clock wall|cpu]
+        [--max-cycles 300] [--reps 3] [--clock wall|cpu] [--l-min 1] [--table lazy]
+
+``--l-min X`` plays the maps at L_min = X, L_max = 2 X instead of their own ranges (the
+decomposition pursuer's grid is L_min / 20: halving L_min quadruples its points);
+``--table`` forces the decomposition pursuer's safety table (``auto``: eager up to
+``DecompositionPursuer.EAGER_TABLE_POINTS`` grid points, else filled lazily), so the two
+can be compared on the same episodes.
 """
 
 from __future__ import annotations
@@ -41,12 +47,20 @@ POLICIES = [("pursuer/decomposition", "pursuer"), ("evader/shooting", "evader")]
 
 
 def _replay(
-    name: str, role: str, result, observations, seed: int, reps: int, clock=time.perf_counter
+    name: str,
+    role: str,
+    result,
+    observations,
+    seed: int,
+    reps: int,
+    clock=time.perf_counter,
+    params: dict | None = None,
 ) -> np.ndarray:
-    """Seconds per decision (least over ``reps`` replays), the first decision first."""
+    """Seconds per decision (least over ``reps`` replays, each by a fresh policy), the
+    first decision first."""
     runs = []
     for _ in range(reps):
-        policy = make_policy(name)
+        policy = make_policy(name, **(params or {}))
         policy.reset(role=role, map=result.config.map, config=result.config, seed=seed)
         times = []
         for obs in observations:
@@ -58,7 +72,13 @@ def _replay(
 
 
 def measure(
-    map_name: str, seeds: int, max_cycles: int, reps: int, clock=time.perf_counter
+    map_name: str,
+    seeds: int,
+    max_cycles: int,
+    reps: int,
+    clock=time.perf_counter,
+    overrides: dict | None = None,
+    table: str = "auto",
 ) -> tuple[dict[str, np.ndarray], dict[str, float]]:
     """Per-decision seconds of each policy (and the reference) on ``map_name``, first
     decisions left out, and the slowest first decision of each."""
@@ -73,12 +93,14 @@ def measure(
             seed,
             start="safe",
             max_cycles=max_cycles,
+            overrides=overrides,
             on_step=lambda t, seen=observations: seen.append(t.observations),
         )
         _, _, s_pursuer, s_evader = episode_seeds(seed)
         role_seed = {"pursuer": s_pursuer, "evader": s_evader}
         for name, role in [*POLICIES, (REFERENCE, "pursuer")]:
-            t = _replay(name, role, result, observations, role_seed[role], reps, clock)
+            params = {"table": table} if name == "pursuer/decomposition" else None
+            t = _replay(name, role, result, observations, role_seed[role], reps, clock, params)
             out.setdefault(name, []).append(t[1:])
             first[name] = max(first.get(name, 0.0), float(t[0]))
     return {name: np.concatenate(v) for name, v in out.items()}, first
@@ -91,15 +113,31 @@ def main(argv=None) -> int:
     ap.add_argument("--max-cycles", type=int, default=300)
     ap.add_argument("--reps", type=int, default=3)
     ap.add_argument("--clock", choices=sorted(CLOCKS), default="wall")
+    ap.add_argument("--l-min", type=float, default=None)
+    ap.add_argument("--table", choices=["auto", "eager", "lazy"], default="auto")
     args = ap.parse_args(argv)
-    print(f"load average: {os.getloadavg()}; clock: {args.clock}")
+    if args.l_min is not None and not args.l_min > 0:
+        ap.error(f"--l-min = {args.l_min}: expected a number > 0")
+    overrides = None if args.l_min is None else {"l_min": args.l_min, "l_max": 2 * args.l_min}
+    print(
+        f"load average: {os.getloadavg()}; clock: {args.clock}; table: {args.table}"
+        + ("" if overrides is None else f"; L in [{args.l_min:g}, {2 * args.l_min:g}]")
+    )
     print(
         f"{'map':<11}{'policy':<24}{'steps':>6}{'mean ms':>9}{'p99 ms':>8}{'max ms':>8}"
         f"{'first ms':>9}{'mean/ref':>10}{'p99/ref':>9}"
     )
     worst = {name: 0.0 for name, _ in POLICIES}
     for map_name in args.maps:
-        times, first = measure(map_name, args.seeds, args.max_cycles, args.reps, CLOCKS[args.clock])
+        times, first = measure(
+            map_name,
+            args.seeds,
+            args.max_cycles,
+            args.reps,
+            CLOCKS[args.clock],
+            overrides,
+            args.table,
+        )
         ref = float(times[REFERENCE].mean())
         for name in [*(n for n, _ in POLICIES), REFERENCE]:
             t = times[name] * 1e3

@@ -25,7 +25,8 @@ Beside the certificates, :func:`estimate` solves issue 13's plain discrete game 
 players on one lattice, finite headings, the env's losing set checked at each half-step's
 end and continuously during it) at several resolutions and both information orders: an
 *estimate*, not a certificate, whose labels are ``"pursuer"``, ``"evader"`` or
-``"contested"`` (the solutions disagree: the resolution error) (:mod:`.estimates`).
+``"contested"`` (the solutions disagree: the resolution error) (:mod:`.estimates`);
+:class:`EstimateEvader` plays its evader strategy in the env.
 
 Example::
 
@@ -35,6 +36,7 @@ Example::
     ref.summary()["gap"]                       # share of lattice starts left unknown
 """
 
+from strategies.referee.estimate_policy import EstimateEvader
 from strategies.referee.estimates import (
     ESTIMATE_LABELS,
     Estimate,
@@ -64,6 +66,7 @@ __all__ = [
     "LABELS",
     "MARGIN_REL",
     "Estimate",
+    "EstimateEvader",
     "EstimateSolution",
     "EvaderBound",
     "GameSpec",

@@ -65,6 +65,15 @@ loses the whole room at these resolutions, so the estimate can only say ``"evade
 0.4 is won by the pursuer moving first from 98 % of the states at 6 cells per L_min (the
 evader's 1.6-cell moves snap to at most 2.24 cells) and from none at 8 (2.13 cells snap
 to up to 2.83 on the diagonals): 98.5 % contested.
+
+**Played.** The evader-first solve records each state's rank (the sweep in which it left
+the pursuer's set), and :class:`~strategies.referee.estimate_policy.EstimateEvader`
+plays the strategy that lowers it in the env. Against the env's pursuers from the safe
+starts of seeds 0-7 (rho = 0.5, body radius 0.2, 600 steps; 6 / 8 cells per L_min, tau
+1.33 / 1 s) it escapes the decomposition pursuer 4/8 / 8/8 on the corner world, where
+every registered evader is held 48/48, and greedy 7/8 / 8/8; the decomposition pursuer
+3/8 / 2/8 in the pillar room; 0/8 / 0/8 in the open room (contested). So the corner's
+``"evader"`` label is backed by play, not only by the discretisation.
 """
 
 from __future__ import annotations
@@ -177,6 +186,13 @@ class EstimateSolution:
         pursuer_first: (n, W, W) the pursuer wins when it moves first each step.
         iterations: sweeps of the fixed point.
         seconds: ``{"build": ..., "solve": ...}``.
+        evader_first_rank: (n, W, W) the sweep of the evader-first iteration in which each
+            state left the pursuer's set (uint8, or uint16 past 254 sweeps): 0 where
+            surveillance fails, the dtype's largest value where the pursuer wins. From a
+            state of rank k > 0 the evader has a move after which every pursuer answer
+            ends in a state of rank < k (or breaks surveillance within the step): the
+            evader's strategy (:class:`~strategies.referee.estimate_policy.EstimateEvader`).
+            None when not recorded.
     """
 
     spec: GameSpec
@@ -189,6 +205,7 @@ class EstimateSolution:
     pursuer_first: np.ndarray
     iterations: int
     seconds: dict[str, float] = field(default_factory=dict)
+    evader_first_rank: np.ndarray | None = None
 
     @property
     def tau(self) -> float:
@@ -424,9 +441,14 @@ def solve_estimate(
 
     sweeps = [0, 0]
     A = safe_p.copy()  # evader first
+    # the sweep in which each state left the set; 255 (or 65535) where it never does
+    rank = np.where(safe, np.uint16(_NEVER), np.uint16(0))
+    prev = safe
     while True:
         sweeps[0] += 1
         Au = unpack(A)
+        rank[prev & ~Au] = sweeps[0] - 1
+        prev = Au.copy()
         # G[m] at the intermediate state (k, r''): p's move m from k allowed, no fan hit,
         # the rod p-e'' clear, A at the end
         G = [pursuer_step(Au, m) & nofan_p[m] & clear_p for m in range(len(vp))]
@@ -464,6 +486,7 @@ def solve_estimate(
         B = Bn
     A = unpack(A).copy()
     B = unpack(B).copy()
+    rank = _compact_rank(rank, sweeps[0])
     t2 = time.perf_counter()
     return EstimateSolution(
         spec=spec,
@@ -476,13 +499,26 @@ def solve_estimate(
         pursuer_first=B,
         iterations=sum(sweeps),
         seconds={"build": t1 - t0, "solve": t2 - t1},
+        evader_first_rank=rank,
     )
+
+
+_NEVER = np.iinfo(np.uint16).max
+
+
+def _compact_rank(rank: np.ndarray, sweeps: int) -> np.ndarray:
+    """uint8 ranks (255: never left) when the sweeps fit, else uint16 (65535)."""
+    if sweeps < 255:
+        out = rank.astype(np.uint8)
+        out[rank == _NEVER] = 255
+        return out
+    return rank
 
 
 def _cached_solution(spec, cpl, steps, headings, cache, cache_dir, progress) -> EstimateSolution:
     res = _resolution(spec, cpl, steps)
     kind = f"estimate{headings}"
-    names = ("safe", "evader_first", "pursuer_first", "iterations", "seconds")
+    names = ("safe", "evader_first", "pursuer_first", "iterations", "seconds", "rank")
     if cache:
         arrays = load_arrays(kind, spec, res, names, cache_dir)
         if arrays is not None:
@@ -497,6 +533,7 @@ def _cached_solution(spec, cpl, steps, headings, cache, cache_dir, progress) -> 
                     unpack(arrays["pursuer_first"]).astype(bool),
                     int(arrays["iterations"]),
                     {"build": float(arrays["seconds"][0]), "solve": float(arrays["seconds"][1])},
+                    arrays["rank"].reshape(shape),
                 )  # fmt: skip
     sol = solve_estimate(spec, cpl, steps=steps, headings=headings, progress=progress)
     if cache:
@@ -507,6 +544,7 @@ def _cached_solution(spec, cpl, steps, headings, cache, cache_dir, progress) -> 
                 "pursuer_first": np.packbits(sol.pursuer_first),
                 "iterations": np.array(sol.iterations),
                 "seconds": np.array([sol.seconds["build"], sol.seconds["solve"]]),
+                "rank": sol.evader_first_rank.ravel(),
             }, cache_dir)  # fmt: skip
         except OSError:
             pass

@@ -72,7 +72,8 @@ plays the strategy that lowers it in the env. Against the env's pursuers from th
 starts of seeds 0-7 (rho = 0.5, body radius 0.2, 600 steps; 6 / 8 cells per L_min, tau
 1.33 / 1 s) it escapes the decomposition pursuer 4/8 / 8/8 on the corner world, where
 every registered evader is held 48/48, and greedy 7/8 / 8/8; the decomposition pursuer
-3/8 / 2/8 in the pillar room; 0/8 / 0/8 in the open room (contested). So the corner's
+3/8 / 2/8 in the pillar room; 0/8 / 0/8 in the open room (contested); at 8 cells per
+L_min also 4/8 on the corner at rho = 0.3 (the registered evaders 0/48). So the corner's
 ``"evader"`` label is backed by play, not only by the discretisation.
 """
 

@@ -212,11 +212,6 @@ class DecompositionPursuer(BasePolicy):
         self._orbit_k = rho / root  # radius of the evader's circle, per unit of L
         self._orbit_R = 1.0 / root  # radius of the pursuer's circle, per unit of L
         self._orbit_pad = c.body_radius + h  # + a grid step: the margin is read on the grid
-        # does a circle with room fit anywhere (at L_target)? Unknown for a lazy table
-        # (its grid is filled as the evader goes): assumed so
-        self._orbit_room = self._clear is None or bool(
-            self._clear.max() >= self._orbit_R * self.L_target + self._orbit_pad
-        )
         self._wall_times = np.arange(1, round(self.WALL_HORIZON / self.WALL_STEP) + 1) * (
             self.WALL_STEP
         )
@@ -565,18 +560,18 @@ class DecompositionPursuer(BasePolicy):
         override judged on the charge alone undid the decomposition's turns against
         evaders that do not follow the rod (5 maze and pillar episodes lost).
 
-        On a map where no circle with room fits anywhere (no grid node's wall distance
-        reaches ``R + body + h`` at L_target) a circle short of room is never reached,
-        so a hard turn toward one gives way to the decomposition's own ``rate`` when its
-        path meets a wall within ``ORBIT_LOOKAHEAD`` whatever the evader does (both
-        modes of :meth:`_time_to_wall`) and ``rate``'s path stays clear in both. In a
-        10 x 10 room with a 2 x 2 pillar in the middle (the ring round it 4 wide,
-        ``R + body`` = 2.55 at L_min = 2) the hard ccw turn's circle came within
-        ``ORBIT_REACH`` (short by 0.50) and never closer, and the pursuer swung for it
-        into the pillar's face (wall 1.6 s ahead, then 1.5, ... 0.1 s) while the cw turn
-        was clear: pinned, "too_close" at 33.3 s by a straight evader (issue 13). Giving
-        way as soon as any wall lay ahead (or on maps with room too) lost other episodes
-        (an L-shaped hall of 4-wide arms; the corner world's variants).
+        A hard turn toward a circle short of room gives way to the decomposition's own
+        ``rate`` when its path meets a wall within ``ORBIT_LOOKAHEAD`` whatever the
+        evader does (both modes of :meth:`_time_to_wall`) and ``rate``'s path stays
+        clear in both: a circle that needs the pursuer to pass through a wall first is
+        not one it will reach. In a 10 x 10 room with a 2 x 2 pillar in the middle (the
+        ring round it 4 wide, ``R + body`` = 2.55 at L_min = 2) the hard ccw turn's
+        circle came within ``ORBIT_REACH`` (short by 0.50) and never closer, and the
+        pursuer swung for it into the pillar's face (wall 1.6 s ahead, then 1.5, ...
+        0.1 s) while the cw turn was clear: pinned, "too_close" at 33.3 s by a straight
+        evader; in a room with a triangular pillar at rho 0.3 the same swing lost to a
+        charger in 7.6 s (issue 13). Giving way as soon as any wall lay ahead, in either
+        mode, lost other episodes (the corner world's variants, 422 -> 415/432).
         """
         ex, ey = float(snap.evader[0]), float(snap.evader[1])
         ve = snap.evader_velocity
@@ -604,10 +599,10 @@ class DecompositionPursuer(BasePolicy):
             near = near or m >= reach
             if m > best + 0.01 * L:
                 best, pick = m, r
-        if near and (self._orbit_room or pick == rate):
+        if near and pick == rate:
             return pick
-        if near:  # no room anywhere: the decomposition's turn if the pick's path hits a
-            # wall within ORBIT_LOOKAHEAD whatever the evader does, and its own is clear
+        if near:  # the decomposition's turn if the pick's path hits a wall within
+            # ORBIT_LOOKAHEAD whatever the evader does, and its own is clear
             soon = all(self._time_to_wall(snap, pick, L, f) <= T for f in (True, False))
             clear = all(self._time_to_wall(snap, rate, L, f) == math.inf for f in (True, False))
             return rate if soon and clear else pick

@@ -90,3 +90,19 @@ def test_no_swing_for_a_circle_through_a_pillar():
     r = run_episode(room, "pursuer/decomposition", "evader/straight", 101, start="safe",
                     max_cycles=345, overrides=params)  # fmt: skip
     assert r.winner == "pursuer", r.summary()
+
+
+@pytest.mark.parametrize(
+    ("evader", "cycles"), [("evader/toward_away", 120), ("evader/straight", 220)]
+)
+def test_no_swing_into_a_triangle_pillar(evader, cycles):
+    # a 12 x 9 room with a triangular pillar, rho 0.3, L in [2, 3]: a circle with room fits
+    # somewhere in the room, but the hard turn's circle near the pillar did not, and the
+    # pursuer swung for it into the pillar while the decomposition's own turn was clear
+    # (before: "too_close" at 7.6 s against the charger, 18.3 s against the straight
+    # evader; found by an unseen-worlds sweep, issue 13)
+    room = Map([(0, 0), (12, 0), (12, 9), (0, 9)], [[(6, 3), (8.5, 5.5), (5, 6.5)]])
+    params = {"l_min": 2.0, "l_max": 3.0, "v_pursuer": 1.0, "v_evader": 0.3, "body_radius": 0.1}
+    r = run_episode(room, "pursuer/decomposition", evader, 101, start="safe",
+                    max_cycles=cycles, overrides=params)  # fmt: skip
+    assert r.winner == "pursuer", r.summary()

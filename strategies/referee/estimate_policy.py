@@ -18,7 +18,6 @@ and off the lattice, so the rank need not fall every step.
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from envs import validation as V
 from envs.errors import InvalidConfigError
@@ -114,7 +113,7 @@ class EstimateEvader(BasePolicy):
             vp = heading_moves(sol.spec.v_pursuer * sol.tau, lat.h, sol.headings)
             ve = heading_moves(sol.spec.v_evader * sol.tau, lat.h, sol.headings)
             self._tables = (
-                cKDTree(lat.points), vp, ve, _move_targets(lat, vp), _move_targets(lat, ve),
+                sol.tree, vp, ve, _move_targets(lat, vp), _move_targets(lat, ve),
                 kernel_for(sol.spec.map), convex_corners(sol.spec.map)[0],
             )  # fmt: skip
 

@@ -79,6 +79,7 @@ L_min also 4/8 on the corner at rho = 0.3 (the registered evaders 0/48). So the 
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import time
@@ -94,7 +95,7 @@ from envs.errors import InvalidConfigError
 from envs.geometry import kernel_for
 from strategies.referee._fixpoint import shifted
 from strategies.referee.cache import load_arrays, save_arrays
-from strategies.referee.lattice import Lattice, segment_wall_distance
+from strategies.referee.lattice import Lattice, _cross, segment_wall_distance
 from strategies.referee.robust import convex_corners
 from strategies.referee.spec import GameSpec, Resolution
 
@@ -159,13 +160,9 @@ def _segment_origin_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def _in_triangle(w, a, b, c) -> np.ndarray:
     """Whether the points w lie in the closed triangles (a, b, c) (arrays (..., 2))."""
-
-    def cross(u, v):
-        return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
-
-    s1 = cross(b - a, w - a)
-    s2 = cross(c - b, w - b)
-    s3 = cross(a - c, w - c)
+    s1 = _cross(b - a, w - a)
+    s2 = _cross(c - b, w - b)
+    s3 = _cross(a - c, w - c)
     return ((s1 >= 0) & (s2 >= 0) & (s3 >= 0)) | ((s1 <= 0) & (s2 <= 0) & (s3 <= 0))
 
 
@@ -218,10 +215,10 @@ class EstimateSolution:
         """Number of (pursuer, evader) states where surveillance holds."""
         return int(np.count_nonzero(self.safe))
 
-    def _tree(self) -> cKDTree:
-        if not hasattr(self, "_kd"):
-            self._kd = cKDTree(self.lattice.points)
-        return self._kd
+    @functools.cached_property
+    def tree(self) -> cKDTree:
+        """A k-d tree of the lattice points (built on first use), to snap positions."""
+        return cKDTree(self.lattice.points)
 
     def wins(self, pursuer: np.ndarray, evader: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Whether the pursuer wins each start, evader first and pursuer first.
@@ -237,8 +234,8 @@ class EstimateSolution:
             ``(evader_first, pursuer_first)``, each (k,) bool.
         """
         lat = self.lattice
-        _, kp = self._tree().query(np.atleast_2d(pursuer))
-        _, ke = self._tree().query(np.atleast_2d(evader))
+        _, kp = self.tree.query(np.atleast_2d(pursuer))
+        _, ke = self.tree.query(np.atleast_2d(evader))
         ab = lat.point_cells[ke] - lat.point_cells[kp] + lat.hw
         inside = (ab >= 0).all(axis=1) & (ab < lat.W).all(axis=1)
         a = np.zeros(len(kp), dtype=bool)

@@ -17,12 +17,14 @@ Usage::
 ``--no-greedy`` skips the greedy reference (half the time; no decision-time ratio).
 
 ``--referee CPL`` asks the referee (:mod:`strategies.referee`, the bounded-speed ground
-truth) about every loss: the start, mapped back to the as-is world (a rotation and a
+truth) about every start: each start, mapped back to the as-is world (a rotation and a
 uniform scaling of lengths and speeds leave the game unchanged), is classified on the
 as-is world's referee at CPL cells per L_min, with a fine evader lattice (2 cells, 1
-spacing a step). A loss from a certified *evader* start is one no pursuer can avoid; from
-a certified *pursuer* start, a weakness of the policy (its regret); "unknown" is the
-referee's resolution gap. Solutions are cached on disk (minutes per world the first time).
+spacing a step), and the counts are printed per world and variant, then beside each loss.
+A certified *evader* start is one no pursuer can hold (on a world whose safe starts are
+all such, "held" only measures the evaders' weakness); a loss from a certified *pursuer*
+start is a weakness of the policy (its regret); "unknown" is the referee's resolution gap.
+Solutions are cached on disk (minutes per world the first time).
 """
 
 from __future__ import annotations
@@ -128,7 +130,7 @@ def main(argv=None) -> int:
         type=float,
         metavar="CPL",
         default=None,
-        help="label each lost start with the referee at CPL cells per L_min",
+        help="label every start with the referee at CPL cells per L_min",
     )
     args = ap.parse_args(argv)
     pursuers = ("pursuer/decomposition",) if args.no_greedy else PURSUERS
@@ -176,12 +178,28 @@ def main(argv=None) -> int:
         )
     else:
         print(f"decision time per step: decomposition {1e3 * d:.3f} ms")
+    labels: dict[tuple, str] = {}  # (world, variant, rho, seed) -> the referee's verdict
+    if args.referee:
+        # Every start, not only the lost ones: a world whose safe starts are all certified
+        # evader wins is not a pursuer-win world with bounded speeds, whatever it holds.
+        for world, label, rho, _, seed, out in results:
+            key = (world, label, rho, seed)
+            if key not in labels:
+                labels[key] = _referee_label(world, label, rho, out[pursuers[0]][4], args.referee)
+        per: dict[tuple, dict[str, int]] = {}
+        for (world, label, rho, _), v in labels.items():
+            c = per.setdefault((world, label, rho), {})
+            c[v] = c.get(v, 0) + 1
+        print(f"referee (cpl {args.referee:g}) on the starts (one per seed):")
+        for (world, label, rho), c in sorted(per.items()):
+            counts = ", ".join(f"{n} {v}" for v, n in sorted(c.items()))
+            print(f"  {world} [{label}] rho={rho}: {counts}")
     verdicts: dict[str, int] = {}
     for loss in losses:
         world, label, rho, evader, seed, cause, t, start = loss
         ref = ""
         if args.referee:
-            v = _referee_label(world, label, rho, start, args.referee)
+            v = labels[(world, label, rho, seed)]
             verdicts[v] = verdicts.get(v, 0) + 1
             ref = f"; referee: {v}"
         print(f"  lost: {world} [{label}] rho={rho} {evader} seed={seed}: {cause} at {t}{ref}")

@@ -38,6 +38,13 @@ clearance; the lost maze start had 0.18, and starts with 0.24 to 0.31 already he
 the runs that motivated it. At rho >= 1 no turn holds L against a charge and the
 criterion is not applied (like admissibility, Sec. 5).
 
+"Safe" is local, not a certificate: admissibility and the retreat test look at the rod
+and the pursuer's surroundings, not at where the evader can herd the pursuer later. On
+the corner world (Fig. 9b) at rho = 0.5 the referee's sound evader bound certifies every
+start this draws as an evader win (episode seeds 0-31 of four variants, ``python
+benchmarks/pursuer_holds.py --worlds corner --referee 24``); starts certified either way
+come from :func:`strategies.referee.sample_starts`.
+
 ``kind="escapable"``: the opposite, for curricula that teach escapes (and pursuits that
 must recover): a valid start with L just above L_min whose orientation lies in an
 *escapable* cell of the exact decomposition at L_min (or in a free arc at a point where

@@ -22,6 +22,11 @@ Usage::
     python benchmarks/decision_time.py [--maps corridor two_rooms ...] [--seeds 2]
         [--max-cycles 300] [--reps 3] [--clock wall|cpu] [--l-min 1] [--table lazy]
 
+``--maps`` takes built-in names, ``NAME*S`` (the built-in map scaled by S, its L_min, L_max
+and speeds kept: a larger world, S^2 times the table's points) and ``floor_plan:SEED:W``
+(:func:`envs.maps.floor_plan`, a W x W building, 1000 (W / 200)^2 wall vertices, at least
+40; the env's default ranges unless ``--l-min``).
+
 ``--l-min X`` plays the maps at L_min = X, L_max = 2 X instead of their own ranges (the
 decomposition pursuer's grid is L_min / 20: halving L_min quadruples its points);
 ``--table`` forces the decomposition pursuer's safety table (``auto``: eager up to
@@ -37,6 +42,7 @@ import time
 
 import numpy as np
 
+from envs.maps import builtin_info, floor_plan
 from strategies.policies import make_policy
 from strategies.runner import episode_seeds, run_episode
 
@@ -44,6 +50,20 @@ MAPS = ["corridor", "two_rooms", "office", "l_hall", "maze"]
 REFERENCE = "pursuer/greedy"
 CLOCKS = {"wall": time.perf_counter, "cpu": time.thread_time}
 POLICIES = [("pursuer/decomposition", "pursuer"), ("evader/shooting", "evader")]
+
+
+def world(spec: str):
+    """The map and config overrides of a ``--maps`` entry (see the module docstring)."""
+    if spec.startswith("floor_plan:"):
+        _, seed, w = spec.split(":")
+        n = max(40, round(1000 * (float(w) / 200.0) ** 2))
+        return floor_plan(int(seed), n_vertices=n, size=(float(w), float(w))), {}
+    if "*" in spec:
+        name, scale = spec.split("*")
+        info = builtin_info(name)
+        m = info.map.transformed(float(scale) * np.eye(2), (0.0, 0.0))
+        return m, dict(info.params())
+    return spec, {}
 
 
 def _replay(
@@ -84,10 +104,12 @@ def measure(
     decisions left out, and the slowest first decision of each."""
     out: dict[str, list[np.ndarray]] = {}
     first: dict[str, float] = {}
+    m, params = world(map_name)
+    overrides = {**params, **(overrides or {})} or None
     for seed in range(seeds):
         observations = []
         result = run_episode(
-            map_name,
+            m,
             POLICIES[0][0],
             POLICIES[1][0],
             seed,
@@ -114,7 +136,7 @@ def main(argv=None) -> int:
     ap.add_argument("--reps", type=int, default=3)
     ap.add_argument("--clock", choices=sorted(CLOCKS), default="wall")
     ap.add_argument("--l-min", type=float, default=None)
-    ap.add_argument("--table", choices=["auto", "eager", "lazy"], default="auto")
+    ap.add_argument("--table", choices=["auto", "eager", "distinct", "lazy"], default="auto")
     args = ap.parse_args(argv)
     if args.l_min is not None and not args.l_min > 0:
         ap.error(f"--l-min = {args.l_min}: expected a number > 0")
@@ -124,7 +146,7 @@ def main(argv=None) -> int:
         + ("" if overrides is None else f"; L in [{args.l_min:g}, {2 * args.l_min:g}]")
     )
     print(
-        f"{'map':<11}{'policy':<24}{'steps':>6}{'mean ms':>9}{'p99 ms':>8}{'max ms':>8}"
+        f"{'map':<16}{'policy':<24}{'steps':>6}{'mean ms':>9}{'p99 ms':>8}{'max ms':>8}"
         f"{'first ms':>9}{'mean/ref':>10}{'p99/ref':>9}"
     )
     worst = {name: 0.0 for name, _ in POLICIES}
@@ -145,7 +167,7 @@ def main(argv=None) -> int:
             if name in worst:
                 worst[name] = max(worst[name], mean)
             print(
-                f"{map_name:<11}{name:<24}{len(t):>6}{mean:>9.3f}{p99:>8.3f}{t.max():>8.3f}"
+                f"{map_name:<16}{name:<24}{len(t):>6}{mean:>9.3f}{p99:>8.3f}{t.max():>8.3f}"
                 f"{1e3 * first[name]:>9.3f}{mean / (1e3 * ref):>10.1f}{p99 / (1e3 * ref):>9.1f}"
             )
     for name, mean in worst.items():

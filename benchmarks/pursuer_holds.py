@@ -16,6 +16,11 @@ Usage::
 
 ``--no-greedy`` skips the greedy reference (half the time; no decision-time ratio).
 
+``--l-min X`` plays at L_min = X (times the variant's scale) instead of the world's own,
+with the world's ratio L_max / L_min kept: a smaller rod on the same map, as on a larger
+map with the same rod (the decomposition pursuer's grid is L_min / 20, so halving L_min
+quadruples its points; issue 13's decision time on large worlds).
+
 ``--referee CPL`` asks the referee (:mod:`strategies.referee`, the bounded-speed ground
 truth) about every start: each start, mapped back to the as-is world (a rotation and a
 uniform scaling of lengths and speeds leave the game unchanged), is classified on the
@@ -80,9 +85,12 @@ def _evader(label: str):
 
 
 def _play(job):
-    world, variant, rho, evader, seed, max_cycles, pursuers = job
+    world, variant, rho, evader, seed, max_cycles, pursuers, l_min = job
     label, rot, scale, offset = variant
     m, params = _world(world, rot, scale, offset)
+    if l_min is not None:  # the world's L_max / L_min kept
+        params["l_max"] *= l_min * scale / params["l_min"]
+        params["l_min"] = l_min * scale
     params["v_evader"] = rho * params["v_pursuer"]
     params["body_radius"] = 0.2 * scale
     out = {}
@@ -125,6 +133,7 @@ def main(argv=None) -> int:
     ap.add_argument("--worlds", nargs="+", default=WORLDS)
     ap.add_argument("--variants", nargs="+", default=[v[0] for v in VARIANTS])
     ap.add_argument("--no-greedy", action="store_true", help="skip the greedy reference")
+    ap.add_argument("--l-min", type=float, default=None, help="play at this L_min (see above)")
     ap.add_argument(
         "--referee",
         type=float,
@@ -133,11 +142,13 @@ def main(argv=None) -> int:
         help="label every start with the referee at CPL cells per L_min",
     )
     args = ap.parse_args(argv)
+    if args.l_min is not None and not args.l_min > 0:
+        ap.error(f"--l-min = {args.l_min}: expected a number > 0")
     pursuers = ("pursuer/decomposition",) if args.no_greedy else PURSUERS
     print(f"load average: {os.getloadavg()}")
     variants = [v for v in VARIANTS if v[0] in args.variants]
     jobs = [
-        (w, v, rho, e, s, args.max_cycles, pursuers)
+        (w, v, rho, e, s, args.max_cycles, pursuers, args.l_min)
         for w in args.worlds
         for v in variants
         for rho in args.rho

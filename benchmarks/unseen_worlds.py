@@ -249,6 +249,14 @@ def row_key(row) -> str:
     return job_key([row[k] for k in ("role", "world", "combo", "opponent", "seed")])
 
 
+job_max_cycles, job_k = 600, 8.0  # the horizons, set by main (and in each worker)
+
+
+def _init(max_cycles: int, k: float) -> None:
+    global job_max_cycles, job_k
+    job_max_cycles, job_k = max_cycles, k
+
+
 def play(job) -> dict:
     """Play one job; its JSONL row."""
     role, w, combo, opponent, seed = job
@@ -284,14 +292,6 @@ def play(job) -> dict:
     return row
 
 
-job_max_cycles, job_k = 600, 8.0  # the horizons, set by main (and in each worker)
-
-
-def _init(max_cycles: int, k: float) -> None:
-    global job_max_cycles, job_k
-    job_max_cycles, job_k = max_cycles, k
-
-
 def _won(row) -> bool:
     """The policy under test won (held for the pursuer, escaped for the evader)."""
     return row.get("winner") == row["role"]
@@ -307,17 +307,15 @@ def select(args) -> list[tuple]:
         jobs = pursuer_jobs(args.worlds or PURSUER_WORLDS, combos, args.opponents or EVADERS,
                             args.seeds or [101])  # fmt: skip
     else:
-        jobs = evader_jobs(args.draws)
-        keep = {
-            "world": args.worlds,
-            "combo": args.combos and [list(EVADER_COMBOS[c]) for c in args.combos],
-            "opponent": args.opponents,
-            "seed": args.seeds,
-        }
-        for i, (field, allowed) in enumerate(keep.items(), start=1):
-            if allowed:
-                get = (lambda j: j[2][:2]) if field == "combo" else (lambda j, i=i: j[i])
-                jobs = [j for j in jobs if get(j) in allowed]
+        combos = args.combos and [EVADER_COMBOS[c] for c in args.combos]
+        jobs = [
+            (role, w, combo, opponent, seed)
+            for role, w, combo, opponent, seed in evader_jobs(args.draws)
+            if (not args.worlds or w in args.worlds)
+            and (not combos or tuple(combo[:2]) in combos)
+            and (not args.opponents or opponent in args.opponents)
+            and (not args.seeds or seed in args.seeds)
+        ]
     verdict: dict[tuple, bool] = {}
     out = []
     for job in jobs:

@@ -98,16 +98,20 @@ class DecompositionPursuer(BasePolicy):
             turn either way; ``"one"``, ``(V_p / L)(1 - rho)``, the least rate in one
             given direction (conservative: what the start sampler judges with).
         table: ``"eager"`` (the whole map's safety table, built once and cached on
-            disk), ``"lazy"`` (classified around the evader as it goes, for large
-            maps: ready at once, memory grows with the area visited) or ``"auto"``
-            (lazy when the eager table would have more than :attr:`EAGER_TABLE_POINTS`
-            grid points: its build costs about 0.1 ms a point, once per map and rod
-            length, while a lazy table classifies the points new to each step's probes,
-            4-11 ms a step on the built-in maps at L_min = 1, issue 13).
+            disk), ``"distinct"`` (the same table with each distinct row stored once,
+            classified in vectorised batches: ``safety_table(..., distinct=True)``),
+            ``"lazy"`` (classified around the evader as it goes, for large maps:
+            ready at once, memory grows with the area visited) or ``"auto"`` (eager
+            up to :attr:`EAGER_TABLE_POINTS` grid points, distinct up to
+            :attr:`DISTINCT_TABLE_POINTS`, lazy above). An eager build costs about 0.1
+            ms a point, once per map and rod length (cached on disk); a lazy table
+            classifies the points new to each step's probes, 5-8 ms a step on the
+            built-in maps at L_min = 0.5, issue 13).
     """
 
     roles = ("pursuer",)
-    EAGER_TABLE_POINTS = 200_000  # grid points above which "auto" fills the table lazily
+    EAGER_TABLE_POINTS = 200_000  # grid points above which "auto" stores distinct rows
+    DISTINCT_TABLE_POINTS = 1_000_000  # grid points above which "auto" fills it lazily
     CLOSING = 0.3  # share of V_p kept for closing in while L exceeds its target
     ORBIT_LOOKAHEAD = 1.0  # seconds of the charge a candidate rate is followed for
     ORBIT_REACH = 0.3  # a circle short of room by less than this x L is worth turning for
@@ -139,7 +143,7 @@ class DecompositionPursuer(BasePolicy):
         self.distance_gain = positive_param("distance_gain", distance_gain)
         self.range_margin = validation.unit_interval("range_margin", range_margin, open=False)
         self.turn_rate = validation.choice("turn_rate", turn_rate, ("both", "one"))
-        self.table_kind = validation.choice("table", table, ("auto", "eager", "lazy"))
+        self.table_kind = validation.choice("table", table, ("auto", "eager", "distinct", "lazy"))
 
     def _reset(self) -> None:
         c = self.config
@@ -150,12 +154,15 @@ class DecompositionPursuer(BasePolicy):
         res = self.resolution if self.resolution is not None else c.l_min / 20.0
         kind = self.table_kind
         if kind == "auto":
-            big = c.map.free_region.area / res**2 > self.EAGER_TABLE_POINTS
-            kind = "lazy" if big else "eager"
+            points = c.map.free_region.area / res**2
+            kind = "eager" if points <= self.EAGER_TABLE_POINTS else "distinct"
+            kind = "lazy" if points > self.DISTINCT_TABLE_POINTS else kind
         if kind == "lazy":
             self.table = LazySafetyTable(c.map, self.table_length, res, self.n_bins)
         else:
-            self.table = safety_table(c.map, self.table_length, res, self.n_bins)
+            self.table = safety_table(
+                c.map, self.table_length, res, self.n_bins, distinct=kind == "distinct"
+            )
         rho = c.rho
         # Sec. 6.1, eq. (6): the evader can hold the pursuer's rate down to
         # (V_p/L) sqrt(1 - rho^2) when the pursuer may turn either way (it takes the

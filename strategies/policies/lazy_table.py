@@ -5,8 +5,9 @@ when it is built: on a 200 m x 200 m floor plan at L_min = 3 that is 1.7 million
 about 1 GB and 200 s. A pursuer only ever looks at the points around the evader (its
 probes reach ``V_e pi / omega``), so :class:`LazySafetyTable` has the same grid, the
 same rows and the same answers as the eager table, but classifies a grid point the first
-time a lookup touches it (``Decomposition.free_arcs`` and ``safe_arcs``, exact, about
-0.1 ms a point) and keeps it. Ready as soon as the decomposition is; memory grows with
+time a lookup touches it (the points new to a lookup in one vectorised batch,
+:func:`~strategies.policies._batch_classify.classify_points`, about 20 us a point) and
+keeps it. Ready as soon as the decomposition is; memory grows with
 the area the evader has visited, not with the map.
 
 Example:
@@ -32,12 +33,8 @@ import shapely
 from envs.maps import Map
 from envs.tolerances import REL_LENGTH_TOL
 from strategies.cspace.grids import grid_axis
-from strategies.policies.safety import (
-    SafetyTable,
-    _arc_bins,
-    _circular_distance,
-    _classified,
-)
+from strategies.policies._batch_classify import classify_points
+from strategies.policies.safety import SafetyTable, _circular_distance
 
 __all__ = ["LazySafetyTable"]
 
@@ -155,20 +152,17 @@ class LazySafetyTable:
             return
         self._grow(self._n + len(new))
         pts = np.stack([x[inside], y[inside]], axis=1)
-        rows = np.arange(self._n, self._n + len(new))
-        for r, p in zip(rows, pts, strict=True):
-            arcs, safe_arcs = _classified(self.decomposition, p, self.resolution)
-            self._free[r] = _arc_bins(arcs, self._centres)
-            if safe_arcs is not None:
-                self._safe[r] = self._free[r] & _arc_bins(safe_arcs, self._centres)
         sl = slice(self._n, self._n + len(new))
+        self._free[sl], self._safe[sl] = classify_points(
+            self.decomposition, pts, self.resolution, self._centres
+        )
         g = self._safe[sl].any(axis=1)
         self._guaranteed[sl] = g
         self._safe[sl] = np.where(g[:, None], self._safe[sl], self._free[sl])
         self._ccw[sl] = _circular_distance(self._safe[sl], +1)
         self._cw[sl] = _circular_distance(self._safe[sl], -1)
         self._need[sl] = np.minimum(self._ccw[sl], self._cw[sl])
-        self._cell[new[:, 0], new[:, 1]] = rows
+        self._cell[new[:, 0], new[:, 1]] = np.arange(self._n, self._n + len(new))
         self._n += len(new)
 
     def _grow(self, n: int) -> None:

@@ -144,6 +144,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if args.l_min is not None and not args.l_min > 0:
         ap.error(f"--l-min = {args.l_min}: expected a number > 0")
+    if args.l_min is not None and args.referee:  # the referee solves the world's own L_min
+        ap.error("--l-min and --referee: the referee judges the world's own L_min only")
     pursuers = ("pursuer/decomposition",) if args.no_greedy else PURSUERS
     print(f"load average: {os.getloadavg()}")
     variants = [v for v in VARIANTS if v[0] in args.variants]

@@ -60,6 +60,7 @@ import numpy as np
 from envs.errors import InfeasibleError, InvalidConfigError
 from envs.geometry import kernel_for
 from envs.surveillance.placement import random_start, spawn_margins
+from strategies.policies.lazy_table import LazySafetyTable
 
 __all__ = ["START_KINDS", "has_retreat_clearance", "retreat_clearance_required", "sample_start"]
 
@@ -99,9 +100,21 @@ def sample_start(
     tab = judge.table
     if kind == "escapable":
         return _near_l_min(config, kernel, rng, judge, tab, None, escapable=True)
-    if not tab.guaranteed.any():  # Prop. 2: nothing is safe anywhere
+    if not _anything_safe(tab):  # Prop. 2: nothing is safe anywhere
         return _near_l_min(config, kernel, rng, judge, tab, None)
     return _near_l_min(config, kernel, rng, judge, tab, angle_margin)
+
+
+def _anything_safe(tab) -> bool:
+    """Some point of the map has a non-escapable orientation.
+
+    An eager table knows it from its rows; a lazy one (maps over
+    ``DecompositionPursuer.DISTINCT_TABLE_POINTS`` grid points) has classified nothing
+    yet, so its exact decomposition answers: some cell is known not to be escapable.
+    """
+    if isinstance(tab, LazySafetyTable):
+        return any(c.escapable is False for c in tab.decomposition.cells)
+    return bool(tab.guaranteed.any())
 
 
 def _escapable(dec, e, theta: float) -> bool:

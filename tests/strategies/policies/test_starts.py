@@ -107,3 +107,20 @@ def test_retreat_clearance_rejects_a_pursuer_backed_against_a_wall():
     assert not has_retreat_clearance(cfg.map, kernel, p, e, 0.21, cfg.body_radius)
     assert has_retreat_clearance(cfg.map, kernel, e, p, 0.74, cfg.body_radius)  # turned round
     env.close()
+
+
+@pytest.mark.parametrize("map_name", ["corridor", "two_rooms"])
+def test_a_lazy_table_draws_the_same_start_as_an_eager_one(map_name, monkeypatch):
+    """On maps too large for a stored table the judge's table is lazy and has classified
+    nothing before the first draw; "nothing is safe anywhere" (Prop. 2, which lets any
+    valid start through) must still be decided for the whole map, not for the empty
+    table (it was: every large map drew unchecked starts)."""
+    from strategies.policies.decomposition import DecompositionPursuer
+
+    env = surveillance_v0.parallel_env(map=map_name)
+    eager = [sample_start(env.config, np.random.default_rng(s), kind="safe") for s in (1, 2)]
+    monkeypatch.setattr(DecompositionPursuer, "EAGER_TABLE_POINTS", 0)
+    monkeypatch.setattr(DecompositionPursuer, "DISTINCT_TABLE_POINTS", 0)
+    lazy = [sample_start(env.config, np.random.default_rng(s), kind="safe") for s in (1, 2)]
+    assert lazy == eager
+    env.close()

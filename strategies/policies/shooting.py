@@ -15,17 +15,17 @@ Sec. 5 "minimax": its tip meets walls as if the rod were that long):
    reach) where the current orientation is not safe. For each, the rotation the pursuer
    must make each way round to a safe orientation there (the safety table) is compared
    with the rotation it can make while the evader travels (eq. 6 integrated along the
-   straight path). The best candidate with a positive margin is re-solved with the
-   optimal escape arc of Sec. 6 (:func:`strategies.control.evasion.solve_escape`, for the
-   branch the pursuer would turn) and the evader follows that arc, replanning every
-   ``replan`` steps.
+   straight path). The best candidate with a positive margin (in line of sight, once
+   an arc made no headway) is re-solved with the optimal escape arc of Sec. 6
+   (:func:`strategies.control.evasion.solve_escape`, for the branch the pursuer would
+   turn) and the evader follows that arc, replanning every ``replan`` steps.
 3. **Witness region** (Prop. 2 holds on the map): walk a shortest grid path to a
    region whose cells are all escapable (``Decomposition.witness_regions``).
 For rho > 1 it runs straight at the pursuer (footnote 4; see :meth:`ShootingEvader._decide`).
 
-4. Otherwise **pressure**: move straight toward or away from the pursuer (Sec. 6.1, the
-   headings minimising max |theta_dot|), whichever points more toward the most
-   promising candidate.
+4. Otherwise **pressure**: move straight at the pursuer (Sec. 6.1, a heading
+   minimising max |theta_dot|); against a wall, slide along it perpendicular to the rod,
+   the way that does not press straight into the wall.
 """
 
 from __future__ import annotations
@@ -53,6 +53,7 @@ __all__ = ["ShootingEvader"]
 
 _EULER = 8  # sub-steps of the straight-path rotation estimate
 _WALL_TOL = 1e-9  # beyond the rounding of a distance to the walls
+_PRESSING = 2.0 * math.sin(math.radians(80.0))  # see ShootingEvader._decide's slide
 # the moves tried, in order, to keep a walk inside a region: the heading turned by 0, 5,
 # ... 90 degrees either way, at a whole, half or quarter step, most progress first
 _TURN_DEG = np.array([s * d for d in range(0, 91, 5) for s in ((1, -1) if d else (1,))])
@@ -151,6 +152,8 @@ class ShootingEvader(BasePolicy):
         self._arc: tuple[np.ndarray, float, np.ndarray] | None = None  # (start, frame, path)
         self._arc_length: np.ndarray | None = None  # along the arc's path, from its start
         self._arc_age = 0
+        self._shot: tuple[float, float, int] | None = None  # (x, y, step) of the last shot
+        self._in_sight = False  # shoot only at probes in sight (until the plan resumes)
         self._plan_cell, self._plan_lost, self._witness = -1, False, None
         # progress toward the witness: a crossing the evader cannot reach (its disc
         # pressed to a corner on the way) or one that leads back where it came from is
@@ -184,20 +187,36 @@ class ShootingEvader(BasePolicy):
         near = np.linalg.norm(self._corner_points - e, axis=1) <= self._n_r * tab.resolution
         return cand, rows[pick].astype(np.int64), self._corner_points[near], self._corner_rows[near]
 
-    def _best_candidate(self, e: np.ndarray, theta: float) -> tuple[np.ndarray, str] | None:
+    def _best_candidate(
+        self, e: np.ndarray, theta: float, in_sight: bool = False
+    ) -> tuple[np.ndarray, str] | None:
         """The candidate endpoint with the largest positive escape margin (the first such
         in the order rays, then visible corners), and the pursuer's branch there.
 
         Corners are candidates only in line of sight of ``e``. The margins do not depend
         on the other candidates, so only a corner that would beat every probe (and 0)
-        needs its line of sight checked.
+        needs its line of sight checked. With ``in_sight`` the probes too: a ray stops at
+        its first grid point off the free region, and a wall thinner than the grid can
+        lie across it (issue 13: random:convex:11, a spike's tip between the evader and
+        the probe it ran at for the whole horizon).
         """
         rays, ray_rows, corners, corner_rows = self._candidates(e)
         n = len(rays)
         rows = np.concatenate([ray_rows, corner_rows])
         margin, branch = self._margins(e, theta, np.concatenate([rays, corners]), rows)
-        top = max(float(margin[:n].max()) if n else -math.inf, 0.0)
         ex, ey = float(e[0]), float(e[1])
+        ray, top = -1, 0.0  # the best probe (in sight if asked) and its margin
+        if in_sight:
+            for i in np.argsort(-margin[:n], kind="stable").tolist():
+                if margin[i] <= 0.0:
+                    break
+                q = rays[i]
+                if self.kernel.line_of_sight((ex, ey), (float(q[0]), float(q[1]))):
+                    ray, top = i, float(margin[i])
+                    break
+        elif n and margin[:n].max() > 0:
+            ray = int(np.argmax(margin[:n]))
+            top = float(margin[ray])
         best = -1
         for i in np.flatnonzero(margin[n:] > top).tolist():
             q = corners[i]
@@ -205,8 +224,8 @@ class ShootingEvader(BasePolicy):
                 (ex, ey), (float(q[0]), float(q[1]))
             ):
                 best = n + i
-        if best < 0 and n and margin[:n].max() > 0:
-            best = int(np.argmax(margin[:n]))
+        if best < 0:
+            best = ray
         if best < 0:
             return None
         return np.concatenate([rays, corners])[best], str(branch[best])
@@ -286,14 +305,25 @@ class ShootingEvader(BasePolicy):
         heading = self._plan_heading(e, theta)
         if heading is not None:
             self.mode = "plan"
-            self._arc = None
+            self._arc, self._in_sight = None, False
             return c.v_evader * heading
         if self._arc is not None and self._arc_age < self.replan:
             self._arc_age += 1
             return c.v_evader * self._arc_heading(e)
-        best = self._best_candidate(e, theta)
+        # stuck: less than a step made good since the last shot, one arc ago (pressed
+        # against a wall between the evader and its target): from then on until the plan
+        # resumes, aim only at probes in sight
+        last = self._shot
+        if (
+            last is not None
+            and self._steps - last[2] <= self.replan
+            and math.hypot(float(e[0]) - last[0], float(e[1]) - last[1]) < c.v_evader * c.dt
+        ):
+            self._in_sight = True
+        best = self._best_candidate(e, theta, in_sight=self._in_sight)
         if best is not None:
             self.mode = "shoot"
+            self._shot = (float(e[0]), float(e[1]), self._steps)
             return c.v_evader * self._start_arc(e, theta, *best)
         row = self.table.row(e)
         if row >= 0 and self._has_region and not self.plan.region[row]:
@@ -310,8 +340,16 @@ class ShootingEvader(BasePolicy):
         u = unit(snap.rod)
         if self._near_wall(e, c.body_radius + 2.0 * c.v_evader * c.dt):
             # against a wall the push is lost: slide along it, perpendicular to the rod
-            # (which turns the rod fastest)
-            return c.v_evader * np.array([-u[1], u[0]])
+            # (which turns the rod fastest); the other way round where this one presses
+            # straight into the wall, within 10 degrees of its normal (a step this way
+            # ends 2 sin(80 deg) steps nearer the wall than a step the other way). A rod
+            # along the wall left the evader pressing in place for the whole horizon
+            # (issue 13: random:rectangles:11, a pursuer copying the evader's moves);
+            # turning the slide at 30 degrees already lost escapes the slide made
+            s = np.array([-u[1], u[0]])
+            h = c.v_evader * c.dt
+            d = self.map.distance_to_walls(np.stack([e + h * s, e - h * s]))
+            return c.v_evader * (-s if d[1] - d[0] > _PRESSING * h else s)
         return c.v_evader * u
 
     def _near_wall(self, e: np.ndarray, r: float) -> bool:

@@ -37,7 +37,8 @@ Usage::
         [--workers 1] [--max-cycles 600] [--k 8] [--draws 2]
 
 ``--combos`` indexes the role's combos (``--help`` lists them). ``--seeds`` is the
-seed list in the pursuer role and a filter on the drawn seeds in the evader role.
+seed list in the pursuer role and a filter on the drawn seeds in the evader role. On one
+busy core (load ~4.5 on 2): ``--role pursuer --combos 0`` 10 min, ``--role evader`` 25 min.
 """
 
 from __future__ import annotations

@@ -423,6 +423,11 @@ def main(argv=None) -> int:
         known = PURSUER_WORLDS if args.role == "pursuer" else [w for w, _ in EVADER_WORLDS]
         if name not in known:
             ap.error(f"unknown {args.role}-role world {name!r} (one of {sorted(set(known))})")
+    for label in args.opponents or []:
+        try:
+            make_opponent(label)
+        except ValueError as exc:  # the project's errors subclass ValueError
+            ap.error(f"--opponents: {label!r} is no opponent ({exc})")
     combos = PURSUER_COMBOS if args.role == "pursuer" else EVADER_COMBOS
     if any(not 0 <= c < len(combos) for c in args.combos or []):
         ap.error(f"--combos: indices 0-{len(combos) - 1}")

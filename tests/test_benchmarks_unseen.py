@@ -73,3 +73,14 @@ def test_a_loss_is_printed_with_its_replay_command(unseen, capsys) -> None:
         "replay: python benchmarks/unseen_worlds.py --role pursuer --worlds maze~x0.7rot-2.6 "
         "--combos 0 --opponents 'herder' --seeds 101" in text
     )
+
+
+@pytest.mark.parametrize("label", ["nope", "zigzag:x:1"])
+def test_an_unknown_opponent_is_a_usage_error_naming_it(unseen, tmp_path, capsys, label) -> None:
+    results = tmp_path / "r.jsonl"
+    with pytest.raises(SystemExit) as exc:
+        unseen.main(["--role", "pursuer", "--worlds", "plus_w6", "--opponents", label,
+                     "--results", str(results)])  # fmt: skip
+    assert exc.value.code == 2
+    assert f"--opponents: {label!r} is no opponent" in capsys.readouterr().err
+    assert not results.exists()  # nothing played

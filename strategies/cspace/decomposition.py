@@ -300,6 +300,11 @@ class Decomposition:
         near = self._tree.nearest(pt)
         return None if near is None else int(near)
 
+    @property
+    def neighbours(self) -> list[tuple[int, ...]]:
+        """Each region's neighbours (the regions it shares a boundary with), sorted."""
+        return self._neighbours
+
     def _match(self, region: int | None, fa: FreeArcs) -> list[int | None]:
         """Cells of the arcs at a point located in ``region`` (neighbours as fallback)."""
         if region is None:

@@ -80,12 +80,7 @@ class _CellKeys:
     def __init__(self, dec) -> None:
         self.dec = dec
         self._of: dict[int, dict[tuple[int, int], int]] = {}
-        nb: list[set[int]] = [set() for _ in dec.regions]
-        for b in dec.boundaries:
-            a, c = b.regions
-            nb[a].add(c)
-            nb[c].add(a)
-        self.neighbours = [tuple(sorted(s)) for s in nb]
+        self.neighbours = dec.neighbours
         # the same keys as sorted integers: (region, lo, hi) with the codes numbered
         cells = dec.cells
         lo = np.array([stop_code(c.stops[0]) for c in cells], dtype=np.int64)

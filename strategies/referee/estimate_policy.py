@@ -5,11 +5,11 @@ evader moves first, the sweep in which each state left the pursuer's set (its *r
 From a state of rank k > 0 the evader has a move after which every pursuer answer lands
 in a state of rank < k or breaks surveillance within the step (the discrete game's
 in-step checks). :class:`EstimateEvader` plays that strategy in the env: every env step
-it snaps both real positions to the state of positive rank nearest to them (within the
-six nearest lattice points of each), evaluates every evader move against every pursuer
-answer with the game's own checks, and walks at full speed towards the lattice point of
-the move whose worst answer has the lowest rank. Where it finds no state of positive
-rank, or no allowed move, it charges the pursuer.
+it snaps both real positions to the evader-win state (positive rank, not the pursuer's
+"never left") nearest to them (within the six nearest lattice points of each), evaluates
+every evader move against every pursuer answer with the game's own checks, and walks at
+full speed towards the lattice point of the move whose worst answer has the lowest rank.
+Where it finds no such state, or no allowed move, it charges the pursuer.
 
 It is an estimate's strategy, not a certified one: the env's pursuer moves continuously
 and off the lattice, so the rank need not fall every step.
@@ -118,8 +118,8 @@ class EstimateEvader(BasePolicy):
             )  # fmt: skip
 
     def _snap(self, pursuer: np.ndarray, evader: np.ndarray):
-        """The lattice points (kp, ke) of positive rank nearest to the real positions
-        (least summed distance), or None."""
+        """The lattice points (kp, ke) of an evader win (positive rank, not the pursuer's)
+        nearest to the real positions (least summed distance), or None."""
         sol = self.solution
         lat, tree = sol.lattice, self._tables[0]
         dp, kp = tree.query(pursuer, k=_SNAP)
@@ -127,8 +127,12 @@ class EstimateEvader(BasePolicy):
         ab = lat.point_cells[ke][None, :, :] - lat.point_cells[kp][:, None, :] + lat.hw
         inside = ((ab >= 0) & (ab < lat.W)).all(axis=2)
         ab = np.where(inside[..., None], ab, 0)
-        rank = np.where(inside, sol.evader_first_rank[kp[:, None], ab[..., 0], ab[..., 1]], 0)
-        cost = np.where(rank > 0, dp[:, None] + de[None, :], np.inf)
+        ranks = sol.evader_first_rank
+        rank = np.where(inside, ranks[kp[:, None], ab[..., 0], ab[..., 1]], 0)
+        # a state the pursuer wins (the rank that never left the set) has no move to rank
+        # by: every move scores the same there, and the evader would play arbitrarily
+        won = rank == np.iinfo(ranks.dtype).max
+        cost = np.where((rank > 0) & ~won, dp[:, None] + de[None, :], np.inf)
         i, j = np.unravel_index(int(np.argmin(cost)), cost.shape)
         if not np.isfinite(cost[i, j]):
             return None

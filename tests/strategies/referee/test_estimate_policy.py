@@ -77,3 +77,28 @@ def test_bad_input():
     with pytest.raises(Exception, match="not the solved game"):  # v_evader 0.4, solved 0.5
         run_episode(dead_end(), "pursuer/greedy", EstimateEvader(sol), 0, max_cycles=5,
                     overrides=other)  # fmt: skip
+
+
+def test_it_snaps_to_evader_wins_only():
+    """From a lattice state the pursuer wins (every move scores the same there), the
+    policy snaps to a nearby state the evader wins, or charges; never to a won state."""
+    sol = solve_estimate(spec(dead_end(), 0.5), 4)
+    rank = sol.evader_first_rank
+    never = np.iinfo(rank.dtype).max
+    ev = EstimateEvader(sol)
+    ev._prepare()
+    lat = sol.lattice
+    won = np.flatnonzero(sol.safe & (rank == never))
+    rng = np.random.default_rng(1)
+    seen = 0
+    for flat in rng.choice(won, 60, replace=False):
+        k, a, b = np.unravel_index(flat, rank.shape)
+        e = lat.points[k] + lat.h * (np.array([a, b]) - lat.hw)
+        got = ev._snap(lat.points[k], e)
+        if got is None:
+            continue
+        kp, ke = got
+        ab = lat.point_cells[ke] - lat.point_cells[kp] + lat.hw
+        assert 0 < rank[kp, ab[0], ab[1]] < never
+        seen += 1
+    assert seen > 0  # some won states have an evader win among their neighbours

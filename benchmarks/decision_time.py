@@ -29,9 +29,9 @@ and speeds kept: a larger world, S^2 times the table's points) and ``floor_plan:
 
 ``--l-min X`` plays the maps at L_min = X, L_max = 2 X instead of their own ranges (the
 decomposition pursuer's grid is L_min / 20: halving L_min quadruples its points);
-``--table`` forces the decomposition pursuer's safety table (``auto``: eager up to
-``DecompositionPursuer.EAGER_TABLE_POINTS`` grid points, else filled lazily), so the two
-can be compared on the same episodes.
+``--table`` forces the decomposition pursuer's safety table (``auto``: distinct rows up
+to ``DecompositionPursuer.DISTINCT_TABLE_POINTS`` grid points, else filled lazily), so the
+kinds can be compared on the same episodes.
 """
 
 from __future__ import annotations

@@ -28,9 +28,9 @@ from strategies.runner import build_env, run_episode
 OVERRIDES = {"v_evader": 0.5, "body_radius": 0.2}  # rho = 0.5, as benchmarks/pursuer_holds.py
 
 
-def _pursuer():
+def _pursuer(**params):
     config = build_env("open_room", dict(OVERRIDES)).config  # 10 x 10, V_p = 1
-    policy = make_policy("pursuer/decomposition")
+    policy = make_policy("pursuer/decomposition", **params)
     policy.reset(role="pursuer", map=config.map, config=config, seed=0)
     return policy
 
@@ -157,7 +157,7 @@ def test_no_safe_orientation_counts_as_a_full_turn_one_way_round():
 
     from strategies.policies.safety import NO_PATH
 
-    p = _pursuer()
+    p = _pursuer(table="eager")  # one row per grid point: the test writes two probes' rows
     tab = p.table
     e = np.array([5.0, 5.0])
     k = 2  # the third probe radius

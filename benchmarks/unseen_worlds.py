@@ -25,6 +25,25 @@ registered policies live in ``benchmarks/unseen_opponents.py``):
   worlds' order, so a subset replays the same episodes as the whole. Horizon
   ``--k`` D / V_e (8), D the bounding-box diagonal.
 
+Other worlds than the default sets can be named in ``--worlds`` (a fresh set, played
+without editing this file; the role's Prop. 2 rule still skips the wrong ones):
+
+* ``NAME~[xS][rotR][off(X,Y)]``: a built-in world scaled by S, rotated by R radians,
+  then shifted by (X, Y), e.g. ``maze~x1.3rot0.4``, ``office~rot-1off(3,-2)``;
+* ``L_AxW``: an A x A room less its (A - W) x (A - W) corner (arms W wide);
+  ``U_WxHxAxB``: a W x H room less the notch between arms A wide above a base B deep;
+  ``pillar:W:H:X0:Y0:X1:Y1``: a W x H room with the rectangular pillar [X0, X1] x [Y0, Y1];
+* ``plus_wW``, ``tee_wW`` (optionally ``aA``: arms A long, e.g. ``plus_w5a7``): a
+  crossroads and a T-junction of width W (arms 5 and 6 in the pursuer role, 4 and 3 in
+  the evader role);
+* ``rand:KIND:SEED:GAP``: a random map of 4 obstacles of KIND with gaps >= GAP;
+  ``random:KIND:SEED``: the map ``load_map`` names so; ``floor_plan:SEED``: a 30 x 30
+  floor plan.
+
+In the evader role such a world plays at each ``--l-mins`` (default 1 and 2); its
+episodes are drawn from a generator seeded by (52, the label, L_min), so they do not
+depend on the other worlds selected.
+
 Body radius 0.1 (times the scale). Episodes are appended to ``--results`` (JSON lines)
 as they finish; a rerun plays only what the file lacks, then prints the table of every
 selected episode: per world and combo, per opponent, the total, and every loss with the
@@ -34,7 +53,7 @@ Usage::
 
     python benchmarks/unseen_worlds.py --role pursuer|evader [--worlds W ...]
         [--combos I ...] [--opponents O ...] [--seeds S ...] [--results F.jsonl]
-        [--workers 1] [--max-cycles 600] [--k 8] [--draws 2]
+        [--workers 1] [--max-cycles 600] [--k 8] [--draws 2] [--l-mins L ...]
 
 ``--combos`` indexes the role's combos (``--help`` lists them). ``--seeds`` is the
 seed list in the pursuer role and a filter on the drawn seeds in the evader role. On one
@@ -48,12 +67,15 @@ import json
 import math
 import multiprocessing as mp
 import os
+import re
 import time
+import zlib
 
 import numpy as np
 from unseen_opponents import make_opponent
 
-from envs.maps import Map, builtin_info, load_map
+from envs.errors import InvalidConfigError
+from envs.maps import Map, builtin_info, builtin_names, load_map
 from envs.maps.floor_plans import floor_plan
 from envs.maps.junctions import crossroads, t_junction
 from envs.maps.random_maps import random_map
@@ -113,6 +135,7 @@ EVADER_WORLDS = [
     *[(f"random:rectangles:{s}", 2.0) for s in range(11, 17)],
     *[(f"floor_plan:{s}", 2.0) for s in (3, 4, 5)],
 ]  # fmt: skip
+EVADER_NAMES = [w for w, _ in EVADER_WORLDS]
 PURSUERS = ["pursuer/corner_rounding", "pursuer/decomposition", "pursuer/greedy",
             "pursuer/random", "pursuer/referee", "pursuer/tractrix", "pursuer/wall_following",
             "still", "central", "shadow", "mirror", "greedy g1 t.6", "greedy g12 t.3"]  # fmt: skip
@@ -146,6 +169,62 @@ PILLARS = {
 }
 
 
+# ------------------------------------------------------------------ world labels
+_NUM = r"-?\d+(?:\.\d+)?"
+_TRANSFORM = re.compile(
+    rf"(?:x(?P<s>{_NUM}))?(?:rot(?P<r>{_NUM}))?(?:off\((?P<x>{_NUM}),(?P<y>{_NUM})\))?"
+)
+_JUNCTION = re.compile(rf"(?P<kind>plus|tee)_w(?P<w>{_NUM})(?:a(?P<a>{_NUM}))?")
+_L_ROOM = re.compile(rf"L_(?P<a>{_NUM})x(?P<w>{_NUM})")
+_U_ROOM = re.compile(rf"U_(?P<w>{_NUM})x(?P<h>{_NUM})x(?P<a>{_NUM})x(?P<b>{_NUM})")
+_PILLAR = re.compile(rf"pillar(?::{_NUM}){{6}}")
+ARMS = {"pursuer": {"plus": 5.0, "tee": 6.0}, "evader": {"plus": 4.0, "tee": 3.0}}
+
+
+def _unknown(key: str) -> InvalidConfigError:
+    return InvalidConfigError(f"world: unknown world {key!r} (see the module docstring's labels)")
+
+
+def transform_of(key: str) -> tuple[str, float, float, tuple[float, float]]:
+    """(built-in name, rotation, scale, offset) of a label ``NAME~[xS][rotR][off(X,Y)]``."""
+    name, _, spec = key.partition("~")
+    m = _TRANSFORM.fullmatch(spec)
+    if name not in builtin_names() or m is None or not spec:
+        raise _unknown(key)
+    scale = float(m["s"]) if m["s"] else 1.0
+    if scale <= 0:
+        raise _unknown(key)
+    offset = (float(m["x"]), float(m["y"])) if m["x"] else (0.0, 0.0)
+    return name, float(m["r"] or 0.0), scale, offset
+
+
+def room_map(key: str, role: str = "pursuer") -> Map:
+    """A constructed world named by a label of the module docstring (V_p = 1 units)."""
+    if m := _JUNCTION.fullmatch(key):
+        arm = float(m["a"]) if m["a"] else ARMS[role][m["kind"]]
+        build = crossroads if m["kind"] == "plus" else t_junction
+        return build(arm=arm, width=float(m["w"]))
+    if m := _L_ROOM.fullmatch(key):
+        a, w = float(m["a"]), float(m["w"])
+        return Map([(0, 0), (a, 0), (a, w), (w, w), (w, a), (0, a)], [], name=key)
+    if m := _U_ROOM.fullmatch(key):
+        w, h, a, b = (float(m[k]) for k in "whab")
+        pts = [(0, 0), (w, 0), (w, h), (w - a, h), (w - a, b), (a, b), (a, h), (0, h)]
+        return Map(pts, [], name=key)
+    if _PILLAR.fullmatch(key):
+        w, h, x0, y0, x1, y1 = (float(v) for v in key.split(":")[1:])
+        box = [(0, 0), (w, 0), (w, h), (0, h)]
+        return Map(box, [[(x0, y0), (x1, y0), (x1, y1), (x0, y1)]], name=key)
+    if key.startswith("rand:"):  # rand:kind:seed:min_gap
+        try:
+            _, kind, seed, gap = key.split(":")
+            seed, gap = int(seed), float(gap)
+        except ValueError as exc:  # not four fields, or not numbers
+            raise _unknown(key) from exc
+        return random_map(seed, kind=kind, min_gap=gap, n_obstacles=4)
+    raise _unknown(key)
+
+
 def built_map(key: str) -> Map:
     """A constructed world of the pursuer role (lengths in units where V_p = 1)."""
     if key in PILLARS:
@@ -153,21 +232,14 @@ def built_map(key: str) -> Map:
         return Map([(0, 0), (w, 0), (w, h), (0, h)], [pillar], name=key)
     if key in BUILT_OUTLINES:
         return Map(BUILT_OUTLINES[key], [], name=key)
-    if key == "tee_w5":
-        return t_junction(arm=6.0, width=5.0)
-    if key.startswith("plus_w"):
-        return crossroads(arm=5.0, width=float(key[len("plus_w") :]))
-    if key.startswith("rand:"):  # rand:kind:seed:min_gap
-        _, kind, seed, gap = key.split(":")
-        return random_map(int(seed), kind=kind, min_gap=float(gap), n_obstacles=4)
-    raise ValueError(f"unknown world {key!r}")
+    return room_map(key, "pursuer")
 
 
 def pursuer_world(key: str, combo) -> tuple[Map, dict]:
     """(map, env overrides) of a pursuer-role world at a (rho, L_max / L_min, L_min) combo."""
     rho, ratio, l_min = combo
-    if key in PAPER:
-        name, rot, scale, offset = PAPER[key]
+    if key in PAPER or "~" in key:
+        name, rot, scale, offset = PAPER[key] if key in PAPER else transform_of(key)
         info = builtin_info(name)
         m = info.map.transformed(_rotm(rot, scale), offset)
         lm, vp, r = info.l_min * scale * (l_min / 2.0), info.v_pursuer * scale, BODY * scale
@@ -181,20 +253,23 @@ def pursuer_world(key: str, combo) -> tuple[Map, dict]:
 def evader_world(key: str, l_min: float, rho: float, ratio: float) -> tuple[Map, dict]:
     """(map, env overrides) of an evader-role world (V_p = 1, lengths times the scale)."""
     scale = 1.0
-    if "~" in key:  # two_rooms~VARIANT, office~VARIANT
-        name, variant = key.split("~")
-        rot, scale, offset = BVARS[variant]
+    if "~" in key:  # two_rooms~VARIANT, office~VARIANT, NAME~[xS][rotR][off(X,Y)]
+        name, variant = key.split("~", 1)
+        if name in ("two_rooms", "office") and variant in BVARS:
+            rot, scale, offset = BVARS[variant]
+        else:
+            name, rot, scale, offset = transform_of(key)
         m = builtin_info(name).map.transformed(_rotm(rot, scale), offset)
-    elif key.startswith("plus_w"):
-        m = crossroads(width=float(key[len("plus_w") :]))
-    elif key.startswith("tee_w"):
-        m = t_junction(width=float(key[len("tee_w") :]))
     elif key.startswith("random:"):
         m = load_map(key)
     elif key.startswith("floor_plan:"):
-        m = floor_plan(int(key.split(":")[1]), n_vertices=60, size=(30.0, 30.0))
+        try:
+            seed = int(key.split(":")[1])
+        except (IndexError, ValueError) as exc:
+            raise _unknown(key) from exc
+        m = floor_plan(seed, n_vertices=60, size=(30.0, 30.0))
     else:
-        raise ValueError(f"unknown world {key!r}")
+        m = room_map(key, "evader")
     ov = {"l_min": l_min * scale, "l_max": ratio * l_min * scale, "v_pursuer": scale,
           "v_evader": rho * scale, "body_radius": BODY * scale}  # fmt: skip
     return m, ov
@@ -239,6 +314,24 @@ def evader_jobs(draws: int) -> list[tuple]:
             for _ in range(draws if p != "pursuer/referee" else 1):
                 rho, ratio = EVADER_COMBOS[int(rng.integers(len(EVADER_COMBOS)))]
                 jobs.append(("evader", w, [rho, ratio, lu], p, 100 + int(rng.integers(1000))))
+    return jobs
+
+
+def other_evader_jobs(worlds, l_mins, draws: int) -> list[tuple]:
+    """Evader-role jobs of worlds outside the default set, at each L_min: the same draws
+    as the default set's, from a generator seeded by (52, the label, L_min) so each world's
+    episodes do not depend on the others selected."""
+    jobs = []
+    for w in worlds:
+        junction = bool(_JUNCTION.fullmatch(w))
+        for lu in l_mins:
+            rng = np.random.default_rng([DRAW_SEED, zlib.crc32(w.encode()), round(1000 * lu)])
+            for p in PURSUERS:
+                if p == "pursuer/referee" and not junction:
+                    continue
+                for _ in range(draws if p != "pursuer/referee" else 1):
+                    rho, ratio = EVADER_COMBOS[int(rng.integers(len(EVADER_COMBOS)))]
+                    jobs.append(("evader", w, [rho, ratio, lu], p, 100 + int(rng.integers(1000))))
     return jobs
 
 
@@ -309,10 +402,16 @@ def select(args) -> list[tuple]:
                             args.seeds or [101])  # fmt: skip
     else:
         combos = args.combos and [EVADER_COMBOS[c] for c in args.combos]
+        others = [w for w in args.worlds or [] if w not in EVADER_NAMES]
+        l_mins = getattr(args, "l_mins", None)
         jobs = [
             (role, w, combo, opponent, seed)
-            for role, w, combo, opponent, seed in evader_jobs(args.draws)
+            for role, w, combo, opponent, seed in [
+                *evader_jobs(args.draws),
+                *other_evader_jobs(others, l_mins or [1.0, 2.0], args.draws),
+            ]
             if (not args.worlds or w in args.worlds)
+            and (not l_mins or combo[2] in l_mins)
             and (not combos or tuple(combo[:2]) in combos)
             and (not args.opponents or opponent in args.opponents)
             and (not args.seeds or seed in args.seeds)
@@ -342,12 +441,19 @@ def _combo_index(role: str, combo) -> int:
     return EVADER_COMBOS.index(tuple(combo[:2]))
 
 
+def _shell_word(label: str) -> str:
+    return label if re.fullmatch(r"[\w@%+=:,./~-]+", label) else f"'{label}'"
+
+
 def replay_command(row, results: str = "replay.jsonl") -> str:
     """The command that plays this episode again (alone)."""
+    other = row["role"] == "evader" and row["world"] not in EVADER_NAMES
+    l_min = f" --l-mins {row['combo'][2]:g}" if other else ""
     return (
-        f"python benchmarks/unseen_worlds.py --role {row['role']} --worlds {row['world']} "
+        f"python benchmarks/unseen_worlds.py --role {row['role']} "
+        f"--worlds {_shell_word(row['world'])} "
         f"--combos {_combo_index(row['role'], row['combo'])} --opponents '{row['opponent']}' "
-        f"--seeds {row['seed']} --results {results}"
+        f"--seeds {row['seed']}{l_min} --results {results}"
     )
 
 
@@ -407,22 +513,35 @@ def main(argv=None) -> int:
         f"evader role (rho, L_max/L_min) {EVADER_COMBOS}",
     )
     ap.add_argument("--role", choices=("pursuer", "evader"), required=True)
-    ap.add_argument("--worlds", nargs="+", help="world names (default: all of the role's)")
+    ap.add_argument("--worlds", nargs="+", help="world names (default: all of the role's), "
+                    "or labels of other worlds: NAME~[xS][rotR][off(X,Y)], L_AxW, U_WxHxAxB, "
+                    "pillar:W:H:X0:Y0:X1:Y1, plus_wW[aA], tee_wW[aA], rand:KIND:SEED:GAP, "
+                    "random:KIND:SEED, floor_plan:SEED (module docstring)")  # fmt: skip
     ap.add_argument("--combos", nargs="+", type=int, help="indices into the role's combos")
     ap.add_argument("--opponents", nargs="+", help="opponent labels (default: all)")
     ap.add_argument("--seeds", nargs="+", type=int, help="pursuer role: seeds (101); "
                     "evader role: keep the episodes with these drawn seeds")  # fmt: skip
     ap.add_argument("--draws", type=int, default=2, help="evader role: episodes per world "
                     "and pursuer")  # fmt: skip
+    ap.add_argument("--l-mins", nargs="+", type=float, help="evader role: the L_min (before "
+                    "scaling) of worlds outside the default set (1 2), and a filter on the "
+                    "default set's")  # fmt: skip
     ap.add_argument("--max-cycles", type=int, default=600, help="pursuer role: horizon in steps")
     ap.add_argument("--k", type=float, default=8.0, help="evader role: horizon in D / V_e")
     ap.add_argument("--results", help="JSON-lines file (default out/unseen_worlds_ROLE.jsonl)")
     ap.add_argument("--workers", type=int, default=1)
     args = ap.parse_args(argv)
     for name in args.worlds or []:
-        known = PURSUER_WORLDS if args.role == "pursuer" else [w for w, _ in EVADER_WORLDS]
+        known = PURSUER_WORLDS if args.role == "pursuer" else EVADER_NAMES
         if name not in known:
-            ap.error(f"unknown {args.role}-role world {name!r} (one of {sorted(set(known))})")
+            try:
+                if args.role == "pursuer":
+                    pursuer_world(name, PURSUER_COMBOS[0])
+                else:
+                    evader_world(name, 1.0, 0.5, 2.0)
+            except ValueError as exc:  # the project's errors subclass ValueError
+                ap.error(f"unknown {args.role}-role world {name!r} ({exc}; the default set: "
+                         f"{sorted(set(known))})")  # fmt: skip
     for label in args.opponents or []:
         try:
             make_opponent(label)

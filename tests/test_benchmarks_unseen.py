@@ -84,3 +84,68 @@ def test_an_unknown_opponent_is_a_usage_error_naming_it(unseen, tmp_path, capsys
     assert exc.value.code == 2
     assert f"--opponents: {label!r} is no opponent" in capsys.readouterr().err
     assert not results.exists()  # nothing played
+
+
+def test_the_label_grammar_rebuilds_the_default_worlds(unseen) -> None:
+    """Generic labels give the same geometry as the default set's hand-written worlds."""
+    assert unseen.room_map("L_12x5") == unseen.built_map("L_12x5")
+    assert unseen.room_map("U_14x10x5x4") == unseen.built_map("U_14x10")
+    assert unseen.room_map("U_18x9x6x5") == unseen.built_map("U_wide")
+    assert unseen.room_map("pillar:10:10:4:4:6:6") == unseen.built_map("pillar_centre")
+    assert unseen.room_map("tee_w5") == unseen.built_map("tee_w5")  # arms 6: the role's
+    assert unseen.room_map("plus_w1.2", "evader") == unseen.evader_world("plus_w1.2", 1, 0.5, 2)[0]
+    assert unseen.room_map("plus_w5a7") != unseen.room_map("plus_w5")
+    for combo in [(0.5, 2.0, 2.0), (0.3, 2.0, 1.0)]:  # "x0.30" is no default label
+        assert unseen.pursuer_world("pillars~x0.30", combo) == unseen.pursuer_world(
+            "pillars~x0.3", combo
+        )
+    assert unseen.transform_of("corner~x1.7rot-1.9") == unseen.PAPER["corner~x1.7rot-1.9"]
+    assert unseen.transform_of("two_rooms~x0.7rot0.9off(5,-7)") == (
+        "two_rooms", 0.9, 0.7, (5.0, -7.0))  # fmt: skip
+    assert unseen.transform_of("maze~rot-1") == ("maze", -1.0, 1.0, (0.0, 0.0))
+    # a fresh transform scales L_min and the speeds as the default set's do
+    m, ov = unseen.pursuer_world("corner~x0.8rot1.2", (0.5, 2.0, 1.0))
+    assert ov == pytest.approx({"l_min": 0.8, "l_max": 1.6, "v_pursuer": 0.8,
+                                "v_evader": 0.4, "body_radius": 0.08})  # fmt: skip
+    assert m.bounds[2] - m.bounds[0] < 14.0 * 0.8 * 1.42
+
+
+@pytest.mark.parametrize(
+    "role, label",
+    [("pursuer", "maze~spin3"), ("pursuer", "nope~x2"), ("pursuer", "L_10"),
+     ("pursuer", "rand:convex:x:3"), ("pursuer", "maze~x0"), ("evader", "floor_plan:x"),
+     ("evader", "office~")],
+)  # fmt: skip
+def test_an_unknown_world_label_is_a_usage_error_naming_it(unseen, tmp_path, capsys, role,
+                                                           label) -> None:  # fmt: skip
+    results = tmp_path / "r.jsonl"
+    with pytest.raises(SystemExit) as exc:
+        unseen.main(["--role", role, "--worlds", label, "--results", str(results)])
+    assert exc.value.code == 2
+    assert f"unknown {role}-role world {label!r}" in capsys.readouterr().err
+    assert not results.exists()
+
+
+def test_a_fresh_evader_world_draws_its_own_episodes(unseen, tmp_path, capsys) -> None:
+    """Each other world's draws depend only on its label and L_min; it plays and its replay
+    line names the L_min."""
+    both = unseen.other_evader_jobs(["tee_w1.4", "random:star:2017"], [1.0, 2.0], 2)
+    alone = unseen.other_evader_jobs(["random:star:2017"], [2.0], 2)
+    assert alone == [j for j in both if j[1] == "random:star:2017" and j[2][2] == 2.0]
+    assert len(alone) == 24  # 12 pursuers x 2 draws (the referee only on junctions)
+    assert len([j for j in both if j[1] == "tee_w1.4"]) == 2 * 25
+    assert len({j[4] for j in both}) > 40  # drawn seeds, not one per world
+    out = tmp_path / "e.jsonl"
+    argv = ["--role", "evader", "--worlds", "tee_w1.4", "--opponents", "still", "--l-mins",
+            "2", "--draws", "1", "--results", str(out)]  # fmt: skip
+    assert unseen.main(argv) == 0
+    (row,) = _rows(out)
+    assert row["world"] == "tee_w1.4" and row["combo"][2] == 2.0 and row["winner"] == "evader"
+    assert "shooting evader escaped 1/1" in capsys.readouterr().out
+    assert unseen.replay_command({**row, "winner": "pursuer"}).endswith(
+        f"--seeds {row['seed']} --l-mins 2 --results replay.jsonl"
+    )
+    label = "office~x0.6rot1.7off(1,2)"
+    assert f"--worlds '{label}' " in unseen.replay_command(
+        {"role": "pursuer", "world": label, "combo": [0.5, 2.0, 2.0], "opponent": "herder",
+         "seed": 101})  # fmt: skip

@@ -38,7 +38,7 @@ from envs.geometry.types import Arc, FreeArcs
 from envs.maps.map import Map
 from strategies.cspace._arcs import StopPair, pairs
 from strategies.cspace.curves import CriticalCurve, _check_map, check_length
-from strategies.cspace.tolerances import diameter
+from strategies.cspace.tolerances import diameter, min_length
 
 __all__ = ["Boundary", "Cell", "CellArc", "Decomposition", "Region", "decompose"]
 
@@ -577,7 +577,8 @@ def decompose(
         The :class:`Decomposition`.
 
     Raises:
-        InvalidConfigError: for a non-map or a bad ``L`` / ``chord_tol`` / budget.
+        InvalidConfigError: for a non-map or a bad ``L`` / ``chord_tol`` / budget, or an
+            ``L`` shorter than the map's tolerances resolve (:func:`.tolerances.min_length`).
         InfeasibleError: if the build would exceed the memory budget (the message gives
             the estimate and how to change it).
     """
@@ -585,6 +586,13 @@ def decompose(
 
     world = _check_map(map)
     L = check_length(L)
+    if L < min_length(world):
+        raise InvalidConfigError(
+            f"L = {L:g}: too short to decompose on map {world.name!r}: expected L >= "
+            f"{min_length(world):.3g} (its diameter {diameter(world):.4g} times "
+            f"{min_length(world) / diameter(world):.2g}; the geometry's tolerances are "
+            "relative to the map's size)"
+        )
     if chord_tol is not None:
         chord_tol = check_length(chord_tol, "chord_tol")
     if progress is not None and not isinstance(progress, bool):

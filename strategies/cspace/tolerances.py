@@ -65,11 +65,13 @@ __all__ = [
     "COLLAPSE_REL",
     "KERNEL_FLOOR",
     "MERGE_REL",
+    "MIN_LENGTH_FLOOR",
     "PROBE_REL",
     "THIN_REL",
     "TOUCH_REL",
     "Tolerances",
     "diameter",
+    "min_length",
 ]
 
 CHORD_TOL_REL = 1e-4
@@ -94,6 +96,13 @@ times the kernel's resolution ``sqrt(ANGLE_TOL)`` near a type-4 end (module docs
 KERNEL_FLOOR = {"touch": 2.0, "merge": 20.0, "thin": 20.0, "probe": 200.0, "collapse": 200.0}
 """Each tolerance is at least this many times ``REL_LENGTH_TOL * sqrt(2) * diameter``, a
 rotation-invariant bound on the kernel's tolerance ``REL_LENGTH_TOL * scale``."""
+
+MIN_LENGTH_FLOOR = 2.0 * KERNEL_FLOOR["probe"]
+"""The shortest rod the decomposition resolves, in the same units as
+:data:`KERNEL_FLOOR`: below it the probes across a boundary piece and the speck size
+(floored at ``KERNEL_FLOOR["probe"]`` and ``["collapse"]``) exceed half the rod, and the
+answer is an artefact (the corridor, 16.9 across: 27 regions and 6 escapable cells at
+every L from 1e-5 to 0.5; 9 regions and none at L = 2e-6; no region at 3e-7)."""
 
 
 @dataclass(frozen=True)
@@ -134,6 +143,12 @@ class Tolerances:
             collapse=max(COLLAPSE_REL * L, KERNEL_FLOOR["collapse"] * k),
             kernel=REL_LENGTH_TOL * world.scale,
         )
+
+
+def min_length(world: Map) -> float:
+    """The shortest rod length the decomposition of ``world`` resolves
+    (:data:`MIN_LENGTH_FLOOR` kernel tolerances; about 5.7e-7 of the map's diameter)."""
+    return MIN_LENGTH_FLOOR * REL_LENGTH_TOL * math.sqrt(2.0) * diameter(world)
 
 
 def diameter(world: Map) -> float:

@@ -246,6 +246,15 @@ def test_bad_length_rejected(bad):
         decompose(corridor(), bad)
 
 
+@pytest.mark.parametrize("tiny", [2e-6, 1e-7])
+def test_a_length_below_the_tolerances_is_rejected(tiny):
+    # L = 1e-7 on the corridor (16.9 across) crashed in the probing (numpy reshape of
+    # nothing); 2e-6 answered 9 regions, no escapable cell (27 and 6 at 1e-5 .. 0.5)
+    with pytest.raises(InvalidConfigError, match=rf"L = {tiny:g}: too short .* 'corridor'"):
+        decompose(corridor(), tiny, cache=False)
+    assert len(decompose(corridor(), 1e-5, cache=False).regions) == 27
+
+
 @pytest.mark.parametrize(
     "call",
     [

@@ -336,9 +336,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         interrupted. A traceback means a bug.
     """
     try:
-        args = build_parser().parse_args(argv)
+        args = build_parser().parse_args(argv)  # imports for seconds: Ctrl-C lands here too
     except SystemExit as exc:  # argparse: --help (0) or a usage error (2, already printed)
         return int(exc.code or 0) if not isinstance(exc.code, str) else 2
+    except KeyboardInterrupt:
+        print("surveil: interrupted", file=sys.stderr)
+        return 130
     with warnings.catch_warnings():
         warnings.showwarning = _OneLineWarnings(warnings.showwarning)
         try:

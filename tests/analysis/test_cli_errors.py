@@ -216,3 +216,16 @@ def test_only_user_errors_lose_their_traceback():
     assert user_error(failure) == str(failure)
     failure.__cause__ = KeyError("a bug inside a policy")
     assert user_error(failure) is None
+
+
+def test_ctrl_c_while_the_parser_imports_is_a_clean_exit(monkeypatch, capsys) -> None:
+    # building the parser imports training (torch, SB3) for seconds: a Ctrl-C there was a
+    # KeyboardInterrupt traceback (`timeout -s INT 5 surveil tournament ...`)
+    import analysis.cli
+
+    def interrupted():
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(analysis.cli, "build_parser", interrupted)
+    assert main(["maps"]) == 130
+    assert capsys.readouterr().err == "surveil: interrupted\n"

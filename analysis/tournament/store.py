@@ -129,6 +129,7 @@ class Store:
         try:
             self.conn = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
             self.conn.row_factory = sqlite3.Row
+            self._check_foreign(create)
             mode = self.conn.execute("PRAGMA journal_mode=WAL").fetchone()[0]
             if mode.lower() != "wal":  # pragma: no cover - e.g. a network file system
                 raise InvalidConfigError(f"store {self.path}: cannot use WAL mode (got {mode})")
@@ -140,6 +141,21 @@ class Store:
             raise InvalidConfigError(
                 f"store {str(self.path)!r} is not a tournament store (SQLite): {exc}"
             ) from exc
+
+    def _check_foreign(self, create: bool) -> None:
+        """Refuse, before writing anything (the schema, WAL mode), a SQLite file that is
+        not a store: one with other tables, or an empty one for a reader."""
+        tables = sorted(
+            r[0] for r in self.conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")
+        )
+        if "meta" in tables or (create and not tables):
+            return
+        self.conn.close()
+        what = f"a SQLite database with other tables {tables}" if tables else "an empty file"
+        raise InvalidConfigError(
+            f"store {str(self.path)!r} is not a tournament store: it is {what}; left "
+            "unchanged (give a new path, or a store a tournament wrote)"
+        )
 
     def _init_schema(self) -> None:
         with self.transaction() as c:

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import json
+import re
 import shutil
 import sqlite3
 
@@ -187,6 +189,27 @@ def test_store_rejects_foreign_files_and_exports(tmp_path, small_spec):
         Store(bogus)
     with pytest.raises(InvalidConfigError, match="no such file"):
         Store(tmp_path / "missing.sqlite", create=False)
+    # another program's database, or an empty file: refused and left as it was (the
+    # schema and WAL mode were written into them, and a reader said "no runs yet")
+    other = tmp_path / "other.db"
+    with contextlib.closing(sqlite3.connect(other)) as conn:
+        conn.execute("CREATE TABLE notes (a)")
+        conn.commit()
+    empty = tmp_path / "empty.sqlite"
+    empty.touch()
+    cases = [
+        (other, True, "other tables ['notes']"),
+        (other, False, "other tables"),
+        (empty, False, "an empty file"),
+    ]
+    for path, create, what in cases:
+        before = path.read_bytes()
+        with pytest.raises(
+            InvalidConfigError, match=f"not a tournament store: it is .*{re.escape(what)}"
+        ):
+            Store(path, create=create)
+        assert path.read_bytes() == before
+    Store(empty).close()  # a writer may start a store in an empty file
     store = tmp_path / "s.sqlite"
     summary = run_tournament(spec_from_dict(small_spec), store, backend="serial", progress=False)
     with Store(store) as db:

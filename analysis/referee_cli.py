@@ -79,6 +79,8 @@ def run(args: argparse.Namespace) -> int:
     from envs.errors import SurveilValueError, VacuousBoundWarning
     from envs.surveillance.config import EnvConfig
     from strategies.referee import referee_for
+    from strategies.referee.estimates import check_cpls
+    from strategies.referee.referee import check_start
     from strategies.runner import map_parameters
 
     overrides = json_object("--config", args.config, example=CONFIG_EXAMPLE)
@@ -92,6 +94,17 @@ def run(args: argparse.Namespace) -> int:
     except SurveilValueError as exc:
         raise type(exc)(f"map: {exc}") from None
     cfg = EnvConfig(map=world, **{**params, **overrides})
+    # what the solve cannot change is checked before it (it can take minutes)
+    if args.classify is not None:
+        try:
+            check_start(cfg, tuple(args.classify[:2]), tuple(args.classify[2:]))
+        except SurveilValueError as exc:
+            raise type(exc)(f"--classify: {exc}") from None
+    if args.estimate:
+        try:
+            check_cpls(args.estimate)
+        except SurveilValueError as exc:
+            raise type(exc)(f"--estimate: {exc}") from None
     t = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", VacuousBoundWarning)  # the summary says it below

@@ -103,6 +103,7 @@ __all__ = [
     "ESTIMATE_LABELS",
     "Estimate",
     "EstimateSolution",
+    "check_cpls",
     "estimate",
     "solve_estimate",
 ]
@@ -634,6 +635,21 @@ class Estimate:
         }
 
 
+def check_cpls(cpls: Sequence[float]) -> list[float]:
+    """The resolutions of :func:`estimate` as floats: at least two, all different.
+
+    Raises:
+        InvalidConfigError: otherwise (the resolution error is their disagreement).
+    """
+    values = [V.positive("cpls", c) for c in cpls]
+    if len(set(values)) < 2 or len(set(values)) < len(values):
+        raise InvalidConfigError(
+            f"cpls = {tuple(cpls)!r}: expected at least two different resolutions (the "
+            "resolution error is their disagreement)"
+        )
+    return values
+
+
 def estimate(
     spec: GameSpec,
     cpls: Sequence[float] = (6.0, 8.0),
@@ -669,12 +685,7 @@ def estimate(
     """
     if not isinstance(spec, GameSpec):
         raise InvalidConfigError(f"estimate: expected a GameSpec, got {type(spec).__name__}")
-    values = [V.positive("cpls", c) for c in cpls]
-    if len(set(values)) < 2 or len(set(values)) < len(values):
-        raise InvalidConfigError(
-            f"cpls = {tuple(cpls)!r}: expected at least two different resolutions (the "
-            "resolution error is their disagreement)"
-        )
+    values = check_cpls(cpls)
     order = np.argsort(values, kind="stable")
     if steps is None:
         per = [4.0 * values[i] / values[order[0]] for i in order]

@@ -37,6 +37,7 @@ __all__ = [
     "StartSet",
     "cached_evader_bound",
     "cached_pursuer_bound",
+    "check_start",
     "label_starts",
     "referee_for",
     "sample_starts",
@@ -156,19 +157,7 @@ class Referee:
             InvalidPlacementError: surveillance does not hold at the start (out of range
                 or occluded), so it is not a start of the game.
         """
-        p = V.point("pursuer", pursuer)
-        e = V.point("evader", evader)
-        spec = self.spec
-        L = float(np.hypot(*(p - e)))
-        if not spec.l_min <= L <= spec.l_max:
-            raise InvalidPlacementError(
-                f"start pursuer={tuple(p.tolist())}, evader={tuple(e.tolist())}: distance "
-                f"{L:.6g} outside [l_min, l_max] = [{spec.l_min:g}, {spec.l_max:g}]"
-            )
-        if not kernel_for(spec.map).line_of_sight(p, e):
-            raise InvalidPlacementError(
-                f"start pursuer={tuple(p.tolist())}, evader={tuple(e.tolist())}: occluded"
-            )
+        p, e = check_start(self.spec, pursuer, evader)
         if self.pursuer.certifies(p, e):
             return "pursuer"
         if self.evader.certifies(p, e):
@@ -426,6 +415,29 @@ def solve(
     if reason is not None:
         warnings.warn(f"map {spec.map.name!r}: {reason}", VacuousBoundWarning, stacklevel=2)
     return ref
+
+
+def check_start(game: Any, pursuer: Any, evader: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The start as two points, if it is one of the game's (finite points, the range in
+    ``[l_min, l_max]``, in line of sight); ``game`` is a :class:`GameSpec` or an env
+    config (anything with ``map``, ``l_min``, ``l_max``), so a caller can check a start
+    before solving.
+
+    Raises:
+        InvalidConfigError: a position is not a finite (x, y) point.
+        InvalidPlacementError: out of range or occluded.
+    """
+    p = V.point("pursuer", pursuer)
+    e = V.point("evader", evader)
+    L = float(np.hypot(*(p - e)))
+    where = f"start pursuer={tuple(p.tolist())}, evader={tuple(e.tolist())}"
+    if not game.l_min <= L <= game.l_max:
+        raise InvalidPlacementError(
+            f"{where}: distance {L:.6g} outside [l_min, l_max] = [{game.l_min:g}, {game.l_max:g}]"
+        )
+    if not kernel_for(game.map).line_of_sight(p, e):
+        raise InvalidPlacementError(f"{where}: occluded")
+    return p, e
 
 
 def referee_for(config: Any, cells_per_lmin: float = 24.0, **kwargs: Any) -> Referee:

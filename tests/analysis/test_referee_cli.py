@@ -74,3 +74,27 @@ def test_referee_bad_input_is_one_line(argv, message, capsys, tmp_path, monkeypa
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert err.startswith("surveil: error:") and message in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--classify", "1", "1", "9", "9"], "--classify: start pursuer=(1.0, 1.0)"),
+        (["--classify", "nan", "1", "3", "1"], "--classify: pursuer = (nan, 1.0)"),
+        (["--estimate", "6"], "--estimate: cpls = (6.0,): expected at least two"),
+        (["--estimate", "6", "6"], "--estimate: cpls = (6.0, 6.0)"),
+    ],
+)
+def test_referee_bad_start_or_resolutions_fail_before_the_solve(extra, message, capsys, tmp_path,
+                                                                 monkeypatch):  # fmt: skip
+    # they were found only after the whole solve (minutes at a fine resolution)
+    import strategies.referee
+
+    def no_solve(*args, **kwargs):
+        raise AssertionError("the solve started")
+
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(strategies.referee, "referee_for", no_solve)
+    assert main(["referee", "open_room", "--cells-per-lmin", "4", *extra]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("surveil: error:") and message in err and "Traceback" not in err

@@ -179,6 +179,10 @@ class DecompositionPursuer(BasePolicy):
         self.horizon = horizon = math.pi / self.omega
         h = self.table.resolution
         n_r = max(2, math.ceil(c.v_evader * horizon / h))
+        # a ray stops at its first sample off the table's grid, and from a point of the
+        # grid every sample past the grid's diagonal is off it: a slow pursuer's long
+        # horizon adds only samples never reached (v_pursuer = 1e-6: 150 GiB of them)
+        n_r = min(n_r, math.ceil(math.hypot(*self.table.shape)) + 2)
         radii = h * np.arange(1, n_r + 1)
         ang = 2.0 * math.pi * np.arange(self.rays) / self.rays
         dirs = np.stack([np.cos(ang), np.sin(ang)], axis=1)

@@ -117,6 +117,10 @@ class ShootingEvader(BasePolicy):
         reach = c.v_evader * math.pi / omega_max + 2.0 * c.l_min
         h = self.table.resolution
         n_r = max(2, math.ceil(reach / h))
+        # a ray stops at its first sample off the table's grid, and from a point of the
+        # grid every sample past the grid's diagonal is off it (and so is every corner
+        # farther): a slow pursuer's long reach adds only samples never reached
+        n_r = min(n_r, math.ceil(math.hypot(*self.table.shape)) + 2)
         radii = h * np.arange(1, n_r + 1)
         ang = 2.0 * math.pi * np.arange(self.rays) / self.rays
         dirs = np.stack([np.cos(ang), np.sin(ang)], axis=1)

@@ -303,6 +303,8 @@ class DecompositionPursuer(BasePolicy):
         starts = self._corners
         if not len(starts) or (self._clear is None and self._clear_memo is None):
             return []
+        if not len(self._t_e):  # a slow evader: no probe within the horizon's reach
+            return []
         c = self.config
         vx, vy = float(velocity[0]), float(velocity[1])
         speed = math.hypot(vx, vy)

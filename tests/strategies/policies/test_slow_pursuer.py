@@ -1,4 +1,4 @@
-"""A very slow pursuer (rho huge) is legal input: the analytic policies still play it.
+"""A very slow pursuer (rho huge) or evader is legal input: the analytic policies play it.
 
 Their probe rays were sized by the evader's reach within the pursuer's turning horizon,
 which grows as 1 / V_p: at V_p = 1e-9 that asked numpy for terabytes. A ray stops at its
@@ -15,6 +15,7 @@ import pytest
 from envs.errors import RhoAboveOneWarning
 from envs.surveillance.config import EnvConfig
 from strategies.policies import make_policy
+from strategies.runner import run_episode
 from tests.strategies.policies.conftest import state_observations
 
 
@@ -31,3 +32,13 @@ def test_a_very_slow_pursuer_is_played(box_world, name, role) -> None:
         action = policy.act(obs)
         assert action.shape == (2,) and np.all(np.isfinite(action))
         assert np.all(np.abs(action) <= 1.0)
+
+
+def test_a_very_slow_evader_is_played() -> None:
+    # with no probe within the horizon's reach (V_e = 1e-3: the rays hold 2 samples, the
+    # first probe is the 3rd) the corner probes indexed an empty array: IndexError at step 1
+    result = run_episode(
+        "corridor", "pursuer/decomposition", "evader/shooting", seed=0, max_cycles=5,
+        overrides={"v_evader": 1e-3},
+    )  # fmt: skip
+    assert result.winner == "pursuer" and result.steps == 5

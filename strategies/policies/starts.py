@@ -216,6 +216,8 @@ def has_retreat_clearance(m, kernel, p, e, distance: float, radius: float) -> bo
     p = np.asarray(p, dtype=float)
     d = p - np.asarray(e, dtype=float)
     q = p + distance * d / np.linalg.norm(d)
+    if np.array_equal(q, p):  # too short a retreat to move p (a very slow evader)
+        return bool(m.distance_to_walls(p[None])[0] >= radius)
     if not m.contains(q[None])[0] or not kernel.line_of_sight(p, q):
         return False
     # no crossing, so the segment's distance to the walls is the least of its ends' and

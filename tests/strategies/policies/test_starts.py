@@ -109,6 +109,16 @@ def test_retreat_clearance_rejects_a_pursuer_backed_against_a_wall():
     env.close()
 
 
+def test_a_very_slow_evader_has_safe_starts():
+    # rho = 1e-12 asks for a retreat of 2e-24, which does not move p: the zero-length
+    # segment's test divided 0 by 0 and refused every start ("no safe start at L = 2.3")
+    env = surveillance_v0.parallel_env(map="corridor", v_evader=1e-12)
+    start = sample_start(env.config, np.random.default_rng(0), kind="safe")
+    env.reset(seed=0, options=start)
+    assert env.agents
+    env.close()
+
+
 @pytest.mark.parametrize("map_name", ["corridor", "two_rooms"])
 def test_a_lazy_table_draws_the_same_start_as_an_eager_one(map_name, monkeypatch):
     """On maps too large for a stored table the judge's table is lazy and has classified

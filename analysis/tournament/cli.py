@@ -15,9 +15,12 @@ import sys
 from importlib import resources
 from pathlib import Path
 
+from analysis.arguments import integer, json_object, output_file
 from envs.errors import InvalidConfigError
 
 __all__ = ["add_parsers", "format_cells", "shipped_specs"]
+
+CONFIG_EXAMPLE = "'{\"v_evader\": 0.8}'"
 
 EXIT_SIGNAL = {"SIGINT": 130, "SIGTERM": 143}
 
@@ -146,14 +149,15 @@ def _roster_entry(item: str) -> str | dict[str, str]:
 
 
 def _cmd_evaluate(args: argparse.Namespace) -> int:
-    import json
-
     from analysis.tournament.driver import run_tournament
     from analysis.tournament.spec import spec_from_dict
 
-    env = json.loads(args.config) if args.config else {}
+    env = json_object("--config", args.config, example=CONFIG_EXAMPLE)
     if args.max_cycles is not None:
         env["max_cycles"] = args.max_cycles
+    plot = None  # checked now, drawn after the run
+    if args.plot:
+        plot = output_file("--plot", args.plot, suffixes=(".png",), default_name="evaluate.png")
     store = Path(args.results or "out/evaluate.sqlite")
     if store.suffix.lower() in (".jsonl", ".json", ".csv", ".ndjson"):
         raise InvalidConfigError(
@@ -175,23 +179,21 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     summary = run_tournament(
         spec,
         store,
-        backend="serial" if args.workers <= 1 else "process",
-        workers=max(args.workers, 1),
+        backend="serial" if args.workers == 1 else "process",
+        workers=args.workers,
         progress=not args.no_progress,
         resume_hint="the same surveil evaluate command",
     )
     code = _print_outcome(summary, store, None, False)
-    if args.plot:
+    if plot is not None:
         from analysis.tournament import statistics as st
         from analysis.tournament.report import heatmaps_png
         from analysis.tournament.store import Store
 
         with Store(store, create=False) as db:
             cells = st.cells(db.rows(summary.run_id))
-        out = Path(args.plot)
-        out.parent.mkdir(parents=True, exist_ok=True)
-        out.write_bytes(heatmaps_png(st.payoff_matrices(cells), cells))
-        print(f"table picture written to {out}")
+        plot.write_bytes(heatmaps_png(st.payoff_matrices(cells), cells))
+        print(f"table picture written to {plot}")
     return code
 
 
@@ -245,14 +247,14 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                    help=roster)  # fmt: skip
     p.add_argument("--seeds", type=int, default=10, help="number of seeded starts per match")
     p.add_argument("--max-cycles", type=int, default=None)
-    p.add_argument("--config", help="env overrides as JSON, e.g. '{\"v_evader\": 0.8}'")
+    p.add_argument("--config", help=f"env overrides as JSON, e.g. {CONFIG_EXAMPLE}")
     p.add_argument(
         "--start",
         choices=["safe", "valid"],
         default="safe",
         help="starts in a non-escapable cell at L_min (safe) or any valid one",
     )
-    p.add_argument("--workers", type=int, default=1, help="processes to play in")
+    p.add_argument("--workers", type=integer(1), default=1, help="processes to play in")
     p.add_argument("--results", help="SQLite store (default: out/evaluate.sqlite; resumable)")
     p.add_argument("--plot", help="also draw the table as heat maps to this PNG")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")

@@ -229,3 +229,26 @@ def test_ctrl_c_while_the_parser_imports_is_a_clean_exit(monkeypatch, capsys) ->
     monkeypatch.setattr(analysis.cli, "build_parser", interrupted)
     assert main(["maps"]) == 130
     assert capsys.readouterr().err == "surveil: interrupted\n"
+
+
+EVALUATE = ["evaluate", "--maps", "corridor", "--pursuers", "pursuer/greedy", "--evaders",
+            "evader/straight", "--seeds", "1", "--max-cycles", "5", "--no-progress"]  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("extra", "needles"),
+    [
+        # the first two were json's and a TypeError's tracebacks
+        (["--config", "{"], ["--config = '{': not valid JSON"]),
+        (["--config", "[1]"], ["--config = '[1]': expected a JSON object"]),
+        # these ran (0: serially), or played every match before refusing the picture
+        (["--workers", "0"], ["--workers = '0': expected an integer >= 1"]),
+        (["--plot", "table.txt"], ["--plot = 'table.txt': expected a file ending in .png"]),
+        (["--plot", "notes/table.png"], ["--plot", "'notes' is a file, not a directory"]),
+    ],
+)
+def test_evaluate_bad_flags_fail_before_any_match(capsys, tmp_path, monkeypatch, extra, needles):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "notes").write_text("a file")
+    line = assert_fails(capsys, [*EVALUATE, "--results", "e.sqlite", *extra], *needles)
+    assert not (tmp_path / "e.sqlite").exists(), line

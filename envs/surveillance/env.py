@@ -22,6 +22,7 @@ from envs.errors import (
     EpisodeStateError,
     InvalidActionError,
     InvalidPlacementError,
+    UnknownNameError,
 )
 from envs.geometry import Kernel, kernel_for
 from envs.maps import Map
@@ -122,11 +123,19 @@ class parallel_env(ParallelEnv, EzPickle):
     # ------------------------------------------------------------------ spaces
     def observation_space(self, agent: str) -> Box:
         """The observation Box of ``agent`` (the same object on every call)."""
-        return self._observation_spaces[agent]
+        return self._space(self._observation_spaces, agent)
 
     def action_space(self, agent: str) -> Box:
         """The action Box(-1, 1, (2,)) of ``agent`` (the same object on every call)."""
-        return self._action_spaces[agent]
+        return self._space(self._action_spaces, agent)
+
+    def _space(self, spaces: dict, agent: str) -> Box:
+        try:
+            return spaces[agent]
+        except (KeyError, TypeError):  # TypeError: an unhashable name
+            raise UnknownNameError(
+                f"agent = {agent!r}: expected one of {self.possible_agents}"
+            ) from None
 
     # ------------------------------------------------------------------ episode
     def reset(

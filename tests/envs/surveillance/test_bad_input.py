@@ -5,7 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from envs.errors import InvalidActionError, InvalidConfigError, InvalidPlacementError
+from envs import surveillance_v0
+from envs.errors import (
+    InvalidActionError,
+    InvalidConfigError,
+    InvalidPlacementError,
+    UnknownNameError,
+)
 from envs.surveillance_v0 import parallel_env
 
 
@@ -57,3 +63,15 @@ def test_step_rejects_non_real_actions(env, action):
 def test_integer_and_list_actions_are_accepted(env):
     env.step({"pursuer_0": np.array([1, 0]), "evader_0": [0, 0]})
     assert env._step == 1
+
+
+@pytest.mark.parametrize("make", [surveillance_v0.parallel_env, surveillance_v0.env])
+@pytest.mark.parametrize("space", ["observation_space", "action_space"])
+def test_an_unknown_agent_is_a_project_error_naming_it(make, space):
+    # was a bare KeyError('pursuer'); UnknownNameError is still a KeyError
+    e = make()
+    with pytest.raises(UnknownNameError, match=r"agent = 'pursuer': expected one of \['pursuer_0'"):
+        getattr(e, space)("pursuer")
+    with pytest.raises(KeyError):
+        getattr(e, space)(["pursuer_0"])
+    e.close()

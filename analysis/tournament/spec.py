@@ -49,6 +49,7 @@ import itertools
 import json
 import os
 import warnings
+import zipfile
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -472,6 +473,7 @@ def _entry(item: Any, role: str, where: str, base: Path) -> PolicyEntry:
         return PolicyEntry(role, label, name, _canonical(params), None, None, observation)
     text = string("model", d["model"], where=where)
     path = _model_path(text, where, base)
+    _check_model_zip(path, text, where)
     digest = hashlib.sha256(path.read_bytes()).hexdigest()
     provenance = _provenance(path)
     if provenance.get("role") not in (None, role):
@@ -537,6 +539,18 @@ def _model_path(text: str, where: str, base: Path) -> Path:
     if not path.is_file():
         raise InvalidConfigError(f"{where}: model = {text!r}: no such file ({path})")
     return path
+
+
+def _check_model_zip(path: Path, text: str, where: str) -> None:
+    """A model file is a zip with SB3's ``data`` entry (checked on load, not by every
+    match's worker: a wrong file was an error row per match)."""
+    try:
+        with zipfile.ZipFile(path) as zf:
+            zf.getinfo("data")
+    except (OSError, KeyError, zipfile.BadZipFile) as exc:
+        raise InvalidConfigError(
+            f"{where}: model = {text!r}: not a stable-baselines3 model zip ({exc})"
+        ) from None
 
 
 def _provenance(model: Path) -> dict[str, Any]:

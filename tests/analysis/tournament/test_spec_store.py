@@ -189,6 +189,11 @@ def test_store_rejects_foreign_files_and_exports(tmp_path, small_spec):
         Store(bogus)
     with pytest.raises(InvalidConfigError, match="no such file"):
         Store(tmp_path / "missing.sqlite", create=False)
+    # a model file that is no model: refused on load (was: every match an error row)
+    (tmp_path / "notes.zip").write_text("not a zip")
+    bad = {**small_spec, "pursuers": [{"model": "notes.zip"}]}
+    with pytest.raises(InvalidConfigError, match=r"\[pursuers #1\]: model = 'notes.zip': not a"):
+        spec_from_dict(bad, base_dir=tmp_path)
     # another program's database, or an empty file: refused and left as it was (the
     # schema and WAL mode were written into them, and a reader said "no runs yet")
     other = tmp_path / "other.db"

@@ -133,9 +133,12 @@ def _cmd_report(args: argparse.Namespace) -> int:
 def _cmd_export(args: argparse.Namespace) -> int:
     from analysis.tournament.store import Store
 
+    out = output_file(
+        "out", args.out, suffixes=(".csv", ".jsonl", ".ndjson"), default_name="results.csv"
+    )
     with Store(args.store, create=False) as db:
         run = db.run(args.run)
-        path = db.export(run["run_id"], args.out)
+        path = db.export(run["run_id"], out)
         print(f"{len(db.rows(run['run_id']))} matches of run {run['run_id']} written to {path}")
     return 0
 

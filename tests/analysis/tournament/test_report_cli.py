@@ -82,6 +82,8 @@ def test_cli_tournament_report_export_and_errors(tmp_path, capsys):
         (["tournament", str(tmp_path / "missing.toml")], "no such file"),
         (["report", str(tmp_path / "missing.sqlite")], "no such file"),
         (["export", str(store), str(tmp_path / "x.txt")], ".csv"),
+        # under a file: was "x.csv: File exists"
+        (["export", str(store), str(tmp_path / "x.csv" / "y.csv")], "is a file, not a directory"),
         (["evaluate", "--results", str(tmp_path / "old.jsonl")], "SQLite store"),
     ]:
         capsys.readouterr()

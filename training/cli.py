@@ -8,8 +8,10 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 from collections.abc import Callable, Sequence
+from pathlib import Path
 
 from envs.errors import InvalidConfigError, SurveilValueError
 from training.config import TrainConfig, load_any_config
@@ -48,6 +50,7 @@ def run_train(args: argparse.Namespace) -> int:
     if args.seed is not None:
         overrides["seed"] = args.seed
     config = load_any_config(args.config, **overrides)
+    _check_output_dir(os.fspath(config.output_dir))
     if not isinstance(config, TrainConfig):  # a DAgger recipe
         if args.timesteps is not None or args.self_play:
             raise InvalidConfigError(
@@ -69,6 +72,17 @@ def run_train(args: argparse.Namespace) -> int:
     for r in results:
         print(summary(r))
     return 0
+
+
+def _check_output_dir(text: str) -> None:
+    """Refuse, before any training, an output_dir that is a file or lies under one (was
+    ``x.json: File exists`` from the first checkpoint's mkdir)."""
+    path = Path(text)
+    blocker = next((p for p in (path, *path.parents) if p.exists() and not p.is_dir()), None)
+    if blocker is not None:
+        raise InvalidConfigError(
+            f"output_dir = {text!r}: {str(blocker)!r} is a file, expected a directory"
+        )
 
 
 def cli_train(argv: Sequence[str] | None = None) -> int:

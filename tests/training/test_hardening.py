@@ -110,6 +110,21 @@ def test_python_m_training_reports_bad_configs_in_one_line(tmp_path, capsys, ext
     assert "Traceback" not in err and err.count("\n") == 1
 
 
+@pytest.mark.parametrize("under", [False, True])
+def test_an_output_dir_that_is_a_file_is_refused_before_training(tmp_path, capsys, under):
+    (tmp_path / "notes.json").write_text("{}")
+    out = tmp_path / "notes.json" / "run" if under else tmp_path / "notes.json"
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(
+        'role = "pursuer"\nopponent = "evader/straight"\ntotal_timesteps = 64\n'
+        f'output_dir = "{out}"\n'
+    )
+    assert cli_train([str(cfg)]) == 2
+    err = capsys.readouterr().err
+    assert f"output_dir = '{out}': '{tmp_path / 'notes.json'}' is a file" in err
+    assert err.count("\n") == 1
+
+
 def test_python_m_training_zoo_reports_bad_input_in_one_line(capsys):
     assert zoo_main(["info", "no_such_model"]) == 2
     assert "unknown zoo model 'no_such_model'" in capsys.readouterr().err

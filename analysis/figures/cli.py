@@ -18,6 +18,8 @@ import sys
 import time
 from pathlib import Path
 
+from envs.errors import InvalidConfigError
+
 __all__ = ["add_parser", "run"]
 
 DEFAULT_OUT = Path("out") / "figures"
@@ -77,10 +79,12 @@ def run(args: argparse.Namespace) -> int:
     if args.check:
         return _check(Path(args.check))
     if args.update:
-        _update(Path(args.update))
+        _update(Path(args.update), "--update")
         return 0
     specs = select(args.only)
     check_scale(args.scale)  # before drawing anything
+    if args.report:
+        _report_text(Path(args.report), "--report")
     from tqdm import tqdm
 
     out = Path(args.out)
@@ -92,7 +96,7 @@ def run(args: argparse.Namespace) -> int:
         size = path.stat().st_size / 1024
         tqdm.write(f"{path}  ({size:.0f} kB, {time.perf_counter() - t0:.1f} s)")
     if args.report:
-        _update(Path(args.report))
+        _update(Path(args.report), "--report")
     return 0
 
 
@@ -113,11 +117,34 @@ def _check(path: Path) -> int:
     return 0
 
 
-def _update(path: Path) -> None:
-    from analysis.figures.numbers import compute_numbers
-    from analysis.figures.report import read, update_report
+def _report_text(path: Path, flag: str) -> str:
+    """The text of the report ``flag`` names: a file with tagged numbers or the gallery
+    markers, or an empty one (it gets the gallery). Any other file is refused unchanged
+    (the gallery was appended to whatever file was given, a JSON file included).
 
-    text, changes = update_report(read(path), compute_numbers())
+    Raises:
+        InvalidConfigError: no such file, or not a report.
+    """
+    from analysis.figures.report import BEGIN, END, read, tags
+
+    try:
+        text = read(path)
+    except (OSError, UnicodeDecodeError) as exc:
+        reason = getattr(exc, "strerror", None) or type(exc).__name__
+        raise InvalidConfigError(f"{flag} = {str(path)!r}: cannot read it ({reason})") from None
+    if text.strip() and not tags(text) and not (BEGIN in text and END in text):
+        raise InvalidConfigError(
+            f"{flag} = {str(path)!r}: not a report (no tagged number such as "
+            f"31<!--n:corridor.regions--> and no {BEGIN} ... {END}); left unchanged"
+        )
+    return text
+
+
+def _update(path: Path, flag: str) -> None:
+    from analysis.figures.numbers import compute_numbers
+    from analysis.figures.report import update_report
+
+    text, changes = update_report(_report_text(path, flag), compute_numbers())
     path.write_text(text, encoding="utf-8")
     for c in changes:
         print(f"{path}: {c}")

@@ -94,3 +94,18 @@ def test_numbers_are_described_and_prefixes_checked():
     assert set(compute_numbers(["e5.T"])) == {"e5.T_plus", "e5.T_minus"}
     with pytest.raises(UnknownNameError, match="no number starts"):
         compute_numbers(["no.such."])
+
+
+def test_a_file_that_is_not_a_report_is_refused_unchanged(tmp_path, capsys):
+    # --update appended the gallery to any file (a JSON file, say); --report did so after
+    # drawing every figure, and found a missing file only then
+    notes = tmp_path / "notes.json"
+    notes.write_text('{"a": 1}\n', encoding="utf-8")
+    assert main(["figures", "--update", str(notes)]) == 2
+    assert "not a report" in capsys.readouterr().err
+    assert notes.read_text(encoding="utf-8") == '{"a": 1}\n'
+    out = tmp_path / "f"
+    for report, needle in [(notes, "not a report"), (tmp_path / "no.md", "cannot read it")]:
+        assert main(["figures", "--only", "fig12", "--out", str(out), "--report", str(report)]) == 2
+        assert needle in capsys.readouterr().err
+    assert not out.exists()  # refused before drawing

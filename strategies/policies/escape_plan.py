@@ -174,15 +174,39 @@ class EscapePlan:
 
     def _piece(self, b: int) -> tuple[np.ndarray, ...]:
         """Boundary ``b``'s segment starts, directions, lengths, left normals (into A),
-        and samples along the piece with their segment and wall clearance (computed on
-        first use: a plan crosses few of the pieces)."""
+        and samples along the piece with their segment (computed on first use: a plan
+        crosses few of the pieces)."""
         got = self._pieces.get(b)
         if got is not None:
             return got
         p0, d, ln, u, s, seg = _samples(self.dec.boundaries[b].segments, self.dec.chord_tol)
-        clear = self.dec.map.distance_to_walls(s) if len(s) else np.zeros(0)
-        got = (p0, d, ln, np.stack([-u[:, 1], u[:, 0]], axis=1), s, seg, clear)
+        got = (p0, d, ln, np.stack([-u[:, 1], u[:, 0]], axis=1), s, seg)
         self._pieces[b] = got
+        return got
+
+    @functools.cached_property
+    def _keeps(self) -> dict[tuple[int, float], np.ndarray]:
+        return {}
+
+    def _keep(self, b: int, clearance: float) -> np.ndarray:
+        """Which samples of piece ``b`` keep ``clearance`` from the walls (first use)."""
+        got = self._keeps.get((b, clearance))
+        if got is None:
+            s = self._piece(b)[4]
+            clear = self.dec.map.distance_to_walls(s) if len(s) else np.zeros(0)
+            got = self._keeps[(b, clearance)] = clear >= clearance
+        return got
+
+    @functools.cached_property
+    def _ends(self) -> dict[int, np.ndarray]:
+        return {}
+
+    def _end_distances(self, b: int) -> np.ndarray:
+        """The distances to the walls of piece ``b``'s segments' starts, then ends."""
+        got = self._ends.get(b)
+        if got is None:
+            p0, d = self._piece(b)[:2]
+            got = self._ends[b] = self.dec.map.distance_to_walls(np.concatenate([p0, p0 + d]))
         return got
 
     @functools.cached_property
@@ -201,11 +225,11 @@ class EscapePlan:
         key = (b, clearance, margin)
         if key in self._spans:
             return self._spans[key]
-        p0, d, ln, nrm, s, seg, clear = self._piece(b)
+        p0, d, ln, nrm, s, seg = self._piece(b)
         got = None
         if len(ln):
             lo, hi, live = 0.0, 1.0, None
-            ok = clear >= clearance
+            ok = self._keep(b, clearance).copy()
             if margin > 0.0:
                 # keep `margin` (arc length) from the piece's ends, where it meets other
                 # pieces: a step across near an end can cross one of those instead (into
@@ -222,7 +246,7 @@ class EscapePlan:
                 live = (cum[:-1] <= arc_hi) & (cum[1:] >= arc_lo)
             ok = np.flatnonzero(ok)
             # the segments' ends' distances to the walls, less `clearance`, and lengths
-            ends = self.dec.map.distance_to_walls(np.concatenate([p0, p0 + d])) - clearance
+            ends = self._end_distances(b) - clearance
             room = np.stack([ends[: len(p0)], ends[len(p0) :], ln], axis=1).tolist()
             got = (p0, d, ln**2, lo, hi, live, nrm, room, s[ok], nrm[seg[ok]])
         self._spans[key] = got
@@ -263,6 +287,45 @@ class EscapePlan:
         """(n,) bool: :meth:`well_inside` for each of ``points`` (n, 2)."""
         poly = self._polygon(region, -4.0 * self.dec.chord_tol)
         return shapely.contains_xy(poly, points[:, 0], points[:, 1])
+
+    def prepare(self, clearance: float, margins: tuple[float, ...]) -> None:
+        """Build now what :meth:`witness` (at ``clearance`` and each of ``margins``),
+        :meth:`inside` and :meth:`well_inside` would otherwise build on first use: the
+        spans of every escapable cell's vias, the polygons of the regions on either side
+        of them, and every region's shrunk polygon (issue 13: built during an episode,
+        they cost 1-2 ms in each decision that enters a new cell). The samples' wall
+        clearance is tested in one batch, measured only near the walls
+        (:func:`_clear_within`: the same test, a fraction of the time). Idempotent (cached
+        on the plan)."""
+        dec = self.dec
+        esc = np.flatnonzero(self.rank >= 0).tolist()
+        vias = sorted({b for c in esc for b in self.vias[c]})
+        new = [b for b in vias if (b, clearance) not in self._keeps]
+        if new:
+            got = [self._piece(b) for b in new]
+            counts = np.cumsum([len(g[4]) for g in got])[:-1]
+            near = _clear_within(dec.map, np.concatenate([g[4] for g in got]), clearance)
+            for b, keep in zip(new, np.split(near >= clearance, counts), strict=True):
+                self._keeps[(b, clearance)] = keep
+        new = [b for b in vias if b not in self._ends]
+        if new:
+            got = [self._piece(b)[:2] for b in new]
+            counts = np.cumsum([2 * len(p0) for p0, _ in got])[:-1]
+            pts = np.concatenate([x for p0, d in got for x in (p0, p0 + d)])
+            dist = dec.map.distance_to_walls(pts) if len(pts) else np.zeros(0)
+            for b, ends in zip(new, np.split(dist, counts), strict=True):
+                self._ends[b] = ends
+        for b in vias:
+            for margin in margins:
+                self._span(b, clearance, margin)
+        for cell in esc:
+            self._inside(dec.cells[cell].region)
+        for b in vias:
+            for r in dec.boundaries[b].regions:
+                self._polygon(r)
+        shrink = -4.0 * dec.chord_tol
+        for r in range(len(dec.regions)):
+            self._polygon(r, shrink)
 
     def cell_at(self, point: np.ndarray, theta: float) -> int:
         """The cell holding configuration ``(point, theta)``, -1 if none is identified."""

@@ -111,6 +111,9 @@ class ShootingEvader(BasePolicy):
         bins = np.arange(256).astype(float)
         self._radians = np.where(bins >= NO_PATH, 2 * math.pi, bins * self.table.bin_width)
         self.plan = escape_plan(c.map, self.L_eff, res, c.body_radius)
+        # the plan's crossings and region tests, built here rather than mid-episode
+        # (margins: those of _new_witness)
+        self.plan.prepare(c.body_radius, (c.v_evader * c.dt, 0.0))
         self.kernel = kernel_for(c.map)
         self.rho = c.rho
         omega_max = c.v_pursuer * (1.0 + min(self.rho, 1.0)) / c.l_min  # Sec. 6.1 maximum

@@ -19,6 +19,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import networkx as nx
@@ -354,3 +355,36 @@ def test_clear_within_measures_every_point_near_a_wall(name):
     assert np.array_equal(got[measured], want[measured])  # the same values
     assert (want[~measured] > reach).all()
     assert measured.any() and not measured.all()
+
+
+def test_prepare_builds_what_witness_would_build():
+    # the shooting evader prepares its plan at reset (issue 13: no set-up mid-episode);
+    # the batch gives the same spans, bit for bit, and witness then builds nothing more
+    plan = escape_plan(builtin_map("two_rooms"), L)
+    ready, lazy = dataclasses.replace(plan), dataclasses.replace(plan)
+    clearance, margins = 0.1, (0.05, 0.0)
+    ready.prepare(clearance, margins)
+    built = {k: len(v) for k, v in ready.__dict__.items() if k.startswith("_")}
+    assert built["_spans"] == 2 * len(
+        {b for c in np.flatnonzero(plan.rank >= 0) for b in plan.vias[c]}
+    )
+    for key, want in ready._spans.items():
+        got = lazy._span(*key)
+        assert (got is None) == (want is None)
+        for g, w in zip(got or (), want or (), strict=True):
+            assert np.asarray(g).tobytes() == np.asarray(w).tobytes()
+    rng = np.random.default_rng(5)
+    cells = np.flatnonzero(plan.rank >= 0)
+    for _ in range(200):
+        c = int(rng.choice(cells))
+        x0, y0, x1, y1 = plan.dec.regions[plan.dec.cells[c].region].polygon.bounds
+        p = rng.uniform([x0, y0], [x1, y1])
+        margin = float(rng.choice(margins))
+        got = ready.witness(c, p, clearance, margin=margin)
+        want = lazy.witness(c, p, clearance, margin=margin)
+        assert (got is None) == (want is None)
+        if got is not None:
+            assert got.boundary == want.boundary
+            assert got.cross.tobytes() == want.cross.tobytes()
+        ready.well_inside(plan.dec.cells[c].region, p)
+    assert {k: len(v) for k, v in ready.__dict__.items() if k.startswith("_")} == built

@@ -42,7 +42,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from envs import validation
-from envs.errors import SurveilValueError
+from envs.errors import InfeasibleError, SurveilValueError
 from strategies.control._integrators import (
     REACHED,
     first_return,
@@ -235,7 +235,8 @@ def shoot(
         SurveilValueError: non-finite input, ``L <= 0``, ``x_max <= 0``, ``step <= 0``,
             ``1 + s lambda2_0 <= 0`` (μ keeps its sign along the arc, so transversality
             ``λ2(x_e) = 0`` would be impossible), unknown branch or method.
-        InfeasibleError: ``rho >= 1``.
+        InfeasibleError: ``rho >= 1``, or more than ``_MAX_SHOOT_STEPS`` default steps
+            up to ``x_max`` (rho within ~1e-4 of 0 or 1, or ``x_max`` ~1e5 ``L``).
     """
     th0 = validation.real("theta0", theta0)
     l1 = validation.real("lambda1", lambda1)
@@ -245,6 +246,12 @@ def shoot(
     s = branch_sign(branch)
     x_max = validation.positive("x_max", x_max)
     h = default_step(x_max, L, rho) if step is None else validation.positive("step", step)
+    if step is None and x_max / h > _MAX_SHOOT_STEPS:
+        raise InfeasibleError(
+            f"x_max = {x_max!r} with L = {L!r}, rho = {rho!r} needs {x_max / h:.3g} RK4 steps "
+            f"of the default step {h:.3g} (budget {_MAX_SHOOT_STEPS:,}: about 1 GB and 30 s); "
+            "pass step= to integrate anyway"
+        )
     if method not in ("reduced", "pmp"):
         raise SurveilValueError(f"method = {method!r}: expected 'reduced' or 'pmp'")
     mu0 = 1.0 + s * l20
@@ -278,6 +285,12 @@ def shoot(
     a0, _ = solve_stationary(l1 / mu0, th0, L, rho, s, 0.0)
     rows, status = integrate_reduced(th0, a0, s, L, rho, h, x_max, True, _max_steps(x_max, L, h))
     return _build_result(rows, status, th0, l1, l20, s, L, rho, True, stop_at_crossing)
+
+
+_MAX_SHOOT_STEPS = 2_000_000
+"""Largest ``x_max / h`` :func:`shoot` integrates with the default step: each step is kept
+(rho = 0.9999, x_max = 2.5, L = 1: 1.6 million, 24 s, 0.9 GB; rho = 0.999999 asked for 100
+times that)."""
 
 
 def _max_steps(x_max: float, L: float, h: float) -> int:

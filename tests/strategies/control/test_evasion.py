@@ -427,3 +427,12 @@ def test_solve_escape_integrates_each_heading_once(monkeypatch):
     sol = solve_escape(-4.29821055010567, 0.9, L=2.0, rho=0.5, branch="+")
     assert sol.success and sol.candidates == 1
     assert len(runs) == len(set(runs)) == 18  # (it was 23: 18 coarse, 4 fine, 1 stored)
+
+
+@pytest.mark.parametrize("rho", [1.0 - 1e-6, 1e-6])
+def test_shoot_refuses_a_default_step_budget_it_cannot_keep(rho):
+    # `surveil figure greedy --params '{"rho": 0.999999}'` ran for minutes, growing toward
+    # ~100 GB (every RK4 node is kept; the default step scales with min(rho, 1 - rho))
+    with pytest.raises(InfeasibleError, match=r"needs \S+e\+0[78] RK4 steps .* pass step="):
+        shoot(math.pi, 0.0, 0.0, L=1.0, rho=rho, x_max=2.5)
+    assert len(shoot(math.pi, 0.0, 0.0, L=1.0, rho=rho, x_max=2.5, step=0.05).x) > 1

@@ -332,6 +332,16 @@ class EscapePlan:
         c = self.dec.cell_at(float(point[0]), float(point[1]), float(theta))
         return -1 if c is None else c.id
 
+    @functools.cached_property
+    def _witness_region(self) -> np.ndarray:
+        out = np.zeros(len(self.dec.regions), dtype=bool)
+        out[list(self.dec.witness_regions)] = True
+        return out
+
+    def in_witness_region(self, cell: int) -> bool:
+        """Whether ``cell``'s region is a witness region (False for ``cell`` -1)."""
+        return cell >= 0 and bool(self._witness_region[self.dec.cells[cell].region])
+
     def witness(
         self,
         cell: int,

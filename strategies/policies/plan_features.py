@@ -24,7 +24,8 @@ cross_n         (:meth:`~strategies.policies.escape_plan.EscapePlan.witness`, ch
                 evader chooses a fresh one; 0, 0 where there is none)
 cross_dist      distance to that point over L_max, clipped to [0, 1] (1 where there is none)
 region_u        direction to the next grid point of the walk to a witness region, where
-region_n        the evader is outside one and the walk exists (0, 0 otherwise)
+region_n        the evader is outside one (its grid point and its cell's region) and the
+                walk exists (0, 0 otherwise)
 shot_u          direction to the shooting candidate with the largest positive escape margin
 shot_n          (0, 0 where none has a positive margin)
 shot_margin     that margin (radians the pursuer lacks, eq. 6) over pi, clipped to [0, 1]
@@ -131,7 +132,12 @@ class PlanFeatures:
                     out[2], out[3] = line_of_sight_frame(to, u)
                     out[4] = min(math.hypot(float(to[0]), float(to[1])) / c.l_max, 1.0)
         row = ev.table.row(e)
-        if row >= 0 and plan.region.any() and not plan.region[row]:
+        if (
+            row >= 0
+            and plan.region.any()
+            and not plan.region[row]
+            and not plan.in_witness_region(cell)
+        ):
             nxt = int(plan.region_next[row])
             if nxt >= 0:
                 out[5], out[6] = line_of_sight_frame(plan.points[nxt] - e, u)

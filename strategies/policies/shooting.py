@@ -19,13 +19,16 @@ Sec. 5 "minimax": its tip meets walls as if the rod were that long):
    an arc made no headway) is re-solved with the optimal escape arc of Sec. 6
    (:func:`strategies.control.evasion.solve_escape`, for the branch the pursuer would
    turn) and the evader follows that arc, replanning every ``replan`` steps.
-3. **Witness region** (Prop. 2 holds on the map): walk a shortest grid path to a
-   region whose cells are all escapable (``Decomposition.witness_regions``).
+3. **Witness region** (Prop. 2 holds on the map): from a region that is not one, walk a
+   shortest grid path to a region whose cells are all escapable
+   (``Decomposition.witness_regions``).
 For rho > 1 it runs straight at the pursuer (footnote 4; see :meth:`ShootingEvader._decide`).
 
 4. Otherwise **pressure**: move straight at the pursuer (Sec. 6.1, a heading
    minimising max |theta_dot|); against a wall, slide along it perpendicular to the rod,
-   the way that does not press straight into the wall.
+   the way that does not press straight into the wall. After ``HERD_AFTER`` steps of it,
+   herd instead: get to the far side of the pursuer from its nearest concave corner, then
+   charge, pinning it there.
 """
 
 from __future__ import annotations
@@ -101,6 +104,12 @@ class ShootingEvader(BasePolicy):
 
     STALL_STEPS = 10  # steps without getting closer to a crossing before giving it up
     FORGIVE_STEPS = 20  # steps without a crossing in an escapable cell before a retry
+    # steps of pressure before it herds the pursuer into a corner instead, a last resort
+    # (issue 13): herding from the first step lost two escapes the charge makes (two_rooms
+    # at L_min 1, after 8 and 13 steps of it); from the 1,000th it slowed escapes the charge
+    # makes after 1,092 steps (random:polygons:0), from the 1,500th or 2,000th it lost one
+    # it makes after 2,405 (office turned by 2.2 rad)
+    HERD_AFTER = 2500
 
     def _reset(self) -> None:
         c = self.config
@@ -143,6 +152,7 @@ class ShootingEvader(BasePolicy):
         bis = bis / np.maximum(np.linalg.norm(bis, axis=1, keepdims=True), 1e-12)
         self._corner_points = m.vertices[idx] + (c.body_radius + 2.0 * h) * bis
         self._corner_rows = self.table.rows(self._corner_points)
+        self._concave = m.vertices[~m.vertex_convex]  # the corners pressure herds into
         self.restart()
 
     def restart(self) -> None:
@@ -171,6 +181,7 @@ class ShootingEvader(BasePolicy):
         self._trail: list[tuple[int, int]] = []  # the last crossings (cell left, piece)
         self._no_way = 0  # steps in an escapable cell whose crossings are all excluded
         self._forgiven = 0  # retries so far (each waits twice as long as the last)
+        self._pressed = 0  # pressure steps so far
 
     # ------------------------------------------------------------------ candidates
     def _candidates(self, e: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -333,7 +344,15 @@ class ShootingEvader(BasePolicy):
             self._shot = (float(e[0]), float(e[1]), self._steps)
             return c.v_evader * self._start_arc(e, theta, *best)
         row = self.table.row(e)
-        if row >= 0 and self._has_region and not self.plan.region[row]:
+        if (
+            row >= 0
+            and self._has_region
+            and not self.plan.region[row]
+            and not self.plan.in_witness_region(self._plan_cell)
+        ):
+            # (in a witness region already, the walk only steps onto a grid point inside
+            # its polygon: alternated with pressure at a wall, it held the evader in place
+            # for the whole horizon, issue 13: office x0.5)
             nxt = self.plan.region_next[row]
             if nxt >= 0:
                 self.mode = "region"
@@ -345,6 +364,12 @@ class ShootingEvader(BasePolicy):
         # or away by the best candidate's side, as before, flipped every step and left the
         # evader in place.)
         u = unit(snap.rod)
+        self._pressed += 1
+        if self._pressed > self.HERD_AFTER and len(self._concave):
+            # the charge made no end of it: pin the pursuer into its nearest concave
+            # corner, where it cannot back off (issue 13: random:star:11 at rho 0.3
+            # against the decomposition pursuer, 4,700 steps of charging in the open)
+            return c.v_evader * self._herd(e, snap.pursuer, u, float(snap.L))
         if self._near_wall(e, c.body_radius + 2.0 * c.v_evader * c.dt):
             # against a wall the push is lost: slide along it, perpendicular to the rod
             # (which turns the rod fastest); the other way round where this one presses
@@ -358,6 +383,19 @@ class ShootingEvader(BasePolicy):
             d = self.map.distance_to_walls(np.stack([e + h * s, e - h * s]))
             return c.v_evader * (-s if d[1] - d[0] > _PRESSING * h else s)
         return c.v_evader * u
+
+    def _herd(self, e: np.ndarray, p: np.ndarray, u: np.ndarray, L: float) -> np.ndarray:
+        """Heading that pins the pursuer at ``p`` into its nearest concave corner: toward
+        the point at range ``L`` on the far side of the pursuer from the corner, and
+        straight at the pursuer (``u``) once the rod points within 18 degrees of the
+        corner."""
+        d = self._concave - p
+        q = d[int(np.argmin(np.einsum("ij,ij->i", d, d)))]
+        n = unit(q)
+        if float(u @ n) > 0.95:
+            return u
+        to = p - L * n - e
+        return unit(to) if math.hypot(float(to[0]), float(to[1])) > 1e-9 else u
 
     def _near_wall(self, e: np.ndarray, r: float) -> bool:
         """Whether ``e`` lies within ``r`` of a wall (``Map.distance_to_walls``), from the

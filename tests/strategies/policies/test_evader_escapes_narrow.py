@@ -1,0 +1,59 @@
+"""The shooting evader escapes where its plan ends at a crossing its disc cannot make.
+
+On these worlds every plan of the point evader ends at a via piece closer to a wall
+than the evader's body radius (issue 13): the crossings get excluded and the evader
+falls back. Each episode was held for the whole 8 D / V_e horizon before:
+
+* ``office`` at half scale (L_min 1, body radius 0.05), rho = 0.3, against the greedy
+  pursuer (seed 1020): in a witness region, at a wall, the walk "to a witness region"
+  stepped onto a grid point inside the region's polygon and the charge stepped back off
+  it, every other step for 7,600 steps. The walk now starts only outside a witness
+  region; the charge escapes in 0.35 D / V_e.
+* ``random:star:11``, rho = 0.3, L_max = 1.5 L_min, against the decomposition pursuer
+  (seed 507): 4,700 steps of charging in the open, the pursuer backing off. After
+  ``HERD_AFTER`` steps of it the evader herds the pursuer into its nearest concave
+  corner and escapes in 6.54 D / V_e.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from envs.maps import builtin_info, load_map
+from strategies.policies.shooting import ShootingEvader
+from strategies.runner import run_episode
+
+
+def _horizon(m, v_evader: float, k: float) -> int:
+    """``k`` D / V_e in steps (D the bounding-box diagonal)."""
+    x0, y0, x1, y1 = m.bounds
+    return math.ceil(k * math.hypot(x1 - x0, y1 - y0) / v_evader / 0.1)
+
+
+def test_no_walk_to_a_witness_region_from_inside_one():
+    m = builtin_info("office").map.transformed(0.5 * np.eye(2))
+    params = {"l_min": 1.0, "l_max": 2.0, "v_pursuer": 0.5, "v_evader": 0.15,
+              "body_radius": 0.05}  # fmt: skip
+    ev = ShootingEvader()
+    modes: dict[str, int] = {}
+
+    def count(_):
+        modes[ev.mode] = modes.get(ev.mode, 0) + 1
+
+    r = run_episode(m, "pursuer/greedy", ev, 1020, start="safe", overrides=params,
+                    max_cycles=_horizon(m, 0.15, 1.0), on_step=count)  # fmt: skip
+    assert r.winner == "evader", (r.summary(), modes)
+    assert "region" not in modes, modes  # every region of this map is a witness region
+
+
+def test_herds_the_pursuer_into_a_corner_after_a_long_charge():
+    m = load_map("random:star:11")
+    params = {"l_min": 2.0, "l_max": 3.0, "v_pursuer": 1.0, "v_evader": 0.3,
+              "body_radius": 0.1}  # fmt: skip
+    ev = ShootingEvader()
+    r = run_episode(m, "pursuer/decomposition", ev, 507, start="safe", overrides=params,
+                    max_cycles=_horizon(m, 0.3, 7.0))  # fmt: skip
+    assert r.winner == "evader", r.summary()
+    assert ev._pressed > ShootingEvader.HERD_AFTER  # it escaped herding

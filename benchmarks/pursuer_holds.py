@@ -41,8 +41,9 @@ import os
 import time
 
 import numpy as np
+from bench_cli import ignore_sigint, integer, real, run
 
-from envs.maps import builtin_info
+from envs.maps import builtin_info, builtin_names
 from strategies.runner import run_episode
 
 EVADERS = [
@@ -126,24 +127,23 @@ def _referee_label(world: str, variant_label: str, rho: float, start, cpl: float
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", type=int, default=3)
-    ap.add_argument("--rho", type=float, nargs="+", default=[0.3, 0.5])
-    ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--max-cycles", type=int, default=600)
-    ap.add_argument("--worlds", nargs="+", default=WORLDS)
-    ap.add_argument("--variants", nargs="+", default=[v[0] for v in VARIANTS])
+    ap.add_argument("--seeds", type=integer(1), default=3)
+    ap.add_argument("--rho", type=real(0), nargs="+", default=[0.3, 0.5])
+    ap.add_argument("--workers", type=integer(1), default=2)
+    ap.add_argument("--max-cycles", type=integer(1), default=600)
+    ap.add_argument("--worlds", nargs="+", choices=builtin_names(), default=WORLDS)
+    ap.add_argument("--variants", nargs="+", choices=[v[0] for v in VARIANTS],
+                    default=[v[0] for v in VARIANTS])  # fmt: skip
     ap.add_argument("--no-greedy", action="store_true", help="skip the greedy reference")
-    ap.add_argument("--l-min", type=float, default=None, help="play at this L_min (see above)")
+    ap.add_argument("--l-min", type=real(0), default=None, help="play at this L_min (see above)")
     ap.add_argument(
         "--referee",
-        type=float,
+        type=real(0),
         metavar="CPL",
         default=None,
         help="label every start with the referee at CPL cells per L_min",
     )
     args = ap.parse_args(argv)
-    if args.l_min is not None and not args.l_min > 0:
-        ap.error(f"--l-min = {args.l_min}: expected a number > 0")
     if args.l_min is not None and args.referee:  # the referee solves the world's own L_min
         ap.error("--l-min and --referee: the referee judges the world's own L_min only")
     pursuers = ("pursuer/decomposition",) if args.no_greedy else PURSUERS
@@ -158,7 +158,7 @@ def main(argv=None) -> int:
         for s in range(args.seeds)
     ]
     t0 = time.perf_counter()
-    with mp.get_context("spawn").Pool(args.workers) as pool:
+    with mp.get_context("spawn").Pool(args.workers, ignore_sigint) as pool:
         results = pool.map(_play, jobs, chunksize=4)
     wall = time.perf_counter() - t0
     held: dict[tuple, list[int]] = {}
@@ -227,4 +227,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run(main))

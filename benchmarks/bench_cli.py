@@ -1,0 +1,45 @@
+"""What the benchmark scripts share on the command line: checked values, a clean stop.
+
+* :func:`integer` and :func:`real` (from :mod:`analysis.arguments`) are argparse
+  ``type=`` functions with ranges: ``--seeds 0`` or ``--rho nan`` is a usage error naming
+  the value and what was expected (exit code 2) before any long work.
+* :func:`run` calls a script's ``main`` and turns SIGINT (Ctrl-C) and SIGTERM (``timeout``,
+  ``kill``) into one line on stderr and exit code 130 / 143, no traceback. What a script
+  wrote before the signal is kept (results files are appended and flushed row by row; rerun
+  the same command to resume where a script resumes).
+* :func:`ignore_sigint` is a ``multiprocessing`` pool initializer: Ctrl-C reaches the whole
+  process group, and only the parent should answer it (the pool's workers are terminated
+  when the parent leaves its ``with`` block).
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+from collections.abc import Callable
+
+from analysis.arguments import integer, real
+
+__all__ = ["ignore_sigint", "integer", "real", "run"]
+
+EXIT_CODE = {"SIGINT": 130, "SIGTERM": 143}
+
+
+def _raise_interrupt(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt(signal.Signals(signum).name)
+
+
+def run(main: Callable[[], int]) -> int:
+    """``main()``'s exit code; 130 (SIGINT) or 143 (SIGTERM) with one line if stopped."""
+    signal.signal(signal.SIGTERM, _raise_interrupt)
+    try:
+        return int(main() or 0)
+    except KeyboardInterrupt as exc:
+        name = str(exc) if str(exc) in EXIT_CODE else "SIGINT"
+        print(f"{sys.argv[0]}: stopped by {name}", file=sys.stderr)
+        return EXIT_CODE[name]
+
+
+def ignore_sigint() -> None:
+    """Pool initializer: the parent answers Ctrl-C (and terminates the pool)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)

@@ -41,8 +41,9 @@ import os
 import time
 
 import numpy as np
+from bench_cli import integer, real, run
 
-from envs.maps import builtin_info, floor_plan
+from envs.maps import builtin_info, builtin_names, floor_plan
 from strategies.policies import make_policy
 from strategies.runner import episode_seeds, run_episode
 
@@ -64,6 +65,26 @@ def world(spec: str):
         m = info.map.transformed(float(scale) * np.eye(2), (0.0, 0.0))
         return m, dict(info.params())
     return spec, {}
+
+
+def map_spec(text: str) -> str:
+    """An argparse ``type=`` for ``--maps``: a ``world()`` spec, checked without building it."""
+    names = builtin_names()
+    expected = f"expected a built-in map {names}, NAME*S (S > 0) or floor_plan:SEED:W (W > 0)"
+    try:
+        if text.startswith("floor_plan:"):
+            _, seed, w = text.split(":")
+            ok = int(seed) >= 0 and 0 < float(w) < float("inf")
+        elif "*" in text:
+            name, scale = text.split("*")
+            ok = name in names and 0 < float(scale) < float("inf")
+        else:
+            ok = text in names
+    except ValueError:
+        ok = False
+    if not ok:
+        raise argparse.ArgumentTypeError(f"{text!r}: {expected}")
+    return text
 
 
 def _replay(
@@ -130,16 +151,14 @@ def measure(
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--maps", nargs="+", default=MAPS)
-    ap.add_argument("--seeds", type=int, default=2)
-    ap.add_argument("--max-cycles", type=int, default=300)
-    ap.add_argument("--reps", type=int, default=3)
+    ap.add_argument("--maps", nargs="+", type=map_spec, default=MAPS)
+    ap.add_argument("--seeds", type=integer(1), default=2)
+    ap.add_argument("--max-cycles", type=integer(1), default=300)
+    ap.add_argument("--reps", type=integer(1), default=3)
     ap.add_argument("--clock", choices=sorted(CLOCKS), default="wall")
-    ap.add_argument("--l-min", type=float, default=None)
+    ap.add_argument("--l-min", type=real(0), default=None)
     ap.add_argument("--table", choices=["auto", "eager", "distinct", "lazy"], default="auto")
     args = ap.parse_args(argv)
-    if args.l_min is not None and not args.l_min > 0:
-        ap.error(f"--l-min = {args.l_min}: expected a number > 0")
     overrides = None if args.l_min is None else {"l_min": args.l_min, "l_max": 2 * args.l_min}
     print(
         f"load average: {os.getloadavg()}; clock: {args.clock}; table: {args.table}"
@@ -177,4 +196,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run(main))

@@ -48,6 +48,7 @@ import os
 import time
 
 import numpy as np
+from bench_cli import ignore_sigint, integer, real, run
 
 from envs.maps import Map, builtin_info, load_map
 from envs.maps.junctions import crossroads, t_junction
@@ -144,24 +145,33 @@ def _play(job):
 def main(argv=None) -> int:
     from strategies.cspace import decompose
     from strategies.policies import policy_names
+    from strategies.policies.starts import START_KINDS
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", type=int, default=4)
-    ap.add_argument("--k", type=float, default=8.0, help="horizon in units of D / V_e")
-    ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--worlds", nargs="+", default=WORLDS)
-    ap.add_argument("--variants", nargs="+", default=list(VARIANTS))
-    ap.add_argument("--pursuers", nargs="+", default=[*policy_names("pursuer"), "still"])
-    ap.add_argument("--start", default="safe", help="start kind of the start sampler")
+    pursuers = [*policy_names("pursuer"), "still"]
+    ap.add_argument("--seeds", type=integer(1), default=4)
+    ap.add_argument("--k", type=real(0), default=8.0, help="horizon in units of D / V_e")
+    ap.add_argument("--workers", type=integer(1), default=2)
+    ap.add_argument("--worlds", nargs="+", default=WORLDS, help="built-in names, plus, tee, "
+                    "random:KIND:SEED (default: %(default)s)")  # fmt: skip
+    ap.add_argument("--variants", nargs="+", choices=list(VARIANTS), default=list(VARIANTS))
+    ap.add_argument("--pursuers", nargs="+", choices=pursuers, default=pursuers)
+    ap.add_argument("--start", choices=START_KINDS, default="safe",
+                    help="start kind of the start sampler")  # fmt: skip
     ap.add_argument(
         "--simple-seeds",
-        type=int,
+        type=integer(0),
         default=2,
         help="seeds (the first ones) also played by the "
         "simple evaders, from the same starts (0: none)",
     )
     ap.add_argument("--progress", action="store_true", help="print progress while playing")
     args = ap.parse_args(argv)
+    for w in args.worlds:
+        try:
+            world(w)
+        except (ValueError, KeyError) as exc:  # the project's errors subclass ValueError
+            ap.error(f"--worlds: {w!r} is no world ({exc}; the default set: {WORLDS})")
     print(f"load average: {os.getloadavg()}")
     simple = SIMPLE if args.simple_seeds > 0 else []
     jobs = []
@@ -180,7 +190,7 @@ def main(argv=None) -> int:
                     )
     t0 = time.perf_counter()
     results = []
-    with mp.get_context("spawn").Pool(args.workers) as pool:
+    with mp.get_context("spawn").Pool(args.workers, ignore_sigint) as pool:
         for i, res in enumerate(pool.imap_unordered(_play, jobs), 1):
             results.append(res)
             if args.progress and i % 20 == 0:
@@ -249,4 +259,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run(main))

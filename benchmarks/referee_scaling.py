@@ -29,6 +29,8 @@ import subprocess
 import sys
 import time
 
+from bench_cli import real, run
+
 WORLDS = ("dead_end", "open", "pillar")
 
 
@@ -87,8 +89,8 @@ def _fit(xs, ys) -> float:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--world", choices=WORLDS, default="dead_end")
-    parser.add_argument("--rho", type=float, default=0.2)
-    parser.add_argument("--cpl", type=float, nargs="+", default=[8, 12, 16, 20, 24])
+    parser.add_argument("--rho", type=real(0), default=0.2)
+    parser.add_argument("--cpl", type=real(0), nargs="+", default=[8, 12, 16, 20, 24])
     parser.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.child:
@@ -102,8 +104,13 @@ def main(argv: list[str] | None = None) -> int:
         out = subprocess.run(
             [sys.executable, __file__, "--child", "--world", args.world, "--rho",
              str(args.rho), "--cpl", str(cpl)],
-            capture_output=True, text=True, check=True,
+            capture_output=True, text=True,
         )  # fmt: skip
+        if out.returncode != 0:  # the child's last line says why (e.g. out of memory)
+            last = (out.stderr.strip().splitlines() or ["no message"])[-1]
+            print(f"cpl {cpl:g}: the solve failed (exit code {out.returncode}): {last}",
+                  file=sys.stderr)  # fmt: skip
+            return 1
         rows.append(json.loads(out.stdout.strip().splitlines()[-1]))
     ref = rows[0]
     head = (f"{'cpl':>5} {'cell':>7} {'states P':>10} {'states E':>10} {'time P':>8} "
@@ -129,4 +136,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run(main))

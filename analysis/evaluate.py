@@ -128,6 +128,10 @@ def evaluate(
     SQLite store ``results_path`` (default: a temporary one), which resumes. Duplicate
     names are played once. Returns one :class:`MatchupRow` per (overrides, map, pursuer,
     evader).
+
+    Raises:
+        KeyboardInterrupt: SIGINT or SIGTERM stopped the tournament (its name is the
+            message); the matches played so far are in the store.
     """
     import tempfile
 
@@ -170,6 +174,8 @@ def evaluate(
                 workers=max(workers, 1),
                 progress=progress,
             )
+            if summary.interrupted:  # the store keeps what was played: the same call resumes
+                raise KeyboardInterrupt(summary.interrupted)
             with Store(store, create=False) as db:
                 cells = st.cells(db.rows(summary.run_id), confidence=confidence, overall=False)
             for c in cells:

@@ -24,8 +24,10 @@ import math
 import time
 
 import numpy as np
+from bench_cli import integer, run
 
 from analysis.evaluate import evaluate, format_table
+from analysis.tournament import spec_from_dict
 from envs.maps import builtin_names
 from strategies.policies import make_policy, policy_names
 from strategies.policies.starts import sample_start
@@ -120,22 +122,29 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--maps", nargs="+", default=builtin_names())
     ap.add_argument("--pursuers", nargs="+", default=policy_names("pursuer"))
     ap.add_argument("--evaders", nargs="+", default=policy_names("evader"))
-    ap.add_argument("--seeds", type=int, default=10)
-    ap.add_argument("--fast-seeds", type=int, default=3, help="seeds of the rho > 1 rows")
-    ap.add_argument("--max-cycles", type=int, default=1000)
+    ap.add_argument("--seeds", type=integer(1), default=10)
+    ap.add_argument("--fast-seeds", type=integer(0), default=3, help="seeds of the rho > 1 rows")
+    ap.add_argument("--max-cycles", type=integer(1), default=1000)
     ap.add_argument("--results", default="out/analytic_matchups.jsonl")
-    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--workers", type=integer(1), default=2)
     args = ap.parse_args(argv)
+    roster = {"maps": args.maps, "pursuers": args.pursuers, "evaders": args.evaders}
+    try:  # the names, checked as the tournament will (before any episode)
+        spec_from_dict({"name": "evaluate", **roster, "seeds": [0]}, source="arguments")
+    except ValueError as exc:  # the project's errors subclass ValueError
+        ap.error(str(exc))
     common = dict(max_cycles=args.max_cycles, results_path=args.results, workers=args.workers)
     rows = evaluate(args.maps, args.pursuers, args.evaders, range(args.seeds), **common)
-    fast = evaluate(
-        args.maps,
-        args.pursuers,
-        ["evader/shooting", "evader/straight"],
-        range(args.fast_seeds),
-        overrides=FAST_RHO,
-        **common,
-    )
+    fast = []  # --fast-seeds 0: no rho > 1 rows
+    if args.fast_seeds > 0:
+        fast = evaluate(
+            args.maps,
+            args.pursuers,
+            ["evader/shooting", "evader/straight"],
+            range(args.fast_seeds),
+            overrides=FAST_RHO,
+            **common,
+        )
     print(format_table(rows + fast))
     print()
     for line in check_theory(rows, fast):
@@ -151,4 +160,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run(main))

@@ -91,6 +91,24 @@ def test_evaluate_is_a_resumable_one_off_tournament(tmp_path):
     assert "pursuer/greedy" in text and "evader/random" in text
 
 
+def test_evaluate_stops_when_a_signal_stopped_its_tournament(tmp_path, monkeypatch):
+    """SIGTERM ends the tournament early; evaluate must not play its next variant."""
+    import analysis.tournament as tournament
+
+    calls = []
+
+    def interrupted(spec, store, **kw):
+        calls.append(spec)
+        return tournament.RunSummary("r", "evaluate", store, 3, 0, interrupted="SIGTERM")
+
+    monkeypatch.setattr(tournament, "run_tournament", interrupted)
+    with pytest.raises(KeyboardInterrupt, match="SIGTERM"):
+        evaluate(["open_room"], ["pursuer/greedy"], ["evader/random"], range(3),
+                 overrides=[{}, {"v_evader": 1.5}], results_path=tmp_path / "r.sqlite",
+                 progress=False)  # fmt: skip
+    assert len(calls) == 1
+
+
 @pytest.mark.parametrize("n", [1, 3, 10, 57])
 def test_wilson_ends_agree_with_the_general_formula(n):
     z = stats.norm.ppf(0.975)

@@ -1,0 +1,71 @@
+"""The benchmark scripts refuse bad arguments up front and stop cleanly on SIGTERM."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+BENCHMARKS = Path(__file__).resolve().parents[1] / "benchmarks"
+
+
+def _run(script: str, *args: str, **kwargs) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, script, *args],
+        cwd=BENCHMARKS,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        **kwargs,
+    )
+
+
+@pytest.mark.parametrize(
+    ("script", "args", "message"),
+    [
+        ("pursuer_holds.py", ["--worlds", "nope"], "--worlds: invalid choice: 'nope'"),
+        ("pursuer_holds.py", ["--rho", "nan"], "'nan': expected a finite number > 0"),
+        ("decision_time.py", ["--maps", "nope"], "'nope': expected a built-in map"),
+        ("decision_time.py", ["--seeds", "0"], "'0': expected an integer >= 1"),
+        ("evader_escapes.py", ["--seeds", "0"], "'0': expected an integer >= 1"),
+        ("referee_scaling.py", ["--cpl", "0"], "'0': expected a finite number > 0"),
+        ("analytic_matchups.py", ["--workers", "0"], "'0': expected an integer >= 1"),
+    ],
+)
+def test_a_bad_argument_is_a_usage_error(script, args, message) -> None:
+    """Exit code 2 and one line naming the value, no traceback, nothing run."""
+    out = _run(script, *args)
+    assert out.returncode == 2, out.stderr
+    assert message in out.stderr
+    assert "Traceback" not in out.stderr
+    assert out.stdout == ""  # no work started (the scripts print the load average first)
+
+
+def test_sigterm_stops_a_run_with_one_line() -> None:
+    """SIGTERM (``timeout``) stops the run: exit code 143, no traceback from any process."""
+    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+    args = ["--seeds", "50", "--worlds", "maze", "--no-greedy", "--workers", "1"]
+    proc = subprocess.Popen(
+        [sys.executable, "pursuer_holds.py", *args],
+        cwd=BENCHMARKS,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
+    assert proc.stdout.readline().startswith("load average")  # the episodes are starting
+    time.sleep(1.0)
+    proc.send_signal(signal.SIGTERM)
+    try:
+        _, err = proc.communicate(timeout=30)
+    except subprocess.TimeoutExpired:  # pragma: no cover - the bug this test is for
+        proc.kill()
+        raise
+    assert proc.returncode == 143, err
+    assert "stopped by SIGTERM" in err
+    assert "Traceback" not in err

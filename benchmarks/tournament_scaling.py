@@ -27,6 +27,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from bench_cli import integer, run
+
 from analysis.tournament import Store, run_tournament, spec_from_dict
 
 
@@ -56,9 +58,9 @@ def _play(spec: dict, store: Path, backend: str, workers: int | None) -> tuple[f
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", type=int, default=12)
-    ap.add_argument("--max-cycles", type=int, default=300)
-    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--seeds", type=integer(1), default=12)
+    ap.add_argument("--max-cycles", type=integer(1), default=300)
+    ap.add_argument("--workers", type=integer(1), default=2)
     ap.add_argument("--no-ray", action="store_true", help="skip the Ray backend")
     args = ap.parse_args(argv)
     print(f"load average: {os.getloadavg()}; cpus: {os.cpu_count()}")
@@ -118,4 +120,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run(main))

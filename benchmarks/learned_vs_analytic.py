@@ -32,6 +32,8 @@ import os
 from collections import defaultdict
 from pathlib import Path
 
+from bench_cli import integer, run
+
 from analysis.tournament import run_tournament, spec_from_dict
 from analysis.tournament.report import analyse, write_report
 from analysis.tournament.statistics import wilson_interval
@@ -149,11 +151,11 @@ def card(name: str, role: str, rows, args, decide=None) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", type=int, default=20, help="seeded safe starts per map")
+    ap.add_argument("--seeds", type=integer(1), default=20, help="seeded safe starts per map")
     ap.add_argument("--models", nargs="*", default=None, help="zoo names (default: all)")
     ap.add_argument("--store", default="out/bench/learned.sqlite")
-    ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--max-cycles", type=int, default=300)
+    ap.add_argument("--workers", type=integer(1), default=2)
+    ap.add_argument("--max-cycles", type=integer(1), default=300)
     ap.add_argument("--maps", nargs="*", default=None,
                     help="play only these maps (default: the seen and held-out maps)")  # fmt: skip
     ap.add_argument("--cards", action="store_true",
@@ -265,4 +267,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run(main))

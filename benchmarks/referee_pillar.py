@@ -35,6 +35,7 @@ import time
 import warnings
 
 import numpy as np
+from bench_cli import integer, real, run
 
 
 def _world(name: str):
@@ -47,11 +48,11 @@ def _world(name: str):
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--cpl", type=float, nargs="+", default=[24.0, 32.0])
-    parser.add_argument("--starts", type=int, default=6)
+    parser.add_argument("--cpl", type=real(0), nargs="+", default=[24.0, 32.0])
+    parser.add_argument("--starts", type=integer(1), default=6)
     parser.add_argument("--world", choices=["box", "centered"], default="box")
-    parser.add_argument("--rho", type=float, default=0.5)
-    parser.add_argument("--estimate-cpl", type=float, nargs="*", default=[6.0, 8.0],
+    parser.add_argument("--rho", type=real(0), default=0.5)
+    parser.add_argument("--estimate-cpl", type=real(0), nargs="*", default=[6.0, 8.0],
                         help="resolutions of the estimate (none: skip it)")  # fmt: skip
     args = parser.parse_args(argv)
 
@@ -140,4 +141,4 @@ def _print_estimate(cfg, starts, cpls) -> None:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run(main))

@@ -24,6 +24,7 @@ import tempfile
 import time
 
 import numpy as np
+from bench_cli import integer, run
 
 
 def _world(spec):
@@ -72,7 +73,7 @@ def _measure(spec, steps, q):
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--steps", type=int, default=300)
+    ap.add_argument("--steps", type=integer(1), default=300)
     ap.add_argument("--quick", action="store_true", help="skip the 1000-vertex plans")
     args = ap.parse_args(argv)
     print(f"load average: {os.getloadavg()}")
@@ -108,4 +109,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run(main))

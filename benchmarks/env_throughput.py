@@ -30,6 +30,7 @@ import pstats
 import time
 
 import numpy as np
+from bench_cli import integer, run
 
 from envs import surveillance_v0
 from envs.maps import load_map, random_map
@@ -128,7 +129,7 @@ def breakdown(env, record) -> dict[str, float]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--steps", type=int, default=20000, help="timed steps per env")
+    parser.add_argument("--steps", type=integer(1), default=20000, help="timed steps per env")
     parser.add_argument("--profile", action="store_true", help="cProfile the large-map run")
     args = parser.parse_args()
 
@@ -181,4 +182,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run(main))

@@ -29,6 +29,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from bench_cli import integer, run
+
 EPISODE = dict(map="open_room", pursuer="pursuer/greedy", evader="evader/random", seed=0)
 
 
@@ -77,7 +79,7 @@ def _run(variant: str, steps: int) -> dict:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--steps", type=int, default=500, help="episode length (frames - 1)")
+    parser.add_argument("--steps", type=integer(1), default=500, help="episode length (frames - 1)")
     parser.add_argument("--variant", choices=["list", "stream"], help=argparse.SUPPRESS)
     parser.add_argument("--out", help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -100,4 +102,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run(main))

@@ -26,6 +26,8 @@ import time
 
 import gymnasium as gym
 import numpy as np
+from bench_cli import integer
+from bench_cli import run as run_main
 
 from envs.surveillance.config import OBSERVATION_KINDS
 
@@ -89,7 +91,7 @@ def run(args, layout: str, n: int, threads: int) -> tuple[float, float]:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--steps", type=int, default=8192)
+    ap.add_argument("--steps", type=integer(1), default=8192)
     ap.add_argument("--opponent", default="evader/straight")
     ap.add_argument("--map", default="corridor")
     ap.add_argument("--observation", default="lidar_track", choices=OBSERVATION_KINDS)
@@ -108,4 +110,4 @@ def main(argv=None) -> int:
 
 if __name__ == "__main__":
     np.set_printoptions(precision=3)
-    raise SystemExit(main())
+    raise SystemExit(run_main(main))

@@ -20,6 +20,8 @@ import argparse
 import os
 import tempfile
 
+from bench_cli import integer, real, run
+
 from training.dagger import DaggerConfig, dagger
 
 
@@ -28,12 +30,12 @@ def main(argv=None) -> int:
     ap.add_argument("--expert", default="pursuer/greedy")
     ap.add_argument("--opponent", default="evader/straight")
     ap.add_argument("--maps", nargs="+", default=["open_room"])
-    ap.add_argument("--iterations", type=int, default=6)
-    ap.add_argument("--episodes", type=int, default=25)
-    ap.add_argument("--max-cycles", type=int, default=150)
-    ap.add_argument("--epochs", type=int, default=100)
-    ap.add_argument("--lr", type=float, default=3e-4)
-    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--iterations", type=integer(1), default=6)
+    ap.add_argument("--episodes", type=integer(1), default=25)
+    ap.add_argument("--max-cycles", type=integer(1), default=150)
+    ap.add_argument("--epochs", type=integer(1), default=100)
+    ap.add_argument("--lr", type=real(0), default=3e-4)
+    ap.add_argument("--seed", type=integer(0), default=0)
     args = ap.parse_args(argv)
     print(f"load average: {os.getloadavg()}")
     role = args.expert.partition("/")[0]
@@ -63,4 +65,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run(main))

@@ -26,6 +26,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from bench_cli import integer, real, run
 
 from analysis.evaluate import wilson_interval
 from strategies.runner import run_episode
@@ -79,9 +80,9 @@ def main(argv=None) -> int:
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--model", default="dagger_pursuer_generalist")
-    ap.add_argument("--steps", type=int, default=40_000)
-    ap.add_argument("--every", type=int, default=10_000)
-    ap.add_argument("--episodes", type=int, default=24)
+    ap.add_argument("--steps", type=integer(1), default=40_000)
+    ap.add_argument("--every", type=integer(1), default=10_000)
+    ap.add_argument("--episodes", type=integer(1), default=24)
     ap.add_argument("--opponent", nargs="+", default=None,
                     help="fine-tune against these (a uniform pool) and evaluate against each "
                     "(default: evader/shooting for a pursuer, pursuer/decomposition for an "
@@ -92,7 +93,7 @@ def main(argv=None) -> int:
                     help="the DAgger dataset.npz for the BC term (default: the recipe's "
                     "output_dir)")  # fmt: skip
     ap.add_argument("--arms", nargs="+", choices=sorted(ARMS), default=sorted(ARMS))
-    ap.add_argument("--learning-rate", type=float, default=1e-4)
+    ap.add_argument("--learning-rate", type=real(0), default=1e-4)
     ap.add_argument("--save", default=None, help="directory to keep each arm's last model in")
     args = ap.parse_args(argv)
     torch.set_num_threads(1)
@@ -149,4 +150,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run(main))

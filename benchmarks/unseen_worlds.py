@@ -72,6 +72,7 @@ import time
 import zlib
 
 import numpy as np
+from bench_cli import integer, real, run
 from unseen_opponents import make_opponent
 
 from envs.errors import InvalidConfigError
@@ -519,17 +520,19 @@ def main(argv=None) -> int:
                     "random:KIND:SEED, floor_plan:SEED (module docstring)")  # fmt: skip
     ap.add_argument("--combos", nargs="+", type=int, help="indices into the role's combos")
     ap.add_argument("--opponents", nargs="+", help="opponent labels (default: all)")
-    ap.add_argument("--seeds", nargs="+", type=int, help="pursuer role: seeds (101); "
+    ap.add_argument("--seeds", nargs="+", type=integer(0), help="pursuer role: seeds (101); "
                     "evader role: keep the episodes with these drawn seeds")  # fmt: skip
-    ap.add_argument("--draws", type=int, default=2, help="evader role: episodes per world "
+    ap.add_argument("--draws", type=integer(1), default=2, help="evader role: episodes per world "
                     "and pursuer")  # fmt: skip
-    ap.add_argument("--l-mins", nargs="+", type=float, help="evader role: the L_min (before "
+    ap.add_argument("--l-mins", nargs="+", type=real(0), help="evader role: the L_min (before "
                     "scaling) of worlds outside the default set (1 2), and a filter on the "
                     "default set's")  # fmt: skip
-    ap.add_argument("--max-cycles", type=int, default=600, help="pursuer role: horizon in steps")
-    ap.add_argument("--k", type=float, default=8.0, help="evader role: horizon in D / V_e")
+    ap.add_argument(
+        "--max-cycles", type=integer(1), default=600, help="pursuer role: horizon in steps"
+    )
+    ap.add_argument("--k", type=real(0), default=8.0, help="evader role: horizon in D / V_e")
     ap.add_argument("--results", help="JSON-lines file (default out/unseen_worlds_ROLE.jsonl)")
-    ap.add_argument("--workers", type=int, default=1)
+    ap.add_argument("--workers", type=integer(1), default=1)
     args = ap.parse_args(argv)
     for name in args.worlds or []:
         known = PURSUER_WORLDS if args.role == "pursuer" else EVADER_NAMES
@@ -589,4 +592,4 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run(main))

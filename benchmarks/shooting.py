@@ -8,12 +8,13 @@ the same arc, so the ratios are machine independent.
 
 from __future__ import annotations
 
+import argparse
 import math
-import sys
 import time
 from functools import partial
 
 import numpy as np
+from bench_cli import integer, run
 from scipy.integrate import solve_ivp
 
 from strategies.control.evasion import shoot, solve_escape
@@ -96,5 +97,12 @@ def main(n_cases: int = 40) -> None:
     print(f"ratio solve_escape / solve_ivp arc: {np.median(t_solve) / np.median(t_ref):.2f}")
 
 
+def _cli() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("n_cases", nargs="?", type=integer(1), default=40, help="cases (40)")
+    main(ap.parse_args().n_cases)
+    return 0
+
+
 if __name__ == "__main__":
-    main(int(sys.argv[1]) if len(sys.argv) > 1 else 40)
+    raise SystemExit(run(_cli))

@@ -37,6 +37,7 @@ import tempfile
 import time
 
 import numpy as np
+from bench_cli import run
 
 from envs.maps import Map, builtin_map, floor_plan
 
@@ -186,4 +187,4 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    raise SystemExit(run(main))

@@ -16,6 +16,7 @@ import time
 
 import numpy as np
 import shapely
+from bench_cli import run
 from shapely.geometry import LineString
 
 from envs.geometry import Kernel
@@ -127,4 +128,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run(main))

@@ -50,6 +50,8 @@ def _play(spec: dict, store: Path, backend: str, workers: int | None) -> tuple[f
         spec_from_dict(spec), store, backend=backend, workers=workers, progress=False
     )
     wall = time.perf_counter() - t0
+    if summary.interrupted:  # a timing of part of the run would be wrong: stop
+        raise KeyboardInterrupt(summary.interrupted)
     with Store(store, create=False) as db:
         rows = db.rows(summary.run_id)
     inside = sum(r["wall_seconds"] or 0.0 for r in rows)

@@ -179,6 +179,8 @@ def main(argv=None) -> int:
         }
     )
     summary = run_tournament(spec, args.store, workers=args.workers)
+    if summary.interrupted:  # the store keeps the matches played: the same command resumes
+        raise KeyboardInterrupt(summary.interrupted)
     print(f"{summary.played} played, {summary.reused} reused, {summary.seconds:.0f} s")
     a = analyse(args.store)
     rows = a.rows

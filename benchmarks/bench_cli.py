@@ -6,7 +6,10 @@
 * :func:`run` calls a script's ``main`` and turns SIGINT (Ctrl-C) and SIGTERM (``timeout``,
   ``kill``) into one line on stderr and exit code 130 / 143, no traceback. What a script
   wrote before the signal is kept (results files are appended and flushed row by row; rerun
-  the same command to resume where a script resumes).
+  the same command to resume where a script resumes). A user error found later than
+  argparse can (an unknown map or zoo model named by a flag: the project's
+  ``SurveilValueError``, or a file error) is one line and exit code 2, as in the ``surveil``
+  CLI (:func:`analysis.arguments.user_error`); a bug keeps its traceback.
 * :func:`ignore_sigint` is a ``multiprocessing`` pool initializer: Ctrl-C reaches the whole
   process group, and only the parent should answer it (the pool's workers are terminated
   when the parent leaves its ``with`` block).
@@ -14,11 +17,12 @@
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
 from collections.abc import Callable
 
-from analysis.arguments import integer, real
+from analysis.arguments import integer, real, user_error
 
 __all__ = ["ignore_sigint", "integer", "real", "run"]
 
@@ -29,15 +33,22 @@ def _raise_interrupt(signum: int, frame: object) -> None:
     raise KeyboardInterrupt(signal.Signals(signum).name)
 
 
-def run(main: Callable[[], int]) -> int:
-    """``main()``'s exit code; 130 (SIGINT) or 143 (SIGTERM) with one line if stopped."""
+def run(main: Callable[[], int | None]) -> int:
+    """``main()``'s exit code; 130 (SIGINT) or 143 (SIGTERM) if stopped, 2 for a user error."""
     signal.signal(signal.SIGTERM, _raise_interrupt)
+    prog = os.path.basename(sys.argv[0])
     try:
         return int(main() or 0)
     except KeyboardInterrupt as exc:
         name = str(exc) if str(exc) in EXIT_CODE else "SIGINT"
-        print(f"{sys.argv[0]}: stopped by {name}", file=sys.stderr)
+        print(f"{prog}: stopped by {name}", file=sys.stderr)
         return EXIT_CODE[name]
+    except Exception as exc:
+        message = user_error(exc)
+        if message is None:
+            raise  # a bug: keep the traceback
+        print(f"{prog}: error: {message}", file=sys.stderr)
+        return 2
 
 
 def ignore_sigint() -> None:

@@ -46,6 +46,14 @@ def test_a_bad_argument_is_a_usage_error(script, args, message) -> None:
     assert out.stdout == ""  # no work started (the scripts print the load average first)
 
 
+def test_a_name_found_unknown_after_parsing_is_one_line() -> None:
+    """A project error (here an unknown zoo model) is one line and exit code 2."""
+    out = _run("exploitability.py", "--models", "nope")
+    assert out.returncode == 2, out.stderr
+    assert out.stderr.startswith("exploitability.py: error: unknown zoo model 'nope'")
+    assert "Traceback" not in out.stderr
+
+
 def test_sigterm_stops_a_run_with_one_line() -> None:
     """SIGTERM (``timeout``) stops the run: exit code 143, no traceback from any process."""
     env = {**os.environ, "PYTHONUNBUFFERED": "1"}

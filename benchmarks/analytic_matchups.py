@@ -1,8 +1,9 @@
 """Every pursuer against every evader on the built-in worlds: surveillance rates and escape times.
 
 Plays seeded episodes from safe starts (a non-escapable cell at L_min, admissible, where
-one exists; any valid start otherwise) with :func:`analysis.evaluate.evaluate`, appends
-them to a JSON-lines file as they finish (rerun the same command to resume), and prints
+one exists; any valid start otherwise) with :func:`analysis.evaluate.evaluate`, stores
+them in a SQLite tournament store as they finish (rerun the same command to resume), and
+prints
 
 * the matchup table: surveillance success rate with its Wilson 95% interval, mean time to
   escape with its Student t 95% interval, escape causes;
@@ -13,7 +14,7 @@ them to a JSON-lines file as they finish (rerun the same command to resume), and
 Usage::
 
     python benchmarks/analytic_matchups.py [--seeds 10] [--maps corridor two_rooms ...]
-        [--max-cycles 1000] [--results out/analytic_matchups.jsonl] [--workers 2]
+        [--max-cycles 1000] [--results out/analytic_matchups.sqlite] [--workers 2]
 """
 
 from __future__ import annotations
@@ -125,7 +126,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", type=integer(1), default=10)
     ap.add_argument("--fast-seeds", type=integer(0), default=3, help="seeds of the rho > 1 rows")
     ap.add_argument("--max-cycles", type=integer(1), default=1000)
-    ap.add_argument("--results", default="out/analytic_matchups.jsonl")
+    ap.add_argument("--results", default="out/analytic_matchups.sqlite")
     ap.add_argument("--workers", type=integer(1), default=2)
     args = ap.parse_args(argv)
     roster = {"maps": args.maps, "pursuers": args.pursuers, "evaders": args.evaders}

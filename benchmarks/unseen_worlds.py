@@ -44,6 +44,11 @@ In the evader role such a world plays at each ``--l-mins`` (default 1 and 2); it
 episodes are drawn from a generator seeded by (52, the label, L_min), so they do not
 depend on the other worlds selected.
 
+A held-out set of such worlds ships beside this file, one label a line, never used to
+develop the policies (seeds 2001-2026, floor plans 6-8, other transforms and rooms):
+``--worlds @benchmarks/heldout_worlds_pursuer.txt`` (37 labels) and
+``@benchmarks/heldout_worlds_evader.txt`` (32).
+
 Body radius 0.1 (times the scale). Episodes are appended to ``--results`` (JSON lines)
 as they finish; a rerun plays only what the file lacks, then prints the table of every
 selected episode: per world and combo, per opponent, the total, and every loss with the
@@ -510,6 +515,7 @@ def report(rows: list[dict]) -> None:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(
         description=__doc__.splitlines()[0],
+        fromfile_prefix_chars="@",  # --worlds @benchmarks/heldout_worlds_pursuer.txt
         epilog=f"combos: pursuer role (rho, L_max/L_min, L_min) {PURSUER_COMBOS}; "
         f"evader role (rho, L_max/L_min) {EVADER_COMBOS}",
     )

@@ -149,3 +149,20 @@ def test_a_fresh_evader_world_draws_its_own_episodes(unseen, tmp_path, capsys) -
     assert f"--worlds '{label}' " in unseen.replay_command(
         {"role": "pursuer", "world": label, "combo": [0.5, 2.0, 2.0], "opponent": "herder",
          "seed": 101})  # fmt: skip
+
+
+@pytest.mark.parametrize("role", ["pursuer", "evader"])
+def test_the_held_out_sets_parse_and_are_not_the_defaults(unseen, tmp_path, capsys, role) -> None:
+    """``--worlds @file`` reads the shipped held-out labels; every one builds (the opponent
+    check comes after the worlds'), and none is in the role's default set."""
+    path = BENCHMARKS / f"heldout_worlds_{role}.txt"
+    labels = path.read_text().split()
+    assert len(labels) > 30 and len(set(labels)) == len(labels)
+    defaults = unseen.PURSUER_WORLDS if role == "pursuer" else unseen.EVADER_NAMES
+    assert not set(labels) & set(defaults)
+    with pytest.raises(SystemExit) as exc:
+        unseen.main(["--role", role, "--worlds", f"@{path}", "--opponents", "nope",
+                     "--results", str(tmp_path / "r.jsonl")])  # fmt: skip
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "--opponents: 'nope' is no opponent" in err and f"unknown {role}-role world" not in err

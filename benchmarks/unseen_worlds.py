@@ -308,37 +308,45 @@ def pursuer_jobs(worlds, combos, opponents, seeds) -> list[tuple]:
     ]
 
 
-def evader_jobs(draws: int) -> list[tuple]:
-    """Every evader-role job, drawn in the worlds' order (the referee plays one draw)."""
-    rng = np.random.default_rng(DRAW_SEED)
+def _draws(w: str, lu: float, junction: bool, rng, draws: int) -> list[tuple]:
+    """One world's jobs at one L_min: ``draws`` episodes per pursuer (the referee, which
+    plays only on junctions, one), each with a drawn (rho, ratio) and seed."""
     jobs = []
-    for w, lu in EVADER_WORLDS:
-        junction = w.startswith(("plus", "tee"))
-        for p in PURSUERS:
-            if p == "pursuer/referee" and not junction:
-                continue
-            for _ in range(draws if p != "pursuer/referee" else 1):
-                rho, ratio = EVADER_COMBOS[int(rng.integers(len(EVADER_COMBOS)))]
-                jobs.append(("evader", w, [rho, ratio, lu], p, 100 + int(rng.integers(1000))))
+    for p in PURSUERS:
+        if p == "pursuer/referee" and not junction:
+            continue
+        for _ in range(draws if p != "pursuer/referee" else 1):
+            rho, ratio = EVADER_COMBOS[int(rng.integers(len(EVADER_COMBOS)))]
+            jobs.append(("evader", w, [rho, ratio, lu], p, 100 + int(rng.integers(1000))))
     return jobs
+
+
+def evader_jobs(draws: int) -> list[tuple]:
+    """Every evader-role job, drawn in the worlds' order from one generator."""
+    rng = np.random.default_rng(DRAW_SEED)
+    return [
+        job
+        for w, lu in EVADER_WORLDS
+        for job in _draws(w, lu, w.startswith(("plus", "tee")), rng, draws)
+    ]
 
 
 def other_evader_jobs(worlds, l_mins, draws: int) -> list[tuple]:
     """Evader-role jobs of worlds outside the default set, at each L_min: the same draws
     as the default set's, from a generator seeded by (52, the label, L_min) so each world's
     episodes do not depend on the others selected."""
-    jobs = []
-    for w in worlds:
-        junction = bool(_JUNCTION.fullmatch(w))
-        for lu in l_mins:
-            rng = np.random.default_rng([DRAW_SEED, zlib.crc32(w.encode()), round(1000 * lu)])
-            for p in PURSUERS:
-                if p == "pursuer/referee" and not junction:
-                    continue
-                for _ in range(draws if p != "pursuer/referee" else 1):
-                    rho, ratio = EVADER_COMBOS[int(rng.integers(len(EVADER_COMBOS)))]
-                    jobs.append(("evader", w, [rho, ratio, lu], p, 100 + int(rng.integers(1000))))
-    return jobs
+    return [
+        job
+        for w in worlds
+        for lu in l_mins
+        for job in _draws(
+            w,
+            lu,
+            bool(_JUNCTION.fullmatch(w)),
+            np.random.default_rng([DRAW_SEED, zlib.crc32(w.encode()), round(1000 * lu)]),
+            draws,
+        )
+    ]
 
 
 def job_key(job) -> str:

@@ -347,6 +347,8 @@ def arrange(world: Map, curves: tuple[CriticalCurve, ...], tol: Tolerances) -> A
     # faces: counter-clockwise cycles, and degenerate ones (zero area but not a tree of
     # dangling edges: two edges whose polylines coincide), which join a neighbour below
     degenerate = ~blocked & (np.abs(c_area) <= area_tol) & ~all_bridges
+    # ... and clockwise ones that are not their component's outer boundary
+    degenerate |= ~blocked & (c_area < -area_tol) & _not_outer(nd, walks, h_edge, h_fwd, c_area)
     outer = np.flatnonzero((~blocked & (c_area > area_tol)) | degenerate)
     inner = np.flatnonzero(~blocked & (c_area <= area_tol) & ~degenerate)
 
@@ -418,6 +420,29 @@ def arrange(world: Map, curves: tuple[CriticalCurve, ...], tol: Tolerances) -> A
     return Arrangement(
         tuple(faces), pieces, cv, nd, e_len, c0, sliver, speck, face_h, bridge, tol, stats
     )
+
+
+def _not_outer(nd: Noded, walks, h_edge, h_fwd, c_area) -> np.ndarray:
+    """Per cycle, whether it is not the outer boundary of its connected component.
+
+    A connected component of the planar graph has exactly one outer (clockwise) cycle;
+    every other cycle of it bounds a face. The edges' signed areas of a component sum to
+    zero over its cycles, so the outer one is the cycle of least signed area. Any other
+    cycle with a negative area on its polylines is a face thinner than the polylines
+    can show (e.g. a lens between a type-1 line and the type-2 arc tangent to it at its
+    end, cut by another arc within the merge tolerance of the line: its polyline area
+    has either sign), not a hole in whichever face surrounds its first vertex.
+    """
+    nv = len(nd.vertices)
+    g = coo_matrix((np.ones(len(nd.u)), (nd.u, nd.v)), shape=(nv, nv))
+    _, comp = connected_components(g, directed=False)
+    h0 = np.array([w[0] for w in walks], dtype=np.intp)
+    c_comp = comp[np.where(h_fwd[h0], nd.u[h_edge[h0]], nd.v[h_edge[h0]])]
+    order = np.lexsort((c_area, c_comp))
+    first = np.concatenate([[True], c_comp[order][1:] != c_comp[order][:-1]])
+    out = np.ones(len(walks), dtype=bool)
+    out[order[first]] = False
+    return out
 
 
 def _face_samples(arr: Arrangement, sel: np.ndarray):

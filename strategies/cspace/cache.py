@@ -46,7 +46,7 @@ __all__ = [
     "write_cache_file",
 ]
 
-FORMAT_VERSION = 7  # 7: specks, vertex angles (6: probes off the middle of an edge)
+FORMAT_VERSION = 8  # 8: thin clockwise cycles are faces (7: specks, vertex angles)
 """Bump when the decomposition's content or the file layout changes."""
 
 MAGIC = b"SURVEIL-CSPACE-DECOMPOSITION\n"

@@ -380,14 +380,18 @@ class Decomposition:
                 f"(its diameter is {diameter(self.map):.4g}): every position and "
                 "orientation is blocked, so surveillance at this distance is impossible"
             )
-        elif w is None:
-            lines.append("  verdict: every region has a non-escapable cell: the pursuer can hold")
         else:
-            x, y = w.point
-            lines.append(
-                f"  verdict: the evader wins (Prop. 2); witness region {w.id} "
-                f"near ({x:.3g}, {y:.3g})"
-            )
+            # a verdict from an inexact arrangement can be wrong (one unmatched piece
+            # makes a cell escapable by condition (a)): say so on the verdict's line
+            head = "  verdict" if self.exact else "  verdict (UNRELIABLE: not exact, see above)"
+            if w is None:
+                lines.append(f"{head}: every region has a non-escapable cell: the pursuer can hold")
+            else:
+                x, y = w.point
+                lines.append(
+                    f"{head}: the evader wins (Prop. 2); witness region {w.id} "
+                    f"near ({x:.3g}, {y:.3g})"
+                )
         return "\n".join(lines)
 
     def __repr__(self) -> str:

@@ -25,7 +25,8 @@ quadruples its points; issue 13's decision time on large worlds).
 truth) about every start: each start, mapped back to the as-is world (a rotation and a
 uniform scaling of lengths and speeds leave the game unchanged), is classified on the
 as-is world's referee at CPL cells per L_min, with a fine evader lattice (2 cells, 1
-spacing a step), and the counts are printed per world and variant, then beside each loss.
+spacing a step; ``benchmarks/referee_labels.py``, shared with ``unseen_worlds.py``), and
+the counts are printed per world and variant, then beside each loss.
 A certified *evader* start is one no pursuer can hold (on a world whose safe starts are
 all such, "held" only measures the evaders' weakness); a loss from a certified *pursuer*
 start is a weakness of the policy (its regret); "unknown" is the referee's resolution gap.
@@ -41,7 +42,9 @@ import os
 import time
 
 import numpy as np
+import referee_labels
 from bench_cli import ignore_sigint, integer, real, run
+from referee_labels import similarity_back
 
 from envs.maps import builtin_info, builtin_names
 from strategies.runner import run_episode
@@ -105,24 +108,11 @@ def _play(job):
 
 def _referee_label(world: str, variant_label: str, rho: float, start, cpl: float) -> str:
     """The referee's label of a variant's start, on the as-is world (see the docstring)."""
-    from envs.errors import InvalidPlacementError
-    from envs.surveillance.config import EnvConfig
-    from strategies.referee import referee_for
-
     _, rot, scale, offset = next(v for v in VARIANTS if v[0] == variant_label)
     m, params = _world(world, 0.0, 1.0, (0.0, 0.0))
-    c, s = math.cos(rot), math.sin(rot)
-    back = lambda q: (
-        (np.asarray(q, float) - np.asarray(offset)) / scale @ np.array([[c, -s], [s, c]])
-    )
-    cfg = EnvConfig(map=m, l_min=params["l_min"], l_max=params["l_max"],
-                    v_pursuer=params["v_pursuer"], v_evader=rho * params["v_pursuer"],
-                    body_radius=0.2)  # fmt: skip
-    ref = referee_for(cfg, cpl, evader_coarse=2, evader_steps=1)
-    try:
-        return ref.classify(back(start["pursuer"]), back(start["evader"]))
-    except InvalidPlacementError:
-        return "not a start"
+    ov = {"l_min": params["l_min"], "l_max": params["l_max"], "v_pursuer": params["v_pursuer"],
+          "v_evader": rho * params["v_pursuer"], "body_radius": 0.2}  # fmt: skip
+    return referee_labels.verdict(m, ov, start, cpl, similarity_back(rot, scale, offset))
 
 
 def main(argv=None) -> int:
@@ -207,22 +197,17 @@ def main(argv=None) -> int:
         for (world, label, rho), c in sorted(per.items()):
             counts = ", ".join(f"{n} {v}" for v, n in sorted(c.items()))
             print(f"  {world} [{label}] rho={rho}: {counts}")
-    verdicts: dict[str, int] = {}
+    verdicts_of_losses = []
     for loss in losses:
         world, label, rho, evader, seed, cause, t, start = loss
         ref = ""
         if args.referee:
             v = labels[(world, label, rho, seed)]
-            verdicts[v] = verdicts.get(v, 0) + 1
+            verdicts_of_losses.append(v)
             ref = f"; referee: {v}"
         print(f"  lost: {world} [{label}] rho={rho} {evader} seed={seed}: {cause} at {t}{ref}")
     if args.referee and losses:
-        meaning = {"evader": "unavoidable", "pursuer": "the policy's regret",
-                   "unknown": "the referee's resolution gap"}  # fmt: skip
-        print(
-            f"referee (cpl {args.referee:g}) on the {len(losses)} lost starts: "
-            + ", ".join(f"{n} {v} ({meaning.get(v, v)})" for v, n in sorted(verdicts.items()))
-        )
+        print(referee_labels.summary(args.referee, verdicts_of_losses))
     return 0
 
 

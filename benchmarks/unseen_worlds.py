@@ -54,11 +54,22 @@ as they finish; a rerun plays only what the file lacks, then prints the table of
 selected episode: per world and combo, per opponent, the total, and every loss with the
 command that replays it.
 
+``--referee CPL`` (pursuer role) asks the referee, the bounded-speed ground truth, about
+every start of the selected episodes (one per world, combo and seed; the opponents share
+it) at CPL cells per L_min (``benchmarks/referee_labels.py``): the counts per world and
+combo, the label beside each loss, and over the lost starts: ``evader`` (certified: no
+bounded-speed pursuer holds it, the loss is unavoidable), ``pursuer`` (certified
+holdable: the policy's regret; never at rho >= 0.35, where the pursuer bound certifies
+nothing), ``unknown``. A transformed built-in world is judged untransformed (the same
+game), so its transforms share one solve, cached on disk; each world costs minutes the
+first time, so restrict ``--worlds`` (the episodes themselves come from ``--results``).
+
 Usage::
 
     python benchmarks/unseen_worlds.py --role pursuer|evader [--worlds W ...]
         [--combos I ...] [--opponents O ...] [--seeds S ...] [--results F.jsonl]
         [--workers 1] [--max-cycles 600] [--k 8] [--draws 2] [--l-mins L ...]
+        [--referee CPL]
 
 ``--combos`` indexes the role's combos (``--help`` lists them). ``--seeds`` is the
 seed list in the pursuer role and a filter on the drawn seeds in the evader role. On one
@@ -77,7 +88,9 @@ import time
 import zlib
 
 import numpy as np
+import referee_labels
 from bench_cli import integer, real, run
+from referee_labels import similarity_back
 from unseen_opponents import make_opponent
 
 from envs.errors import InvalidConfigError
@@ -241,11 +254,23 @@ def built_map(key: str) -> Map:
     return room_map(key, "pursuer")
 
 
-def pursuer_world(key: str, combo) -> tuple[Map, dict]:
-    """(map, env overrides) of a pursuer-role world at a (rho, L_max / L_min, L_min) combo."""
+def similarity_of(key: str) -> tuple[str, float, float, tuple[float, float]] | None:
+    """(built-in name, rotation, scale, offset) when the pursuer-role world ``key`` is a
+    built-in world transformed (a similarity), else None."""
+    if key in PAPER:
+        return PAPER[key]
+    return transform_of(key) if "~" in key else None
+
+
+def pursuer_world(key: str, combo, *, untransformed: bool = False) -> tuple[Map, dict]:
+    """(map, env overrides) of a pursuer-role world at a (rho, L_max / L_min, L_min) combo;
+    with ``untransformed``, a transformed built-in world's game before its similarity (the
+    same game: lengths and speeds scaled alike, the plane moved)."""
     rho, ratio, l_min = combo
-    if key in PAPER or "~" in key:
-        name, rot, scale, offset = PAPER[key] if key in PAPER else transform_of(key)
+    if (sim := similarity_of(key)) is not None:
+        name, rot, scale, offset = sim
+        if untransformed:
+            rot, scale, offset = 0.0, 1.0, (0.0, 0.0)
         info = builtin_info(name)
         m = info.map.transformed(_rotm(rot, scale), offset)
         lm, vp, r = info.l_min * scale * (l_min / 2.0), info.v_pursuer * scale, BODY * scale
@@ -471,9 +496,41 @@ def replay_command(row, results: str = "replay.jsonl") -> str:
     )
 
 
-def report(rows: list[dict]) -> None:
-    """The tables: per world and combo, per opponent, total; every loss."""
+def referee_verdict(row, cpl: float) -> str:
+    """The referee's label of a pursuer-role row's start at ``cpl`` cells per L_min
+    (:mod:`referee_labels`); a transformed built-in world is judged untransformed, so its
+    transforms share one solve."""
+    sim = similarity_of(row["world"])
+    m, ov = pursuer_world(row["world"], row["combo"], untransformed=True)
+    back = None if sim is None else similarity_back(*sim[1:])
+    return referee_labels.verdict(m, ov, row["start"], cpl, back)
+
+
+def _start_key(row) -> str:
+    return json.dumps([row["world"], row["combo"], row["seed"], row["start"]])
+
+
+def referee_verdicts(rows: list[dict], cpl: float) -> dict[str, str]:
+    """The referee's label of every start among ``rows`` (one per world, combo and seed:
+    the opponents share it), keyed by :func:`_start_key`; the time each world and combo's
+    first label took (solving or loading its referee) is printed."""
+    labels: dict[str, str] = {}
+    for r in sorted((r for r in rows if "start" in r), key=lambda r: (r["world"], r["combo"])):
+        key = _start_key(r)
+        if key not in labels:
+            t0 = time.perf_counter()
+            labels[key] = referee_verdict(r, cpl)
+            print(f"  referee (cpl {cpl:g}) {r['world']} {r['combo']} seed={r['seed']}: "
+                  f"{labels[key]} ({time.perf_counter() - t0:.1f} s)", flush=True)  # fmt: skip
+    return labels
+
+
+def report(rows: list[dict], referee: float | None = None) -> None:
+    """The tables: per world and combo, per opponent, total; every loss. With ``referee``
+    (pursuer role), every start's label at that many cells per L_min: the counts per world
+    and combo, beside each loss, and over the lost starts."""
     role = rows[0]["role"]
+    labels = referee_verdicts(rows, referee) if referee and role == "pursuer" else {}
     won, verb = ("held", "held") if role == "pursuer" else ("escaped", "escaped")
     per_world: dict[tuple, list[int]] = {}
     per_opp: dict[str, list[int]] = {}
@@ -482,9 +539,18 @@ def report(rows: list[dict]) -> None:
                     per_opp.setdefault(r["opponent"], [0, 0])):  # fmt: skip
             acc[0] += _won(r)
             acc[1] += 1
-    print(f"{'world':<26}{'rho, L_max/L_min, L_min':<26}{won:>8}")
+    per_label: dict[tuple, dict[str, int]] = {}
+    for r in rows:
+        if "start" in r and _start_key(r) in labels:
+            c = per_label.setdefault((r["world"], tuple(r["combo"])), {})
+            v = labels[_start_key(r)]
+            c[v] = c.get(v, 0) + 1
+    head = "   referee (episodes per start's label)" if labels else ""
+    print(f"{'world':<26}{'rho, L_max/L_min, L_min':<26}{won:>8}{head}")
     for (w, combo), (k, n) in sorted(per_world.items()):
-        print(f"{w:<26}{list(combo)!s:<26}{f'{k}/{n}':>8}")
+        c = per_label.get((w, combo), {})
+        ref = "   " + ", ".join(f"{m} {v}" for v, m in sorted(c.items())) if labels else ""
+        print(f"{w:<26}{list(combo)!s:<26}{f'{k}/{n}':>8}{ref}")
     print(f"{'opponent':<30}{won:>8}")
     for o, (k, n) in sorted(per_opp.items()):
         print(f"{o:<30}{f'{k}/{n}':>8}")
@@ -508,6 +574,7 @@ def report(rows: list[dict]) -> None:
     if dec:
         print(f"decision time per step (episode means): median {np.median(dec):.2f} ms, "
               f"max {max(dec):.2f} ms")  # fmt: skip
+    lost_labels = []
     for r in rows:
         if not _won(r):
             if "error" in r:
@@ -516,8 +583,14 @@ def report(rows: list[dict]) -> None:
                 what = f"held for {r['steps']} steps (the horizon)"
             else:
                 what = f"{r['cause']} at {r['t']:.1f} s"
+            if labels:
+                lost_labels.append(labels.get(_start_key(r), "no start") if "start" in r
+                                   else "no start")  # fmt: skip
+                what += f"; referee: {lost_labels[-1]}"
             print(f"  lost: {r['world']} {r['combo']} {r['opponent']} seed={r['seed']}: {what}")
             print(f"    replay: {replay_command(r)}")
+    if labels:
+        print(referee_labels.summary(referee, lost_labels))
 
 
 def main(argv=None) -> int:
@@ -547,7 +620,11 @@ def main(argv=None) -> int:
     ap.add_argument("--k", type=real(0), default=8.0, help="evader role: horizon in D / V_e")
     ap.add_argument("--results", help="JSON-lines file (default out/unseen_worlds_ROLE.jsonl)")
     ap.add_argument("--workers", type=integer(1), default=1)
+    ap.add_argument("--referee", type=real(0), metavar="CPL", help="pursuer role: label every "
+                    "start with the referee at CPL cells per L_min (module docstring)")  # fmt: skip
     args = ap.parse_args(argv)
+    if args.referee and args.role != "pursuer":
+        ap.error("--referee: the pursuer role only (it labels the pursuer's starts)")
     for name in args.worlds or []:
         known = PURSUER_WORLDS if args.role == "pursuer" else EVADER_NAMES
         if name not in known:
@@ -601,7 +678,7 @@ def main(argv=None) -> int:
             pool.join()
     played = [done[job_key(j)] for j in jobs]
     if played:
-        report(played)
+        report(played, args.referee)
     return 0
 
 

@@ -166,3 +166,65 @@ def test_the_held_out_sets_parse_and_are_not_the_defaults(unseen, tmp_path, caps
     assert exc.value.code == 2
     err = capsys.readouterr().err
     assert "--opponents: 'nope' is no opponent" in err and f"unknown {role}-role world" not in err
+
+
+@pytest.mark.slow
+def test_the_referee_labels_the_starts_it_certifies(unseen, tmp_path, monkeypatch, capsys) -> None:
+    """``--referee CPL``: a start the referee certifies for the evader (found by solving the
+    untransformed corner world by hand, then moved by the label's similarity) is labelled
+    ``evader`` beside its loss and in the summary, an uncertified one ``unknown``; the
+    episodes come from the results file (nothing is played)."""
+    import numpy as np
+
+    from envs.maps import builtin_info
+    from strategies.referee import GameSpec, solve
+
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", str(tmp_path / "cache"))
+    corner = builtin_info("corner").map
+    # corner~x0.5rot1off(3,-2) at combo 0 is the corner game at L in [2, 4], rho 0.5, r 0.1
+    spec = GameSpec(corner, 2.0, 4.0, v_pursuer=1.0, v_evader=0.5, body_radius=0.1)
+    ref = solve(spec, 12, evader_coarse=2, evader_steps=1, dt=0.1)
+    starts = ref.lattice_starts()
+    c, s = np.cos(1.0), np.sin(1.0)
+    fwd = lambda q: (0.5 * np.array([[c, -s], [s, c]]) @ q + (3.0, -2.0)).tolist()
+    label = "corner~x0.5rot1off(3,-2)"
+    rows, want = [], {}
+    for seed, kind in [(101, "evader"), (102, "unknown")]:
+        i = int(np.flatnonzero(starts.label == kind)[0])
+        p, e = starts.pursuer[i], starts.evader[i]
+        assert ref.classify(p, e) == kind
+        rows.append({"role": "pursuer", "world": label, "combo": [0.5, 2.0, 2.0],
+                     "opponent": "herder", "seed": seed, "winner": "evader",
+                     "cause": "too_close", "t": 3.0, "steps": 30,
+                     "start": {"pursuer": fwd(p), "evader": fwd(e)}})  # fmt: skip
+        want[seed] = kind
+    out = tmp_path / "p.jsonl"
+    out.write_text("".join(json.dumps(r) + "\n" for r in rows))
+    argv = ["--role", "pursuer", "--worlds", label, "--combos", "0", "--opponents", "herder",
+            "--seeds", "101", "102", "--results", str(out), "--referee", "12"]  # fmt: skip
+    assert unseen.main(argv) == 0
+    text = capsys.readouterr().out
+    assert "2 episodes selected, 0 to play" in text
+    for seed, kind in want.items():
+        assert f"herder seed={seed}: too_close at 3.0 s; referee: {kind}" in text
+    assert (
+        "referee (cpl 12) on the 2 lost starts: 1 evader (unavoidable), 0 pursuer (the "
+        "policy's regret), 1 unknown (the referee's resolution gap)" in text
+    )
+    assert "1 evader, 1 unknown" in text  # the world's counts
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [(["--role", "pursuer", "--referee", "0"], "argument --referee: '0': expected a finite"),
+     (["--role", "pursuer", "--referee", "nan"], "argument --referee: 'nan': expected a finite"),
+     (["--role", "evader", "--referee", "8"], "--referee: the pursuer role only")],
+)  # fmt: skip
+def test_a_bad_referee_cpl_is_a_usage_error_naming_it(unseen, tmp_path, capsys, argv,
+                                                       message) -> None:  # fmt: skip
+    results = tmp_path / "r.jsonl"
+    with pytest.raises(SystemExit) as exc:
+        unseen.main([*argv, "--worlds", "plus_w6", "--results", str(results)])
+    assert exc.value.code == 2
+    assert message in capsys.readouterr().err
+    assert not results.exists()

@@ -1,0 +1,92 @@
+"""The referee's verdict on a benchmark's starts (``pursuer_holds.py`` and
+``unseen_worlds.py``, ``--referee CPL``).
+
+A start is classified by the referee (:mod:`strategies.referee`, the bounded-speed
+ground truth) at ``CPL`` cells per L_min, with a fine evader lattice (2 cells a spacing,
+1 spacing a step): ``"evader"`` (certified: no bounded-speed pursuer holds it, a loss
+from it is unavoidable), ``"pursuer"`` (certified: some pursuer holds it, a loss is the
+policy's regret), ``"unknown"`` (the referee's resolution gap; at rho >= 0.35 the pursuer
+bound certifies nothing, so there every verdict is ``"evader"`` or ``"unknown"``), or
+``"not a start"`` (surveillance does not hold there).
+
+A world that is a similarity (rotation, uniform scaling, shift) of another is judged on
+the other: scaling lengths and speeds by one factor and moving the plane leave the game
+unchanged (time is not scaled), so :func:`verdict` maps the start back with
+:func:`similarity_back` and the variants of one world share one solve (cached on disk:
+minutes per world the first time, ``SURVEIL_CACHE_DIR``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable, Mapping
+
+import numpy as np
+
+from envs.errors import InvalidPlacementError
+from envs.maps import Map
+
+__all__ = ["MEANING", "similarity_back", "summary", "verdict"]
+
+# the referee's resolution besides CPL: a fine evader lattice (as pursuer_holds.py always had)
+SOLVE = {"evader_coarse": 2, "evader_steps": 1}
+MEANING = {
+    "evader": "unavoidable",
+    "pursuer": "the policy's regret",
+    "unknown": "the referee's resolution gap",
+}
+
+_last: tuple[object, object] | None = None  # (cache key, Referee): one world at a time
+
+
+def similarity_back(
+    rot: float, scale: float, offset: Iterable[float]
+) -> Callable[[object], np.ndarray]:
+    """The inverse of ``x -> scale R(rot) x + offset`` (how a variant was made)."""
+    c, s = math.cos(rot), math.sin(rot)
+    r = np.array([[c, -s], [s, c]])
+    off = np.asarray(tuple(offset), float)
+    return lambda q: (np.asarray(q, float) - off) / scale @ r
+
+
+def _referee(m: Map, overrides: Mapping[str, float], cpl: float):
+    from envs.surveillance.config import EnvConfig
+    from strategies.referee import referee_for
+
+    global _last
+    cfg = EnvConfig(map=m, **overrides)
+    key = (m.digest, tuple(sorted(overrides.items())), float(cpl), cfg.dt)
+    if _last is None or _last[0] != key:
+        _last = (key, referee_for(cfg, cpl, **SOLVE))
+    return _last[1]
+
+
+def verdict(
+    m: Map,
+    overrides: Mapping[str, float],
+    start: Mapping[str, object],
+    cpl: float,
+    back: Callable[[object], np.ndarray] | None = None,
+) -> str:
+    """The referee's label of ``start`` (``{"pursuer": (x, y), "evader": (x, y)}``) in the
+    game on ``m`` with env ``overrides`` (``l_min, l_max, v_pursuer, v_evader,
+    body_radius``), at ``cpl`` cells per L_min; ``back`` maps the start's points into
+    ``m`` when the start was played on a similar world."""
+    back = back or (lambda q: np.asarray(q, float))
+    ref = _referee(m, overrides, cpl)
+    try:
+        return ref.classify(back(start["pursuer"]), back(start["evader"]))
+    except InvalidPlacementError:
+        return "not a start"
+
+
+def summary(cpl: float, verdicts: Iterable[str], what: str = "lost starts") -> str:
+    """``referee (cpl X) on the N lost starts: a evader (unavoidable), b pursuer (the
+    policy's regret), c unknown (...)`` (and any ``not a start``)."""
+    counts = {v: 0 for v in MEANING}
+    n = 0
+    for v in verdicts:
+        counts[v] = counts.get(v, 0) + 1
+        n += 1
+    parts = [f"{k} {v} ({MEANING[v]})" if v in MEANING else f"{k} {v}" for v, k in counts.items()]
+    return f"referee (cpl {cpl:g}) on the {n} {what}: " + ", ".join(parts)

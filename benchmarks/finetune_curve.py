@@ -96,6 +96,9 @@ def main(argv=None) -> int:
     ap.add_argument("--learning-rate", type=real(0), default=1e-4)
     ap.add_argument("--save", default=None, help="directory to keep each arm's last model in")
     args = ap.parse_args(argv)
+    if args.every > args.steps:
+        ap.error(f"--every {args.every} > --steps {args.steps}: no model would be evaluated "
+                 "after step 0; expected --every <= --steps")  # fmt: skip
     torch.set_num_threads(1)
     try:
         cfg = zoo.config(args.model)

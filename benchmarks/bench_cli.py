@@ -13,18 +13,24 @@
 * :func:`ignore_sigint` is a ``multiprocessing`` pool initializer: Ctrl-C reaches the whole
   process group, and only the parent should answer it (the pool's workers are terminated
   when the parent leaves its ``with`` block).
+* :func:`worker_pool` is such a pool whose workers ignore SIGINT from their first
+  instruction (a Ctrl-C while they are still importing is no traceback either), terminated
+  when its ``with`` block is left, a stop included.
 """
 
 from __future__ import annotations
 
+import contextlib
+import multiprocessing as mp
 import os
 import signal
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from multiprocessing.pool import Pool
 
 from analysis.arguments import integer, real, user_error
 
-__all__ = ["ignore_sigint", "integer", "real", "run"]
+__all__ = ["ignore_sigint", "integer", "real", "run", "worker_pool"]
 
 EXIT_CODE = {"SIGINT": 130, "SIGTERM": 143}
 
@@ -54,3 +60,23 @@ def run(main: Callable[[], int | None]) -> int:
 def ignore_sigint() -> None:
     """Pool initializer: the parent answers Ctrl-C (and terminates the pool)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+@contextlib.contextmanager
+def worker_pool(
+    processes: int, initializer: Callable[..., object] | None = None, initargs: tuple = ()
+) -> Iterator[Pool]:
+    """A ``spawn`` pool of ``processes`` workers that leave Ctrl-C to the parent.
+
+    The workers are started with SIGINT ignored (an ignored signal stays ignored across
+    ``exec``, and Python then installs no KeyboardInterrupt handler), so a Ctrl-C at any
+    moment, their start-up included, prints no worker traceback; leaving the block, a
+    stop included, terminates them.
+    """
+    old = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        pool = mp.get_context("spawn").Pool(processes, initializer, initargs)
+    finally:
+        signal.signal(signal.SIGINT, old)
+    with pool:
+        yield pool

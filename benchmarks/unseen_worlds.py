@@ -79,9 +79,9 @@ busy core (load ~4.5 on 2): ``--role pursuer --combos 0`` 10 min, ``--role evade
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
-import multiprocessing as mp
 import os
 import re
 import time
@@ -89,7 +89,7 @@ import zlib
 
 import numpy as np
 import referee_labels
-from bench_cli import integer, real, run
+from bench_cli import integer, real, run, worker_pool
 from referee_labels import similarity_back
 from unseen_opponents import make_opponent
 
@@ -658,9 +658,9 @@ def main(argv=None) -> int:
     os.makedirs(os.path.dirname(os.path.abspath(results)), exist_ok=True)
     _init(args.max_cycles, args.k)
     t0 = time.perf_counter()
-    with open(results, "a") as f:
-        if args.workers > 1:
-            pool = mp.get_context("spawn").Pool(args.workers, _init, (args.max_cycles, args.k))
+    with open(results, "a") as f, contextlib.ExitStack() as stack:
+        if args.workers > 1:  # leaving the with block (a stop included) terminates the pool
+            pool = stack.enter_context(worker_pool(args.workers, _init, (args.max_cycles, args.k)))
             rows = pool.imap_unordered(play, todo)
         else:
             pool, rows = None, map(play, todo)

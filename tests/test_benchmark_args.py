@@ -78,3 +78,33 @@ def test_sigterm_stops_a_run_with_one_line() -> None:
     assert proc.returncode == 143, err
     assert "stopped by SIGTERM" in err
     assert "Traceback" not in err
+
+
+def test_ctrl_c_stops_a_pool_run_with_one_line(tmp_path) -> None:
+    """Ctrl-C (SIGINT to the whole process group) stops ``unseen_worlds.py --workers 2``
+    with exit code 130 and one line: no worker traceback, no leaked-semaphore warning."""
+    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+    rows = str(tmp_path / "rows.jsonl")
+    args = ["--role", "pursuer", "--worlds", "maze~x0.7rot-2.6", "--combos", "0",
+            "--seeds", "0", "1", "--workers", "2", "--results", rows]  # fmt: skip
+    proc = subprocess.Popen(
+        [sys.executable, "unseen_worlds.py", *args],
+        cwd=BENCHMARKS,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+        start_new_session=True,  # its own process group, as a terminal's job
+    )
+    for line in proc.stdout:  # the pool starts after this line
+        if "to play" in line:
+            break
+    time.sleep(5.0)  # the workers are playing (before, they may still be importing)
+    os.killpg(proc.pid, signal.SIGINT)
+    try:
+        _, err = proc.communicate(timeout=30)
+    except subprocess.TimeoutExpired:  # pragma: no cover - the bug this test is for
+        os.killpg(proc.pid, signal.SIGKILL)
+        raise
+    assert proc.returncode == 130, err
+    assert err.strip() == "unseen_worlds.py: stopped by SIGINT"

@@ -14,8 +14,8 @@
   process group, and only the parent should answer it (the pool's workers are terminated
   when the parent leaves its ``with`` block).
 * :func:`worker_pool` is such a pool whose workers ignore SIGINT from their first
-  instruction (a Ctrl-C while they are still importing is no traceback either), terminated
-  when its ``with`` block is left, a stop included.
+  instruction (a Ctrl-C while they are still importing is no traceback either), closed
+  when its ``with`` block ends and terminated when a stop leaves it.
 """
 
 from __future__ import annotations
@@ -70,13 +70,21 @@ def worker_pool(
 
     The workers are started with SIGINT ignored (an ignored signal stays ignored across
     ``exec``, and Python then installs no KeyboardInterrupt handler), so a Ctrl-C at any
-    moment, their start-up included, prints no worker traceback; leaving the block, a
-    stop included, terminates them.
+    moment, their start-up included, prints no worker traceback. Leaving the block closes
+    the pool and waits for its workers; leaving it by an exception (a stop included)
+    terminates them first.
     """
     old = signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         pool = mp.get_context("spawn").Pool(processes, initializer, initargs)
     finally:
         signal.signal(signal.SIGINT, old)
-    with pool:
+    try:
         yield pool
+    except BaseException:
+        pool.terminate()
+        raise
+    else:
+        pool.close()
+    finally:
+        pool.join()

@@ -30,7 +30,13 @@ Usage::
 
     python benchmarks/evader_escapes.py [--seeds 4] [--simple-seeds 2] [--k 8]
         [--workers 2] [--worlds two_rooms plus ...] [--pursuers pursuer/greedy ...]
-        [--start safe] [--progress]
+        [--start safe] [--progress] [--results F.jsonl]
+
+Each failure (the pursuer held) is printed as it happens, and a progress line every 20
+jobs (``--progress``: a line per job). With ``--results F.jsonl`` every job (the shooting
+evader's episode and the simple evaders' from the same start) is appended to F as it
+completes (JSON lines, ``benchmarks/episode_rows.py``); the same command with the same F
+after a stop plays only the jobs missing from it and reports over all of them.
 
 The simple evaders play only the first ``--simple-seeds`` seeds (they lose often, and a
 lost episode runs the whole horizon). The full default run takes about an hour on two
@@ -42,13 +48,14 @@ from __future__ import annotations
 
 import argparse
 import collections
+import contextlib
 import math
-import multiprocessing as mp
 import os
 import time
 
+import episode_rows
 import numpy as np
-from bench_cli import ignore_sigint, integer, real, run
+from bench_cli import integer, real, run, worker_pool
 
 from envs.maps import Map, builtin_info, load_map
 from envs.maps.junctions import crossroads, t_junction
@@ -131,15 +138,23 @@ def _play(job):
                     start=start, on_step=on_step)  # fmt: skip
     end = r.trajectory[-1].tolist()
     out = {
-        "shooting": (r.winner, r.escape_time, r.decide_seconds["evader"], dict(modes), end),
+        "shooting": [r.winner, r.escape_time, r.decide_seconds["evader"], dict(modes), end],
         "steps": r.steps,
         "unit": unit_t,
     }
     for e in simple:
         s = run_episode(m, _policy(pursuer), _policy(e), seed, max_cycles=max_cycles,
                         overrides=params, start=start)  # fmt: skip
-        out[e] = (s.winner, s.escape_time, s.decide_seconds["evader"], s.steps)
-    return name, variant, pursuer, seed, out
+        out[e] = [s.winner, s.escape_time, s.decide_seconds["evader"], s.steps]
+    return {**dict(zip(_KEY, job, strict=True)), "out": out}
+
+
+_KEY = ("world", "variant", "pursuer", "seed", "k", "start", "simple")
+"""What identifies an episode (its row's fields): a rerun skips the rows it finds."""
+
+
+def _row_key(row: dict) -> str:
+    return episode_rows.key(row[k] for k in _KEY)
 
 
 def main(argv=None) -> int:
@@ -165,7 +180,11 @@ def main(argv=None) -> int:
         help="seeds (the first ones) also played by the "
         "simple evaders, from the same starts (0: none)",
     )
-    ap.add_argument("--progress", action="store_true", help="print progress while playing")
+    ap.add_argument("--progress", action="store_true",
+                    help="a line per job (default: every 20 jobs, and each failure)")  # fmt: skip
+    ap.add_argument("--results", metavar="FILE", default=None,
+                    help="append each episode to FILE (JSON lines) as it completes; a rerun "
+                    "with the same FILE plays only the episodes missing from it")  # fmt: skip
     args = ap.parse_args(argv)
     for w in args.worlds:
         try:
@@ -188,17 +207,36 @@ def main(argv=None) -> int:
                     jobs.append(
                         (w, v, p, s, args.k, args.start, simple if s < args.simple_seeds else [])
                     )
+    done = episode_rows.read(args.results, _row_key) if args.results else {}
+    todo = [j for j in jobs if episode_rows.key(j) not in done]
+    if args.results:
+        print(f"{len(jobs)} jobs selected, {len(todo)} to play, results in {args.results}")
     t0 = time.perf_counter()
+    with contextlib.ExitStack() as stack:
+        write = stack.enter_context(episode_rows.appending(args.results)) if args.results else None
+        pool = stack.enter_context(worker_pool(args.workers))
+        held = 0
+        for i, row in enumerate(pool.imap_unordered(_play, todo), 1):
+            if write is not None:
+                write(row)
+            done[_row_key(row)] = row
+            winner, t = row["out"]["shooting"][:2]
+            what = f"{row['world']} [{row['variant']}] {row['pursuer']} seed={row['seed']}"
+            held += winner != "evader"
+            if winner != "evader" or args.progress:
+                print(f"  {'escaped' if winner == 'evader' else 'held'}: {what}", flush=True)
+            if i % 20 == 0 or i == len(todo):
+                print(f"  {i}/{len(todo)} jobs, {held} held, {time.perf_counter() - t0:.0f} s",
+                      flush=True)  # fmt: skip
     results = []
-    with mp.get_context("spawn").Pool(args.workers, ignore_sigint) as pool:
-        for i, res in enumerate(pool.imap_unordered(_play, jobs), 1):
-            results.append(res)
-            if args.progress and i % 20 == 0:
-                print(f"  {i}/{len(jobs)} jobs, {time.perf_counter() - t0:.0f} s", flush=True)
+    for j in jobs:
+        r = done[episode_rows.key(j)]
+        results.append((r["world"], r["variant"], r["pursuer"], r["seed"], r["out"]))
     results.sort(key=lambda r: (r[0], list(VARIANTS).index(r[1]), r[2], r[3]))
     wall = time.perf_counter() - t0
-    print(f"{len(jobs)} x {1 + len(simple)} episodes in {wall:.0f} s ({args.workers} workers), "
-          f"horizon {args.k:g} D / V_e, start {args.start!r}")  # fmt: skip
+    print(f"{len(todo)} x {1 + len(simple)} episodes played in {wall:.0f} s ({args.workers} "
+          f"workers; the report is over all {len(jobs)} jobs), horizon {args.k:g} D / V_e, "
+          f"start {args.start!r}")  # fmt: skip
     rows: dict[tuple, list] = {}
     failures, times = [], []
     # decision time: the shooting evader's over all its episodes, and the same-run pair

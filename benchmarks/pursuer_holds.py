@@ -12,7 +12,12 @@ the same run).
 Usage::
 
     python benchmarks/pursuer_holds.py [--seeds 10] [--rho 0.3 0.5] [--workers 2]
-        [--max-cycles 600] [--worlds corridor corner ...] [--no-greedy]
+        [--max-cycles 600] [--worlds corridor corner ...] [--no-greedy] [--results F.jsonl]
+
+Each loss is printed as it happens, and a progress line every 25 episodes. With
+``--results F.jsonl`` every episode is appended to F as it completes (JSON lines,
+``benchmarks/episode_rows.py``); the same command with the same F after a stop plays only
+the episodes missing from it and reports over all of them.
 
 ``--no-greedy`` skips the greedy reference (half the time; no decision-time ratio).
 
@@ -36,14 +41,15 @@ Solutions are cached on disk (minutes per world the first time).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
-import multiprocessing as mp
 import os
 import time
 
+import episode_rows
 import numpy as np
 import referee_labels
-from bench_cli import ignore_sigint, integer, real, run
+from bench_cli import integer, real, run, worker_pool
 from referee_labels import similarity_back
 
 from envs.maps import builtin_info, builtin_names
@@ -90,7 +96,7 @@ def _evader(label: str):
 
 def _play(job):
     world, variant, rho, evader, seed, max_cycles, pursuers, l_min = job
-    label, rot, scale, offset = variant
+    _, rot, scale, offset = variant
     m, params = _world(world, rot, scale, offset)
     if l_min is not None:  # the world's L_max / L_min kept
         params["l_max"] *= l_min * scale / params["l_min"]
@@ -102,8 +108,22 @@ def _play(job):
         r = run_episode(
             m, pursuer, _evader(evader), seed, max_cycles=max_cycles, overrides=params, start="safe"
         )
-        out[pursuer] = (r.winner, r.cause, r.escape_time, r.decide_seconds["pursuer"], r.start)
-    return world, label, rho, evader, seed, out
+        out[pursuer] = [r.winner, r.cause, r.escape_time, r.decide_seconds["pursuer"], r.start]
+    row = dict(zip(_KEY, _job_values(job), strict=True))
+    return {**row, "out": out}
+
+
+_KEY = ("world", "variant", "rho", "evader", "seed", "max_cycles", "pursuers", "l_min")
+"""What identifies an episode (its row's fields): a rerun skips the rows it finds."""
+
+
+def _job_values(job) -> list:
+    world, variant, rho, evader, seed, max_cycles, pursuers, l_min = job
+    return [world, variant[0], rho, evader, seed, max_cycles, list(pursuers), l_min]
+
+
+def _row_key(row: dict) -> str:
+    return episode_rows.key(row[k] for k in _KEY)
 
 
 def _referee_label(world: str, variant_label: str, rho: float, start, cpl: float) -> str:
@@ -133,6 +153,9 @@ def main(argv=None) -> int:
         default=None,
         help="label every start with the referee at CPL cells per L_min",
     )
+    ap.add_argument("--results", metavar="FILE", default=None,
+                    help="append each episode to FILE (JSON lines) as it completes; a rerun "
+                    "with the same FILE plays only the episodes missing from it")  # fmt: skip
     args = ap.parse_args(argv)
     if args.l_min is not None and args.referee:  # the referee solves the world's own L_min
         ap.error("--l-min and --referee: the referee judges the world's own L_min only")
@@ -147,10 +170,32 @@ def main(argv=None) -> int:
         for e in EVADERS
         for s in range(args.seeds)
     ]
+    done = episode_rows.read(args.results, _row_key) if args.results else {}
+    todo = [j for j in jobs if episode_rows.key(_job_values(j)) not in done]
+    if args.results:
+        print(f"{len(jobs)} episodes selected, {len(todo)} to play, results in {args.results}")
     t0 = time.perf_counter()
-    with mp.get_context("spawn").Pool(args.workers, ignore_sigint) as pool:
-        results = pool.map(_play, jobs, chunksize=4)
+    with contextlib.ExitStack() as stack:
+        write = stack.enter_context(episode_rows.appending(args.results)) if args.results else None
+        pool = stack.enter_context(worker_pool(args.workers))
+        lost = 0
+        for i, row in enumerate(pool.imap_unordered(_play, todo), 1):
+            if write is not None:
+                write(row)
+            done[_row_key(row)] = row
+            winner, cause, t = row["out"]["pursuer/decomposition"][:3]
+            if winner != "pursuer":
+                lost += 1
+                where = f"{row['world']} [{row['variant']}] rho={row['rho']} {row['evader']}"
+                print(f"  episode lost: {where} seed={row['seed']}: {cause} at {t}", flush=True)
+            if i % 25 == 0 or i == len(todo):
+                print(f"  {i}/{len(todo)} played, {lost} lost, {time.perf_counter() - t0:.0f} s",
+                      flush=True)  # fmt: skip
     wall = time.perf_counter() - t0
+    results = []
+    for j in jobs:
+        r = done[episode_rows.key(_job_values(j))]
+        results.append((r["world"], r["variant"], r["rho"], r["evader"], r["seed"], r["out"]))
     held: dict[tuple, list[int]] = {}
     losses = []
     decide = {p: [] for p in pursuers}
@@ -165,7 +210,8 @@ def main(argv=None) -> int:
         h[2] += "pursuer/greedy" in out and out["pursuer/greedy"][0] == "pursuer"
         if winner != "pursuer":
             losses.append((world, label, rho, evader, seed, cause, t, start))
-    print(f"{len(jobs)} x {len(pursuers)} episodes in {wall:.0f} s ({args.workers} workers)")
+    print(f"{len(todo)} x {len(pursuers)} episodes played in {wall:.0f} s ({args.workers} "
+          f"workers); the report is over all {len(jobs)}")  # fmt: skip
     print(f"{'world':<10}{'evader':<26}{'decomposition held':>20}{'greedy held':>14}")
     for (world, evader), (h, n, g) in sorted(held.items()):
         greedy = f"{g}/{n}" if len(pursuers) > 1 else "-"

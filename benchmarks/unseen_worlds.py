@@ -87,6 +87,7 @@ import re
 import time
 import zlib
 
+import episode_rows
 import numpy as np
 import referee_labels
 from bench_cli import integer, real, run, worker_pool
@@ -375,7 +376,7 @@ def other_evader_jobs(worlds, l_mins, draws: int) -> list[tuple]:
 
 
 def job_key(job) -> str:
-    return json.dumps(list(job))
+    return episode_rows.key(job)
 
 
 def row_key(row) -> str:
@@ -647,18 +648,12 @@ def main(argv=None) -> int:
     results = args.results or f"out/unseen_worlds_{args.role}.jsonl"
     print(f"load average: {os.getloadavg()}")
     jobs = select(args)
-    done = {}
-    if os.path.exists(results):
-        with open(results) as f:
-            for line in f:
-                r = json.loads(line)
-                done[row_key(r)] = r
+    done = episode_rows.read(results, row_key)
     todo = [j for j in jobs if job_key(j) not in done]
     print(f"{len(jobs)} episodes selected, {len(todo)} to play, results in {results}")
-    os.makedirs(os.path.dirname(os.path.abspath(results)), exist_ok=True)
     _init(args.max_cycles, args.k)
     t0 = time.perf_counter()
-    with open(results, "a") as f, contextlib.ExitStack() as stack:
+    with episode_rows.appending(results) as write, contextlib.ExitStack() as stack:
         if args.workers > 1:  # leaving the with block (a stop included) terminates the pool
             pool = stack.enter_context(worker_pool(args.workers, _init, (args.max_cycles, args.k)))
             rows = pool.imap_unordered(play, todo)
@@ -666,8 +661,7 @@ def main(argv=None) -> int:
             pool, rows = None, map(play, todo)
         lost = 0
         for i, row in enumerate(rows, 1):
-            f.write(json.dumps(row) + "\n")
-            f.flush()
+            write(row)
             done[row_key(row)] = row
             lost += not _won(row)
             if i % 25 == 0 or i == len(todo):

@@ -1,0 +1,82 @@
+"""Episode rows kept as they complete (JSON lines), and read back to resume a run.
+
+The format of ``unseen_worlds.py --results`` (also ``pursuer_holds.py`` and
+``evader_escapes.py``): one JSON object per line, one line per episode, appended and
+flushed as each episode completes, so a stop (Ctrl-C, ``timeout``, a crash) loses at most
+the episodes in flight. A rerun with the same file skips the episodes whose key is already
+in it and reports over all of them. A last line cut short by a hard kill is dropped (that
+episode is played again) and never glued to the next row.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Callable, Iterable, Iterator
+from contextlib import contextmanager
+from typing import IO, Any
+
+__all__ = ["appending", "key", "read"]
+
+
+def key(values: Iterable[Any]) -> str:
+    """A job's identity as text: the JSON list of its values."""
+    return json.dumps(list(values))
+
+
+def read(path: str | os.PathLike, key_of: Callable[[dict], str]) -> dict[str, dict]:
+    """The rows already in ``path`` by ``key_of(row)``; empty when there is no file.
+
+    Raises:
+        ValueError: a line other than the last is not a JSON object (the file is not
+            such a results file); the message names the file and the line.
+    """
+    rows: dict[str, dict] = {}
+    if not os.path.exists(path):
+        return rows
+    with open(path) as f:
+        lines = f.read().split("\n")
+    last = len(lines) - 1
+    while last >= 0 and not lines[last].strip():
+        last -= 1
+    for i, line in enumerate(lines[: last + 1]):
+        if not line.strip():
+            continue
+        try:
+            row = json.loads(line)
+        except json.JSONDecodeError:
+            row = None
+        if not isinstance(row, dict):
+            if i == last:  # cut short by a hard kill: play that episode again
+                break
+            raise ValueError(
+                f"{os.fspath(path)}, line {i + 1}: {line[:60]!r} is not a JSON object; "
+                "expected a results file of JSON lines (one episode a line)"
+            )
+        rows[key_of(row)] = row
+    return rows
+
+
+@contextmanager
+def appending(path: str | os.PathLike) -> Iterator[Callable[[dict], None]]:
+    """``write(row)``: append one row to ``path`` and flush it. The directory is made,
+    and a last line cut short by a hard kill (no newline after it) is removed first: it
+    is no row (:func:`read` drops it), and the next row must start a line of its own."""
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    if os.path.exists(path):
+        with open(path, "rb+") as f:
+            data = f.read()
+            end = data.rfind(b"\n") + 1
+            if end < len(data):
+                f.truncate(end)
+    with open(path, "a") as f:
+
+        def write(row: dict) -> None:
+            _write(f, row)
+
+        yield write
+
+
+def _write(f: IO[str], row: dict) -> None:
+    f.write(json.dumps(row) + "\n")
+    f.flush()

@@ -1,0 +1,80 @@
+"""Benchmarks keep each episode as it completes (``--results``) and resume from it."""
+
+from __future__ import annotations
+
+import importlib
+import json
+from pathlib import Path
+
+import pytest
+
+BENCHMARKS = Path(__file__).resolve().parents[1] / "benchmarks"
+
+
+@pytest.fixture
+def bench(monkeypatch):
+    """Import a benchmark module (they import their helpers from beside them)."""
+    monkeypatch.syspath_prepend(str(BENCHMARKS))
+    return importlib.import_module
+
+
+def _lines(path: Path) -> list[str]:
+    return path.read_text().splitlines()
+
+
+def test_a_row_cut_short_by_a_kill_is_dropped_and_not_glued_to_the_next(bench, tmp_path):
+    rows = bench("episode_rows")
+    path = tmp_path / "r.jsonl"
+    path.write_text('{"id": 1}\n{"id": 2}\n{"id"')  # killed while writing row 3
+    key = lambda r: str(r["id"])
+    assert set(rows.read(path, key)) == {"1", "2"}
+    with rows.appending(path) as write:
+        write({"id": 3})
+    assert [json.loads(line) for line in _lines(path)] == [{"id": 1}, {"id": 2}, {"id": 3}]
+
+
+def test_a_file_that_is_not_json_lines_is_refused_naming_the_line(bench, tmp_path):
+    rows = bench("episode_rows")
+    path = tmp_path / "notes.txt"
+    path.write_text("some notes\nmore\n")
+    with pytest.raises(ValueError, match=r"notes.txt, line 1: 'some notes' is not a JSON"):
+        rows.read(path, str)
+
+
+def test_pursuer_holds_writes_each_episode_and_resumes(bench, tmp_path, capsys):
+    """Six episodes are written as rows; after losing two (and a row cut short), the same
+    command plays only those two and reports over all six."""
+    holds = bench("pursuer_holds")
+    out = tmp_path / "holds.jsonl"
+    argv = ["--worlds", "open_room", "--variants", "as is", "--rho", "0.3", "--seeds", "1",
+            "--no-greedy", "--workers", "1", "--max-cycles", "30",
+            "--results", str(out)]  # fmt: skip
+    assert holds.main(argv) == 0
+    first = capsys.readouterr().out
+    rows = [json.loads(line) for line in _lines(out)]
+    assert len(rows) == 6
+    assert {r["evader"] for r in rows} == set(holds.EVADERS)
+    assert all(r["out"]["pursuer/decomposition"][0] in ("pursuer", "evader") for r in rows)
+    out.write_text("\n".join(_lines(out)[:4]) + '\n{"world": "open_')
+    assert holds.main(argv) == 0
+    second = capsys.readouterr().out
+    assert "6 episodes selected, 2 to play" in second
+    assert len(_lines(out)) == 6
+    summary = [line for line in first.splitlines() if "held" in line and "/6" in line]
+    assert summary and summary[0] in second  # the same report over all six
+
+
+def test_evader_escapes_writes_each_job_and_resumes(bench, tmp_path, capsys):
+    escapes = bench("evader_escapes")
+    out = tmp_path / "escapes.jsonl"
+    argv = ["--worlds", "tee", "--pursuers", "still", "--seeds", "2", "--simple-seeds", "0",
+            "--k", "1", "--workers", "1", "--results", str(out)]  # fmt: skip
+    assert escapes.main(argv) == 0
+    capsys.readouterr()
+    rows = [json.loads(line) for line in _lines(out)]
+    assert sorted(r["seed"] for r in rows) == [0, 1]
+    assert all(r["pursuer"] == "still" and r["out"]["shooting"][0] for r in rows)
+    out.write_text(_lines(out)[0] + "\n")
+    assert escapes.main(argv) == 0
+    assert "2 jobs selected, 1 to play" in capsys.readouterr().out
+    assert len(_lines(out)) == 2

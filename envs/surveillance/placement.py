@@ -13,7 +13,14 @@ from envs.surveillance import rules
 from envs.surveillance.config import EnvConfig
 from envs.tolerances import REL_LENGTH_TOL
 
-__all__ = ["BATCH", "MAX_BATCHES", "random_start", "spawn_margins", "validate_placement"]
+__all__ = [
+    "BATCH",
+    "MAX_BATCHES",
+    "check_room",
+    "random_start",
+    "spawn_margins",
+    "validate_placement",
+]
 
 BATCH = 256
 """Candidate start configurations drawn at once by :func:`random_start`."""
@@ -118,6 +125,52 @@ def _segment_point_distance(a: np.ndarray, b: np.ndarray, v: np.ndarray) -> np.n
     return np.linalg.norm(v[None, :, :] - closest, axis=2)
 
 
+_ROOM: dict[tuple[str, float], tuple[bool, float]] = {}
+"""(map digest, body radius) -> (some point is that far from the walls, the largest
+distance between two such points): what :func:`check_room` computes once per map."""
+
+
+def check_room(m: Any, body_radius: float, length: float, where: str = "start") -> None:
+    """Refuse up front a start that cannot exist at all on map ``m``: no point of free
+    space is ``body_radius`` from the walls (no agent fits), or no two such points are
+    ``length`` apart (no rod of that length fits).
+
+    The region at least ``body_radius`` from the walls is shapely's inward buffer, whose
+    arcs are chords inside the true region; its diameter (the largest distance between
+    two vertices of its hull) is at most 2 % of ``body_radius`` short, so the test allows
+    that much.
+
+    Raises:
+        InfeasibleError: naming the map, the figures and what to change.
+    """
+    key = (m.digest, float(body_radius))
+    if key not in _ROOM:
+        import shapely
+
+        region = m.free_region.buffer(-body_radius)
+        if region.is_empty:
+            _ROOM[key] = (False, 0.0)
+        else:
+            xy = shapely.get_coordinates(shapely.convex_hull(region))
+            d = np.hypot(*(xy[:, None, :] - xy[None, :, :]).transpose(2, 0, 1))
+            _ROOM[key] = (True, float(d.max()))
+        if len(_ROOM) > 64:
+            _ROOM.pop(next(iter(_ROOM)))
+    fits, diameter = _ROOM[key]
+    if not fits:
+        raise InfeasibleError(
+            f"{where}: map {m.name!r} cannot hold an agent: no point of its free space is "
+            f"body_radius = {body_radius:g} from the walls (the map's diameter is "
+            f"{m.diameter:.4g}); use a smaller body_radius or a larger map"
+        )
+    if length > diameter + 0.02 * body_radius:
+        raise InfeasibleError(
+            f"{where}: map {m.name!r} cannot hold the rod: no two points of its free space "
+            f"body_radius = {body_radius:g} from the walls are L = {length:.4g} apart (at "
+            f"most {diameter:.4g}); lower l_min (or the start's L) or use a larger map"
+        )
+
+
 def random_start(
     config: EnvConfig, kernel: Any, rng: np.random.Generator
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -155,6 +208,7 @@ def random_start(
         )
     convex = m.vertices[m.vertex_convex]
     r = config.body_radius
+    check_room(m, r, l_lo, "random start")
     for _ in range(MAX_BATCHES):
         e = rng.uniform(lo_xy, hi_xy, size=(BATCH, 2))
         theta = rng.uniform(0.0, 2.0 * math.pi, size=BATCH)

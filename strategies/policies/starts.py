@@ -59,7 +59,7 @@ import numpy as np
 
 from envs.errors import InfeasibleError, InvalidConfigError
 from envs.geometry import kernel_for
-from envs.surveillance.placement import random_start, spawn_margins
+from envs.surveillance.placement import check_room, random_start, spawn_margins
 from strategies.policies.lazy_table import LazySafetyTable
 
 __all__ = ["START_KINDS", "has_retreat_clearance", "retreat_clearance_required", "sample_start"]
@@ -86,6 +86,9 @@ def sample_start(
     """
     if kind not in START_KINDS:
         raise InvalidConfigError(f"kind must be one of {START_KINDS}, got {kind!r}")
+    range_margin = spawn_margins(config)[0]
+    shortest = min(config.l_min + range_margin, config.l_max - range_margin)
+    check_room(config.map, config.body_radius, shortest, f"{kind} start")
     kernel = kernel_for(config.map)
     if kind == "valid":
         p, e = random_start(config, kernel, rng)

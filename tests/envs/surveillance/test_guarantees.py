@@ -76,6 +76,6 @@ def test_impossible_random_start_raises_a_clear_error() -> None:
     # two discs 0.1 from the walls of a 10 x 10 room are at most 9.8 sqrt(2) = 13.86 apart
     env = surveillance_v0.parallel_env(map=pillar_room(), l_min=14.0, l_max=14.1)
     with pytest.raises(
-        InfeasibleError, match=r"random start: no valid surveillance configuration .* 'test_pillar'"
+        InfeasibleError, match=r"random start: map 'test_pillar' cannot hold the rod: .*13.86"
     ):
         env.reset(seed=0)

@@ -31,3 +31,33 @@ def test_l_min_beyond_the_map_names_the_diameter() -> None:
     env = surveillance_v0.parallel_env(map="corridor", l_min=50.0, l_max=60.0, body_radius=0.1)
     with pytest.raises(InfeasibleError, match=r"no two points 50.45 apart \(its diameter is 16.9"):
         env.reset(seed=0)
+
+
+def _room(w: float, h: float, name: str):
+    from envs.maps import Map
+
+    return Map([(0, 0), (w, 0), (w, h), (0, h)], name=name)
+
+
+@pytest.mark.parametrize("kind", ["valid", "safe"])
+def test_a_map_too_small_for_the_bodies_says_so_up_front(kind) -> None:
+    """A 1 mm map cannot hold a disc of radius 0.1: said at once, not after 25,600 tries."""
+    from envs.surveillance.config import EnvConfig
+    from strategies.policies.starts import sample_start
+
+    cfg = EnvConfig(map=_room(0.001, 0.001, "mm"), l_min=2.0, l_max=4.0)
+    with pytest.raises(InfeasibleError, match=r"map 'mm' cannot hold an agent: no point .* "
+                       r"body_radius = 0.1 from the walls"):  # fmt: skip
+        sample_start(cfg, np.random.default_rng(0), kind=kind)
+
+
+def test_a_map_too_narrow_for_the_rod_says_so_up_front() -> None:
+    """A 1 x 0.3 room holds the bodies (0.1) and has a diameter of 1.04, but no two points
+    0.1 from its walls are more than 0.81 apart: the shortest rod a start may have (l_min
+    0.45 plus the spawn margin 0.45) cannot fit."""
+    env = surveillance_v0.parallel_env(
+        map=_room(1.0, 0.3, "slot"), l_min=0.45, l_max=3.0, body_radius=0.1
+    )
+    with pytest.raises(InfeasibleError, match=r"map 'slot' cannot hold the rod: .* L = 0.9 "
+                       r"apart \(at most 0.806"):  # fmt: skip
+        env.reset(seed=0)

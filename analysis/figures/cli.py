@@ -18,6 +18,7 @@ import sys
 import time
 from pathlib import Path
 
+from analysis.arguments import output_dir
 from envs.errors import InvalidConfigError
 
 __all__ = ["add_parser", "run"]
@@ -83,11 +84,11 @@ def run(args: argparse.Namespace) -> int:
         return 0
     specs = select(args.only)
     check_scale(args.scale)  # before drawing anything
+    out = output_dir("--out", args.out)  # an existing file is refused up front
     if args.report:
         _report_text(Path(args.report), "--report")
     from tqdm import tqdm
 
-    out = Path(args.out)
     bar = tqdm(specs, unit="figure", disable=not sys.stderr.isatty())
     for s in bar:
         bar.set_description(s.name)

@@ -21,6 +21,7 @@ import numpy as np
 
 from analysis.figures import cases, style
 from analysis.figures.registry import register
+from envs import validation
 from envs.errors import InvalidConfigError, SurveilValueError, UnknownNameError
 from strategies.control import greedy_heading, shoot, solve_escape, tractrix
 
@@ -90,7 +91,9 @@ def draw_greedy(ax, theta0=math.pi, x_max=2.0, L=1.0, rho=0.5, branch="+") -> No
 
 
 def draw_tractrix(ax, t_max=4.0, L=1.0, v_e=1.0, theta0=0.5 * math.pi) -> None:
-    """Fig. 14 style: the follower's tractrix behind a leader on the x-axis (E4)."""
+    """Fig. 14 style: the follower's tractrix behind a leader on the x-axis (E4), over
+    the leader's times [0, t_max] (t_max > 0: at 0 the figure is a single rod)."""
+    t_max = validation.positive("t_max", t_max)
     tr = tractrix(np.linspace(0.0, t_max, 400), L=L, v_e=v_e, theta0=theta0)
     ax.plot(
         tr.leader[:, 0], tr.leader[:, 1], "-", color=style.EVADER, lw=2, label="leader (evader)"

@@ -252,3 +252,19 @@ def test_evaluate_bad_flags_fail_before_any_match(capsys, tmp_path, monkeypatch,
     (tmp_path / "notes").write_text("a file")
     line = assert_fails(capsys, [*EVALUATE, "--results", "e.sqlite", *extra], *needles)
     assert not (tmp_path / "e.sqlite").exists(), line
+
+
+def test_figures_into_an_existing_file_is_refused_before_drawing(capsys, tmp_path):
+    blocker = tmp_path / "somefile"
+    blocker.write_text("x")
+    assert_fails(capsys, ["figures", "--out", str(blocker), "--only", "fig10"], "--out",
+                 "is a file, expected a directory")  # fmt: skip
+
+
+@pytest.mark.parametrize("t_max", [0, -2])
+def test_a_tractrix_over_no_time_is_refused(capsys, tmp_path, t_max):
+    out = str(tmp_path / "t.png")
+    params = json.dumps({"t_max": t_max})
+    assert_fails(capsys, ["figure", "tractrix", "--params", params, "--out", out], "--params",
+                 f"t_max = {t_max}: expected a finite number > 0")  # fmt: skip
+    assert not (tmp_path / "t.png").exists()

@@ -13,6 +13,7 @@ import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from envs import validation
 from envs.errors import InvalidConfigError, SurveilValueError
 from training.config import TrainConfig, load_any_config
 from training.selfplay import self_play
@@ -44,6 +45,12 @@ def run_train(args: argparse.Namespace) -> int:
     Raises:
         InvalidConfigError: a bad config file or override (naming the field).
     """
+    # the flags' values are named as flags, not as fields of the config file
+    if args.timesteps is not None:
+        validation.integer("--timesteps", args.timesteps, minimum=1)
+    if args.seed is not None:
+        validation.integer("--seed", args.seed, minimum=0)
+    validation.integer("--self-play", args.self_play, minimum=0)
     overrides = {}
     if args.output_dir is not None:
         overrides["output_dir"] = args.output_dir

@@ -401,9 +401,10 @@ def train(
             # a finished run at least this long: returned as is, and its config.toml
             # (the values that produced the model) is left alone
             return _result_from_provenance(config, out, previous)
-    _atomic_write(out / "config.toml", config.to_toml())
-
+    # the envs first: an opponent that does not resolve (a misspelt name) must not leave a
+    # config.toml behind, which would refuse the corrected rerun as "a different config"
     vec_env = _make_vec_env(config)
+    _atomic_write(out / "config.toml", config.to_toml())
     cls = _algo_class(config.algo)
     ckpt = _load_checkpoint(out, cls, vec_env)
     resumed_from = None

@@ -151,3 +151,36 @@ def test_config_values_are_checked_before_sb3_sees_them():
     TrainConfig(role="evader", opponent="pursuer/greedy", algo="sac",
                 algo_kwargs={"ent_coef": "auto_0.1"})  # fmt: skip
     assert latest_checkpoint(Path("/nonexistent")) is None
+
+
+@pytest.mark.parametrize(
+    ("flags", "message"),
+    [
+        (["--timesteps", "0"], "--timesteps = 0: expected an integer >= 1"),
+        (["--seed", "-3"], "--seed = -3: expected an integer >= 0"),
+        (["--self-play", "-1"], "--self-play = -1: expected an integer >= 0"),
+    ],
+)
+def test_a_bad_flag_is_named_as_the_flag_not_as_a_config_field(tmp_path, capsys, flags, message):
+    """Was 'config.toml: total_timesteps = 0' (a file the user never wrote) or 'c.toml:
+    seed = -3' (a value not in that file)."""
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(f'role = "pursuer"\nopponent = "evader/straight"\noutput_dir = "{tmp_path}/r"\n')
+    assert cli_train([str(cfg), *flags]) == 2
+    err = capsys.readouterr().err
+    assert err == f"python -m training: error: {message}\n"
+
+
+def test_an_unknown_opponent_leaves_no_config_that_refuses_the_fixed_rerun(tmp_path, capsys):
+    """A misspelt opponent wrote output_dir/config.toml before failing, so the corrected
+    command was refused ('holds a run with a different config')."""
+    out = tmp_path / "run"
+    cfg = tmp_path / "c.toml"
+    body = 'role = "pursuer"\ntotal_timesteps = 64\nn_steps = 32\nbatch_size = 32\n'
+    body += f'output_dir = "{out}"\n'
+    cfg.write_text(body + 'opponent = "evader/nope"\n')
+    assert cli_train([str(cfg)]) == 2
+    assert "unknown policy 'evader/nope'" in capsys.readouterr().err
+    assert not (out / "config.toml").exists()
+    cfg.write_text(body + 'opponent = "evader/straight"\n')
+    assert cli_train([str(cfg)]) == 0

@@ -244,6 +244,7 @@ class parallel_env(ParallelEnv, EzPickle):
                 (loop ``while env.agents:``).
             InvalidActionError: ``actions`` is not a dict, or an action is missing, not
                 numeric, of the wrong shape, or not finite.
+            UnknownNameError: ``actions`` has a key that is not an agent's name.
         """
         if not self.agents:
             if self._ended_at is None:
@@ -261,6 +262,11 @@ class parallel_env(ParallelEnv, EzPickle):
             missing = [a for a in AGENTS if a not in actions]
             raise InvalidActionError(
                 f"step: missing actions for {missing}; got keys {sorted(actions)}"
+            )
+        if len(actions) > 2:  # a misspelt agent would otherwise be ignored silently
+            unknown = sorted((a for a in actions if a not in AGENTS), key=repr)
+            raise UnknownNameError(
+                f"step: actions for unknown agent(s) {unknown}; the agents are {list(AGENTS)}"
             )
         cfg = self.config
         vp = self._command(PURSUER, actions[PURSUER])

@@ -75,3 +75,11 @@ def test_an_unknown_agent_is_a_project_error_naming_it(make, space):
     with pytest.raises(KeyError):
         getattr(e, space)(["pursuer_0"])
     e.close()
+
+
+def test_an_action_for_an_unknown_agent_is_refused_naming_it(env):
+    """A misspelt agent's action was ignored silently (the episode went on without it)."""
+    actions = {"pursuer_0": [1.0, 0.0], "evader_0": [0.0, 0.0], "pursuer_1": [0.0, 1.0]}
+    with pytest.raises(UnknownNameError, match=r"unknown agent\(s\) \['pursuer_1'\]"):
+        env.step(actions)
+    assert env._step == 0  # refused before anything moved

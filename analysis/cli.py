@@ -223,7 +223,9 @@ def _cmd_figure(args: argparse.Namespace) -> int:
     try:
         draw_figure(args.name, out, **params)
     except SurveilValueError as exc:
-        raise type(exc)(f"--params: {exc}") from None
+        # the theory's "pass step=" is, on this command line, a "step" in --params
+        message = str(exc).replace("pass step=", """add "step": H (the RK4 step) to --params""")
+        raise type(exc)(f"--params: {message}") from None
     print(f"figure written to {out}")
     return 0
 

@@ -53,9 +53,18 @@ def draw_arc(ax, arc, title: str, rods: int = 6, legend: bool = True) -> None:
 
 
 def draw_shooting(
-    ax, theta0=math.pi, x_e=1.0, L=1.0, rho=0.5, branch="+", lambda1=None, lambda2_0=None
+    ax,
+    theta0=math.pi,
+    x_e=1.0,
+    L=1.0,
+    rho=0.5,
+    branch="+",
+    lambda1=None,
+    lambda2_0=None,
+    step=None,
 ) -> None:
-    """Fig. 11 style: the optimal escape to (x_e, 0); with multipliers, the plain shot."""
+    """Fig. 11 style: the optimal escape to (x_e, 0); with multipliers, the plain shot.
+    ``step``: the RK4 step (None: :func:`strategies.control.default_step`)."""
     if lambda1 is not None or lambda2_0 is not None:
         arc = shoot(
             theta0,
@@ -65,6 +74,7 @@ def draw_shooting(
             rho=rho,
             branch=branch,
             x_max=x_e,
+            step=step,
             stop_at_crossing=True,
         )
         title = (
@@ -72,7 +82,7 @@ def draw_shooting(
             f"L={L}, ρ={rho}, x_c={arc.x_c}"
         )
     else:
-        sol = solve_escape(theta0, x_e, L=L, rho=rho, branch=branch)
+        sol = solve_escape(theta0, x_e, L=L, rho=rho, branch=branch, step=step)
         if not sol.success:
             raise SurveilValueError(f"no optimal escape to draw: {sol.reason}")
         arc = sol.arc
@@ -83,9 +93,10 @@ def draw_shooting(
     draw_arc(ax, arc, title)
 
 
-def draw_greedy(ax, theta0=math.pi, x_max=2.0, L=1.0, rho=0.5, branch="+") -> None:
-    """Fig. 12 style: final y free, λ1 = 0, the evader minimises the instantaneous rotation."""
-    arc = shoot(theta0, 0.0, 0.0, L=L, rho=rho, branch=branch, x_max=x_max)
+def draw_greedy(ax, theta0=math.pi, x_max=2.0, L=1.0, rho=0.5, branch="+", step=None) -> None:
+    """Fig. 12 style: final y free, λ1 = 0, the evader minimises the instantaneous rotation.
+    ``step``: the RK4 step (None: :func:`strategies.control.default_step`)."""
+    arc = shoot(theta0, 0.0, 0.0, L=L, rho=rho, branch=branch, x_max=x_max, step=step)
     a0 = greedy_heading(theta0, L=L, rho=rho, branch=branch).alpha
     draw_arc(ax, arc, f"greedy (λ1 = 0): θ0={theta0:.3f}, L={L}, ρ={rho}, α*(0)={a0:.4f}")
 
@@ -134,9 +145,9 @@ def draw_figure(name: str, path: str | Path, **params: Any) -> Path:
     """Draw one parametric figure to a PNG file (``surveil figure NAME --params JSON``).
 
     Args:
-        name: ``"shooting"`` (Fig. 11; params ``theta0, x_e, L, rho, branch`` and
+        name: ``"shooting"`` (Fig. 11; params ``theta0, x_e, L, rho, branch, step`` and
             optionally ``lambda1, lambda2_0`` to draw a plain shot), ``"greedy"``
-            (Fig. 12; ``theta0, x_max, L, rho, branch``) or ``"tractrix"`` (Fig. 14;
+            (Fig. 12; ``theta0, x_max, L, rho, branch, step``) or ``"tractrix"`` (Fig. 14;
             ``t_max, L, v_e, theta0``).
         path: output file.
         **params: figure parameters (see :func:`figure_parameters`).

@@ -268,3 +268,14 @@ def test_a_tractrix_over_no_time_is_refused(capsys, tmp_path, t_max):
     assert_fails(capsys, ["figure", "tractrix", "--params", params, "--out", out], "--params",
                  f"t_max = {t_max}: expected a finite number > 0")  # fmt: skip
     assert not (tmp_path / "t.png").exists()
+
+
+def test_the_step_budget_error_says_how_to_pass_a_step_here(capsys, tmp_path):
+    """The theory says "pass step="; surveil figure takes it as a --params key."""
+    out = str(tmp_path / "g.png")
+    line = assert_fails(capsys, ["figure", "greedy", "--params", '{"x_max": 3e4}', "--out", out],
+                        "--params", 'add "step": H (the RK4 step) to --params')  # fmt: skip
+    assert "step=" not in line
+    params = '{"x_max": 3e4, "step": 1.0}'
+    assert main(["figure", "greedy", "--params", params, "--out", out]) == 0
+    assert (tmp_path / "g.png").stat().st_size > 1000

@@ -1,0 +1,154 @@
+"""Hindsight reachable sets against known evader paths (issue 13's ground truth).
+
+Oracles: closed forms (a stationary evader, an evader running away faster than the
+pursuer, an evader passing behind a square pillar), the env itself (every pursuer that
+played is a witness the optimistic set must contain; the pessimistic set's witness path
+must hold under the kernel's continuous sweep).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from envs.errors import InvalidConfigError, InvalidPlacementError
+from envs.geometry import kernel_for
+from envs.maps import Map
+from envs.surveillance.config import EnvConfig
+from strategies.referee.hindsight import hindsight, record_evader_path
+from strategies.referee.lattice import segment_wall_distance
+
+ROOM = Map([(0, 0), (20, 0), (20, 10), (0, 10)])
+PILLAR = Map([(0, 0), (20, 0), (20, 10), (0, 10)], [[(9, 4), (11, 4), (11, 6), (9, 6)]])
+
+
+def _config(world, dt=0.1, l_min=1.0, l_max=2.0):
+    return EnvConfig(map=world, l_min=l_min, l_max=l_max, v_pursuer=1.0, v_evader=0.5,
+                     body_radius=0.1, dt=dt)  # fmt: skip
+
+
+def _assert_witness_holds(cfg, E_frames, res):
+    """The pessimistic witness, replayed step by step under the env's semantics (both
+    linear over a step, the kernel's continuous sweep), holds and keeps its clearance."""
+    w = res.witness
+    sub = round(cfg.dt / res.pessimistic_tau)
+    s = np.arange(sub) / sub
+    E = np.concatenate(
+        [(E_frames[:-1, None] * (1 - s)[None, :, None] + E_frames[1:, None] * s[None, :, None])
+         .reshape(-1, 2), E_frames[-1:]]
+    )  # fmt: skip
+    assert len(w) == round(res.pessimistic_until / res.pessimistic_tau) + 1
+    kernel = kernel_for(cfg.map)
+    for k in range(len(w) - 1):
+        assert np.hypot(*(w[k + 1] - w[k])) <= cfg.v_pursuer * res.pessimistic_tau * (1 + 1e-9)
+        assert kernel.sweep(w[k], E[k], w[k + 1], E[k + 1], cfg.l_min, cfg.l_max) is None, k
+    assert segment_wall_distance(w[:-1], w[1:], cfg.map).min() >= cfg.body_radius
+
+
+def test_stationary_evader_in_range_is_held():
+    cfg = _config(ROOM)
+    E = np.tile([[10.0, 5.0]], (31, 1))
+    res = hindsight(cfg, E, (8.5, 5.0), 0.02)
+    assert res.verdict == "pursuer"
+    assert res.optimistic_empty is None
+    assert res.pessimistic_until == pytest.approx(res.horizon) == pytest.approx(3.0)
+    _assert_witness_holds(cfg, E, res)
+
+
+@pytest.mark.parametrize("heading", [0.0, 0.7])
+def test_runaway_evader_breaks_range_at_the_closed_form_time(heading):
+    # the evader runs straight away at 1.5 from a pursuer (speed 1) 1.5 behind it: the
+    # distance grows at best at 0.5, so it reaches L_max = 2 at T = (2 - 1.5) / 0.5 = 1 s
+    cfg = _config(ROOM)
+    Ve, d0 = 1.5, 1.5
+    u = np.array([math.cos(heading), math.sin(heading)])
+    t = cfg.dt * np.arange(31)
+    E = np.array([6.0, 3.0]) + (Ve * t)[:, None] * u
+    P0 = E[0] - d0 * u
+    T = (cfg.l_max - d0) / (Ve - cfg.v_pursuer)
+    widths = []
+    for h, substeps in ((0.02, 1), (0.01, 2), (0.005, 4)):  # tau shrinks with the cell
+        res = hindsight(cfg, E, P0, h, substeps=substeps, moves=5)
+        assert res.verdict == "evader"
+        delta = h / math.sqrt(2)
+        # sound: no pursuer holds past T, the optimistic set survives until then
+        assert T <= res.optimistic_empty + 1e-9
+        assert res.optimistic_empty <= T + res.tau + 2 * delta / (Ve - 1.0) + 1e-9
+        # sound: a pursuer held until pessimistic_until, so it is <= T
+        assert res.pessimistic_until <= T + 1e-9
+        widths.append(res.optimistic_empty - res.pessimistic_until)
+        _assert_witness_holds(cfg, E, res)
+    assert widths[2] < widths[1] < widths[0]  # the bracket closes as the cell shrinks
+    if heading == 0.0:  # along a lattice axis the pessimistic lattice loses no speed
+        assert res.pessimistic_until >= T - res.pessimistic_tau - 1e-9
+
+
+def test_evader_passing_behind_a_pillar_too_fast():
+    # The evader drops at 10 along x = 12.5 behind the pillar [9, 11] x [4, 6] from y = 8;
+    # the pursuer (speed 1) starts at (6, 5). It sees the evader above the line through
+    # the evader and the pillar's corner c = (9, 6). Standing still it sees it until
+    # t_c (the line passes through (6, 5)); no pursuer sees it after t_c', when the
+    # line is V_p t beyond (6, 5) (the disc it can reach lies wholly below the line).
+    dt, Ve = 0.01, 10.0
+    cfg = _config(PILLAR, dt=dt, l_min=5.0, l_max=9.0)
+    E = np.stack([np.full(61, 12.5), 8.0 - Ve * dt * np.arange(61)], axis=1)
+
+    def beyond(t):  # distance of (6, 5) below the line through E(t) and c
+        m = (E[0, 1] - Ve * t - 6.0) / 3.5
+        return (1 - 3 * m) / math.sqrt(1 + m * m)
+
+    t_c = (8.0 - (6.0 + 3.5 / 3.0)) / Ve
+    t_c2 = brentq(lambda t: beyond(t) - t, 0.0, 0.5)
+    assert beyond(t_c) == pytest.approx(0.0, abs=1e-12)
+    assert t_c < t_c2 < t_c + 0.02
+    for h in (0.02, 0.01):
+        res = hindsight(cfg, E, (6.0, 5.0), h)
+        assert res.verdict == "evader"
+        assert t_c <= res.optimistic_empty <= t_c2 + res.tau + 1e-9
+        assert t_c - res.pessimistic_tau - 1e-9 <= res.pessimistic_until <= t_c2
+        _assert_witness_holds(cfg, E, res)
+
+
+def test_played_pursuers_are_witnesses_of_the_optimistic_set():
+    # the env's own episodes: each pursuer held until its escape time, so the
+    # optimistic set must not empty before the frame at which it broke
+    over = {"v_evader": 0.5, "body_radius": 0.2}
+    path = record_evader_path(
+        "l_hall", "evader/wall_hugging", 1, pursuers=("pursuer/greedy", "pursuer/random"),
+        overrides=over, max_cycles=80, extend_to=80,
+    )  # fmt: skip
+    assert path.lengths["(evader alone)"] == 81
+    from strategies.runner import build_env
+
+    cfg = build_env("l_hall", over).config
+    res = hindsight(cfg, path, path.pursuer_start, 0.05)
+    from strategies.runner import run_episode
+
+    for p in ("pursuer/greedy", "pursuer/random"):
+        ep = run_episode("l_hall", p, "evader/wall_hugging", 1, overrides=over, max_cycles=80)
+        held = ep.escape_time if ep.escape_time is not None else ep.steps * ep.dt
+        assert res.optimistic_empty is None or res.optimistic_empty > held - 1e-9
+
+
+def test_record_evader_path_rejects_a_closed_loop_evader():
+    with pytest.raises(InvalidConfigError, match="open-loop"):
+        record_evader_path(
+            "open_room", "evader/toward_away", 0, pursuers=("pursuer/greedy", "pursuer/random"),
+            max_cycles=40,
+        )  # fmt: skip
+
+
+def test_bad_input_is_named():
+    cfg = _config(ROOM)
+    E = np.tile([[10.0, 5.0]], (5, 1))
+    with pytest.raises(InvalidConfigError, match="cell"):
+        hindsight(cfg, E, (8.5, 5.0), 0.0)
+    with pytest.raises(InvalidConfigError, match="evader_path"):
+        hindsight(cfg, E[:, :1], (8.5, 5.0), 0.1)
+    with pytest.raises(InvalidConfigError, match="substeps"):
+        hindsight(cfg, E, (8.5, 5.0), 0.1, substeps=0)
+    with pytest.raises(InvalidPlacementError, match="pursuer_start"):
+        hindsight(cfg, E, (9.5, 5.0), 0.1)  # too close

@@ -93,6 +93,7 @@ from scipy.spatial import cKDTree
 from envs import validation as V
 from envs.errors import InvalidConfigError
 from envs.geometry import kernel_for
+from strategies.referee._budget import check_budget, estimate_size
 from strategies.referee._fixpoint import shifted
 from strategies.referee.cache import load_arrays, save_arrays
 from strategies.referee.lattice import Lattice, _cross, segment_wall_distance
@@ -358,6 +359,7 @@ def solve_estimate(
     steps: float = 4.0,
     headings: int = 16,
     progress: bool = False,
+    memory_budget: object = None,
 ) -> EstimateSolution:
     """Solve the discrete game (module docstring) at one resolution, in both orders.
 
@@ -367,12 +369,25 @@ def solve_estimate(
         steps: cells the pursuer covers per step (> 0; the evader ``rho`` times that).
         headings: directions of the moves (>= 4).
         progress: print each sweep.
+        memory_budget: bytes (or ``"2GB"``) the solve may take; default
+            ``$SURVEIL_MEMORY_BUDGET`` or half the RAM (:mod:`strategies.referee._budget`).
+
+    Raises:
+        InfeasibleError: the solve's estimated memory exceeds the budget (checked before
+            anything is allocated; the message names the estimate and the knobs).
     """
     if not isinstance(spec, GameSpec):
         raise InvalidConfigError(f"solve_estimate: expected a GameSpec, got {type(spec).__name__}")
     cpl = V.positive("cells_per_lmin", cells_per_lmin)
     steps = V.positive("steps", steps)
     headings = V.integer("headings", headings, minimum=4)
+    check_budget(
+        f"solve_estimate(map {spec.map.name!r}, {cpl:g} cells per L_min)",
+        [estimate_size(spec, cpl, steps, headings)],
+        memory_budget,
+        resize=lambda c: [estimate_size(spec, c, steps * c / cpl, headings)],
+        cells_per_lmin=cpl,
+    )
     t0 = time.perf_counter()
     res, lat, vp, ve = _discretise(spec, cpl, steps, headings)
     h = res.cell
@@ -514,7 +529,9 @@ def _compact_rank(rank: np.ndarray, sweeps: int) -> np.ndarray:
     return rank
 
 
-def _cached_solution(spec, cpl, steps, headings, cache, cache_dir, progress) -> EstimateSolution:
+def _cached_solution(
+    spec, cpl, steps, headings, cache, cache_dir, progress, memory_budget=None
+) -> EstimateSolution:
     res = _resolution(spec, cpl, steps)
     kind = f"estimate{headings}"
     names = ("safe", "evader_first", "pursuer_first", "iterations", "seconds", "rank")
@@ -534,7 +551,9 @@ def _cached_solution(spec, cpl, steps, headings, cache, cache_dir, progress) -> 
                     {"build": float(arrays["seconds"][0]), "solve": float(arrays["seconds"][1])},
                     arrays["rank"].reshape(shape),
                 )  # fmt: skip
-    sol = solve_estimate(spec, cpl, steps=steps, headings=headings, progress=progress)
+    sol = solve_estimate(
+        spec, cpl, steps=steps, headings=headings, progress=progress, memory_budget=memory_budget
+    )
     if cache:
         try:
             save_arrays(kind, spec, res, {
@@ -659,6 +678,7 @@ def estimate(
     cache: bool = True,
     cache_dir: str | os.PathLike | None = None,
     progress: bool = False,
+    memory_budget: object = None,
 ) -> Estimate:
     """Solve (or load) the discrete game at each resolution in ``cpls`` (two or more).
 
@@ -682,6 +702,13 @@ def estimate(
         cache: read and write the on-disk cache (:mod:`.cache`).
         cache_dir: cache directory (default ``$SURVEIL_CACHE_DIR`` or ``~/.cache/surveil``).
         progress: print the sweeps.
+        memory_budget: bytes (or ``"2GB"``) the solves may take together (each solution
+            is kept while the next is solved); default ``$SURVEIL_MEMORY_BUDGET`` or half
+            the RAM. Checked before anything is solved or loaded.
+
+    Raises:
+        InfeasibleError: the estimated peak exceeds the budget (the message gives the
+            estimate and the knobs: fewer or coarser ``cpls``, the budget).
     """
     if not isinstance(spec, GameSpec):
         raise InvalidConfigError(f"estimate: expected a GameSpec, got {type(spec).__name__}")
@@ -699,6 +726,20 @@ def estimate(
     else:
         per = [V.positive("steps", steps)] * len(values)
     headings = V.integer("headings", headings, minimum=4)
-    sols = [_cached_solution(spec, values[i], s, headings, cache, cache_dir, progress)
+    finest = values[order[-1]]
+
+    def sizes(c: float) -> list:  # every resolution scaled by c / finest
+        return [estimate_size(spec, values[i] * c / finest, s * c / finest, headings)
+                for i, s in zip(order, per, strict=True)]  # fmt: skip
+
+    budget = check_budget(
+        f"estimate(map {spec.map.name!r}, cpls = {tuple(cpls)!r})",
+        sizes(finest),
+        memory_budget,
+        resize=sizes,
+        cells_per_lmin=finest,
+        knob="the finest of cpls (the others in proportion)",
+    )
+    sols = [_cached_solution(spec, values[i], s, headings, cache, cache_dir, progress, budget)
             for i, s in zip(order, per, strict=True)]  # fmt: skip
     return Estimate(spec, sols)

@@ -34,6 +34,7 @@ import numpy as np
 from scipy import ndimage
 
 from strategies.referee._bound import SolvedBound
+from strategies.referee._budget import bound_size, check_budget
 from strategies.referee._fixpoint import Worklist, erode, reach_rectangles
 from strategies.referee.lattice import Lattice, segment_wall_distance
 from strategies.referee.robust import (
@@ -220,17 +221,30 @@ def _occlusion_broken(lat: Lattice, spec: GameSpec, candidates: np.ndarray) -> n
     return out
 
 
-def solve_evader_bound(spec: GameSpec, res: Resolution, *, progress: bool = False) -> EvaderBound:
+def solve_evader_bound(
+    spec: GameSpec, res: Resolution, *, progress: bool = False, memory_budget: object = None
+) -> EvaderBound:
     """Solve the pursuer-favoured discrete game (see the module docstring).
 
     Args:
         spec: the game.
         res: the resolution.
         progress: print one line per round.
+        memory_budget: bytes (or ``"2GB"``) the solve may take; default
+            ``$SURVEIL_MEMORY_BUDGET`` or half the RAM (:mod:`strategies.referee._budget`).
 
     Returns:
         The :class:`EvaderBound`.
+
+    Raises:
+        InfeasibleError: the solve's estimated memory exceeds the budget (checked before
+            anything is allocated; the message names the estimate and the knobs).
     """
+    check_budget(
+        f"solve_evader_bound(map {spec.map.name!r}, cell = {res.cell:g})",
+        [bound_size(spec, res, "evader")],
+        memory_budget,
+    )
     t0 = time.perf_counter()
     lat = Lattice(spec, res, "evader")
     vectors, targets = lat.moves(spec.v_evader * res.tau)

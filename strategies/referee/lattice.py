@@ -31,7 +31,13 @@ from numpy.lib.stride_tricks import sliding_window_view
 from envs.errors import InvalidConfigError
 from strategies.referee.spec import GameSpec, Resolution
 
-__all__ = ["Lattice", "segment_wall_distance"]
+__all__ = [
+    "Lattice",
+    "grid_shape",
+    "lattice_vectors",
+    "segment_wall_distance",
+    "window_half_width",
+]
 
 _QUAD_SEGS = 32
 """Arc segments per quarter circle of the eroded region (its polygon lies *outside* the
@@ -86,6 +92,39 @@ def _point_segment(X: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.hypot(X[..., 0] - foot[..., 0], X[..., 1] - foot[..., 1])
 
 
+def grid_shape(bounds: tuple[float, float, float, float], h: float) -> tuple[int, int, int, int]:
+    """``(i0, j0, nx, ny)``: the cells of side ``h`` covering ``bounds``, centred on the
+    bounding box's centre (the first cell's indices and the counts along x and y)."""
+    x0, y0, x1, y1 = bounds
+    cx, cy = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
+    eps = 1e-9
+    i0 = math.ceil((x0 - cx) / h - 0.5 - eps)
+    j0 = math.ceil((y0 - cy) / h - 0.5 - eps)
+    i1 = math.floor((x1 - cx) / h + 0.5 + eps)
+    j1 = math.floor((y1 - cy) / h + 0.5 + eps)
+    return i0, j0, i1 - i0 + 1, j1 - j0 + 1
+
+
+def window_half_width(reach: float, h: float) -> int:
+    """Half-width in cells of a window that holds every cell whose disc (radius
+    ``h / sqrt(2)``) comes within ``reach`` of the window's centre, plus one cell."""
+    return math.ceil((reach + h / math.sqrt(2.0)) / h) + 1
+
+
+def lattice_vectors(length: float, spacing: float) -> list[tuple[int, int]]:
+    """The integer vectors (in spacings) of length <= ``length``: standing still first,
+    then by length and angle (a fixed, symmetric order)."""
+    r = math.floor(length / spacing + 1e-9)
+    cand = [
+        (a, b)
+        for a in range(-r, r + 1)
+        for b in range(-r, r + 1)
+        if math.hypot(a, b) * spacing <= length * (1.0 + 1e-12)
+    ]
+    cand.sort(key=lambda v: (v != (0, 0), math.hypot(*v), math.atan2(v[1], v[0])))
+    return cand
+
+
 class Lattice:
     """Cells, certified points and moves of one game at one resolution.
 
@@ -122,14 +161,8 @@ class Lattice:
         self.delta = res.cell_radius
         x0, y0, x1, y1 = world.bounds
         self.anchor = np.array([0.5 * (x0 + x1), 0.5 * (y0 + y1)])
-        cx, cy = self.anchor
-        eps = 1e-9
-        self.i0 = math.ceil((x0 - cx) / h - 0.5 - eps)
-        self.j0 = math.ceil((y0 - cy) / h - 0.5 - eps)
-        i1 = math.floor((x1 - cx) / h + 0.5 + eps)
-        j1 = math.floor((y1 - cy) / h + 0.5 + eps)
-        self.nx = i1 - self.i0 + 1
-        self.ny = j1 - self.j0 + 1
+        self.i0, self.j0, self.nx, self.ny = grid_shape(world.bounds, h)
+        i1, j1 = self.i0 + self.nx - 1, self.j0 + self.ny - 1
         n_cells = self.nx * self.ny
         if n_cells > 50_000_000:
             raise InvalidConfigError(
@@ -139,7 +172,7 @@ class Lattice:
         self.centers = self.anchor + h * np.stack([ii, jj], axis=-1).astype(float)
         self.cell_open = self._opponent_cells()
         self._certified_points()
-        self.hw = math.ceil((spec.l_max + reach + self.delta) / h) + 1
+        self.hw = window_half_width(spec.l_max + reach, h)
         w = np.arange(-self.hw, self.hw + 1) * h
         self.offsets = np.stack(np.meshgrid(w, w, indexing="ij"), axis=-1)
 
@@ -281,16 +314,7 @@ class Lattice:
             closer than the body radius to a wall.
         """
         m = self.coarse
-        r = math.floor(length / self.spacing + 1e-9)
-        cand = [
-            (a, b)
-            for a in range(-r, r + 1)
-            for b in range(-r, r + 1)
-            if math.hypot(a, b) * self.spacing <= length * (1.0 + 1e-12)
-        ]
-        # standing still first, then by length and angle (a fixed, symmetric order)
-        cand.sort(key=lambda v: (v != (0, 0), math.hypot(*v), math.atan2(v[1], v[0])))
-        vec = np.array(cand, dtype=np.int64) * m
+        vec = np.array(lattice_vectors(length, self.spacing), dtype=np.int64) * m
         n, k = self.n_points, len(vec)
         dest = self.point_cells[:, None, :] + vec[None, :, :]
         targets = self.point_index(dest.reshape(-1, 2)).reshape(n, k)

@@ -76,6 +76,7 @@ import numpy as np
 
 from envs.geometry import kernel_for
 from strategies.referee._bound import SolvedBound
+from strategies.referee._budget import bound_size, check_budget
 from strategies.referee._fixpoint import Worklist, erode, reach_rectangles, shifted
 from strategies.referee.lattice import Lattice, segment_wall_distance
 from strategies.referee.robust import convex_corners, sweep_hits_vertex, sweep_range_ok
@@ -403,17 +404,30 @@ def _unpack(table: np.ndarray, W: int) -> np.ndarray:
     return np.unpackbits(table, axis=-1, count=W).view(bool)
 
 
-def solve_pursuer_bound(spec: GameSpec, res: Resolution, *, progress: bool = False) -> PursuerBound:
+def solve_pursuer_bound(
+    spec: GameSpec, res: Resolution, *, progress: bool = False, memory_budget: object = None
+) -> PursuerBound:
     """Solve the evader-favoured discrete game (see the module docstring).
 
     Args:
         spec: the game.
         res: the resolution.
         progress: print one line per fixed-point sweep.
+        memory_budget: bytes (or ``"2GB"``) the solve may take; default
+            ``$SURVEIL_MEMORY_BUDGET`` or half the RAM (:mod:`strategies.referee._budget`).
 
     Returns:
         The :class:`PursuerBound`.
+
+    Raises:
+        InfeasibleError: the solve's estimated memory exceeds the budget (checked before
+            anything is allocated; the message names the estimate and the knobs).
     """
+    check_budget(
+        f"solve_pursuer_bound(map {spec.map.name!r}, cell = {res.cell:g})",
+        [bound_size(spec, res, "pursuer")],
+        memory_budget,
+    )
     t0 = time.perf_counter()
     lat = Lattice(spec, res, "pursuer")
     vectors, targets = lat.moves(spec.v_pursuer * res.tau)

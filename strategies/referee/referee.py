@@ -26,6 +26,7 @@ import numpy as np
 from envs import validation as V
 from envs.errors import InvalidConfigError, InvalidPlacementError, VacuousBoundWarning
 from envs.geometry import kernel_for
+from strategies.referee._budget import SolveSize, bound_size, check_budget
 from strategies.referee.cache import load_arrays, save_arrays
 from strategies.referee.evader_bound import EvaderBound, solve_evader_bound
 from strategies.referee.pursuer_bound import PursuerBound, solve_pursuer_bound
@@ -48,7 +49,7 @@ LABELS = ("pursuer", "evader", "unknown")
 """What a start can be labelled: who provably wins it, or unknown."""
 
 
-def _cached(kind, cls, solver, spec, res, cache, cache_dir, progress):
+def _cached(kind, cls, solver, spec, res, cache, cache_dir, progress, memory_budget=None):
     """The bound ``kind`` of ``spec`` at ``res``: loaded from the cache, or solved and
     stored (a read-only or full disk only costs the recomputation next time)."""
     if cache:
@@ -59,7 +60,7 @@ def _cached(kind, cls, solver, spec, res, cache, cache_dir, progress):
                 return cls.from_arrays(spec, res, arrays)
             except ValueError:
                 pass
-    bound = solver(spec, res, progress=progress)
+    bound = solver(spec, res, progress=progress, memory_budget=memory_budget)
     if cache:
         try:
             save_arrays(kind, spec, res, bound.to_arrays(), cache_dir)
@@ -75,10 +76,11 @@ def cached_pursuer_bound(
     cache: bool = True,
     cache_dir: str | os.PathLike | None = None,
     progress: bool = False,
+    memory_budget: object = None,
 ) -> PursuerBound:
     """The pursuer bound of ``spec`` at ``res``, from the cache or solved (and stored)."""
     return _cached("pursuer", PursuerBound, solve_pursuer_bound, spec, res, cache, cache_dir,
-                   progress)  # fmt: skip
+                   progress, memory_budget)  # fmt: skip
 
 
 def cached_evader_bound(
@@ -88,10 +90,11 @@ def cached_evader_bound(
     cache: bool = True,
     cache_dir: str | os.PathLike | None = None,
     progress: bool = False,
+    memory_budget: object = None,
 ) -> EvaderBound:
     """The evader bound of ``spec`` at ``res``, from the cache or solved (and stored)."""
     return _cached("evader", EvaderBound, solve_evader_bound, spec, res, cache, cache_dir,
-                   progress)  # fmt: skip
+                   progress, memory_budget)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -345,6 +348,7 @@ def solve(
     cache: bool = True,
     cache_dir: str | os.PathLike | None = None,
     progress: bool = False,
+    memory_budget: object = None,
 ) -> Referee:
     """Solve (or load) both bounds of ``spec`` at one resolution.
 
@@ -386,6 +390,13 @@ def solve(
         cache: read and write the on-disk cache.
         cache_dir: cache directory (default ``$SURVEIL_CACHE_DIR`` or ``~/.cache/surveil``).
         progress: print the fixed points' progress.
+        memory_budget: bytes (or ``"2GB"``) the two solves may take together; default
+            ``$SURVEIL_MEMORY_BUDGET`` or half the RAM. Checked before anything is solved
+            or loaded, from the lattice sizes (:mod:`strategies.referee._budget`).
+
+    Raises:
+        InfeasibleError: the estimated peak exceeds the budget; the message gives the
+            estimate (memory, states, time) and the ``cells_per_lmin`` that would fit.
 
     Warns:
         VacuousBoundWarning: the pursuer bound's wins say nothing about the game
@@ -393,23 +404,40 @@ def solve(
     """
     if not isinstance(spec, GameSpec):
         raise InvalidConfigError(f"solve: expected a GameSpec, got {type(spec).__name__}")
-    kw = dict(sweep_pieces=sweep_pieces, dt=dt)
-    # at least four lattice spacings across the sensor range [l_min, l_max]
-    cap = max(2, math.floor((spec.l_max - spec.l_min) * V.positive("cells_per_lmin",
-                                                                  cells_per_lmin)
-                            / (4.0 * spec.l_min)))  # fmt: skip
-    if pursuer_coarse is None:
-        pursuer_coarse = int(min(12, cap, max(2, round(2.0 / spec.rho))))
-    if evader_coarse is None:
-        evader_coarse = int(min(8, cap, max(2, round(8.0 * spec.rho))))
-    rp = Resolution.for_role(spec, "pursuer", cells_per_lmin, coarse=pursuer_coarse,
-                             steps=pursuer_steps, **kw)  # fmt: skip
-    re = Resolution.for_role(spec, "evader", cells_per_lmin, coarse=evader_coarse,
-                             steps=evader_steps, **kw)  # fmt: skip
+    cells_per_lmin = V.positive("cells_per_lmin", cells_per_lmin)
+
+    def resolutions(cpl: float) -> tuple[Resolution, Resolution]:
+        kw = dict(sweep_pieces=sweep_pieces, dt=dt)
+        # at least four lattice spacings across the sensor range [l_min, l_max]
+        cap = max(2, math.floor((spec.l_max - spec.l_min) * cpl / (4.0 * spec.l_min)))
+        pc = pursuer_coarse
+        ec = evader_coarse
+        if pc is None:
+            pc = int(min(12, cap, max(2, round(2.0 / spec.rho))))
+        if ec is None:
+            ec = int(min(8, cap, max(2, round(8.0 * spec.rho))))
+        rp = Resolution.for_role(spec, "pursuer", cpl, coarse=pc, steps=pursuer_steps, **kw)
+        re = Resolution.for_role(spec, "evader", cpl, coarse=ec, steps=evader_steps, **kw)
+        return rp, re
+
+    def sizes(cpl: float) -> list[SolveSize]:
+        rp, re = resolutions(cpl)
+        return [bound_size(spec, rp, "pursuer"), bound_size(spec, re, "evader")]
+
+    rp, re = resolutions(cells_per_lmin)
+    budget = check_budget(
+        f"solve(map {spec.map.name!r}, L in [{spec.l_min:g}, {spec.l_max:g}], "
+        f"{cells_per_lmin:g} cells per L_min)",
+        sizes(cells_per_lmin),
+        memory_budget,
+        resize=sizes,
+        cells_per_lmin=cells_per_lmin,
+    )
+    kw = dict(cache=cache, cache_dir=cache_dir, progress=progress, memory_budget=budget)
     ref = Referee(
         spec=spec,
-        pursuer=cached_pursuer_bound(spec, rp, cache=cache, cache_dir=cache_dir, progress=progress),
-        evader=cached_evader_bound(spec, re, cache=cache, cache_dir=cache_dir, progress=progress),
+        pursuer=cached_pursuer_bound(spec, rp, **kw),
+        evader=cached_evader_bound(spec, re, **kw),
     )
     reason = ref.pursuer.vacuity()
     if reason is not None:

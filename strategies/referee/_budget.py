@@ -1,0 +1,271 @@
+"""How much memory and time a referee solve needs, estimated before it starts.
+
+Every per-state array of a bound (:mod:`.pursuer_bound`, :mod:`.evader_bound`) or of the
+estimate (:mod:`.estimates`) has the shape ``(n_points, W, W)``: the certified lattice's
+points times the window of opponent cells. So the memory of a solve is
+
+    bytes ~ BASE_BYTES + per_state * n_points * W^2
+
+with ``W = 2 ceil((l_max + reach + h / sqrt(2)) / h) + 3`` exactly the lattice's, and
+``n_points`` from the free region eroded by the body radius (its area over the spacing
+squared plus half its perimeter over the spacing: 0-20 % above the lattice's count).
+``per_state`` follows the solvers' arrays (the constants below say which), its figures
+measured: peak resident memory of one solve in a fresh process (``/usr/bin/time -v``),
+rho = 0.5, L in [1, 2], body radius 0.05, the resolutions :func:`~.referee.solve` picks,
+one busy core, a fresh process per solve. The error is that of the
+memory above the interpreter's 125 MB:
+
+======================================  ========  ==========  ==========  ======
+solve (map, cells per L_min)            states    measured    estimated   error
+======================================  ========  ==========  ==========  ======
+pursuer bound, empty 16 x 10 room, 16   11.7 M    336 MB      340 MB      +2 %
+pursuer bound, empty 16 x 10 room, 24   57.2 M    1045 MB     1150 MB     +11 %
+pursuer bound, ``pillars`` 20 x 14, 12  11.2 M    332 MB      334 MB      +1 %
+evader bound, empty 16 x 10 room, 32    177 M     3275 MB     3399 MB     +4 %
+evader bound, ``pillars``, 20           45.8 M    1583 MB     1813 MB     +16 %
+estimate, empty 5 x 5 room, 12          15.6 M    645 MB      743 MB      +19 %
+estimate, empty 16 x 10 room, 6         10.4 M    485 MB      540 MB      +15 %
+estimate, 8 x 8 room and a pillar, 8    10.1 M    581 MB      849 MB      +59 %
+estimate, ``pillars``, 4                4.9 M     419 MB      487 MB      +23 %
+estimate, ``pillars``, 6                16.9 M    741 MB      1334 MB     +96 %
+======================================  ========  ==========  ==========  ======
+
+Smaller solves (0.5 to 5 M states, the empty 5 x 5 room and the 8 x 8 room with a pillar
+at 8 to 20 cells per L_min): -23 % to +14 %, a few MB either way. The estimate's blocked
+fans (int64 indices per move) are a smaller share of its states at finer resolutions, so
+on maps with obstacles its figure errs large by up to 2x. The time varies far more (the
+fixed points' sweeps depend on the game) and is given as an upper bound.
+
+Solves run one after the other, and a :class:`~strategies.referee.referee.Referee` keeps
+each solved bound while it solves the next, so the peak of several solves is the largest
+of (a solve's peak plus what the solves before it keep).
+
+The budget is the ``memory_budget`` argument, else ``$SURVEIL_MEMORY_BUDGET`` (bytes, or
+``"1.5GB"``), else half the machine's physical memory: the decompositions' budget
+(:func:`strategies.cspace._budget.memory_budget`). Issue 13's probe, ``pursuer/referee``
+on a 16 x 10 room at L_min = 0.3 (133 M states per bound), is estimated at about 3 GB, up
+to 45 min; it ran over 5 min and 1.8-3.8 GB before it was killed.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+from envs.errors import InfeasibleError
+from strategies.cspace._budget import memory_budget
+from strategies.referee.lattice import grid_shape, lattice_vectors, window_half_width
+from strategies.referee.spec import GameSpec, Resolution
+
+__all__ = ["SolveSize", "bound_size", "check_budget", "estimate_size", "memory_budget", "peak"]
+
+BASE_BYTES = 125e6
+"""The interpreter with numpy, scipy and shapely loaded (measured: 121-124 MB)."""
+
+PURSUER_BYTES_PER_STATE = 10.0
+PURSUER_BYTES_PER_STATE_MOVE = 0.25
+"""The pursuer bound: five bool arrays and the erosions' temporaries, plus its packed
+safe-move tables (one bit a state per move, twice while they are stacked)."""
+EVADER_BYTES_PER_STATE = 18.0
+EVADER_OCCLUSION_BYTES_PER_STATE = 17.0
+"""The evader bound: bool arrays, rank (int32) and choice (int16); on a map with a convex
+obstacle vertex its robust occlusion test adds a representative point per state (two
+float64) and the groups' labels (int32)."""
+ESTIMATE_BYTES_PER_STATE = 30.0
+ESTIMATE_BYTES_PER_STATE_MOVE = 0.25
+ESTIMATE_OCCLUSION_BYTES_PER_STATE = 30.0
+"""The estimate: int64 indices of the clear states, packed per-move masks; on a map with
+a convex obstacle vertex the blocked fans' indices (int64) per move."""
+KEPT_BYTES_PER_STATE = {"pursuer": 3.0, "evader": 7.0, "estimate": 4.0}
+"""What a solved bound or estimate solution keeps: win (1) and choice (2); win, rank (4)
+and choice; safe, both orders' wins and the rank (1 each)."""
+
+SECONDS_PER_STATE = {"pursuer": 2e-5, "evader": 4e-7, "estimate": 2.5e-5}
+"""Build plus fixed point on one busy core, the most measured (the fixed points' sweeps
+depend on the game: the pursuer bound took 0.65 us a state on the 16 x 10 room at 16
+cells per L_min and 18 us at 24): an upper bound, said as "up to"."""
+
+
+@dataclass(frozen=True)
+class SolveSize:
+    """The estimated size of one solve.
+
+    Attributes:
+        what: ``"pursuer bound"``, ``"evader bound"`` or ``"estimate at CPL cells per
+            L_min"``.
+        kind: ``"pursuer"``, ``"evader"`` or ``"estimate"``.
+        points: certified lattice points (estimated).
+        window: W, the window side in cells.
+        moves: the moves of the player(s) whose tables are stored per move.
+        bytes: peak memory of the solve, the interpreter included.
+        kept: memory the solved result keeps.
+        seconds: build and fixed point, order of magnitude.
+    """
+
+    what: str
+    kind: str
+    points: int
+    window: int
+    moves: int
+    bytes: float
+    kept: float
+    seconds: float
+
+    @property
+    def states(self) -> int:
+        """``points * window^2``."""
+        return self.points * self.window**2
+
+    def describe(self) -> str:
+        """``"pursuer bound: 27,641 points x 69^2 window cells = 132 M states"``."""
+        return (
+            f"{self.what}: {self.points:,} points x {self.window}^2 window cells = "
+            f"{self.states / 1e6:.3g} M states"
+        )
+
+
+def _points(spec: GameSpec, spacing: float) -> int:
+    """The certified lattice's points, from the area and perimeter of the region at
+    least ``body_radius`` from the walls: a lattice of spacing s in a region of area A
+    and perimeter P has about A / s^2 + P / (2 s) points (measured: 0-20 % more than the
+    lattice's count, the most on small maps at coarse spacings)."""
+    region = spec.map.free_region.buffer(-spec.body_radius)
+    if region.is_empty:
+        return 0
+    return math.ceil(region.area / spacing**2 + region.length / (2.0 * spacing)) + 1
+
+
+def _cells(spec: GameSpec, h: float) -> int:
+    _, _, nx, ny = grid_shape(spec.map.bounds, h)
+    return nx * ny
+
+
+def bound_size(spec: GameSpec, res: Resolution, role: str) -> SolveSize:
+    """The size of :func:`~strategies.referee.pursuer_bound.solve_pursuer_bound`
+    (``role="pursuer"``) or :func:`~strategies.referee.evader_bound.solve_evader_bound`."""
+    points = _points(spec, res.spacing)
+    W = 2 * window_half_width(spec.l_max, res.cell) + 1
+    moves = len(lattice_vectors(spec.speed(role) * res.tau, res.spacing))
+    states = points * W * W
+    if role == "pursuer":
+        per = PURSUER_BYTES_PER_STATE + PURSUER_BYTES_PER_STATE_MOVE * moves
+    else:
+        per = EVADER_BYTES_PER_STATE
+        if spec.map.vertex_convex.any():
+            per += EVADER_OCCLUSION_BYTES_PER_STATE
+    return SolveSize(
+        what=f"{role} bound",
+        kind=role,
+        points=points,
+        window=W,
+        moves=moves,
+        bytes=BASE_BYTES + per * states,
+        kept=KEPT_BYTES_PER_STATE[role] * states,
+        seconds=SECONDS_PER_STATE[role] * states,
+    )
+
+
+def estimate_size(spec: GameSpec, cpl: float, steps: float, headings: int) -> SolveSize:
+    """The size of :func:`~strategies.referee.estimates.solve_estimate` at one resolution."""
+    from strategies.referee.estimates import _resolution, heading_moves
+
+    res = _resolution(spec, cpl, steps)
+    h = res.cell
+    vp = heading_moves(spec.v_pursuer * res.tau, h, headings)
+    ve = heading_moves(spec.v_evader * res.tau, h, headings)
+    reach = h * (max(math.hypot(*v) for v in vp) + max(math.hypot(*v) for v in ve))
+    points = _points(spec, h)
+    W = 2 * window_half_width(spec.l_max + reach, h) + 1
+    moves = len(vp) + len(ve)
+    states = points * W * W
+    per = ESTIMATE_BYTES_PER_STATE + ESTIMATE_BYTES_PER_STATE_MOVE * moves
+    if spec.map.vertex_convex.any():
+        per += ESTIMATE_OCCLUSION_BYTES_PER_STATE
+    return SolveSize(
+        what=f"estimate at {cpl:g} cells per L_min",
+        kind="estimate",
+        points=points,
+        window=W,
+        moves=moves,
+        bytes=BASE_BYTES + per * states,
+        kept=KEPT_BYTES_PER_STATE["estimate"] * states,
+        seconds=SECONDS_PER_STATE["estimate"] * states,
+    )
+
+
+def peak(sizes: Sequence[SolveSize]) -> tuple[float, SolveSize]:
+    """The peak memory of ``sizes`` solved in order, each result kept, and the solve at
+    which it is reached."""
+    kept, best, at = 0.0, -1.0, sizes[0]
+    for s in sizes:
+        if kept + s.bytes > best:
+            best, at = kept + s.bytes, s
+        kept += s.kept
+    return best, at
+
+
+def check_budget(
+    call: str,
+    sizes: Sequence[SolveSize],
+    budget: object = None,
+    *,
+    resize: Callable[[float], Sequence[SolveSize]] | None = None,
+    cells_per_lmin: float | None = None,
+    knob: str = "cells_per_lmin",
+) -> float:
+    """The budget in bytes, after checking that ``sizes`` fit in it.
+
+    Args:
+        call: what is being solved, for the message (``"solve(map 'x', ...)"``).
+        sizes: the solves, in the order they run.
+        budget: ``memory_budget`` as given (None: ``$SURVEIL_MEMORY_BUDGET`` or half the
+            physical memory).
+        resize: the solves at another number of cells per L_min, to name one that fits.
+        cells_per_lmin: the resolution asked for (with ``resize``).
+        knob: the argument that sets it, for the message.
+
+    Raises:
+        InfeasibleError: the estimated peak exceeds the budget; the message names the
+            estimate (memory, states, time) and the knobs that change it.
+        InvalidConfigError: the budget is not a positive size.
+    """
+    limit = memory_budget(budget)
+    need, at = peak(sizes)
+    if need <= limit:
+        return limit
+    total_seconds = sum(s.seconds for s in sizes)
+    advice = []
+    if resize is not None and cells_per_lmin is not None:
+        lo, hi = 0.0, float(cells_per_lmin)
+        for _ in range(30):  # the largest resolution that fits, to 1e-9 relative
+            mid = 0.5 * (lo + hi)
+            if mid <= 0 or peak(resize(mid))[0] <= limit:
+                lo = mid
+            else:
+                hi = mid
+        fit = math.floor(lo * 10) / 10
+        if fit > 0:
+            advice.append(f"Use {knob} <= {fit:g} (asked: {cells_per_lmin:g})")
+        else:
+            advice.append(f"Use a smaller {knob}")
+    more = math.ceil(1.2 * need / 1e9)
+    advice.append(
+        f"{'raise' if advice else 'Raise'} the budget with memory_budget='{more}GB' or "
+        "$SURVEIL_MEMORY_BUDGET"
+    )
+    advice.append("or solve a smaller map or a smaller L_max / L_min")
+    raise InfeasibleError(
+        f"{call}: the solve would need about {need / 1e9:.1f} GB at its peak, during the "
+        f"{at.what} ({'; '.join(s.describe() for s in sizes)}; up to about "
+        f"{_duration(total_seconds)} in all), more than the memory budget of "
+        f"{limit / 1e9:.1f} GB. " + "; ".join(advice[:-1]) + ", " + advice[-1]
+    )
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 90:
+        return f"{seconds:.0f} s"
+    if seconds < 5400:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"

@@ -1,0 +1,121 @@
+"""The referee's solves are refused before they start when they would not fit in memory."""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import pytest
+
+from envs.errors import InfeasibleError, InvalidConfigError
+from envs.maps import Map
+from envs.surveillance.config import EnvConfig
+from strategies.referee import (
+    GameSpec,
+    RefereePursuer,
+    Resolution,
+    estimate,
+    solve,
+    solve_estimate,
+    solve_evader_bound,
+    solve_pursuer_bound,
+)
+from strategies.referee._budget import bound_size, estimate_size, peak
+from strategies.referee.estimates import _discretise
+from strategies.referee.lattice import Lattice
+
+from .conftest import dead_end, open_room, spec
+
+ROLES = ("pursuer", "evader")
+
+
+def _room(w: float, h: float) -> Map:
+    return Map([(0, 0), (w, 0), (w, h), (0, h)], name=f"room{w:g}x{h:g}")
+
+
+def _resolutions(s: GameSpec, cpl: float) -> list[Resolution]:
+    """The resolutions solve() picks at rho = 0.5 and L_max = 2 L_min (coarse 4 and 4)."""
+    return [Resolution.for_role(s, "pursuer", cpl, coarse=4, steps=3.0),
+            Resolution.for_role(s, "evader", cpl, coarse=4, steps=2.0)]  # fmt: skip
+
+
+@pytest.mark.parametrize("world", [open_room(), dead_end(), _room(16, 10)])
+@pytest.mark.parametrize(("role", "cpl", "coarse"), [("pursuer", 12, 3), ("evader", 16, 2)])
+def test_the_estimated_sizes_are_the_lattice_s(world, role, cpl, coarse):
+    """The window is the lattice's exactly, the points within 25 % and never fewer (an
+    independent count: the lattice built by Lattice itself)."""
+    s = spec(world, 0.5)
+    res = Resolution.for_role(s, role, cpl, coarse=coarse)
+    size = bound_size(s, res, role)
+    lat = Lattice(s, res, role)
+    assert size.window == lat.W
+    assert lat.n_points <= size.points <= 1.25 * lat.n_points + 5
+    moves = lat.moves(s.speed(role) * res.tau)[0]
+    assert size.moves == len(moves)
+
+
+def test_the_estimate_s_size_is_its_lattice_s():
+    s = spec(dead_end(), 0.5)
+    size = estimate_size(s, 6.0, 4.0, 16)
+    _, lat, vp, ve = _discretise(s, 6.0, 4.0, 16)
+    assert size.window == lat.W
+    assert lat.n_points <= size.points <= 1.25 * lat.n_points
+    assert size.moves == len(vp) + len(ve)
+
+
+def test_a_referee_over_the_budget_is_refused_up_front_naming_the_figures_and_knobs():
+    """The 16 x 10 room at L_min = 0.3 (issue 13's probe: > 5 min and 1.8-3.8 GB before it
+    was killed), refused at once under a 1 GB budget; the resolution it names fits."""
+    s = GameSpec(_room(16, 10), 0.3, 0.6, 1.0, 0.5, body_radius=0.1)
+    t0 = time.perf_counter()
+    with pytest.raises(InfeasibleError) as err:
+        solve(s, 16, cache=False, memory_budget="1GB")
+    assert time.perf_counter() - t0 < 2.0
+    msg = str(err.value)
+    assert "solve(map 'room16x10', L in [0.3, 0.6], 16 cells per L_min)" in msg
+    assert "more than the memory budget of 1.0 GB" in msg
+    assert "pursuer bound: 27,8" in msg and "evader bound: 27,8" in msg  # 27,641 points
+    assert "69^2 window cells = 133 M states" in msg
+    assert "$SURVEIL_MEMORY_BUDGET" in msg and "memory_budget='4GB'" in msg  # 1.2 x 3.1 GB
+    fit = float(msg.split("Use cells_per_lmin <= ")[1].split(" ")[0])
+    assert 4 < fit < 16
+    with pytest.raises(InfeasibleError):  # just above it: refused too
+        solve(s, fit + 0.2, cache=False, memory_budget="1GB")
+    sizes = [bound_size(s, r, role) for r, role in zip(_resolutions(s, fit), ROLES, strict=True)]
+    assert peak(sizes)[0] <= 1e9  # and it fits
+
+
+def test_the_budget_comes_from_the_environment_for_a_policy(monkeypatch):
+    """A referee policy solves at reset: $SURVEIL_MEMORY_BUDGET refuses it there, with the
+    policy's knob (cells_per_lmin) in the message."""
+    monkeypatch.setenv("SURVEIL_MEMORY_BUDGET", "200MB")
+    cfg = EnvConfig(map=_room(16, 10), l_min=0.3, l_max=0.6, v_evader=0.5)
+    pol = RefereePursuer(cells_per_lmin=16)
+    with pytest.raises(InfeasibleError, match=r"Use cells_per_lmin <= \d"):
+        pol.reset(role="pursuer", map=cfg.map, config=cfg, seed=0)
+
+
+def test_each_solver_checks_its_own_budget():
+    s = spec(open_room(), 0.5)
+    res = Resolution.for_role(s, "pursuer", 12, coarse=3)
+    with pytest.raises(InfeasibleError, match=r"solve_pursuer_bound\(map 'open5'"):
+        solve_pursuer_bound(s, res, memory_budget="10MB")
+    with pytest.raises(InfeasibleError, match=r"solve_evader_bound\(map 'open5'"):
+        solve_evader_bound(s, res, memory_budget="10MB")
+    with pytest.raises(InfeasibleError, match=r"solve_estimate\(map 'open5', 6 cells"):
+        solve_estimate(s, 6, memory_budget="10MB")
+    with pytest.raises(InfeasibleError, match=r"estimate\(map 'open5', cpls = \(6, 8\)\).*"
+                       r"the finest of cpls"):  # fmt: skip
+        estimate(s, (6, 8), cache=False, memory_budget="10MB")
+    with pytest.raises(InvalidConfigError, match="memory_budget"):
+        solve(s, 12, memory_budget="lots")
+
+
+def test_a_solve_within_the_budget_runs():
+    s = spec(open_room(), 0.5)
+    ref = solve(s, 6, cache=False, memory_budget="4GB")
+    assert ref.pursuer.win.shape == (ref.pursuer.lattice.n_points,) + (ref.pursuer.lattice.W,) * 2
+    size = bound_size(s, ref.pursuer.res, "pursuer")
+    assert size.states >= np.prod(ref.pursuer.win.shape)
+    assert math.isfinite(size.seconds)

@@ -247,8 +247,8 @@ def check_budget(
         fit = math.floor(lo * 10) / 10
         if fit > 0:
             advice.append(f"Use {knob} <= {fit:g} (asked: {cells_per_lmin:g})")
-        else:
-            advice.append(f"Use a smaller {knob}")
+        else:  # not even the coarsest solve: the interpreter alone is over the budget
+            advice.append(f"No {knob} fits (the interpreter alone takes {_size(BASE_BYTES)})")
     more = math.ceil(1.2 * need / 1e9)
     advice.append(
         f"{'raise' if advice else 'Raise'} the budget with memory_budget='{more}GB' or "
@@ -256,11 +256,15 @@ def check_budget(
     )
     advice.append("or solve a smaller map or a smaller L_max / L_min")
     raise InfeasibleError(
-        f"{call}: the solve would need about {need / 1e9:.1f} GB at its peak, during the "
+        f"{call}: the solve would need about {_size(need)} at its peak, during the "
         f"{at.what} ({'; '.join(s.describe() for s in sizes)}; up to about "
         f"{_duration(total_seconds)} in all), more than the memory budget of "
-        f"{limit / 1e9:.1f} GB. " + "; ".join(advice[:-1]) + ", " + advice[-1]
+        f"{_size(limit)}. " + "; ".join(advice[:-1]) + ", " + advice[-1]
     )
+
+
+def _size(n: float) -> str:
+    return f"{n / 1e9:.1f} GB" if n >= 1e9 else f"{n / 1e6:.0f} MB"
 
 
 def _duration(seconds: float) -> str:

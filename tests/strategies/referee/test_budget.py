@@ -110,6 +110,9 @@ def test_each_solver_checks_its_own_budget():
         estimate(s, (6, 8), cache=False, memory_budget="10MB")
     with pytest.raises(InvalidConfigError, match="memory_budget"):
         solve(s, 12, memory_budget="lots")
+    with pytest.raises(InfeasibleError, match=r"budget of 50 MB\. No cells_per_lmin fits "
+                       r"\(the interpreter alone takes 125 MB\)"):  # fmt: skip
+        solve(s, 12, memory_budget="50MB")
 
 
 def test_a_solve_within_the_budget_runs():

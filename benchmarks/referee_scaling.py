@@ -2,8 +2,10 @@
 
 For each resolution (``--cpl``: opponent cells per L_min) the referee of one small world is
 solved in a fresh subprocess (so its peak memory is its own), uncached. Printed per
-resolution: the cell size, the state counts of both bounds, the wall time of each bound
-(build + fixed point), the peak resident memory, the fractions of lattice starts each
+resolution, as each completes: the cell size, the state counts of both bounds, the wall
+time of each bound (build + fixed point), the peak resident memory and beside it the
+estimate the referee's memory budget made of it before solving (``est MB``,
+:mod:`strategies.referee._budget`), the fractions of lattice starts each
 bound certifies and the gap between them (the resolution error), and the time and memory
 as ratios to the first (reference) resolution, measured in the same run. Then the
 exponents k of ``time ~ cpl^k`` and ``memory ~ cpl^k`` fitted by least squares (the
@@ -62,7 +64,14 @@ def _child(world: str, rho: float, cpl: float) -> dict:
     total = time.perf_counter() - t
     s = ref.summary()
     peak_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    from strategies.referee._budget import bound_size, peak
+
+    sizes = [
+        bound_size(spec, ref.pursuer.res, "pursuer"),
+        bound_size(spec, ref.evader.res, "evader"),
+    ]
     return {
+        "est_mb": peak(sizes)[0] / 2**20,
         "cpl": cpl,
         "cell": ref.pursuer.res.cell,
         "states_p": s["pursuer_bound"]["states"],
@@ -100,6 +109,9 @@ def main(argv: list[str] | None = None) -> int:
           f"{os.getloadavg()[2]:.2f} on {os.cpu_count()} cores; world {args.world}, "
           f"rho = {args.rho:g}, L in [1, 2]")  # fmt: skip
     rows = []
+    head = (f"{'cpl':>5} {'cell':>7} {'states P':>10} {'states E':>10} {'time P':>8} "
+            f"{'time E':>8} {'time':>8} {'x ref':>7} {'peak MB':>8} {'x ref':>6} "
+            f"{'est MB':>7} {'pursuer':>8} {'evader':>7} {'gap':>6}")  # fmt: skip
     for cpl in args.cpl:
         out = subprocess.run(
             [sys.executable, __file__, "--child", "--world", args.world, "--rho",
@@ -111,19 +123,18 @@ def main(argv: list[str] | None = None) -> int:
             print(f"cpl {cpl:g}: the solve failed (exit code {out.returncode}): {last}",
                   file=sys.stderr)  # fmt: skip
             return 1
-        rows.append(json.loads(out.stdout.strip().splitlines()[-1]))
-    ref = rows[0]
-    head = (f"{'cpl':>5} {'cell':>7} {'states P':>10} {'states E':>10} {'time P':>8} "
-            f"{'time E':>8} {'time':>8} {'x ref':>7} {'peak MB':>8} {'x ref':>6} "
-            f"{'pursuer':>8} {'evader':>7} {'gap':>6}")  # fmt: skip
-    print(head)
-    for r in rows:
-        print(
+        r = json.loads(out.stdout.strip().splitlines()[-1])
+        rows.append(r)
+        ref = rows[0]
+        if len(rows) == 1:
+            print(head)
+        print(  # each row as its resolution completes (a stop keeps the rows printed)
             f"{r['cpl']:>5g} {r['cell']:>7.4f} {r['states_p']:>10d} {r['states_e']:>10d} "
             f"{r['time_p']:>7.2f}s {r['time_e']:>7.2f}s {r['time']:>7.2f}s "
             f"{r['time'] / ref['time']:>7.1f} {r['peak_mb']:>8.0f} "
-            f"{r['peak_mb'] / ref['peak_mb']:>6.1f} {r['pursuer']:>8.3f} {r['evader']:>7.3f} "
-            f"{r['gap']:>6.3f}"
+            f"{r['peak_mb'] / ref['peak_mb']:>6.1f} {r['est_mb']:>7.0f} {r['pursuer']:>8.3f} "
+            f"{r['evader']:>7.3f} {r['gap']:>6.3f}",
+            flush=True,
         )
     if len(rows) > 1:
         cpl = [r["cpl"] for r in rows]

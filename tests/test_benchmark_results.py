@@ -78,3 +78,23 @@ def test_evader_escapes_writes_each_job_and_resumes(bench, tmp_path, capsys):
     assert escapes.main(argv) == 0
     assert "2 jobs selected, 1 to play" in capsys.readouterr().out
     assert len(_lines(out)) == 2
+
+
+def test_referee_scaling_prints_each_resolution_with_the_budget_s_estimate():
+    """Each row as its resolution completes, with the memory the referee's budget estimated
+    before solving (est MB) beside the measured peak."""
+    import subprocess
+    import sys
+
+    out = subprocess.run(
+        [sys.executable, "referee_scaling.py", "--world", "open", "--cpl", "4", "6"],
+        cwd=BENCHMARKS, capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    head = next(i for i, line in enumerate(lines) if line.split()[:2] == ["cpl", "cell"])
+    assert "peak MB  x ref  est MB" in lines[head]
+    rows = [line.split() for line in lines[head + 1 : head + 3]]
+    assert [r[0] for r in rows] == ["4", "6"]
+    for r in rows:  # est MB (the 11th column) within a factor of 2 of the peak (the 9th)
+        assert 0.5 < float(r[10]) / float(r[8]) < 2.0

@@ -253,7 +253,8 @@ def main(argv=None) -> int:
             ref = f"; referee: {v}"
         print(f"  lost: {world} [{label}] rho={rho} {evader} seed={seed}: {cause} at {t}{ref}")
     if args.referee and losses:
-        print(referee_labels.summary(args.referee, verdicts_of_losses))
+        distinct = {(w, label, rho, seed) for w, label, rho, _, seed, *_ in losses}
+        print(referee_labels.summary(args.referee, verdicts_of_losses, len(distinct)))
     return 0
 
 

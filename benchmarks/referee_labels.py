@@ -80,13 +80,15 @@ def verdict(
         return "not a start"
 
 
-def summary(cpl: float, verdicts: Iterable[str], what: str = "lost starts") -> str:
-    """``referee (cpl X) on the N lost starts: a evader (unavoidable), b pursuer (the
-    policy's regret), c unknown (...)`` (and any ``not a start``)."""
+def summary(cpl: float, verdicts: Iterable[str], distinct: int | None = None) -> str:
+    """``referee (cpl X) on the N lost starts (K distinct): a evader (unavoidable), b
+    pursuer (the policy's regret), c unknown (...)`` (and any ``not a start``): one verdict
+    per lost episode; ``distinct`` says how many starts they are (opponents share them)."""
     counts = {v: 0 for v in MEANING}
     n = 0
     for v in verdicts:
         counts[v] = counts.get(v, 0) + 1
         n += 1
     parts = [f"{k} {v} ({MEANING[v]})" if v in MEANING else f"{k} {v}" for v, k in counts.items()]
-    return f"referee (cpl {cpl:g}) on the {n} {what}: " + ", ".join(parts)
+    of = "" if distinct is None else f" ({distinct} distinct)"
+    return f"referee (cpl {cpl:g}) on the {n} lost starts{of}: " + ", ".join(parts)

@@ -591,7 +591,8 @@ def report(rows: list[dict], referee: float | None = None) -> None:
             print(f"  lost: {r['world']} {r['combo']} {r['opponent']} seed={r['seed']}: {what}")
             print(f"    replay: {replay_command(r)}")
     if labels:
-        print(referee_labels.summary(referee, lost_labels))
+        distinct = {_start_key(r) for r in rows if not _won(r) and "start" in r}
+        print(referee_labels.summary(referee, lost_labels, len(distinct)))
 
 
 def main(argv=None) -> int:

@@ -193,25 +193,30 @@ def test_the_referee_labels_the_starts_it_certifies(unseen, tmp_path, monkeypatc
         i = int(np.flatnonzero(starts.label == kind)[0])
         p, e = starts.pursuer[i], starts.evader[i]
         assert ref.classify(p, e) == kind
-        rows.append({"role": "pursuer", "world": label, "combo": [0.5, 2.0, 2.0],
-                     "opponent": "herder", "seed": seed, "winner": "evader",
-                     "cause": "too_close", "t": 3.0, "steps": 30,
-                     "start": {"pursuer": fwd(p), "evader": fwd(e)}})  # fmt: skip
         want[seed] = kind
+        # the darter is held from the unknown start: 3 losses from 2 starts
+        darter = "evader" if kind == "evader" else "pursuer"
+        for opponent, winner in [("herder", "evader"), ("darter", darter)]:
+            rows.append({"role": "pursuer", "world": label, "combo": [0.5, 2.0, 2.0],
+                         "opponent": opponent, "seed": seed, "winner": winner,
+                         "cause": "too_close" if winner == "evader" else None, "t": 3.0,
+                         "steps": 30, "start": {"pursuer": fwd(p), "evader": fwd(e)}})  # fmt: skip
     out = tmp_path / "p.jsonl"
     out.write_text("".join(json.dumps(r) + "\n" for r in rows))
     argv = ["--role", "pursuer", "--worlds", label, "--combos", "0", "--opponents", "herder",
-            "--seeds", "101", "102", "--results", str(out), "--referee", "12"]  # fmt: skip
+            "darter", "--seeds", "101", "102", "--results", str(out),
+            "--referee", "12"]  # fmt: skip
     assert unseen.main(argv) == 0
     text = capsys.readouterr().out
-    assert "2 episodes selected, 0 to play" in text
+    assert "4 episodes selected, 0 to play" in text
     for seed, kind in want.items():
         assert f"herder seed={seed}: too_close at 3.0 s; referee: {kind}" in text
-    assert (
-        "referee (cpl 12) on the 2 lost starts: 1 evader (unavoidable), 0 pursuer (the "
-        "policy's regret), 1 unknown (the referee's resolution gap)" in text
+    assert "darter seed=101: too_close at 3.0 s; referee: evader" in text
+    assert (  # one verdict per lost episode; the two at seed 101 share a start
+        "referee (cpl 12) on the 3 lost starts (2 distinct): 2 evader (unavoidable), 0 "
+        "pursuer (the policy's regret), 1 unknown (the referee's resolution gap)" in text
     )
-    assert "1 evader, 1 unknown" in text  # the world's counts
+    assert "2 evader, 2 unknown" in text  # the world's episodes per start's label
 
 
 @pytest.mark.parametrize(

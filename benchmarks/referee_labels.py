@@ -6,8 +6,10 @@ ground truth) at ``CPL`` cells per L_min, with a fine evader lattice (2 cells a 
 1 spacing a step): ``"evader"`` (certified: no bounded-speed pursuer holds it, a loss
 from it is unavoidable), ``"pursuer"`` (certified: some pursuer holds it, a loss is the
 policy's regret), ``"unknown"`` (the referee's resolution gap; at rho >= 0.35 the pursuer
-bound certifies nothing, so there every verdict is ``"evader"`` or ``"unknown"``), or
-``"not a start"`` (surveillance does not hold there).
+bound certifies nothing, so there every verdict is ``"evader"`` or ``"unknown"``),
+``"not a start"`` (surveillance does not hold there) or ``"not solved"`` (the solve would
+exceed the referee's memory budget, ``$SURVEIL_MEMORY_BUDGET``; the message, printed once
+per world, names the CPL that fits).
 
 A world that is a similarity (rotation, uniform scaling, shift) of another is judged on
 the other: scaling lengths and speeds by one factor and moving the plane leave the game
@@ -23,7 +25,7 @@ from collections.abc import Callable, Iterable, Mapping
 
 import numpy as np
 
-from envs.errors import InvalidPlacementError
+from envs.errors import InfeasibleError, InvalidPlacementError
 from envs.maps import Map
 
 __all__ = ["MEANING", "similarity_back", "summary", "verdict"]
@@ -50,6 +52,8 @@ def similarity_back(
 
 
 def _referee(m: Map, overrides: Mapping[str, float], cpl: float):
+    """The world's referee, or the InfeasibleError that refused its solve (the memory
+    budget, ``$SURVEIL_MEMORY_BUDGET``): one world at a time."""
     from envs.surveillance.config import EnvConfig
     from strategies.referee import referee_for
 
@@ -57,7 +61,11 @@ def _referee(m: Map, overrides: Mapping[str, float], cpl: float):
     cfg = EnvConfig(map=m, **overrides)
     key = (m.digest, tuple(sorted(overrides.items())), float(cpl), cfg.dt)
     if _last is None or _last[0] != key:
-        _last = (key, referee_for(cfg, cpl, **SOLVE))
+        try:
+            _last = (key, referee_for(cfg, cpl, **SOLVE))
+        except InfeasibleError as exc:
+            print(f"  referee (cpl {cpl:g}) not solved on map {m.name!r}: {exc}", flush=True)
+            _last = (key, exc)
     return _last[1]
 
 
@@ -71,9 +79,13 @@ def verdict(
     """The referee's label of ``start`` (``{"pursuer": (x, y), "evader": (x, y)}``) in the
     game on ``m`` with env ``overrides`` (``l_min, l_max, v_pursuer, v_evader,
     body_radius``), at ``cpl`` cells per L_min; ``back`` maps the start's points into
-    ``m`` when the start was played on a similar world."""
+    ``m`` when the start was played on a similar world. ``"not solved"`` when the solve
+    would exceed the memory budget (the reason is printed once per world): the other
+    worlds are still labelled."""
     back = back or (lambda q: np.asarray(q, float))
     ref = _referee(m, overrides, cpl)
+    if isinstance(ref, InfeasibleError):
+        return "not solved"
     try:
         return ref.classify(back(start["pursuer"]), back(start["evader"]))
     except InvalidPlacementError:

@@ -219,6 +219,27 @@ def test_the_referee_labels_the_starts_it_certifies(unseen, tmp_path, monkeypatc
     assert "2 evader, 2 unknown" in text  # the world's episodes per start's label
 
 
+def test_a_world_the_referee_cannot_afford_is_not_solved(unseen, tmp_path, monkeypatch,
+                                                         capsys) -> None:  # fmt: skip
+    """A solve over the memory budget labels that world's starts ``not solved`` (its reason
+    printed) instead of stopping the report."""
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", str(tmp_path / "cache"))
+    # the referee's budget only ($SURVEIL_MEMORY_BUDGET would refuse Prop. 2's decomposition)
+    monkeypatch.setitem(importlib.import_module("referee_labels").SOLVE, "memory_budget", "10MB")
+    row = {"role": "pursuer", "world": "L_10x4", "combo": [0.5, 2.0, 2.0], "opponent": "herder",
+           "seed": 101, "winner": "evader", "cause": "too_close", "t": 3.0, "steps": 30,
+           "start": {"pursuer": [1.0, 1.0], "evader": [1.0, 3.5]}}  # fmt: skip
+    out = tmp_path / "p.jsonl"
+    out.write_text(json.dumps(row) + "\n")
+    argv = ["--role", "pursuer", "--worlds", "L_10x4", "--combos", "0", "--opponents", "herder",
+            "--results", str(out), "--referee", "12"]  # fmt: skip
+    assert unseen.main(argv) == 0
+    text = capsys.readouterr().out
+    assert "referee (cpl 12) not solved on map 'L_10x4'" in text and "memory budget" in text
+    assert "herder seed=101: too_close at 3.0 s; referee: not solved" in text
+    assert "on the 1 lost starts (1 distinct): 0 evader" in text and "1 not solved" in text
+
+
 @pytest.mark.parametrize(
     "argv, message",
     [(["--role", "pursuer", "--referee", "0"], "argument --referee: '0': expected a finite"),

@@ -37,6 +37,12 @@ arc_u           direction to the end of the escape arc it follows at the next st
 arc_n           shooting candidate, kept for ``replan`` steps; 0, 0 where none)
 =============== ==============================================================================
 
+Not a feature: the pressure time so far, after which the evader herds the pursuer into a
+corner instead of charging it (``ShootingEvader.HERD_AFTER`` D / V_e; issue 13). The
+shipped ``training/zoo/models/dagger_evader_memory`` was trained on these 11 numbers, so a
+12th would change its observation size; a learner given these features does not see when
+the expert's charge turns into a herd (the ``pressure`` mode covers both).
+
 Stateful: call :meth:`MemoryFeatures.restart` at each episode start and the features once
 per step, in order (:class:`~strategies.policies.learner_inputs.LearnerInputs` does both).
 Each call costs one shooting decision.

@@ -26,9 +26,10 @@ For rho > 1 it runs straight at the pursuer (footnote 4; see :meth:`ShootingEvad
 
 4. Otherwise **pressure**: move straight at the pursuer (Sec. 6.1, a heading
    minimising max |theta_dot|); against a wall, slide along it perpendicular to the rod,
-   the way that does not press straight into the wall. After ``HERD_AFTER`` steps of it,
-   herd instead: get to the far side of the pursuer from its nearest concave corner, then
-   charge, pinning it there.
+   the way that does not press straight into the wall. After ``HERD_AFTER`` D / V_e of it
+   (D the map's diameter), from the first step the pursuer comes within L_min of a
+   concave corner, herd instead: get to the far side of the pursuer from that corner,
+   then charge, pinning it there.
 """
 
 from __future__ import annotations
@@ -40,6 +41,7 @@ import numpy as np
 from envs import validation
 from envs.geometry import kernel_for
 from strategies.control.evasion import escape_path
+from strategies.cspace.tolerances import diameter
 from strategies.policies.base import (
     MAX_RAYS,
     BasePolicy,
@@ -104,12 +106,16 @@ class ShootingEvader(BasePolicy):
 
     STALL_STEPS = 10  # steps without getting closer to a crossing before giving it up
     FORGIVE_STEPS = 20  # steps without a crossing in an escapable cell before a retry
-    # steps of pressure before it herds the pursuer into a corner instead, a last resort
-    # (issue 13): herding from the first step lost two escapes the charge makes (two_rooms
-    # at L_min 1, after 8 and 13 steps of it); from the 1,000th it slowed escapes the charge
-    # makes after 1,092 steps (random:polygons:0), from the 1,500th or 2,000th it lost one
-    # it makes after 2,405 (office turned by 2.2 rad)
-    HERD_AFTER = 2500
+    # pressure time, in D / V_e (D the map's diameter, a similarity invariant), after which
+    # it herds the pursuer into a corner instead, a last resort (issue 13). In game time, so
+    # that it does not depend on dt or on how fast the evader is (2,500 steps, as it was,
+    # were 3.3 D / V_e at rho 0.3 on random:star:11, 6.6 at dt 0.2 s, and more than the
+    # 8 D / V_e horizon at rho 0.8). The charges that escape in the three evader benchmarks
+    # take at most 2.5 D / V_e of it (office turned by 2.2 rad, rho 0.3: 2.50;
+    # random:polygons:0, rho 0.5: 2.40); herding from 1 or 2 D / V_e slowed them (escape
+    # times in the benchmarks' D / V_e: 2.92 -> 7.09 or 3.30, 5.98 -> 6.64 or 6.50), from
+    # the first step it lost two (two_rooms at L_min 1, after 8 and 13 steps of charging)
+    HERD_AFTER = 3.0
 
     def _reset(self) -> None:
         c = self.config
@@ -153,6 +159,8 @@ class ShootingEvader(BasePolicy):
         self._corner_points = m.vertices[idx] + (c.body_radius + 2.0 * h) * bis
         self._corner_rows = self.table.rows(self._corner_points)
         self._concave = m.vertices[~m.vertex_convex]  # the corners pressure herds into
+        # the pressure steps after which it herds (HERD_AFTER D / V_e of them)
+        self._herd_after = self.HERD_AFTER * diameter(m) / (c.v_evader * c.dt)
         self.restart()
 
     def restart(self) -> None:
@@ -182,6 +190,7 @@ class ShootingEvader(BasePolicy):
         self._no_way = 0  # steps in an escapable cell whose crossings are all excluded
         self._forgiven = 0  # retries so far (each waits twice as long as the last)
         self._pressed = 0  # pressure steps so far
+        self._herding = False  # herding the pursuer into a corner (from then on)
 
     # ------------------------------------------------------------------ candidates
     def _candidates(self, e: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -365,11 +374,22 @@ class ShootingEvader(BasePolicy):
         # evader in place.)
         u = unit(snap.rod)
         self._pressed += 1
-        if self._pressed > self.HERD_AFTER and len(self._concave):
+        if self._pressed > self._herd_after and len(self._concave):
             # the charge made no end of it: pin the pursuer into its nearest concave
             # corner, where it cannot back off (issue 13: random:star:11 at rho 0.3
-            # against the decomposition pursuer, 4,700 steps of charging in the open)
-            return c.v_evader * self._herd(e, snap.pursuer, u, float(snap.L))
+            # against the decomposition pursuer, 4,700 steps of charging in the open).
+            # Only from a step where the corner lies within a rod's length (L_min) of the
+            # pursuer: from farther off the pursuer, faster, slips round the evader, and the
+            # herd dragged it along the walls round the whole map until the plan escaped
+            # (random:star:11, seed 507: herding from wherever the pursuer was after
+            # 2,500 steps or 3 D / V_e, occluded at 6.54 or 7.10 D / V_e; from within L_min
+            # of a corner, pinned there, too close, at 5.54; seeds 600 and 601 likewise,
+            # 6.67 -> 5.67, 6.48 -> 5.48)
+            if not self._herding:
+                d = self._concave - snap.pursuer
+                self._herding = float(np.einsum("ij,ij->i", d, d).min()) <= c.l_min**2
+            if self._herding:
+                return c.v_evader * self._herd(e, snap.pursuer, u, float(snap.L))
         if self._near_wall(e, c.body_radius + 2.0 * c.v_evader * c.dt):
             # against a wall the push is lost: slide along it, perpendicular to the rod
             # (which turns the rod fastest); the other way round where this one presses

@@ -11,8 +11,12 @@ falls back. Each episode was held for the whole 8 D / V_e horizon before:
   region; the charge escapes in 0.35 D / V_e.
 * ``random:star:11``, rho = 0.3, L_max = 1.5 L_min, against the decomposition pursuer
   (seed 507): 4,700 steps of charging in the open, the pursuer backing off. After
-  ``HERD_AFTER`` steps of it the evader herds the pursuer into its nearest concave
-  corner and escapes in 6.54 D / V_e.
+  ``HERD_AFTER`` D / V_e of it, from the first step the pursuer is within L_min of a
+  concave corner, the evader herds it into that corner and pins it there (too close).
+  Herding from wherever the pursuer was after 2,500 steps dragged it round the map and
+  escaped (occluded) 1 D / V_e later. The trigger is game time, not steps: at twice the
+  step (dt 0.2 s) 2,500 steps of charging came after the 8 D / V_e horizon and the
+  pursuer held.
 """
 
 from __future__ import annotations
@@ -20,6 +24,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
 from envs.maps import builtin_info, load_map
 from strategies.policies.shooting import ShootingEvader
@@ -56,4 +61,20 @@ def test_herds_the_pursuer_into_a_corner_after_a_long_charge():
     r = run_episode(m, "pursuer/decomposition", ev, 507, start="safe", overrides=params,
                     max_cycles=_horizon(m, 0.3, 7.0))  # fmt: skip
     assert r.winner == "evader", r.summary()
-    assert ev._pressed > ShootingEvader.HERD_AFTER  # it escaped herding
+    assert r.cause == "too_close", r.summary()  # pinned in the corner
+    assert ev._pressed > ev._herd_after  # it escaped herding
+
+
+def test_herds_after_a_charge_of_three_crossings_in_game_time():
+    # the same episode at twice the step: the herd starts after 3 D / V_e of charging
+    # (1,139 steps of 0.2 s here), not after a count of steps (2,500 steps: 6.6 D / V_e)
+    m = load_map("random:star:11")
+    params = {"l_min": 2.0, "l_max": 3.0, "v_pursuer": 1.0, "v_evader": 0.3,
+              "body_radius": 0.1, "dt": 0.2}  # fmt: skip
+    ev = ShootingEvader()
+    r = run_episode(m, "pursuer/decomposition", ev, 507, start="safe", overrides=params,
+                    max_cycles=_horizon(m, 0.3, 8.0) // 2)  # fmt: skip
+    assert r.winner == "evader", r.summary()
+    x0, y0, x1, y1 = m.bounds  # this map's diameter is its bounding-box diagonal
+    assert ev._herd_after == pytest.approx(3.0 * math.hypot(x1 - x0, y1 - y0) / 0.3 / 0.2)
+    assert ev._pressed > ev._herd_after  # it escaped herding

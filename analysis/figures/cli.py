@@ -84,9 +84,9 @@ def run(args: argparse.Namespace) -> int:
         return 0
     specs = select(args.only)
     check_scale(args.scale)  # before drawing anything
-    out = output_dir("--out", args.out)  # an existing file is refused up front
     if args.report:
         _report_text(Path(args.report), "--report")
+    out = output_dir("--out", args.out)  # made here; an existing file is refused up front
     from tqdm import tqdm
 
     bar = tqdm(specs, unit="figure", disable=not sys.stderr.isatty())

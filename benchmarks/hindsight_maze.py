@@ -10,12 +10,13 @@ evader alone (``--steps`` env steps in all); then, for each cell side, the optim
 set (empty: no pursuer could hold) and the pessimistic one (non-empty: a pursuer held,
 its witness path) are computed, with their wall-clock cost. ``--witness`` replays the
 pessimistic witness of each cell in the env as a scripted pursuer (when the pessimistic
-step is the env's).
+step is the env's). ``--v-pursuer`` asks the question of a slower (or faster) pursuer
+against the same path.
 
 Usage::
 
     python benchmarks/hindsight_maze.py [--cells 0.04 0.02 0.01] [--steps 60]
-        [--moves 10] [--pieces 4] [--clearance R] [--witness]
+        [--moves 10] [--pieces 4] [--clearance R] [--v-pursuer 1] [--witness]
 """
 
 from __future__ import annotations
@@ -54,6 +55,7 @@ def main(argv=None) -> int:
     ap.add_argument("--moves", type=real(1), default=10.0)
     ap.add_argument("--pieces", type=integer(1), default=4)
     ap.add_argument("--clearance", type=real(0), default=None)
+    ap.add_argument("--v-pursuer", type=real(0), default=None, help="the pursuer's speed bound")
     ap.add_argument("--witness", action="store_true", help="replay the witnesses in the env")
     args = ap.parse_args(argv)
     print(f"load average: {os.getloadavg()}")
@@ -69,6 +71,9 @@ def main(argv=None) -> int:
     )
     print(f"evader path: {path.lengths} frames (the same on their common frames)")
     cfg = EnvConfig(map=info.map, **params)
+    if args.v_pursuer is not None:  # the question of another pursuer; the path stays
+        cfg = EnvConfig(map=info.map, **{**params, "v_pursuer": args.v_pursuer})
+        print(f"V_p = {args.v_pursuer:g} (the path was recorded at V_p = {params['v_pursuer']:g})")
     for h in args.cells:
         r = hindsight(
             cfg,
@@ -87,7 +92,8 @@ def main(argv=None) -> int:
             f"{r.seconds:.1f} s",
             flush=True,
         )
-        if args.witness and abs(r.pessimistic_tau - cfg.dt) < 1e-12 and len(r.witness) > 1:
+        replayable = args.v_pursuer is None and abs(r.pessimistic_tau - cfg.dt) < 1e-12
+        if args.witness and replayable and len(r.witness) > 1:
             ep = run_episode(
                 info.map,
                 _Scripted(r.witness),

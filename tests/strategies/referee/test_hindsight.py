@@ -48,6 +48,18 @@ def _assert_witness_holds(cfg, E_frames, res):
     assert segment_wall_distance(w[:-1], w[1:], cfg.map).min() >= cfg.body_radius
 
 
+def _assert_inside_optimistic(res, k, x, P0, h):
+    """Every cell whose disc (radius h / sqrt 2) holds the feasible point x is kept at
+    step k: the optimistic set's invariant, with x a position some pursuer reaches."""
+    kept = {tuple(q) for q in np.rint((res.optimistic_sets[k] - P0) / h).astype(int).tolist()}
+    base = np.floor((np.asarray(x) - P0) / h).astype(int)
+    for di in (0, 1):
+        for dj in (0, 1):
+            ij = (int(base[0] + di), int(base[1] + dj))
+            if np.hypot(*(P0 + h * np.array(ij) - x)) <= h / math.sqrt(2) * (1 - 1e-9):
+                assert ij in kept, (k, x, ij)
+
+
 def test_stationary_evader_in_range_is_held():
     cfg = _config(ROOM)
     E = np.tile([[10.0, 5.0]], (31, 1))
@@ -71,11 +83,14 @@ def test_runaway_evader_breaks_range_at_the_closed_form_time(heading):
     T = (cfg.l_max - d0) / (Ve - cfg.v_pursuer)
     widths = []
     for h, substeps in ((0.02, 1), (0.01, 2), (0.005, 4)):  # tau shrinks with the cell
-        res = hindsight(cfg, E, P0, h, substeps=substeps, moves=5)
+        res = hindsight(cfg, E, P0, h, substeps=substeps, moves=5, keep_sets=True)
+        for k in range(round(T / res.tau) + 1):  # the chaser, straight after the evader
+            _assert_inside_optimistic(res, k, P0 + cfg.v_pursuer * k * res.tau * u, P0, h)
         assert res.verdict == "evader"
         delta = h / math.sqrt(2)
-        # sound: no pursuer holds past T, the optimistic set survives until then
-        assert T <= res.optimistic_empty + 1e-9
+        # sound: a pursuer holds until T (a frame: the set there is one point at L_max),
+        # so the optimistic set survives it
+        assert T + 1e-9 < res.optimistic_empty
         assert res.optimistic_empty <= T + res.tau + 2 * delta / (Ve - 1.0) + 1e-9
         # sound: a pursuer held until pessimistic_until, so it is <= T
         assert res.pessimistic_until <= T + 1e-9
@@ -107,7 +122,7 @@ def test_evader_passing_behind_a_pillar_too_fast():
     for h in (0.02, 0.01):
         res = hindsight(cfg, E, (6.0, 5.0), h)
         assert res.verdict == "evader"
-        assert t_c <= res.optimistic_empty <= t_c2 + res.tau + 1e-9
+        assert t_c < res.optimistic_empty <= t_c2 + res.tau + 1e-9
         assert t_c - res.pessimistic_tau - 1e-9 <= res.pessimistic_until <= t_c2
         _assert_witness_holds(cfg, E, res)
 
@@ -124,13 +139,17 @@ def test_played_pursuers_are_witnesses_of_the_optimistic_set():
     from strategies.runner import build_env
 
     cfg = build_env("l_hall", over).config
-    res = hindsight(cfg, path, path.pursuer_start, 0.05)
+    # the env's physics may press a disc to half its radius from a wall
+    res = hindsight(cfg, path, path.pursuer_start, 0.05, clearance=0.1, keep_sets=True)
     from strategies.runner import run_episode
 
+    sub = round(cfg.dt / res.tau)
     for p in ("pursuer/greedy", "pursuer/random"):
         ep = run_episode("l_hall", p, "evader/wall_hugging", 1, overrides=over, max_cycles=80)
         held = ep.escape_time if ep.escape_time is not None else ep.steps * ep.dt
         assert res.optimistic_empty is None or res.optimistic_empty > held - 1e-9
+        for f in range(int(held / ep.dt + 1e-9) + 1):  # its frames while it held
+            _assert_inside_optimistic(res, f * sub, ep.trajectory[f, 0], path.pursuer_start, 0.05)
 
 
 def test_record_evader_path_rejects_a_closed_loop_evader():
@@ -152,3 +171,26 @@ def test_bad_input_is_named():
         hindsight(cfg, E, (8.5, 5.0), 0.1, substeps=0)
     with pytest.raises(InvalidPlacementError, match="pursuer_start"):
         hindsight(cfg, E, (9.5, 5.0), 0.1)  # too close
+
+
+def test_robust_occlusion_blocks_every_point_of_the_disc():
+    # the optimistic set drops a cell for occlusion only when no point of its disc sees E
+    from strategies.referee.hindsight import _robustly_blocked
+
+    rng = np.random.default_rng(3)
+    kernel = kernel_for(PILLAR)
+    a, b, n = PILLAR.edge_start, PILLAR.edge_end, PILLAR.edge_normal
+    delta = 0.3
+    E = np.array([12.5, 5.3])
+    C = rng.uniform((0.5, 0.5), (19.5, 9.5), size=(400, 2))
+    blocked = _robustly_blocked(E, C, delta, a, b, n)
+    ang = rng.uniform(0, 2 * np.pi, 64)
+    rad = delta * np.sqrt(rng.uniform(0, 1, 64))
+    rad[:16] = delta  # the rim too
+    ring = np.stack([np.cos(ang), np.sin(ang)], axis=1) * rad[:, None]
+    assert 10 <= blocked.sum() <= 390  # both kinds occur
+    for c in C[blocked]:
+        assert not any(kernel.line_of_sight(E, c + d) for d in ring), c
+    # and the test is not vacuous: discs of centres that see E are never dropped
+    sees = np.array([kernel.line_of_sight(E, c) for c in C])
+    assert not (blocked & sees).any()

@@ -25,6 +25,7 @@ import multiprocessing as mp
 import os
 import signal
 import sys
+import threading
 from collections.abc import Callable, Iterator
 from multiprocessing.pool import Pool
 
@@ -62,6 +63,18 @@ def ignore_sigint() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
+def _start_worker(initializer: Callable[..., object] | None, initargs: tuple) -> None:
+    """A pool worker's start: tqdm's lock for this process is a thread lock, not its
+    default ``multiprocessing`` one (a named semaphore that a terminated worker leaves
+    behind: "resource_tracker: There appear to be 2 leaked semaphore objects" after a stop,
+    once the workers had built a table behind a progress bar), then ``initializer``."""
+    from tqdm import tqdm
+
+    tqdm.set_lock(threading.RLock())
+    if initializer is not None:
+        initializer(*initargs)
+
+
 @contextlib.contextmanager
 def worker_pool(
     processes: int, initializer: Callable[..., object] | None = None, initargs: tuple = ()
@@ -71,12 +84,13 @@ def worker_pool(
     The workers are started with SIGINT ignored (an ignored signal stays ignored across
     ``exec``, and Python then installs no KeyboardInterrupt handler), so a Ctrl-C at any
     moment, their start-up included, prints no worker traceback. Leaving the block closes
-    the pool and waits for its workers; leaving it by an exception (a stop included)
-    terminates them first.
+    the pool and waits for its workers; leaving it by an exception (a stop included), or a
+    stop during that wait, terminates them first. The workers' progress bars lock within
+    each worker (:func:`_start_worker`), so a terminated worker leaks no semaphore.
     """
     old = signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
-        pool = mp.get_context("spawn").Pool(processes, initializer, initargs)
+        pool = mp.get_context("spawn").Pool(processes, _start_worker, (initializer, initargs))
     finally:
         signal.signal(signal.SIGINT, old)
     try:
@@ -87,4 +101,9 @@ def worker_pool(
     else:
         pool.close()
     finally:
-        pool.join()
+        try:
+            pool.join()
+        except BaseException:  # a stop while the closed pool finishes its last jobs
+            pool.terminate()
+            pool.join()
+            raise

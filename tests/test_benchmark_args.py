@@ -83,11 +83,13 @@ def test_sigterm_stops_a_run_with_one_line() -> None:
 
 def test_ctrl_c_stops_a_pool_run_with_one_line(tmp_path) -> None:
     """Ctrl-C (SIGINT to the whole process group) stops ``unseen_worlds.py --workers 2``
-    with exit code 130 and one line: no worker traceback, no leaked-semaphore warning."""
-    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+    with exit code 130 and one line: no worker traceback, no leaked-semaphore warning. An
+    empty cache: the workers build their tables behind progress bars (tqdm's lock was a
+    semaphore per worker, left behind by the terminated workers)."""
+    env = {**os.environ, "PYTHONUNBUFFERED": "1", "SURVEIL_CACHE_DIR": str(tmp_path / "cache")}
     rows = str(tmp_path / "rows.jsonl")
     args = ["--role", "pursuer", "--worlds", "maze~x0.7rot-2.6", "--combos", "0",
-            "--seeds", "0", "1", "--workers", "2", "--results", rows]  # fmt: skip
+            "--seeds", *map(str, range(8)), "--workers", "2", "--results", rows]  # fmt: skip
     proc = subprocess.Popen(
         [sys.executable, "unseen_worlds.py", *args],
         cwd=BENCHMARKS,

@@ -10,10 +10,8 @@
   argparse can (an unknown map or zoo model named by a flag: the project's
   ``SurveilValueError``, or a file error) is one line and exit code 2, as in the ``surveil``
   CLI (:func:`analysis.arguments.user_error`); a bug keeps its traceback.
-* :func:`ignore_sigint` is a ``multiprocessing`` pool initializer: Ctrl-C reaches the whole
-  process group, and only the parent should answer it (the pool's workers are terminated
-  when the parent leaves its ``with`` block).
-* :func:`worker_pool` is such a pool whose workers ignore SIGINT from their first
+* :func:`worker_pool` is a ``multiprocessing`` pool whose workers ignore SIGINT (Ctrl-C
+  reaches the whole process group; only the parent answers it) from their first
   instruction (a Ctrl-C while they are still importing is no traceback either), closed
   when its ``with`` block ends and terminated when a stop leaves it.
 """
@@ -31,7 +29,7 @@ from multiprocessing.pool import Pool
 
 from analysis.arguments import integer, real, user_error
 
-__all__ = ["ignore_sigint", "integer", "real", "run", "worker_pool"]
+__all__ = ["integer", "real", "run", "worker_pool"]
 
 EXIT_CODE = {"SIGINT": 130, "SIGTERM": 143}
 
@@ -56,11 +54,6 @@ def run(main: Callable[[], int | None]) -> int:
             raise  # a bug: keep the traceback
         print(f"{prog}: error: {message}", file=sys.stderr)
         return 2
-
-
-def ignore_sigint() -> None:
-    """Pool initializer: the parent answers Ctrl-C (and terminates the pool)."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _start_worker(initializer: Callable[..., object] | None, initargs: tuple) -> None:

@@ -16,7 +16,7 @@ against the same path.
 Usage::
 
     python benchmarks/hindsight_maze.py [--cells 0.04 0.02 0.01] [--steps 60]
-        [--moves 10] [--pieces 4] [--clearance R] [--v-pursuer 1] [--witness]
+        [--substeps N] [--moves 10] [--pieces 4] [--clearance R] [--v-pursuer 1] [--witness]
 """
 
 from __future__ import annotations
@@ -52,6 +52,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cells", type=real(0), nargs="+", default=[0.04, 0.02, 0.01])
     ap.add_argument("--steps", type=integer(1), default=60, help="env steps of evader path")
+    ap.add_argument("--substeps", type=integer(1), default=None, help="optimistic steps a frame")
     ap.add_argument("--moves", type=real(1), default=10.0)
     ap.add_argument("--pieces", type=integer(1), default=4)
     ap.add_argument("--clearance", type=real(0), default=None)
@@ -80,6 +81,7 @@ def main(argv=None) -> int:
             path,
             path.pursuer_start,
             h,
+            substeps=args.substeps,
             moves=args.moves,
             pieces=args.pieces,
             clearance=args.clearance,

@@ -39,11 +39,13 @@ Two grids bracket the truth (cells of side h, radius delta = h / sqrt(2)):
 
 Between them the truth is unknown at that resolution. The pessimistic lattice loses speed
 to its directions only (the hull of the lattice moves: 5 % at V_p tau = 5 h, 3 % at 10 h,
-2 % at 15 h) and erodes the set by about V_p tau / (2 pieces) near the visibility
+2 % at 15 h, 1 % at 30 h) and erodes the set by about V_p tau / (2 pieces) near the visibility
 boundaries; ``moves`` and ``pieces`` trade these against time.
 
 :func:`record_evader_path` plays a seeded episode against one or more pursuers, checks that
-the evader's path is the same against each (open loop), and returns the longest.
+the evader's path is the same against each (open loop), and returns the longest; with
+``extend_to`` it replays the evader alone past the break (checked identical on the frames
+the episodes played).
 """
 
 from __future__ import annotations

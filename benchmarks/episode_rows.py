@@ -4,8 +4,11 @@ The format of ``unseen_worlds.py --results`` (also ``pursuer_holds.py`` and
 ``evader_escapes.py``): one JSON object per line, one line per episode, appended and
 flushed as each episode completes, so a stop (Ctrl-C, ``timeout``, a crash) loses at most
 the episodes in flight. A rerun with the same file skips the episodes whose key is already
-in it and reports over all of them. A last line cut short by a hard kill is dropped (that
-episode is played again) and never glued to the next row.
+in it and reports over all of them. A last line cut short by a hard kill (no newline after
+it: every row is written with its newline) is dropped (that episode is played again) and
+never glued to the next row; any other line that is not a row of this script (not JSON, or
+a row of another script, without the fields of its key) is refused before anything is
+played or appended.
 """
 
 from __future__ import annotations
@@ -15,6 +18,8 @@ import os
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from typing import IO, Any
+
+from envs.errors import InvalidConfigError
 
 __all__ = ["appending", "key", "read"]
 
@@ -28,18 +33,19 @@ def read(path: str | os.PathLike, key_of: Callable[[dict], str]) -> dict[str, di
     """The rows already in ``path`` by ``key_of(row)``; empty when there is no file.
 
     Raises:
-        ValueError: a line other than the last is not a JSON object (the file is not
-            such a results file); the message names the file and the line.
+        InvalidConfigError: a line is not a JSON object (the file is not such a results
+            file), the last one included unless it was cut short (no newline after it), or
+            a row lacks a field of ``key_of`` (a results file of another script); the
+            message names the file and the line.
     """
     rows: dict[str, dict] = {}
     if not os.path.exists(path):
         return rows
     with open(path) as f:
-        lines = f.read().split("\n")
-    last = len(lines) - 1
-    while last >= 0 and not lines[last].strip():
-        last -= 1
-    for i, line in enumerate(lines[: last + 1]):
+        text = f.read()
+    lines = text.split("\n")  # a row cut short is the last item (text ends without "\n")
+    expected = "expected a results file of JSON lines (one episode a line) of this script"
+    for i, line in enumerate(lines):
         if not line.strip():
             continue
         try:
@@ -47,13 +53,17 @@ def read(path: str | os.PathLike, key_of: Callable[[dict], str]) -> dict[str, di
         except json.JSONDecodeError:
             row = None
         if not isinstance(row, dict):
-            if i == last:  # cut short by a hard kill: play that episode again
+            if i == len(lines) - 1:  # cut short by a hard kill: play that episode again
                 break
-            raise ValueError(
-                f"{os.fspath(path)}, line {i + 1}: {line[:60]!r} is not a JSON object; "
-                "expected a results file of JSON lines (one episode a line)"
+            raise InvalidConfigError(
+                f"{os.fspath(path)}, line {i + 1}: {line[:60]!r} is not a JSON object; " + expected
             )
-        rows[key_of(row)] = row
+        try:
+            rows[key_of(row)] = row
+        except KeyError as exc:
+            raise InvalidConfigError(
+                f"{os.fspath(path)}, line {i + 1}: the row has no field {exc}; {expected}"
+            ) from None
     return rows
 
 

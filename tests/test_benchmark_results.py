@@ -4,9 +4,12 @@ from __future__ import annotations
 
 import importlib
 import json
+import signal
 from pathlib import Path
 
 import pytest
+
+from envs.errors import InvalidConfigError
 
 BENCHMARKS = Path(__file__).resolve().parents[1] / "benchmarks"
 
@@ -39,6 +42,47 @@ def test_a_file_that_is_not_json_lines_is_refused_naming_the_line(bench, tmp_pat
     path.write_text("some notes\nmore\n")
     with pytest.raises(ValueError, match=r"notes.txt, line 1: 'some notes' is not a JSON"):
         rows.read(path, str)
+
+
+def test_a_last_line_that_is_no_row_but_ends_its_line_is_refused(bench, tmp_path):
+    """Only a line without its newline was cut short by a kill: a whole bad last line (a
+    one-line file of notes, a row edited by hand) is refused, not silently kept under the
+    rows appended after it (which made the next rerun fail on it)."""
+    rows = bench("episode_rows")
+    for text in ("garbage\n", '{"id": 1}\n{"id"\n'):
+        path = tmp_path / "r.jsonl"
+        path.write_text(text)
+        with pytest.raises(InvalidConfigError, match=r"r.jsonl, line \d: .* is not a JSON object"):
+            rows.read(path, lambda r: str(r["id"]))
+
+
+def test_a_results_file_of_another_script_is_refused_naming_the_field(bench, tmp_path):
+    rows = bench("episode_rows")
+    path = tmp_path / "escapes.jsonl"
+    path.write_text('{"world": "tee", "pursuer": "still", "seed": 0}\n')
+    with pytest.raises(
+        InvalidConfigError, match=r"escapes.jsonl, line 1: the row has no field 'rho'"
+    ):
+        rows.read(path, lambda r: str((r["world"], r["rho"])))
+
+
+def test_a_bad_results_file_is_one_line_and_exit_2_and_left_as_it_was(bench, tmp_path, capsys):
+    holds = bench("pursuer_holds")
+    bench_cli = bench("bench_cli")
+    out = tmp_path / "other.jsonl"
+    text = '{"world": "tee", "pursuer": "still", "seed": 0}\n'
+    out.write_text(text)
+    argv = ["--worlds", "open_room", "--variants", "as is", "--rho", "0.3", "--seeds", "1",
+            "--no-greedy", "--workers", "1", "--results", str(out)]  # fmt: skip
+    old = signal.getsignal(signal.SIGTERM)
+    try:
+        assert bench_cli.run(lambda: holds.main(argv)) == 2
+    finally:
+        signal.signal(signal.SIGTERM, old)  # run() answers SIGTERM: not in pytest's process
+    err = capsys.readouterr().err
+    assert "other.jsonl, line 1: the row has no field 'variant'" in err
+    assert "Traceback" not in err
+    assert out.read_text() == text
 
 
 def test_pursuer_holds_writes_each_episode_and_resumes(bench, tmp_path, capsys):

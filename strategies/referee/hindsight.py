@@ -60,9 +60,11 @@ import numpy as np
 from scipy import ndimage
 
 from envs import validation
-from envs.errors import InvalidConfigError, InvalidPlacementError
+from envs.errors import InfeasibleError, InvalidConfigError, InvalidPlacementError
 from envs.geometry import kernel_for
 from envs.geometry.segments import point_in_walls
+from strategies.cspace._budget import memory_budget as _memory_budget
+from strategies.referee._budget import BASE_BYTES, _size
 from strategies.referee.lattice import segment_wall_distance
 from strategies.referee.robust import convex_corners, sweep_hits_vertex, sweep_range_ok
 from strategies.referee.spec import MARGIN_REL
@@ -70,6 +72,16 @@ from strategies.referee.spec import MARGIN_REL
 __all__ = ["HINDSIGHT_VERDICTS", "EvaderPath", "Hindsight", "hindsight", "record_evader_path"]
 
 HINDSIGHT_VERDICTS = ("evader", "pursuer", "unknown")
+
+_BYTES_PER_CELL = (700.0, 24.0)
+"""Peak memory per cell of the grid, ``a + b pieces^2`` bytes (the full-grid arrays and
+distance transforms, and the pessimistic sight tests on the lattice of spacing h /
+pieces), measured as peak resident memory above the interpreter's (``ru_maxrss``): an
+evader standing nearly still in ``open_room`` (so the pessimistic set's crop is most of
+the grid), 30 frames, cell 0.01 (254 k cells): 381, 454, 779, 2257 and 4173 bytes per
+cell at pieces 1, 2, 4, 8 and 12; cell 0.005 (960 k cells): 1072 at pieces 4, 2255 at 8.
+The formula gives 724, 796, 1084, 2236 and 4156: within 2 % from 4 pieces up, and over
+(never under) at fewer."""
 
 
 @dataclass(frozen=True)
@@ -143,6 +155,29 @@ def _param(config: Any, name: str) -> float:
     if not math.isfinite(value) or value <= 0:
         raise InvalidConfigError(f"config.{name} = {value!r}: expected a finite number > 0")
     return value
+
+
+def _check_memory(lo: np.ndarray, hi: np.ndarray, h: float, pieces: int, budget: object) -> None:
+    """Refuse (InfeasibleError) a grid over [lo, hi] of cells h whose estimated peak memory
+    (:data:`_BYTES_PER_CELL`) exceeds the budget, naming the cell side that fits."""
+    limit = _memory_budget(budget)
+    cells = float(np.prod(np.floor((hi - lo) / h) + 3))  # _Grid's count, up to rounding
+    per_cell = _BYTES_PER_CELL[0] + _BYTES_PER_CELL[1] * pieces * pieces
+    need = BASE_BYTES + cells * per_cell
+    if need <= limit:
+        return
+    room = limit - BASE_BYTES
+    if room > 0:  # the cells scale as 1 / h^2
+        fit = h * math.sqrt(cells * per_cell / room)
+        advice = f"use cell >= {fit:.2g} or fewer pieces, or"
+    else:
+        advice = f"no cell fits (the interpreter alone takes {_size(BASE_BYTES)}):"
+    raise InfeasibleError(
+        f"hindsight(cell = {h:g}, pieces = {pieces}): the grid of {cells:,.0f} cells would "
+        f"need about {_size(need)} at its peak, more than the memory budget of "
+        f"{_size(limit)}; {advice} raise the budget with memory_budget='"
+        f"{math.ceil(1.2 * need / 1e9)}GB' or $SURVEIL_MEMORY_BUDGET"
+    )
 
 
 def _point_wall_distance(X: np.ndarray, world) -> np.ndarray:
@@ -258,6 +293,7 @@ def hindsight(
     clearance: float | None = None,
     dt: float | None = None,
     keep_sets: bool = False,
+    memory_budget: object = None,
 ) -> Hindsight:
     """Bracket, on two grids, whether any pursuer could hold against an evader path.
 
@@ -283,13 +319,18 @@ def hindsight(
         dt: frame period (default ``config.dt``; the path's own for an
             :class:`EvaderPath`).
         keep_sets: keep the optimistic set of every frame in the result.
+        memory_budget: bytes (or ``"2GB"``) the computation may take; default
+            ``$SURVEIL_MEMORY_BUDGET``, else half the physical memory (as the referee's
+            solves). The grid's size is known before anything is allocated.
 
     Returns:
         The :class:`Hindsight`.
 
     Raises:
-        InvalidConfigError: a bad parameter or path (named).
+        InvalidConfigError: a bad parameter or path (named), or a bad budget.
         InvalidPlacementError: the pursuer start is not admissible at t = 0.
+        InfeasibleError: the grid would need more memory than the budget (the message
+            names the estimate and the cell that fits).
     """
     t_start = time.perf_counter()
     world = config.map
@@ -347,6 +388,7 @@ def hindsight(
     pad = 3 * h + max(step, step_p)
     lo = np.maximum(path.min(axis=0) - l_max, P0 - V * horizon) - pad
     hi = np.minimum(path.max(axis=0) + l_max, P0 + V * horizon) + pad
+    _check_memory(lo, hi, h, pieces, memory_budget)
     grid = _Grid(world, P0, lo, hi, h)  # P0 is a centre: the pessimistic pursuer may wait
 
     # ---- optimistic: lower bound ell on each centre's distance to S_k, stored shifted:

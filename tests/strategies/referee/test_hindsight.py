@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from envs.errors import InvalidConfigError, InvalidPlacementError
+from envs.errors import InfeasibleError, InvalidConfigError, InvalidPlacementError
 from envs.geometry import kernel_for
 from envs.maps import Map
 from envs.surveillance.config import EnvConfig
@@ -194,3 +194,22 @@ def test_robust_occlusion_blocks_every_point_of_the_disc():
     # and the test is not vacuous: discs of centres that see E are never dropped
     sees = np.array([kernel.line_of_sight(E, c) for c in C])
     assert not (blocked & sees).any()
+
+
+def test_a_grid_beyond_the_memory_budget_is_refused_before_it_is_allocated(monkeypatch):
+    """A cell of 1e-5 in a 10 m room allocated (and was killed, or MemoryError) before;
+    now the grid's estimate (about 324 MB at cell 1e-3 here) is checked against the
+    referee's budget ($SURVEIL_MEMORY_BUDGET, or memory_budget=) and refused naming it
+    and a cell that fits; the budget's own errors are the referee's."""
+    cfg = _config(ROOM, l_min=2.0, l_max=4.0)
+    E = np.array([[5.0 + 0.01 * k, 5.0] for k in range(3)])
+    P = np.array([5.0, 2.0])
+    monkeypatch.setenv("SURVEIL_MEMORY_BUDGET", "150MB")
+    with pytest.raises(InfeasibleError, match=r"cell = 0.001, pieces = 4\): the grid of .* cells"):
+        hindsight(cfg, E, P, 1e-3)
+    assert hindsight(cfg, E, P, 0.1).verdict == "pursuer"  # 100-odd cells fit
+    with pytest.raises(InfeasibleError, match=r"more than the memory budget of 12\.0 GB"):
+        hindsight(cfg, E, P, 1e-5, memory_budget="12GB")
+    monkeypatch.setenv("SURVEIL_MEMORY_BUDGET", "garbage")
+    with pytest.raises(InvalidConfigError, match=r"\$SURVEIL_MEMORY_BUDGET = 'garbage'"):
+        hindsight(cfg, E, P, 0.1)

@@ -83,6 +83,11 @@ cell at pieces 1, 2, 4, 8 and 12; cell 0.005 (960 k cells): 1072 at pieces 4, 22
 The formula gives 724, 796, 1084, 2236 and 4156: within 2 % from 4 pieces up, and over
 (never under) at fewer."""
 
+_BYTES_PER_INSTANT = 96.0
+"""Peak memory per instant of the subdivided evader paths: two float64 coordinates (16
+bytes) for the optimistic path kept while the pessimistic one is interpolated (four such
+arrays at once, 64), and the per-step counts (8 each)."""
+
 
 @dataclass(frozen=True)
 class EvaderPath:
@@ -157,26 +162,33 @@ def _param(config: Any, name: str) -> float:
     return value
 
 
-def _check_memory(lo: np.ndarray, hi: np.ndarray, h: float, pieces: int, budget: object) -> None:
-    """Refuse (InfeasibleError) a grid over [lo, hi] of cells h whose estimated peak memory
-    (:data:`_BYTES_PER_CELL`) exceeds the budget, naming the cell side that fits."""
+def _check_memory(
+    lo: np.ndarray, hi: np.ndarray, h: float, pieces: int, instants: int, budget: object
+) -> None:
+    """Refuse (InfeasibleError) a grid over [lo, hi] of cells h, and ``instants`` of the
+    evader's subdivided paths, whose estimated peak memory (:data:`_BYTES_PER_CELL`, and
+    :data:`_BYTES_PER_INSTANT`) exceeds the budget, naming the cell side that fits."""
     limit = _memory_budget(budget)
     cells = float(np.prod(np.floor((hi - lo) / h) + 3))  # _Grid's count, up to rounding
     per_cell = _BYTES_PER_CELL[0] + _BYTES_PER_CELL[1] * pieces * pieces
-    need = BASE_BYTES + cells * per_cell
+    path_bytes = _BYTES_PER_INSTANT * instants
+    need = BASE_BYTES + cells * per_cell + path_bytes
     if need <= limit:
         return
-    room = limit - BASE_BYTES
+    room = limit - BASE_BYTES - path_bytes
     if room > 0:  # the cells scale as 1 / h^2
         fit = h * math.sqrt(cells * per_cell / room)
         advice = f"use cell >= {fit:.2g} or fewer pieces, or"
+    elif path_bytes > cells * per_cell:  # substeps ~ V_p dt / h: a larger cell, fewer
+        advice = "use a larger cell (fewer substeps) or a shorter path, or"
     else:
         advice = f"no cell fits (the interpreter alone takes {_size(BASE_BYTES)}):"
     raise InfeasibleError(
-        f"hindsight(cell = {h:g}, pieces = {pieces}): the grid of {cells:,.0f} cells would "
-        f"need about {_size(need)} at its peak, more than the memory budget of "
-        f"{_size(limit)}; {advice} raise the budget with memory_budget='"
-        f"{math.ceil(1.2 * need / 1e9)}GB' or $SURVEIL_MEMORY_BUDGET"
+        f"hindsight(cell = {h:g}, pieces = {pieces}): the grid of {cells:,.0f} cells and "
+        f"the evader's path at {instants:,} instants would need about {_size(need)} at "
+        f"its peak, more than the memory budget of {_size(limit)}; {advice} raise the "
+        f"budget with memory_budget='{math.ceil(1.2 * need / 1e9)}GB' or "
+        "$SURVEIL_MEMORY_BUDGET"
     )
 
 
@@ -360,8 +372,6 @@ def hindsight(
     pieces = validation.integer("pieces", pieces, minimum=1)
     r_opt = r if clearance is None else validation.real("clearance", clearance, minimum=0.0)
 
-    E_o = _subdivide(path, substeps)
-    E_p = _subdivide(path, pes_substeps)
     tau, tau_p = dt / substeps, dt / pes_substeps
     step, step_p = V * tau, V * tau_p
     horizon = dt * (len(path) - 1)
@@ -388,7 +398,10 @@ def hindsight(
     pad = 3 * h + max(step, step_p)
     lo = np.maximum(path.min(axis=0) - l_max, P0 - V * horizon) - pad
     hi = np.minimum(path.max(axis=0) + l_max, P0 + V * horizon) + pad
-    _check_memory(lo, hi, h, pieces, memory_budget)
+    instants = (len(path) - 1) * (substeps + pes_substeps)
+    _check_memory(lo, hi, h, pieces, instants, memory_budget)
+    E_o = _subdivide(path, substeps)
+    E_p = _subdivide(path, pes_substeps)
     grid = _Grid(world, P0, lo, hi, h)  # P0 is a centre: the pessimistic pursuer may wait
 
     # ---- optimistic: lower bound ell on each centre's distance to S_k, stored shifted:

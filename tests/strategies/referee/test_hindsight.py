@@ -9,6 +9,7 @@ must hold under the kernel's continuous sweep).
 from __future__ import annotations
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -213,3 +214,13 @@ def test_a_grid_beyond_the_memory_budget_is_refused_before_it_is_allocated(monke
     monkeypatch.setenv("SURVEIL_MEMORY_BUDGET", "garbage")
     with pytest.raises(InvalidConfigError, match=r"\$SURVEIL_MEMORY_BUDGET = 'garbage'"):
         hindsight(cfg, E, P, 0.1)
+
+
+def test_a_path_subdivided_beyond_the_memory_budget_is_refused():
+    """A pursuer of 1e9 m/s (``hindsight_maze.py --v-pursuer 1e9``) asks for 1e8
+    optimistic substeps per frame: 64 GB for the evader's path alone, a numpy
+    MemoryError traceback before; now refused with the budget's message."""
+    cfg = SimpleNamespace(map=ROOM, l_min=2.0, l_max=4.0, v_pursuer=1e9, body_radius=0.1, dt=0.1)
+    E = np.tile([[5.0, 5.0]], (43, 1))
+    with pytest.raises(InfeasibleError, match=r"the evader's path at [\d,]+ instants"):
+        hindsight(cfg, E, (5.0, 2.0), 0.5, memory_budget="12GB")

@@ -156,10 +156,17 @@ def _param(config: Any, name: str) -> float:
     value = getattr(config, name, None)
     if value is None:
         raise InvalidConfigError(f"config.{name}: expected a positive number, got None")
-    value = float(value)
-    if not math.isfinite(value) or value <= 0:
-        raise InvalidConfigError(f"config.{name} = {value!r}: expected a finite number > 0")
-    return value
+    return validation.positive(f"config.{name}", value)
+
+
+def _points(name: str, value: Any) -> np.ndarray:
+    """``value`` as a float array, or InvalidConfigError naming it (not numpy's error)."""
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidConfigError(
+            f"{name} = {value!r:.60}: expected numbers (x, y), got {type(value).__name__}"
+        ) from None
 
 
 def _check_memory(
@@ -345,7 +352,12 @@ def hindsight(
             names the estimate and the cell that fits).
     """
     t_start = time.perf_counter()
-    world = config.map
+    world = getattr(config, "map", None)
+    if world is None:
+        raise InvalidConfigError(
+            f"config = {config!r:.60}: expected the game (an EnvConfig or a GameSpec: "
+            "map, l_min, l_max, v_pursuer, body_radius)"
+        )
     l_min, l_max = _param(config, "l_min"), _param(config, "l_max")
     V = _param(config, "v_pursuer")
     r = _param(config, "body_radius")
@@ -356,12 +368,12 @@ def hindsight(
         dt = _param(config, "dt")
     dt = validation.positive("dt", dt)
     h = validation.positive("cell", cell)
-    path = np.asarray(evader_path, dtype=float)
+    path = _points("evader_path", evader_path)
     if path.ndim != 2 or path.shape[1] != 2 or len(path) < 2 or not np.isfinite(path).all():
         raise InvalidConfigError(
             f"evader_path of shape {path.shape}: expected finite (n + 1, 2) positions, n >= 1"
         )
-    P0 = np.asarray(pursuer_start, dtype=float)
+    P0 = _points("pursuer_start", pursuer_start)
     if P0.shape != (2,) or not np.isfinite(P0).all():
         raise InvalidConfigError(f"pursuer_start = {pursuer_start!r}: expected a finite (x, y)")
     if substeps is None:  # V_p tau about 2 h: the optimistic set is checked every 2 cells
@@ -722,9 +734,15 @@ def record_evader_path(
     """
     from strategies.runner import run_episode
 
+    if isinstance(pursuers, str):  # not its characters
+        raise InvalidConfigError(
+            f"pursuers = {pursuers!r}: expected a sequence of pursuers, e.g. ({pursuers!r},)"
+        )
     if len(pursuers) < 1:
         raise InvalidConfigError("pursuers: expected at least one pursuer, got none")
-    if extend_to is not None and (int(extend_to) != extend_to or extend_to < 1):
+    if extend_to is not None and not (
+        validation.is_real(extend_to) and float(extend_to).is_integer() and extend_to >= 1
+    ):
         raise InvalidConfigError(f"extend_to = {extend_to!r}: expected an integer >= 1")
     paths: dict[str, np.ndarray] = {}
     res = None

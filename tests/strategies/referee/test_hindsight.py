@@ -224,3 +224,25 @@ def test_a_path_subdivided_beyond_the_memory_budget_is_refused():
     E = np.tile([[5.0, 5.0]], (43, 1))
     with pytest.raises(InfeasibleError, match=r"the evader's path at [\d,]+ instants"):
         hindsight(cfg, E, (5.0, 2.0), 0.5, memory_budget="12GB")
+
+
+def test_input_that_is_not_numbers_is_named_not_numpy_s_error():
+    """Before: numpy's 'could not convert string to float' (no name), an AttributeError
+    for config None, int()'s errors for extend_to, and a bare string of pursuers taken
+    letter by letter ("got 'p'")."""
+    cfg = _config(ROOM)
+    E = np.tile([[10.0, 5.0]], (5, 1))
+    with pytest.raises(InvalidConfigError, match=r"pursuer_start = 'ab': expected numbers"):
+        hindsight(cfg, E, "ab", 0.1)
+    with pytest.raises(InvalidConfigError, match=r"evader_path = 'abc': expected numbers"):
+        hindsight(cfg, "abc", (8.5, 5.0), 0.1)
+    with pytest.raises(InvalidConfigError, match=r"config = None: expected the game"):
+        hindsight(None, E, (8.5, 5.0), 0.1)
+    bad = SimpleNamespace(map=ROOM, l_min=1.0, l_max=2.0, v_pursuer="x", body_radius=0.1, dt=0.1)
+    with pytest.raises(InvalidConfigError, match=r"config.v_pursuer = 'x'"):
+        hindsight(bad, E, (8.5, 5.0), 0.1)
+    for extend_to in (math.nan, "x", 2.5, 0):
+        with pytest.raises(InvalidConfigError, match=r"extend_to = .*: expected an integer >= 1"):
+            record_evader_path("open_room", "evader/straight", 0, extend_to=extend_to)
+    with pytest.raises(InvalidConfigError, match=r"pursuers = 'pursuer/greedy': expected a seq"):
+        record_evader_path("open_room", "evader/straight", 0, pursuers="pursuer/greedy")

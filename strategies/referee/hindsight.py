@@ -334,7 +334,8 @@ def hindsight(
         clearance: the wall clearance the *optimistic* set assumes of the pursuer
             (default ``body_radius``; the env's physics can press a disc to
             ``body_radius / 2`` from a wall, so pass that for a certificate that covers
-            it). The pessimistic pursuer always keeps ``body_radius``.
+            it; no more than ``body_radius``). The pessimistic pursuer always keeps
+            ``body_radius``.
         dt: frame period (default ``config.dt``; the path's own for an
             :class:`EvaderPath`).
         keep_sets: keep the optimistic set of every frame in the result.
@@ -383,6 +384,11 @@ def hindsight(
     pes_substeps = max(1, math.ceil(V * dt / (moves * h) - 1e-9))
     pieces = validation.integer("pieces", pieces, minimum=1)
     r_opt = r if clearance is None else validation.real("clearance", clearance, minimum=0.0)
+    if r_opt > r:  # a larger one shrinks the set below the truth: no certificate
+        raise InvalidConfigError(
+            f"clearance = {clearance!r}: expected a value in [0, body_radius = {r:g}] (the "
+            "optimistic set must contain every pursuer the env lets play)"
+        )
 
     tau, tau_p = dt / substeps, dt / pes_substeps
     step, step_p = V * tau, V * tau_p

@@ -246,3 +246,15 @@ def test_input_that_is_not_numbers_is_named_not_numpy_s_error():
             record_evader_path("open_room", "evader/straight", 0, extend_to=extend_to)
     with pytest.raises(InvalidConfigError, match=r"pursuers = 'pursuer/greedy': expected a seq"):
         record_evader_path("open_room", "evader/straight", 0, pursuers="pursuer/greedy")
+
+
+def test_a_clearance_above_the_body_radius_is_refused():
+    """clearance = 100 in a 10 m room emptied the optimistic set at 0.1 s (verdict
+    'evader') while the pessimistic witness held to the horizon (1 s): a contradiction
+    presented as a certificate."""
+    cfg = _config(ROOM, l_min=2.0, l_max=4.0)
+    E = np.array([[5.0 + 0.01 * k, 5.0] for k in range(11)])
+    with pytest.raises(InvalidConfigError, match=r"clearance = 100: expected a value in \[0, b"):
+        hindsight(cfg, E, (5.0, 2.0), 0.1, clearance=100)
+    res = hindsight(cfg, E, (5.0, 2.0), 0.1, clearance=0.1)  # body_radius: allowed
+    assert res.verdict == "pursuer"

@@ -28,7 +28,7 @@ import numpy as np
 from envs.errors import InfeasibleError, InvalidPlacementError
 from envs.maps import Map
 
-__all__ = ["MEANING", "similarity_back", "summary", "verdict"]
+__all__ = ["MEANING", "hindsight_summary", "similarity_back", "summary", "tally", "verdict"]
 
 # the referee's resolution besides CPL: a fine evader lattice (as pursuer_holds.py always had)
 SOLVE = {"evader_coarse": 2, "evader_steps": 1}
@@ -92,15 +92,33 @@ def verdict(
         return "not a start"
 
 
-def summary(cpl: float, verdicts: Iterable[str], distinct: int | None = None) -> str:
-    """``referee (cpl X) on the N lost starts (K distinct): a evader (unavoidable), b
-    pursuer (the policy's regret), c unknown (...)`` (and any ``not a start``): one verdict
-    per lost episode; ``distinct`` says how many starts they are (opponents share them)."""
-    counts = {v: 0 for v in MEANING}
+def tally(verdicts: Iterable[str], gap: str = MEANING["unknown"]) -> tuple[int, str]:
+    """(n, ``a evader (unavoidable), b pursuer (the policy's regret), c unknown (GAP)``)
+    (and any other label, e.g. ``not a start``, with its count): one verdict per loss;
+    ``gap`` says what an ``unknown`` is (the referee's resolution gap by default)."""
+    meaning = {**MEANING, "unknown": gap}
+    counts = {v: 0 for v in meaning}
     n = 0
     for v in verdicts:
         counts[v] = counts.get(v, 0) + 1
         n += 1
-    parts = [f"{k} {v} ({MEANING[v]})" if v in MEANING else f"{k} {v}" for v, k in counts.items()]
+    parts = [f"{k} {v} ({meaning[v]})" if v in meaning else f"{k} {v}" for v, k in counts.items()]
+    return n, ", ".join(parts)
+
+
+def summary(cpl: float, verdicts: Iterable[str], distinct: int | None = None) -> str:
+    """``referee (cpl X) on the N lost starts (K distinct): a evader (unavoidable), b
+    pursuer (the policy's regret), c unknown (...)`` (and any ``not a start``): one verdict
+    per lost episode; ``distinct`` says how many starts they are (opponents share them)."""
+    n, parts = tally(verdicts)
     of = "" if distinct is None else f" ({distinct} distinct)"
-    return f"referee (cpl {cpl:g}) on the {n} lost starts{of}: " + ", ".join(parts)
+    return f"referee (cpl {cpl:g}) on the {n} lost starts{of}: " + parts
+
+
+def hindsight_summary(cell: float, verdicts: Iterable[str]) -> str:
+    """``hindsight (cell H) on the N losses to open-loop evaders: a evader (unavoidable), b
+    pursuer (the policy's regret), c unknown (the hindsight's resolution gap)``: one
+    verdict per lost episode (:mod:`strategies.referee.hindsight`, against the evader's
+    recorded path to the episode's horizon)."""
+    n, parts = tally(verdicts, "the hindsight's resolution gap")
+    return f"hindsight (cell {cell:g}) on the {n} losses to open-loop evaders: " + parts

@@ -64,12 +64,24 @@ nothing), ``unknown``. A transformed built-in world is judged untransformed (the
 game), so its transforms share one solve, cached on disk; each world costs minutes the
 first time, so restrict ``--worlds`` (the episodes themselves come from ``--results``).
 
+``--hindsight CELL`` (pursuer role) labels every loss to an *open-loop* evader
+(``evader/straight``, ``evader/wall_hugging``, ``evader/random``, ``evader/orbit:*``,
+whose path does not depend on the pursuer) with :func:`strategies.referee.hindsight.hindsight`
+at cell side CELL: the evader's path is recorded from the episode (replayed, then extended
+alone to the horizon, ``--max-cycles``), and the verdict is ``evader`` (no pursuer of
+speed V_p holds to the horizon: unavoidable), ``pursuer`` (some pursuer holds to the
+horizon: the policy's regret) or ``unknown`` (``not solved``: the grid would exceed the
+memory budget, ``$SURVEIL_MEMORY_BUDGET``, the reason printed); beside each such loss,
+with the times the two grids give (optimistic set empty at, pessimistic set until), and
+over them. The other losses are not labelled. Cell 0.02: 45-50 s a loss on the held-out
+random maps (18 x 18; held-out combo 0 has four such losses).
+
 Usage::
 
     python benchmarks/unseen_worlds.py --role pursuer|evader [--worlds W ...]
         [--combos I ...] [--opponents O ...] [--seeds S ...] [--results F.jsonl]
         [--workers 1] [--max-cycles 600] [--k 8] [--draws 2] [--l-mins L ...]
-        [--referee CPL]
+        [--referee CPL] [--hindsight CELL]
 
 ``--combos`` indexes the role's combos (``--help`` lists them). ``--seeds`` is the
 seed list in the pursuer role and a filter on the drawn seeds in the evader role. On one
@@ -94,11 +106,12 @@ from bench_cli import integer, real, run, worker_pool
 from referee_labels import similarity_back
 from unseen_opponents import make_opponent
 
-from envs.errors import InvalidConfigError
+from envs.errors import InfeasibleError, InvalidConfigError
 from envs.maps import Map, builtin_info, builtin_names, load_map
 from envs.maps.floor_plans import floor_plan
 from envs.maps.junctions import crossroads, t_junction
 from envs.maps.random_maps import random_map
+from strategies.referee.hindsight import hindsight, record_evader_path
 from strategies.runner import run_episode
 
 BODY = 0.1
@@ -507,6 +520,49 @@ def referee_verdict(row, cpl: float) -> str:
     return referee_labels.verdict(m, ov, row["start"], cpl, back)
 
 
+# evaders whose path does not depend on the pursuer (labels: these, or these + ":...")
+OPEN_LOOP = ("evader/straight", "evader/wall_hugging", "evader/random", "evader/orbit")
+
+
+def open_loop(opponent: str) -> bool:
+    """The opponent label names an open-loop evader (:data:`OPEN_LOOP`)."""
+    return any(opponent == o or opponent.startswith(o + ":") for o in OPEN_LOOP)
+
+
+def hindsight_verdict(row, cell: float, max_cycles: int):
+    """The hindsight (:func:`strategies.referee.hindsight.hindsight`, cell side ``cell``)
+    against the evader's path of a pursuer-role row, recorded from its episode and
+    extended alone to ``max_cycles`` steps (the episode's horizon)."""
+    from envs.surveillance.config import EnvConfig
+
+    m, ov = pursuer_world(row["world"], row["combo"])
+    path = record_evader_path(m, make_opponent(row["opponent"]), row["seed"],
+                              pursuers=("pursuer/decomposition",), overrides=ov,
+                              max_cycles=max_cycles, extend_to=max_cycles)  # fmt: skip
+    return hindsight(EnvConfig(map=m, **ov), path, path.pursuer_start, cell)
+
+
+def hindsight_verdicts(rows: list[dict], cell: float, max_cycles: int) -> dict[str, str]:
+    """The hindsight's label of every loss to an open-loop evader among ``rows``, keyed by
+    :func:`row_key`; each is printed with the grids' times and its cost."""
+    labels: dict[str, str] = {}
+    for r in rows:
+        if not _won(r) and "error" not in r and open_loop(r["opponent"]):
+            what = f"  hindsight (cell {cell:g}) {r['world']} {r['combo']} {r['opponent']} "
+            try:
+                h = hindsight_verdict(r, cell, max_cycles)
+            except InfeasibleError as exc:  # over the memory budget: the others still run
+                labels[row_key(r)] = "not solved"
+                print(f"{what}seed={r['seed']}: not solved ({exc})", flush=True)
+                continue
+            labels[row_key(r)] = h.verdict
+            empty = "never" if h.optimistic_empty is None else f"{h.optimistic_empty:.1f} s"
+            print(f"{what}seed={r['seed']}: {h.verdict} (optimistic empty {empty}, pessimistic "
+                  f"until {h.pessimistic_until:.1f} s of {h.horizon:.1f}; {h.seconds:.1f} s)",
+                  flush=True)  # fmt: skip
+    return labels
+
+
 def _start_key(row) -> str:
     return json.dumps([row["world"], row["combo"], row["seed"], row["start"]])
 
@@ -526,12 +582,24 @@ def referee_verdicts(rows: list[dict], cpl: float) -> dict[str, str]:
     return labels
 
 
-def report(rows: list[dict], referee: float | None = None) -> None:
+def report(
+    rows: list[dict],
+    referee: float | None = None,
+    hindsight_cell: float | None = None,
+    max_cycles: int = 600,
+) -> None:
     """The tables: per world and combo, per opponent, total; every loss. With ``referee``
     (pursuer role), every start's label at that many cells per L_min: the counts per world
-    and combo, beside each loss, and over the lost starts."""
+    and combo, beside each loss, and over the lost starts. With ``hindsight_cell`` (pursuer
+    role), every loss to an open-loop evader labelled by the hindsight at that cell side
+    (its path extended to ``max_cycles`` steps), beside the loss and over them."""
     role = rows[0]["role"]
     labels = referee_verdicts(rows, referee) if referee and role == "pursuer" else {}
+    hind = (
+        hindsight_verdicts(rows, hindsight_cell, max_cycles)
+        if hindsight_cell and role == "pursuer"
+        else {}
+    )
     won, verb = ("held", "held") if role == "pursuer" else ("escaped", "escaped")
     per_world: dict[tuple, list[int]] = {}
     per_opp: dict[str, list[int]] = {}
@@ -588,11 +656,15 @@ def report(rows: list[dict], referee: float | None = None) -> None:
                 lost_labels.append(labels.get(_start_key(r), "no start") if "start" in r
                                    else "no start")  # fmt: skip
                 what += f"; referee: {lost_labels[-1]}"
+            if row_key(r) in hind:
+                what += f"; hindsight: {hind[row_key(r)]}"
             print(f"  lost: {r['world']} {r['combo']} {r['opponent']} seed={r['seed']}: {what}")
             print(f"    replay: {replay_command(r)}")
     if labels:
         distinct = {_start_key(r) for r in rows if not _won(r) and "start" in r}
         print(referee_labels.summary(referee, lost_labels, len(distinct)))
+    if hindsight_cell and role == "pursuer":
+        print(referee_labels.hindsight_summary(hindsight_cell, hind.values()))
 
 
 def main(argv=None) -> int:
@@ -624,9 +696,14 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=integer(1), default=1)
     ap.add_argument("--referee", type=real(0), metavar="CPL", help="pursuer role: label every "
                     "start with the referee at CPL cells per L_min (module docstring)")  # fmt: skip
+    ap.add_argument("--hindsight", type=real(0), metavar="CELL", help="pursuer role: label "
+                    "every loss to an open-loop evader by hindsight at cell side CELL (module "
+                    "docstring)")  # fmt: skip
     args = ap.parse_args(argv)
     if args.referee and args.role != "pursuer":
         ap.error("--referee: the pursuer role only (it labels the pursuer's starts)")
+    if args.hindsight and args.role != "pursuer":
+        ap.error("--hindsight: the pursuer role only (it labels the pursuer's losses)")
     for name in args.worlds or []:
         known = PURSUER_WORLDS if args.role == "pursuer" else EVADER_NAMES
         if name not in known:
@@ -673,7 +750,7 @@ def main(argv=None) -> int:
             pool.join()
     played = [done[job_key(j)] for j in jobs]
     if played:
-        report(played, args.referee)
+        report(played, args.referee, args.hindsight, args.max_cycles)
     return 0
 
 

@@ -240,11 +240,66 @@ def test_a_world_the_referee_cannot_afford_is_not_solved(unseen, tmp_path, monke
     assert "on the 1 lost starts (1 distinct): 0 evader" in text and "1 not solved" in text
 
 
+def test_hindsight_labels_the_losses_to_open_loop_evaders(unseen, tmp_path, capsys) -> None:
+    """``--hindsight CELL``: a loss to an open-loop evader gets the hindsight's verdict
+    against its recorded path; a closed-loop evader's loss gets none. The orbit episode is
+    in fact held by the decomposition pursuer over the horizon (played here), so no verdict
+    but ``pursuer`` is right; its row is written as a loss to be labelled."""
+    world, combo, orbit = "L_10x4", [0.5, 2.0, 2.0], "evader/orbit:1:0.25"
+    unseen._init(50, 8.0)
+    played = unseen.play(("pursuer", world, combo, orbit, 101))
+    assert played["winner"] == "pursuer" and played["steps"] == 50  # a pursuer held: oracle
+    lost = {**played, "winner": "evader", "cause": "occluded", "t": 3.0, "steps": 30}
+    herder = {**lost, "opponent": "herder", "cause": "too_close"}
+    out = tmp_path / "p.jsonl"
+    out.write_text("".join(json.dumps(r) + "\n" for r in (lost, herder)))
+    argv = ["--role", "pursuer", "--worlds", world, "--combos", "0", "--opponents", orbit,
+            "herder", "--max-cycles", "50", "--results", str(out),
+            "--hindsight", "0.05"]  # fmt: skip
+    assert unseen.main(argv) == 0
+    text = capsys.readouterr().out
+    assert f"hindsight (cell 0.05) {world} {combo} {orbit} seed=101: pursuer" in text
+    assert "of 5.0; " in text  # the path extended to the horizon, 50 steps
+    assert f"{orbit} seed=101: occluded at 3.0 s; hindsight: pursuer" in text
+    assert "herder seed=101: too_close at 3.0 s\n" in text  # closed loop: not labelled
+    assert (
+        "hindsight (cell 0.05) on the 1 losses to open-loop evaders: 0 evader (unavoidable), "
+        "1 pursuer (the policy's regret), 0 unknown (the hindsight's resolution gap)" in text
+    )
+
+
+def test_a_hindsight_over_the_memory_budget_is_not_solved(unseen, tmp_path, capsys) -> None:
+    """A cell whose grid would exceed the memory budget labels the loss ``not solved`` (the
+    reason printed) instead of stopping the report."""
+    row = {"role": "pursuer", "world": "L_10x4", "combo": [0.5, 2.0, 2.0],
+           "opponent": "evader/straight", "seed": 101, "winner": "evader", "cause": "occluded",
+           "t": 3.0, "steps": 30}  # fmt: skip
+    out = tmp_path / "p.jsonl"
+    out.write_text(json.dumps(row) + "\n")
+    argv = ["--role", "pursuer", "--worlds", "L_10x4", "--combos", "0", "--opponents",
+            "evader/straight", "--max-cycles", "20", "--results", str(out),
+            "--hindsight", "1e-6"]  # fmt: skip
+    assert unseen.main(argv) == 0
+    text = capsys.readouterr().out
+    assert "evader/straight seed=101: not solved (hindsight(cell = 1e-06" in text
+    assert "occluded at 3.0 s; hindsight: not solved" in text
+    assert "on the 1 losses to open-loop evaders: 0 evader" in text and "1 not solved" in text
+
+
+def test_open_loop_names_the_evaders_whose_path_ignores_the_pursuer(unseen) -> None:
+    assert all(map(unseen.open_loop, ["evader/straight", "evader/wall_hugging",
+                                      "evader/random", "evader/orbit:-1:1.0"]))  # fmt: skip
+    assert not any(map(unseen.open_loop, ["evader/shooting", "evader/toward_away:toward",
+                                          "herder", "evader/orbiter", "darter"]))  # fmt: skip
+
+
 @pytest.mark.parametrize(
     "argv, message",
     [(["--role", "pursuer", "--referee", "0"], "argument --referee: '0': expected a finite"),
      (["--role", "pursuer", "--referee", "nan"], "argument --referee: 'nan': expected a finite"),
-     (["--role", "evader", "--referee", "8"], "--referee: the pursuer role only")],
+     (["--role", "evader", "--referee", "8"], "--referee: the pursuer role only"),
+     (["--role", "pursuer", "--hindsight", "0"], "argument --hindsight: '0': expected a finite"),
+     (["--role", "evader", "--hindsight", "0.1"], "--hindsight: the pursuer role only")],
 )  # fmt: skip
 def test_a_bad_referee_cpl_is_a_usage_error_naming_it(unseen, tmp_path, capsys, argv,
                                                        message) -> None:  # fmt: skip

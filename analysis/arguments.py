@@ -152,10 +152,14 @@ def output_dir(flag: str, value: str | os.PathLike[str]) -> Path:
     """A directory an option names, created if needed and checked for writing.
 
     Raises:
-        InvalidConfigError: an existing file, or a directory that cannot be created or
-            written.
+        InvalidConfigError: an empty name, an existing file, or a directory that cannot be
+            created or written.
     """
     text = os.fspath(value)
+    if not text.strip():  # Path("") is "." (the figures landed in the working directory)
+        raise InvalidConfigError(
+            f"{flag} = {text!r}: expected a directory name ('.' for the current directory)"
+        )
     path = Path(text)
     if path.exists() and not path.is_dir():
         raise InvalidConfigError(f"{flag} = {text!r}: is a file, expected a directory")

@@ -261,6 +261,15 @@ def test_figures_into_an_existing_file_is_refused_before_drawing(capsys, tmp_pat
                  "is a file, expected a directory")  # fmt: skip
 
 
+@pytest.mark.parametrize("empty", ["", "  "])
+def test_figures_into_an_empty_directory_name_is_refused(capsys, tmp_path, monkeypatch, empty):
+    """--out '' was the working directory (Path('') is '.'): the figures landed there."""
+    monkeypatch.chdir(tmp_path)
+    assert_fails(capsys, ["figures", "--out", empty, "--only", "fig10"], "--out",
+                 "expected a directory name")  # fmt: skip
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("t_max", [0, -2])
 def test_a_tractrix_over_no_time_is_refused(capsys, tmp_path, t_max):
     out = str(tmp_path / "t.png")

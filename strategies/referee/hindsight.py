@@ -374,6 +374,14 @@ def hindsight(
         raise InvalidConfigError(
             f"evader_path of shape {path.shape}: expected finite (n + 1, 2) positions, n >= 1"
         )
+    out = np.flatnonzero(~point_in_walls(path, world.edge_start, world.edge_end))
+    if len(out):  # a path the env cannot play: a verdict on it would certify nothing
+        k = int(out[0])
+        raise InvalidConfigError(
+            f"evader_path: position {k} {tuple(map(float, path[k]))} (and {len(out) - 1} "
+            f"more) lies outside map {world.name!r}'s free space: expected a path the evader "
+            "can play"
+        )
     P0 = _points("pursuer_start", pursuer_start)
     if P0.shape != (2,) or not np.isfinite(P0).all():
         raise InvalidConfigError(f"pursuer_start = {pursuer_start!r}: expected a finite (x, y)")

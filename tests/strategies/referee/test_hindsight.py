@@ -174,6 +174,17 @@ def test_bad_input_is_named():
         hindsight(cfg, E, (9.5, 5.0), 0.1)  # too close
 
 
+def test_a_path_through_an_obstacle_or_off_the_map_is_refused():
+    # the env never plays such a path: a verdict on it would certify nothing
+    cfg = _config(PILLAR)
+    through = np.array([[7.0, 5.0], [8.5, 5.0], [10.0, 5.0], [11.5, 5.0]])  # the pillar
+    with pytest.raises(InvalidConfigError, match=r"position 2 \(10.0, 5.0\) \(and 0 more\)"):
+        hindsight(cfg, through, (5.5, 5.0), 0.1)
+    off = np.array([[18.0, 5.0], [19.5, 5.0], [21.0, 5.0], [22.5, 5.0]])  # off the map
+    with pytest.raises(InvalidConfigError, match=r"position 2 .* \(and 1 more\)"):
+        hindsight(cfg, off, (16.5, 5.0), 0.1)
+
+
 def test_robust_occlusion_blocks_every_point_of_the_disc():
     # the optimistic set drops a cell for occlusion only when no point of its disc sees E
     from strategies.referee.hindsight import _robustly_blocked

@@ -76,8 +76,13 @@ def default_step(x_max: float, L: float, rho: float) -> float:
     32 steps per natural length keep J and the crossing within ~1e-8 of a 4x finer grid on
     the cases in the tests.
     """
-    scale = L * min(rho, 1.0 - rho) / (1.0 + rho)
-    return min(scale / _STEPS_PER_SCALE, x_max / 32.0)
+    return min(_natural_length(L, rho) / _STEPS_PER_SCALE, x_max / 32.0)
+
+
+def _natural_length(L: float, rho: float) -> float:
+    """The extremal ODE's natural length ``L min(rho, 1 - rho)/(1 + rho)`` (see
+    :func:`default_step`): over one, θ or α can turn by about a radian."""
+    return L * min(rho, 1.0 - rho) / (1.0 + rho)
 
 
 @dataclass(frozen=True)
@@ -232,11 +237,12 @@ def shoot(
         minimiser (THEORY §4.3), e.g. Fig. 11(b)'s multipliers at rho = 0.9.
 
     Raises:
-        SurveilValueError: non-finite input, ``L <= 0``, ``x_max <= 0``, ``step <= 0``,
-            ``1 + s lambda2_0 <= 0`` (μ keeps its sign along the arc, so transversality
-            ``λ2(x_e) = 0`` would be impossible), unknown branch or method.
-        InfeasibleError: ``rho >= 1``, or more than ``_MAX_SHOOT_STEPS`` default steps
-            up to ``x_max`` (rho within ~1e-4 of 0 or 1, or ``x_max`` ~1e5 ``L``).
+        SurveilValueError: non-finite input, ``L <= 0``, ``x_max <= 0``, ``step <= 0`` or
+            ``step > x_max``, ``1 + s lambda2_0 <= 0`` (μ keeps its sign along the arc,
+            so transversality ``λ2(x_e) = 0`` would be impossible), unknown branch or
+            method.
+        InfeasibleError: ``rho >= 1``, or more than ``_MAX_SHOOT_STEPS`` steps up to
+            ``x_max`` (by default: rho within ~1e-4 of 0 or 1, or ``x_max`` ~1e5 ``L``).
     """
     th0 = validation.real("theta0", theta0)
     l1 = validation.real("lambda1", lambda1)
@@ -245,13 +251,17 @@ def shoot(
     rho = check_evasion_rho(rho)
     s = branch_sign(branch)
     x_max = validation.positive("x_max", x_max)
-    h = default_step(x_max, L, rho) if step is None else validation.positive("step", step)
-    if step is None and x_max / h > _MAX_SHOOT_STEPS:
-        raise InfeasibleError(
-            f"x_max = {x_max!r} with L = {L!r}, rho = {rho!r} needs {x_max / h:.3g} RK4 steps "
-            f"of the default step {h:.3g} (budget {_MAX_SHOOT_STEPS:,}: about 1 GB and 30 s); "
-            "pass step= to integrate anyway"
-        )
+    if step is not None:
+        h = _explicit_step(step, x_max, "x_max")
+    else:
+        h = default_step(x_max, L, rho)
+        if x_max / h > _MAX_SHOOT_STEPS:
+            raise InfeasibleError(
+                f"x_max = {x_max!r} with L = {L!r}, rho = {rho!r} needs {x_max / h:.3g} RK4 "
+                f"steps of the default step {h:.3g} (budget {_MAX_SHOOT_STEPS:,}: about 1 GB "
+                f"and 30 s); pass step= (at least {x_max / _MAX_SHOOT_STEPS:.3g}, coarser than "
+                "the default) to integrate anyway"
+            )
     if method not in ("reduced", "pmp"):
         raise SurveilValueError(f"method = {method!r}: expected 'reduced' or 'pmp'")
     mu0 = 1.0 + s * l20
@@ -291,6 +301,31 @@ _MAX_SHOOT_STEPS = 2_000_000
 """Largest ``x_max / h`` :func:`shoot` integrates with the default step: each step is kept
 (rho = 0.9999, x_max = 2.5, L = 1: 1.6 million, 24 s, 0.9 GB; rho = 0.999999 asked for 100
 times that)."""
+
+
+def _explicit_step(step: object, horizon: float, horizon_name: str) -> float:
+    """A step the caller chose: finite, > 0, at most the horizon (a longer RK4 step leaps
+    past it at once: at ``step = 1e12`` the figure was one node, an "unbounded" arc), and
+    at most :data:`_MAX_SHOOT_STEPS` of them to the horizon (every node is kept: at
+    ``step = 1e-9`` the integration grew toward a terabyte).
+
+    Raises:
+        SurveilValueError: not a finite number > 0, or above the horizon.
+        InfeasibleError: so small that the horizon needs more than the budget of steps.
+    """
+    h = validation.positive("step", step)
+    if h > horizon:
+        raise SurveilValueError(
+            f"step = {step!r}: expected at most {horizon_name} = {horizon!r} (one RK4 step "
+            "longer than the horizon leaps past it)"
+        )
+    if horizon / h > _MAX_SHOOT_STEPS:
+        raise InfeasibleError(
+            f"step = {step!r} with {horizon_name} = {horizon!r} needs {horizon / h:.3g} RK4 "
+            f"steps (budget {_MAX_SHOOT_STEPS:,}: about 1 GB and 30 s); expected a step of "
+            f"at least {horizon / _MAX_SHOOT_STEPS:.3g}"
+        )
+    return h
 
 
 def _max_steps(x_max: float, L: float, h: float) -> int:
@@ -336,19 +371,29 @@ def solve_escape(
         (pass an explicit ``step`` to force the integration).
 
     Raises:
-        SurveilValueError: non-finite input, ``x_e <= 0``, ``L <= 0``, ``rho <= 0``.
+        SurveilValueError: non-finite input, ``x_e <= 0``, ``L <= 0``, ``rho <= 0``,
+            ``step <= 0`` or ``step > x_e``.
+        InfeasibleError: an explicit ``step`` so small that ``x_e`` needs more than
+            ``_MAX_SHOOT_STEPS`` of them.
     """
     args, reason = _escape_inputs(theta0, x_e, L, rho, branch, step)
     if reason:
         return EscapeSolution(success=False, reason=reason)
-    th0, x_e, L, rho_v, s, _ = args
+    th0, x_e, L, rho_v, s, h = args
     roots, best = _shoot_escape(*args)
     if best is None:
+        coarse = ""
+        if step is not None and h > _natural_length(L, rho_v):
+            coarse = (
+                f"; or the step {h:g} is too coarse: it exceeds the extremals' natural length "
+                f"{_natural_length(L, rho_v):.3g}, where RK4 is not to be trusted (the "
+                f"default step is {default_step(x_e, L, rho_v):.3g})"
+            )
         return EscapeSolution(
             success=False,
             reason=f"no bounded extremal from theta0 = {th0!r} reaches (x_e, 0) = "
             f"({x_e!r}, 0) with L = {L!r}, rho = {rho_v!r}, branch "
-            f"{'+' if s > 0 else '-'} (the arcs turn back before x_e, THEORY §4.3)",
+            f"{'+' if s > 0 else '-'} (the arcs turn back before x_e, THEORY §4.3){coarse}",
         )
     a0, J, rows = best
     mu0 = math.exp(-rows[-1][5])  # transversality: μ(x_e) = 1, i.e. λ2(x_e) = 0 (E3c)
@@ -400,7 +445,7 @@ def _escape_inputs(theta0, x_e, L, rho, branch, step):
             f"rho = {rho_v!r} >= 1: the evader escapes trivially by moving away "
             "from the pursuer (footnote 4); at rho = 1, θ̇⁺ can vanish (E1)"
         )
-    h = default_step(x_e, L, rho_v) if step is None else validation.positive("step", step)
+    h = default_step(x_e, L, rho_v) if step is None else _explicit_step(step, x_e, "x_e")
     if step is None and x_e / h > _MAX_DEFAULT_STEPS:
         return None, (
             f"x_e = {x_e!r} with L = {L!r}, rho = {rho_v!r} needs {x_e / h:.3g} RK4 "

@@ -436,3 +436,36 @@ def test_shoot_refuses_a_default_step_budget_it_cannot_keep(rho):
     with pytest.raises(InfeasibleError, match=r"needs \S+e\+0[78] RK4 steps .* pass step="):
         shoot(math.pi, 0.0, 0.0, L=1.0, rho=rho, x_max=2.5)
     assert len(shoot(math.pi, 0.0, 0.0, L=1.0, rho=rho, x_max=2.5, step=0.05).x) > 1
+
+
+@pytest.mark.parametrize("method", ["reduced", "pmp"])
+def test_shoot_refuses_a_step_beyond_the_horizon(method):
+    # `surveil figure greedy --params '{"step": 1e12}'` drew an empty figure and exited 0:
+    # one RK4 step of 1e12 leapt past x_max and came back as a one-node "unbounded" arc
+    with pytest.raises(SurveilValueError, match=r"step = 1000000000000.0: expected at most x_max"):
+        shoot(math.pi, 0.0, 0.0, L=1.0, rho=0.5, x_max=2.0, step=1e12, method=method)
+    arc = shoot(math.pi, 0.0, 0.0, L=1.0, rho=0.5, x_max=2.0, step=2.0, method=method)
+    assert arc.x[-1] == pytest.approx(2.0) and not arc.unbounded  # the horizon itself is fine
+
+
+def test_solve_escape_refuses_a_step_beyond_the_escape_point():
+    with pytest.raises(SurveilValueError, match=r"step = 5: expected at most x_e = 1"):
+        solve_escape(math.pi, 1.0, L=1.0, rho=0.5, step=5)
+
+
+def test_an_explicit_step_is_held_to_the_memory_budget():
+    # step = 1e-9 to x_max = 2 is 2e9 kept RK4 nodes: the run grew without bound (killed
+    # after 60 s) where the default step's budget refuses at once
+    with pytest.raises(InfeasibleError, match=r"step = 1e-09 .* needs 2e\+09 RK4 steps"):
+        shoot(math.pi, 0.0, 0.0, L=1.0, rho=0.5, x_max=2.0, step=1e-9)
+    with pytest.raises(InfeasibleError, match=r"expected a step of at least 1e-06"):
+        solve_escape(math.pi, 2.0, L=1.0, rho=0.5, step=1e-9)
+
+
+def test_a_failed_escape_at_a_coarse_step_says_the_step_may_be_why():
+    # at step 0.5 (above the natural length 1/3) no extremal was found, with the theory
+    # blamed ("the arcs turn back"); the default step finds one
+    assert solve_escape(math.pi, 2.0, L=1.0, rho=0.5).success
+    sol = solve_escape(math.pi, 2.0, L=1.0, rho=0.5, step=0.5)
+    assert not sol.success
+    assert "the step 0.5 is too coarse" in sol.reason and "natural length 0.333" in sol.reason

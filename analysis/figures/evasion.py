@@ -22,7 +22,7 @@ import numpy as np
 from analysis.figures import cases, style
 from analysis.figures.registry import register
 from envs import validation
-from envs.errors import InvalidConfigError, SurveilValueError, UnknownNameError
+from envs.errors import InfeasibleError, InvalidConfigError, SurveilValueError, UnknownNameError
 from strategies.control import greedy_heading, shoot, solve_escape, tractrix
 
 __all__ = [
@@ -37,8 +37,21 @@ __all__ = [
 
 
 def draw_arc(ax, arc, title: str, rods: int = 6, legend: bool = True) -> None:
-    """An extremal (evader frame): the evader's path, the pursuer's, and a few rods."""
+    """An extremal (evader frame): the evader's path, the pursuer's, and a few rods; the
+    title says where an unbounded arc stops (THEORY §4.3).
+
+    Raises:
+        InfeasibleError: the arc is unbounded from its start (nothing to draw).
+    """
     ev, pu = arc.evader_path(), arc.pursuer_path()
+    if len(ev) < 2:
+        raise InfeasibleError(
+            f"nothing to draw: H has no minimiser at the start (THEORY §4.3) with theta0 = "
+            f"{arc.theta0!r}, lambda1 = {arc.lambda1!r}, lambda2_0 = {arc.lambda2_0!r}, "
+            f"L = {arc.L!r}, rho = {arc.rho!r}: the arc is unbounded from x = 0"
+        )
+    if arc.unbounded:
+        title += f"\nunbounded (H has no minimiser, THEORY §4.3) from x = {arc.x[-1]:.4g}"
     ax.plot(ev[:, 0], ev[:, 1], "-", color=style.EVADER, lw=2, label="evader E")
     ax.plot(pu[:, 0], pu[:, 1], "--", color=style.PURSUER, lw=1.5, label="pursuer P")
     for i in np.linspace(0, len(ev) - 1, rods).astype(int):
@@ -103,8 +116,12 @@ def draw_greedy(ax, theta0=math.pi, x_max=2.0, L=1.0, rho=0.5, branch="+", step=
 
 def draw_tractrix(ax, t_max=4.0, L=1.0, v_e=1.0, theta0=0.5 * math.pi) -> None:
     """Fig. 14 style: the follower's tractrix behind a leader on the x-axis (E4), over
-    the leader's times [0, t_max] (t_max > 0: at 0 the figure is a single rod)."""
+    the leader's times [0, t_max] (t_max > 0 and v_e > 0: else the figure is a single rod)."""
     t_max = validation.positive("t_max", t_max)
+    if validation.nonnegative("v_e", v_e) == 0.0:
+        raise InvalidConfigError(
+            f"v_e = {v_e!r}: expected > 0 (a leader at rest: the figure would be a single rod)"
+        )
     tr = tractrix(np.linspace(0.0, t_max, 400), L=L, v_e=v_e, theta0=theta0)
     ax.plot(
         tr.leader[:, 0], tr.leader[:, 1], "-", color=style.EVADER, lw=2, label="leader (evader)"

@@ -57,13 +57,22 @@ def _tractrix_args(t, L, v_e, theta0, alpha, leader_start):
     tt = np.atleast_1d(validation.finite_array("t", t))
     if tt.ndim != 1:
         raise SurveilValueError(f"t has shape {tt.shape}: expected a 1-D array of times")
+    v_e = validation.nonnegative("v_e", v_e)
+    start = validation.points("leader_start", leader_start)
+    reach = v_e * float(np.max(np.abs(tt), initial=0.0)) + float(np.max(np.abs(start)))
+    if not math.isfinite(reach):
+        # the leader's positions would overflow to inf and the follower's to nan
+        raise SurveilValueError(
+            f"v_e = {v_e!r} with times up to {float(np.max(np.abs(tt))):.4g}: the leader's "
+            "travel v_e t overflows; expected it finite"
+        )
     return (
         tt,
         validation.positive("L", L),
-        validation.nonnegative("v_e", v_e),
+        v_e,
         validation.real("theta0", theta0),
         validation.real("alpha", alpha),
-        validation.points("leader_start", leader_start),
+        start,
     )
 
 

@@ -235,3 +235,12 @@ def test_bad_input():
         wall_follow_speed(0.0, math.nan, v_e=1.0)
     with pytest.raises(SurveilValueError, match=r"rho = -0\.5"):
         straight_leader_time(0.0, 1.0, alpha=0.0, L=1.0, v_p=1.0, rho=-0.5)
+
+
+def test_tractrix_refuses_a_leader_travel_that_overflows():
+    # v_e t = 1e300 * 1e300 was inf: the leader at inf, the follower nan (no error)
+    with pytest.raises(SurveilValueError, match=r"v_e = 1e\+300 .* overflows"):
+        tractrix([0.0, 1e300], v_e=1e300)
+    with pytest.raises(SurveilValueError, match="overflows"):
+        tractrix_numeric([0.0, 1e300], v_e=1e300)
+    assert np.isfinite(tractrix([0.0, 1e300], v_e=1e-10).follower).all()

@@ -36,7 +36,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     )
     p.add_argument("--out", default=str(DEFAULT_OUT), help=f"directory (default: {DEFAULT_OUT})")
     p.add_argument("--only", nargs="+", metavar="NAME", help="figure names or unique prefixes")
-    p.add_argument("--scale", type=float, default=1.0, help="size factor (default 1)")
+    p.add_argument("--scale", type=float, default=1.0, help="size factor in [0.25, 4] (default 1)")
     p.add_argument("--list", action="store_true", help="list the figures and exit")
     p.add_argument(
         "--numbers",

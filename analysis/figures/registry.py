@@ -18,6 +18,11 @@ from envs.validation import positive
 
 MAX_SCALE = 4.0
 """Largest size factor (a 4x documentation figure is already a few thousand pixels wide)."""
+MIN_SCALE = 0.25
+"""Smallest size factor: below it the smaller replays (Fig. 9's and footnote 4's, drawn at 0.8
+times the factor) would fall under the 60-pixel floor of ``replays._size`` and, under 0.2,
+the PNGs under the 20 dpi floor of ``style.save_png``: a smaller factor was silently drawn
+larger than asked."""
 
 __all__ = [
     "FigureSpec",
@@ -152,10 +157,13 @@ def select(names: Iterable[str] | None) -> tuple[FigureSpec, ...]:
 
 
 def check_scale(scale: object) -> float:
-    """``scale`` as a float in (0, :data:`MAX_SCALE`], or InvalidConfigError naming it."""
+    """``scale`` as a float in [:data:`MIN_SCALE`, :data:`MAX_SCALE`], or InvalidConfigError
+    naming it."""
     value = positive("scale", scale)
-    if value > MAX_SCALE:
-        raise InvalidConfigError(f"scale = {scale!r}: expected a size factor in (0, {MAX_SCALE:g}]")
+    if not MIN_SCALE <= value <= MAX_SCALE:
+        raise InvalidConfigError(
+            f"scale = {scale!r}: expected a size factor in [{MIN_SCALE:g}, {MAX_SCALE:g}]"
+        )
     return value
 
 
@@ -165,7 +173,7 @@ def build_figure(name: str, out_dir: str | Path, *, scale: float = 1.0) -> Path:
     Args:
         name: a figure name or unique prefix (:func:`figure_names`).
         out_dir: output directory.
-        scale: size factor in (0, 4] (1 for the documentation; smaller is faster).
+        scale: size factor in [0.25, 4] (1 for the documentation; smaller is faster).
     """
     spec = figure_spec(name)
     scale = check_scale(scale)

@@ -34,3 +34,11 @@ def test_bad_input_is_a_clear_error(tmp_path, capsys):
     assert main(["figures", "--numbers", "zzz"]) == 2
     assert main(["figures", "--only", "fig12", "--scale", "-1", "--out", str(tmp_path)]) == 2
     assert "scale" in capsys.readouterr().err
+
+
+def test_a_scale_below_the_drawing_floors_is_refused(tmp_path, capsys):
+    # --scale 1e-9 exited 0 with a 128 x 72 PNG: the 20 dpi floor drew it at scale 0.2
+    out = tmp_path / "f"
+    assert main(["figures", "--only", "fig12", "--scale", "1e-9", "--out", str(out)]) == 2
+    assert "scale = 1e-09: expected a size factor in [0.25, 4]" in capsys.readouterr().err
+    assert not out.exists()

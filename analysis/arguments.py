@@ -26,7 +26,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
-from envs.errors import InvalidConfigError, SurveilValueError
+from envs.errors import InvalidConfigError, MemoryBudgetError, SurveilValueError
 
 __all__ = [
     "Parser",
@@ -193,6 +193,8 @@ def user_error(exc: BaseException) -> str | None:
     those (a model fed the wrong observation). Anything else is a bug and keeps its
     traceback.
     """
+    if isinstance(exc, MemoryBudgetError):  # a command line has no memory_budget= argument
+        return str(exc.named(budget=MemoryBudgetError.ENV_BUDGET))
     if isinstance(exc, SurveilValueError):
         return str(exc)
     if isinstance(exc, OSError):

@@ -25,6 +25,10 @@ from analysis.arguments import integer, json_object, output_file, real
 __all__ = ["add_parser", "run"]
 
 CONFIG_EXAMPLE = "'{\"v_evader\": 0.25}'"
+ESTIMATE_CPLS = (6.0, 8.0)
+"""``--estimate``'s resolutions when none is given."""
+ESTIMATE_KNOB = "the largest --estimate CPL (the others in proportion)"
+"""How a memory budget message names ``--estimate``'s knob."""
 
 
 def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -76,11 +80,12 @@ def run(args: argparse.Namespace) -> int:
 
     import numpy as np
 
-    from envs.errors import SurveilValueError, VacuousBoundWarning
+    from envs.errors import MemoryBudgetError, SurveilValueError, VacuousBoundWarning
     from envs.surveillance.config import EnvConfig
     from strategies.referee import referee_for
-    from strategies.referee.estimates import check_cpls
+    from strategies.referee.estimates import check_cpls, check_estimate
     from strategies.referee.referee import check_start
+    from strategies.referee.spec import GameSpec
     from strategies.runner import map_parameters
 
     overrides = json_object("--config", args.config, example=CONFIG_EXAMPLE)
@@ -105,10 +110,14 @@ def run(args: argparse.Namespace) -> int:
             check_cpls(args.estimate)
         except SurveilValueError as exc:
             raise type(exc)(f"--estimate: {exc}") from None
+    if args.estimate is not None:  # its memory too, before the referee's solve
+        with MemoryBudgetError.naming(ESTIMATE_KNOB):
+            check_estimate(GameSpec.from_config(cfg), tuple(args.estimate) or ESTIMATE_CPLS)
     t = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", VacuousBoundWarning)  # the summary says it below
-        ref = referee_for(cfg, args.cells_per_lmin, cache=not args.no_cache)
+        with MemoryBudgetError.naming("--cells-per-lmin"):  # this command's flag
+            ref = referee_for(cfg, args.cells_per_lmin, cache=not args.no_cache)
     s = ref.summary()
     print(
         f"{world.name}: rho = {cfg.rho:g}, L in [{cfg.l_min:g}, {cfg.l_max:g}], "
@@ -151,11 +160,13 @@ def run(args: argparse.Namespace) -> int:
 
 def _print_estimate(spec, args: argparse.Namespace) -> None:
     """The estimate's shares beside the certificates (never mixed with them)."""
+    from envs.errors import MemoryBudgetError
     from strategies.referee import estimate
 
-    cpls = tuple(args.estimate) or (6.0, 8.0)
+    cpls = tuple(args.estimate) or ESTIMATE_CPLS
     t = time.perf_counter()
-    est = estimate(spec, cpls, cache=not args.no_cache)
+    with MemoryBudgetError.naming(ESTIMATE_KNOB):  # checked up front too
+        est = estimate(spec, cpls, cache=not args.no_cache)
     s = est.summary()
     print(
         f"estimate (the plain discrete game at {', '.join(f'{c:g}' for c in est.cpls)} cells "

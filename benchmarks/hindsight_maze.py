@@ -27,6 +27,7 @@ import os
 import numpy as np
 from bench_cli import integer, real, run
 
+from envs.errors import MemoryBudgetError
 from envs.maps import builtin_info
 from envs.surveillance.config import EnvConfig
 from strategies.policies.base import BasePolicy
@@ -76,16 +77,17 @@ def main(argv=None) -> int:
         cfg = EnvConfig(map=info.map, **{**params, "v_pursuer": args.v_pursuer})
         print(f"V_p = {args.v_pursuer:g} (the path was recorded at V_p = {params['v_pursuer']:g})")
     for h in args.cells:
-        r = hindsight(
-            cfg,
-            path,
-            path.pursuer_start,
-            h,
-            substeps=args.substeps,
-            moves=args.moves,
-            pieces=args.pieces,
-            clearance=args.clearance,
-        )
+        with MemoryBudgetError.naming("--cells"):  # this script's flag
+            r = hindsight(
+                cfg,
+                path,
+                path.pursuer_start,
+                h,
+                substeps=args.substeps,
+                moves=args.moves,
+                pieces=args.pieces,
+                clearance=args.clearance,
+            )
         print(
             f"cell {h:g}: {r.verdict:8s} optimistic empty at {r.optimistic_empty}, "
             f"pessimistic until {r.pessimistic_until:.2f} s of {r.horizon:.2f} "

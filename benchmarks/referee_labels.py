@@ -25,7 +25,7 @@ from collections.abc import Callable, Iterable, Mapping
 
 import numpy as np
 
-from envs.errors import InfeasibleError, InvalidPlacementError
+from envs.errors import InfeasibleError, InvalidPlacementError, MemoryBudgetError
 from envs.maps import Map
 
 __all__ = ["MEANING", "hindsight_summary", "similarity_back", "summary", "tally", "verdict"]
@@ -62,7 +62,8 @@ def _referee(m: Map, overrides: Mapping[str, float], cpl: float):
     key = (m.digest, tuple(sorted(overrides.items())), float(cpl), cfg.dt)
     if _last is None or _last[0] != key:
         try:
-            _last = (key, referee_for(cfg, cpl, **SOLVE))
+            with MemoryBudgetError.naming("--referee CPL"):  # the scripts' flag
+                _last = (key, referee_for(cfg, cpl, **SOLVE))
         except InfeasibleError as exc:
             print(f"  referee (cpl {cpl:g}) not solved on map {m.name!r}: {exc}", flush=True)
             _last = (key, exc)

@@ -56,7 +56,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="resolutions of the estimate (none: skip it)")  # fmt: skip
     args = parser.parse_args(argv)
 
-    from envs.errors import VacuousBoundWarning
+    from envs.errors import MemoryBudgetError, VacuousBoundWarning
     from envs.surveillance.config import EnvConfig
     from strategies.cspace import decompose, surveillance_verdict
     from strategies.policies.registry import policy_names
@@ -83,7 +83,8 @@ def main(argv: list[str] | None = None) -> int:
         t = time.perf_counter()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", VacuousBoundWarning)  # printed below
-            ref = referee_for(cfg, cpl)
+            with MemoryBudgetError.naming("--cpl"):  # this script's flag
+                ref = referee_for(cfg, cpl)
         s = ref.summary()
         print(f"\ncells per L_min {cpl:g} ({time.perf_counter() - t:.0f} s): {s['starts']} "
               f"lattice starts, pursuer {s['pursuer']:.1%}, evader {s['evader']:.1%}, "
@@ -120,10 +121,12 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _print_estimate(cfg, starts, cpls) -> None:
+    from envs.errors import MemoryBudgetError
     from strategies.referee import GameSpec, estimate
 
     t = time.perf_counter()
-    est = estimate(GameSpec.from_config(cfg), cpls)
+    with MemoryBudgetError.naming("the largest --estimate-cpl (the others in proportion)"):
+        est = estimate(GameSpec.from_config(cfg), cpls)
     s = est.summary()
     print(f"\nthe estimate (the plain discrete game at {', '.join(f'{c:g}' for c in est.cpls)} "
           f"cells per L_min, both information orders; not a certificate; "

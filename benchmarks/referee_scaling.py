@@ -56,11 +56,13 @@ def _world(name: str):
 
 def _child(world: str, rho: float, cpl: float) -> dict:
     """Solve once (in this process) and report."""
+    from envs.errors import MemoryBudgetError
     from strategies.referee import GameSpec, solve
 
     spec = GameSpec(_world(world), 1.0, 2.0, 1.0, rho, body_radius=0.05)
     t = time.perf_counter()
-    ref = solve(spec, cpl, cache=False)
+    with MemoryBudgetError.naming("--cpl"):  # this script's flag
+        ref = solve(spec, cpl, cache=False)
     total = time.perf_counter() - t
     s = ref.summary()
     peak_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss

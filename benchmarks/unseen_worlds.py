@@ -106,7 +106,7 @@ from bench_cli import integer, real, run, worker_pool
 from referee_labels import similarity_back
 from unseen_opponents import make_opponent
 
-from envs.errors import InfeasibleError, InvalidConfigError
+from envs.errors import InfeasibleError, InvalidConfigError, MemoryBudgetError
 from envs.maps import Map, builtin_info, builtin_names, load_map
 from envs.maps.floor_plans import floor_plan
 from envs.maps.junctions import crossroads, t_junction
@@ -550,7 +550,8 @@ def hindsight_verdicts(rows: list[dict], cell: float, max_cycles: int) -> dict[s
         if not _won(r) and "error" not in r and open_loop(r["opponent"]):
             what = f"  hindsight (cell {cell:g}) {r['world']} {r['combo']} {r['opponent']} "
             try:
-                h = hindsight_verdict(r, cell, max_cycles)
+                with MemoryBudgetError.naming("--hindsight CELL"):  # this script's flag
+                    h = hindsight_verdict(r, cell, max_cycles)
             except InfeasibleError as exc:  # over the memory budget: the others still run
                 labels[row_key(r)] = "not solved"
                 print(f"{what}seed={r['seed']}: not solved ({exc})", flush=True)

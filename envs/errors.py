@@ -7,6 +7,9 @@ the offending value and say what was expected.
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
+
 __all__ = [
     "EpisodeStateError",
     "InfeasibleError",
@@ -15,6 +18,7 @@ __all__ = [
     "InvalidMapError",
     "InvalidObservationError",
     "InvalidPlacementError",
+    "MemoryBudgetError",
     "RhoAboveOneWarning",
     "SurveilValueError",
     "UnknownNameError",
@@ -55,6 +59,56 @@ class EpisodeStateError(SurveilValueError, RuntimeError):
 
 class InfeasibleError(SurveilValueError):
     """A requested computation has no solution for the given parameters."""
+
+
+class MemoryBudgetError(InfeasibleError):
+    """A solve refused before it starts: its estimated peak memory exceeds the budget
+    (the referee's solves, the estimate, the hindsight's grid).
+
+    The message names the knobs by the names of the function that refused
+    (``cells_per_lmin``, ``memory_budget=``); a command line, a benchmark or a policy
+    that sets them under other names re-raises :meth:`named` with its own (``surveil
+    referee --cells-per-lmin``, ``unseen_worlds.py --referee CPL``), so the user reads
+    what they can change where they are.
+
+    Args:
+        template: the message, with :data:`KNOB` where the resolution's knob goes and
+            :data:`BUDGET` where the budget's.
+        knob: the resolution's knob (``"cells_per_lmin"``).
+        budget: how to raise the budget, a format string with ``{size}``.
+        size: the budget that would fit (``"4GB"``).
+    """
+
+    KNOB = "\x00knob\x00"
+    BUDGET = "\x00budget\x00"
+    PYTHON_BUDGET = "memory_budget='{size}' or $SURVEIL_MEMORY_BUDGET"
+    """How a Python caller raises the budget."""
+    ENV_BUDGET = "SURVEIL_MEMORY_BUDGET={size} in the environment"
+    """How a command line (or a policy, which has no budget argument) raises it."""
+
+    def __init__(self, template: str, knob: str = "", budget: str = PYTHON_BUDGET, size: str = ""):
+        super().__init__(template, knob, budget, size)  # pickles (pool workers) by its args
+
+    def __str__(self) -> str:
+        template, knob, budget, size = self.args
+        return template.replace(self.KNOB, knob).replace(self.BUDGET, budget.format(size=size))
+
+    @classmethod
+    @contextlib.contextmanager
+    def naming(cls, knob: str, budget: str = ENV_BUDGET) -> Iterator[None]:
+        """Within it, a MemoryBudgetError is re-raised :meth:`named` ``knob`` and ``budget``
+        (by default ``$SURVEIL_MEMORY_BUDGET``: a command line has no ``memory_budget=``)."""
+        try:
+            yield
+        except cls as exc:
+            raise exc.named(knob, budget) from None
+
+    def named(self, knob: str | None = None, budget: str | None = None) -> MemoryBudgetError:
+        """The same error with the knobs named as the caller's user sets them."""
+        template, k, b, size = self.args
+        return type(self)(
+            template, k if knob is None else knob, b if budget is None else budget, size
+        )
 
 
 class UnknownNameError(SurveilValueError, KeyError):

@@ -236,6 +236,9 @@ def test_a_world_the_referee_cannot_afford_is_not_solved(unseen, tmp_path, monke
     assert unseen.main(argv) == 0
     text = capsys.readouterr().out
     assert "referee (cpl 12) not solved on map 'L_10x4'" in text and "memory budget" in text
+    # the flag and the variable a user of this script sets, not solve()'s keywords
+    assert "No --referee CPL fits" in text and "SURVEIL_MEMORY_BUDGET=1GB in the env" in text
+    assert "cells_per_lmin" not in text and "memory_budget=" not in text
     assert "herder seed=101: too_close at 3.0 s; referee: not solved" in text
     assert "on the 1 lost starts (1 distinct): 0 evader" in text and "1 not solved" in text
 
@@ -282,6 +285,7 @@ def test_a_hindsight_over_the_memory_budget_is_not_solved(unseen, tmp_path, caps
     assert unseen.main(argv) == 0
     text = capsys.readouterr().out
     assert "evader/straight seed=101: not solved (hindsight(cell = 1e-06" in text
+    assert "use --hindsight CELL >= " in text and "memory_budget=" not in text
     assert "occluded at 3.0 s; hindsight: not solved" in text
     assert "on the 1 losses to open-loop evaders: 0 evader" in text and "1 not solved" in text
 

@@ -19,13 +19,14 @@ physical memory.
 
 from __future__ import annotations
 
+import math
 import os
 import re
 from dataclasses import dataclass
 
 from scipy.spatial import cKDTree
 
-from envs.errors import InfeasibleError, InvalidConfigError
+from envs.errors import InvalidConfigError, MemoryBudgetError
 from envs.maps.map import Map
 
 __all__ = ["Estimate", "check_budget", "estimate", "memory_budget"]
@@ -93,15 +94,18 @@ def memory_budget(value: object = None) -> float:
 
 
 def check_budget(world: Map, L: float, budget: float) -> Estimate:
-    """The estimate; raises :class:`InfeasibleError` if it exceeds ``budget`` bytes."""
+    """The estimate; raises :class:`~envs.errors.MemoryBudgetError` if it exceeds ``budget``
+    bytes (a command line names ``$SURVEIL_MEMORY_BUDGET`` alone,
+    :func:`analysis.arguments.user_error`)."""
     est = estimate(world, L)
     if est.bytes > budget:
-        raise InfeasibleError(
+        raise MemoryBudgetError(
             f"decompose(map {world.name!r}, L = {L:g}): the decomposition would need about "
             f"{est.bytes / 1e9:.1f} GB ({est.pairs:,} pairs of critical curves meet; about "
             f"{est.seconds / 60:.0f} min), more than the memory budget of "
-            f"{budget / 1e9:.1f} GB. Raise the budget with decompose(..., memory_budget="
-            f"'{2 * est.bytes / 1e9:.0f}GB') or SURVEIL_MEMORY_BUDGET, or use a shorter L "
-            "or a smaller map"
+            f"{budget / 1e9:.1f} GB. Raise the budget with {MemoryBudgetError.BUDGET}, or use "
+            "a shorter L or a smaller map",
+            budget="decompose(..., memory_budget='{size}') or $SURVEIL_MEMORY_BUDGET",
+            size=f"{max(1, math.ceil(2 * est.bytes / 1e9))}GB",
         )
     return est

@@ -53,7 +53,7 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from envs.errors import InfeasibleError
+from envs.errors import MemoryBudgetError
 from strategies.cspace._budget import memory_budget
 from strategies.referee.lattice import grid_shape, lattice_vectors, window_half_width
 from strategies.referee.spec import GameSpec, Resolution
@@ -226,8 +226,10 @@ def check_budget(
         knob: the argument that sets it, for the message.
 
     Raises:
-        InfeasibleError: the estimated peak exceeds the budget; the message names the
-            estimate (memory, states, time) and the knobs that change it.
+        MemoryBudgetError: the estimated peak exceeds the budget; the message names the
+            estimate (memory, states, time) and the knobs that change it (``knob`` and
+            ``memory_budget=``: a caller that sets them otherwise renames them,
+            :meth:`~envs.errors.MemoryBudgetError.named`).
         InvalidConfigError: the budget is not a positive size.
     """
     limit = memory_budget(budget)
@@ -245,21 +247,21 @@ def check_budget(
             else:
                 hi = mid
         fit = math.floor(lo * 10) / 10
+        K = MemoryBudgetError.KNOB
         if fit > 0:
-            advice.append(f"Use {knob} <= {fit:g} (asked: {cells_per_lmin:g})")
+            advice.append(f"Use {K} <= {fit:g} (asked: {cells_per_lmin:g})")
         else:  # not even the coarsest solve: the interpreter alone is over the budget
-            advice.append(f"No {knob} fits (the interpreter alone takes {_size(BASE_BYTES)})")
+            advice.append(f"No {K} fits (the interpreter alone takes {_size(BASE_BYTES)})")
     more = math.ceil(1.2 * need / 1e9)
-    advice.append(
-        f"{'raise' if advice else 'Raise'} the budget with memory_budget='{more}GB' or "
-        "$SURVEIL_MEMORY_BUDGET"
-    )
+    advice.append(f"{'raise' if advice else 'Raise'} the budget with {MemoryBudgetError.BUDGET}")
     advice.append("or solve a smaller map or a smaller L_max / L_min")
-    raise InfeasibleError(
+    raise MemoryBudgetError(
         f"{call}: the solve would need about {_size(need)} at its peak, during the "
         f"{at.what} ({'; '.join(s.describe() for s in sizes)}; up to about "
         f"{_duration(total_seconds)} in all), more than the memory budget of "
-        f"{_size(limit)}. " + "; ".join(advice[:-1]) + ", " + advice[-1]
+        f"{_size(limit)}. " + "; ".join(advice[:-1]) + ", " + advice[-1],
+        knob,
+        size=f"{more}GB",
     )
 
 

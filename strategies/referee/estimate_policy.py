@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from envs import validation as V
-from envs.errors import InvalidConfigError
+from envs.errors import InvalidConfigError, MemoryBudgetError
 from envs.geometry import kernel_for
 from strategies.policies.base import BasePolicy, Snapshot, unit
 from strategies.referee.estimates import (
@@ -92,9 +92,11 @@ class EstimateEvader(BasePolicy):
     def _reset(self) -> None:
         spec = GameSpec.from_config(self.config)
         if not self._given and (self.solution is None or _key(self.solution.spec) != _key(spec)):
-            self.solution = _cached_solution(
-                spec, self.cells_per_lmin, self.steps, self.headings, True, None, False
-            )
+            # a policy has no memory_budget argument
+            with MemoryBudgetError.naming(f"{self.name!r} with cells_per_lmin"):
+                self.solution = _cached_solution(
+                    spec, self.cells_per_lmin, self.steps, self.headings, True, None, False
+                )
             self._tables = None
         if _key(self.solution.spec) != _key(spec):
             raise InvalidConfigError(

@@ -105,6 +105,7 @@ __all__ = [
     "Estimate",
     "EstimateSolution",
     "check_cpls",
+    "check_estimate",
     "estimate",
     "solve_estimate",
 ]
@@ -707,9 +708,36 @@ def estimate(
             the RAM. Checked before anything is solved or loaded.
 
     Raises:
-        InfeasibleError: the estimated peak exceeds the budget (the message gives the
+        MemoryBudgetError: the estimated peak exceeds the budget (the message gives the
             estimate and the knobs: fewer or coarser ``cpls``, the budget).
     """
+    values, order, per, headings, budget = _plan(spec, cpls, steps, headings, memory_budget)
+    sols = [_cached_solution(spec, values[i], s, headings, cache, cache_dir, progress, budget)
+            for i, s in zip(order, per, strict=True)]  # fmt: skip
+    return Estimate(spec, sols)
+
+
+def check_estimate(
+    spec: GameSpec,
+    cpls: Sequence[float] = (6.0, 8.0),
+    *,
+    steps: float | Sequence[float] | None = None,
+    headings: int = 16,
+    memory_budget: object = None,
+) -> None:
+    """Check :func:`estimate`'s arguments and memory budget without solving anything, so a
+    caller can refuse them before its other long work (``surveil referee --estimate``).
+
+    Raises:
+        InvalidConfigError, MemoryBudgetError: as :func:`estimate`.
+    """
+    _plan(spec, cpls, steps, headings, memory_budget)
+
+
+def _plan(spec, cpls, steps, headings, memory_budget):
+    """:func:`estimate`'s checked arguments ``(values, order, per, headings, budget)``:
+    the resolutions, their order (coarsest first), the steps in that order, the headings
+    and the memory budget in bytes, after checking that the solves fit in it."""
     if not isinstance(spec, GameSpec):
         raise InvalidConfigError(f"estimate: expected a GameSpec, got {type(spec).__name__}")
     values = check_cpls(cpls)
@@ -740,6 +768,4 @@ def estimate(
         cells_per_lmin=finest,
         knob="the finest of cpls (the others in proportion)",
     )
-    sols = [_cached_solution(spec, values[i], s, headings, cache, cache_dir, progress, budget)
-            for i, s in zip(order, per, strict=True)]  # fmt: skip
-    return Estimate(spec, sols)
+    return values, order, per, headings, budget

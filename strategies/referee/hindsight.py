@@ -60,7 +60,7 @@ import numpy as np
 from scipy import ndimage
 
 from envs import validation
-from envs.errors import InfeasibleError, InvalidConfigError, InvalidPlacementError
+from envs.errors import InvalidConfigError, InvalidPlacementError, MemoryBudgetError
 from envs.geometry import kernel_for
 from envs.geometry.segments import point_in_walls
 from strategies.cspace._budget import memory_budget as _memory_budget
@@ -172,7 +172,7 @@ def _points(name: str, value: Any) -> np.ndarray:
 def _check_memory(
     lo: np.ndarray, hi: np.ndarray, h: float, pieces: int, instants: int, budget: object
 ) -> None:
-    """Refuse (InfeasibleError) a grid over [lo, hi] of cells h, and ``instants`` of the
+    """Refuse (MemoryBudgetError) a grid over [lo, hi] of cells h, and ``instants`` of the
     evader's subdivided paths, whose estimated peak memory (:data:`_BYTES_PER_CELL`, and
     :data:`_BYTES_PER_INSTANT`) exceeds the budget, naming the cell side that fits."""
     limit = _memory_budget(budget)
@@ -183,19 +183,21 @@ def _check_memory(
     if need <= limit:
         return
     room = limit - BASE_BYTES - path_bytes
+    K = MemoryBudgetError.KNOB
     if room > 0:  # the cells scale as 1 / h^2
         fit = h * math.sqrt(cells * per_cell / room)
-        advice = f"use cell >= {fit:.2g} or fewer pieces, or"
+        advice = f"use {K} >= {fit:.2g} or fewer pieces, or"
     elif path_bytes > cells * per_cell:  # substeps ~ V_p dt / h: a larger cell, fewer
-        advice = "use a larger cell (fewer substeps) or a shorter path, or"
+        advice = f"use a larger {K} (fewer substeps) or a shorter path, or"
     else:
-        advice = f"no cell fits (the interpreter alone takes {_size(BASE_BYTES)}):"
-    raise InfeasibleError(
+        advice = f"no {K} fits (the interpreter alone takes {_size(BASE_BYTES)}):"
+    raise MemoryBudgetError(
         f"hindsight(cell = {h:g}, pieces = {pieces}): the grid of {cells:,.0f} cells and "
         f"the evader's path at {instants:,} instants would need about {_size(need)} at "
         f"its peak, more than the memory budget of {_size(limit)}; {advice} raise the "
-        f"budget with memory_budget='{math.ceil(1.2 * need / 1e9)}GB' or "
-        "$SURVEIL_MEMORY_BUDGET"
+        f"budget with {MemoryBudgetError.BUDGET}",
+        "cell",
+        size=f"{math.ceil(1.2 * need / 1e9)}GB",
     )
 
 
@@ -349,7 +351,7 @@ def hindsight(
     Raises:
         InvalidConfigError: a bad parameter or path (named), or a bad budget.
         InvalidPlacementError: the pursuer start is not admissible at t = 0.
-        InfeasibleError: the grid would need more memory than the budget (the message
+        MemoryBudgetError: the grid would need more memory than the budget (the message
             names the estimate and the cell that fits).
     """
     t_start = time.perf_counter()

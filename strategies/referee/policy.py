@@ -25,7 +25,7 @@ import math
 import numpy as np
 
 from envs import validation as V
-from envs.errors import InvalidConfigError
+from envs.errors import InvalidConfigError, MemoryBudgetError
 from strategies.policies.base import BasePolicy, Snapshot, unit
 from strategies.referee.evader_bound import EvaderBound
 from strategies.referee.pursuer_bound import PursuerBound
@@ -93,7 +93,9 @@ class _RefereePolicy(BasePolicy):
     def _reset(self) -> None:
         cfg = self.config
         if self._solve:
-            ref = _solved(cfg, self.cells_per_lmin)
+            # a policy has no memory_budget argument; its users set cells_per_lmin
+            with MemoryBudgetError.naming(f"{self.name!r} with cells_per_lmin"):
+                ref = _solved(cfg, self.cells_per_lmin)
             self.bound = ref.pursuer if self.role_name == "pursuer" else ref.evader
         spec = self.bound.spec
         for attr in ("l_min", "l_max", "v_pursuer", "v_evader"):

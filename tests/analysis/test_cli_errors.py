@@ -288,3 +288,14 @@ def test_the_step_budget_error_says_how_to_pass_a_step_here(capsys, tmp_path):
     params = '{"x_max": 3e4, "step": 1.0}'
     assert main(["figure", "greedy", "--params", params, "--out", out]) == 0
     assert (tmp_path / "g.png").stat().st_size > 1000
+
+
+def test_a_decomposition_over_the_budget_names_the_variable_not_the_keyword(
+    tmp_path, capsys, monkeypatch
+):
+    # a command line has no memory_budget= (the message said decompose(..., memory_budget=))
+    monkeypatch.setenv("SURVEIL_MEMORY_BUDGET", "100MB")
+    assert main(["analyze", "corner", "--out", str(tmp_path / "x.png")]) == 2
+    err = capsys.readouterr().err
+    assert "SURVEIL_MEMORY_BUDGET=1GB in the environment" in err, err
+    assert "memory_budget=" not in err and "0GB" not in err

@@ -98,3 +98,21 @@ def test_referee_bad_start_or_resolutions_fail_before_the_solve(extra, message, 
     assert main(["referee", "open_room", "--cells-per-lmin", "4", *extra]) == 2
     err = capsys.readouterr().err
     assert err.startswith("surveil: error:") and message in err and "Traceback" not in err
+
+
+def test_a_solve_over_the_budget_names_this_command_s_flags(capsys, monkeypatch):
+    """The budget message names --cells-per-lmin and $SURVEIL_MEMORY_BUDGET (it named
+    solve()'s cells_per_lmin and memory_budget=, neither of which this command has); an
+    --estimate over the budget is refused before the referee's solve, not after it."""
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", "/nonexistent")
+    monkeypatch.setenv("SURVEIL_MEMORY_BUDGET", "200MB")
+    base = ["referee", "open_room", "--config", '{"v_evader": 0.2}', "--no-cache"]
+    assert main([*base, "--cells-per-lmin", "40"]) == 2
+    err = capsys.readouterr().err
+    assert "Use --cells-per-lmin <= " in err and "SURVEIL_MEMORY_BUDGET=6GB in the env" in err
+    assert "cells_per_lmin" not in err and "memory_budget=" not in err
+    assert main([*base, "--cells-per-lmin", "4", "--estimate", "30", "40"]) == 2
+    out, err = capsys.readouterr()
+    assert out == ""  # refused before the referee's solve printed its summary
+    assert "Use the largest --estimate CPL (the others in proportion) <= " in err
+    assert "cpls" not in err.split("):", 1)[1] and "memory_budget=" not in err

@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import math
+import pickle
+import re
 import time
 
 import numpy as np
 import pytest
 
-from envs.errors import InfeasibleError, InvalidConfigError
+from envs.errors import InfeasibleError, InvalidConfigError, MemoryBudgetError
 from envs.maps import Map
 from envs.surveillance.config import EnvConfig
 from strategies.referee import (
@@ -92,8 +94,34 @@ def test_the_budget_comes_from_the_environment_for_a_policy(monkeypatch):
     monkeypatch.setenv("SURVEIL_MEMORY_BUDGET", "200MB")
     cfg = EnvConfig(map=_room(16, 10), l_min=0.3, l_max=0.6, v_evader=0.5)
     pol = RefereePursuer(cells_per_lmin=16)
-    with pytest.raises(InfeasibleError, match=r"Use cells_per_lmin <= \d"):
+    with pytest.raises(InfeasibleError, match=r"with cells_per_lmin <= \d") as err:
         pol.reset(role="pursuer", map=cfg.map, config=cfg, seed=0)
+    # a policy has no memory_budget argument: its message names what its user sets
+    msg = str(err.value)
+    assert "Use 'pursuer/referee' with cells_per_lmin <= " in msg, msg
+    assert "memory_budget=" not in msg and "SURVEIL_MEMORY_BUDGET=" in msg
+
+
+def test_a_budget_error_renames_its_knobs_and_survives_pickling():
+    """A command line names its own flags (MemoryBudgetError.named / naming); the error
+    crosses a process pool intact."""
+    s = spec(open_room(), 0.5)
+    with pytest.raises(MemoryBudgetError) as err:
+        solve(s, 40, cache=False, memory_budget="200MB")
+    msg = str(err.value)
+    size = re.search(r"memory_budget='(\d+GB)' or \$SURVEIL_MEMORY_BUDGET", msg).group(1)
+    assert "Use cells_per_lmin <= " in msg
+    again = pickle.loads(pickle.dumps(err.value))
+    assert type(again) is MemoryBudgetError and str(again) == msg
+    with pytest.raises(MemoryBudgetError) as err:
+        with MemoryBudgetError.naming("--cells-per-lmin"):
+            solve(s, 40, cache=False, memory_budget="200MB")
+    renamed = str(err.value)
+    assert renamed == msg.replace("Use cells_per_lmin", "Use --cells-per-lmin").replace(
+        f"memory_budget='{size}' or $SURVEIL_MEMORY_BUDGET",
+        f"SURVEIL_MEMORY_BUDGET={size} in the environment",
+    )
+    assert "\x00" not in renamed
 
 
 def test_each_solver_checks_its_own_budget():

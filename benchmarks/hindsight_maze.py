@@ -93,7 +93,7 @@ def main(argv=None) -> int:
             f"pessimistic until {r.pessimistic_until:.2f} s of {r.horizon:.2f} "
             f"(tau {r.tau:.4f}, {r.pessimistic_tau:.4f}); "
             f"largest sets {r.optimistic_cells.max()} / {r.pessimistic_cells.max()} cells; "
-            f"{r.seconds:.1f} s",
+            f"{r.seconds:.1f} s (estimated up to {r.estimated_seconds:.1f} s)",
             flush=True,
         )
         replayable = args.v_pursuer is None and abs(r.pessimistic_tau - cfg.dt) < 1e-12

@@ -559,7 +559,8 @@ def hindsight_verdicts(rows: list[dict], cell: float, max_cycles: int) -> dict[s
             labels[row_key(r)] = h.verdict
             empty = "never" if h.optimistic_empty is None else f"{h.optimistic_empty:.1f} s"
             print(f"{what}seed={r['seed']}: {h.verdict} (optimistic empty {empty}, pessimistic "
-                  f"until {h.pessimistic_until:.1f} s of {h.horizon:.1f}; {h.seconds:.1f} s)",
+                  f"until {h.pessimistic_until:.1f} s of {h.horizon:.1f}; {h.seconds:.1f} s, "
+                  f"estimated up to {h.estimated_seconds:.1f} s)",
                   flush=True)  # fmt: skip
     return labels
 

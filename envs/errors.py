@@ -18,6 +18,7 @@ __all__ = [
     "InvalidMapError",
     "InvalidObservationError",
     "InvalidPlacementError",
+    "LongRunWarning",
     "MemoryBudgetError",
     "RhoAboveOneWarning",
     "SurveilValueError",
@@ -120,6 +121,12 @@ class UnknownNameError(SurveilValueError, KeyError):
 
 class RhoAboveOneWarning(UserWarning):
     """V_e > V_p: legal, but escape is trivial for the evader (Sec. 5 of the paper)."""
+
+
+class LongRunWarning(UserWarning):
+    """A computation estimated, before it starts, to run longer than its module's limit
+    (the hindsight's grids: :data:`strategies.referee.hindsight.LONG_SECONDS`); the
+    message gives the estimate and the knobs that shorten it."""
 
 
 class VacuousBoundWarning(UserWarning):

@@ -52,6 +52,7 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -60,11 +61,16 @@ import numpy as np
 from scipy import ndimage
 
 from envs import validation
-from envs.errors import InvalidConfigError, InvalidPlacementError, MemoryBudgetError
+from envs.errors import (
+    InvalidConfigError,
+    InvalidPlacementError,
+    LongRunWarning,
+    MemoryBudgetError,
+)
 from envs.geometry import kernel_for
 from envs.geometry.segments import point_in_walls
 from strategies.cspace._budget import memory_budget as _memory_budget
-from strategies.referee._budget import BASE_BYTES, _size
+from strategies.referee._budget import BASE_BYTES, _duration, _size
 from strategies.referee.lattice import segment_wall_distance
 from strategies.referee.robust import convex_corners, sweep_hits_vertex, sweep_range_ok
 from strategies.referee.spec import MARGIN_REL
@@ -87,6 +93,32 @@ _BYTES_PER_INSTANT = 96.0
 """Peak memory per instant of the subdivided evader paths: two float64 coordinates (16
 bytes) for the optimistic path kept while the pessimistic one is interpolated (four such
 arrays at once, 64), and the per-step counts (8 each)."""
+
+
+_SECONDS_PER_INSTANT = 1e-3
+_SECONDS_PER_OPTIMISTIC_CELL = 2e-6
+_SECONDS_PER_PESSIMISTIC_CELL = 0.6e-6
+"""The time model of :func:`_estimate_seconds`: per instant of either grid (its fixed
+work: the walls near the evader, the crops), per cell of the optimistic set and instant,
+and per cell of the pessimistic set and step, times ``pieces^2`` on a map with convex
+corners (its sight tests run on a lattice of spacing h / pieces; none without corners).
+Measured on ``hindsight_maze``'s path (the maze, wall_hugging, 60 and 300 frames;
+``/work/scratch/s12/helper-75/hs_time.py``): 0.5-1 ms an instant with sets of a few
+cells; 1.1-1.7 us (up to 4 at a few hundred cells) per optimistic cell; 0.6 us per
+pessimistic cell at 1 piece, 6.7-9.3 us at 4 (0.42-0.58 x 16), cells 0.01-0.3, moves
+5-20. With the set sizes bounded as :func:`_estimate_seconds` does, the estimate was 1.6
+to 3.3 times the time taken there (cells 0.16-0.01, pieces 1 and 4) and 2 to 5.5 times in
+``open_room`` (a slow evader, 4 s, cells 0.05-0.02): an upper bound, give or take the
+machine's load."""
+
+LONG_SECONDS = 600.0
+"""An estimate above this warns (:class:`~envs.errors.LongRunWarning`) before the grids
+are built: ten minutes, so that with the estimate up to 5.5 times high (the time model
+above) the run still takes about two minutes or more (``hindsight_maze``'s finest
+default cell, 0.01, takes 22 s)."""
+
+_BAR_SECONDS = 10.0
+"""By default (``progress=None``) a bar is shown, on a terminal, beyond this estimate."""
 
 
 @dataclass(frozen=True)
@@ -136,6 +168,8 @@ class Hindsight:
             length <= V_p pessimistic_tau in between, from the pursuer's start).
         optimistic_sets: with ``keep_sets``, the optimistic set's cell centres ((n, 2))
             at each step of ``tau`` until it empties (for drawing and diagnosis).
+        estimated_seconds: the time estimated before the grids were built (an upper
+            bound, give or take the machine's load: :func:`_estimate_seconds`).
     """
 
     verdict: str
@@ -150,6 +184,7 @@ class Hindsight:
     seconds: float
     witness: np.ndarray
     optimistic_sets: list[np.ndarray] | None = None
+    estimated_seconds: float = math.nan
 
 
 def _param(config: Any, name: str) -> float:
@@ -167,6 +202,63 @@ def _points(name: str, value: Any) -> np.ndarray:
         raise InvalidConfigError(
             f"{name} = {value!r:.60}: expected numbers (x, y), got {type(value).__name__}"
         ) from None
+
+
+def _estimate_seconds(
+    world,
+    path: np.ndarray,
+    P0: np.ndarray,
+    V: float,
+    dt: float,
+    substeps: int,
+    pes_substeps: int,
+    h: float,
+    l_min: float,
+    l_max: float,
+    pieces: int,
+) -> tuple[float, float]:
+    """``(seconds, cells)``: the time both grids may take (the model of
+    :data:`_SECONDS_PER_INSTANT` and the per-cell constants), and the most cells either
+    set may hold, estimated before anything is allocated.
+
+    A set at time t holds at most the cells within ``V t + 2 h`` of the start (the
+    pursuer's reach) that are admissible against the evader: their area is measured at
+    up to 65 frames of the path on a lattice of spacing ``max(h, l_max / 16)`` (points in
+    the range annulus widened by the lattice's disc, inside the walls, not robustly
+    occluded: an over-approximation, as the optimistic set's own test; the clearance
+    test would cost ten times as much and took little off), each instant
+    taking the larger of its two nearest measured frames.
+    """
+    n = len(path) - 1
+    hc = max(h, l_max / 16.0)
+    dc = hc / math.sqrt(2.0)
+    g = np.arange(-math.ceil((l_max + dc) / hc), math.ceil((l_max + dc) / hc) + 1) * hc
+    off = np.stack(np.meshgrid(g, g, indexing="ij"), axis=-1).reshape(-1, 2)
+    d = np.hypot(off[:, 0], off[:, 1])
+    ring = off[(d >= l_min - dc) & (d <= l_max + dc)]
+    a, b, nrm = world.edge_start, world.edge_end, world.edge_normal
+    frames = np.unique(np.linspace(0, n, min(n + 1, 65)).round().astype(int))
+    area = np.empty(len(frames))
+    for i, k in enumerate(frames):
+        C = path[k] + ring
+        C = C[point_in_walls(C, a, b) & (np.hypot(*(C - P0).T) <= V * k * dt + 2 * h + dc)]
+        area[i] = hc * hc * np.count_nonzero(~_robustly_blocked(path[k], C, dc, a, b, nrm))
+
+    def cells(m: int) -> np.ndarray:  # the bound at each of n m instants after the start
+        t = np.arange(1, n * m + 1) * (dt / m)
+        j = np.searchsorted(frames, t / dt)  # frames[j - 1] < t / dt <= frames[j]
+        last = len(frames) - 1
+        adm = np.maximum(area[np.clip(j - 1, 0, last)], area[np.clip(j, 0, last)])
+        return np.minimum(adm, math.pi * (V * t + 2.0 * h) ** 2) / (h * h)
+
+    opt, pes = cells(substeps), cells(pes_substeps)
+    sight = pieces * pieces if len(world.convex_vertices) else 1  # no corner, no sight test
+    seconds = (
+        _SECONDS_PER_INSTANT * (len(opt) + len(pes))
+        + _SECONDS_PER_OPTIMISTIC_CELL * float(opt.sum())
+        + _SECONDS_PER_PESSIMISTIC_CELL * sight * float(pes.sum())
+    )
+    return seconds, float(max(opt.max(initial=1.0), pes.max(initial=1.0)))
 
 
 def _check_memory(
@@ -315,6 +407,7 @@ def hindsight(
     dt: float | None = None,
     keep_sets: bool = False,
     memory_budget: object = None,
+    progress: bool | None = None,
 ) -> Hindsight:
     """Bracket, on two grids, whether any pursuer could hold against an evader path.
 
@@ -344,6 +437,9 @@ def hindsight(
         memory_budget: bytes (or ``"2GB"``) the computation may take; default
             ``$SURVEIL_MEMORY_BUDGET``, else half the physical memory (as the referee's
             solves). The grid's size is known before anything is allocated.
+        progress: a bar per grid on standard error (``True``), none (``False``), or
+            (``None``) one on a terminal when the time estimated up front exceeds
+            :data:`_BAR_SECONDS`; the bars' titles give the estimate.
 
     Returns:
         The :class:`Hindsight`.
@@ -353,6 +449,10 @@ def hindsight(
         InvalidPlacementError: the pursuer start is not admissible at t = 0.
         MemoryBudgetError: the grid would need more memory than the budget (the message
             names the estimate and the cell that fits).
+
+    Warns:
+        LongRunWarning: the time estimated before the grids are built exceeds
+            :data:`LONG_SECONDS` (the message names it and the knobs that shorten it).
     """
     t_start = time.perf_counter()
     world = getattr(config, "map", None)
@@ -428,6 +528,19 @@ def hindsight(
     hi = np.minimum(path.max(axis=0) + l_max, P0 + V * horizon) + pad
     instants = (len(path) - 1) * (substeps + pes_substeps)
     _check_memory(lo, hi, h, pieces, instants, memory_budget)
+    estimated, most = _estimate_seconds(
+        world, path, P0, V, dt, substeps, pes_substeps, h, l_min, l_max, pieces
+    )
+    about = f"up to about {_duration(estimated)}"
+    if estimated > LONG_SECONDS:
+        warnings.warn(
+            f"hindsight(cell = {h:g}, pieces = {pieces}): estimated {about} ({instants:,} "
+            f"instants of sets of up to {most:,.0f} cells); the time grows as 1 / cell^2, "
+            "pieces^2 (pessimistic) and the path's length",
+            LongRunWarning,
+            stacklevel=2,
+        )
+    show = progress if progress is not None else (None if estimated > _BAR_SECONDS else False)
     E_o = _subdivide(path, substeps)
     E_p = _subdivide(path, pes_substeps)
     grid = _Grid(world, P0, lo, hi, h)  # P0 is a centre: the pessimistic pursuer may wait
@@ -448,7 +561,9 @@ def hindsight(
     # box grown by opt_pad cells: the next candidates
     opt_pad = math.ceil((step + 2 * delta) / h) + 1
     box = _crop(opt, opt_pad)
+    bar = _bar(show, len(E_o) - 1, f"hindsight cell {h:g} ({about}): optimistic")
     for k in range(len(E_o) - 1):
+        bar.update(1)
         E1 = E_o[k + 1]
         near = np.hypot(mid[:, 0] - E1[0], mid[:, 1] - E1[1]) <= l_max + delta + half + margin
         # candidates: every centre within V tau + delta of S_k (ell is a lower bound),
@@ -474,6 +589,7 @@ def hindsight(
         box = _crop(opt, opt_pad)
         bound = _distance_to(opt, box, h) - delta + (k + 1) * step
         np.maximum(shifted[box], bound, out=shifted[box])
+    bar.close()
 
     # ---- pessimistic: exact centres, continuous-time moves
     ell_max = step_p + float(np.max(np.hypot(*np.diff(E_p, axis=0).T), initial=0.0))
@@ -488,7 +604,9 @@ def hindsight(
     pes_cells[0] = 1
     pes_kept: list = []  # per frame after the first: kept indices, their predecessors
     pes_until = 0.0
+    bar = _bar(show, len(E_p) - 1, f"hindsight cell {h:g}: pessimistic")
     for k in range(len(E_p) - 1):
+        bar.update(1)
         if e_seg_clear[k] <= margin:  # the evader's own step touches a wall
             break
         kept = _pessimistic_step(
@@ -501,6 +619,7 @@ def hindsight(
         pes_cells[k + 1] = len(idx[0])
         pes_kept.append((idx, pred))
         pes_until = float(tau_p * (k + 1))
+    bar.close()
 
     if opt_empty is not None:
         verdict = "evader"
@@ -521,7 +640,18 @@ def hindsight(
         seconds=time.perf_counter() - t_start,
         witness=_backtrack(grid, pes_kept, P0),
         optimistic_sets=opt_sets if keep_sets else None,
+        estimated_seconds=estimated,
     )
+
+
+def _bar(show: bool | None, total: int, desc: str):
+    """A tqdm bar over ``total`` steps: shown (True), hidden (False) or on a terminal."""
+    from tqdm import tqdm
+
+    return tqdm(
+        total=total, desc=desc, unit="step", disable=None if show is None else not show,
+        leave=False,
+    )  # fmt: skip
 
 
 def _grazes(A, B, C: np.ndarray, R: float, verts, eta: float) -> np.ndarray:

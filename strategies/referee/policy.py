@@ -13,9 +13,9 @@ at the middle of the sensor range, the evader charges the pursuer) and records t
 did, in ``uncertified_steps``.
 
 Built without a bound (``make_policy("evader/referee", cells_per_lmin=16)``), a policy
-solves the env's game at reset, at that resolution and with its ``tau`` a whole number of
-env steps (:func:`strategies.referee.referee_for`; cached on disk, so only the first
-episode on a world pays).
+solves the bound it plays at reset, at that resolution and with its ``tau`` a whole number
+of env steps (:func:`strategies.referee.referee.solve_role`; cached on disk, so only the
+first episode on a world pays).
 """
 
 from __future__ import annotations
@@ -49,22 +49,25 @@ def env_steps_per_referee_step(tau: float, dt: float) -> int:
 
 
 _SOLVED: dict = {}
-"""The referees solved in this process, by (game, resolution, dt): episodes on the same
-world reuse them instead of reloading the disk cache at every reset."""
+"""The bounds solved in this process, by (game, resolution, dt, role): episodes on the
+same world reuse them instead of reloading the disk cache at every reset."""
 
 
-def _solved(config, cells_per_lmin: float):
-    from strategies.referee.referee import referee_for
+def _solved(config, cells_per_lmin: float, role: str):
+    """The bound ``role`` plays in the env's game, solved or loaded once per process (the
+    other bound is not needed: it was solved too, half of the reset's time, before)."""
+    from strategies.referee.referee import solve_role
     from strategies.referee.spec import GameSpec
 
-    key = (GameSpec.from_config(config), float(cells_per_lmin), float(config.dt))
-    ref = _SOLVED.get(key)
-    if ref is None:
-        ref = referee_for(config, cells_per_lmin)
+    spec = GameSpec.from_config(config)
+    key = (spec, float(cells_per_lmin), float(config.dt), role)
+    bound = _SOLVED.get(key)
+    if bound is None:
+        bound = solve_role(spec, role, cells_per_lmin, dt=config.dt)
         if len(_SOLVED) >= 8:
             _SOLVED.pop(next(iter(_SOLVED)))
-        _SOLVED[key] = ref
-    return ref
+        _SOLVED[key] = bound
+    return bound
 
 
 class _RefereePolicy(BasePolicy):
@@ -95,8 +98,7 @@ class _RefereePolicy(BasePolicy):
         if self._solve:
             # a policy has no memory_budget argument; its users set cells_per_lmin
             with MemoryBudgetError.naming(f"{self.name!r} with cells_per_lmin"):
-                ref = _solved(cfg, self.cells_per_lmin)
-            self.bound = ref.pursuer if self.role_name == "pursuer" else ref.evader
+                self.bound = _solved(cfg, self.cells_per_lmin, self.role_name)
         spec = self.bound.spec
         for attr in ("l_min", "l_max", "v_pursuer", "v_evader"):
             if not math.isclose(getattr(cfg, attr), getattr(spec, attr), rel_tol=1e-12):

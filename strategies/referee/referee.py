@@ -43,6 +43,7 @@ __all__ = [
     "referee_for",
     "sample_starts",
     "solve",
+    "solve_role",
 ]
 
 LABELS = ("pursuer", "evader", "unknown")
@@ -405,20 +406,12 @@ def solve(
     if not isinstance(spec, GameSpec):
         raise InvalidConfigError(f"solve: expected a GameSpec, got {type(spec).__name__}")
     cells_per_lmin = V.positive("cells_per_lmin", cells_per_lmin)
+    knobs = dict(pursuer_coarse=pursuer_coarse, evader_coarse=evader_coarse,
+                 pursuer_steps=pursuer_steps, evader_steps=evader_steps,
+                 sweep_pieces=sweep_pieces, dt=dt)  # fmt: skip
 
     def resolutions(cpl: float) -> tuple[Resolution, Resolution]:
-        kw = dict(sweep_pieces=sweep_pieces, dt=dt)
-        # at least four lattice spacings across the sensor range [l_min, l_max]
-        cap = max(2, math.floor((spec.l_max - spec.l_min) * cpl / (4.0 * spec.l_min)))
-        pc = pursuer_coarse
-        ec = evader_coarse
-        if pc is None:
-            pc = int(min(12, cap, max(2, round(2.0 / spec.rho))))
-        if ec is None:
-            ec = int(min(8, cap, max(2, round(8.0 * spec.rho))))
-        rp = Resolution.for_role(spec, "pursuer", cpl, coarse=pc, steps=pursuer_steps, **kw)
-        re = Resolution.for_role(spec, "evader", cpl, coarse=ec, steps=evader_steps, **kw)
-        return rp, re
+        return _resolution(spec, "pursuer", cpl, **knobs), _resolution(spec, "evader", cpl, **knobs)
 
     def sizes(cpl: float) -> list[SolveSize]:
         rp, re = resolutions(cpl)
@@ -443,6 +436,94 @@ def solve(
     if reason is not None:
         warnings.warn(f"map {spec.map.name!r}: {reason}", VacuousBoundWarning, stacklevel=2)
     return ref
+
+
+def _resolution(
+    spec: GameSpec,
+    role: str,
+    cpl: float,
+    *,
+    pursuer_coarse: int | None = None,
+    evader_coarse: int | None = None,
+    pursuer_steps: float = 3.0,
+    evader_steps: float = 2.0,
+    sweep_pieces: int = 2,
+    dt: float | None = None,
+) -> Resolution:
+    """The resolution of ``role``'s bound in :func:`solve` (its docstring says why)."""
+    # at least four lattice spacings across the sensor range [l_min, l_max]
+    cap = max(2, math.floor((spec.l_max - spec.l_min) * cpl / (4.0 * spec.l_min)))
+    if role == "pursuer":
+        coarse = pursuer_coarse
+        if coarse is None:
+            coarse = int(min(12, cap, max(2, round(2.0 / spec.rho))))
+        steps = pursuer_steps
+    else:
+        coarse = evader_coarse
+        if coarse is None:
+            coarse = int(min(8, cap, max(2, round(8.0 * spec.rho))))
+        steps = evader_steps
+    return Resolution.for_role(
+        spec, role, cpl, coarse=coarse, steps=steps, sweep_pieces=sweep_pieces, dt=dt
+    )
+
+
+def solve_role(
+    spec: GameSpec,
+    role: str,
+    cells_per_lmin: float = 24.0,
+    *,
+    dt: float | None = None,
+    cache: bool = True,
+    cache_dir: str | os.PathLike | None = None,
+    progress: bool = False,
+    memory_budget: object = None,
+    **knobs: Any,
+) -> PursuerBound | EvaderBound:
+    """The one bound of :func:`solve` that ``role`` plays: the pursuer bound for
+    ``"pursuer"``, the evader bound for ``"evader"`` (a referee policy needs no other),
+    at the resolution :func:`solve` gives it, from the same cache.
+
+    Args:
+        spec, cells_per_lmin, dt, cache, cache_dir, progress: as :func:`solve`.
+        role: ``"pursuer"`` or ``"evader"``.
+        memory_budget: as :func:`solve`, for this one solve.
+        **knobs: :func:`solve`'s ``pursuer_coarse, evader_coarse, pursuer_steps,
+            evader_steps, sweep_pieces``.
+
+    Raises:
+        MemoryBudgetError: the solve's estimated peak exceeds the budget (naming the
+            ``cells_per_lmin`` that fits).
+
+    Warns:
+        VacuousBoundWarning: as :func:`solve`, for the pursuer bound.
+    """
+    if not isinstance(spec, GameSpec):
+        raise InvalidConfigError(f"solve_role: expected a GameSpec, got {type(spec).__name__}")
+    if role not in ("pursuer", "evader"):
+        raise InvalidConfigError(f"role = {role!r}: expected 'pursuer' or 'evader'")
+    cells_per_lmin = V.positive("cells_per_lmin", cells_per_lmin)
+
+    def sizes(cpl: float) -> list[SolveSize]:
+        return [bound_size(spec, _resolution(spec, role, cpl, dt=dt, **knobs), role)]
+
+    budget = check_budget(
+        f"solve_role(map {spec.map.name!r}, {role!r}, L in [{spec.l_min:g}, "
+        f"{spec.l_max:g}], {cells_per_lmin:g} cells per L_min)",
+        sizes(cells_per_lmin),
+        memory_budget,
+        resize=sizes,
+        cells_per_lmin=cells_per_lmin,
+    )
+    res = _resolution(spec, role, cells_per_lmin, dt=dt, **knobs)
+    kw = dict(cache=cache, cache_dir=cache_dir, progress=progress, memory_budget=budget)
+    if role == "evader":
+        return cached_evader_bound(spec, res, **kw)
+    bound = cached_pursuer_bound(spec, res, **kw)
+    reason = bound.vacuity()
+    if reason is not None:
+        warnings.warn(f"map {spec.map.name!r}: {reason}", VacuousBoundWarning, stacklevel=2)
+    return bound
 
 
 def check_start(game: Any, pursuer: Any, evader: Any) -> tuple[np.ndarray, np.ndarray]:

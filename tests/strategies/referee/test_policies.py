@@ -118,3 +118,34 @@ def test_registered_referee_policies_solve_their_game_at_reset(tmp_path, monkeyp
     assert len(referee_policy._SOLVED) == 1
     with pytest.raises(InvalidConfigError, match="cells_per_lmin = 0"):
         make_policy("pursuer/referee", cells_per_lmin=0)
+
+
+@pytest.mark.parametrize("role", ["pursuer", "evader"])
+def test_a_referee_policy_solves_only_the_bound_it_plays(role, tmp_path, monkeypatch):
+    """Issue 13 leftover: ``pursuer/referee`` solved both bounds at reset (the evader bound
+    too, about half the reset: corner at 16 cells per L_min, 1.58 s cold). Now the
+    other bound's solver is never called, and the bound played is the one solve() gives."""
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", str(tmp_path))
+    from strategies.referee import policy as referee_policy
+    from strategies.referee import referee as referee_module
+    from tests.strategies.referee.conftest import dead_end, spec
+
+    monkeypatch.setattr(referee_policy, "_SOLVED", {})
+    calls = []
+
+    def counted(kind):
+        real = getattr(referee_module, f"solve_{kind}_bound")
+        return lambda *a, **kw: calls.append(kind) or real(*a, **kw)
+
+    for kind in ("pursuer", "evader"):
+        monkeypatch.setattr(referee_module, f"solve_{kind}_bound", counted(kind))
+    s = spec(dead_end(), 0.5)
+    cfg = EnvConfig(map=s.map, l_min=s.l_min, l_max=s.l_max, v_pursuer=s.v_pursuer,
+                    v_evader=s.v_evader, body_radius=RADIUS, dt=DT)  # fmt: skip
+    pol = make_policy(f"{role}/referee", cells_per_lmin=12)
+    pol.reset(role=role, map=cfg.map, config=cfg, seed=0)
+    assert calls == [role]
+    ref = referee_module.solve(s, 12, dt=DT, cache_dir=tmp_path)  # the other from scratch
+    assert calls == [role, "pursuer" if role == "evader" else "evader"]
+    mine = ref.pursuer if role == "pursuer" else ref.evader
+    assert pol.bound.res == mine.res and np.array_equal(pol.bound.win, mine.win)

@@ -30,6 +30,7 @@ import math
 import numpy as np
 import pymunk
 
+from envs.errors import InvalidConfigError
 from envs.maps import Map
 
 __all__ = ["MAX_SUBSTEP_TRAVEL", "World", "substeps_for"]
@@ -78,9 +79,22 @@ class World:
         body_radius: disc radius of both agents.
         dt: env step duration.
         max_speed: the larger speed bound, which fixes the substep count.
+
+    Raises:
+        InvalidConfigError: ``max_speed * dt`` exceeds the map's diameter.
     """
 
     def __init__(self, world_map: Map, body_radius: float, dt: float, max_speed: float) -> None:
+        if max_speed * dt > world_map.diameter:
+            # a step that crosses the map: the substeps grow as V dt (v_pursuer = 1e6 hung
+            # on 2e6 a step), and the sweep's linear motion within the step no longer
+            # follows bodies stopped by the walls (dt = 100 timed a break 20 times late)
+            raise InvalidConfigError(
+                f"dt = {dt!r} with max(v_pursuer, v_evader) = {max_speed!r}: a body would "
+                f"cross map {world_map.name!r} (diameter {world_map.diameter:.4g}) in one "
+                "step; expected max(v_pursuer, v_evader) dt <= the map's diameter, i.e. "
+                f"dt <= {world_map.diameter / max_speed:.4g}"
+            )
         self.map = world_map
         self.body_radius = float(body_radius)
         self.dt = float(dt)

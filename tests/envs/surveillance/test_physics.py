@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from envs.errors import InvalidConfigError
 from envs.surveillance.physics import MAX_SUBSTEP_TRAVEL, World, substeps_for
 from tests.envs.surveillance._worlds import open_room, pillar_room, spiky_room
 
@@ -102,3 +103,21 @@ def test_rebuilt_space_replays_bit_identically() -> None:
 def test_step_before_reset_is_an_error() -> None:
     with pytest.raises(RuntimeError, match=r"before World\.reset"):
         World(open_room(), 0.1, 0.1, 1.0).step((0.0, 0.0), (0.0, 0.0))
+
+
+@pytest.mark.parametrize(("over", "speed"), [({"dt": 100.0}, 1.0), ({"v_pursuer": 1e6}, 1e6)])
+def test_a_step_that_crosses_the_map_is_refused(over, speed) -> None:
+    """v_pursuer = 1e6 hung (2e6 physics substeps a step); dt = 100 timed the break of a
+    pursuer and evader running apart at 12.6 s instead of 0.58 s (both stopped by the
+    walls long before the step's end, the sweep taking their motion as linear); the start
+    margins also covered the map ("no valid start found on map 'corridor'")."""
+    from envs import surveillance_v0
+
+    world = open_room()  # 10 x 10: diameter 14.14
+    with pytest.raises(InvalidConfigError, match=(
+        rf"^dt = {over.get('dt', 0.1)!r} with max\(v_pursuer, v_evader\) = {speed!r}: a body "
+        r"would cross map 'test_open' \(diameter 14.14\) in one step; .* i\.e\. dt <= "
+    )):  # fmt: skip
+        surveillance_v0.parallel_env(map=world, l_min=2.0, l_max=4.0, v_evader=0.5, **over)
+    env = surveillance_v0.parallel_env(map=world, l_min=2.0, l_max=4.0, v_evader=0.5, dt=14.0)
+    env.close()  # a step within the map's diameter is the user's choice

@@ -187,9 +187,14 @@ def _near_l_min(config, kernel, rng, judge, tab, angle_margin, escapable=False):
                 "evader": (float(e[i, 0]), float(e[i, 1])),
             }
     what = "escapable" if escapable else ("safe" if angle_margin is not None else "valid")
+    retreating = f", a retreat of {retreat:.4g} along the rod" if angle_margin is not None else ""
+    fastest = max(config.v_pursuer, config.v_evader)
     raise InfeasibleError(
-        f"no {what} start at L = {length:.4g} found "
-        f"on map {m.name!r} in {MAX_BATCHES * BATCH} proposals"
+        f"no {what} start at L = {length:.4g} found on map {m.name!r} in "
+        f"{MAX_BATCHES * BATCH} proposals (body radius {r:g}, rod clearance "
+        f"{rod_clearance:.4g} from convex vertices{retreating}); the rod clearance is "
+        f"max(v_pursuer, v_evader) dt spawn_margin_steps = {fastest:g} x {config.dt:g} x "
+        f"{config.spawn_margin_steps}: lower spawn_margin_steps, dt or the speeds"
     )
 
 

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from envs import surveillance_v0
+from envs.errors import InfeasibleError
 from envs.geometry import kernel_for
 from strategies.policies.starts import sample_start
 
@@ -134,3 +135,18 @@ def test_a_lazy_table_draws_the_same_start_as_an_eager_one(map_name, monkeypatch
     lazy = [sample_start(env.config, np.random.default_rng(s), kind="safe") for s in (1, 2)]
     assert lazy == eager
     env.close()
+
+
+def test_a_start_the_margins_rule_out_names_them():
+    """``surveil play --config '{"v_pursuer": 100}'`` said only "no safe start at L = 2.5
+    found on map 'corridor' in 25600 proposals": the cause is the rod clearance the start
+    margins ask (max(V_p, V_e) dt spawn_margin_steps = 30 m), now named with its factors;
+    with spawn_margin_steps = 0 a start is found."""
+    from envs.surveillance.config import EnvConfig
+
+    cfg = EnvConfig(map="corridor", v_pursuer=100.0)
+    with pytest.raises(InfeasibleError, match=r"rod clearance 30 from convex vertices.*"
+                       r"= 100 x 0.1 x 3: lower spawn_margin_steps"):  # fmt: skip
+        sample_start(cfg, np.random.default_rng(0), kind="safe")
+    cfg = EnvConfig(map="corridor", v_pursuer=100.0, spawn_margin_steps=0)
+    assert set(sample_start(cfg, np.random.default_rng(0), kind="safe")) == {"pursuer", "evader"}

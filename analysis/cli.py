@@ -40,7 +40,7 @@ CONFIG_EXAMPLE = "'{\"v_evader\": 0.8}'"
 def _cmd_maps(args: argparse.Namespace) -> int:
     from envs.maps import builtin_info, builtin_names
 
-    out = output_dir("--plot", args.plot) if args.plot else None
+    out = output_dir("--plot", args.plot) if args.plot is not None else None  # '' refused
     for name in builtin_names():
         info = builtin_info(name)
         m = info.map

@@ -82,6 +82,8 @@ def test_an_output_under_a_file_is_refused_before_the_episode(capsys, tmp_path):
     assert_fails(capsys, ["play", *FAST, "--out", out], "--out", "is a file, not a directory")
     assert_fails(capsys, ["figure", "tractrix", "--out", out.replace(".gif", ".png")], "--out")
     assert_fails(capsys, ["maps", "--plot", str(blocker)], "--plot", "is a file")
+    # an empty name listed the maps, drew nothing and exited 0
+    assert_fails(capsys, ["maps", "--plot", ""], "--plot")
 
 
 def test_an_output_with_a_wrong_suffix(capsys, tmp_path):

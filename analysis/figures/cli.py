@@ -103,9 +103,14 @@ def run(args: argparse.Namespace) -> int:
 
 def _check(path: Path) -> int:
     from analysis.figures.numbers import compute_numbers
-    from analysis.figures.report import check_report, read
+    from analysis.figures.report import check_report
 
-    problems = check_report(read(path), compute_numbers())
+    # not a report (a JSON file, an empty one) is exit 2, as for --update: it listed 122
+    # "problems" (exit 1) and advised --update, which then refused the file
+    text = _report_text(path, "--check")
+    if not text.strip():
+        raise InvalidConfigError(f"--check = {str(path)!r}: an empty file, not a report")
+    problems = check_report(text, compute_numbers())
     for p in problems:
         print(f"{path}: {p}")
     if problems:

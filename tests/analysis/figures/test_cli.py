@@ -42,3 +42,17 @@ def test_a_scale_below_the_drawing_floors_is_refused(tmp_path, capsys):
     assert main(["figures", "--only", "fig12", "--scale", "1e-9", "--out", str(out)]) == 2
     assert "scale = 1e-09: expected a size factor in [0.25, 4]" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_check_refuses_a_file_that_is_not_a_report(tmp_path, capsys):
+    # a JSON file or an empty one got 122 "problems" (exit 1) and the advice to --update
+    # it, which --update then refused; a missing file named no flag
+    other = tmp_path / "x.json"
+    other.write_text('{"a": 1}\n')
+    empty = tmp_path / "empty.md"
+    empty.write_text("")
+    for path, needle in ((other, "not a report"), (empty, "an empty file, not a report"),
+                         (tmp_path / "no.md", "cannot read it")):  # fmt: skip
+        assert main(["figures", "--check", str(path)]) == 2
+        out, err = capsys.readouterr()
+        assert f"--check = '{path}': " in err and needle in err and out == "", err

@@ -30,8 +30,10 @@ import math
 import numpy as np
 import shapely
 
+from envs.errors import MemoryBudgetError
 from envs.maps import Map
 from envs.tolerances import REL_LENGTH_TOL
+from strategies.cspace._budget import memory_budget
 from strategies.cspace.grids import grid_axis
 from strategies.policies._batch_classify import classify_points
 from strategies.policies.safety import SafetyTable, _circular_distance
@@ -39,6 +41,35 @@ from strategies.policies.safety import SafetyTable, _circular_distance
 __all__ = ["LazySafetyTable"]
 
 _UNKNOWN = -2  # a grid node not classified yet (-1: outside the free region)
+
+
+_BYTES_PER_NODE = 5
+"""The grid's per-node arrays: the row index (int32) and the membership flag (int8)."""
+
+
+def _check_grid(world: Map, resolution: float, shape: tuple[int, int]) -> None:
+    """Refuse a grid whose per-node arrays exceed the memory budget (``$SURVEIL_MEMORY_
+    BUDGET`` or half the RAM, as the decompositions'), before allocating them: at
+    ``resolution = 1e-6`` the corridor's grid asked numpy for 582 TiB (a MemoryError
+    traceback through the pursuer's reset).
+
+    Raises:
+        MemoryBudgetError: naming the estimate and the resolution that fits.
+    """
+    limit = memory_budget()
+    need = _BYTES_PER_NODE * float(shape[0]) * float(shape[1])
+    if need <= limit:
+        return
+    fit = resolution * math.sqrt(need / limit) * 1.01  # the nodes scale as 1 / resolution^2
+    raise MemoryBudgetError(
+        f"LazySafetyTable(map {world.name!r}, resolution = {resolution:g}): its grid of "
+        f"{shape[0]:,} x {shape[1]:,} nodes would need about {need / 1e9:.3g} GB, more than "
+        f"the memory budget of {limit / 1e9:.3g} GB; use {MemoryBudgetError.KNOB} >= "
+        f"{fit:.3g}, or raise the budget with {MemoryBudgetError.BUDGET}",
+        "resolution",
+        budget=MemoryBudgetError.ENV_BUDGET,  # no memory_budget argument here
+        size=f"{math.ceil(1.2 * need / 1e9)}GB",
+    )
 
 
 class LazySafetyTable:
@@ -68,12 +99,13 @@ class LazySafetyTable:
         self.L = float(L)
         self.resolution = float(resolution)
         self.n_bins = int(n_bins)
-        self.decomposition = decompose(world, self.L, cache=True)
         xmin, ymin, xmax, ymax = world.bounds
         self._xs = grid_axis(xmin, xmax, self.resolution)
         self._ys = grid_axis(ymin, ymax, self.resolution)
         self.origin = np.array([self._xs[0], self._ys[0]])
         self.shape = (len(self._xs), len(self._ys))
+        _check_grid(world, self.resolution, self.shape)  # before the decomposition's work
+        self.decomposition = decompose(world, self.L, cache=True)
         self._cell = np.full(self.shape, _UNKNOWN, dtype=np.int32)
         self._member = np.zeros(self.shape, dtype=np.int8)  # 0 unknown, 1 inside, 2 not
         self._centres = -math.pi + (np.arange(self.n_bins) + 0.5) * self.bin_width

@@ -69,3 +69,20 @@ def test_rotation_distances_against_brute_force(p):
             for b in range(36):
                 ks = [k for k in range(36) if safe[i, (b + step * k) % 36]]
                 assert got[i, b] == (ks[0] if ks else NO_PATH)
+
+
+def test_a_grid_beyond_the_memory_budget_is_refused_before_it_is_allocated(monkeypatch):
+    """``surveil play --pursuer-params '{"resolution": 1e-6}'`` ended in a numpy
+    MemoryError traceback (582 TiB for the corridor's grid); now a MemoryBudgetError
+    names the estimate and a resolution that fits, and that resolution builds."""
+    from envs.errors import MemoryBudgetError
+
+    monkeypatch.setenv("SURVEIL_MEMORY_BUDGET", "500MB")  # the decomposition fits
+    world = builtin_map("corridor")
+    with pytest.raises(MemoryBudgetError, match=r"resolution = 1e-06\): its grid of "
+                       r"16,000,000 x 10,000,000 nodes .* use resolution >= ") as err:  # fmt: skip
+        LazySafetyTable(world, 2.2, 1e-6, 36)
+    fit = float(str(err.value).split("use resolution >= ")[1].split(",")[0])
+    assert "SURVEIL_MEMORY_BUDGET=" in str(err.value) and "memory_budget=" not in str(err.value)
+    table = LazySafetyTable(world, 2.2, fit, 36)
+    assert 5 * table.shape[0] * table.shape[1] <= 500e6

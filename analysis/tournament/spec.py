@@ -285,10 +285,11 @@ def spec_from_dict(
     maps = _maps(d["maps"], source, base)
     pursuers = _roster(d["pursuers"], "pursuer", source, base)
     evaders = _roster(d["evaders"], "evader", source, base)
-    seeds = _seeds(d.get("seeds", 10), source)
     starts = _starts(d.get("start", "safe"), source)
     env = _env_table(d.get("env", {}), f"{source} [env]")
     variants = _grid(d.get("grid", {}), f"{source} [grid]")
+    per_seed = len(maps) * len(variants) * len(starts) * len(pursuers) * len(evaders)
+    seeds = _seeds(d.get("seeds", 10), source, per_seed)
     time_limit = positive("time_limit", d.get("time_limit", DEFAULT_TIME_LIMIT), where=source)
     salt = string("salt", d.get("salt", ""), where=source, nonempty=False)
     sprt = None
@@ -562,16 +563,52 @@ def _provenance(model: Path) -> dict[str, Any]:
     return data if isinstance(data, dict) else {}
 
 
-def _seeds(value: Any, source: str) -> tuple[int, ...]:
+_BYTES_PER_MATCH = 2100.0
+"""Peak memory of one planned match in the driver (its identity, the plan's lists, the
+store's registration): 1,987-2,084 bytes measured (``ru_maxrss`` above the start, 2e4 and
+1e5 matches, ``/work/scratch/s12/helper-75/plan_mem.py``)."""
+
+
+def _seeds(value: Any, source: str, per_seed: int = 1) -> tuple[int, ...]:
+    """The seeds, after checking that the plan of ``per_seed`` matches a seed fits in the
+    memory budget (``seeds = 1e9`` built a tuple of a billion seeds: a MemoryError
+    traceback, or the OOM killer, before any check).
+
+    Raises:
+        InvalidConfigError: a bad seed, none, or a repeated one.
+        MemoryBudgetError: too many matches to plan (naming how many seeds fit).
+    """
     if isinstance(value, (list, tuple)):
         seeds = [integer(f"seeds[{i}]", s, minimum=0, where=source) for i, s in enumerate(value)]
         if not seeds:
             raise InvalidConfigError(f"{source}: seeds = []: expected at least one seed")
         if len(set(seeds)) != len(seeds):
             raise InvalidConfigError(f"{source}: seeds = {seeds}: a seed is repeated")
+        _check_plan(len(seeds), per_seed, source)
         return tuple(seeds)
     n = integer("seeds", value, minimum=1, where=source)
+    _check_plan(n, per_seed, source)
     return tuple(range(n))
+
+
+def _check_plan(n: int, per_seed: int, source: str) -> None:
+    from envs.errors import MemoryBudgetError
+    from strategies.cspace._budget import memory_budget
+
+    limit = memory_budget()
+    need = _BYTES_PER_MATCH * n * per_seed
+    if need <= limit:
+        return
+    fit = int(limit // (_BYTES_PER_MATCH * per_seed))
+    raise MemoryBudgetError(
+        f"{source}: seeds = {n:,} make {n * per_seed:,} matches ({per_seed:,} a seed: maps x "
+        f"grid x starts x pursuers x evaders), about {need / 1e9:.3g} GB to plan, more than "
+        f"the memory budget of {limit / 1e9:.3g} GB; expected {MemoryBudgetError.KNOB} <= "
+        f"{fit:,}, or raise the budget with {MemoryBudgetError.BUDGET}",
+        "seeds",
+        budget=MemoryBudgetError.ENV_BUDGET,  # a spec has no memory_budget argument
+        size=f"{max(1, round(1.2 * need / 1e9))}GB",
+    )
 
 
 def _starts(value: Any, source: str) -> tuple[str, ...]:

@@ -250,3 +250,22 @@ def test_a_different_spec_reuses_shared_matches(tmp_path, small_spec):
     by_id = {r["match_id"]: r for r in comparable(wide)}
     for r in comparable(narrow):
         assert by_id[r["match_id"]] == r | {"seq": by_id[r["match_id"]]["seq"]}
+
+
+def test_more_matches_than_the_memory_budget_can_plan_are_refused(small_spec, monkeypatch):
+    """``surveil evaluate --seeds 1000000000`` built a tuple of a billion seeds (MemoryError,
+    or the OOM killer) and ``--seeds 1000000`` grew past 1.5 GB planning: the plan's size
+    (2.1 kB a match, measured) is checked against the memory budget from the counts alone,
+    naming how many seeds fit."""
+    from envs.errors import MemoryBudgetError
+
+    monkeypatch.setenv("SURVEIL_MEMORY_BUDGET", "10MB")
+    per_seed = len(list(plan(spec_from_dict({**small_spec, "seeds": 1}))))
+    fit = int(10e6 // (2100 * per_seed))
+    with pytest.raises(MemoryBudgetError, match=rf"SPEC.toml: seeds = 1,000,000 make "
+                       rf"{1_000_000 * per_seed:,} matches .* expected seeds <= {fit:,}, "
+                       r"or raise the budget with SURVEIL_MEMORY_BUDGET=20GB in"):  # fmt: skip
+        spec_from_dict({**small_spec, "seeds": 10**6}, source="SPEC.toml")
+    with pytest.raises(MemoryBudgetError):
+        spec_from_dict({**small_spec, "seeds": list(range(fit + 1))})
+    assert len(spec_from_dict({**small_spec, "seeds": fit}).seeds) == fit

@@ -34,6 +34,7 @@ __all__ = [
     "json_object",
     "output_dir",
     "output_file",
+    "path_text",
     "real",
     "user_error",
 ]
@@ -88,6 +89,20 @@ def real(minimum: float, *, strict: bool = True) -> Callable[[str], float]:
         return value
 
     parse.__name__ = "real"
+    return parse
+
+
+def path_text(what: str) -> Callable[[str], str]:
+    """An argparse ``type=``: a file or directory name, not empty or blank (an empty one
+    was taken as the flag's absence wherever the code tested its truth: ``--out ''`` drew
+    nothing, or to the default path, and exited 0)."""
+
+    def parse(text: str) -> str:
+        if not text.strip():
+            raise argparse.ArgumentTypeError(f"{text!r}: expected {what}")
+        return text
+
+    parse.__name__ = "path"
     return parse
 
 

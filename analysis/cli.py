@@ -22,6 +22,7 @@ from analysis.arguments import (
     json_object,
     output_dir,
     output_file,
+    path_text,
     real,
     user_error,
 )
@@ -254,7 +255,12 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("maps", help="list the built-in maps")
-    p.add_argument("--plot", metavar="DIR", help="also draw each map to DIR/NAME.png")
+    p.add_argument(
+        "--plot",
+        metavar="DIR",
+        type=path_text("a directory name ('.' for the current directory)"),
+        help="also draw each map to DIR/NAME.png",
+    )
     p.set_defaults(func=_cmd_maps)
 
     p = sub.add_parser("policies", help="list the registered policies")
@@ -263,7 +269,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("play", help="play one episode and write its replay (the main job)")
     p.add_argument(
-        "--map", default="corridor", help="built-in name or map file (default: corridor)"
+        "--map",
+        default="corridor",
+        type=path_text("a built-in map name or a map file"),
+        help="built-in name or map file (default: corridor)",
     )
     p.add_argument("--pursuer", default="pursuer/decomposition", help="registered pursuer policy")
     p.add_argument("--evader", default="evader/shooting", help="registered evader policy")
@@ -275,6 +284,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--out",
         default=str(DEFAULT_OUT / "play.gif"),
+        type=path_text("a file name or a directory"),
         help="replay: a .gif, a .png strip, or a directory (DIR/play.gif)",
     )
     p.add_argument(
@@ -285,18 +295,28 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_play)
 
     p = sub.add_parser("analyze", help="draw the critical curves, regions and graph G_L")
-    p.add_argument("map", help="built-in name or map file")
+    p.add_argument(
+        "map", type=path_text("a built-in map name or a map file"), help="built-in name or map file"
+    )
     p.add_argument(
         "--length", type=real(0.0), default=None, help="rod length L (default: a built-in's L_min)"
     )
-    p.add_argument("--out", help="picture (.png, .pdf, .svg) or a directory")
+    p.add_argument(
+        "--out",
+        type=path_text("a file name or a directory"),
+        help="picture (.png, .pdf, .svg) or a directory",
+    )
     p.add_argument("--no-graph", action="store_true", help="omit the connectivity graph panel")
     p.set_defaults(func=_cmd_analyze)
 
     p = sub.add_parser("figure", help="draw the paper's optimal-control figures")
     p.add_argument("name", choices=["shooting", "greedy", "tractrix"])
     p.add_argument("--params", help="parameters as JSON, e.g. '{\"rho\": 0.5}'")
-    p.add_argument("--out", help="picture (.png, .pdf, .svg) or a directory")
+    p.add_argument(
+        "--out",
+        type=path_text("a file name or a directory"),
+        help="picture (.png, .pdf, .svg) or a directory",
+    )
     p.set_defaults(func=_cmd_figure)
 
     from analysis.tournament.cli import add_parsers as add_tournament_parsers

@@ -20,7 +20,7 @@ import json
 import time
 from pathlib import Path
 
-from analysis.arguments import integer, json_object, output_file, real
+from analysis.arguments import integer, json_object, output_file, path_text, real
 
 __all__ = ["add_parser", "run"]
 
@@ -40,7 +40,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
         "the starts the pursuer provably holds from, those the evader provably escapes from, "
         "and the gap between them (the resolution error).",
     )
-    p.add_argument("map", help="built-in name or map file")
+    p.add_argument(
+        "map", type=path_text("a built-in map name or a map file"), help="built-in name or map file"
+    )
     p.add_argument("--config", help=f"env overrides as JSON, e.g. {CONFIG_EXAMPLE}")
     p.add_argument(
         "--cells-per-lmin",
@@ -49,7 +51,11 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
         help="resolution: opponent cells per L_min (default 16; the states grow about as its "
         "third to fourth power)",
     )
-    p.add_argument("--out", help="draw the winning sets to this picture (.png, .pdf, .svg)")
+    p.add_argument(
+        "--out",
+        type=path_text("a file name or a directory"),
+        help="draw the winning sets to this picture (.png, .pdf, .svg)",
+    )
     p.add_argument(
         "--classify",
         nargs=4,

@@ -18,7 +18,7 @@ import sys
 import time
 from pathlib import Path
 
-from analysis.arguments import output_dir
+from analysis.arguments import output_dir, path_text
 from envs.errors import InvalidConfigError
 
 __all__ = ["add_parser", "run"]
@@ -34,7 +34,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
         description="Regenerate our version of every figure of the paper (PNGs and GIF "
         "replays), and print, check or update the numbers docs/REPRODUCTION.md quotes.",
     )
-    p.add_argument("--out", default=str(DEFAULT_OUT), help=f"directory (default: {DEFAULT_OUT})")
+    p.add_argument(
+        "--out",
+        default=str(DEFAULT_OUT),
+        type=path_text("a directory name ('.' for the current directory)"),
+        help=f"directory (default: {DEFAULT_OUT})",
+    )
     p.add_argument("--only", nargs="+", metavar="NAME", help="figure names or unique prefixes")
     p.add_argument("--scale", type=float, default=1.0, help="size factor in [0.25, 4] (default 1)")
     p.add_argument("--list", action="store_true", help="list the figures and exit")
@@ -47,16 +52,19 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     p.add_argument(
         "--report",
         metavar="FILE",
+        type=path_text("a file name"),
         help="after drawing, rewrite FILE's tagged numbers and figure gallery",
     )
     p.add_argument(
         "--check",
         metavar="FILE",
+        type=path_text("a file name"),
         help="only check FILE against the code: exit 1 listing what drifted",
     )
     p.add_argument(
         "--update",
         metavar="FILE",
+        type=path_text("a file name"),
         help="only rewrite FILE's tagged numbers and figure gallery (draw nothing)",
     )
     p.set_defaults(func=run)

@@ -15,7 +15,7 @@ import sys
 from importlib import resources
 from pathlib import Path
 
-from analysis.arguments import integer, json_object, output_file
+from analysis.arguments import integer, json_object, output_file, path_text
 from envs.errors import InvalidConfigError
 
 __all__ = ["add_parsers", "format_cells", "shipped_specs"]
@@ -210,12 +210,20 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("spec", nargs="?", help="a spec file, or a shipped spec's name (--list)")
     p.add_argument("--list", action="store_true", help="list the shipped specs")
-    p.add_argument("--store", help="SQLite store (default: out/tournaments/NAME.sqlite)")
+    p.add_argument(
+        "--store",
+        type=path_text("a file name or a directory"),
+        help="SQLite store (default: out/tournaments/NAME.sqlite)",
+    )
     p.add_argument("--backend", choices=["serial", "process", "ray"], default="process")
     p.add_argument("--workers", type=int, default=None, help="processes, or local Ray CPUs")
     p.add_argument("--address", help="Ray cluster address (with --backend ray)")
     p.add_argument("--retry-errors", action="store_true", help="replay matches stored as errors")
-    p.add_argument("--report", help="also write the report to this directory")
+    p.add_argument(
+        "--report",
+        type=path_text("a directory name ('.' for the current directory)"),
+        help="also write the report to this directory",
+    )
     p.add_argument(
         "--no-report",
         dest="report_default",
@@ -229,13 +237,21 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("report", help="write a tournament's Markdown and HTML report")
     p.add_argument("store", help="the tournament's SQLite store")
     p.add_argument("--run", help="run id (prefix) or name (default: the latest)")
-    p.add_argument("--out", help="directory (default: STORE_report beside the store)")
+    p.add_argument(
+        "--out",
+        type=path_text("a directory name ('.' for the current directory)"),
+        help="directory (default: STORE_report beside the store)",
+    )
     p.add_argument("--no-replays", action="store_true", help="skip the GIF replays")
     p.set_defaults(func=_cmd_report)
 
     p = sub.add_parser("export", help="export a tournament's results as CSV or JSON lines")
     p.add_argument("store", help="the tournament's SQLite store")
-    p.add_argument("out", help="FILE.csv, FILE.jsonl or FILE.ndjson")
+    p.add_argument(
+        "out",
+        type=path_text("a file name or a directory"),
+        help="FILE.csv, FILE.jsonl or FILE.ndjson",
+    )
     p.add_argument("--run", help="run id (prefix) or name (default: the latest)")
     p.set_defaults(func=_cmd_export)
 
@@ -258,8 +274,16 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
         help="starts in a non-escapable cell at L_min (safe) or any valid one",
     )
     p.add_argument("--workers", type=integer(1), default=1, help="processes to play in")
-    p.add_argument("--results", help="SQLite store (default: out/evaluate.sqlite; resumable)")
-    p.add_argument("--plot", help="also draw the table as heat maps to this PNG")
+    p.add_argument(
+        "--results",
+        type=path_text("a file name or a directory"),
+        help="SQLite store (default: out/evaluate.sqlite; resumable)",
+    )
+    p.add_argument(
+        "--plot",
+        type=path_text("a file name or a directory"),
+        help="also draw the table as heat maps to this PNG",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=_cmd_evaluate)
 

@@ -301,3 +301,30 @@ def test_a_decomposition_over_the_budget_names_the_variable_not_the_keyword(
     err = capsys.readouterr().err
     assert "SURVEIL_MEMORY_BUDGET=1GB in the environment" in err, err
     assert "memory_budget=" not in err and "0GB" not in err
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        (["play", "--no-gif", "--out", ""], "--out = ''"),
+        (["play", "--no-gif", "--map", " "], "--map = ' '"),
+        (["analyze", "corridor", "--out", ""], "--out = ''"),
+        (["analyze", ""], "map = ''"),
+        (["figure", "tractrix", "--out", ""], "--out = ''"),
+        (["referee", "corridor", "--out", ""], "--out = ''"),
+        (["evaluate", "--maps", "corridor", "--seeds", "1", "--plot", ""], "--plot = ''"),
+        (["evaluate", "--maps", "corridor", "--seeds", "1", "--results", ""], "--results = ''"),
+        (["tournament", "quick", "--store", ""], "--store = ''"),
+        (["tournament", "quick", "--report", ""], "--report = ''"),
+        (["report", "x.sqlite", "--out", ""], "--out = ''"),
+        (["export", "x.sqlite", ""], "out = ''"),
+        (["figures", "--check", ""], "--check = ''"),
+        (["figures", "--out", ""], "--out = ''"),
+    ],
+)
+def test_an_empty_file_or_map_name_is_refused(argv, needle, capsys, tmp_path, monkeypatch):
+    # an empty name counted as the flag's absence: `figure --out ''` wrote out/...png,
+    # `referee --out ''` and `evaluate --plot ''` drew nothing, all with exit 0
+    monkeypatch.chdir(tmp_path)
+    assert_fails(capsys, argv, needle, "expected")
+    assert not any(tmp_path.iterdir())  # nothing written

@@ -26,14 +26,20 @@ import shapely
 from envs.maps.map import Map
 from envs.tolerances import REL_LENGTH_TOL
 
-__all__ = ["grid_axis", "grid_points"]
+__all__ = ["grid_axis", "grid_points", "grid_size"]
 
 _CHUNK = 1 << 20  # points per vectorised membership test
 
 
+def grid_size(lo: float, hi: float, resolution: float) -> int:
+    """How many abscissae :func:`grid_axis` has, without making them (a caller checks a
+    grid's memory before allocating it)."""
+    return max(1, math.floor((hi - lo) / resolution))
+
+
 def grid_axis(lo: float, hi: float, resolution: float) -> np.ndarray:
     """Grid abscissae with spacing ``resolution``, centred in ``[lo, hi]`` (at least one)."""
-    n = max(1, math.floor((hi - lo) / resolution))
+    n = grid_size(lo, hi, resolution)
     return lo + 0.5 * ((hi - lo) - (n - 1) * resolution) + resolution * np.arange(n)
 
 

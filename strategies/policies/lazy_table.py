@@ -34,7 +34,7 @@ from envs.errors import MemoryBudgetError
 from envs.maps import Map
 from envs.tolerances import REL_LENGTH_TOL
 from strategies.cspace._budget import memory_budget
-from strategies.cspace.grids import grid_axis
+from strategies.cspace.grids import grid_axis, grid_size
 from strategies.policies._batch_classify import classify_points
 from strategies.policies.safety import SafetyTable, _circular_distance
 
@@ -100,11 +100,15 @@ class LazySafetyTable:
         self.resolution = float(resolution)
         self.n_bins = int(n_bins)
         xmin, ymin, xmax, ymax = world.bounds
+        self.shape = (
+            grid_size(xmin, xmax, self.resolution),
+            grid_size(ymin, ymax, self.resolution),
+        )
+        # before any allocation (a 1e9 m map's axes alone were 75 GiB) or the decomposition
+        _check_grid(world, self.resolution, self.shape)
         self._xs = grid_axis(xmin, xmax, self.resolution)
         self._ys = grid_axis(ymin, ymax, self.resolution)
         self.origin = np.array([self._xs[0], self._ys[0]])
-        self.shape = (len(self._xs), len(self._ys))
-        _check_grid(world, self.resolution, self.shape)  # before the decomposition's work
         self.decomposition = decompose(world, self.L, cache=True)
         self._cell = np.full(self.shape, _UNKNOWN, dtype=np.int32)
         self._member = np.zeros(self.shape, dtype=np.int8)  # 0 unknown, 1 inside, 2 not

@@ -86,3 +86,18 @@ def test_a_grid_beyond_the_memory_budget_is_refused_before_it_is_allocated(monke
     assert "SURVEIL_MEMORY_BUDGET=" in str(err.value) and "memory_budget=" not in str(err.value)
     table = LazySafetyTable(world, 2.2, fit, 36)
     assert 5 * table.shape[0] * table.shape[1] <= 500e6
+
+
+def test_a_huge_map_is_refused_before_its_grid_axes_are_made(monkeypatch):
+    """A 1e9 m square map (``surveil play --map huge.json``): the grid's axes alone asked
+    numpy for 75 GiB (a MemoryError traceback) before the grid's check."""
+    from envs.errors import MemoryBudgetError
+    from envs.maps import Map
+
+    made = []
+    monkeypatch.setattr("strategies.policies.lazy_table.grid_axis",
+                        lambda *a: made.append(a) or np.zeros(1))  # fmt: skip
+    huge = Map([(0, 0), (1e9, 0), (1e9, 1e9), (0, 1e9)], name="huge")
+    with pytest.raises(MemoryBudgetError, match=r"10,000,000,000 x 10,000,000,000 nodes"):
+        LazySafetyTable(huge, 2.0, 0.1, 36)
+    assert made == []

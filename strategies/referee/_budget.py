@@ -250,8 +250,11 @@ def check_budget(
         K = MemoryBudgetError.KNOB
         if fit > 0:
             advice.append(f"Use {K} <= {fit:g} (asked: {cells_per_lmin:g})")
-        else:  # not even the coarsest solve: the interpreter alone is over the budget
+        elif BASE_BYTES >= limit:  # the interpreter alone is over the budget
             advice.append(f"No {K} fits (the interpreter alone takes {_size(BASE_BYTES)})")
+        else:  # a huge map: it said "the interpreter alone" there too
+            coarsest = peak(resize(0.1))[0]
+            advice.append(f"No {K} fits (even {K} = 0.1 needs about {_size(coarsest)})")
     more = math.ceil(1.2 * need / 1e9)
     advice.append(f"{'raise' if advice else 'Raise'} the budget with {MemoryBudgetError.BUDGET}")
     advice.append("or solve a smaller map or a smaller L_max / L_min")
@@ -266,6 +269,8 @@ def check_budget(
 
 
 def _size(n: float) -> str:
+    if n >= 1e13:  # 4.8e+14 GB, not 479908800287946.0 GB
+        return f"{n / 1e9:.3g} GB"
     return f"{n / 1e9:.1f} GB" if n >= 1e9 else f"{n / 1e6:.0f} MB"
 
 
@@ -274,4 +279,4 @@ def _duration(seconds: float) -> str:
         return f"{seconds:.0f} s"
     if seconds < 5400:
         return f"{seconds / 60:.0f} min"
-    return f"{seconds / 3600:.1f} h"
+    return f"{seconds / 3600:.3g} h"  # 1.08e+14 h, not 107916000064749.6 h

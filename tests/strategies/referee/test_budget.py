@@ -150,3 +150,16 @@ def test_a_solve_within_the_budget_runs():
     size = bound_size(s, ref.pursuer.res, "pursuer")
     assert size.states >= np.prod(ref.pursuer.win.shape)
     assert math.isfinite(size.seconds)
+
+
+def test_a_map_too_large_for_any_resolution_says_so_not_the_interpreter():
+    """A 1e9 m square (``surveil referee huge.json``) was refused with "No cells_per_lmin fits
+    (the interpreter alone takes 125 MB)" and "up to about 107916000064749.6 h": the map is
+    the reason, and the figures are readable."""
+    huge = Map([(0, 0), (1e9, 0), (1e9, 1e9), (0, 1e9)], name="huge")
+    s = GameSpec(huge, 2.0, 4.0, 1.0, 0.5, body_radius=0.1)
+    with pytest.raises(MemoryBudgetError) as err:
+        solve(s, 16, cache=False, memory_budget="1GB")
+    msg = str(err.value)
+    assert "No cells_per_lmin fits (even cells_per_lmin = 0.1 needs about " in msg, msg
+    assert "interpreter" not in msg and re.search(r"up to about [\d.]+e\+\d+ h in all", msg)

@@ -319,8 +319,16 @@ def _regret_section(a: Analysis) -> tuple[str, str]:
             "regret here, the fraction of certified-winnable starts it loses."
         )
         return text, f"<p>{html.escape(text)}</p>"
+    from envs.errors import MemoryBudgetError
+    from strategies.referee.regrets import DEFAULT_CELLS_PER_LMIN
+
     geometry = {d: g for d, g in a.geometry.items() if g is not None}
-    table = tournament_regret(a.run["spec"], a.rows, geometry=geometry)
+    try:
+        table = tournament_regret(a.run["spec"], a.rows, geometry=geometry)
+    except MemoryBudgetError as exc:  # one table, not the whole report (it stopped there)
+        knob = f"the resolution (the report's is {DEFAULT_CELLS_PER_LMIN:g} cells per L_min)"
+        text = f"Not solved: {exc.named(knob, MemoryBudgetError.ENV_BUDGET)}"
+        return text, f"<p>{html.escape(text)}</p>"
     return _md_table(table), _html_table(table)
 
 

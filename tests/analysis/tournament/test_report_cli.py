@@ -132,3 +132,20 @@ def test_evaluate_takes_zoo_models_by_name(tmp_path, capsys):
     assert main(argv) == 0
     out = capsys.readouterr().out
     assert "1 of 1 matches stored" in out and "zoo:ppo_pursuer_vs_straight_open_room" in out
+
+
+def test_a_regret_table_over_the_memory_budget_leaves_the_rest_of_the_report(
+    tmp_path, small_spec, monkeypatch
+):
+    """`surveil report` under SURVEIL_MEMORY_BUDGET=130MB stopped with exit 2 at the
+    referee's solve for the regret table (naming cells_per_lmin, which the report does not
+    take); now the table says why it is missing and the report is written."""
+    store = tmp_path / "s.sqlite"
+    run_tournament(spec_from_dict(small_spec), store, backend="serial", progress=False)
+    monkeypatch.setenv("SURVEIL_MEMORY_BUDGET", "130MB")
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", str(tmp_path / "cache"))
+    files = write_report(store, tmp_path / "rep", replays=False)
+    regret = files["markdown"].read_text().split("## Regret", 1)[1].split("\n## ", 1)[0]
+    assert "Not solved: solve(map " in regret and "more than the memory budget" in regret
+    assert "Use the resolution (the report's is 16 cells per L_min) <= " in regret
+    assert "SURVEIL_MEMORY_BUDGET=" in regret and "memory_budget=" not in regret

@@ -1,6 +1,7 @@
 """The decomposition-based pursuer (Secs. 4-5): keep the rod in admissible safe cells at L_min.
 
-Per step (a table lookup plus a little arithmetic, no geometry kernel call):
+Per step (a table lookup plus a little arithmetic; a geometry kernel call only on the rare
+steps the table reads the rod's own orientation as blocked, :func:`crossable_steps`):
 
 1. From the :class:`~strategies.policies.safety.SafetyTable` (safe = free and not in an
    escapable cell at L_min, Sec. 4), the rotation each orientation bin needs to reach a
@@ -45,6 +46,7 @@ import math
 import numpy as np
 
 from envs import validation
+from envs.geometry import kernel_for
 from strategies.control.kinematics import _holding_range, _theta_dot_rates
 from strategies.policies.base import (
     MAX_RAYS,
@@ -59,7 +61,7 @@ from strategies.policies.baselines import nearest_wall_point
 from strategies.policies.lazy_table import LazySafetyTable
 from strategies.policies.safety import NO_PATH, SafetyTable, safety_table
 
-__all__ = ["DecompositionPursuer", "reachable_steps"]
+__all__ = ["DecompositionPursuer", "crossable_steps", "reachable_steps"]
 
 
 @functools.lru_cache(maxsize=16)
@@ -442,14 +444,26 @@ class DecompositionPursuer(BasePolicy):
         value = self._values(snap.evader, row, snap.evader_velocity)
         free = tab.free[row]
         nb = tab.n_bins
-        ccw_steps, cw_steps = reachable_steps(free, b0)
+        room: list[tuple[float, float] | None] = []  # the real rod's room, computed once
+
+        def steps_from(free: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            ccw, cw = reachable_steps(free, b0)
+            if free[b0] or not ccw.size or not cw.size:
+                return ccw, cw
+            if not room:
+                room.append(self._rod_room(snap))
+            if room[0] is None:
+                return ccw, cw
+            return crossable_steps(ccw, cw, b0, snap.theta, self._bw, room[0])
+
+        ccw_steps, cw_steps = steps_from(free)
         # pinned one way: no clockwise step, or no counter-clockwise one (ccw_steps also
         # holds 0, staying at b0, when b0 is free)
         if not cw_steps.size or not (ccw_steps > 0).any():
             ahead = tab.row(snap.evader + self.config.dt * snap.evader_velocity)
             if ahead >= 0 and ahead != row:  # pinned one way here: the row ahead as well
                 free = free | tab.free[ahead]
-                ccw_steps, cw_steps = reachable_steps(free, b0)
+                ccw_steps, cw_steps = steps_from(free)
         if not ccw_steps.size and not cw_steps.size:
             return 0.0, b0
         cand_bins = np.concatenate([(b0 + ccw_steps) % nb, (b0 - cw_steps) % nb])
@@ -471,6 +485,26 @@ class DecompositionPursuer(BasePolicy):
         elif rot < 0 and offset > 0:
             offset -= 2.0 * math.pi
         return offset, target
+
+    def _rod_room(self, snap: Snapshot) -> tuple[float, float] | None:
+        """How far (radians) the real rod can turn counter-clockwise and clockwise.
+
+        The rod of the actual length ``L`` from the actual evader, up to its first
+        contact each way (the kernel's free arcs, THEORY.md 1.3); ``None`` if the rod is
+        already blocked. Called only on the rare steps the table reads the rod's bin as
+        blocked.
+        """
+        arcs = kernel_for(self.config.map).free_arcs(snap.evader, max(snap.L, 1e-9))
+        if arcs.is_full:
+            return math.inf, math.inf
+        i = arcs.arc_index(snap.theta)
+        if i is None:
+            return None
+        arc = arcs.arcs[i]
+        past_lo = (snap.theta - arc.lo) % (2.0 * math.pi)
+        if past_lo > arc.width:  # theta within the tolerance before lo
+            past_lo = 0.0
+        return arc.width - past_lo, past_lo
 
     def _orbit_margins(self, ex: float, ey: float, theta: float, L: float) -> tuple[float, float]:
         """How much room the orbit about the evader has, turning ccw and cw (negative: none).
@@ -785,6 +819,49 @@ def _corner_neighbours(world, corners: list[int]) -> tuple[np.ndarray, np.ndarra
         din[k, 1] = -world.edge_dir[e_out]
         nxt[k, 1] = index.get(int(world.edge_vertices[e_in, 0]), -1)
     return nxt, din
+
+
+def crossable_steps(
+    ccw: np.ndarray,
+    cw: np.ndarray,
+    b0: int,
+    theta: float,
+    bw: float,
+    room: tuple[float, float],
+) -> tuple[np.ndarray, np.ndarray]:
+    """Drop the way round whose table-blocked gap the real rod cannot sweep (issue 13).
+
+    :func:`reachable_steps` crosses the bins the table calls blocked between the rod's
+    bin ``b0`` and the first free bin on either side, trusting that the real rod (shorter
+    than the table's) is clear there. A gap can be an obstacle's whole shadow: on
+    rand:polygons:2006 (evader orbiting an obstacle, seed 101) the evader 0.05 off its
+    table node put the rod's bin in the table's shadow at 32.4 s while the real rod was
+    0.031 clear; counter-clockwise the gap was 0 bins, clockwise 59 (148 degrees), and
+    the best bin's shorter way round was clockwise: the pursuer reversed into the corner
+    and lost sight within the step. Here a gap counts as crossable only if the real rod's
+    room that way (``room``, radians from ``theta``, :meth:`DecompositionPursuer._rod_room`)
+    reaches the first free bin. When one way is crossable and the other is not, the other
+    is dropped; when neither is, both stay (the table's verdict is all there is).
+
+    Args:
+        ccw, cw: :func:`reachable_steps`' candidates with the rod's bin blocked (both
+            non-empty; the first of each is the first free bin that way).
+        b0: the rod's bin; theta: its angle; bw: the bin width.
+        room: the real rod's room counter-clockwise and clockwise from ``theta``.
+
+    Returns:
+        ``(ccw, cw)``, one of them possibly emptied.
+    """
+    two_pi = 2.0 * math.pi
+    enter_ccw = (-math.pi + (b0 + int(ccw[0])) * bw - theta) % two_pi  # its lower edge
+    enter_cw = (theta - (-math.pi + (b0 - int(cw[0]) + 1) * bw)) % two_pi  # its upper edge
+    ok_ccw = room[0] >= enter_ccw
+    ok_cw = room[1] >= enter_cw
+    if ok_ccw and not ok_cw:
+        return ccw, cw[:0]
+    if ok_cw and not ok_ccw:
+        return ccw[:0], cw
+    return ccw, cw
 
 
 def reachable_steps(free: np.ndarray, b0: int) -> tuple[np.ndarray, np.ndarray]:

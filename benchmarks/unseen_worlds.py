@@ -97,6 +97,7 @@ import math
 import os
 import re
 import time
+import warnings
 import zlib
 
 import episode_rows
@@ -106,7 +107,7 @@ from bench_cli import integer, real, run, worker_pool
 from referee_labels import similarity_back
 from unseen_opponents import make_opponent
 
-from envs.errors import InfeasibleError, InvalidConfigError, MemoryBudgetError
+from envs.errors import InfeasibleError, InvalidConfigError, LongRunWarning, MemoryBudgetError
 from envs.maps import Map, builtin_info, builtin_names, load_map
 from envs.maps.floor_plans import floor_plan
 from envs.maps.junctions import crossroads, t_junction
@@ -550,7 +551,13 @@ def hindsight_verdicts(rows: list[dict], cell: float, max_cycles: int) -> dict[s
         if not _won(r) and "error" not in r and open_loop(r["opponent"]):
             what = f"  hindsight (cell {cell:g}) {r['world']} {r['combo']} {r['opponent']} "
             try:
-                with MemoryBudgetError.naming("--hindsight CELL"):  # this script's flag
+                with MemoryBudgetError.naming("--hindsight CELL"), warnings.catch_warnings():
+                    # a long estimate is a line of the report, printed before the run
+                    # (not a Python warning quoting this file's source)
+                    warnings.simplefilter("always", LongRunWarning)
+                    warnings.showwarning = lambda message, *_, what=what, r=r: print(
+                        f"{what}seed={r['seed']}: {message}", flush=True
+                    )
                     h = hindsight_verdict(r, cell, max_cycles)
             except InfeasibleError as exc:  # over the memory budget: the others still run
                 labels[row_key(r)] = "not solved"

@@ -271,6 +271,34 @@ def test_hindsight_labels_the_losses_to_open_loop_evaders(unseen, tmp_path, caps
     )
 
 
+def test_a_long_hindsight_estimate_is_a_line_of_the_report(
+    unseen, tmp_path, capsys, monkeypatch
+) -> None:
+    """An estimate beyond ``LONG_SECONDS`` is printed as one line of the report before the
+    run, not as a Python warning quoting the script's source."""
+    import warnings
+
+    from strategies.referee import hindsight
+
+    monkeypatch.setattr(hindsight, "LONG_SECONDS", 0.0)  # every estimate is long
+    world, combo, orbit = "L_10x4", [0.5, 2.0, 2.0], "evader/orbit:1:0.25"
+    unseen._init(50, 8.0)
+    lost = {**unseen.play(("pursuer", world, combo, orbit, 101)), "winner": "evader",
+            "cause": "occluded", "t": 3.0, "steps": 30}  # fmt: skip
+    out = tmp_path / "p.jsonl"
+    out.write_text(json.dumps(lost) + "\n")
+    argv = ["--role", "pursuer", "--worlds", world, "--combos", "0", "--opponents", orbit,
+            "--max-cycles", "50", "--results", str(out), "--hindsight", "0.05"]  # fmt: skip
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assert unseen.main(argv) == 0
+    assert not [w for w in caught if "hindsight(cell" in str(w.message)]
+    text = capsys.readouterr().out
+    line = f"hindsight (cell 0.05) {world} {combo} {orbit} seed=101: hindsight(cell = 0.05"
+    assert line in text and "estimated up to about" in text
+    assert text.index(line) < text.index(f"{orbit} seed=101: pursuer")  # before the verdict
+
+
 def test_a_hindsight_over_the_memory_budget_is_not_solved(unseen, tmp_path, capsys) -> None:
     """A cell whose grid would exceed the memory budget labels the loss ``not solved`` (the
     reason printed) instead of stopping the report."""

@@ -41,7 +41,10 @@ Not a feature: the pressure time so far, after which the evader herds the pursue
 corner instead of charging it (``ShootingEvader.HERD_AFTER`` D / V_e; issue 13). The
 shipped ``training/zoo/models/dagger_evader_memory`` was trained on these 11 numbers, so a
 12th would change its observation size; a learner given these features does not see when
-the expert's charge turns into a herd (the ``pressure`` mode covers both).
+the expert's charge turns into a herd (the ``pressure`` mode covers both). Nor whether it
+shoots before the plan, as it does from a dead end of the plan until a shot has no
+candidate or its cell's rank is a guarantee (``ShootingEvader._shoot_first``; the ``shoot``
+mode shows the shots).
 
 Stateful: call :meth:`MemoryFeatures.restart` at each episode start and the features once
 per step, in order (:class:`~strategies.policies.learner_inputs.LearnerInputs` does both).

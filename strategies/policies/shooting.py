@@ -10,6 +10,11 @@ Sec. 5 "minimax": its tip meets walls as if the rod were that long):
    rank falls at every crossing whatever the pursuer does, until condition (a) breaks
    surveillance. The plan goes round the pieces the evader's disc cannot cross (closer
    to a wall than its body radius all along) wherever a route without them exists.
+   Where none does (a rank of at least n_cells: the route counts a crossing the disc
+   cannot make, so the rank promises nothing) the plan can end in a *dead end*, a cell
+   whose every via is such a piece; from there on the evader shoots first (step 2) and
+   takes the plan only where no shot has a positive margin, until it reaches a cell
+   whose rank is a guarantee.
 2. **Shooting escape**: candidate endpoints (Fig. 13) are points the evader can reach in
    a straight line (probes on rays, and points just past each convex obstacle vertex in
    reach) where the current orientation is not safe. For each, the rotation the pursuer
@@ -191,6 +196,9 @@ class ShootingEvader(BasePolicy):
         self._forgiven = 0  # retries so far (each waits twice as long as the last)
         self._pressed = 0  # pressure steps so far
         self._herding = False  # herding the pursuer into a corner (from then on)
+        # shots before the plan in cells whose rank guarantees nothing (from a dead end of
+        # the plan until a shot has no candidate or the rank is a guarantee again)
+        self._shoot_first = False
 
     # ------------------------------------------------------------------ candidates
     def _candidates(self, e: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -330,7 +338,9 @@ class ShootingEvader(BasePolicy):
             self.mode = "toward"
             return c.v_evader * unit(snap.rod)
         heading = self._plan_heading(e, theta)
-        if heading is not None:
+        if heading is not None and self.plan.rank[self._plan_cell] < len(self.plan.rank):
+            self._shoot_first = False  # a rank below n_cells: a route the disc can take
+        if heading is not None and not self._shoot_first:
             self.mode = "plan"
             self._arc, self._in_sight = None, False
             return c.v_evader * heading
@@ -352,6 +362,12 @@ class ShootingEvader(BasePolicy):
             self.mode = "shoot"
             self._shot = (float(e[0]), float(e[1]), self._steps)
             return c.v_evader * self._start_arc(e, theta, *best)
+        if heading is not None:
+            # no shot: back to the plan (and to the plan first, until the next dead end)
+            self._shoot_first = False
+            self.mode = "plan"
+            self._arc, self._in_sight = None, False
+            return c.v_evader * heading
         row = self.table.row(e)
         if (
             row >= 0
@@ -507,6 +523,21 @@ class ShootingEvader(BasePolicy):
         else:
             self._no_way = 0
         w = self._witness
+        if (
+            w is None
+            and not self._shoot_first
+            and plan.rank[cell] >= len(plan.rank)
+            and plan.witness(cell, e, self.config.body_radius) is None
+        ):
+            # a dead end: the cell's rank counts a crossing the disc cannot make and no
+            # crossing of its vias keeps the disc clear. Its plan (and that of the cells
+            # ranked through it) promises nothing: shoot first from here on. (Falling back
+            # to a shot here and back to the plan in the next cell, whose plan led straight
+            # back, the evader went round the chain for the whole horizon, issue 13:
+            # two_rooms~x1.6rot-2.5 at L_min 1.6, rho 0.5, against the decomposition
+            # pursuer, every route through a corridor end closer to a door jamb than the
+            # evader's body radius.)
+            self._shoot_first = True
         if w is None:
             return None
         if np.linalg.norm(w.cross - e) <= step:

@@ -25,7 +25,7 @@ import math
 import time
 
 import numpy as np
-from bench_cli import integer, run
+from bench_cli import integer, path_text, run
 
 from analysis.evaluate import evaluate, format_table
 from analysis.tournament import spec_from_dict
@@ -126,7 +126,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", type=integer(1), default=10)
     ap.add_argument("--fast-seeds", type=integer(0), default=3, help="seeds of the rho > 1 rows")
     ap.add_argument("--max-cycles", type=integer(1), default=1000)
-    ap.add_argument("--results", default="out/analytic_matchups.sqlite")
+    ap.add_argument(
+        "--results",
+        type=path_text("a results database file"),
+        default="out/analytic_matchups.sqlite",
+    )
     ap.add_argument("--workers", type=integer(1), default=2)
     args = ap.parse_args(argv)
     roster = {"maps": args.maps, "pursuers": args.pursuers, "evaders": args.evaders}

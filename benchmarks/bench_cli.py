@@ -27,9 +27,9 @@ import threading
 from collections.abc import Callable, Iterator
 from multiprocessing.pool import Pool
 
-from analysis.arguments import integer, real, user_error
+from analysis.arguments import integer, path_text, real, user_error
 
-__all__ = ["integer", "real", "run", "worker_pool"]
+__all__ = ["integer", "path_text", "real", "run", "worker_pool"]
 
 EXIT_CODE = {"SIGINT": 130, "SIGTERM": 143}
 

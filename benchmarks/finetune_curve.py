@@ -26,7 +26,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from bench_cli import integer, real, run
+from bench_cli import integer, path_text, real, run
 
 from analysis.evaluate import wilson_interval
 from strategies.runner import run_episode
@@ -94,7 +94,12 @@ def main(argv=None) -> int:
                     "output_dir)")  # fmt: skip
     ap.add_argument("--arms", nargs="+", choices=sorted(ARMS), default=sorted(ARMS))
     ap.add_argument("--learning-rate", type=real(0), default=1e-4)
-    ap.add_argument("--save", default=None, help="directory to keep each arm's last model in")
+    ap.add_argument(
+        "--save",
+        default=None,
+        type=path_text("a directory"),
+        help="directory to keep each arm's last model in",
+    )
     args = ap.parse_args(argv)
     if args.every > args.steps:
         ap.error(f"--every {args.every} > --steps {args.steps}: no model would be evaluated "

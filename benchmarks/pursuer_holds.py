@@ -49,7 +49,7 @@ import time
 import episode_rows
 import numpy as np
 import referee_labels
-from bench_cli import integer, real, run, worker_pool
+from bench_cli import integer, path_text, real, run, worker_pool
 from referee_labels import similarity_back
 
 from envs.maps import builtin_info, builtin_names
@@ -153,7 +153,7 @@ def main(argv=None) -> int:
         default=None,
         help="label every start with the referee at CPL cells per L_min",
     )
-    ap.add_argument("--results", metavar="FILE", default=None,
+    ap.add_argument("--results", metavar="FILE", default=None, type=path_text("a file"),
                     help="append each episode to FILE (JSON lines) as it completes; a rerun "
                     "with the same FILE plays only the episodes missing from it")  # fmt: skip
     args = ap.parse_args(argv)

@@ -103,7 +103,7 @@ import zlib
 import episode_rows
 import numpy as np
 import referee_labels
-from bench_cli import integer, real, run, worker_pool
+from bench_cli import integer, path_text, real, run, worker_pool
 from referee_labels import similarity_back
 from unseen_opponents import make_opponent
 
@@ -701,7 +701,11 @@ def main(argv=None) -> int:
         "--max-cycles", type=integer(1), default=600, help="pursuer role: horizon in steps"
     )
     ap.add_argument("--k", type=real(0), default=8.0, help="evader role: horizon in D / V_e")
-    ap.add_argument("--results", help="JSON-lines file (default out/unseen_worlds_ROLE.jsonl)")
+    ap.add_argument(
+        "--results",
+        type=path_text("a file"),
+        help="JSON-lines file (default out/unseen_worlds_ROLE.jsonl)",
+    )
     ap.add_argument("--workers", type=integer(1), default=1)
     ap.add_argument("--referee", type=real(0), metavar="CPL", help="pursuer role: label every "
                     "start with the referee at CPL cells per L_min (module docstring)")  # fmt: skip

@@ -37,6 +37,13 @@ def _run(script: str, *args: str, **kwargs) -> subprocess.CompletedProcess:
         ("analytic_matchups.py", ["--workers", "0"], "'0': expected an integer >= 1"),
         ("hindsight_maze.py", ["--cells", "0"], "'0': expected a finite number > 0"),
         ("finetune_curve.py", ["--steps", "100", "--every", "1000"], "--every 1000 > --steps 100"),
+        # an empty name (an unset shell variable) was the flag's absence: results not kept
+        # (pursuer_holds, evader_escapes) or written to the default path (unseen_worlds)
+        ("pursuer_holds.py", ["--results", ""], "--results: '': expected a file"),
+        ("evader_escapes.py", ["--results", " "], "--results: ' ': expected a file"),
+        ("unseen_worlds.py", ["--results", ""], "--results: '': expected a file"),
+        ("analytic_matchups.py", ["--results", ""], "'': expected a results database file"),
+        ("finetune_curve.py", ["--save", ""], "--save: '': expected a directory"),
     ],
 )
 def test_a_bad_argument_is_a_usage_error(script, args, message) -> None:

@@ -108,7 +108,8 @@ def _policy(flag: str, name: str, params_flag: str, params_text: str | None):
 
 
 def _cmd_play(args: argparse.Namespace) -> int:
-    from strategies.runner import run_episode
+    from envs.errors import MemoryBudgetError
+    from strategies.runner import VALID_START, run_episode
 
     # everything is checked before the episode: options, policies, the output file
     overrides = json_object("--config", args.config, example=CONFIG_EXAMPLE)
@@ -131,14 +132,20 @@ def _cmd_play(args: argparse.Namespace) -> int:
 
         stream = GifStream(out, args.fps)  # frames go to the file as they are drawn
     try:
-        result = run_episode(
-            args.map,
-            pursuer,
-            evader,
-            seed=args.seed,
-            overrides=overrides,
-            on_frame=stream if stream is not None and not shading else None,
-        )
+        try:
+            result = run_episode(
+                args.map,
+                pursuer,
+                evader,
+                seed=args.seed,
+                overrides=overrides,
+                start=args.start,
+                on_frame=stream if stream is not None and not shading else None,
+            )
+        except MemoryBudgetError as exc:  # the safe start's judge: this command's --start
+            if exc.args[1] != VALID_START:
+                raise
+            raise exc.named("--start valid") from None
         print(result.summary())
         if stream is not None and shading:  # redraw under the overlay, one frame at a time
             from analysis.replay import iter_trajectory_frames
@@ -279,6 +286,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--pursuer-params", help="pursuer parameters as JSON (see surveil policies)")
     p.add_argument("--evader-params", help='evader parameters as JSON, e.g. \'{"mode": "away"}\'')
     p.add_argument("--seed", type=integer(0), default=0, help="episode seed (>= 0)")
+    p.add_argument(
+        "--start",
+        choices=["safe", "valid"],
+        default="safe",
+        help="safe: in a non-escapable cell at L_min where one exists (judged by a "
+        "decomposition pursuer); valid: any valid surveillance configuration",
+    )
     p.add_argument("--max-cycles", type=integer(1), default=None, help="episode horizon in steps")
     p.add_argument("--config", help=f"env overrides as JSON, e.g. {CONFIG_EXAMPLE}")
     p.add_argument(

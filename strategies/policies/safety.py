@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from envs import validation
-from envs.errors import InfeasibleError
+from envs.errors import MemoryBudgetError
 from envs.maps import Map
 from strategies.cspace import _budget
 from strategies.cspace.cache import CacheWarning, resolve_cache_dir, write_cache_file
@@ -367,7 +367,7 @@ def safety_table(
 
     Raises:
         InvalidConfigError: non-positive L or resolution, or a bad bin count.
-        InfeasibleError: the table's estimated memory exceeds the budget (the message
+        MemoryBudgetError: the table's estimated memory exceeds the budget (the message
             gives the estimate and the resolution that would fit).
     """
     where = "safety_table"
@@ -380,11 +380,13 @@ def safety_table(
     need = table_bytes(world, resolution, n_bins, distinct)
     if need > budget:
         fit = resolution * math.sqrt(need / budget) * 1.05
-        raise InfeasibleError(
+        raise MemoryBudgetError(  # its knobs named late: a policy's caller has others
             f"safety_table(map {world.name!r}, L = {L:g}, resolution = {resolution:g}): the "
-            f"table would need about {need / 1e9:.1f} GB, more than the memory budget of "
-            f"{budget / 1e9:.1f} GB; use resolution >= {fit:.3g} or raise the budget "
-            "($SURVEIL_MEMORY_BUDGET)"
+            f"table would need about {need / 1e9:.3g} GB, more than the memory budget of "
+            f"{budget / 1e9:.3g} GB; use {MemoryBudgetError.KNOB} >= {fit:.3g} or raise the "
+            f"budget with {MemoryBudgetError.BUDGET}",
+            "resolution",
+            size=f"{math.ceil(1.2 * need / 1e9)}GB",
         )
     key = (
         f"{TABLE_VERSION}|{SOURCE}|{world.digest}|{float(L).hex()}|{float(resolution).hex()}"

@@ -57,7 +57,7 @@ import math
 
 import numpy as np
 
-from envs.errors import InfeasibleError, InvalidConfigError
+from envs.errors import InfeasibleError, InvalidConfigError, MemoryBudgetError
 from envs.geometry import kernel_for
 from envs.surveillance.placement import check_room, random_start, spawn_margins
 from strategies.policies.lazy_table import LazySafetyTable
@@ -83,6 +83,9 @@ def sample_start(
     Raises:
         InvalidConfigError: unknown kind.
         InfeasibleError: no start found (the message names the map).
+        MemoryBudgetError: the judge of a ``"safe"`` or ``"escapable"`` start (a
+            decomposition pursuer) has a table grid beyond the memory budget; the message
+            names ``kind='valid'``, which needs no judge.
     """
     if kind not in START_KINDS:
         raise InvalidConfigError(f"kind must be one of {START_KINDS}, got {kind!r}")
@@ -99,13 +102,35 @@ def sample_start(
     # least rate in one given direction (eq. 6, Sec. 6.1), not the sqrt(1 - rho^2) of a
     # pursuer free to turn either way: a start called safe is safe at the slower rate
     judge = DecompositionPursuer(turn_rate="one")
-    judge.reset(role="pursuer", map=config.map, config=config, seed=0)
+    try:
+        judge.reset(role="pursuer", map=config.map, config=config, seed=0)
+    except MemoryBudgetError as exc:
+        if exc.args[1] != "resolution":  # not its table's grid
+            raise
+        raise _judge_refused(exc, kind, config) from None
     tab = judge.table
     if kind == "escapable":
         return _near_l_min(config, kernel, rng, judge, tab, None, escapable=True)
     if not _anything_safe(tab):  # Prop. 2: nothing is safe anywhere
         return _near_l_min(config, kernel, rng, judge, tab, None)
     return _near_l_min(config, kernel, rng, judge, tab, angle_margin)
+
+
+def _judge_refused(exc: MemoryBudgetError, kind: str, config) -> MemoryBudgetError:
+    """The judge's table refused by the memory budget, told as the start's caller can act
+    on it: the judge's resolution (its default, L_min / 20) is not a parameter here, so
+    the remedy is a ``kind="valid"`` start (no judge) or a larger budget."""
+    _, _, budget, size = exc.args
+    refusal = exc.args[0].partition("; use ")[0]  # the table's own remedy names its resolution
+    return MemoryBudgetError(
+        f"a {kind!r} start on map {config.map.name!r} is judged on a decomposition pursuer's "
+        f"safety table at L_min / 20, which does not fit: {refusal}; use "
+        f"{MemoryBudgetError.KNOB} (a valid start needs no judge), or raise the budget with "
+        f"{MemoryBudgetError.BUDGET}",
+        "kind='valid'",
+        budget,
+        size,
+    )
 
 
 def _anything_safe(tab) -> bool:

@@ -303,6 +303,29 @@ def test_a_decomposition_over_the_budget_names_the_variable_not_the_keyword(
     assert "memory_budget=" not in err and "0GB" not in err
 
 
+def test_play_on_a_huge_map_names_its_own_flags(tmp_path, capsys, monkeypatch):
+    """``surveil play`` on a 1.4e9 m map said "use resolution >= 2.81e+04": the safe
+    start's judge has no such flag here. Now the judge's refusal names ``--start valid``,
+    a policy's names the policy whose resolution it is, and a valid start plays."""
+    from envs.maps import Map, save_map
+
+    monkeypatch.setenv("SURVEIL_MEMORY_BUDGET", "1GB")
+    s = 1e8
+    path = tmp_path / "huge.json"
+    save_map(Map([(0, 0), (14 * s, 0), (14 * s, 5 * s), (5 * s, 5 * s), (5 * s, 14 * s),
+                  (0, 14 * s)], name="huge"), path)  # fmt: skip
+    play = ["play", "--map", str(path), "--no-gif"]
+    line = assert_fails(capsys, play, "'safe' start on map 'huge'", "use --start valid")
+    assert "resolution >=" not in line and "kind=" not in line
+    line = assert_fails(capsys, [*play, "--start", "valid"],
+                        "use 'pursuer/decomposition' with resolution >= ")  # fmt: skip
+    line = assert_fails(capsys, [*play, "--start", "valid", "--pursuer", "pursuer/greedy"],
+                        "use 'evader/shooting' with resolution >= ",
+                        "SURVEIL_MEMORY_BUDGET=")  # fmt: skip
+    assert main([*play, "--start", "valid", *FAST]) == 0
+    assert "kept surveillance" in capsys.readouterr().out
+
+
 @pytest.mark.parametrize(
     ("argv", "needle"),
     [

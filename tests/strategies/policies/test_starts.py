@@ -150,3 +150,26 @@ def test_a_start_the_margins_rule_out_names_them():
         sample_start(cfg, np.random.default_rng(0), kind="safe")
     cfg = EnvConfig(map="corridor", v_pursuer=100.0, spawn_margin_steps=0)
     assert set(sample_start(cfg, np.random.default_rng(0), kind="safe")) == {"pursuer", "evader"}
+
+
+def test_a_judge_beyond_the_memory_budget_names_the_valid_start(monkeypatch):
+    """``surveil play`` on a 1.4e9 m map: the safe start's judge (a decomposition pursuer
+    at L_min / 20) refused its table naming ``resolution >= 2.81e+04``, which neither the
+    sampler nor ``play`` lets the user set; the refusal now names ``kind='valid'``, and
+    that start is drawn."""
+    from envs.errors import MemoryBudgetError
+    from envs.maps import Map
+    from envs.surveillance.config import EnvConfig
+
+    monkeypatch.setenv("SURVEIL_MEMORY_BUDGET", "1GB")
+    s = 1e8
+    huge = Map([(0, 0), (14 * s, 0), (14 * s, 5 * s), (5 * s, 5 * s), (5 * s, 14 * s),
+                (0, 14 * s)], name="huge")  # fmt: skip
+    cfg = EnvConfig(map=huge)
+    with pytest.raises(MemoryBudgetError, match=r"'safe' start on map 'huge' .* its grid of "
+                       r"14,000,000,000 x 14,000,000,000 nodes .*; use kind='valid' \(a valid "
+                       r"start needs no judge\)") as err:  # fmt: skip
+        sample_start(cfg, np.random.default_rng(0), kind="safe")
+    assert "resolution >=" not in str(err.value)
+    start = sample_start(cfg, np.random.default_rng(0), kind="valid")
+    assert set(start) == {"pursuer", "evader"}

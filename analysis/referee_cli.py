@@ -86,7 +86,12 @@ def run(args: argparse.Namespace) -> int:
 
     import numpy as np
 
-    from envs.errors import MemoryBudgetError, SurveilValueError, VacuousBoundWarning
+    from envs.errors import (
+        InvalidConfigError,
+        MemoryBudgetError,
+        SurveilValueError,
+        VacuousBoundWarning,
+    )
     from envs.surveillance.config import EnvConfig
     from strategies.referee import referee_for
     from strategies.referee.estimates import check_cpls, check_estimate
@@ -125,6 +130,8 @@ def run(args: argparse.Namespace) -> int:
         with MemoryBudgetError.naming("--cells-per-lmin"):  # this command's flag
             ref = referee_for(cfg, args.cells_per_lmin, cache=not args.no_cache)
     s = ref.summary()
+    if s["starts"] == 0:  # nothing to report, classify or sample: say what resolution has some
+        raise InvalidConfigError(_no_starts(ref, args.cells_per_lmin, cfg.dt))
     print(
         f"{world.name}: rho = {cfg.rho:g}, L in [{cfg.l_min:g}, {cfg.l_max:g}], "
         f"{args.cells_per_lmin:g} cells per L_min ({time.perf_counter() - t:.1f} s)"
@@ -162,6 +169,26 @@ def run(args: argparse.Namespace) -> int:
         draw_referee(ref, path=Path(out))
         print(f"wrote {out}")
     return 0
+
+
+def _no_starts(ref, cpl: float, dt: float) -> str:
+    """Why a referee with no lattice start is refused, and the coarsest resolution with one."""
+    from strategies.referee.referee import COARSEST_SCAN_LIMIT, coarsest_with_starts
+
+    spec = ref.spec
+    fit = coarsest_with_starts(spec, dt=dt)
+    advice = (
+        f"the coarsest resolution with one is --cells-per-lmin {fit:.3g} (scanning up from "
+        f"L_min / L_max = {spec.l_min / spec.l_max:.3g}; the default is 16)"
+        if fit is not None
+        else f"no resolution up to {COARSEST_SCAN_LIMIT:g} cells per L_min has one"
+    )
+    return (
+        f"--cells-per-lmin = {cpl:g}: the referee's lattices (spacings "
+        f"{ref.pursuer.lattice.spacing:.4g} and {ref.evader.lattice.spacing:.4g}) hold no "
+        f"start with the players in range [{spec.l_min:g}, {spec.l_max:g}] and in sight on "
+        f"map {spec.map.name!r}, so there is nothing to certify; {advice}"
+    )
 
 
 def _print_estimate(spec, args: argparse.Namespace) -> None:

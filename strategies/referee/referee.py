@@ -39,6 +39,7 @@ __all__ = [
     "cached_evader_bound",
     "cached_pursuer_bound",
     "check_start",
+    "coarsest_with_starts",
     "label_starts",
     "referee_for",
     "sample_starts",
@@ -466,6 +467,47 @@ def _resolution(
     return Resolution.for_role(
         spec, role, cpl, coarse=coarse, steps=steps, sweep_pieces=sweep_pieces, dt=dt
     )
+
+
+COARSEST_SCAN_STEP = 2.0**0.125
+""":func:`coarsest_with_starts` scans resolutions in this ratio (eight per doubling)."""
+COARSEST_SCAN_LIMIT = 64.0
+"""... up to this many cells per L_min (the referee's solves at 64 take minutes to hours)."""
+
+
+def _lattice_has_start(spec: GameSpec, cpl: float, dt: float | None, knobs) -> bool:
+    """Some start with the pursuer on the pursuer bound's lattice and the evader on the
+    evader bound's, at :func:`solve`'s resolutions for ``cpl``, is in range and in sight
+    (what :meth:`Referee.lattice_starts` enumerates, without solving)."""
+    from strategies.referee.lattice import Lattice
+
+    try:
+        P = Lattice(spec, _resolution(spec, "pursuer", cpl, dt=dt, **knobs), "pursuer").points
+        E = Lattice(spec, _resolution(spec, "evader", cpl, dt=dt, **knobs), "evader").points
+    except InvalidConfigError:  # no lattice point at all
+        return False
+    pi, ei = _pairs_in_range(P, E, spec.l_min, spec.l_max)
+    return bool(len(pi)) and bool(kernel_for(spec.map).line_of_sight_many(P[pi], E[ei]).any())
+
+
+def coarsest_with_starts(spec: GameSpec, *, dt: float | None = None, **knobs: Any) -> float | None:
+    """The coarsest resolution (cells per L_min) whose lattices hold a start
+    (:meth:`Referee.lattice_starts` not empty), or None up to :data:`COARSEST_SCAN_LIMIT`.
+
+    Two points of the fine lattice are at least a cell ``h = l_min / cpl`` apart, so no
+    start exists while ``h > l_max``: the scan begins at ``l_min / l_max`` and goes up in
+    steps of :data:`COARSEST_SCAN_STEP`. At such coarse resolutions both of :func:`solve`'s
+    lattices have spacing ``2 h``, so the built-in maps' first start is at exactly
+    ``2 l_min / l_max`` (the spacing equal to ``l_max``). The lattices are not nested: a
+    finer resolution than the one found can still hold none on a map with narrow passages.
+    ``dt`` and ``knobs`` are :func:`solve`'s.
+    """
+    cpl = spec.l_min / spec.l_max
+    while cpl <= COARSEST_SCAN_LIMIT * (1.0 + 1e-9):
+        if _lattice_has_start(spec, cpl, dt, knobs):
+            return cpl
+        cpl *= COARSEST_SCAN_STEP
+    return None
 
 
 def solve_role(

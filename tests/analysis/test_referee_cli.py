@@ -116,3 +116,19 @@ def test_a_solve_over_the_budget_names_this_command_s_flags(capsys, monkeypatch)
     assert out == ""  # refused before the referee's solve printed its summary
     assert "Use the largest --estimate CPL (the others in proportion) <= " in err
     assert "cpls" not in err.split("):", 1)[1] and "memory_budget=" not in err
+
+
+@pytest.mark.parametrize(("cpl", "fit"), [("1e-09", "1"), ("0.9", "1")])
+def test_a_resolution_with_no_lattice_start_is_refused_naming_one_that_has(
+    cpl, fit, capsys, monkeypatch
+):
+    """``--cells-per-lmin 1e-9`` printed "0 lattice starts: pursuer wins 0.0%, ..." and
+    exited 0 (a cell of 2e9 m on the corridor)."""
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", "/nonexistent")
+    assert main(["referee", "corridor", "--cells-per-lmin", cpl, "--no-cache"]) == 2
+    out, err = capsys.readouterr()
+    assert out == ""
+    assert f"--cells-per-lmin = {cpl}: the referee's lattices" in err
+    assert f"the coarsest resolution with one is --cells-per-lmin {fit} (" in err
+    assert main(["referee", "corridor", "--cells-per-lmin", fit, "--no-cache"]) == 0
+    assert "16 lattice starts" in capsys.readouterr().out

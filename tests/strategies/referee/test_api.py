@@ -178,3 +178,18 @@ def test_draw_referee_renders_the_panels(corridor_half, tmp_path):
     mine = np.all(np.isclose(starts.evader, (-0.9, 0.0), atol=0.2), axis=1)
     assert any(lab.startswith("evader") for lab in labels) and mine.any()
     assert set(COLORS) == {"pursuer", "evader", "unknown"}
+
+
+@pytest.mark.parametrize("l_max", [4.0, 2.2])
+def test_coarsest_with_starts_is_where_the_lattice_starts_begin(l_max):
+    """At coarse resolutions both lattices have spacing 2 h (h = l_min / cpl), so the
+    first start is at a spacing of l_max: cpl = 2 l_min / l_max. Checked against the
+    solved referee's own lattice starts one scan step below and at the value found."""
+    from strategies.referee.referee import COARSEST_SCAN_STEP, coarsest_with_starts
+
+    cfg = EnvConfig(map="corridor", l_min=2.0, l_max=l_max)
+    game = GameSpec.from_config(cfg)
+    fit = coarsest_with_starts(game, dt=cfg.dt)
+    assert 2 * 2.0 / l_max <= fit < 2 * 2.0 / l_max * COARSEST_SCAN_STEP
+    assert len(referee_for(cfg, fit, cache=False).lattice_starts()) > 0
+    assert len(referee_for(cfg, fit / COARSEST_SCAN_STEP, cache=False).lattice_starts()) == 0

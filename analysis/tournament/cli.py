@@ -23,6 +23,8 @@ __all__ = ["add_parsers", "format_cells", "shipped_specs"]
 CONFIG_EXAMPLE = "'{\"v_evader\": 0.8}'"
 
 EXIT_SIGNAL = {"SIGINT": 130, "SIGTERM": 143}
+EXIT_ALL_ERRORS = 1
+"""Exit code of a run (tournament, evaluate) whose every match ended in an error."""
 
 
 def shipped_specs() -> dict[str, Path]:
@@ -72,6 +74,7 @@ def _print_outcome(summary, store: Path, report: str | None, replays: bool) -> i
     print(summary.describe())
     with Store(store, create=False) as db:
         rows = db.rows(summary.run_id)
+        failed = [r for r in rows if r["status"] == "error"]
         cells = st.cells(rows)
         scopes = {c.scope for c in cells}
         print(format_cells(cells, st.OVERALL if st.OVERALL in scopes else None))
@@ -80,6 +83,13 @@ def _print_outcome(summary, store: Path, report: str | None, replays: bool) -> i
             print(f"report written to {files['html']} and {files['markdown']}")
     if summary.interrupted:
         return EXIT_SIGNAL.get(summary.interrupted, 130)
+    if rows and len(failed) == len(rows):  # nothing was played: not a success
+        print(
+            f"surveil: error: every one of the {len(rows)} matches of run {summary.run_id} "
+            f"in {store} ended in an error, the first: {failed[0]['error']}",
+            file=sys.stderr,
+        )
+        return EXIT_ALL_ERRORS
     return 0
 
 

@@ -186,6 +186,7 @@ class Spec:
         """
         from envs.errors import RhoAboveOneWarning
         from envs.surveillance.config import EnvConfig
+        from envs.surveillance.physics import check_step
 
         kwargs = {**map_entry.params, **self.env, **variant.overrides}
         where = f"{self.source} [env]" + (f" [grid] {variant.label}" if variant.label else "")
@@ -197,6 +198,9 @@ class Spec:
                 if variant.rho is not None:
                     kwargs["v_evader"] = variant.rho * cfg.v_pursuer
                     cfg = EnvConfig(map=map_entry.map, **kwargs)
+            # what building the env would refuse, refused before any match (every match
+            # was stored as an error and the run exited 0)
+            check_step(cfg.map, cfg.dt, max(cfg.v_pursuer, cfg.v_evader))
         except ValueError as exc:
             raise InvalidConfigError(f"{where}: {exc}") from exc
         d = cfg.to_dict()

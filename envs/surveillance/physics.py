@@ -33,7 +33,7 @@ import pymunk
 from envs.errors import InvalidConfigError
 from envs.maps import Map
 
-__all__ = ["MAX_SUBSTEP_TRAVEL", "World", "substeps_for"]
+__all__ = ["MAX_SUBSTEP_TRAVEL", "World", "check_step", "substeps_for"]
 
 MAX_SUBSTEP_TRAVEL = 0.5
 """Largest distance a body may travel in one substep, as a fraction of its radius.
@@ -71,6 +71,25 @@ def substeps_for(max_speed: float, dt: float, body_radius: float) -> int:
     return max(1, math.ceil(travel * (1.0 - 1e-12)))
 
 
+def check_step(world_map: Map, dt: float, max_speed: float) -> None:
+    """Refuse a step in which a body could cross the map (``max_speed * dt`` beyond its
+    diameter): the substeps grow as V dt (``v_pursuer = 1e6`` hung on 2e6 a step), and the
+    sweep's linear motion within the step no longer follows bodies stopped by the walls
+    (``dt = 100`` timed a break 20 times late). Callers that validate a config before
+    building an env (tournament specs) call it too.
+
+    Raises:
+        InvalidConfigError: naming dt, the speed and the largest dt that fits.
+    """
+    if max_speed * dt > world_map.diameter:
+        raise InvalidConfigError(
+            f"dt = {dt!r} with max(v_pursuer, v_evader) = {max_speed!r}: a body would "
+            f"cross map {world_map.name!r} (diameter {world_map.diameter:.4g}) in one "
+            "step; expected max(v_pursuer, v_evader) dt <= the map's diameter, i.e. "
+            f"dt <= {world_map.diameter / max_speed:.4g}"
+        )
+
+
 class World:
     """A pymunk space holding the map's walls and the pursuer and evader discs.
 
@@ -85,16 +104,7 @@ class World:
     """
 
     def __init__(self, world_map: Map, body_radius: float, dt: float, max_speed: float) -> None:
-        if max_speed * dt > world_map.diameter:
-            # a step that crosses the map: the substeps grow as V dt (v_pursuer = 1e6 hung
-            # on 2e6 a step), and the sweep's linear motion within the step no longer
-            # follows bodies stopped by the walls (dt = 100 timed a break 20 times late)
-            raise InvalidConfigError(
-                f"dt = {dt!r} with max(v_pursuer, v_evader) = {max_speed!r}: a body would "
-                f"cross map {world_map.name!r} (diameter {world_map.diameter:.4g}) in one "
-                "step; expected max(v_pursuer, v_evader) dt <= the map's diameter, i.e. "
-                f"dt <= {world_map.diameter / max_speed:.4g}"
-            )
+        check_step(world_map, dt, max_speed)
         self.map = world_map
         self.body_radius = float(body_radius)
         self.dt = float(dt)

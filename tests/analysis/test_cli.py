@@ -168,3 +168,17 @@ def test_train_runs_a_tiny_config_through_the_cli(tmp_path, capsys):
     assert main(["train", str(small), "--output-dir", str(tmp_path / "run")]) == 0
     assert (tmp_path / "run" / "model.zip").exists()
     assert (tmp_path / "run" / "provenance.json").exists()
+
+
+def test_a_run_whose_every_match_errored_does_not_exit_0(tmp_path, capsys):
+    """Every match stored as an error (here: no safe start, the start margins cover the
+    corridor at v_pursuer = 100) printed an empty table and exited 0; one ok match is
+    enough for 0 (the table then says the rest)."""
+    argv = ["evaluate", "--maps", "corridor", "--pursuers", "pursuer/greedy", "--evaders",
+            "evader/straight", "--seeds", "1", "--max-cycles", "5", "--no-progress",
+            "--workers", "1", "--results", str(tmp_path / "r.sqlite")]  # fmt: skip
+    assert main([*argv, "--config", '{"v_pursuer": 100}']) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("surveil: error: every one of the 1 matches")
+    assert "no safe start" in err[0]
+    assert main(argv) == 0

@@ -40,6 +40,9 @@ from .conftest import comparable
         ({"grid": {"rho": [0.5, "fast"]}}, r"\[grid\].*rho = 'fast'"),
         ({"grid": {"rho": [0.5], "v_evader": [1.0]}}, r"rho.*v_evader"),
         ({"env": {"l_max": 1.0}}, r"l_max"),
+        # a step across the map: every match was stored as an error, the run exited 0
+        ({"env": {"dt": 1e9}}, r"\[env\] on map .*: dt = 1000000000.0 with .* i\.e\. dt <= "),
+        ({"grid": {"dt": [0.1, 1e9]}}, r"\[grid\] dt=1e\+09 on map .*: dt = 1000000000.0 "),
         ({"time_limit": 0}, r"time_limit = 0"),
         ({"colour": "red"}, r"unknown field.*colour"),
         ({"evaders": [{"model": "zoo:no_such_model"}]}, r"no zoo model 'no_such_model'"),

@@ -11,6 +11,8 @@ code 2, no traceback, and is found before any long work starts:
 * :func:`output_file` and :func:`output_dir` check an output path (not a directory where
   a file is meant, a known suffix, a parent that can be created and written) before the
   run whose result it will hold.
+* :func:`why_not_a_file` says what a path that should be a regular file is instead
+  (missing, a directory, a device such as ``/dev/null``, a broken link).
 * :func:`user_error` tells a project error or a file error (reported as one line) from
   a bug (which keeps its traceback).
 """
@@ -21,6 +23,7 @@ import argparse
 import json
 import os
 import re
+import stat
 import tempfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -37,6 +40,7 @@ __all__ = [
     "path_text",
     "real",
     "user_error",
+    "why_not_a_file",
 ]
 
 PROG = "surveil"
@@ -104,6 +108,40 @@ def path_text(what: str) -> Callable[[str], str]:
 
     parse.__name__ = "path"
     return parse
+
+
+_SPECIAL_FILES = (
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISFIFO, "a named pipe"),
+    (stat.S_ISSOCK, "a socket"),
+)
+
+
+def why_not_a_file(path: str | os.PathLike[str]) -> str | None:
+    """None when ``path`` is a regular file (or a link to one), else what it is instead,
+    as the end of a message: ``"no such file"``, ``"is a directory, not a file"``, ``"is
+    a character device, not a regular file"`` (``/dev/null`` was "no such file").
+
+    Examples:
+        >>> why_not_a_file("/dev/null")
+        'is a character device, not a regular file'
+        >>> why_not_a_file("/")
+        'is a directory, not a file'
+    """
+    p = Path(path)
+    try:
+        mode = p.stat().st_mode
+    except FileNotFoundError:
+        return "is a broken symbolic link" if p.is_symlink() else "no such file"
+    except OSError as exc:
+        return f"cannot be read ({exc.strerror or exc})"
+    if stat.S_ISREG(mode):
+        return None
+    if stat.S_ISDIR(mode):
+        return "is a directory, not a file"
+    kind = next((name for test, name in _SPECIAL_FILES if test(mode)), "a special file")
+    return f"is {kind}, not a regular file"
 
 
 def json_object(flag: str, text: str | None, *, example: str) -> dict[str, Any]:

@@ -15,7 +15,7 @@ import sys
 from importlib import resources
 from pathlib import Path
 
-from analysis.arguments import integer, json_object, output_file, path_text
+from analysis.arguments import integer, json_object, output_file, path_text, why_not_a_file
 from envs.errors import InvalidConfigError
 
 __all__ = ["add_parsers", "format_cells", "shipped_specs"]
@@ -37,11 +37,14 @@ def shipped_specs() -> dict[str, Path]:
 
 def _spec_path(text: str) -> Path:
     path = Path(text)
-    if path.is_file():
+    problem = why_not_a_file(path)
+    if problem is None:
         return path
     shipped = shipped_specs()
     if text in shipped:
         return shipped[text]
+    if problem != "no such file":  # it exists, but is no spec file (/dev/null, a folder)
+        raise InvalidConfigError(f"tournament spec {text!r}: {problem}")
     raise InvalidConfigError(
         f"tournament spec {text!r}: no such file and no shipped spec of that name; shipped "
         f"specs: {', '.join(sorted(shipped))}"

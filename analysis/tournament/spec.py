@@ -55,6 +55,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from analysis.arguments import why_not_a_file
 from envs.errors import InvalidConfigError
 from envs.validation import choice, integer, mapping, positive, string, unit_interval
 
@@ -259,8 +260,9 @@ def load_spec(path: str | os.PathLike[str]) -> Spec:
         import tomli as tomllib
 
     p = Path(path)
-    if not p.is_file():
-        raise InvalidConfigError(f"tournament spec {str(p)!r}: no such file")
+    problem = why_not_a_file(p)
+    if problem is not None:
+        raise InvalidConfigError(f"tournament spec {str(p)!r}: {problem}")
     try:
         data = tomllib.loads(p.read_text(encoding="utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:

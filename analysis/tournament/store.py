@@ -37,6 +37,7 @@ from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
+from analysis.arguments import why_not_a_file
 from envs.errors import InvalidConfigError, SurveilValueError
 
 __all__ = ["RESULT_FIELDS", "SCHEMA_VERSION", "Store", "StoreBusyError"]
@@ -119,10 +120,11 @@ class Store:
 
     def __init__(self, path: str | os.PathLike[str], *, create: bool = True) -> None:
         self.path = Path(path)
-        if self.path.is_dir():
-            raise InvalidConfigError(f"store {str(self.path)!r} is a directory, not a file")
-        if not create and not self.path.is_file():
-            raise InvalidConfigError(f"store {str(self.path)!r}: no such file")
+        problem = why_not_a_file(self.path)
+        if problem is not None and (not create or problem != "no such file"):
+            # a device (/dev/null) was "no such file" to readers, an SQLite I/O error to
+            # writers; a writer creates a missing file
+            raise InvalidConfigError(f"store {str(self.path)!r}: {problem}")
         if create:
             self.path.parent.mkdir(parents=True, exist_ok=True)
         self._lock_file = None

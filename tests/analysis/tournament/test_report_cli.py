@@ -85,6 +85,12 @@ def test_cli_tournament_report_export_and_errors(tmp_path, capsys):
         # under a file: was "x.csv: File exists"
         (["export", str(store), str(tmp_path / "x.csv" / "y.csv")], "is a file, not a directory"),
         (["evaluate", "--results", str(tmp_path / "old.jsonl")], "SQLite store"),
+        # a device was "no such file" (readers) or "disk I/O error" (writers)
+        (["tournament", "/dev/null"], "spec '/dev/null': is a character device, not a regular"),
+        (["report", "/dev/null"], "store '/dev/null': is a character device, not a regular"),
+        (["export", "/dev/null", str(tmp_path / "y.csv")], "is a character device"),
+        (["tournament", "quick", "--store", "/dev/null"], "is a character device"),
+        (["tournament", str(tmp_path)], "is a directory, not a file"),
     ]:
         capsys.readouterr()
         assert main(bad) == 2

@@ -109,7 +109,16 @@ pessimistic cell at 1 piece, 6.7-9.3 us at 4 (0.42-0.58 x 16), cells 0.01-0.3, m
 5-20. With the set sizes bounded as :func:`_estimate_seconds` does, the estimate was 1.6
 to 3.3 times the time taken there (cells 0.16-0.01, pieces 1 and 4) and 2 to 5.5 times in
 ``open_room`` (a slow evader, 4 s, cells 0.05-0.02): an upper bound, give or take the
-machine's load."""
+machine's load. On the orbit losses of the random maps (``unseen_worlds.py --hindsight``,
+60 s paths) it was far higher: at cell 0.02, under a load of 5 on 2 cores, 15 times the
+time on rand:polygons:3004 (the pessimistic set died at 14.6 s) and 8 times on
+rand:star:3007 (it lasted the 60 s); at cell 0.04 14 times on both (dead at 13.7 and
+13.8 s); 20-45 times on an idle machine (helper-75). Both sets are bounded by the same
+admissible area, which they fill to a half or less (at 0.04 on rand:polygons:3004 the
+estimate counts 24 M optimistic and 12.1 M pessimistic cell-instants, the run met 3.1 M and
+0.66 M; ``/work/scratch/s13/helper-78/hs_est.py``). The pessimistic set's death, the
+larger part, is what the run computes, so the message names the estimate an upper bound
+and says which share ends early rather than tighten the model."""
 
 LONG_SECONDS = 600.0
 """An estimate above this warns (:class:`~envs.errors.LongRunWarning`) before the grids
@@ -217,9 +226,11 @@ def _estimate_seconds(
     l_max: float,
     pieces: int,
 ) -> tuple[float, float]:
-    """``(seconds, cells)``: the time both grids may take (the model of
-    :data:`_SECONDS_PER_INSTANT` and the per-cell constants), and the most cells either
-    set may hold, estimated before anything is allocated.
+    """``(seconds, cells, pessimistic)``: the time both grids may take (the model of
+    :data:`_SECONDS_PER_INSTANT` and the per-cell constants), the most cells either set
+    may hold, and the pessimistic grid's share of the time, estimated before anything is
+    allocated. Both sets are assumed to last the whole path: the pessimistic grid stops
+    where its set empties, which on a lost path is often early (below).
 
     A set at time t holds at most the cells within ``V t + 2 h`` of the start (the
     pursuer's reach) that are admissible against the evader: their area is measured at
@@ -253,12 +264,13 @@ def _estimate_seconds(
 
     opt, pes = cells(substeps), cells(pes_substeps)
     sight = pieces * pieces if len(world.convex_vertices) else 1  # no corner, no sight test
-    seconds = (
-        _SECONDS_PER_INSTANT * (len(opt) + len(pes))
-        + _SECONDS_PER_OPTIMISTIC_CELL * float(opt.sum())
-        + _SECONDS_PER_PESSIMISTIC_CELL * sight * float(pes.sum())
+    pessimistic = _SECONDS_PER_INSTANT * len(pes) + _SECONDS_PER_PESSIMISTIC_CELL * sight * float(
+        pes.sum()
     )
-    return seconds, float(max(opt.max(initial=1.0), pes.max(initial=1.0)))
+    seconds = (
+        _SECONDS_PER_INSTANT * len(opt) + _SECONDS_PER_OPTIMISTIC_CELL * float(opt.sum())
+    ) + pessimistic
+    return seconds, float(max(opt.max(initial=1.0), pes.max(initial=1.0))), pessimistic
 
 
 def _check_memory(
@@ -528,15 +540,20 @@ def hindsight(
     hi = np.minimum(path.max(axis=0) + l_max, P0 + V * horizon) + pad
     instants = (len(path) - 1) * (substeps + pes_substeps)
     _check_memory(lo, hi, h, pieces, instants, memory_budget)
-    estimated, most = _estimate_seconds(
+    estimated, most, pessimistic = _estimate_seconds(
         world, path, P0, V, dt, substeps, pes_substeps, h, l_min, l_max, pieces
     )
     about = f"up to about {_duration(estimated)}"
     if estimated > LONG_SECONDS:
+        # an upper bound: said so, with the share that ends early on a lost path (the
+        # orbit losses took 1/8 to 1/45 of it; see _SECONDS_PER_INSTANT)
         warnings.warn(
-            f"hindsight(cell = {h:g}, pieces = {pieces}): estimated {about} ({instants:,} "
-            f"instants of sets of up to {most:,.0f} cells); the time grows as 1 / cell^2, "
-            "pieces^2 (pessimistic) and the path's length",
+            f"hindsight(cell = {h:g}, pieces = {pieces}): estimated {about} if both sets "
+            f"last the whole {horizon:g} s path ({instants:,} instants of sets of up to "
+            f"{most:,.0f} cells), an upper bound: {_duration(pessimistic)} of it is the "
+            "pessimistic grid's, which stops where its set empties (early when the pursuer "
+            "cannot hold), and measured runs took 1/2 to 1/45 of the estimate; the time "
+            "grows as 1 / cell^2, pieces^2 (pessimistic) and the path's length",
             LongRunWarning,
             stacklevel=2,
         )

@@ -9,6 +9,7 @@ must hold under the kernel's continuous sweep).
 from __future__ import annotations
 
 import math
+import re
 import warnings
 from types import SimpleNamespace
 
@@ -293,8 +294,14 @@ def test_a_long_run_is_estimated_and_warned_before_the_grids_are_built(monkeypat
     cfg = _config(ROOM, l_min=2.0, l_max=4.0)
     E = np.tile([[10.0, 5.0]], (601, 1))
     with pytest.warns(LongRunWarning, match=r"hindsight\(cell = 0.002, pieces = 4\): "
-                      r"estimated up to about [\d.]+ h \("), pytest.raises(Built):  # fmt: skip
+                      r"estimated up to about [\d.]+ h if both sets last the whole 60 s "
+                      r"path \(.*\), an upper bound: [\d.]+ h of it is the pessimistic "
+                      r"grid's, which stops where its set empties") as w, pytest.raises(
+                      Built):  # fmt: skip
         hindsight(cfg, E, (10.0, 2.0), 0.002, memory_budget="1000GB")
+    # the share is the pessimistic grid's part of the model, less than the whole
+    total, share = re.findall(r"([\d.]+) h", str(w[0].message))[:2]
+    assert 0 < float(share) < float(total)
 
 
 def test_the_estimate_bounds_the_sets_and_comes_with_the_result(capsys):
@@ -316,5 +323,5 @@ def test_the_estimate_bounds_the_sets_and_comes_with_the_result(capsys):
         assert "hindsight cell 0.05: pessimistic" in err
         assert 0 < res.estimated_seconds < 60
         subs = (round(0.1 / res.tau), round(0.1 / res.pessimistic_tau))
-        _, most = _estimate_seconds(world, E, P0, 1.0, 0.1, *subs, 0.05, 2.0, 4.0, 4)
+        _, most, _ = _estimate_seconds(world, E, P0, 1.0, 0.1, *subs, 0.05, 2.0, 4.0, 4)
         assert max(res.optimistic_cells.max(), res.pessimistic_cells.max()) <= most

@@ -23,7 +23,9 @@ registered policies live in ``benchmarks/unseen_opponents.py``):
   pursuer with other gains. Each (world, pursuer) plays ``--draws`` episodes whose
   (rho, L_max / L_min) and seed are drawn from ``numpy.random.default_rng(52)`` in the
   worlds' order, so a subset replays the same episodes as the whole. Horizon
-  ``--k`` D / V_e (8), D the bounding-box diagonal.
+  ``--k`` D / V_e (8), D the bounding-box diagonal. The report splits the episodes by
+  whether Prop. 2 holds for the evader's body (some region escapes by crossings its
+  disc can make) or only for a point evader, and says so beside each loss.
 
 Other worlds than the default sets can be named in ``--worlds`` (a fresh set, played
 without editing this file; the role's Prop. 2 rule still skips the wrong ones):
@@ -334,6 +336,19 @@ def _evader_wins(m: Map, ov: dict) -> bool:
     return decompose(m, L, cache=True).evader_wins
 
 
+def body_open(world: str, l_min: float) -> bool:
+    """Whether Prop. 2 holds for the evader's body on an evader-role world at ``l_min``
+    (before scaling): some region's cells all escape by crossings the body's disc can
+    make (:func:`strategies.policies.escape_plan.body_witness_regions`). Where it does
+    not, the theory's escape is open only to a point evader."""
+    from strategies.cspace import decompose
+    from strategies.policies.escape_plan import body_witness_regions
+
+    m, ov = evader_world(world, l_min, 0.5, 2.0)  # (rho and L_max do not enter)
+    dec = decompose(m, round(ov["l_min"] + ov["body_radius"], 6), cache=True)
+    return bool(body_witness_regions(dec, ov["body_radius"]))
+
+
 # ------------------------------------------------------------------ jobs
 # a job: (role, world, combo = [rho, L_max / L_min, L_min], opponent, seed)
 
@@ -642,7 +657,19 @@ def report(
     for combo, (k, n) in sorted(by_combo.items()):
         at = f" at rho {combo[0]:g}, L_max {combo[1]:g} L_min, L_min {combo[2]:g}" if combo else ""
         print(f"{who} {verb} {k}/{n}{at}")
+    body: dict[tuple, bool] = {}
     if role == "evader":
+        for r in rows:
+            key = (r["world"], r["combo"][2])
+            if key not in body:
+                body[key] = body_open(*key)
+        for kind, is_open in (("open to the evader's body", True), ("open only to a point "
+                              "evader (every escape crosses nearer a wall than the body's "
+                              "radius)", False)):  # fmt: skip
+            sub = [r for r in rows if body[(r["world"], r["combo"][2])] == is_open]
+            if sub:
+                print(f"  on worlds whose Prop. 2 escape is {kind}: {sum(map(_won, sub))}/"
+                      f"{len(sub)} escaped")  # fmt: skip
         ts = [r["t"] / r["unit"] for r in rows if _won(r)]
         if ts:
             q = np.quantile(ts, [0.5, 0.9, 0.99, 1.0])
@@ -667,6 +694,8 @@ def report(
                 what += f"; referee: {lost_labels[-1]}"
             if row_key(r) in hind:
                 what += f"; hindsight: {hind[row_key(r)]}"
+            if role == "evader" and not body[(r["world"], r["combo"][2])]:
+                what += "; Prop. 2's escape is open only to a point evader"
             print(f"  lost: {r['world']} {r['combo']} {r['opponent']} seed={r['seed']}: {what}")
             print(f"    replay: {replay_command(r)}")
     if labels:

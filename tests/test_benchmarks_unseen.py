@@ -75,6 +75,24 @@ def test_a_loss_is_printed_with_its_replay_command(unseen, capsys) -> None:
     )
 
 
+def test_an_evader_loss_says_whether_the_escape_is_open_to_the_body(unseen, capsys) -> None:
+    """two_rooms at L_min 1: Prop. 2 holds only for a point evader (every escape crosses a
+    piece nearer a wall than the 0.1 body); at L_min 2 the body has its escape."""
+    base = {"role": "evader", "world": "two_rooms~rot2.2", "opponent": "pursuer/decomposition",
+            "unit": 70.0, "steps": 100}  # fmt: skip
+    lost = {"combo": [0.5, 1.5, 1.0], "seed": 619, "winner": "pursuer", "cause": None, "t": None}
+    won = {"combo": [0.5, 1.5, 2.0], "seed": 7, "winner": "evader", "cause": "occluded", "t": 20}
+    rows = [base | lost, base | won]
+    unseen.report(rows)
+    text = capsys.readouterr().out
+    assert "escape is open to the evader's body: 1/1 escaped" in text
+    assert "open only to a point evader (every escape crosses nearer a wall" in text
+    assert ": 0/1 escaped" in text
+    assert "(the horizon); Prop. 2's escape is open only to a point evader" in text
+    assert unseen.body_open("two_rooms~rot2.2", 2.0)
+    assert not unseen.body_open("two_rooms~x0.5", 1.0)
+
+
 @pytest.mark.parametrize("label", ["nope", "zigzag:x:1"])
 def test_an_unknown_opponent_is_a_usage_error_naming_it(unseen, tmp_path, capsys, label) -> None:
     results = tmp_path / "r.jsonl"

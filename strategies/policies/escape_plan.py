@@ -546,6 +546,25 @@ def _narrow(dec: Decomposition, clearance: float) -> frozenset[int]:
     return frozenset(out)
 
 
+def body_witness_regions(dec: Decomposition, clearance: float) -> tuple[int, ...]:
+    """Prop. 2 for an evader with a body: the regions whose cells all escape by routes
+    that cross only boundary pieces a disc of radius ``clearance`` can cross, largest
+    first (``dec.witness_regions`` at clearance 0).
+
+    Sec. 4's evader is a point. A crossing that comes closer to a wall than the body's
+    radius everywhere along its piece (:func:`_narrow`) is not one the body can make; a
+    cell escapes without one iff its weighted rank (:func:`escape_ranks`) is below
+    ``n_cells``. Where no region qualifies, the theory's escape is open only to a point:
+    an evader with this body wins, if at all, by beating the pursuer's bounded speed
+    (issue 13: every world on which the shooting evader failed to escape in the
+    evader benchmarks is such a world, for the 0.1 body of the benchmarks).
+    """
+    rank, _ = escape_ranks(dec, _narrow(dec, clearance))
+    ok = (rank >= 0) & (rank < len(dec.cells))
+    w = [r for r in dec.regions if all(ok[c] for c in r.cells)]
+    return tuple(r.id for r in sorted(w, key=lambda r: -r.area))
+
+
 @functools.lru_cache(maxsize=8)
 def escape_plan(
     world: Map, L: float, resolution: float = 0.1, clearance: float = 0.0

@@ -13,6 +13,9 @@
   still lowers the rank, the plan of a cell that has a route without them takes none,
   and on random:polygons:0 cells whose every point-plan via is too close to a wall get
   a crossing the disc can make (issue 13).
+* Prop. 2 for a disc: the regions whose cells all escape without a narrow piece are
+  those of an independent fixed point that never crosses one (sets, not ranks); at
+  clearance 0 they are the decomposition's witness regions.
 * The witness-region walk: every hop is a grid neighbour joined by a wall-free segment
   (shapely) and the walk is a shortest one (networkx breadth first search).
 """
@@ -36,6 +39,7 @@ from strategies.policies.escape_plan import (
     _narrow,
     _region_next,
     _samples,
+    body_witness_regions,
     escape_plan,
     escape_ranks,
 )
@@ -211,6 +215,55 @@ def test_disc_plan_avoids_the_pieces_its_disc_cannot_cross():
         w = disc.witness(c, start, radius)
         assert w is not None and w.boundary not in narrow
         assert shapely.distance(shapely.Point(w.cross), walls) >= radius
+
+
+def _escape_without(dec, narrow) -> set[int]:
+    """The cells that escape crossing no piece of ``narrow``: Sec. 4's fixed point on sets,
+    with the pairs across a narrow piece left out."""
+    out: set[int] = set()
+    grew = True
+    while grew:
+        grew = False
+        for c in dec.cells:
+            if c.id in out:
+                continue
+            for b in dec.regions[c.region].boundaries:
+                if b in narrow:
+                    continue
+                nbrs = [
+                    x
+                    for x in dec.graph.neighbors(c.id)
+                    if b in dec.graph.edges[c.id, x]["boundaries"]
+                ]
+                if all(x in out for x in nbrs):
+                    out.add(c.id)
+                    grew = True
+                    break
+    return out
+
+
+@pytest.mark.parametrize(
+    ("name", "length", "kind"),
+    [("two_rooms", 1.1, "none"), ("two_rooms", 2.1, "all"), ("random:rectangles:0", 2.1, "some")],
+)
+def test_body_witness_regions_are_prop_2_for_the_disc(name, length, kind):
+    """two_rooms at L_min 1 + 0.1: four pieces too near the walls for the 0.1 disc block
+    every region's escape (Prop. 2 holds for a point evader only); at L_min 2 none is
+    narrow; random:rectangles:0 at 2.1: 34 narrow pieces take 16 of its 317 witness
+    regions from the disc."""
+    world = builtin_map(name) if ":" not in name else load_map(name)
+    dec = escape_plan(world, length, 0.5).dec
+    assert body_witness_regions(dec, 0.0) == dec.witness_regions
+    ok = _escape_without(dec, _narrow(dec, 0.1))
+    want = [r.id for r in dec.regions if all(c in ok for c in r.cells)]
+    got = body_witness_regions(dec, 0.1)
+    assert sorted(got) == sorted(want)
+    areas = [dec.regions[r].area for r in got]
+    assert areas == sorted(areas, reverse=True)
+    n = len(dec.witness_regions)
+    assert n  # Prop. 2 holds for the point evader on all three
+    assert {"none": len(got) == 0, "all": got == dec.witness_regions,
+            "some": 0 < len(got) < n}[kind]  # fmt: skip
 
 
 def test_plan_grid_is_the_safety_tables():

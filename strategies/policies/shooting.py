@@ -126,7 +126,9 @@ class ShootingEvader(BasePolicy):
         c = self.config
         self.L_eff = round(c.l_min + c.body_radius, 6)
         res = self.resolution if self.resolution is not None else c.l_min / 20.0
-        self.table = safety_table(c.map, self.L_eff, res)
+        # distinct rows: the eager table's lookups at every node, built in about a tenth of
+        # the time (corridor at L_min 0.5: 22 s -> 2 s, issue 13)
+        self.table = safety_table(c.map, self.L_eff, res, distinct=True)
         # a rotation table entry (uint8 bins) in radians, the whole turn for NO_PATH
         bins = np.arange(256).astype(float)
         self._radians = np.where(bins >= NO_PATH, 2 * math.pi, bins * self.table.bin_width)

@@ -45,3 +45,24 @@ def test_decisions_build_nothing_after_reset():
         assert after_reset["_spans"] > 0
         assert _built(evader.plan) == after_reset
     assert "plan" in modes  # the decisions used the plan's witnesses
+
+
+def test_the_table_is_distinct_rows_with_the_eager_lookups():
+    # issue 13: the eager table costs about 0.1 ms a grid point at reset (22 s on the
+    # corridor at L_min 0.5, 94 s at 0.21); distinct rows answer the same at every node
+    import numpy as np
+
+    from strategies.policies.safety import safety_table
+    from strategies.runner import build_env
+
+    config = build_env("corridor", {}).config
+    evader = make_policy("evader/shooting")
+    evader.reset(role="evader", map=config.map, config=config, seed=0)
+    tab = evader.table
+    eager = safety_table(config.map, evader.L_eff, tab.resolution, tab.n_bins, disk_cache=False)
+    inside = eager.cell >= 0
+    assert len(tab.safe) < int(inside.sum())  # one row per distinct row, not per node
+    assert np.array_equal(tab.cell >= 0, inside) and tab.shape == eager.shape
+    mine, want = tab.cell[inside], eager.cell[inside]
+    for field in ("free", "safe", "guaranteed", "ccw", "cw"):
+        assert np.array_equal(getattr(tab, field)[mine], getattr(eager, field)[want]), field

@@ -10,7 +10,13 @@ the bounded-speed sense of Sec. 5 as the decomposition pursuer estimates it (val
 ``V(theta) >= 0``: from there the rod reaches a safe orientation at every point before
 the evader does; for rho >= 1 nothing is admissible and only the safe cell is
 required). On maps where no safe cell exists (Prop. 2 holds) it falls back to a
-valid start at L_min, since no safe start exists to draw.
+valid start at L_min, since no safe start exists to draw. Where some proposal lies in a
+safe cell but none is admissible or leaves room to retreat (below), the first such
+proposal is drawn, as at rho >= 1: as rho -> 1 the rod's rate V_p sqrt(1 - rho^2) / L
+vanishes (nothing was admissible on the corridor, open room, maze and pillars at rho =
+0.9, on the L hall at 0.95) and the retreat grows without bound (25 at rho = 0.99 and
+L_min = 2, more than their diameters), so ``"safe"`` refused every start there, naming
+the rod clearance, while rho = 1 drew one.
 
 For rho < 1 a safe start must also leave the pursuer room to *retreat* (issue 13): the
 cell test is about orientations, not about the pursuer's body, and a start at L_0 (just
@@ -173,6 +179,7 @@ def _near_l_min(config, kernel, rng, judge, tab, angle_margin, escapable=False):
     convex = m.vertices[m.vertex_convex]
     margin_bins = 0 if angle_margin is None else math.ceil(angle_margin / tab.bin_width)
     retreat = retreat_clearance_required(config, length) if admissible else 0.0
+    in_safe_cell = None  # the first proposal refused only as inadmissible or unretreatable
     for _ in range(MAX_BATCHES):
         e = rng.uniform((xmin, ymin), (xmax, ymax), size=(BATCH, 2))
         theta = rng.uniform(-math.pi, math.pi, size=BATCH)
@@ -203,14 +210,16 @@ def _near_l_min(config, kernel, rng, judge, tab, angle_margin, escapable=False):
                 bins = (b + np.arange(-margin_bins, margin_bins + 1)) % tab.n_bins
                 if not tab.safe[row, bins].all():
                     continue
-                if admissible and judge.orientation_values(e[i])[b] < 0.0:
+                if admissible and (
+                    judge.orientation_values(e[i])[b] < 0.0
+                    or not has_retreat_clearance(m, kernel, p[i], e[i], retreat, r)
+                ):
+                    if in_safe_cell is None:
+                        in_safe_cell = _placement(p[i], e[i])
                     continue
-                if admissible and not has_retreat_clearance(m, kernel, p[i], e[i], retreat, r):
-                    continue
-            return {
-                "pursuer": (float(p[i, 0]), float(p[i, 1])),
-                "evader": (float(e[i, 0]), float(e[i, 1])),
-            }
+            return _placement(p[i], e[i])
+    if in_safe_cell is not None:  # nothing admissible (rho near 1): a safe cell, as at rho >= 1
+        return in_safe_cell
     what = "escapable" if escapable else ("safe" if angle_margin is not None else "valid")
     retreating = f", a retreat of {retreat:.4g} along the rod" if angle_margin is not None else ""
     fastest = max(config.v_pursuer, config.v_evader)
@@ -241,6 +250,10 @@ def retreat_clearance_required(config, length: float) -> float:
     if rho >= 1.0:
         return math.inf
     return rho * length * math.asin(rho) / math.sqrt(1.0 - rho * rho)
+
+
+def _placement(p: np.ndarray, e: np.ndarray) -> dict[str, tuple[float, float]]:
+    return {"pursuer": (float(p[0]), float(p[1])), "evader": (float(e[0]), float(e[1]))}
 
 
 def has_retreat_clearance(m, kernel, p, e, distance: float, radius: float) -> bool:

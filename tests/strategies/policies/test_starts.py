@@ -173,3 +173,29 @@ def test_a_judge_beyond_the_memory_budget_names_the_valid_start(monkeypatch):
     assert "resolution >=" not in str(err.value)
     start = sample_start(cfg, np.random.default_rng(0), kind="valid")
     assert set(start) == {"pursuer", "evader"}
+
+
+@pytest.mark.parametrize("rho", [0.9, 0.99])
+def test_near_one_rho_draws_a_safe_cell_start_as_rho_one_does(rho):
+    """Issue 13: at rho = 0.99 the retreat a safe start asks for (25 at L_min = 2) is longer
+    than the corridor, and at rho = 0.9 no orientation is admissible: ``"safe"`` refused
+    every start (InfeasibleError naming the rod clearance) while rho = 1 drew one. Where
+    nothing is admissible the start lies in a safe cell, as at rho >= 1."""
+    from strategies.policies.decomposition import DecompositionPursuer
+    from strategies.runner import run_episode
+
+    env = surveillance_v0.parallel_env(map="corridor", v_evader=rho)
+    cfg = env.config
+    start = sample_start(cfg, np.random.default_rng(0), kind="safe")
+    p, e = np.asarray(start["pursuer"]), np.asarray(start["evader"])
+    judge = DecompositionPursuer(turn_rate="one")
+    judge.reset(role="pursuer", map=cfg.map, config=cfg, seed=0)
+    tab = judge.table
+    theta = float(np.arctan2(*(p - e)[::-1]))
+    assert tab.safe[tab.row(e), tab.bin_of(theta)]
+    env.reset(seed=0, options=start)
+    assert env.agents
+    env.close()
+    r = run_episode("corridor", "pursuer/decomposition", "evader/shooting", 0,
+                    overrides={"v_evader": rho}, max_cycles=5)  # fmt: skip
+    assert r.start_kind == "safe" and r.steps >= 1

@@ -201,7 +201,7 @@ class Spec:
                     cfg = EnvConfig(map=map_entry.map, **kwargs)
             # what building the env would refuse, refused before any match (every match
             # was stored as an error and the run exited 0)
-            check_step(cfg.map, cfg.dt, max(cfg.v_pursuer, cfg.v_evader))
+            check_step(cfg.map, cfg.dt, max(cfg.v_pursuer, cfg.v_evader), cfg.body_radius)
         except ValueError as exc:
             raise InvalidConfigError(f"{where}: {exc}") from exc
         d = cfg.to_dict()

@@ -33,7 +33,7 @@ import pymunk
 from envs.errors import InvalidConfigError
 from envs.maps import Map
 
-__all__ = ["MAX_SUBSTEP_TRAVEL", "World", "check_step", "substeps_for"]
+__all__ = ["MAX_SUBSTEPS", "MAX_SUBSTEP_TRAVEL", "World", "check_step", "substeps_for"]
 
 MAX_SUBSTEP_TRAVEL = 0.5
 """Largest distance a body may travel in one substep, as a fraction of its radius.
@@ -44,6 +44,12 @@ solved, so a disc driven into a wall overlaps it by up to one substep's travel: 
 radius keeps the centre at least half a radius inside free space, with the fewest
 substeps (each costs a ``Space.step``).
 """
+
+MAX_SUBSTEPS = 100_000
+"""Most physics substeps an env step may take. A substep (one ``Space.step`` of two discs)
+costs about 1 us (measured: 0.99-1.07 us at 200 and 20,000 substeps a step, 3.3 us at 2),
+so this is about 0.1 s of physics a step, a minute for a 600-step episode, against 7 us a
+step at the defaults. ``body_radius = 1e-12`` asked for 2e11 substeps a step and hung."""
 
 COLLISION_SLOP_FRACTION = 0.01
 """Overlap Chipmunk tolerates before pushing back, as a fraction of the body radius."""
@@ -71,15 +77,19 @@ def substeps_for(max_speed: float, dt: float, body_radius: float) -> int:
     return max(1, math.ceil(travel * (1.0 - 1e-12)))
 
 
-def check_step(world_map: Map, dt: float, max_speed: float) -> None:
+def check_step(
+    world_map: Map, dt: float, max_speed: float, body_radius: float | None = None
+) -> None:
     """Refuse a step in which a body could cross the map (``max_speed * dt`` beyond its
     diameter): the substeps grow as V dt (``v_pursuer = 1e6`` hung on 2e6 a step), and the
     sweep's linear motion within the step no longer follows bodies stopped by the walls
-    (``dt = 100`` timed a break 20 times late). Callers that validate a config before
-    building an env (tournament specs) call it too.
+    (``dt = 100`` timed a break 20 times late). With ``body_radius``, also a step that
+    needs more than :data:`MAX_SUBSTEPS` substeps (they grow as V dt / radius). Callers
+    that validate a config before building an env (tournament specs) call it too.
 
     Raises:
-        InvalidConfigError: naming dt, the speed and the largest dt that fits.
+        InvalidConfigError: naming dt, the speed and the largest dt that fits, or the
+            radius, the substeps and the smallest radius that fits.
     """
     if max_speed * dt > world_map.diameter:
         raise InvalidConfigError(
@@ -87,6 +97,18 @@ def check_step(world_map: Map, dt: float, max_speed: float) -> None:
             f"cross map {world_map.name!r} (diameter {world_map.diameter:.4g}) in one "
             "step; expected max(v_pursuer, v_evader) dt <= the map's diameter, i.e. "
             f"dt <= {world_map.diameter / max_speed:.4g}"
+        )
+    if body_radius is None:
+        return
+    travel = max_speed * dt
+    need = travel / (MAX_SUBSTEP_TRAVEL * body_radius)  # inf for a radius of 1e-320
+    if need * (1.0 - 1e-12) > MAX_SUBSTEPS:  # substeps_for's slack: 2e-06 fits exactly
+        raise InvalidConfigError(
+            f"body_radius = {body_radius!r} with max(v_pursuer, v_evader) dt = {travel:g}: "
+            f"a step would take {need:.3g} physics substeps (a body moves at most "
+            f"{MAX_SUBSTEP_TRAVEL:g} of its radius a substep, so as not to pass through a "
+            f"wall), more than {MAX_SUBSTEPS:,} (about 0.1 s a step); expected body_radius "
+            f">= {travel / (MAX_SUBSTEPS * MAX_SUBSTEP_TRAVEL):.3g}, or a smaller dt or speed"
         )
 
 
@@ -100,11 +122,12 @@ class World:
         max_speed: the larger speed bound, which fixes the substep count.
 
     Raises:
-        InvalidConfigError: ``max_speed * dt`` exceeds the map's diameter.
+        InvalidConfigError: ``max_speed * dt`` exceeds the map's diameter, or the step
+            needs more than :data:`MAX_SUBSTEPS` substeps.
     """
 
     def __init__(self, world_map: Map, body_radius: float, dt: float, max_speed: float) -> None:
-        check_step(world_map, dt, max_speed)
+        check_step(world_map, dt, max_speed, body_radius)
         self.map = world_map
         self.body_radius = float(body_radius)
         self.dt = float(dt)

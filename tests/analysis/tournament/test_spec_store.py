@@ -42,6 +42,7 @@ from .conftest import comparable
         ({"env": {"l_max": 1.0}}, r"l_max"),
         # a step across the map: every match was stored as an error, the run exited 0
         ({"env": {"dt": 1e9}}, r"\[env\] on map .*: dt = 1000000000.0 with .* i\.e\. dt <= "),
+        ({"env": {"body_radius": 1e-12}}, r"\[env\] on map .*: body_radius = 1e-12 .* substeps"),
         ({"grid": {"dt": [0.1, 1e9]}}, r"\[grid\] dt=1e\+09 on map .*: dt = 1000000000.0 "),
         ({"time_limit": 0}, r"time_limit = 0"),
         ({"colour": "red"}, r"unknown field.*colour"),

@@ -121,3 +121,18 @@ def test_a_step_that_crosses_the_map_is_refused(over, speed) -> None:
         surveillance_v0.parallel_env(map=world, l_min=2.0, l_max=4.0, v_evader=0.5, **over)
     env = surveillance_v0.parallel_env(map=world, l_min=2.0, l_max=4.0, v_evader=0.5, dt=14.0)
     env.close()  # a step within the map's diameter is the user's choice
+
+
+@pytest.mark.parametrize("radius", [1e-12, 1e-300])
+def test_a_step_of_too_many_substeps_is_refused(radius) -> None:
+    """``surveil play --config '{"body_radius": 1e-12}'`` hung: 2e11 physics substeps a
+    step (a body moves at most half its radius a substep). Refused beyond MAX_SUBSTEPS,
+    naming the smallest radius that fits, which builds."""
+    from envs.surveillance.physics import MAX_SUBSTEPS
+
+    with pytest.raises(InvalidConfigError, match=(
+        rf"^body_radius = {radius!r} with max\(v_pursuer, v_evader\) dt = 0.1: a step would "
+        r"take [\d.e+]+ physics substeps .* more than 100,000 .* expected body_radius >= 2e-06"
+    )):  # fmt: skip
+        World(open_room(), radius, 0.1, 1.0)
+    assert World(open_room(), 2e-6, 0.1, 1.0).n_substeps == MAX_SUBSTEPS

@@ -93,6 +93,7 @@ def run(args: argparse.Namespace) -> int:
         VacuousBoundWarning,
     )
     from envs.surveillance.config import EnvConfig
+    from envs.surveillance.physics import check_step
     from strategies.referee import referee_for
     from strategies.referee.estimates import check_cpls, check_estimate
     from strategies.referee.referee import check_start
@@ -111,6 +112,10 @@ def run(args: argparse.Namespace) -> int:
         raise type(exc)(f"map: {exc}") from None
     cfg = EnvConfig(map=world, **{**params, **overrides})
     # what the solve cannot change is checked before it (it can take minutes)
+    try:  # a step the env refuses: dt = 1e4 hung in the budget's move count (4e8 vectors)
+        check_step(cfg.map, cfg.dt, max(cfg.v_pursuer, cfg.v_evader), cfg.body_radius)
+    except SurveilValueError as exc:
+        raise type(exc)(f"--config: {exc}") from None
     if args.classify is not None:
         try:
             check_start(cfg, tuple(args.classify[:2]), tuple(args.classify[2:]))

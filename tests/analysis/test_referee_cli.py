@@ -132,3 +132,16 @@ def test_a_resolution_with_no_lattice_start_is_refused_naming_one_that_has(
     assert f"the coarsest resolution with one is --cells-per-lmin {fit} (" in err
     assert main(["referee", "corridor", "--cells-per-lmin", fit, "--no-cache"]) == 0
     assert "16 lattice starts" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("dt", ["1e4", "1e9"])
+def test_a_step_the_env_refuses_is_refused_before_the_solve(dt, capsys, monkeypatch):
+    """``--config '{"dt": 1e4}'`` hung (killed after 60 s): the budget check enumerates the
+    moves of a step, about 4e8 lattice vectors at V_p tau = 1e4 m. The env refuses a step
+    that crosses the map (physics.check_step); so does the referee now, before solving."""
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", "/nonexistent")
+    argv = ["referee", "corridor", "--config", f'{{"dt": {dt}}}', "--no-cache"]
+    assert main(argv) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.startswith(f"surveil: error: --config: dt = {float(dt)!r} with ")
+    assert "i.e. dt <= 16.92" in err

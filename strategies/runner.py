@@ -406,7 +406,7 @@ def run_episode(
         on_frame: called with each rendered RGB frame (the env renders ``"rgb_array"``);
             frames are not kept, so a writer can stream them.
         record: also keep the frames in ``result.frames`` (memory grows with the episode).
-        time_limit: wall-clock seconds the episode may take; checked between steps.
+        time_limit: wall-clock seconds the episode may take (> 0); checked between steps.
 
     Returns:
         The :class:`EpisodeResult`.
@@ -414,11 +414,16 @@ def run_episode(
     Raises:
         PolicyFailure: a policy raised while playing (its role forfeits).
         EpisodeTimeout: ``time_limit`` was exceeded.
-        InvalidConfigError: bad arguments (names, overrides, start, observations).
+        InvalidConfigError: bad arguments (names, overrides, start, observations,
+            time_limit).
     """
     from strategies.policies.starts import START_KINDS, sample_start
 
     t_start = time.perf_counter()
+    if time_limit is not None:  # a bad limit is the caller's error, not a policy's forfeit
+        from envs.validation import positive
+
+        time_limit = positive("time_limit", time_limit)
     overrides = dict(overrides or {})
     if max_cycles is not None:
         overrides["max_cycles"] = max_cycles

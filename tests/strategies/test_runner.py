@@ -170,3 +170,12 @@ def test_bad_arguments_are_clear_errors():
     given = {"pursuer": (3.0, 5.0), "evader": (5.5, 5.0)}
     r = run_episode(MAP, "pursuer/greedy", "evader/random", 0, start=given, max_cycles=3)
     assert r.start_kind == "given" and r.start["pursuer"] == [3.0, 5.0]
+
+
+@pytest.mark.parametrize("limit", [-1.0, 0.0, float("nan"), "5", True])
+def test_a_bad_time_limit_is_refused_not_blamed_on_a_policy(limit):
+    # time_limit = -1 (or 0) made the pursuer forfeit at step 1 with EpisodeTimeout
+    # ("episode exceeded its time limit of -1 s"); nan silently set no limit
+    with pytest.raises(InvalidConfigError, match=r"time_limit = .*expected a finite number > 0"):
+        run_episode(MAP, "pursuer/greedy", "evader/straight", seed=0, max_cycles=5,
+                    time_limit=limit)  # fmt: skip

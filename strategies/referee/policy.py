@@ -8,9 +8,9 @@ not make it drift. From a start its bound certifies, it cannot lose (pursuer) or
 break surveillance within the certified number of steps (evader), whatever the opponent
 does: that is what the tests check, episode by episode, against every registered opponent.
 
-Off certified states it falls back to a simple heuristic (the pursuer keeps the distance
-at the middle of the sensor range, the evader charges the pursuer) and records that it
-did, in ``uncertified_steps``.
+Off certified states it falls back to a simple heuristic, decided every env step (the
+pursuer keeps the distance at the middle of the sensor range, the evader charges the
+pursuer) and records that it did, in ``uncertified_steps``.
 
 Built without a bound (``make_policy("evader/referee", cells_per_lmin=16)``), a policy
 solves the bound it plays at reset, at that resolution and with its ``tau`` a whole number
@@ -89,7 +89,6 @@ class _RefereePolicy(BasePolicy):
         self.cells_per_lmin = V.positive("cells_per_lmin", cells_per_lmin)
         self._k = 1
         self._target: np.ndarray | None = None
-        self._fallback = np.zeros(2)
         self.uncertified_steps = 0
         self.referee_steps = 0
 
@@ -129,9 +128,11 @@ class _RefereePolicy(BasePolicy):
             self._target = self._plan(snap)
             if self._target is None:
                 self.uncertified_steps += 1
-                self._fallback = self._heuristic(snap)
         if self._target is None:
-            return self._fallback
+            # off certified states the heuristic answers every env step: held for a whole
+            # referee step, the pursuer's range keeper ran at V_p for tau and overshot
+            # the range by up to V_p tau (corridor: out of range in 2.3 s, whoever the evader)
+            return self._heuristic(snap)
         remaining = (self._k - phase) * float(self.config.dt)
         return (self._target - mine) / remaining
 

@@ -8,6 +8,7 @@ import pytest
 
 from envs.errors import InvalidConfigError
 from envs.surveillance.config import EnvConfig
+from strategies.policies.base import BasePolicy
 from strategies.policies.registry import make_policy, policy_names
 from strategies.referee import RefereeEvader, RefereePursuer
 from strategies.referee.policy import env_steps_per_referee_step
@@ -149,3 +150,27 @@ def test_a_referee_policy_solves_only_the_bound_it_plays(role, tmp_path, monkeyp
     assert calls == [role, "pursuer" if role == "evader" else "evader"]
     mine = ref.pursuer if role == "pursuer" else ref.evader
     assert pol.bound.res == mine.res and np.array_equal(pol.bound.win, mine.win)
+
+
+class _Still(BasePolicy):
+    """An evader that never moves."""
+
+    def _decide(self, snap):
+        return np.zeros(2)
+
+
+def test_the_referee_pursuers_range_keeper_keeps_the_range_off_certified_states():
+    """Off certified states the pursuer keeps L at the middle of the sensor range. Its
+    heuristic was decided once per referee step (tau = 1.5 s on the corridor) and held: at
+    V_p for the whole step it overshot the middle by up to V_p tau, so L swung between 2.45
+    and 3.95 against an evader that never moves, and every charging evader (toward_away,
+    shooting) won "too_close" at t = 2.3 s. Decided every env step it settles at 3."""
+    from strategies.runner import run_episode
+
+    pursuer = make_policy("pursuer/referee")
+    r = run_episode("corridor", pursuer, _Still(name="evader/still"), seed=0, max_cycles=60)
+    assert pursuer.uncertified_steps > 0  # the heuristic played
+    L = np.linalg.norm(r.trajectory[:, 0] - r.trajectory[:, 1], axis=1)
+    mid = 0.5 * (r.config.l_min + r.config.l_max)
+    assert r.winner == "pursuer"
+    assert np.all(np.abs(L[20:] - mid) < 0.05), L.round(2)

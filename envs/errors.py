@@ -20,6 +20,7 @@ __all__ = [
     "InvalidPlacementError",
     "LongRunWarning",
     "MemoryBudgetError",
+    "RelaxedStartWarning",
     "RhoAboveOneWarning",
     "SurveilValueError",
     "UnknownNameError",
@@ -121,6 +122,12 @@ class UnknownNameError(SurveilValueError, KeyError):
 
 class RhoAboveOneWarning(UserWarning):
     """V_e > V_p: legal, but escape is trivial for the evader (Sec. 5 of the paper)."""
+
+
+class RelaxedStartWarning(UserWarning):
+    """A "safe" start drawn with fewer guarantees than the name promises: no proposal in a
+    safe cell was admissible or left room to retreat (rho near 1), so one in a safe cell
+    only was drawn, as at rho >= 1 (:mod:`strategies.policies.starts`)."""
 
 
 class LongRunWarning(UserWarning):

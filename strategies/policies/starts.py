@@ -60,10 +60,16 @@ no cell is safe). On maps with no escapable orientation it raises ``InfeasibleEr
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 
-from envs.errors import InfeasibleError, InvalidConfigError, MemoryBudgetError
+from envs.errors import (
+    InfeasibleError,
+    InvalidConfigError,
+    MemoryBudgetError,
+    RelaxedStartWarning,
+)
 from envs.geometry import kernel_for
 from envs.surveillance.placement import check_room, random_start, spawn_margins
 from strategies.policies.lazy_table import LazySafetyTable
@@ -219,6 +225,13 @@ def _near_l_min(config, kernel, rng, judge, tab, angle_margin, escapable=False):
                     continue
             return _placement(p[i], e[i])
     if in_safe_cell is not None:  # nothing admissible (rho near 1): a safe cell, as at rho >= 1
+        warnings.warn(
+            f"map {m.name!r}, rho = {config.rho:g}: no proposal in a safe cell was admissible "
+            f"(V(theta) >= 0) with a retreat of {retreat:.4g} along the rod; drew one in a "
+            "safe cell only, as at rho >= 1 (the pursuer may not be able to hold from it)",
+            RelaxedStartWarning,
+            stacklevel=2,
+        )
         return in_safe_cell
     what = "escapable" if escapable else ("safe" if angle_margin is not None else "valid")
     retreating = f", a retreat of {retreat:.4g} along the rod" if angle_margin is not None else ""

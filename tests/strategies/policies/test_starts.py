@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
 from envs import surveillance_v0
-from envs.errors import InfeasibleError
+from envs.errors import InfeasibleError, RelaxedStartWarning
 from envs.geometry import kernel_for
 from strategies.policies.starts import sample_start
 
@@ -186,7 +188,8 @@ def test_near_one_rho_draws_a_safe_cell_start_as_rho_one_does(rho):
 
     env = surveillance_v0.parallel_env(map="corridor", v_evader=rho)
     cfg = env.config
-    start = sample_start(cfg, np.random.default_rng(0), kind="safe")
+    with pytest.warns(RelaxedStartWarning, match="safe cell only"):
+        start = sample_start(cfg, np.random.default_rng(0), kind="safe")
     p, e = np.asarray(start["pursuer"]), np.asarray(start["evader"])
     judge = DecompositionPursuer(turn_rate="one")
     judge.reset(role="pursuer", map=cfg.map, config=cfg, seed=0)
@@ -196,6 +199,14 @@ def test_near_one_rho_draws_a_safe_cell_start_as_rho_one_does(rho):
     env.reset(seed=0, options=start)
     assert env.agents
     env.close()
-    r = run_episode("corridor", "pursuer/decomposition", "evader/shooting", 0,
-                    overrides={"v_evader": rho}, max_cycles=5)  # fmt: skip
+    with pytest.warns(RelaxedStartWarning):
+        r = run_episode("corridor", "pursuer/decomposition", "evader/shooting", 0,
+                        overrides={"v_evader": rho}, max_cycles=5)  # fmt: skip
     assert r.start_kind == "safe" and r.steps >= 1
+    with warnings.catch_warnings():  # where an admissible start exists, no warning
+        warnings.simplefilter("error", RelaxedStartWarning)
+        sample_start(
+            surveillance_v0.parallel_env(map="corridor", v_evader=0.5).config,
+            np.random.default_rng(0),
+            kind="safe",
+        )

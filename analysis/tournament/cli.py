@@ -277,8 +277,10 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
                    help=roster)  # fmt: skip
     p.add_argument("--evaders", nargs="+", default=["evader/shooting", "evader/straight"],
                    help=roster)  # fmt: skip
-    p.add_argument("--seeds", type=int, default=10, help="number of seeded starts per match")
-    p.add_argument("--max-cycles", type=int, default=None)
+    p.add_argument("--seeds", type=integer(1), default=10,
+                   help="number of seeded starts per match (>= 1)")  # fmt: skip
+    p.add_argument("--max-cycles", type=integer(1), default=None,
+                   help="episode horizon in steps (>= 1)")  # fmt: skip
     p.add_argument("--config", help=f"env overrides as JSON, e.g. {CONFIG_EXAMPLE}")
     p.add_argument(
         "--start",

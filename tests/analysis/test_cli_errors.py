@@ -303,6 +303,20 @@ def test_a_decomposition_over_the_budget_names_the_variable_not_the_keyword(
     assert "memory_budget=" not in err and "0GB" not in err
 
 
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        (["evaluate", "--seeds", "0"], "--seeds = '0': expected an integer >= 1"),
+        (["evaluate", "--seeds", "2.5"], "--seeds = '2.5': expected an integer >= 1"),
+        (["evaluate", "--max-cycles", "0"], "--max-cycles = '0': expected an integer >= 1"),
+    ],
+)
+def test_evaluate_counts_are_checked_as_its_flags(capsys, argv, needle):
+    """``surveil evaluate --seeds 0`` said "surveil evaluate: seeds = 0" (the spec's field,
+    not the flag) and ``--seeds 2.5`` was argparse's "invalid int value"."""
+    assert_fails(capsys, argv, needle)
+
+
 def test_play_on_a_huge_map_names_its_own_flags(tmp_path, capsys, monkeypatch):
     """``surveil play`` on a 1.4e9 m map said "use resolution >= 2.81e+04": the safe
     start's judge has no such flag here. Now the judge's refusal names ``--start valid``,

@@ -124,3 +124,14 @@ def test_orbit_evader_circles_the_nearest_obstacle():
         swept = np.unwrap(np.arctan2(rel[:, 1], rel[:, 0]))
         assert np.sign(swept[-1] - swept[0]) == direction
         assert np.all(np.sign(np.diff(swept)) == direction)
+
+
+def test_orbit_evader_does_not_stand_against_a_wall():
+    """On the maze the obstacle it circles lies past the end of a wall: heading straight at
+    it, the evader stood still from 12.5 s to the end (seed 0); its velocity into the wall
+    now goes along it, and it walks at full speed the whole episode."""
+    ev = make_policy("evader/orbit", direction=1, offset=0.5)
+    r = run_episode("maze", "pursuer/decomposition", ev, 0, max_cycles=300)
+    step = np.linalg.norm(np.diff(r.trajectory[:, 1], axis=0), axis=1)
+    walked = np.convolve(step, np.ones(50), "valid")  # metres per 5 s
+    assert walked.min() > 0.8 * 0.5 * 5.0, walked.min()

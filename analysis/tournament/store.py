@@ -200,14 +200,18 @@ class Store:
     def lock(self) -> None:
         """Take the single-writer lock, or raise :class:`StoreBusyError` naming the holder.
 
-        A POSIX record lock (``lockf``) on ``STORE.lock``: the kernel releases it when the
-        driver dies, however it dies, and forked workers do not inherit it. Within one
+        A POSIX record lock (``lockf``) on ``STORE.lock`` beside the file the store's path
+        resolves to (so a symlink to the store takes the same lock): the kernel releases it
+        when the driver dies, however it dies, and forked workers do not inherit it. Within one
         process a registry of held stores plays the same part.
         """
         import fcntl
 
-        lock_path = self.path.with_name(self.path.name + ".lock")
-        key = str(lock_path.resolve())
+        # beside the file the path resolves to: a symlink to the store (or another
+        # spelling of its path) takes the same lock, not one of its own
+        real = self.path.resolve()
+        lock_path = real.with_name(real.name + ".lock")
+        key = str(lock_path)
         f = open(lock_path, "a+", encoding="utf-8")  # held until unlock()
         try:
             if key in _HELD:

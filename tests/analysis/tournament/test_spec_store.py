@@ -186,6 +186,23 @@ def test_store_lock_refuses_a_second_writer(tmp_path, small_spec):
     assert done.played == 24  # the lock is free again
 
 
+def test_store_lock_is_the_same_through_a_symlink(tmp_path, small_spec):
+    # a symlink to the store took a lock file of its own (link.sqlite.lock): two drivers
+    # wrote the one store at once
+    store = tmp_path / "s.sqlite"
+    Store(store).close()
+    link = tmp_path / "link.sqlite"
+    link.symlink_to(store.name)
+    holder = Store(link)
+    holder.lock()
+    try:
+        with pytest.raises(StoreBusyError, match=r"being written by pid \d+"):
+            run_tournament(spec_from_dict(small_spec), store, backend="serial", progress=False)
+    finally:
+        holder.close()
+    assert not (tmp_path / "link.sqlite.lock").exists()
+
+
 def test_store_rejects_foreign_files_and_exports(tmp_path, small_spec):
     bogus = tmp_path / "notes.sqlite"
     bogus.write_text("hello, not a database" * 100)

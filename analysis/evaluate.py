@@ -36,7 +36,7 @@ __all__ = [
 
 
 def make_env(map_: Any, overrides: Mapping[str, Any] | None = None, *, record: bool = False):
-    """A ``surveillance_v0`` parallel env with the state observation (see
+    """A ``surveillance_v1`` parallel env with the state observation (see
     :func:`strategies.runner.build_env`)."""
     from strategies.runner import build_env
 

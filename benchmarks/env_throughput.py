@@ -1,14 +1,14 @@
-"""Parallel-API step throughput of surveillance_v0 against MPE2's simple_tag_v3 (1 v 1).
+"""Parallel-API step throughput of surveillance_v1 against MPE2's simple_tag_v3 (1 v 1).
 
 Measured in one run, so the ratios do not depend on the machine:
 
-* surveillance_v0 (state observations, render off) on a small map (``open_room``, 4
+* surveillance_v1 (state observations, render off) on a small map (``open_room``, 4
   walls) and on a large seeded random map (>= 500 walls);
 * ``mpe2.simple_tag_v3`` with one adversary, one good agent, no obstacles, continuous
   actions: the reference.
 
 Actions are pre-sampled (uniform in each agent's Box) so the loop times only
-``env.step``. Episodes of surveillance_v0 end when the evader escapes; the env is then
+``env.step``. Episodes of surveillance_v1 end when the evader escapes; the env is then
 reset outside the timed region. The three envs run in interleaved chunks, so that load
 from other processes affects them alike. Goals: ours >= 6x simple_tag, and the large map
 no more than 1.5x slower than the small one.
@@ -32,7 +32,7 @@ import time
 import numpy as np
 from bench_cli import integer, run
 
-from envs import surveillance_v0
+from envs import surveillance_v1
 from envs.maps import load_map, random_map
 
 N_ACTIONS = 4096
@@ -50,10 +50,10 @@ def _presampled(env, agents, rng: np.random.Generator) -> dict[str, np.ndarray]:
 
 
 class OurRunner:
-    """Steps surveillance_v0 on one map with pre-sampled actions; times ``step`` only."""
+    """Steps surveillance_v1 on one map with pre-sampled actions; times ``step`` only."""
 
     def __init__(self, world_map, seed: int = 0) -> None:
-        self.env = surveillance_v0.parallel_env(map=world_map, max_cycles=10**9)
+        self.env = surveillance_v1.parallel_env(map=world_map, max_cycles=10**9)
         self.acts = _presampled(self.env, self.env.possible_agents, np.random.default_rng(seed))
         self.env.reset(seed=seed)
         self.i = 0
@@ -153,11 +153,11 @@ def main() -> None:
     resets_small, resets_large = runners["small"].resets, runners["large"].resets
     print(f"simple_tag_v3 (1v1, continuous): {ref:10.0f} steps/s")
     print(
-        f"surveillance_v0 small map:       {ours_small:10.0f} steps/s"
+        f"surveillance_v1 small map:       {ours_small:10.0f} steps/s"
         f"  ({resets_small} resets, untimed)"
     )
     print(
-        f"surveillance_v0 large map:       {ours_large:10.0f} steps/s"
+        f"surveillance_v1 large map:       {ours_large:10.0f} steps/s"
         f"  ({resets_large} resets, untimed)"
     )
     print(f"ratio ours(small) / simple_tag:  {ours_small / ref:6.2f}   (goal >= 6)")

@@ -44,12 +44,12 @@ def _world(spec):
 def _measure(spec, steps, q):
     with tempfile.TemporaryDirectory() as cache:
         os.environ["SURVEIL_CACHE_DIR"] = cache
-        from envs import surveillance_v0
+        from envs import surveillance_v1
         from strategies.policies import make_policy
         from strategies.policies.starts import sample_start
 
         world, params = _world(spec)
-        env = surveillance_v0.parallel_env(map=world, max_cycles=steps, **params)
+        env = surveillance_v1.parallel_env(map=world, max_cycles=steps, **params)
         c = env.config
         p = make_policy("pursuer/decomposition")
         t0 = time.perf_counter()

@@ -1,5 +1,10 @@
 """
-# Surveillance (finite sensor range)
+# Surveillance (finite sensor range), v0 (retired: use `surveillance_v1`)
+
+v0 sweeps every step along the chord between its two frames, also when a wall stopped
+or deflected a body within the step, where it can miss a break or time it late; v1
+sweeps such a step along the physics' path and is otherwise the same env. v0 stays
+importable so that results recorded with it replay.
 
 | Import               | `from envs import surveillance_v0`                          |
 |----------------------|-------------------------------------------------------------|
@@ -118,15 +123,21 @@ new version.
 
 ### Version History
 
+* v1: see :mod:`envs.surveillance_v1` (steps with a wall contact swept along the path).
 * v0: initial release (continuous-time surveillance check, state and lidar
   observations, zero-sum and sparse rewards).
 """
 
 from __future__ import annotations
 
-from envs.surveillance.env import env, parallel_env, raw_env
-from envs.surveillance.registry import ENV_ID, register_envs
+from envs.surveillance.env import env_v0 as env
+from envs.surveillance.env import parallel_env_v0 as parallel_env
+from envs.surveillance.env import raw_env_v0 as raw_env
+from envs.surveillance.registry import ENV_IDS, register_envs
 
 __all__ = ["ENV_ID", "env", "parallel_env", "raw_env"]
+
+ENV_ID = ENV_IDS[0]
+"""The versioned registry id."""
 
 register_envs()

@@ -1,6 +1,6 @@
 """The one episode loop: `surveil play`, tournaments, benchmarks and training all use it.
 
-:func:`run_episode` builds a ``surveillance_v0`` parallel env from a map and env
+:func:`run_episode` builds a ``surveillance_v1`` parallel env from a map and env
 overrides, draws (or takes) a start, seeds everything from one episode seed, plays two
 policies against each other and returns an :class:`EpisodeResult`.
 
@@ -230,7 +230,7 @@ def build_env(
     *,
     render_mode: str | None = None,
 ):
-    """A ``surveillance_v0`` parallel env on ``map_``.
+    """A ``surveillance_v1`` parallel env on ``map_``.
 
     A built-in map's recommended ``l_min``, ``l_max`` and speeds apply unless
     ``overrides`` sets them.
@@ -238,7 +238,7 @@ def build_env(
     Raises:
         InvalidConfigError: an override is not an env argument or is out of range.
     """
-    from envs import surveillance_v0
+    from envs import surveillance_v1
 
     world, kwargs = map_parameters(map_)
     kwargs.update(dict(overrides or {}))
@@ -246,7 +246,7 @@ def build_env(
         if bad in kwargs:
             raise InvalidConfigError(f"env overrides: {bad!r} is set by the runner, not here")
     try:
-        return surveillance_v0.parallel_env(map=world, render_mode=render_mode, **kwargs)
+        return surveillance_v1.parallel_env(map=world, render_mode=render_mode, **kwargs)
     except TypeError as exc:  # a misspelt env argument
         raise InvalidConfigError(f"env overrides: {exc}") from exc
 

@@ -1,6 +1,6 @@
 """Learned policies: single-agent wrappers, SB3 training, self-play and the model zoo.
 
-* :class:`SingleAgentEnv` -- one role of ``surveillance_v0`` as a Gymnasium env, the
+* :class:`SingleAgentEnv` -- one role of ``surveillance_v1`` as a Gymnasium env, the
   other played by a fixed Policy;
 * :class:`TrainConfig`, :func:`load_config` -- a run's validated config (TOML);
 * :func:`train`, :func:`train_from_config` -- SB3 PPO/SAC with checkpoints, resume and

@@ -1,7 +1,7 @@
 """The frozen, validated configuration of one training run, loaded from TOML.
 
 A config file holds the flat fields of :class:`TrainConfig` plus three tables,
-``[env]`` (arguments of ``surveillance_v0.parallel_env``), ``[policy_kwargs]`` (extra
+``[env]`` (arguments of ``surveillance_v1.parallel_env``), ``[policy_kwargs]`` (extra
 SB3 policy arguments) and ``[algo_kwargs]`` (extra SB3 algorithm arguments)::
 
     role = "pursuer"
@@ -81,7 +81,7 @@ class TrainConfig:
     map: str | tuple[str, ...] = "open_room"
     """Built-in map name, map file path or ``random:SEED``; or several, one per episode."""
     env: dict[str, Any] = field(default_factory=dict)
-    """Overrides of ``surveillance_v0.parallel_env`` arguments (``max_cycles``, ...)."""
+    """Overrides of ``surveillance_v1.parallel_env`` arguments (``max_cycles``, ...)."""
     start: str = "env"
     """Training starts: ``"env"`` (env sampler), ``"valid"`` or ``"safe"`` (sample_start)."""
     algo: str = "ppo"

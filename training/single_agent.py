@@ -1,6 +1,6 @@
-"""One role of ``surveillance_v0`` as a Gymnasium env, the other played by a fixed Policy.
+"""One role of ``surveillance_v1`` as a Gymnasium env, the other played by a fixed Policy.
 
-:class:`SingleAgentEnv` wraps :func:`envs.surveillance_v0.parallel_env` so that SB3 (or
+:class:`SingleAgentEnv` wraps :func:`envs.surveillance_v1.parallel_env` so that SB3 (or
 any single-agent learner) trains the pursuer or the evader against a fixed opponent: a
 registered policy name (``"evader/straight"``), a ``ROLE/sb3:PATH`` model zip, or any
 object with the Policy protocol. SuperSuit's vector envs would need both agents to share
@@ -33,7 +33,7 @@ from typing import Any, ClassVar
 import gymnasium as gym
 import numpy as np
 
-from envs import surveillance_v0
+from envs import surveillance_v1
 from envs.errors import InvalidConfigError
 from envs.surveillance.env import EVADER, PURSUER
 from strategies.policies import Policy, make_policy
@@ -130,7 +130,7 @@ class SingleAgentEnv(gym.Env):
             ``observation`` options replace ``env_kwargs``' observation. The features are
             built once per map (from the features' expert parameters) and reset every
             episode.
-        **env_kwargs: the other arguments of :func:`envs.surveillance_v0.parallel_env`
+        **env_kwargs: the other arguments of :func:`envs.surveillance_v1.parallel_env`
             (``max_cycles``, ``observation``, ``v_evader``...).
 
     Rewards are the learner's env rewards, ``terminated`` means surveillance broke and
@@ -187,7 +187,7 @@ class SingleAgentEnv(gym.Env):
         for world in maps:
             try:
                 self.envs.append(
-                    surveillance_v0.parallel_env(map=world, render_mode=render_mode, **env_kwargs)
+                    surveillance_v1.parallel_env(map=world, render_mode=render_mode, **env_kwargs)
                 )
             except TypeError as exc:  # a misspelt env argument
                 raise InvalidConfigError(f"env: {exc}") from exc
@@ -205,7 +205,7 @@ class SingleAgentEnv(gym.Env):
                 for _ in self.envs
             ]
             # the space of the observation the inputs encode (lidar: the same on every map)
-            base = surveillance_v0.parallel_env(map=maps[0], **env_kwargs, **inputs.observation)
+            base = surveillance_v1.parallel_env(map=maps[0], **env_kwargs, **inputs.observation)
             self.observation_space = inputs.space(base.observation_space(self.agent))
             base.close()
         self.action_space = self.env.action_space(self.agent)

@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from envs.errors import InvalidConfigError
-from envs.surveillance_v0 import ENV_ID
+from envs.surveillance_v1 import ENV_ID
 from strategies.policies import Policy, make_policy
 from training.config import TrainConfig, load_config
 from training.single_agent import SingleAgentEnv, sb3_params
@@ -53,7 +53,7 @@ __all__ = [
     "train_from_config",
 ]
 
-ENV_NAME = "surveillance_v0"
+ENV_NAME = "surveillance_v1"
 """The versioned env every model here is trained on (recorded in provenance)."""
 
 EVAL_SEED_OFFSET = 1_000_003

@@ -25,7 +25,7 @@ __all__ = ["IDENTITY_VERSION", "Match", "match_identity", "plan"]
 IDENTITY_VERSION = 1
 """Bumped when the meaning of an identity field changes (all old matches become new)."""
 
-ENV_ID = "surveillance_v0"
+ENV_ID = "surveillance_v1"
 
 
 @dataclass(frozen=True)

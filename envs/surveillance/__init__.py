@@ -1,6 +1,6 @@
 """The surveillance environment: config, physics, rules, observations, env, renderer.
 
-Import the versioned module :mod:`envs.surveillance_v0` in user code; this package is
+Import the versioned module :mod:`envs.surveillance_v1` in user code; this package is
 its unversioned implementation.
 """
 

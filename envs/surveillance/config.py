@@ -1,4 +1,4 @@
-"""The frozen, validated configuration of a ``surveillance_v0`` environment.
+"""The frozen, validated configuration of a ``surveillance_v1`` environment.
 
 The factories (:func:`envs.surveillance.env.parallel_env` and friends) take flat keyword
 arguments and normalise them into one :class:`EnvConfig`; every later computation reads

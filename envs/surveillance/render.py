@@ -170,9 +170,16 @@ class Renderer:
     """
 
     def __init__(
-        self, world_map: Map, *, human: bool, fps: float, size: int = DEFAULT_SIZE
+        self,
+        world_map: Map,
+        *,
+        human: bool,
+        fps: float,
+        size: int = DEFAULT_SIZE,
+        title: str = "surveillance",
     ) -> None:
         self._pygame = _pygame()
+        self.title = title
         self.frame = _Frame(world_map, size)
         self.human = human
         self.fps = fps
@@ -188,7 +195,7 @@ class Renderer:
             return _to_array(pygame, self._surface)
         if self._window is None:
             pygame.display.init()
-            pygame.display.set_caption("surveillance_v0")
+            pygame.display.set_caption(self.title)
             self._window = pygame.display.set_mode((self.frame.width, self.frame.height))
             self._clock = pygame.time.Clock()
         self._window.blit(self._surface, (0, 0))

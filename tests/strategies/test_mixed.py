@@ -107,9 +107,9 @@ def test_mixed_policy_samples_its_weights_reproducibly():
 
 
 def test_mixed_policy_plays_through_the_policy_protocol():
-    from envs import surveillance_v0
+    from envs import surveillance_v1
 
-    env = surveillance_v0.parallel_env(map="open_room", max_cycles=10)
+    env = surveillance_v1.parallel_env(map="open_room", max_cycles=10)
     mix = MixedPolicy.from_weights({"pursuer/greedy": 1.0, "pursuer/random": 1.0})
     assert mix.roles == ("pursuer",)
     obs, _ = env.reset(seed=0)

@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from envs import surveillance_v0
+from envs import surveillance_v1
 from envs.errors import InvalidConfigError
 from strategies.policies import make_policy
 from training.dagger import DaggerConfig, _Rollout, dagger
@@ -31,7 +31,7 @@ def test_dagger_aggregates_expert_labels_and_fits_them(tmp_path):
     # an ordinary SB3 model: it loads by name, declares its observation and plays
     p = make_policy(f"pursuer/sb3:{r.model_path}")
     assert p.observation_options == {"observation": "state"}
-    env = surveillance_v0.parallel_env(map="open_room")
+    env = surveillance_v1.parallel_env(map="open_room")
     obs, _ = env.reset(seed=0)
     p.reset(role="pursuer", map=env.config.map, config=env.config, seed=0)
     assert p.act(obs["pursuer_0"]).shape == (2,)
@@ -48,7 +48,7 @@ def test_rollout_labels_every_visited_observation_with_the_expert():
     expert = make_policy("pursuer/greedy")
     twin = make_policy("pursuer/greedy")
     roll = _Rollout(expert, model, beta=0.0, seed=0)  # the learner acts, the expert labels
-    penv = surveillance_v0.parallel_env(map="open_room", max_cycles=20)
+    penv = surveillance_v1.parallel_env(map="open_room", max_cycles=20)
     obs, _ = penv.reset(seed=3)
     for pol in (roll, twin):
         pol.reset(role="pursuer", map=penv.config.map, config=penv.config, seed=0)

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from envs import surveillance_v0
+from envs import surveillance_v1
 from envs.errors import InvalidConfigError, InvalidObservationError
 from strategies.policies import make_policy
 from tests.training.test_train import Interrupt
@@ -70,7 +70,7 @@ def test_a_model_checks_its_role_and_observation(tiny):
         make_policy(f"evader/sb3:{result.model_path}")
     policy = make_policy(f"pursuer/sb3:{result.model_path}")
     assert policy.observation_options == {"observation": "state"}
-    env = surveillance_v0.parallel_env(map="open_room", observation="lidar", n_rays=8)
+    env = surveillance_v1.parallel_env(map="open_room", observation="lidar", n_rays=8)
     obs, _ = env.reset(seed=0)
     policy.reset(role="pursuer", map=env.config.map, config=env.config, seed=0)
     with pytest.raises(InvalidObservationError, match="trained on shape"):
@@ -82,7 +82,7 @@ def test_a_damaged_model_file_names_the_file(tmp_path):
     bad = tmp_path / "model.zip"
     bad.write_bytes(b"PK\x03\x04 not really a zip")
     policy = make_policy(f"pursuer/sb3:{bad}", algo="PPO")
-    env = surveillance_v0.parallel_env(map="open_room")
+    env = surveillance_v1.parallel_env(map="open_room")
     with pytest.raises(InvalidConfigError, match=str(bad)):
         policy.reset(role="pursuer", map=env.config.map, config=env.config, seed=0)
 

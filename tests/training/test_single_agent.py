@@ -9,7 +9,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
-from envs import surveillance_v0
+from envs import surveillance_v1
 from envs.errors import InvalidConfigError
 from strategies.policies import make_policy
 from training.single_agent import SingleAgentEnv
@@ -28,7 +28,7 @@ def test_checkers_pass(role, opponent, observation):
         check_env(env, skip_render_check=True)
         sb3_check_env(env, warn=True)
     agent = "pursuer_0" if role == "pursuer" else "evader_0"
-    raw = surveillance_v0.parallel_env(map="pillars", observation=observation, n_rays=8)
+    raw = surveillance_v1.parallel_env(map="pillars", observation=observation, n_rays=8)
     assert env.observation_space == raw.observation_space(agent)
     assert env.action_space == raw.action_space(agent)
 

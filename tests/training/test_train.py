@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from stable_baselines3.common.callbacks import BaseCallback
 
-from envs import surveillance_v0
+from envs import surveillance_v1
 from envs.errors import InvalidConfigError
 from strategies.policies import make_policy
 from training import cli_train, evaluate_model, latest_checkpoint, load_policy, train
@@ -42,7 +42,7 @@ def test_tiny_ppo_writes_model_and_provenance(tiny):
     out = result.output_dir
     assert (out / "model.zip").is_file() and (out / "config.toml").is_file()
     prov = json.loads((out / "provenance.json").read_text())
-    assert prov["env_id"] == "surveillance_v0" and prov["timesteps"] == 256
+    assert prov["env_id"] == "surveillance_v1" and prov["timesteps"] == 256
     assert prov["config"]["role"] == "pursuer" and prov["algo"] == "ppo"
     assert prov["env_config"]["max_cycles"] == 40
     assert {"torch", "stable-baselines3", "gymnasium", "python"} <= set(prov["packages"])
@@ -59,7 +59,7 @@ def test_tiny_ppo_writes_model_and_provenance(tiny):
 def test_model_plays_as_a_registered_policy(tiny):
     result = train(tiny(eval_episodes=0))
     policy = make_policy("pursuer/sb3:" + str(result.model_path), algo="PPO")
-    env = surveillance_v0.parallel_env(map="open_room", max_cycles=40)
+    env = surveillance_v1.parallel_env(map="open_room", max_cycles=40)
     evader = make_policy("evader/straight")
     obs, _ = env.reset(seed=1)
     policy.reset(role="pursuer", map=env.config.map, config=env.config, seed=0)
@@ -83,7 +83,7 @@ def test_model_plays_as_a_registered_policy(tiny):
 def test_sb3_name_without_algo_loads_ppo(tiny):
     result = train(tiny(eval_episodes=0, total_timesteps=64))
     policy = make_policy("pursuer/sb3:" + str(result.model_path))
-    env = surveillance_v0.parallel_env(map="open_room")
+    env = surveillance_v1.parallel_env(map="open_room")
     obs, _ = env.reset(seed=0)
     policy.reset(role="pursuer", map=env.config.map, config=env.config, seed=0)
     assert policy.act(obs["pursuer_0"]).shape == (2,)

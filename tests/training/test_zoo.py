@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from envs import surveillance_v0
+from envs import surveillance_v1
 from envs.errors import UnknownNameError
 from training import zoo
 from training.config import TrainConfig
@@ -40,7 +40,9 @@ def test_model_files_and_provenance(name):
     cfg = zoo.config(name)
     assert isinstance(cfg, TrainConfig)
     assert prov["config"] == cfg.to_dict() and prov["role"] == cfg.role
-    assert prov["env_id"] == "surveillance_v0" and prov["timesteps"] >= cfg.total_timesteps
+    # trained on the version of their day (v0 before the path sweep)
+    assert prov["env_id"] in ("surveillance_v0", "surveillance_v1")
+    assert prov["timesteps"] >= cfg.total_timesteps
     assert prov["evaluation"]["episodes"] == cfg.eval_episodes
     assert zoo.policy_name(name) == f"{cfg.role}/sb3:{zoo.model_path(name)}"
 
@@ -83,7 +85,7 @@ def test_loads_and_acts(name, observation_seed):
     policy = zoo.load(name)
     obs_kw = {k: v for k, v in (policy.observation_options or {}).items()}
     world = cfg.map if isinstance(cfg, TrainConfig) else cfg.maps[0]
-    env = surveillance_v0.parallel_env(map=world, **{**cfg.env, **obs_kw})
+    env = surveillance_v1.parallel_env(map=world, **{**cfg.env, **obs_kw})
     agent = f"{cfg.role}_0"
     obs, _ = env.reset(seed=observation_seed)
     policy.reset(role=cfg.role, map=env.config.map, config=env.config, seed=0)
@@ -105,7 +107,7 @@ def test_a_specialist_warns_on_a_map_it_has_not_seen():
 
     policy = zoo.load("dagger_pursuer_l_hall")
     for world, warns in (("l_hall", False), ("corridor", True)):
-        env = surveillance_v0.parallel_env(map=world)
+        env = surveillance_v1.parallel_env(map=world)
         with warnings.catch_warnings(record=True) as got:
             warnings.simplefilter("always")
             policy.reset(role="pursuer", map=load_map(world), config=env.config, seed=0)
@@ -115,7 +117,7 @@ def test_a_specialist_warns_on_a_map_it_has_not_seen():
         assert all("l_hall" in str(w.message) and world in str(w.message) for w in said)
     # a lidar generalist sees no map coordinates: no warning anywhere
     general = zoo.load("dagger_pursuer_generalist")
-    env = surveillance_v0.parallel_env(map="corridor", **general.observation_options)
+    env = surveillance_v1.parallel_env(map="corridor", **general.observation_options)
     with warnings.catch_warnings():
         warnings.simplefilter("error", UnseenMapWarning)
         general.reset(role="pursuer", map=load_map("pillars"), config=env.config, seed=0)

@@ -228,9 +228,9 @@ def test_random_names_load_the_seeded_random_map() -> None:
 
 
 def test_random_names_work_wherever_a_map_name_does() -> None:
-    from envs import surveillance_v0
+    from envs import surveillance_v1
 
-    env = surveillance_v0.parallel_env(map="random:star:4")
+    env = surveillance_v1.parallel_env(map="random:star:4")
     assert env.config.map == random_map(4, kind="star")
     env.close()
 

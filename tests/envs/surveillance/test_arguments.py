@@ -9,7 +9,7 @@ import warnings
 
 import pytest
 
-from envs import surveillance_v0
+from envs import surveillance_v1
 from envs.errors import RhoAboveOneWarning
 from envs.maps import builtin_info, builtin_map, builtin_names, save_map
 from envs.surveillance.config import (
@@ -21,7 +21,7 @@ from envs.surveillance.config import (
 )
 from tests.envs.surveillance._worlds import open_room
 
-FACTORIES = [surveillance_v0.parallel_env, surveillance_v0.raw_env, surveillance_v0.env]
+FACTORIES = [surveillance_v1.parallel_env, surveillance_v1.raw_env, surveillance_v1.env]
 
 
 @pytest.mark.parametrize("factory", FACTORIES, ids=lambda f: f.__name__)
@@ -42,23 +42,23 @@ def test_a_misspelt_option_is_a_type_error_with_a_suggestion(factory) -> None:
 
 
 def test_positional_arguments_follow_the_field_order() -> None:
-    env = surveillance_v0.parallel_env(open_room(), 1.0, 3.0)
+    env = surveillance_v1.parallel_env(open_room(), 1.0, 3.0)
     assert (env.config.l_min, env.config.l_max) == (1.0, 3.0)
 
 
 @pytest.mark.parametrize("name", builtin_names())
 def test_a_builtin_name_brings_its_recommended_parameters(name: str) -> None:
     info = builtin_info(name)
-    cfg = surveillance_v0.parallel_env(map=name).config
+    cfg = surveillance_v1.parallel_env(map=name).config
     assert {k: getattr(cfg, k) for k in MAP_PARAMETERS} == info.params()
 
 
 def test_every_builtin_recommends_the_global_defaults() -> None:
-    """Changing a built-in's recommendation changes surveillance_v0 (STYLE.md 1: bump it)."""
+    """Changing a built-in's recommendation changes surveillance_v0 and v1 (STYLE.md 1: bump)."""
     for name in builtin_names():
         assert builtin_info(name).params() == GLOBAL_DEFAULTS, (
             f"{name} recommends {builtin_info(name).params()}: this changes what "
-            f"surveillance_v0(map={name!r}) plays; add surveillance_v1 and update this test"
+            f"surveillance_v1(map={name!r}) plays; add surveillance_v2 and update this test"
         )
 
 
@@ -86,25 +86,25 @@ def test_a_map_file_uses_the_global_defaults(tmp_path) -> None:
 
 
 def test_pickling_replays_the_given_arguments() -> None:
-    env = surveillance_v0.parallel_env(map="corridor", l_max=3.5, max_cycles=9)
+    env = surveillance_v1.parallel_env(map="corridor", l_max=3.5, max_cycles=9)
     clone = pickle.loads(pickle.dumps(env))
     assert clone.config == env.config and clone.config.l_max == 3.5
 
 
 def test_rho_above_one_is_legal_with_a_warning() -> None:
     with pytest.warns(RhoAboveOneWarning, match=r"v_evader = 1.5 > v_pursuer = 1.0") as record:
-        env = surveillance_v0.parallel_env(map="open_room", v_evader=1.5)
+        env = surveillance_v1.parallel_env(map="open_room", v_evader=1.5)
     assert record[0].filename == __file__  # points at the caller, not at the env's internals
     env.reset(seed=0)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        surveillance_v0.parallel_env(map="open_room", v_evader=1.0)  # rho = 1: no warning
+        surveillance_v1.parallel_env(map="open_room", v_evader=1.0)  # rho = 1: no warning
 
 
 def test_the_env_card_shows_the_real_signature() -> None:
-    """The signature block of the env card (surveillance_v0's docstring) agrees with the code."""
-    card = surveillance_v0.__doc__
-    block = card[card.index("surveillance_v0.parallel_env(") :]
-    call = block[len("surveillance_v0.parallel_env") : block.index(")\n") + 1]
+    """The signature block of the env card (surveillance_v1's docstring) agrees with the code."""
+    card = surveillance_v1.__doc__
+    block = card[card.index("surveillance_v1.parallel_env(") :]
+    call = block[len("surveillance_v1.parallel_env") : block.index(")\n") + 1]
     shown = eval(f"dict{call}")  # the card writes plain literals
     assert shown == env_parameters()

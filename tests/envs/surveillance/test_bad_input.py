@@ -5,14 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from envs import surveillance_v0
+from envs import surveillance_v1
 from envs.errors import (
     InvalidActionError,
     InvalidConfigError,
     InvalidPlacementError,
     UnknownNameError,
 )
-from envs.surveillance_v0 import parallel_env
+from envs.surveillance_v1 import parallel_env
 
 
 @pytest.fixture
@@ -65,7 +65,7 @@ def test_integer_and_list_actions_are_accepted(env):
     assert env._step == 1
 
 
-@pytest.mark.parametrize("make", [surveillance_v0.parallel_env, surveillance_v0.env])
+@pytest.mark.parametrize("make", [surveillance_v1.parallel_env, surveillance_v1.env])
 @pytest.mark.parametrize("space", ["observation_space", "action_space"])
 def test_an_unknown_agent_is_a_project_error_naming_it(make, space):
     # was a bare KeyError('pursuer'); UnknownNameError is still a KeyError

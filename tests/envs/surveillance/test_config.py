@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from envs import surveillance_v0
+from envs import surveillance_v1
 from envs.errors import InvalidConfigError, UnknownNameError
 from envs.maps import Map
 from envs.surveillance.config import EnvConfig
@@ -55,17 +55,17 @@ def test_bad_values_raise_naming_value_and_range(kwargs: dict, pattern: str) -> 
     with pytest.raises(InvalidConfigError, match=pattern):
         EnvConfig(**{**base, **kwargs})
     with pytest.raises(InvalidConfigError, match=pattern):  # the factories validate too
-        surveillance_v0.parallel_env(**{**base, **kwargs})
+        surveillance_v1.parallel_env(**{**base, **kwargs})
 
 
 def test_misspelt_option_is_a_type_error() -> None:
     with pytest.raises(TypeError, match="lmin"):
-        surveillance_v0.parallel_env(map=open_room(), lmin=2.0)
+        surveillance_v1.parallel_env(map=open_room(), lmin=2.0)
 
 
 def test_unknown_map_name_is_named() -> None:
     with pytest.raises(UnknownNameError, match="no_such_world"):
-        surveillance_v0.parallel_env(map="no_such_world")
+        surveillance_v1.parallel_env(map="no_such_world")
 
 
 def test_config_is_frozen_and_normalised() -> None:
@@ -85,12 +85,12 @@ def test_map_file_path_is_loaded(tmp_path) -> None:
 
     path = tmp_path / "room.json"
     save_map(open_room(), path)
-    env = surveillance_v0.parallel_env(map=str(path))
+    env = surveillance_v1.parallel_env(map=str(path))
     assert env.map == open_room()
 
 
 def test_defaults_match_the_env_card() -> None:
-    env = surveillance_v0.parallel_env()
+    env = surveillance_v1.parallel_env()
     cfg = env.config
     assert cfg.map.name == "corridor"
     assert (cfg.l_min, cfg.l_max, cfg.v_pursuer, cfg.v_evader) == (2.0, 4.0, 1.0, 0.5)

@@ -14,7 +14,7 @@ import pytest
 import shapely
 from shapely.geometry import LineString, Polygon
 
-from envs import surveillance_v0
+from envs import surveillance_v1
 from envs.errors import EpisodeStateError, InvalidActionError, InvalidPlacementError
 from envs.maps import Feature
 from envs.surveillance.observations import STATE_LAYOUT, decode_state
@@ -43,8 +43,8 @@ def _digest(env, seed: int, actions: np.ndarray) -> str:
 @pytest.mark.parametrize("observation", ["state", "lidar"])
 def test_episode_digest_replays_from_seed_and_actions(observation: str) -> None:
     actions = np.random.default_rng(7).uniform(-1.2, 1.2, (300, 2, 2)).astype(np.float32)
-    env = surveillance_v0.parallel_env(map=pillar_room(), observation=observation, max_cycles=300)
-    other = surveillance_v0.parallel_env(map=pillar_room(), observation=observation, max_cycles=300)
+    env = surveillance_v1.parallel_env(map=pillar_room(), observation=observation, max_cycles=300)
+    other = surveillance_v1.parallel_env(map=pillar_room(), observation=observation, max_cycles=300)
     first = _digest(env, 3, actions)
     assert _digest(env, 3, actions) == first  # same env object, reset again
     assert _digest(other, 3, actions) == first  # a fresh env
@@ -52,7 +52,7 @@ def test_episode_digest_replays_from_seed_and_actions(observation: str) -> None:
 
 
 def test_reset_without_seed_continues_the_generator() -> None:
-    env = surveillance_v0.parallel_env(map=pillar_room())
+    env = surveillance_v1.parallel_env(map=pillar_room())
     a, _ = env.reset(seed=11)
     b, _ = env.reset()
     c, _ = env.reset(seed=11)
@@ -61,7 +61,7 @@ def test_reset_without_seed_continues_the_generator() -> None:
 
 def test_random_starts_are_valid_surveillance_configurations() -> None:
     world = pillar_room()
-    env = surveillance_v0.parallel_env(map=world, l_min=1.0, l_max=4.0, spawn_margin_steps=2)
+    env = surveillance_v1.parallel_env(map=world, l_min=1.0, l_max=4.0, spawn_margin_steps=2)
     poly = world.free_region
     for seed in range(40):
         _, infos = env.reset(seed=seed)
@@ -79,7 +79,7 @@ def test_random_starts_are_valid_surveillance_configurations() -> None:
 
 
 def test_options_place_the_agents_exactly() -> None:
-    env = surveillance_v0.parallel_env(map=pillar_room())
+    env = surveillance_v1.parallel_env(map=pillar_room())
     obs, infos = env.reset(options={"pursuer": (2.0, 1.0), "evader": (2.0, 3.5)})
     view = decode_state(obs[P], env.config)
     assert np.allclose(view.pursuer_pos, (2.0, 1.0), atol=1e-5)
@@ -103,14 +103,14 @@ def test_options_place_the_agents_exactly() -> None:
     ],
 )
 def test_bad_placements_raise_naming_positions_and_reason(pursuer, evader, pattern) -> None:
-    env = surveillance_v0.parallel_env(map=pillar_room())
+    env = surveillance_v1.parallel_env(map=pillar_room())
     with pytest.raises(InvalidPlacementError, match=pattern):
         env.reset(options={"pursuer": pursuer, "evader": evader})
 
 
 def test_occluded_placement_names_the_blocking_feature() -> None:
     world = pillar_room()
-    env = surveillance_v0.parallel_env(map=world)
+    env = surveillance_v1.parallel_env(map=world)
     with pytest.raises(InvalidPlacementError) as err:
         env.reset(options={"pursuer": (3.0, 4.5), "evader": (6.5, 4.5)})
     # the rod crosses the pillar's left edge x = 4 first, from the pursuer's side
@@ -119,7 +119,7 @@ def test_occluded_placement_names_the_blocking_feature() -> None:
 
 
 def test_open_space_step_moves_exactly_v_dt() -> None:
-    env = surveillance_v0.parallel_env(map=open_room(), v_pursuer=1.3, v_evader=0.7, dt=0.1)
+    env = surveillance_v1.parallel_env(map=open_room(), v_pursuer=1.3, v_evader=0.7, dt=0.1)
     env.reset(options={"pursuer": (3.0, 5.0), "evader": (6.0, 5.0)})
     a_p = np.array([0.6, -0.8], dtype=np.float32)  # unit length (up to float32): full speed
     a_e = np.array([0.3, 0.4], dtype=np.float32)
@@ -136,7 +136,7 @@ def test_open_space_step_moves_exactly_v_dt() -> None:
 
 
 def test_out_of_box_actions_are_clipped_to_box_then_unit_disc() -> None:
-    env = surveillance_v0.parallel_env(map=open_room(), v_pursuer=1.0, v_evader=0.5)
+    env = surveillance_v1.parallel_env(map=open_room(), v_pursuer=1.0, v_evader=0.5)
     env.reset(options={"pursuer": (3.0, 5.0), "evader": (6.0, 5.0)})
     env.step({P: np.array([5.0, 0.0]), E: [-3.0, 7.0]})  # lists are accepted too
     p, e = env.world.positions()
@@ -148,14 +148,14 @@ def test_out_of_box_actions_are_clipped_to_box_then_unit_disc() -> None:
 
 @pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
 def test_non_finite_actions_raise_naming_the_agent(bad: float) -> None:
-    env = surveillance_v0.parallel_env(map=open_room())
+    env = surveillance_v1.parallel_env(map=open_room())
     env.reset(seed=0)
     with pytest.raises(InvalidActionError, match="evader_0: action must be finite"):
         env.step({P: np.zeros(2), E: np.array([0.0, bad])})
 
 
 def test_wrong_shape_and_missing_actions_raise() -> None:
-    env = surveillance_v0.parallel_env(map=open_room())
+    env = surveillance_v1.parallel_env(map=open_room())
     env.reset(seed=0)
     with pytest.raises(
         InvalidActionError, match=r"pursuer_0: expected an action of shape \(2,\), got shape \(3,\)"
@@ -180,7 +180,7 @@ def _first_contact_oracle(world, p0, e0, p1, e1, n=20001):
 def test_rod_sweeping_a_corner_within_one_step_breaks_surveillance() -> None:
     """Both frames are clear, yet the rod passes over a tiny pillar during the step."""
     world = thin_pillar_room()
-    env = surveillance_v0.parallel_env(
+    env = surveillance_v1.parallel_env(
         map=world, l_min=1.0, l_max=5.0, v_pursuer=3.0, v_evader=3.0, body_radius=0.05
     )
     p0, e0 = np.array([7.0, 4.88]), np.array([3.0, 4.9])
@@ -214,7 +214,7 @@ def test_evader_rounding_a_corner_is_reported_with_that_corner() -> None:
     world = l_room()
     corner = int(np.flatnonzero(world.vertex_convex)[0])
     assert np.allclose(world.vertices[corner], (5.0, 5.0))
-    env = surveillance_v0.parallel_env(map=world, l_min=1.0, l_max=5.0, v_evader=2.0, v_pursuer=2.0)
+    env = surveillance_v1.parallel_env(map=world, l_min=1.0, l_max=5.0, v_evader=2.0, v_pursuer=2.0)
     # the rod passes 0.075 left of the corner; the evader moves 0.2 right in open space
     p0, e0 = np.array([6.2, 2.0]), np.array([4.5, 6.0])
     env.reset(options={"pursuer": tuple(p0), "evader": tuple(e0)})
@@ -245,7 +245,7 @@ def test_evader_rounding_a_corner_is_reported_with_that_corner() -> None:
     ],
 )
 def test_range_breaks_report_cause_and_time(evader_action, cause, t_exact) -> None:
-    env = surveillance_v0.parallel_env(
+    env = surveillance_v1.parallel_env(
         map=open_room(), l_min=2.95, l_max=3.05, v_evader=1.0, body_radius=0.1
     )
     env.reset(options={"pursuer": (6.0, 5.0), "evader": (3.0, 5.0)})
@@ -256,7 +256,7 @@ def test_range_breaks_report_cause_and_time(evader_action, cause, t_exact) -> No
 
 @pytest.mark.parametrize("reward", ["zero_sum", "sparse"])
 def test_rewards_are_zero_sum_and_components_add_up(reward: str) -> None:
-    env = surveillance_v0.parallel_env(map=pillar_room(), reward=reward, max_cycles=40)
+    env = surveillance_v1.parallel_env(map=pillar_room(), reward=reward, max_cycles=40)
     rng = np.random.default_rng(1)
     for seed in range(6):
         env.reset(seed=seed)
@@ -282,7 +282,7 @@ def test_rewards_are_zero_sum_and_components_add_up(reward: str) -> None:
 
 
 def test_agents_emptied_after_the_end_and_further_steps_raise() -> None:
-    env = surveillance_v0.parallel_env(map=open_room(), max_cycles=3)
+    env = surveillance_v1.parallel_env(map=open_room(), max_cycles=3)
     with pytest.raises(EpisodeStateError, match=r"^step\(\) before reset\(\)"):
         env.step({P: np.zeros(2), E: np.zeros(2)})
     env.reset(seed=0)
@@ -298,7 +298,7 @@ def test_agents_emptied_after_the_end_and_further_steps_raise() -> None:
 
 
 def test_step_after_an_escape_names_the_cause() -> None:
-    env = surveillance_v0.parallel_env(map=open_room(), max_cycles=200)
+    env = surveillance_v1.parallel_env(map=open_room(), max_cycles=200)
     env.reset(seed=0)
     while env.agents:  # the evader runs straight at the pursuer: too close
         d = np.subtract(env._pursuer, env._evader)
@@ -308,25 +308,67 @@ def test_step_after_an_escape_names_the_cause() -> None:
 
 
 def test_registry_and_versioned_name() -> None:
-    assert surveillance_v0.parallel_env.metadata["name"] == "surveillance_v0"
-    par = pettingzoo.make("parallel", "surveil/surveillance_v0", map=open_room(), max_cycles=7)
-    assert isinstance(par, surveillance_v0.parallel_env) and par.config.max_cycles == 7
+    from envs import surveillance_v0
+
+    for version, module in enumerate((surveillance_v0, surveillance_v1)):
+        name = f"surveillance_v{version}"
+        assert module.parallel_env.metadata["name"] == name
+        par = pettingzoo.make("parallel", f"surveil/{name}", map=open_room(), max_cycles=7)
+        assert type(par) is module.parallel_env and par.config.max_cycles == 7
+        assert par.metadata["name"] == name
+        assert type(module.env(map=open_room()).unwrapped) is module.parallel_env
+        assert module.ENV_ID == f"surveil/surveillance-v{version}"
     aec = pettingzoo.make("aec", "surveil/surveillance", map=open_room())  # unversioned: latest
-    assert isinstance(aec.unwrapped, surveillance_v0.parallel_env) or hasattr(aec, "agent_iter")
-    assert surveillance_v0.ENV_ID == "surveil/surveillance-v0"
+    assert type(aec.unwrapped) is surveillance_v1.parallel_env
+    assert type(pettingzoo.make("parallel", "surveil/surveillance")) is surveillance_v1.parallel_env
+
+
+def test_v0_is_v1_with_the_chord_sweep() -> None:
+    """v0 differs from v1 only in how a step where a wall bent a body's path is swept: in
+    the open room (no wall between the agents), both agents at the same speed and
+    heading, held until they slide along a wall and the range breaks, the episodes agree
+    step for step, a break's time aside when its step had a contact; and the pickled v0
+    env comes back as v0."""
+    from envs import surveillance_v0
+
+    contacts = 0
+    for seed in range(4):
+        runs = []
+        touched: list[bool] = []  # v1's record of the steps with a wall contact
+        for module in (surveillance_v1, surveillance_v0):
+            env = module.parallel_env(map=open_room(), max_cycles=150, v_evader=1.0)
+            obs, _ = env.reset(seed=seed)
+            rng = np.random.default_rng(seed)
+            rows = [obs[P].tolist()]
+            k = 0
+            while env.agents:
+                if k % 30 == 0:
+                    heading = dict.fromkeys(env.agents, rng.uniform(-1, 1, 2))
+                obs, rew, term, _, infos = env.step(heading)
+                if env.sweep_path:
+                    touched.append(bool(env.world._carry))
+                when = None if touched[k] else infos[P].get("break_time")
+                rows.append((obs[P].tolist(), rew[P], term[P], infos[P].get("cause"), when))
+                k += 1
+            runs.append(rows)
+        assert runs[0] == runs[1], seed
+        contacts += sum(touched)
+    assert contacts > 50  # the walls were met
+    v0 = pickle.loads(pickle.dumps(surveillance_v0.parallel_env(map=open_room())))
+    assert type(v0) is surveillance_v0.parallel_env and not v0.sweep_path
 
 
 def test_env_wrappers_and_aec_conversion() -> None:
     from pettingzoo.utils.wrappers import OrderEnforcingWrapper
 
-    aec = surveillance_v0.env(map=open_room())
+    aec = surveillance_v1.env(map=open_room())
     assert isinstance(aec, OrderEnforcingWrapper)
     with pytest.raises(Exception, match="reset"):
         aec.step(np.zeros(2, dtype=np.float32))
 
 
 def test_rgb_array_frames_show_the_state() -> None:
-    env = surveillance_v0.parallel_env(
+    env = surveillance_v1.parallel_env(
         map=thin_pillar_room(),
         render_mode="rgb_array",
         l_min=1.0,
@@ -356,7 +398,7 @@ def test_rgb_array_frames_show_the_state() -> None:
 
 
 def test_human_render_runs_headless_and_close_is_idempotent() -> None:
-    env = surveillance_v0.parallel_env(map=open_room(), render_mode="human", max_cycles=3)
+    env = surveillance_v1.parallel_env(map=open_room(), render_mode="human", max_cycles=3)
     env.reset(seed=0)
     while env.agents:
         env.step({P: np.zeros(2), E: np.zeros(2)})
@@ -366,7 +408,7 @@ def test_human_render_runs_headless_and_close_is_idempotent() -> None:
 
 
 def test_env_pickles_and_replays() -> None:
-    env = surveillance_v0.parallel_env(map=pillar_room(), observation="lidar", n_rays=8)
+    env = surveillance_v1.parallel_env(map=pillar_room(), observation="lidar", n_rays=8)
     clone = pickle.loads(pickle.dumps(env))
     assert clone.config == env.config
     a, _ = env.reset(seed=5)

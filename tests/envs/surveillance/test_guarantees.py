@@ -9,7 +9,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from envs import surveillance_v0
+from envs import surveillance_v1
 from envs.maps import builtin_names
 from envs.surveillance.physics import MAX_SUBSTEP_TRAVEL, World
 from tests.envs.surveillance._worlds import pillar_room, spiky_room
@@ -45,7 +45,7 @@ def test_disc_centres_stay_in_free_space_for_any_commands(commands, start) -> No
 def test_random_starts_survive_spawn_margin_steps_whatever_the_actions(map_name: str) -> None:
     """The adversary may pick any actions: a random start still lasts k steps."""
     k = 3
-    env = surveillance_v0.parallel_env(map=map_name, spawn_margin_steps=k, max_cycles=k + 1)
+    env = surveillance_v1.parallel_env(map=map_name, spawn_margin_steps=k, max_cycles=k + 1)
     rng = np.random.default_rng(0)
     for seed in range(25):
         env.reset(seed=seed)
@@ -63,7 +63,7 @@ def test_random_starts_survive_spawn_margin_steps_whatever_the_actions(map_name:
 
 def test_every_builtin_map_gives_random_starts_with_the_defaults() -> None:
     for name in builtin_names():
-        env = surveillance_v0.parallel_env(map=name)
+        env = surveillance_v1.parallel_env(map=name)
         _, infos = env.reset(seed=0)
         assert infos[P]["surveillance"] is True, name
         p, e = env.world.positions()
@@ -74,7 +74,7 @@ def test_impossible_random_start_raises_a_clear_error() -> None:
     from envs.errors import InfeasibleError
 
     # two discs 0.1 from the walls of a 10 x 10 room are at most 9.8 sqrt(2) = 13.86 apart
-    env = surveillance_v0.parallel_env(map=pillar_room(), l_min=14.0, l_max=14.1)
+    env = surveillance_v1.parallel_env(map=pillar_room(), l_min=14.0, l_max=14.1)
     with pytest.raises(
         InfeasibleError, match=r"random start: map 'test_pillar' cannot hold the rod: .*13.86"
     ):

@@ -10,7 +10,7 @@ import pytest
 import shapely
 from shapely.geometry import LineString
 
-from envs import surveillance_v0
+from envs import surveillance_v1
 from envs.surveillance.config import EnvConfig
 from envs.surveillance.observations import (
     STATE_LAYOUT,
@@ -81,7 +81,7 @@ def test_decode_rejects_a_wrong_shape() -> None:
 
 
 def test_env_state_observation_decodes_to_the_world() -> None:
-    env = surveillance_v0.parallel_env(map=pillar_room(), max_cycles=50)
+    env = surveillance_v1.parallel_env(map=pillar_room(), max_cycles=50)
     rng = np.random.default_rng(2)
     obs, infos = env.reset(seed=9)
     while env.agents:
@@ -109,7 +109,7 @@ def _ray_oracle(world, origin, angle, max_range) -> float:
 
 def test_lidar_observation_against_shapely() -> None:
     world = pillar_room()
-    env = surveillance_v0.parallel_env(map=world, observation="lidar", n_rays=12, l_max=4.0)
+    env = surveillance_v1.parallel_env(map=world, observation="lidar", n_rays=12, l_max=4.0)
     obs, _ = env.reset(options={"pursuer": (2.0, 1.0), "evader": (2.0, 3.5)})
     layout = lidar_layout(12)
     for agent, me, other in ((P, (2.0, 1.0), (2.0, 3.5)), (E, (2.0, 3.5), (2.0, 1.0))):
@@ -125,7 +125,7 @@ def test_lidar_observation_against_shapely() -> None:
 
 
 def test_lidar_masks_the_other_agent_when_surveillance_breaks() -> None:
-    env = surveillance_v0.parallel_env(
+    env = surveillance_v1.parallel_env(
         map=l_room(),
         observation="lidar",
         n_rays=8,
@@ -162,7 +162,7 @@ def test_lidar_track_reports_the_other_agents_realised_velocity() -> None:
     act = {P: np.array([0.6, 0.0]), E: np.array([-0.5, 0.4])}
     out = {}
     for kind in ("lidar", "lidar_track"):
-        env = surveillance_v0.parallel_env(observation=kind, **kw)
+        env = surveillance_v1.parallel_env(observation=kind, **kw)
         env.reset(options=place)
         out[kind], *_ = env.step(act)
         assert all(env.observation_space(a).contains(out[kind][a]) for a in (P, E))
@@ -178,7 +178,7 @@ def test_lidar_track_reports_the_other_agents_realised_velocity() -> None:
 
 def test_lidar_track_masks_the_velocity_when_surveillance_breaks() -> None:
     kw = dict(l_min=1.0, l_max=5.0, v_evader=2.0, v_pursuer=2.0)
-    env = surveillance_v0.parallel_env(map=l_room(), observation="lidar_track", n_rays=8, **kw)
+    env = surveillance_v1.parallel_env(map=l_room(), observation="lidar_track", n_rays=8, **kw)
     env.reset(options={"pursuer": (6.2, 2.0), "evader": (4.5, 6.0)})
     obs, _, term, _, _ = env.step({P: np.zeros(2), E: np.array([1.0, 1.0])})
     assert term[P]
@@ -194,7 +194,7 @@ def test_encode_state_rebuilds_the_envs_lidar_from_the_state_vector(kind: str) -
 
     from envs.surveillance.observations import LidarEncoder
 
-    env = surveillance_v0.parallel_env(map="l_hall", observation=kind, n_rays=16, max_cycles=80)
+    env = surveillance_v1.parallel_env(map="l_hall", observation=kind, n_rays=16, max_cycles=80)
     obs, _ = env.reset(seed=5)
     state_cfg = dataclasses.replace(env.config, observation="state")
     enc = {r: LidarEncoder(env.config, r, env.kernel) for r in ("pursuer", "evader")}

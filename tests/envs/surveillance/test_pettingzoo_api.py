@@ -22,7 +22,7 @@ with warnings.catch_warnings():
     )
     from pettingzoo.test.state_test import state_test
 
-from envs import surveillance_v0
+from envs import surveillance_v1
 from tests.envs.surveillance._worlds import l_room, pillar_room
 
 CONFIGS = {
@@ -50,9 +50,9 @@ IDS = list(CONFIGS)
 def _module(cfg: dict) -> types.SimpleNamespace:
     """A stand-in for an env module, with the config baked into its factories."""
     return types.SimpleNamespace(
-        env=functools.partial(surveillance_v0.env, **cfg),
-        parallel_env=functools.partial(surveillance_v0.parallel_env, **cfg),
-        raw_env=functools.partial(surveillance_v0.raw_env, **cfg),
+        env=functools.partial(surveillance_v1.env, **cfg),
+        parallel_env=functools.partial(surveillance_v1.parallel_env, **cfg),
+        raw_env=functools.partial(surveillance_v1.raw_env, **cfg),
     )
 
 
@@ -66,12 +66,22 @@ def _no_warnings():
 
 @pytest.mark.parametrize("name", IDS)
 def test_api(name: str) -> None:
-    api_test(surveillance_v0.env(**CONFIGS[name]), num_cycles=200)
+    api_test(surveillance_v1.env(**CONFIGS[name]), num_cycles=200)
 
 
 @pytest.mark.parametrize("name", IDS)
 def test_parallel_api(name: str) -> None:
-    parallel_api_test(surveillance_v0.parallel_env(**CONFIGS[name]), num_cycles=200)
+    parallel_api_test(surveillance_v1.parallel_env(**CONFIGS[name]), num_cycles=200)
+
+
+@pytest.mark.parametrize("name", IDS[:2])
+def test_the_retired_v0_passes_the_suites(name: str) -> None:
+    from envs import surveillance_v0
+
+    cfg = CONFIGS[name]
+    api_test(surveillance_v0.env(**cfg), num_cycles=100)
+    parallel_api_test(surveillance_v0.parallel_env(**cfg), num_cycles=100)
+    parallel_seed_test(functools.partial(surveillance_v0.parallel_env, **cfg), num_cycles=50)
 
 
 @pytest.mark.parametrize("name", IDS)
@@ -101,7 +111,7 @@ def test_state(name: str) -> None:
 @pytest.mark.parametrize("name", IDS)
 def test_declared_spaces_match_data(name: str) -> None:
     """Shape, dtype and bounds of every observation and state match the declared spaces."""
-    env = surveillance_v0.parallel_env(**CONFIGS[name])
+    env = surveillance_v1.parallel_env(**CONFIGS[name])
     rng = np.random.default_rng(0)
     for episode in range(3):
         obs, _ = env.reset(seed=episode)
@@ -134,7 +144,7 @@ def test_sb3_check_env_on_a_single_agent_view() -> None:
 
     class PursuerView(gymnasium.Env):
         def __init__(self) -> None:
-            self.env = surveillance_v0.parallel_env(map=pillar_room(), max_cycles=50)
+            self.env = surveillance_v1.parallel_env(map=pillar_room(), max_cycles=50)
             self.observation_space = self.env.observation_space("pursuer_0")
             self.action_space = self.env.action_space("pursuer_0")
             self._rng = np.random.default_rng(0)

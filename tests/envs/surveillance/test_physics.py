@@ -136,3 +136,69 @@ def test_a_step_of_too_many_substeps_is_refused(radius) -> None:
     )):  # fmt: skip
         World(open_room(), radius, 0.1, 1.0)
     assert World(open_room(), 2e-6, 0.1, 1.0).n_substeps == MAX_SUBSTEPS
+
+
+def test_the_trace_holds_each_substep_and_ends_at_the_step() -> None:
+    world = World(open_room(), 0.1, 0.1, 1.0)  # 2 substeps
+    world.reset(np.array([5.0, 5.0]), np.array([3.0, 5.0]))
+    trace: list = []
+    p, e = world.step((1.0, 0.0), (0.0, -0.5), trace)
+    assert len(trace) == world.n_substeps == 2
+    assert trace[-1] == (p, e)
+    assert np.allclose(trace[0][0], (5.05, 5.0)) and np.allclose(trace[0][1], (3.0, 4.975))
+
+
+@pytest.mark.parametrize(("dt", "speed"), [(0.1, 1.0), (0.37, 1.7), (1.0, 1.0)])
+def test_the_trace_is_the_positions_read_after_each_substep(dt, speed) -> None:
+    """Until a contact the trace computes p += v h instead of reading the bodies (a read
+    costs about 1 us); bit for bit what Chipmunk did, through runs along the walls."""
+    world_map = pillar_room()
+    a, b = World(world_map, 0.1, dt, speed), World(world_map, 0.1, dt, speed)
+    start = (np.array([2.0, 2.0]), np.array([4.0, 6.0]))
+    a.reset(*start)
+    b.reset(*start)
+    rng = np.random.default_rng(3)
+    touched = 0
+    for k in range(600):
+        if k % 25 == 0:  # a heading kept long enough to slide along a wall
+            hp, he = rng.uniform(-math.pi, math.pi, 2)
+        vp = (speed * math.cos(hp), speed * math.sin(hp))
+        ve = (0.5 * math.cos(he), 0.5 * math.sin(he))
+        trace: list = []
+        a.step(vp, ve, trace)
+        b._pursuer.velocity, b._evader.velocity = vp, ve
+        read = []
+        for _ in range(b.n_substeps):
+            b.space.step(b.substep_dt)
+            p, e = b._pursuer.position, b._evader.position
+            read.append(((p.x, p.y), (e.x, e.y)))
+        assert trace == read, k
+        touched += a._carry
+    assert 0 < touched < 600  # both kinds of step were met
+
+
+@pytest.mark.parametrize("dt", [10.0, 1.0, 0.1])
+def test_a_break_after_a_body_stopped_at_a_wall_is_timed_on_its_path(dt) -> None:
+    """Pursuer and evader run apart along the corridor world's room (x in [0, 10]): the
+    pursuer, at x = 9.5 with radius 0.1, stops at the wall after 0.4 s (L = 3.6), the
+    evader recedes at 0.5, so the range breaks at t = 1.2 s exactly. The sweep took each
+    step's motion as linear, so at dt = 10 it said 1.85 s (the chord from 9.5 to 9.9
+    over the whole step). Now within one substep's travel (r / 2 = 0.05 of wall
+    penetration, the physics' own, 0.1 s at the evader's 0.5) of the truth; a step
+    without contact keeps the single sweep. v0, retired, keeps the chord."""
+    from envs import surveillance_v0, surveillance_v1
+
+    def break_at(module) -> float:
+        env = module.parallel_env(map="corridor", dt=dt, spawn_margin_steps=0)
+        env.reset(seed=0, options={"pursuer": (9.5, 0.0), "evader": (6.5, 0.0)})
+        info: dict = {}
+        while env.agents:
+            _, _, _, _, infos = env.step({"pursuer_0": [1.0, 0.0], "evader_0": [-1.0, 0.0]})
+            info = infos["pursuer_0"]
+        env.close()
+        assert info["cause"] == "too_far"
+        return info["break_at"]
+
+    assert 1.2 - 0.1 - 1e-9 <= break_at(surveillance_v1) <= 1.2 + 1e-9
+    if dt == 10.0:  # v0's chord: 3 + 0.5 t + 0.04 t = 4 at t = 1.85
+        assert break_at(surveillance_v0) == pytest.approx(1.0 / 0.54)

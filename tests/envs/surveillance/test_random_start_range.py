@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from envs import surveillance_v0
+from envs import surveillance_v1
 from envs.errors import InfeasibleError
 from envs.maps import builtin_map, builtin_names, random_map
 
@@ -20,7 +20,7 @@ def test_diameter_is_the_largest_vertex_distance(world) -> None:
 
 @pytest.mark.parametrize("l_max", [1e3, 1e6, 1e12])
 def test_a_huge_l_max_still_starts(l_max) -> None:
-    env = surveillance_v0.parallel_env(map="two_rooms", l_max=l_max)
+    env = surveillance_v1.parallel_env(map="two_rooms", l_max=l_max)
     for seed in range(5):
         _, infos = env.reset(seed=seed)
         assert infos["pursuer_0"]["surveillance"]
@@ -28,7 +28,7 @@ def test_a_huge_l_max_still_starts(l_max) -> None:
 
 
 def test_l_min_beyond_the_map_names_the_diameter() -> None:
-    env = surveillance_v0.parallel_env(map="corridor", l_min=50.0, l_max=60.0, body_radius=0.1)
+    env = surveillance_v1.parallel_env(map="corridor", l_min=50.0, l_max=60.0, body_radius=0.1)
     with pytest.raises(InfeasibleError, match=r"no two points 50.45 apart \(its diameter is 16.9"):
         env.reset(seed=0)
 
@@ -55,7 +55,7 @@ def test_a_map_too_narrow_for_the_rod_says_so_up_front() -> None:
     """A 1 x 0.3 room holds the bodies (0.1) and has a diameter of 1.04, but no two points
     0.1 from its walls are more than 0.81 apart: the shortest rod a start may have (l_min
     0.45 plus the spawn margin 0.45) cannot fit."""
-    env = surveillance_v0.parallel_env(
+    env = surveillance_v1.parallel_env(
         map=_room(1.0, 0.3, "slot"), l_min=0.45, l_max=3.0, body_radius=0.1
     )
     with pytest.raises(InfeasibleError, match=r"map 'slot' cannot hold the rod: .* L = 0.9 "

@@ -18,7 +18,7 @@ import math
 import numpy as np
 import pytest
 
-from envs import surveillance_v0
+from envs import surveillance_v1
 from envs.geometry import kernel_for
 from envs.maps import Map, builtin_info
 from strategies.policies import make_policy
@@ -34,7 +34,7 @@ def _turned(name: str, angle: float) -> tuple[Map, dict]:
 
 def test_when_the_table_blocks_the_current_bin_a_rotation_is_still_commanded():
     """The scan crosses table-blocked bins to the nearest free ones (direct check)."""
-    env = surveillance_v0.parallel_env(map="corridor")
+    env = surveillance_v1.parallel_env(map="corridor")
     p = make_policy("pursuer/decomposition")
     p.reset(role="pursuer", map=env.config.map, config=env.config, seed=0)
     tab = p.table
@@ -64,7 +64,7 @@ def test_when_the_table_blocks_the_current_bin_a_rotation_is_still_commanded():
 
 @pytest.mark.parametrize("rho", [0.3, 0.5])
 def test_the_start_judge_assumes_the_one_sided_turn_rate(rho):
-    env = surveillance_v0.parallel_env(map="corridor", v_evader=rho)
+    env = surveillance_v1.parallel_env(map="corridor", v_evader=rho)
     c = env.config
     one = make_policy("pursuer/decomposition", turn_rate="one")
     both = make_policy("pursuer/decomposition")
@@ -109,7 +109,7 @@ def test_free_with_margin_against_shapely():
 
 
 def test_orbit_evader_circles_the_nearest_obstacle():
-    env = surveillance_v0.parallel_env(map="pillars")
+    env = surveillance_v1.parallel_env(map="pillars")
     c = env.config
     for direction in (1, -1):
         ev = make_policy("evader/orbit", direction=direction, offset=0.5)

@@ -7,7 +7,7 @@ import warnings
 import numpy as np
 import pytest
 
-from envs import surveillance_v0
+from envs import surveillance_v1
 from envs.errors import InfeasibleError, RelaxedStartWarning
 from envs.geometry import kernel_for
 from strategies.policies.starts import sample_start
@@ -19,7 +19,7 @@ from strategies.policies.starts import sample_start
     [(2.0, 4.0), (1.0, 1.0001), (1.5, 1.6)],  # the last two are narrower than the buffer
 )
 def test_starts_lie_inside_the_sensor_range_and_reset_accepts_them(kind, l_min, l_max):
-    env = surveillance_v0.parallel_env(map="open_room", l_min=l_min, l_max=l_max)
+    env = surveillance_v1.parallel_env(map="open_room", l_min=l_min, l_max=l_max)
     rng = np.random.default_rng(7)
     for _ in range(3):
         start = sample_start(env.config, rng, kind=kind)
@@ -31,7 +31,7 @@ def test_starts_lie_inside_the_sensor_range_and_reset_accepts_them(kind, l_min, 
 
 
 def test_same_generator_state_same_start():
-    env = surveillance_v0.parallel_env(map="corridor")
+    env = surveillance_v1.parallel_env(map="corridor")
     a = sample_start(env.config, np.random.default_rng(3), kind="safe")
     b = sample_start(env.config, np.random.default_rng(3), kind="safe")
     assert a == b
@@ -45,7 +45,7 @@ def test_escapable_starts_put_the_rod_in_an_escapable_cell(map_name):
 
     from strategies.cspace import decompose
 
-    env = surveillance_v0.parallel_env(map=map_name)
+    env = surveillance_v1.parallel_env(map=map_name)
     cfg = env.config
     dec = decompose(cfg.map, cfg.l_min)
     rng = np.random.default_rng(3)
@@ -72,7 +72,7 @@ def test_safe_starts_leave_retreat_clearance_and_survive_a_charge(map_name):
 
     params = dict(builtin_info(map_name).params())
     params["v_evader"] = 0.5 * params["v_pursuer"]
-    env = surveillance_v0.parallel_env(map=map_name, **params)
+    env = surveillance_v1.parallel_env(map=map_name, **params)
     cfg = env.config
     kernel = kernel_for(cfg.map)
     for seed in (5, 6, 10):
@@ -99,7 +99,7 @@ def test_retreat_clearance_rejects_a_pursuer_backed_against_a_wall():
     """The maze start of issue 13 (seed 5 before the fix): 0.18 of room behind the pursuer."""
     from strategies.policies.starts import has_retreat_clearance
 
-    env = surveillance_v0.parallel_env(map="open_room")
+    env = surveillance_v1.parallel_env(map="open_room")
     cfg = env.config
     kernel = kernel_for(cfg.map)
     _, ymin, xmax, ymax = cfg.map.bounds
@@ -115,7 +115,7 @@ def test_retreat_clearance_rejects_a_pursuer_backed_against_a_wall():
 def test_a_very_slow_evader_has_safe_starts():
     # rho = 1e-12 asks for a retreat of 2e-24, which does not move p: the zero-length
     # segment's test divided 0 by 0 and refused every start ("no safe start at L = 2.3")
-    env = surveillance_v0.parallel_env(map="corridor", v_evader=1e-12)
+    env = surveillance_v1.parallel_env(map="corridor", v_evader=1e-12)
     start = sample_start(env.config, np.random.default_rng(0), kind="safe")
     env.reset(seed=0, options=start)
     assert env.agents
@@ -130,7 +130,7 @@ def test_a_lazy_table_draws_the_same_start_as_an_eager_one(map_name, monkeypatch
     table (it was: every large map drew unchecked starts)."""
     from strategies.policies.decomposition import DecompositionPursuer
 
-    env = surveillance_v0.parallel_env(map=map_name)
+    env = surveillance_v1.parallel_env(map=map_name)
     eager = [sample_start(env.config, np.random.default_rng(s), kind="safe") for s in (1, 2)]
     monkeypatch.setattr(DecompositionPursuer, "EAGER_TABLE_POINTS", 0)
     monkeypatch.setattr(DecompositionPursuer, "DISTINCT_TABLE_POINTS", 0)
@@ -186,7 +186,7 @@ def test_near_one_rho_draws_a_safe_cell_start_as_rho_one_does(rho):
     from strategies.policies.decomposition import DecompositionPursuer
     from strategies.runner import run_episode
 
-    env = surveillance_v0.parallel_env(map="corridor", v_evader=rho)
+    env = surveillance_v1.parallel_env(map="corridor", v_evader=rho)
     cfg = env.config
     with pytest.warns(RelaxedStartWarning, match="safe cell only"):
         start = sample_start(cfg, np.random.default_rng(0), kind="safe")
@@ -206,7 +206,7 @@ def test_near_one_rho_draws_a_safe_cell_start_as_rho_one_does(rho):
     with warnings.catch_warnings():  # where an admissible start exists, no warning
         warnings.simplefilter("error", RelaxedStartWarning)
         sample_start(
-            surveillance_v0.parallel_env(map="corridor", v_evader=0.5).config,
+            surveillance_v1.parallel_env(map="corridor", v_evader=0.5).config,
             np.random.default_rng(0),
             kind="safe",
         )

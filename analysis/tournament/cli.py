@@ -229,7 +229,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
         help="SQLite store (default: out/tournaments/NAME.sqlite)",
     )
     p.add_argument("--backend", choices=["serial", "process", "ray"], default="process")
-    p.add_argument("--workers", type=int, default=None, help="processes, or local Ray CPUs")
+    p.add_argument("--workers", type=integer(1), default=None, help="processes, or local Ray CPUs")
     p.add_argument("--address", help="Ray cluster address (with --backend ray)")
     p.add_argument("--retry-errors", action="store_true", help="replay matches stored as errors")
     p.add_argument(

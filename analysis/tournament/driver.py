@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from analysis.tournament.executors import Executor, SerialExecutor, make_executor
+from analysis.tournament.executors import Executor, SerialExecutor, check_backend, make_executor
 from analysis.tournament.identity import plan
 from analysis.tournament.spec import Spec, load_spec
 from analysis.tournament.store import Store
@@ -119,10 +119,14 @@ def run_tournament(
         The :class:`RunSummary` (``interrupted`` set if a signal stopped it).
 
     Raises:
-        InvalidConfigError: a bad spec, store or backend.
+        InvalidConfigError: a bad spec, store or backend (or ``workers`` not an integer
+            >= 1).
         StoreBusyError: another driver is writing to the store.
     """
     t0 = time.monotonic()
+    if executor is None:
+        # before the store: a refused backend left the run marked 'running'
+        check_backend(backend, workers=workers, address=address)
     if not isinstance(spec, Spec):
         spec = load_spec(spec)
     path = Path(store) if store is not None else default_store(spec)

@@ -41,6 +41,7 @@ __all__ = [
     "ProcessExecutor",
     "RayExecutor",
     "SerialExecutor",
+    "check_backend",
     "make_executor",
 ]
 
@@ -306,6 +307,12 @@ class RayExecutor(Executor):
     name = "ray"
 
     def __init__(self, address: str | None = None, num_cpus: int | None = None) -> None:
+        if num_cpus is not None:
+            from envs.validation import integer
+
+            # 0 CPUs: no task was ever scheduled, and each batch was stored as an error
+            # ("overran the time limit") after time_limit + 6 s
+            num_cpus = integer("workers", num_cpus, minimum=1)
         try:
             import ray
         except ModuleNotFoundError as exc:
@@ -390,6 +397,24 @@ class RayExecutor(Executor):
             self.started = False
 
 
+def check_backend(backend: str, *, workers: int | None = None, address: str | None = None) -> None:
+    """Refuse a backend, worker count or address :func:`make_executor` cannot use.
+
+    Raises:
+        InvalidConfigError: an unknown backend, ``address`` without Ray, or ``workers``
+            not an integer >= 1.
+    """
+    from envs.errors import InvalidConfigError
+    from envs.validation import integer
+
+    if backend not in BACKENDS:
+        raise InvalidConfigError(f"backend = {backend!r}: expected one of {list(BACKENDS)}")
+    if address is not None and backend != "ray":
+        raise InvalidConfigError(f"--address applies to the ray backend, not {backend!r}")
+    if workers is not None:
+        integer("workers", workers, minimum=1)
+
+
 def make_executor(
     backend: str, *, workers: int | None = None, address: str | None = None
 ) -> Executor:
@@ -398,12 +423,8 @@ def make_executor(
     Raises:
         InvalidConfigError: an unknown backend, or ``address`` without Ray.
     """
-    from envs.errors import InvalidConfigError
 
-    if backend not in BACKENDS:
-        raise InvalidConfigError(f"backend = {backend!r}: expected one of {list(BACKENDS)}")
-    if address is not None and backend != "ray":
-        raise InvalidConfigError(f"--address applies to the ray backend, not {backend!r}")
+    check_backend(backend, workers=workers, address=address)
     if backend == "serial":
         return SerialExecutor()
     if backend == "process":

@@ -256,6 +256,18 @@ def test_evaluate_bad_flags_fail_before_any_match(capsys, tmp_path, monkeypatch,
     assert not (tmp_path / "e.sqlite").exists(), line
 
 
+@pytest.mark.parametrize("workers", ["0", "-1", "two"])
+def test_tournament_workers_are_checked_before_the_store(capsys, tmp_path, workers):
+    # --workers 0 with --backend ray never scheduled a match: each batch was stored as an
+    # error ("overran the time limit") after 65 s; with the process backend the run was
+    # refused as "workers = 0" after the store had it marked 'running'
+    store = tmp_path / "t.sqlite"
+    argv = ["tournament", "quick", "--store", str(store), "--workers", workers]
+    assert_fails(capsys, [*argv, "--backend", "ray"], f"--workers = '{workers}': expected an")
+    assert_fails(capsys, argv, f"--workers = '{workers}': expected an integer >= 1")
+    assert not store.exists()
+
+
 def test_figures_into_an_existing_file_is_refused_before_drawing(capsys, tmp_path):
     blocker = tmp_path / "somefile"
     blocker.write_text("x")

@@ -28,6 +28,21 @@ def test_serial_and_process_backends_store_the_same_results(tmp_path, small_spec
         assert comparable(x.rows(a.run_id)) == comparable(y.rows(b.run_id))
 
 
+@pytest.mark.parametrize(("backend", "workers"), [("process", 0), ("ray", 0), ("ray", -2)])
+def test_a_worker_count_below_one_is_refused_before_the_store(
+    tmp_path, small_spec, backend, workers
+):
+    # ray with 0 CPUs scheduled nothing and stored every batch as an overrun error; the
+    # process backend refused it after marking the run 'running' in the store
+    from envs.errors import InvalidConfigError
+
+    store = tmp_path / "s.sqlite"
+    spec = spec_from_dict(small_spec)
+    with pytest.raises(InvalidConfigError, match=f"workers = {workers}: expected an integer >= 1"):
+        run_tournament(spec, store, backend=backend, workers=workers, progress=False)
+    assert not store.exists()
+
+
 def test_sprt_stops_a_decided_run_and_a_rerun_keeps_the_decision(tmp_path):
     import analysis.tournament.statistics as st
 

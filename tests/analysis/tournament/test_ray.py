@@ -37,3 +37,13 @@ def test_ray_backend_matches_the_serial_backend_and_ships_models(tmp_path, small
     assert remote.played == serial.played == 8 and remote.errors == 0
     with Store(tmp_path / "serial.sqlite") as a, Store(tmp_path / "ray.sqlite") as b:
         assert comparable(a.rows(serial.run_id)) == comparable(b.rows(remote.run_id))
+
+
+def test_a_local_instance_of_no_cpus_is_refused_before_ray_starts():
+    # ray.init(num_cpus=0) ran no task; every batch was stored as an overrun error
+    from analysis.tournament.executors import RayExecutor
+    from envs.errors import InvalidConfigError
+
+    with pytest.raises(InvalidConfigError, match=r"workers = 0: expected an integer >= 1"):
+        RayExecutor(num_cpus=0)
+    assert not ray.is_initialized()

@@ -5,11 +5,13 @@ Measured in one run, so the ratios do not depend on the machine:
 * surveillance_v1 (state observations, render off) on a small map (``open_room``, 4
   walls) and on a large seeded random map (>= 500 walls);
 * ``mpe2.simple_tag_v3`` with one adversary, one good agent, no obstacles, continuous
-  actions: the reference.
+  actions: the reference;
+* the retired surveillance_v0 on the small map (it sweeps a step in which a wall bent a
+  body's path along the chord; v1 sweeps it substep by substep): what v1 costs.
 
 Actions are pre-sampled (uniform in each agent's Box) so the loop times only
 ``env.step``. Episodes of surveillance_v1 end when the evader escapes; the env is then
-reset outside the timed region. The three envs run in interleaved chunks, so that load
+reset outside the timed region. The four envs run in interleaved chunks, so that load
 from other processes affects them alike. Goals: ours >= 6x simple_tag, and the large map
 no more than 1.5x slower than the small one.
 
@@ -32,7 +34,7 @@ import time
 import numpy as np
 from bench_cli import integer, run
 
-from envs import surveillance_v1
+from envs import surveillance_v0, surveillance_v1
 from envs.maps import load_map, random_map
 
 N_ACTIONS = 4096
@@ -52,8 +54,8 @@ def _presampled(env, agents, rng: np.random.Generator) -> dict[str, np.ndarray]:
 class OurRunner:
     """Steps surveillance_v1 on one map with pre-sampled actions; times ``step`` only."""
 
-    def __init__(self, world_map, seed: int = 0) -> None:
-        self.env = surveillance_v1.parallel_env(map=world_map, max_cycles=10**9)
+    def __init__(self, world_map, seed: int = 0, module=surveillance_v1) -> None:
+        self.env = module.parallel_env(map=world_map, max_cycles=10**9)
         self.acts = _presampled(self.env, self.env.possible_agents, np.random.default_rng(seed))
         self.env.reset(seed=seed)
         self.i = 0
@@ -140,8 +142,13 @@ def main() -> None:
         f"large map: {large.name}, {large.n_edges} walls"
     )
 
-    # interleave short chunks so that load from other processes hits all three alike
-    runners = {"tag": TagRunner(), "small": OurRunner(small), "large": OurRunner(large)}
+    # interleave short chunks so that load from other processes hits all four alike
+    runners = {
+        "tag": TagRunner(),
+        "small": OurRunner(small),
+        "large": OurRunner(large),
+        "v0": OurRunner(small, module=surveillance_v0),
+    }
     elapsed = dict.fromkeys(runners, 0.0)
     rounds = 10
     chunk = max(1, args.steps // rounds)
@@ -163,6 +170,8 @@ def main() -> None:
     print(f"ratio ours(small) / simple_tag:  {ours_small / ref:6.2f}   (goal >= 6)")
     print(f"ratio ours(large) / simple_tag:  {ours_large / ref:6.2f}")
     print(f"slowdown large / small map:      {ours_small / ours_large:6.2f}   (goal <= 1.5)")
+    print(f"surveillance_v0 small map:       {rate['v0']:10.0f} steps/s")
+    print(f"ratio v1 / v0 (small map):       {ours_small / rate['v0']:6.2f}")
     for label in ("small", "large"):
         runner = runners[label]
         b = breakdown(runner.env, runner.record)

@@ -259,19 +259,22 @@ class parallel_env(ParallelEnv, EzPickle):
         does each substep after one without a break. v0 (``trace`` None) sweeps the chord.
         """
         cfg = self.config
-        dt = cfg.dt
-        moved = abs(p1[0] - p0[0] - vp[0] * dt) + abs(p1[1] - p0[1] - vp[1] * dt)
-        moved += abs(e1[0] - e0[0] - ve[0] * dt) + abs(e1[1] - e0[1] - ve[1] * dt)
-        if trace is None or len(trace) == 1 or moved <= self._linear_tol:
-            return self.kernel.sweep(p0, e0, p1, e1, cfg.l_min, cfg.l_max, start_clear=True)
-        n = len(trace)
-        pa, ea = p0, e0
-        for k, (pb, eb) in enumerate(trace):
-            event = self.kernel.sweep(pa, ea, pb, eb, cfg.l_min, cfg.l_max, start_clear=True)
-            if event is not None:
-                return dataclasses.replace(event, time=(k + event.time) / n)
-            pa, ea = pb, eb
-        return None
+        if trace is not None and len(trace) > 1:  # a contact within the step (World.step)
+            dt = cfg.dt
+            moved = abs(p1[0] - p0[0] - vp[0] * dt) + abs(p1[1] - p0[1] - vp[1] * dt)
+            moved += abs(e1[0] - e0[0] - ve[0] * dt) + abs(e1[1] - e0[1] - ve[1] * dt)
+            if moved > self._linear_tol:
+                n = len(trace)
+                pa, ea = p0, e0
+                for k, (pb, eb) in enumerate(trace):
+                    event = self.kernel.sweep(
+                        pa, ea, pb, eb, cfg.l_min, cfg.l_max, start_clear=True
+                    )
+                    if event is not None:
+                        return dataclasses.replace(event, time=(k + event.time) / n)
+                    pa, ea = pb, eb
+                return None
+        return self.kernel.sweep(p0, e0, p1, e1, cfg.l_min, cfg.l_max, start_clear=True)
 
     def step(self, actions: dict[str, Any]) -> tuple[dict, dict, dict, dict, dict]:
         """Advance both agents by ``dt`` and check surveillance continuously over the step.

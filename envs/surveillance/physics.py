@@ -194,8 +194,9 @@ class World:
             pursuer_velocity: commanded pursuer velocity (already within its bound).
             evader_velocity: commanded evader velocity (already within its bound).
             trace: if given, a list that receives the centres ``((px, py), (ex, ey))``
-                after each substep (the last one is the step's end): the path the env's
-                sweep follows when a wall bent it.
+                after each substep (the last one is the step's end) when a body touched
+                a wall within the step: the path the env's sweep follows. It stays empty
+                when neither did (both moved by the command: the chord is the path).
 
         Returns:
             The new pursuer and evader centres as ``(x, y)`` tuples.
@@ -213,30 +214,43 @@ class World:
         pb.velocity = pursuer_velocity
         eb.velocity = evader_velocity
         h = self.substep_dt
+        n = self.n_substeps
         if trace is None:
-            for _ in range(self.n_substeps):
+            for _ in range(n):
                 space.step(h)
         else:
             # Until a body touches a wall, Chipmunk moves it by exactly p += v h each
-            # substep (no damping, no force, no bias velocity), so those positions are
-            # computed here, bit for bit, rather than read (a read costs about 1 us). A
-            # contact in the last substep of the previous step leaves a bias velocity
-            # for the first one of this step, so it counts as touching too.
-            touched = self._carry
-            (px, py), (ex, ey) = self._at
-            pvx, pvy = pursuer_velocity
-            evx, evy = evader_velocity
-            for _ in range(self.n_substeps):
-                self._hit = False
-                space.step(h)
-                if touched or self._hit:
-                    touched = True
-                    p, e = pb.position, eb.position
-                    px, py, ex, ey = p.x, p.y, e.x, e.y
-                else:
+            # substep (no damping, no force, no bias velocity): such a step needs no
+            # trace (the chord is the path), and in a step with a contact the substeps
+            # before it are computed here, bit for bit, rather than read (a read costs
+            # about 1 us). A contact in the last substep of the previous step leaves a
+            # bias velocity for the first one of this step, so it counts as touching too.
+            hit = self._carry
+            k = 0  # substeps done
+            self._hit = False
+            if not hit:
+                while k < n:
+                    space.step(h)
+                    k += 1
+                    if self._hit:
+                        hit = True
+                        break
+            if hit:
+                (px, py), (ex, ey) = self._at
+                pvx, pvy = pursuer_velocity
+                evx, evy = evader_velocity
+                for _ in range(k - 1):  # before the first contact: the command's motion
                     px, py = px + pvx * h, py + pvy * h
                     ex, ey = ex + evx * h, ey + evy * h
-                trace.append(((px, py), (ex, ey)))
+                    trace.append(((px, py), (ex, ey)))
+                if k:  # the substep of the first contact (none when carried over)
+                    p, e = pb.position, eb.position
+                    trace.append(((p.x, p.y), (e.x, e.y)))
+                for _ in range(n - k):
+                    self._hit = False
+                    space.step(h)
+                    p, e = pb.position, eb.position
+                    trace.append(((p.x, p.y), (e.x, e.y)))
         self._carry = trace is None or self._hit  # untraced: unknown, so assumed
         p = pb.position
         e = eb.position

@@ -138,14 +138,17 @@ def test_a_step_of_too_many_substeps_is_refused(radius) -> None:
     assert World(open_room(), 2e-6, 0.1, 1.0).n_substeps == MAX_SUBSTEPS
 
 
-def test_the_trace_holds_each_substep_and_ends_at_the_step() -> None:
-    world = World(open_room(), 0.1, 0.1, 1.0)  # 2 substeps
+def test_the_trace_holds_each_substep_of_a_step_with_a_contact() -> None:
+    world = World(open_room(), 0.1, 0.1, 1.0)  # 2 substeps of 0.05 s
     world.reset(np.array([5.0, 5.0]), np.array([3.0, 5.0]))
     trace: list = []
+    world.step((1.0, 0.0), (0.0, -0.5), trace)
+    assert trace == []  # no wall touched: the chord is the path
+    world.reset(np.array([9.82, 5.0]), np.array([3.0, 5.0]))  # the wall at x = 10
     p, e = world.step((1.0, 0.0), (0.0, -0.5), trace)
     assert len(trace) == world.n_substeps == 2
-    assert trace[-1] == (p, e)
-    assert np.allclose(trace[0][0], (5.05, 5.0)) and np.allclose(trace[0][1], (3.0, 4.975))
+    assert trace[-1] == (p, e)  # the second substep touched the wall
+    assert np.allclose(trace[0][0], (9.87, 5.0)) and np.allclose(trace[0][1], (3.0, 4.975))
 
 
 @pytest.mark.parametrize(("dt", "speed"), [(0.1, 1.0), (0.37, 1.7), (1.0, 1.0)])
@@ -165,6 +168,7 @@ def test_the_trace_is_the_positions_read_after_each_substep(dt, speed) -> None:
         vp = (speed * math.cos(hp), speed * math.sin(hp))
         ve = (0.5 * math.cos(he), 0.5 * math.sin(he))
         trace: list = []
+        p0, e0 = a.positions()
         a.step(vp, ve, trace)
         b._pursuer.velocity, b._evader.velocity = vp, ve
         read = []
@@ -172,8 +176,12 @@ def test_the_trace_is_the_positions_read_after_each_substep(dt, speed) -> None:
             b.space.step(b.substep_dt)
             p, e = b._pursuer.position, b._evader.position
             read.append(((p.x, p.y), (e.x, e.y)))
-        assert trace == read, k
-        touched += a._carry
+        assert trace in ([], read), k  # empty: no contact, the chord is the path
+        if not trace:
+            h = np.arange(1, b.n_substeps + 1)[:, None] * b.substep_dt
+            assert np.allclose([r[0] for r in read], np.add(p0, h * vp), rtol=0, atol=1e-12)
+            assert np.allclose([r[1] for r in read], np.add(e0, h * ve), rtol=0, atol=1e-12)
+        touched += bool(trace)
     assert 0 < touched < 600  # both kinds of step were met
 
 

@@ -291,8 +291,37 @@ def _ray_play(batch: list[Match], ctx_box: list[Any]) -> list[dict]:
     key = ref.hex()
     if key not in _RAY_CONTEXTS:
         _RAY_CONTEXTS.clear()
-        _RAY_CONTEXTS[key] = ray.get(ref)
+        ctx, registrations = ray.get(ref)
+        _register_missing(registrations)
+        _RAY_CONTEXTS[key] = ctx
     return play_batch(batch, _RAY_CONTEXTS[key])
+
+
+def _roster_registrations(ctx: Context) -> dict[str, tuple[Any, str]]:
+    """``{name: (factory, description)}`` of the roster's registered policies.
+
+    A Ray worker is a fresh process: it knows the built-in policies but not one the driver
+    registered at run time (a forked process worker inherits those), so these travel with
+    the context and :func:`_register_missing` registers them there.
+    """
+    from strategies.policies.registry import policy_spec
+
+    out = {}
+    for entry in ctx.policies.values():
+        if entry.model is None:
+            spec = policy_spec(entry.name)
+            out[entry.name] = (spec.factory, spec.description)
+    return out
+
+
+def _register_missing(registrations: dict[str, tuple[Any, str]]) -> None:
+    """Register in this process the policies of ``registrations`` it does not know."""
+    from strategies.policies.registry import policy_names, register_policy
+
+    known = set(policy_names())
+    for name, (factory, description) in registrations.items():
+        if name not in known:
+            register_policy(name, factory, description)
 
 
 class RayExecutor(Executor):
@@ -340,7 +369,15 @@ class RayExecutor(Executor):
 
     def run(self, matches: Sequence[Match], ctx: Context, stop: threading.Event) -> Iterator[dict]:
         ray = self.ray
-        box = [ray.put(ctx)]  # shipped once; models travel inside it
+        try:  # shipped once; models and the roster's registrations travel inside it
+            box = [ray.put((ctx, _roster_registrations(ctx)))]
+        except Exception as exc:  # e.g. a policy class that cannot be pickled
+            from envs.errors import InvalidConfigError
+
+            raise InvalidConfigError(
+                f"the run's context (maps, policies, models) cannot be sent to Ray workers: "
+                f"{type(exc).__name__}: {exc}; use --backend process"
+            ) from exc
         todo = collections.deque(matches)
         batcher = _Batcher(self.cpus)
         solo: set[str] = set()  # matches of a timed-out batch, replayed one by one

@@ -47,3 +47,42 @@ def test_a_local_instance_of_no_cpus_is_refused_before_ray_starts():
     with pytest.raises(InvalidConfigError, match=r"workers = 0: expected an integer >= 1"):
         RayExecutor(num_cpus=0)
     assert not ray.is_initialized()
+
+
+def test_a_policy_registered_by_the_driver_plays_in_ray_workers(tmp_path, monkeypatch):
+    # Ray workers are fresh processes: a policy registered at run time (as the process
+    # backend's forked workers see it) was an "unknown policy" error in every match
+    from analysis.tournament.executors import RayExecutor
+    from strategies.policies import registry
+    from strategies.policies.baselines import RandomPolicy
+
+    class Boom(RandomPolicy):  # defined here: Ray's cloudpickle ships it by value
+        def _decide(self, snap):
+            if self._steps == 3:
+                raise ZeroDivisionError("boom at step 3")
+            return super()._decide(snap)
+
+    registry.policy_names()
+    monkeypatch.setitem(
+        registry._REGISTRY, "evader/boom", registry.PolicySpec("evader/boom", Boom, "raises")
+    )
+    d = {
+        "name": "boom",
+        "maps": ["open_room"],
+        "pursuers": ["pursuer/greedy"],
+        "evaders": ["evader/boom", "evader/random"],
+        "seeds": 2,
+        "start": "valid",
+        "env": {"max_cycles": 60},
+    }
+    ex = RayExecutor(num_cpus=2)
+    try:
+        s = run_tournament(spec_from_dict(d), tmp_path / "r.sqlite", executor=ex, progress=False)
+    finally:
+        ex.close()
+    assert s.played == 4 and s.forfeits == 2 and s.errors == 0
+    with Store(tmp_path / "r.sqlite") as db:
+        rows = db.rows(s.run_id)
+    boom = [r for r in rows if r["evader"] == "evader/boom"]
+    assert all(r["status"] == "forfeit" and r["blame"] == "evader" for r in boom)
+    assert all("ZeroDivisionError: boom at step 3" in r["error"] for r in boom)

@@ -34,7 +34,7 @@ from scipy.sparse.csgraph import breadth_first_order
 
 from envs.maps import Map
 from strategies.cspace import Decomposition, decompose
-from strategies.policies.safety import grid_points
+from strategies.policies.safety import SafetyTable, grid_points
 
 __all__ = ["CROSS_REL", "EscapePlan", "Witness", "escape_plan", "escape_ranks"]
 
@@ -155,10 +155,12 @@ class EscapePlan:
         rank: (n_cells,) round of the fixed point at which the cell became escapable, -1
             if not escapable (with a clearance: :func:`escape_ranks`'s weighted rounds).
         vias: per cell, the boundary pieces that make it escapable at its rank.
-        points: (n, 2) grid points (the rows of the matching ``SafetyTable``).
+        points: (n, 2) grid points (the rows of the matching eager ``SafetyTable``).
         region: (n,) bool, the grid point lies in a witness region (Prop. 2).
         region_next: (n,) next grid point toward the nearest witness-region point (-1
             where none is reachable or the point is in a witness region).
+        grid: the grid's nodes and their rows of ``points`` (:meth:`row`), or ``None``
+            with no points.
     """
 
     dec: Decomposition
@@ -167,6 +169,15 @@ class EscapePlan:
     points: np.ndarray
     region: np.ndarray
     region_next: np.ndarray
+    grid: _PlanGrid | None = None
+
+    def row(self, point: np.ndarray) -> int:
+        """The row of ``points`` (and of ``region``, ``region_next``) of the grid point
+        nearest to ``point``, or of the nearest free one around it (-1 if none): what the
+        eager ``SafetyTable.row`` answers. Not a row of a distinct or lazy table: those
+        number their rows otherwise (issue 13: the shooting evader looked up its walk to
+        a witness region with its distinct table's rows, the wrong grid points)."""
+        return -1 if self.grid is None else self.grid.row(point)
 
     @functools.cached_property
     def _pieces(self) -> dict[int, tuple[np.ndarray, ...]]:
@@ -581,10 +592,27 @@ def escape_plan(
     dec = decompose(world, L, cache=True)
     dec.region_grid()  # the point-location grid of cell_at, built here rather than mid-episode
     rank, vias = escape_ranks(dec, _narrow(dec, clearance))
-    _origin, cell, pts = grid_points(world, resolution)
+    origin, cell, pts = grid_points(world, resolution)
     region = _inside_any(pts, [dec.regions[r].polygon for r in dec.witness_regions])
     if region.any():
         nxt = _region_next(world, cell, pts, resolution, region)
     else:
         nxt = np.full(len(pts), -1, dtype=np.int64)
-    return EscapePlan(dec, rank, vias, pts, region, nxt)
+    grid = _PlanGrid(origin, float(resolution), (int(cell.shape[0]), int(cell.shape[1])), cell)
+    return EscapePlan(dec, rank, vias, pts, region, nxt, grid)
+
+
+@dataclass(frozen=True, eq=False)
+class _PlanGrid:
+    """An escape plan's grid: node ``(i, j)`` at ``origin + resolution (i, j)`` is row
+    ``cell[i, j]`` of the plan's points (-1 outside the free region), looked up as an
+    eager :class:`~strategies.policies.safety.SafetyTable` is (the same grid and rows)."""
+
+    origin: np.ndarray
+    resolution: float
+    shape: tuple[int, int]
+    cell: np.ndarray
+
+    rows = SafetyTable.rows
+    row = SafetyTable.row
+    _row_search = SafetyTable._row_search

@@ -131,7 +131,8 @@ class PlanFeatures:
                     to = w.target - e
                     out[2], out[3] = line_of_sight_frame(to, u)
                     out[4] = min(math.hypot(float(to[0]), float(to[1])) / c.l_max, 1.0)
-        row = ev.table.row(e)
+        # the plan's own rows (a distinct table numbers its rows otherwise)
+        row = plan.row(e) if plan.region.any() else -1
         if (
             row >= 0
             and plan.region.any()

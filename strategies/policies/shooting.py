@@ -370,20 +370,13 @@ class ShootingEvader(BasePolicy):
             self.mode = "plan"
             self._arc, self._in_sight = None, False
             return c.v_evader * heading
-        row = self.table.row(e)
-        if (
-            row >= 0
-            and self._has_region
-            and not self.plan.region[row]
-            and not self.plan.in_witness_region(self._plan_cell)
-        ):
+        walk = None if self.plan.in_witness_region(self._plan_cell) else self._region_walk(e)
+        if walk is not None:
             # (in a witness region already, the walk only steps onto a grid point inside
             # its polygon: alternated with pressure at a wall, it held the evader in place
             # for the whole horizon, issue 13: office x0.5)
-            nxt = self.plan.region_next[row]
-            if nxt >= 0:
-                self.mode = "region"
-                return c.v_evader * unit(self.plan.points[nxt] - e)
+            self.mode = "region"
+            return c.v_evader * walk
         self.mode = "pressure"
         # charge: straight at the pursuer minimises its best rotation rate (Sec. 6.1, the
         # toward/away strategy) and, with bounded speeds, herds it backwards into walls and
@@ -421,6 +414,25 @@ class ShootingEvader(BasePolicy):
             d = self.map.distance_to_walls(np.stack([e + h * s, e - h * s]))
             return c.v_evader * (-s if d[1] - d[0] > _PRESSING * h else s)
         return c.v_evader * u
+
+    def _region_walk(self, e: np.ndarray) -> np.ndarray | None:
+        """Heading of the grid walk from ``e`` to a witness region (Prop. 2), or ``None``
+        (no witness region, ``e`` off the grid or in one, or none reachable).
+
+        The walk's arrays are the plan's grid points: looked up with the plan's rows
+        (:meth:`EscapePlan.row`), not the safety table's (a distinct table numbers its
+        rows otherwise: issue 13, on office the table's row gave the wrong answer to "in
+        a witness region?" at 1,526 of the 35,214 grid points, and the walk headed for
+        unrelated grid points).
+        """
+        if not self._has_region:
+            return None
+        plan = self.plan
+        row = plan.row(e)
+        if row < 0 or plan.region[row]:
+            return None
+        nxt = plan.region_next[row]
+        return unit(plan.points[nxt] - e) if nxt >= 0 else None
 
     def _herd(self, e: np.ndarray, p: np.ndarray, u: np.ndarray, L: float) -> np.ndarray:
         """Heading that pins the pursuer at ``p`` into its nearest concave corner: toward

@@ -267,10 +267,20 @@ def test_body_witness_regions_are_prop_2_for_the_disc(name, length, kind):
 
 
 def test_plan_grid_is_the_safety_tables():
-    world = builtin_map("corridor")
+    world = builtin_map("two_rooms")  # a map with witness regions (a walk to them)
     plan = escape_plan(world, L, 0.25)
+    assert plan.region.any()
     tab = safety_table(world, L, 0.25, 36, disk_cache=False)
     assert np.array_equal(tab.rows(plan.points), np.arange(len(plan.points)))
+    # plan.row answers as the eager table's row (the plan's rows), also just outside the
+    # free region, where both look around (issue 13: the shooting evader looked its plan
+    # up with its distinct table's rows, which are numbered otherwise)
+    rng = np.random.default_rng(3)
+    x0, y0, x1, y1 = world.bounds
+    pts = np.concatenate([rng.uniform((x0, y0), (x1, y1), (300, 2)), world.vertices + 0.01])
+    assert [plan.row(p) for p in pts] == [tab.row(p) for p in pts]
+    distinct = safety_table(world, L, 0.25, 36, disk_cache=False, distinct=True)
+    assert [distinct.row(p) for p in pts] != [tab.row(p) for p in pts]
 
 
 def test_region_walk_is_a_shortest_wall_free_grid_walk():

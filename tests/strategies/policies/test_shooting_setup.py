@@ -66,3 +66,35 @@ def test_the_table_is_distinct_rows_with_the_eager_lookups():
     mine, want = tab.cell[inside], eager.cell[inside]
     for field in ("free", "safe", "guaranteed", "ccw", "cw"):
         assert np.array_equal(getattr(tab, field)[mine], getattr(eager, field)[want]), field
+
+
+def test_the_walk_to_a_witness_region_looks_up_the_plans_own_grid_points():
+    # issue 13: the walk's arrays are the plan's grid points; they were looked up with the
+    # distinct table's rows (numbered otherwise), which on office answered "in a witness
+    # region?" wrongly at 1,526 of 35,214 grid points and sent the walk elsewhere
+    import numpy as np
+
+    from strategies.policies.base import unit
+    from strategies.runner import build_env
+
+    config = build_env("office", {}).config
+    evader = make_policy("evader/shooting")
+    evader.reset(role="evader", map=config.map, config=config, seed=0)
+    plan, h = evader.plan, evader.table.resolution
+    assert plan.region.any() and not plan.region.all()
+    rng = np.random.default_rng(0)
+    outside = np.flatnonzero(~plan.region & (plan.region_next >= 0))
+    picks = np.concatenate([rng.choice(outside, 300), rng.choice(np.flatnonzero(plan.region), 50)])
+    walked = 0
+    for i in picks.tolist():
+        p = plan.points[i] + rng.uniform(-h / 3, h / 3, 2)
+        d = np.hypot(*(plan.points - p).T)
+        j = int(np.argmin(d))  # the grid point nearest p, by brute force
+        assert j == i
+        got = evader._region_walk(p)
+        if plan.region[j]:
+            assert got is None
+        else:
+            assert np.array_equal(got, unit(plan.points[plan.region_next[j]] - p))
+            walked += 1
+    assert walked == 300

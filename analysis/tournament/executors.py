@@ -331,6 +331,12 @@ class RayExecutor(Executor):
         address: a running cluster (``"auto"``, ``"ray://host:10001"``...); ``None``
             starts a local instance with ``num_cpus`` CPUs (shut down by :meth:`close`).
         num_cpus: CPUs of a local instance (default: all).
+
+    Up to two tasks per CPU are in flight, so a task may wait in Ray's queue; its deadline
+    (its batch at the time limit plus one second a match, plus :data:`KILL_GRACE`) is
+    extended by the longest batch in flight when it was submitted, and restarted for every
+    task in flight when a hung task's worker is killed (a queued task may be waiting for
+    that CPU and a new worker). On a cluster shared with other jobs a wait can be longer.
     """
 
     name = "ray"
@@ -362,7 +368,7 @@ class RayExecutor(Executor):
             self.started = True
         self.cpus = max(1, int(ray.cluster_resources().get("CPU", 1)))
         self.task = ray.remote(num_cpus=1, max_retries=0)(_ray_play)
-        self.inflight: dict[Any, tuple[list[Match], float]] = {}
+        self.inflight: dict[Any, tuple[list[Match], float]] = {}  # ref: (batch, deadline)
 
     def describe(self) -> str:
         return f"ray ({self.cpus} CPUs)"
@@ -385,8 +391,13 @@ class RayExecutor(Executor):
             while todo and len(self.inflight) < 2 * self.cpus:
                 n = 1 if todo[0].match_id in solo else batcher.size(len(todo))
                 batch = [todo.popleft() for _ in range(min(n, len(todo)))]
+                # a task may wait in Ray's queue until the tasks running now end: at most
+                # the longest batch in flight at its time limits (timed from submission,
+                # a match queued behind a hang was killed as an overrun it never made)
+                ahead = max((len(b) for b, _ in self.inflight.values()), default=0)
+                slack = (len(batch) + ahead) * (ctx.time_limit + 1.0) + KILL_GRACE
                 ref = self.task.remote(batch, box)
-                self.inflight[ref] = (batch, time.monotonic())
+                self.inflight[ref] = (batch, time.monotonic() + slack)
             done, _ = ray.wait(list(self.inflight), num_returns=1, timeout=POLL)
             for ref in done:
                 batch, _ = self.inflight.pop(ref)
@@ -408,10 +419,16 @@ class RayExecutor(Executor):
                     batcher.observe(out)
                     yield out
             now = time.monotonic()
-            for ref, (batch, since) in list(self.inflight.items()):
-                if now - since > len(batch) * (ctx.time_limit + 1.0) + KILL_GRACE:
+            for ref in list(self.inflight):
+                batch, deadline = self.inflight[ref]  # as extended by a kill before it
+                if now > deadline:
                     ray.cancel(ref, force=True)
                     self.inflight.pop(ref)
+                    # its worker is killed: a task queued for that CPU starts only now,
+                    # in a new worker, so every task in flight gets its full time again
+                    for other, (b, d) in self.inflight.items():
+                        fresh = now + len(b) * (ctx.time_limit + 1.0) + KILL_GRACE
+                        self.inflight[other] = (b, max(d, fresh))
                     if len(batch) > 1:  # isolate the hanging match
                         solo.update(m.match_id for m in batch)
                         todo.extendleft(reversed(batch))

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import time
+
 import pytest
 
 from analysis.tournament import Store, run_tournament, spec_from_dict
@@ -86,3 +88,76 @@ def test_a_policy_registered_by_the_driver_plays_in_ray_workers(tmp_path, monkey
     boom = [r for r in rows if r["evader"] == "evader/boom"]
     assert all(r["status"] == "forfeit" and r["blame"] == "evader" for r in boom)
     assert all("ZeroDivisionError: boom at step 3" in r["error"] for r in boom)
+
+
+def test_a_match_queued_behind_a_hang_is_not_killed_as_an_overrun(
+    tmp_path, test_policies, monkeypatch
+):
+    # The driver timed each Ray task from its submission: a task queued behind one whose
+    # match hung until the alarm (time limit + 1 s) had KILL_GRACE = 5 s left for its own
+    # match, and a 5.5 s match (time limit 6 s) was stored as an error, "killed: the Ray
+    # task overran the time limit", though it never overran.
+    import threading
+
+    from analysis.tournament.executors import RayExecutor
+    from analysis.tournament.identity import plan
+    from analysis.tournament.worker import context_for
+    from strategies.policies import registry
+    from strategies.policies.baselines import RandomPolicy
+
+    class Slow(RandomPolicy):  # one 5.5 s decision: slow, within the time limit
+        def _decide(self, snap):
+            if self._steps == 1:
+                time.sleep(5.5)
+            return super()._decide(snap)
+
+    monkeypatch.setitem(
+        registry._REGISTRY, "evader/slow", registry.PolicySpec("evader/slow", Slow, "slow")
+    )
+    d = {
+        "maps": ["open_room"],
+        "pursuers": ["pursuer/greedy"],
+        "evaders": ["evader/test_hanging", "evader/slow"],
+        "seeds": 1,
+        "start": "valid",
+        "time_limit": 6,
+        "env": {"max_cycles": 20},
+    }
+    spec = spec_from_dict(d)
+    matches = sorted((m for m, _ in plan(spec)), key=lambda m: m.evader != "evader/test_hanging")
+    ex = RayExecutor(num_cpus=1)  # the second task waits in Ray's queue behind the first
+    try:
+        outs = {o["match_id"]: o for o in ex.run(matches, context_for(spec), threading.Event())}
+    finally:
+        ex.close()
+    hung, slow = (outs[m.match_id] for m in matches)
+    assert hung["status"] == "forfeit" and "time limit" in hung["error"]
+    assert slow["status"] == "ok", slow.get("error")
+
+
+def test_a_deaf_hang_is_killed_and_the_match_queued_behind_it_plays(tmp_path, test_policies):
+    # A hang with SIGALRM blocked is killed by the driver (ray.cancel(force=True)); the
+    # task queued for that CPU starts only then, in a new worker, and was killed with it
+    # as an overrun (its clock had run since its submission).
+    d = {
+        "maps": ["open_room"],
+        "pursuers": ["pursuer/greedy"],
+        "evaders": ["evader/test_deaf", "evader/random"],
+        "seeds": 2,
+        "start": "valid",
+        "time_limit": 2,
+        "env": {"max_cycles": 30},
+    }
+    from analysis.tournament.executors import RayExecutor
+
+    ex = RayExecutor(num_cpus=2)
+    try:
+        s = run_tournament(spec_from_dict(d), tmp_path / "r.sqlite", executor=ex, progress=False)
+    finally:
+        ex.close()
+    with Store(tmp_path / "r.sqlite") as db:
+        rows = db.rows(s.run_id)
+    deaf = [r for r in rows if r["evader"] == "evader/test_deaf"]
+    assert len(deaf) == 2 and all(r["status"] == "error" and "killed" in r["error"] for r in deaf)
+    played = [r for r in rows if r["evader"] == "evader/random"]
+    assert len(played) == 2 and all(r["status"] == "ok" for r in played), played

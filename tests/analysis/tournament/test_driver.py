@@ -269,10 +269,13 @@ def test_sigterm_stops_quickly_says_how_to_resume_and_leaves_no_orphans(tmp_path
     t0 = time.monotonic()
     proc.send_signal(signal.SIGTERM)
     out, err = proc.communicate(timeout=10)
-    assert time.monotonic() - t0 < 3.0
+    # "quickly": well before the remaining matches could finish (a functional bound, not
+    # a speed figure: it read 3.9 s at load average 9 on 2 cores; the run stops short below)
+    assert time.monotonic() - t0 < 8.0
     assert proc.returncode == 143
     assert "Traceback" not in err
     assert "to resume: surveil tournament" in out + err and str(store) in out + err
     assert not any(_alive(w) for w in workers)
     with Store(store) as db:
         assert db.run(slow_spec.run_id)["status"] == "interrupted"
+        assert len(db.rows(slow_spec.run_id)) < 40  # it did not play the run out

@@ -117,6 +117,10 @@ def _cmd_tournament(args: argparse.Namespace) -> int:
     hint = f"surveil tournament {args.spec} --store {store}"
     if args.backend != "process":
         hint += f" --backend {args.backend}"
+    if args.workers is not None:  # else the resumed run took every core
+        hint += f" --workers {args.workers}"
+    if args.address is not None:
+        hint += f" --address {args.address}"
     summary = run_tournament(
         spec,
         store,

@@ -155,3 +155,31 @@ def test_a_regret_table_over_the_memory_budget_leaves_the_rest_of_the_report(
     assert "Not solved: solve(map " in regret and "more than the memory budget" in regret
     assert "Use the resolution (the report's is 16 cells per L_min) <= " in regret
     assert "SURVEIL_MEMORY_BUDGET=" in regret and "memory_budget=" not in regret
+
+
+def test_the_resume_command_keeps_the_backend_workers_and_address(monkeypatch, tmp_path):
+    # "to resume: surveil tournament big.toml --store S --backend ray": without --workers 2
+    # the resumed run took every core
+    import analysis.tournament.driver as driver
+
+    hints = []
+
+    def fake_run(spec, store, **kw):
+        hints.append(kw["resume_hint"])
+        raise KeyboardInterrupt  # stop here: only the hint is under test
+
+    monkeypatch.setattr(driver, "run_tournament", fake_run)
+    store = tmp_path / "q.sqlite"
+    for extra, want in [
+        ([], f"surveil tournament quick --store {store}"),
+        (["--workers", "2"], f"surveil tournament quick --store {store} --workers 2"),
+        (
+            ["--backend", "ray", "--workers", "3", "--address", "auto"],
+            f"surveil tournament quick --store {store} --backend ray --workers 3 --address auto",
+        ),
+    ]:
+        try:
+            main(["tournament", "quick", "--store", str(store), *extra])
+        except KeyboardInterrupt:
+            pass
+        assert hints[-1] == want

@@ -17,7 +17,7 @@ from envs import validation
 from envs.errors import InvalidConfigError, SurveilValueError
 from training.config import TrainConfig, load_any_config
 from training.selfplay import self_play
-from training.train import TrainResult, train
+from training.train import TrainResult, latest_checkpoint, train
 
 __all__ = ["add_train_arguments", "cli_train", "run_cli", "run_train"]
 
@@ -75,10 +75,29 @@ def run_train(args: argparse.Namespace) -> int:
     if args.self_play:
         results = self_play(config, args.self_play, progress_bar=args.progress).stages
     else:
-        results = (train(config, progress_bar=args.progress),)
+        try:
+            results = (train(config, progress_bar=args.progress),)
+        except KeyboardInterrupt:
+            print(resume_note(config), file=sys.stderr)
+            raise
     for r in results:
         print(summary(r))
     return 0
+
+
+def resume_note(config: TrainConfig) -> str:
+    """What an interrupted run kept: the checkpoint a rerun continues from, or nothing."""
+    latest = latest_checkpoint(config.output_dir)
+    if latest is None:
+        return (
+            f"stopped before the first checkpoint (every checkpoint_freq = "
+            f"{config.checkpoint_freq:,} timesteps): a rerun starts over"
+        )
+    done, path = latest
+    return (
+        f"stopped: {done:,} of {config.total_timesteps:,} timesteps are in {path}; rerun the "
+        "same command to resume from there"
+    )
 
 
 def _check_output_dir(text: str) -> None:

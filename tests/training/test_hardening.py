@@ -184,3 +184,28 @@ def test_an_unknown_opponent_leaves_no_config_that_refuses_the_fixed_rerun(tmp_p
     assert not (out / "config.toml").exists()
     cfg.write_text(body + 'opponent = "evader/straight"\n')
     assert cli_train([str(cfg)]) == 0
+
+
+def test_an_interrupted_run_says_what_it_kept_and_the_rerun_resumes(tmp_path, capsys, monkeypatch):
+    # Ctrl-C said only "interrupted": not that the run resumes, nor from where
+    import re
+
+    import training.cli
+
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(
+        'role = "pursuer"\nopponent = "evader/straight"\nmap = "open_room"\nstart = "valid"\n'
+        "total_timesteps = 256\nn_steps = 64\nbatch_size = 32\ncheckpoint_freq = 64\n"
+        f'eval_episodes = 2\neval_start = "valid"\noutput_dir = "{tmp_path / "run"}"\n'
+        "[env]\nmax_cycles = 40\n[algo_kwargs]\nn_epochs = 2\n"
+    )
+    real = training.cli.train
+    monkeypatch.setattr(training.cli, "train", lambda c, **kw: real(c, callbacks=[Interrupt(150)]))
+    assert cli_train([str(cfg)]) == 130
+    err = capsys.readouterr().err
+    kept = re.search(r"stopped: (\d+) of 256 timesteps are in (\S+); rerun the same command", err)
+    assert kept, err
+    assert Path(kept.group(2)).name == f"ckpt_{kept.group(1)}.zip"
+    monkeypatch.setattr(training.cli, "train", real)
+    assert cli_train([str(cfg)]) == 0
+    assert f"(resumed from ckpt_{kept.group(1)}.zip)" in capsys.readouterr().out

@@ -94,6 +94,10 @@ def _policy(flag: str, name: str, params_flag: str, params_text: str | None):
 
     params = json_object(params_flag, params_text, example=PARAMS_EXAMPLE)
     role = flag.lstrip("-")
+    if name.startswith("zoo:") or name.endswith(".zip"):  # as surveil evaluate takes them
+        from analysis.tournament.spec import model_file
+
+        name = f"{role}/sb3:{model_file(name, flag)}"
     if not name.startswith(f"{role}/"):
         raise InvalidConfigError(
             f"{flag} = {name!r}: expected a policy name of the form '{role}/KIND' "
@@ -281,8 +285,16 @@ def build_parser() -> argparse.ArgumentParser:
         type=path_text("a built-in map name or a map file"),
         help="built-in name or map file (default: corridor)",
     )
-    p.add_argument("--pursuer", default="pursuer/decomposition", help="registered pursuer policy")
-    p.add_argument("--evader", default="evader/shooting", help="registered evader policy")
+    p.add_argument(
+        "--pursuer",
+        default="pursuer/decomposition",
+        help="registered pursuer policy, zoo:NAME (a shipped model) or a model .zip",
+    )
+    p.add_argument(
+        "--evader",
+        default="evader/shooting",
+        help="registered evader policy, zoo:NAME (a shipped model) or a model .zip",
+    )
     p.add_argument("--pursuer-params", help="pursuer parameters as JSON (see surveil policies)")
     p.add_argument("--evader-params", help='evader parameters as JSON, e.g. \'{"mode": "away"}\'')
     p.add_argument("--seed", type=integer(0), default=0, help="episode seed (>= 0)")

@@ -531,6 +531,19 @@ def zoo_dir() -> Path | None:
     return Path(next(iter(spec.submodule_search_locations))) / "zoo" / "models"
 
 
+def model_file(text: str, where: str, base: Path | None = None) -> Path:
+    """The model file ``text`` names: ``zoo:NAME`` (a shipped model) or a path (relative
+    to ``base``, default the current directory), checked to be an SB3 model zip.
+
+    Raises:
+        InvalidConfigError: no such zoo model (listing them) or file, or not a model zip;
+            the message starts with ``where``.
+    """
+    path = _model_path(text, where, Path.cwd() if base is None else base)
+    _check_model_zip(path, text, where)
+    return path
+
+
 def _model_path(text: str, where: str, base: Path) -> Path:
     if text.startswith("zoo:"):
         name = text[len("zoo:") :]

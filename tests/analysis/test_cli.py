@@ -182,3 +182,19 @@ def test_a_run_whose_every_match_errored_does_not_exit_0(tmp_path, capsys):
     assert len(err) == 1 and err[0].startswith("surveil: error: every one of the 1 matches")
     assert "no safe start" in err[0]
     assert main(argv) == 0
+
+
+def test_play_takes_a_shipped_model_or_a_model_file_as_evaluate_does(tmp_path, capsys):
+    # `surveil evaluate --pursuers zoo:NAME` played; `surveil play --pursuer zoo:NAME` said
+    # "expected a policy name of the form 'pursuer/KIND'"
+    from analysis.tournament.spec import zoo_dir
+
+    model = zoo_dir() / "ppo_evader_vs_greedy_open_room" / "model.zip"
+    fast = ["--map", "open_room", "--max-cycles", "5", "--no-gif"]
+    for argv in (
+        ["--pursuer", "zoo:ppo_pursuer_vs_straight_open_room", "--evader", "evader/straight"],
+        ["--pursuer", "pursuer/greedy", "--evader", str(model)],
+    ):
+        assert main(["play", *argv, *fast]) == 0
+        out = capsys.readouterr().out
+        assert "sb3:" in out and ("kept surveillance" in out or "escaped" in out)

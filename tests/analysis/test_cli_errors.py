@@ -268,6 +268,18 @@ def test_tournament_workers_are_checked_before_the_store(capsys, tmp_path, worke
     assert not store.exists()
 
 
+def test_play_refuses_a_model_that_is_not_there_or_of_the_other_role(capsys, tmp_path):
+    (tmp_path / "notes.zip").write_text("not a zip")
+    cases = [
+        (["--pursuer", "zoo:nope"], "--pursuer: model = 'zoo:nope': no zoo model 'nope'; known: ["),
+        (["--evader", str(tmp_path / "notes.zip")], "not a stable-baselines3 model zip"),
+        (["--evader", str(tmp_path / "gone.zip")], "--evader: model = ", "no such file"),
+        (["--pursuer", "zoo:ppo_evader_vs_greedy_open_room"], "trained as the evader"),
+    ]
+    for argv, *needles in cases:
+        assert_fails(capsys, ["play", *FAST, *argv, "--no-gif"], *needles)
+
+
 def test_figures_into_an_existing_file_is_refused_before_drawing(capsys, tmp_path):
     blocker = tmp_path / "somefile"
     blocker.write_text("x")

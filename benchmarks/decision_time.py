@@ -21,6 +21,7 @@ Usage::
 
     python benchmarks/decision_time.py [--maps corridor two_rooms ...] [--seeds 2]
         [--max-cycles 300] [--reps 3] [--clock wall|cpu] [--l-min 1] [--table lazy]
+        [--rho 0.99]
 
 ``--maps`` takes built-in names, ``NAME*S`` (the built-in map scaled by S, its L_min, L_max
 and speeds kept: a larger world, S^2 times the table's points) and ``floor_plan:SEED:W``
@@ -32,6 +33,9 @@ decomposition pursuer's grid is L_min / 20: halving L_min quadruples its points)
 ``--table`` forces the decomposition pursuer's safety table (``auto``: distinct rows up
 to ``DecompositionPursuer.DISTINCT_TABLE_POINTS`` grid points, else filled lazily), so the
 kinds can be compared on the same episodes.
+
+``--rho R`` plays the evader at R times the pursuer's speed (the map's V_p kept) instead
+of the map's ratio: the shooting evader's arcs near rho = 1 (issue 13).
 """
 
 from __future__ import annotations
@@ -44,6 +48,7 @@ import numpy as np
 from bench_cli import integer, real, run
 
 from envs.maps import builtin_info, builtin_names, floor_plan
+from envs.surveillance.config import map_recommendations
 from strategies.policies import make_policy
 from strategies.runner import episode_seeds, run_episode
 
@@ -120,13 +125,18 @@ def measure(
     clock=time.perf_counter,
     overrides: dict | None = None,
     table: str = "auto",
+    rho: float | None = None,
 ) -> tuple[dict[str, np.ndarray], dict[str, float]]:
     """Per-decision seconds of each policy (and the reference) on ``map_name``, first
     decisions left out, and the slowest first decision of each."""
     out: dict[str, list[np.ndarray]] = {}
     first: dict[str, float] = {}
     m, params = world(map_name)
-    overrides = {**params, **(overrides or {})} or None
+    overrides = {**params, **(overrides or {})}
+    if rho is not None:
+        v_pursuer = {**map_recommendations(m), **overrides}["v_pursuer"]
+        overrides["v_evader"] = rho * v_pursuer
+    overrides = overrides or None
     for seed in range(seeds):
         observations = []
         result = run_episode(
@@ -158,11 +168,13 @@ def main(argv=None) -> int:
     ap.add_argument("--clock", choices=sorted(CLOCKS), default="wall")
     ap.add_argument("--l-min", type=real(0), default=None)
     ap.add_argument("--table", choices=["auto", "eager", "distinct", "lazy"], default="auto")
+    ap.add_argument("--rho", type=real(0), default=None)
     args = ap.parse_args(argv)
     overrides = None if args.l_min is None else {"l_min": args.l_min, "l_max": 2 * args.l_min}
     print(
         f"load average: {os.getloadavg()}; clock: {args.clock}; table: {args.table}"
         + ("" if overrides is None else f"; L in [{args.l_min:g}, {2 * args.l_min:g}]")
+        + ("" if args.rho is None else f"; rho {args.rho:g}")
     )
     print(
         f"{'map':<16}{'policy':<24}{'steps':>6}{'mean ms':>9}{'p99 ms':>8}{'max ms':>8}"
@@ -178,6 +190,7 @@ def main(argv=None) -> int:
             CLOCKS[args.clock],
             overrides,
             args.table,
+            args.rho,
         )
         ref = float(times[REFERENCE].mean())
         for name in [*(n for n, _ in POLICIES), REFERENCE]:

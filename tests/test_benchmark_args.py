@@ -32,6 +32,7 @@ def _run(script: str, *args: str, **kwargs) -> subprocess.CompletedProcess:
         ("pursuer_holds.py", ["--rho", "nan"], "'nan': expected a finite number > 0"),
         ("decision_time.py", ["--maps", "nope"], "'nope': expected a built-in map"),
         ("decision_time.py", ["--seeds", "0"], "'0': expected an integer >= 1"),
+        ("decision_time.py", ["--rho", "0"], "'0': expected a finite number > 0"),
         ("evader_escapes.py", ["--seeds", "0"], "'0': expected an integer >= 1"),
         ("referee_scaling.py", ["--cpl", "0"], "'0': expected a finite number > 0"),
         ("analytic_matchups.py", ["--workers", "0"], "'0': expected an integer >= 1"),

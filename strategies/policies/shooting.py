@@ -23,7 +23,8 @@ Sec. 5 "minimax": its tip meets walls as if the rod were that long):
    straight path). The best candidate with a positive margin (in line of sight, once
    an arc made no headway) is re-solved with the optimal escape arc of Sec. 6
    (:func:`strategies.control.evasion.solve_escape`, for the branch the pursuer would
-   turn) and the evader follows that arc, replanning every ``replan`` steps.
+   turn) and the evader follows that arc (where no bounded arc reaches the candidate,
+   as near rho = 1 most do not, the straight path), replanning every ``replan`` steps.
 3. **Witness region** (Prop. 2 holds on the map): from a region that is not one, walk a
    shortest grid path to a region whose cells are all escapable
    (``Decomposition.witness_regions``).
@@ -610,9 +611,20 @@ class ShootingEvader(BasePolicy):
                     [[math.cos(frame), -math.sin(frame)], [math.sin(frame), math.cos(frame)]]
                 )
                 self._arc = (e.copy(), frame, path @ rot.T + e)
-                self._arc_length = _arc_lengths(self._arc[2])
-                self._arc_age = 1
-                return self._arc_heading(e)
+            else:
+                # no optimal arc reaches the target (the extremals turn back first: near
+                # rho = 1 most do, THEORY §4.3): the shot is the straight path its margin
+                # was computed on, followed like an arc until the replan. Re-solved every
+                # step, the same failure (a new problem each step, as the evader moves)
+                # cost a solve per step: 100-150 ms at rho 0.99 on the corridor, where
+                # nearly every solve fails (issue 13). Sampled at least every step, as an
+                # arc's nodes are, so that _arc_heading follows it the same way
+                n = 1 + math.ceil(dist / (self.config.v_evader * self.config.dt))
+                f = np.linspace(0.0, 1.0, n + 1)[:, None]
+                self._arc = (e.copy(), frame, e + f * d)
+            self._arc_length = _arc_lengths(self._arc[2])
+            self._arc_age = 1
+            return self._arc_heading(e)
         return unit(d)
 
     def _arc_heading(self, e: np.ndarray) -> np.ndarray:

@@ -261,9 +261,18 @@ class Decomposition:
 
     @property
     def witness_regions(self) -> tuple[int, ...]:
-        """Regions whose cylinder holds only escapable cells (Prop. 2), largest first."""
+        """Regions whose cylinder holds only escapable cells (Prop. 2), largest first.
+
+        Areas equal to 1e-9 of the largest (mirror images, whose computed areas differ in
+        the last bits) are in id order: which of two rooms comes first no longer hangs on
+        rounding (at L = 2 the two_rooms' middles have areas 36.021165555610615 and
+        36.02116555561061, and Fig. 6's evader walked to whichever came first).
+        """
         w = [r for r in self.regions if all(self.cells[c].escapable for c in r.cells)]
-        return tuple(r.id for r in sorted(w, key=lambda r: -r.area))
+        if not w:
+            return ()
+        quantum = 1e-9 * max(r.area for r in w)
+        return tuple(r.id for r in sorted(w, key=lambda r: (-round(r.area / quantum), r.id)))
 
     @property
     def evader_wins(self) -> bool:

@@ -141,6 +141,25 @@ def test_fig6_two_rooms_every_cell_escapable(two_rooms_dec):
         assert c.reason in ("a", "b") and c.via is not None
 
 
+def test_witness_regions_of_equal_area_come_in_id_order(two_rooms_dec):
+    # the two rooms' middle regions are mirror images; their computed areas differ in
+    # the last bits, and that noise chose which room Fig. 6's evader walked to
+    dec = two_rooms_dec
+    w = [dec.regions[r] for r in dec.witness_regions]
+    top = max(r.area for r in w)
+    for a, b in itertools.pairwise(w):
+        if abs(a.area - b.area) <= 1e-9 * top:
+            assert a.id < b.id, (a.id, a.area, b.id, b.area)
+        else:
+            assert a.area > b.area
+    # the builtin world: the largest two are the rooms' middles, equal but for rounding
+    from envs.maps import builtin_map
+
+    big = decompose(builtin_map("two_rooms"), 2.0, cache=True)
+    first, second = (big.regions[r] for r in big.witness_regions[:2])
+    assert math.isclose(first.area, second.area, rel_tol=1e-12) and first.id < second.id
+
+
 def test_empty_room_larger_than_L_is_a_pursuer_win():
     dec = decompose(open_room(10.0), 2.0)
     assert not dec.evader_wins

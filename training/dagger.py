@@ -49,6 +49,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
+import re
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -469,6 +470,7 @@ def _resume(cfg: DaggerConfig, out: Path, env) -> tuple[Any, dict[str, Any], lis
 
     prog_path = out / "progress.json"
     if not prog_path.is_file():
+        _settle(out, -1)  # an iteration 0 stopped before its commit
         return None
     try:
         progress = json.loads(prog_path.read_text())
@@ -486,6 +488,7 @@ def _resume(cfg: DaggerConfig, out: Path, env) -> tuple[Any, dict[str, Any], lis
             f"{diff}: {[before[k] for k in diff]} there, {[now[k] for k in diff]} now); "
             "use another output_dir or delete that one"
         )
+    _settle(out, len(progress["samples"]) - 1)
     try:
         last = out / "model_last.zip"
         model = PPO.load(str(last if last.is_file() else out / "model.zip"), env=env, device="cpu")
@@ -505,22 +508,41 @@ def _resume(cfg: DaggerConfig, out: Path, env) -> tuple[Any, dict[str, Any], lis
 
 
 def _write_iteration(out: Path, model, obs, act, progress: dict[str, Any], best: bool) -> None:
-    """Model, dataset and curves of a finished iteration, each replaced atomically;
-    ``model.zip`` too when this iteration is the best so far (or there is no validation)."""
+    """Model, dataset and curves of a finished iteration (``model.zip`` too when it is the
+    best so far, or there is no validation), committed by ``progress.json``.
+
+    The model and dataset are written beside the last iteration's as ``NAME.next-K``,
+    then ``progress.json`` is replaced (the commit), then they take their names
+    (:func:`_settle`). Replaced one by one, a Ctrl-C between them resumed with iteration
+    K's model and K - 1's dataset: a different model at the end, and nothing said.
+    """
     import shutil
 
-    tmp = out / "model_last.zip.tmp"
-    model.save(str(tmp))
-    os.replace(tmp, out / "model_last.zip")
+    tag = f".next-{len(progress['samples']) - 1}"
+    model.save(str(out / f"model_last{tag}.zip"))
     if best:
-        shutil.copyfile(out / "model_last.zip", out / "model.zip.tmp")
-        os.replace(out / "model.zip.tmp", out / "model.zip")
-    tmp_npz = out / "dataset.tmp.npz"
-    np.savez_compressed(tmp_npz, obs=np.asarray(obs), act=np.asarray(act))
-    os.replace(tmp_npz, out / "dataset.npz")
+        shutil.copyfile(out / f"model_last{tag}.zip", out / f"model{tag}.zip")
+    np.savez_compressed(out / f"dataset{tag}.npz", obs=np.asarray(obs), act=np.asarray(act))
     tmp_json = out / "progress.json.tmp"
     tmp_json.write_text(json.dumps(progress, indent=2) + "\n")
     os.replace(tmp_json, out / "progress.json")
+    _settle(out, len(progress["samples"]) - 1)
+
+
+_NEXT = re.compile(r"(model_last|model|dataset)\.next-(\d+)\.(zip|npz)")
+
+
+def _settle(out: Path, committed: int) -> None:
+    """Finish or undo an interrupted :func:`_write_iteration`: files of the iteration
+    ``progress.json`` commits (``committed``, -1 for none) take their names, others go."""
+    for path in sorted(out.iterdir()):
+        m = _NEXT.fullmatch(path.name)
+        if m is None:
+            continue
+        if int(m.group(2)) == committed:
+            os.replace(path, out / f"{m.group(1)}.{m.group(3)}")
+        else:
+            path.unlink()
 
 
 def _validate(cfg: DaggerConfig, model, opponent) -> float:

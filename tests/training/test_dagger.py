@@ -115,6 +115,45 @@ def test_an_interrupted_run_resumes_to_the_same_model_bit_for_bit(tmp_path):
     assert all(torch.equal(a[k], b[k]) for k in a)
 
 
+@pytest.mark.parametrize("where", ["savez_compressed", "_settle"])
+def test_a_ctrl_c_while_an_iteration_is_written_resumes_to_the_same_model(
+    tmp_path, monkeypatch, where
+):
+    # model_last.zip, dataset.npz and progress.json were replaced one by one: a Ctrl-C in
+    # the dataset's write resumed with iteration 1's model and iteration 0's dataset, and
+    # ended with samples [80, 141] instead of [80, 160] and another model, saying nothing
+    import torch
+    from stable_baselines3 import PPO
+
+    import training.dagger as D
+
+    whole = dagger(_lidar_cfg(tmp_path, "whole"))
+    real = getattr(D.np, where) if where == "savez_compressed" else D._settle
+    calls = []
+
+    def interrupted(*args, **kwargs):
+        calls.append(args)
+        # savez: iteration 1's dataset (before the commit); _settle: iteration 1's, after
+        # progress.json committed it (the first call is _resume's on a fresh directory)
+        if len(calls) == (2 if where == "savez_compressed" else 3):
+            raise KeyboardInterrupt
+        return real(*args, **kwargs)
+
+    if where == "savez_compressed":
+        monkeypatch.setattr(D.np, where, interrupted)
+    else:
+        monkeypatch.setattr(D, where, interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        dagger(_lidar_cfg(tmp_path, "parts"))
+    monkeypatch.undo()
+    parts = dagger(_lidar_cfg(tmp_path, "parts"))
+    assert parts.samples == whole.samples and parts.disagreement == whole.disagreement
+    a = PPO.load(whole.model_path, device="cpu").policy.state_dict()
+    b = PPO.load(parts.model_path, device="cpu").policy.state_dict()
+    assert all(torch.equal(a[k], b[k]) for k in a)
+    assert not [p.name for p in (tmp_path / "parts").iterdir() if ".next-" in p.name]
+
+
 def test_a_different_config_in_the_same_directory_is_refused(tmp_path):
     dagger(_lidar_cfg(tmp_path, iterations=1))
     with pytest.raises(InvalidConfigError, match="different config"):

@@ -155,7 +155,8 @@ class EscapePlan:
         rank: (n_cells,) round of the fixed point at which the cell became escapable, -1
             if not escapable (with a clearance: :func:`escape_ranks`'s weighted rounds).
         vias: per cell, the boundary pieces that make it escapable at its rank.
-        points: (n, 2) grid points (the rows of the matching eager ``SafetyTable``).
+        points: (n, 2) grid points (the rows of the matching eager ``SafetyTable``; none
+            where the map has no witness region: nothing walks there).
         region: (n,) bool, the grid point lies in a witness region (Prop. 2).
         region_next: (n,) next grid point toward the nearest witness-region point (-1
             where none is reachable or the point is in a witness region).
@@ -592,6 +593,11 @@ def escape_plan(
     dec = decompose(world, L, cache=True)
     dec.region_grid()  # the point-location grid of cell_at, built here rather than mid-episode
     rank, vias = escape_ranks(dec, _narrow(dec, clearance))
+    if not dec.witness_regions:
+        # nothing to walk to: no grid (on the corridor at L_min 0.2 it was 8 of the
+        # shooting evader's 8.6 s reset from a warm disk cache, issue 13)
+        none = np.zeros(0, dtype=np.int64)
+        return EscapePlan(dec, rank, vias, np.zeros((0, 2)), none.astype(bool), none)
     origin, cell, pts = grid_points(world, resolution)
     region = _inside_any(pts, [dec.regions[r].polygon for r in dec.witness_regions])
     if region.any():

@@ -283,6 +283,15 @@ def test_plan_grid_is_the_safety_tables():
     assert [distinct.row(p) for p in pts] != [tab.row(p) for p in pts]
 
 
+def test_a_map_without_witness_regions_has_no_walk_grid():
+    # nothing walks to a witness region there: the grid was 8 of the shooting evader's
+    # 8.6 s reset on the corridor at L_min 0.2 (issue 13)
+    plan = escape_plan(builtin_map("corridor"), L, 0.25)
+    assert not plan.dec.witness_regions
+    assert len(plan.points) == len(plan.region) == len(plan.region_next) == 0
+    assert plan.row(np.array([5.0, 0.0])) == -1
+
+
 def test_region_walk_is_a_shortest_wall_free_grid_walk():
     world = builtin_map("pillars")
     h = 0.25

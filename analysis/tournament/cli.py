@@ -15,7 +15,13 @@ import sys
 from importlib import resources
 from pathlib import Path
 
-from analysis.arguments import integer, json_object, output_file, path_text, why_not_a_file
+from analysis.arguments import (
+    integer,
+    json_object,
+    output_file,
+    path_text,
+    why_not_a_file,
+)
 from envs.errors import InvalidConfigError
 
 __all__ = ["add_parsers", "format_cells", "shipped_specs"]
@@ -114,6 +120,10 @@ def _cmd_tournament(args: argparse.Namespace) -> int:
     path = _spec_path(args.spec)
     spec = load_spec(path)
     store = Path(args.store) if args.store else default_store(spec)
+    if args.report is not None or args.report_default:
+        # before the run: a file there failed only after every match ("x: File exists")
+        where = args.report or str(store.with_name(store.stem + "_report"))
+        _report_dir_possible("--report", where, "(or --no-report)")
     hint = f"surveil tournament {args.spec} --store {store}"
     if args.backend != "process":
         hint += f" --backend {args.backend}"
@@ -137,11 +147,24 @@ def _cmd_tournament(args: argparse.Namespace) -> int:
     return _print_outcome(summary, store, report, not args.no_replays)
 
 
+def _report_dir_possible(flag: str, text: str, alternative: str = "") -> None:
+    """Refuse a report directory that is a file or lies under one, making nothing (the
+    report makes it once there is something to write)."""
+    path = Path(text)
+    blocker = next((p for p in (path, *path.parents) if p.exists() and not p.is_dir()), None)
+    if blocker is not None:
+        raise InvalidConfigError(
+            f"{flag} = {text!r}: {str(blocker)!r} is a file, expected a directory"
+            + (f" {alternative}" if alternative else "")
+        )
+
+
 def _cmd_report(args: argparse.Namespace) -> int:
     from analysis.tournament.report import write_report
 
     store = Path(args.store)
     out = args.out or str(store.with_name(store.stem + "_report"))
+    _report_dir_possible("--out", out)  # was "x: File exists" from the mkdir
     files = write_report(store, out, run_id=args.run, replays=not args.no_replays)
     print(f"report written to {files['html']} and {files['markdown']}")
     return 0

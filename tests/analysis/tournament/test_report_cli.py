@@ -183,3 +183,26 @@ def test_the_resume_command_keeps_the_backend_workers_and_address(monkeypatch, t
         except KeyboardInterrupt:
             pass
         assert hints[-1] == want
+
+
+def test_a_report_directory_that_is_a_file_is_refused_before_the_run(tmp_path, capsys):
+    # the run played every match, printed its table, then failed: "x: File exists"
+    (tmp_path / "notes.txt").write_text("a file")
+    (tmp_path / "s_report").write_text("a file where the default report goes")
+    store = tmp_path / "t.sqlite"
+    cases = [
+        (["--store", str(store), "--report", str(tmp_path / "notes.txt")], "notes.txt"),
+        (["--store", str(store), "--report", str(tmp_path / "notes.txt" / "r")], "notes.txt"),
+        (["--store", str(tmp_path / "s.sqlite")], "s_report"),  # the default, beside it
+    ]
+    for argv, blocker in cases:
+        assert main(["tournament", "quick", *argv]) == 2
+        out, err = capsys.readouterr()
+        assert err.startswith("surveil: error: --report = ") and len(err.splitlines()) == 1
+        assert f"{blocker}' is a file, expected a directory" in err and not out
+    assert not store.exists() and not (tmp_path / "s.sqlite").exists()
+    Store(tmp_path / "empty.sqlite").close()
+    argv = ["report", str(tmp_path / "empty.sqlite"), "--out", str(tmp_path / "notes.txt")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "--out = " in err and "notes.txt' is a file, expected a directory" in err

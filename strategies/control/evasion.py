@@ -56,6 +56,7 @@ __all__ = [
     "EscapeSolution",
     "GreedyHeading",
     "ShootResult",
+    "capped_step",
     "default_step",
     "escape_path",
     "greedy_heading",
@@ -77,6 +78,26 @@ def default_step(x_max: float, L: float, rho: float) -> float:
     the cases in the tests.
     """
     return min(_natural_length(L, rho) / _STEPS_PER_SCALE, x_max / 32.0)
+
+
+def capped_step(x_max: float, L: float, rho: float) -> float | None:
+    """:func:`default_step` with at most ``32² = 1024`` steps to ``x_max`` where that is
+    coarser, but never coarser than a quarter of the natural length (the trust limit:
+    past a natural length RK4 is not to be trusted, see :func:`solve_escape`); ``None``
+    where the default step would need more than the 50,000 steps :func:`solve_escape`
+    attempts (it refuses those: rho within ~1e-2 of 1, or ``x_max`` thousands of ``L``).
+
+    32 steps per natural length, counting a natural length as at least 1/32 of the arc:
+    the natural length ``L min(rho, 1 - rho)/(1 + rho)`` shrinks to 0 as rho -> 1 (the
+    heading's fast scale), and the default step with it (~16,000 steps to 2 L at
+    rho = 0.99). Where ``x_max`` is at most 32 natural lengths it is the default step:
+    below rho ~ 0.8 always, as ``x_max`` stays within a few ``L``.
+    """
+    h = default_step(x_max, L, rho)
+    if x_max / h > _MAX_DEFAULT_STEPS:
+        return None
+    scale = _STEPS_PER_SCALE * _STEPS_PER_SCALE
+    return max(h, min(0.25 * _natural_length(L, rho), x_max / scale))
 
 
 def _natural_length(L: float, rho: float) -> float:

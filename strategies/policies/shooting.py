@@ -46,7 +46,7 @@ import numpy as np
 
 from envs import validation
 from envs.geometry import kernel_for
-from strategies.control.evasion import escape_path
+from strategies.control.evasion import capped_step, escape_path
 from strategies.cspace.tolerances import diameter
 from strategies.policies.base import (
     MAX_RAYS,
@@ -603,9 +603,14 @@ class ShootingEvader(BasePolicy):
         dist = math.hypot(d[0], d[1])
         self._arc, self._arc_age = None, 0
         if self.shoot and 0.0 < self.rho < 1.0:
-            path = escape_path(
-                theta - frame, dist, L=self.config.l_min, rho=self.rho, branch=branch
-            )
+            # at most 1,024 RK4 steps (never coarser than the trust limit): near rho = 1
+            # the default step shrinks with the natural length (issue 13: 100-150 ms a
+            # solve at rho 0.99); where it is the default step, the default's arc
+            L = self.config.l_min
+            step = capped_step(dist, L, self.rho) if dist > 0.0 else None
+            path = None
+            if step is not None:
+                path = escape_path(theta - frame, dist, L=L, rho=self.rho, branch=branch, step=step)
             if path is not None:
                 rot = np.array(
                     [[math.cos(frame), -math.sin(frame)], [math.sin(frame), math.cos(frame)]]

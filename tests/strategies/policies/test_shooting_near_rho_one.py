@@ -4,6 +4,8 @@ every step (issue 13: at rho 0.99 each failure cost 100-150 ms on the corridor).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from strategies.policies import make_policy, shooting
@@ -47,3 +49,49 @@ def test_a_failed_arc_is_followed_straight_until_the_replan(monkeypatch):
         assert np.abs(off).max() < 1e-12  # a straight path
         steps = [t for t in range(s + 1, s + evader.replan) if t in kept]
         assert all(kept[t] is shot or kept[t] is None for t in steps)
+
+
+def test_arcs_near_rho_one_are_integrated_at_the_capped_step(monkeypatch):
+    # issue 13: at rho 0.99 the default step (1/32 of the natural length, 0.01 here) took
+    # ~10,000 RK4 steps per integration and 100-150 ms per solve
+    from strategies.control import evasion
+
+    steps: list[tuple[float, float]] = []  # (step, x_e) of each integration
+    real = evasion.integrate_reduced
+
+    def counted(theta0, alpha0, s, L, rho, step, x_target, store, max_steps):
+        steps.append((step, x_target))
+        return real(theta0, alpha0, s, L, rho, step, x_target, store, max_steps)
+
+    monkeypatch.setattr(evasion, "integrate_reduced", counted)
+    evader = make_policy("evader/shooting")
+    run_episode(
+        "corridor", "pursuer/greedy", evader, 0, start="safe", max_cycles=100,
+        overrides={"v_evader": 0.99},
+    )  # fmt: skip
+    assert len(steps) > 100
+    natural = evasion._natural_length(2.0, 0.99)
+    for h, x_e in steps:
+        want = max(evasion.default_step(x_e, 2.0, 0.99), min(natural / 4, x_e / 1024))
+        assert h in (want, 8.0 * want)  # the fine grid or the bracketing coarse one
+        assert want > natural / 32 or x_e <= 32 * natural  # coarser than the default's
+
+
+def test_the_capped_step_is_the_default_up_to_32_natural_lengths():
+    from strategies.control.evasion import _natural_length, capped_step, default_step
+
+    L = 2.0
+    for rho in np.linspace(0.1, 0.99, 90):
+        ell = _natural_length(L, rho)
+        for x in np.linspace(0.01, 4.0, 80) * L:
+            h, d = capped_step(x, L, rho), default_step(x, L, rho)
+            if x <= 32 * ell:
+                assert h == d
+            else:
+                assert d < h <= max(d, ell / 4)
+                assert x / h <= max(1024, 4 * x / ell) * (1 + 1e-12)
+        # the shooting evader's farthest candidate, L (pi rho / (1 + rho) + 2) + one grid
+        # step L / 20: within 32 natural lengths from rho 0.1 to 0.8 (its arcs unchanged)
+        if rho <= 0.8:
+            assert L * (math.pi * rho / (1 + rho) + 2.05) <= 32 * ell
+    assert capped_step(2.0, L, 0.9999) is None  # refused as solve_escape refuses it

@@ -61,6 +61,7 @@ EVAL_SEED_OFFSET = 1_000_003
 
 KEEP_CHECKPOINTS = 2
 _CKPT = re.compile(r"^ckpt_(\d+)\.zip$")
+_BUFFER = re.compile(r"^replay_buffer_(\d+)\.pkl$")
 _PACKAGES = (
     "numpy",
     "torch",
@@ -353,13 +354,22 @@ def _checkpoint(model, config: TrainConfig, out: Path) -> None:
     ckdir = out / "checkpoints"
     ckdir.mkdir(parents=True, exist_ok=True)
     if config.algo == "sac":  # the buffer first: a checkpoint never lacks its buffer
-        tmp = ckdir / "replay_buffer.pkl.tmp"
+        buf = ckdir / f"replay_buffer_{model.num_timesteps}.pkl"
+        tmp = buf.with_name(buf.name + ".tmp")
         model.save_replay_buffer(str(tmp))
-        os.replace(tmp, ckdir / "replay_buffer.pkl")
+        os.replace(tmp, buf)
     _save_model(model, ckdir / f"ckpt_{model.num_timesteps}.zip")
     old = sorted((int(m.group(1)), p) for p in ckdir.iterdir() if (m := _CKPT.match(p.name)))
     for _, p in old[:-KEEP_CHECKPOINTS]:
         p.unlink(missing_ok=True)
+    # each checkpoint has its own buffer: one shared file (replay_buffer.pkl, still read
+    # by older runs) paired an older checkpoint, resumed when the newest was damaged or
+    # not yet written, with the newer buffer
+    kept = {n for n, _ in old[-KEEP_CHECKPOINTS:]}
+    for p in ckdir.iterdir():
+        m = _BUFFER.match(p.name)
+        if (m is not None and int(m.group(1)) not in kept) or p.name == "replay_buffer.pkl":
+            p.unlink(missing_ok=True)
 
 
 # --------------------------------------------------------------------------- training
@@ -410,7 +420,9 @@ def train(
     resumed_from = None
     if ckpt is not None:
         done, path, model = ckpt
-        buf = out / "checkpoints" / "replay_buffer.pkl"
+        buf = out / "checkpoints" / f"replay_buffer_{done}.pkl"
+        if config.algo == "sac" and not buf.is_file():
+            buf = out / "checkpoints" / "replay_buffer.pkl"  # a run of an older surveil
         if config.algo == "sac" and buf.is_file():
             model.load_replay_buffer(str(buf))
         model.set_random_seed(config.seed + done)

@@ -209,3 +209,33 @@ def test_an_interrupted_run_says_what_it_kept_and_the_rerun_resumes(tmp_path, ca
     monkeypatch.setattr(training.cli, "train", real)
     assert cli_train([str(cfg)]) == 0
     assert f"(resumed from ckpt_{kept.group(1)}.zip)" in capsys.readouterr().out
+
+
+def test_sac_resumes_an_older_checkpoint_with_its_own_replay_buffer(tiny):
+    # one replay_buffer.pkl served every checkpoint: resumed from ckpt_40 (ckpt_80
+    # damaged), SAC read the buffer of 80 steps, transitions its state had not seen
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    class BufferAtStart(BaseCallback):
+        def _on_training_start(self) -> None:
+            seen.append(self.model.replay_buffer.size())
+
+        def _on_step(self) -> bool:
+            return True
+
+    config = tiny(role="evader", opponent="pursuer/greedy", algo="sac", total_timesteps=120,
+                  batch_size=16, checkpoint_freq=40, eval_episodes=0,
+                  algo_kwargs={"buffer_size": 500, "learning_starts": 20})  # fmt: skip
+    with pytest.raises(KeyboardInterrupt):
+        train(config, callbacks=[Interrupt(at=90)])
+    ckdir = Path(config.output_dir) / "checkpoints"
+    newest = ckdir / "ckpt_80.zip"
+    newest.write_bytes(newest.read_bytes()[:200])  # truncated by a crash
+    seen: list[int] = []
+    with pytest.warns(CheckpointWarning, match="ckpt_80.zip"):
+        result = train(config, callbacks=[BufferAtStart()])
+    assert result.resumed_from.name == "ckpt_40.zip" and seen == [40]
+    assert sorted(p.name for p in ckdir.glob("replay_buffer*")) == [
+        "replay_buffer_120.pkl",
+        "replay_buffer_80.pkl",
+    ]  # the buffers of the two checkpoints kept

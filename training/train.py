@@ -584,6 +584,9 @@ def evaluate_model(
     """
     if isinstance(episodes, bool) or not isinstance(episodes, int) or episodes < 1:
         raise InvalidConfigError(f"episodes: expected an integer >= 1, got {episodes!r}")
+    from envs import validation
+
+    validation.integer("seed", seed, minimum=0)  # was numpy's "expected non-negative integer"
     if isinstance(path, Policy):
         learner = path
         if role is None or map is None:

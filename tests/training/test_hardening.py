@@ -23,7 +23,7 @@ from strategies.policies import make_policy
 from tests.training.test_train import Interrupt
 from training.cli import cli_train
 from training.config import TrainConfig
-from training.train import CheckpointWarning, latest_checkpoint, train
+from training.train import CheckpointWarning, evaluate_model, latest_checkpoint, train
 from training.zoo.__main__ import main as zoo_main
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -125,6 +125,12 @@ def test_an_output_dir_that_is_a_file_is_refused_before_training(tmp_path, capsy
     assert err.count("\n") == 1
 
 
+def zoo_dir_model(name):
+    from training import zoo
+
+    return zoo.model_path(name)
+
+
 def test_python_m_training_zoo_reports_bad_input_in_one_line(capsys):
     assert zoo_main(["info", "no_such_model"]) == 2
     assert "unknown zoo model 'no_such_model'" in capsys.readouterr().err
@@ -132,6 +138,17 @@ def test_python_m_training_zoo_reports_bad_input_in_one_line(capsys):
     assert zoo_main(["evaluate", name, "--opponent", "evader/nope", "--episodes", "1"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("python -m training.zoo: error:") and "evader/nope" in err
+    # --seed -3 was numpy's ValueError traceback; --episodes 0 said "episodes"
+    for flag, value, expected in [("--seed", "-3", ">= 0"), ("--episodes", "0", ">= 1")]:
+        argv = ["evaluate", name, "--opponent", "evader/straight", "--episodes", "1"]
+        assert zoo_main([*argv, flag, value]) == 2
+        err = capsys.readouterr().err
+        assert (
+            err
+            == f"python -m training.zoo: error: {flag} = {value}: expected an integer {expected}\n"
+        )
+    with pytest.raises(InvalidConfigError, match="seed = -1: expected an integer >= 0"):
+        evaluate_model(zoo_dir_model(name), "evader/straight", episodes=1, seed=-1)
 
 
 def test_the_entry_points_run_as_modules(tmp_path):

@@ -58,6 +58,11 @@ def _main(argv: list[str] | None) -> int:
         if r.evaluation is not None:
             print(_line(r.evaluation))
     else:
+        from envs import validation
+
+        # named as the flags (was "episodes: ..." and, for --seed -3, numpy's traceback)
+        validation.integer("--episodes", args.episodes, minimum=1)
+        validation.integer("--seed", args.seed, minimum=0)
         ev = evaluate_model(
             zoo.model_path(args.name),
             args.opponent,

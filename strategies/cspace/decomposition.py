@@ -40,7 +40,26 @@ from strategies.cspace._arcs import StopPair, pairs
 from strategies.cspace.curves import CriticalCurve, _check_map, check_length
 from strategies.cspace.tolerances import diameter, min_length
 
-__all__ = ["Boundary", "Cell", "CellArc", "Decomposition", "Region", "decompose"]
+__all__ = [
+    "Boundary",
+    "Cell",
+    "CellArc",
+    "Decomposition",
+    "Region",
+    "decompose",
+    "largest_first",
+]
+
+
+def largest_first(regions) -> tuple[int, ...]:
+    """The ids of ``regions``, largest area first; areas equal to 1e-9 of the largest
+    (mirror images, whose computed areas differ in the last bits) in id order, so that
+    which of two mirror rooms comes first does not hang on rounding."""
+    regions = list(regions)
+    if not regions:
+        return ()
+    quantum = 1e-9 * max(r.area for r in regions)
+    return tuple(r.id for r in sorted(regions, key=lambda r: (-round(r.area / quantum), r.id)))
 
 
 @dataclass(frozen=True)
@@ -268,11 +287,9 @@ class Decomposition:
         rounding (at L = 2 the two_rooms' middles have areas 36.021165555610615 and
         36.02116555561061, and Fig. 6's evader walked to whichever came first).
         """
-        w = [r for r in self.regions if all(self.cells[c].escapable for c in r.cells)]
-        if not w:
-            return ()
-        quantum = 1e-9 * max(r.area for r in w)
-        return tuple(r.id for r in sorted(w, key=lambda r: (-round(r.area / quantum), r.id)))
+        return largest_first(
+            [r for r in self.regions if all(self.cells[c].escapable for c in r.cells)]
+        )
 
     @property
     def evader_wins(self) -> bool:

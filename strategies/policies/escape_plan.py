@@ -34,6 +34,7 @@ from scipy.sparse.csgraph import breadth_first_order
 
 from envs.maps import Map
 from strategies.cspace import Decomposition, decompose
+from strategies.cspace.decomposition import largest_first
 from strategies.policies.safety import SafetyTable, grid_points
 
 __all__ = ["CROSS_REL", "EscapePlan", "Witness", "escape_plan", "escape_ranks"]
@@ -573,8 +574,7 @@ def body_witness_regions(dec: Decomposition, clearance: float) -> tuple[int, ...
     """
     rank, _ = escape_ranks(dec, _narrow(dec, clearance))
     ok = (rank >= 0) & (rank < len(dec.cells))
-    w = [r for r in dec.regions if all(ok[c] for c in r.cells)]
-    return tuple(r.id for r in sorted(w, key=lambda r: -r.area))
+    return largest_first(r for r in dec.regions if all(ok[c] for c in r.cells))
 
 
 @functools.lru_cache(maxsize=8)

@@ -23,6 +23,7 @@
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 
 import networkx as nx
@@ -258,8 +259,8 @@ def test_body_witness_regions_are_prop_2_for_the_disc(name, length, kind):
     want = [r.id for r in dec.regions if all(c in ok for c in r.cells)]
     got = body_witness_regions(dec, 0.1)
     assert sorted(got) == sorted(want)
-    areas = [dec.regions[r].area for r in got]
-    assert areas == sorted(areas, reverse=True)
+    areas = [dec.regions[r].area for r in got]  # largest first, ties (1e-9) in id order
+    assert all(a >= b - 1e-9 * areas[0] for a, b in itertools.pairwise(areas))
     n = len(dec.witness_regions)
     assert n  # Prop. 2 holds for the point evader on all three
     assert {"none": len(got) == 0, "all": got == dec.witness_regions,

@@ -66,14 +66,26 @@ def run_train(args: argparse.Namespace) -> int:
             )
         from training.dagger import dagger
 
-        r = dagger(config, verbose=True)
+        try:
+            r = dagger(config, verbose=True)
+        except KeyboardInterrupt:
+            print(_dagger_resume_note(config), file=sys.stderr)
+            raise
         print(f"dagger {config.role}: {r.samples[-1]} labelled states, disagreement "
               f"{r.disagreement[0]:.3f} -> {r.disagreement[-1]:.3f} -> {r.model_path}")  # fmt: skip
         return 0
     if args.timesteps is not None:
         config = config.replace(total_timesteps=args.timesteps)
     if args.self_play:
-        results = self_play(config, args.self_play, progress_bar=args.progress).stages
+        try:
+            results = self_play(config, args.self_play, progress_bar=args.progress).stages
+        except KeyboardInterrupt:
+            print(
+                "stopped: rerun the same command to resume (finished stages are kept, the "
+                f"interrupted one continues from its checkpoints under {config.output_dir})",
+                file=sys.stderr,
+            )
+            raise
     else:
         try:
             results = (train(config, progress_bar=args.progress),)
@@ -97,6 +109,23 @@ def resume_note(config: TrainConfig) -> str:
     return (
         f"stopped: {done:,} of {config.total_timesteps:,} timesteps are in {path}; rerun the "
         "same command to resume from there"
+    )
+
+
+def _dagger_resume_note(config) -> str:
+    """What an interrupted DAgger run kept (its finished iterations), for the terminal."""
+    import json
+
+    progress = Path(config.output_dir) / "progress.json"
+    try:
+        done = len(json.loads(progress.read_text())["samples"])
+    except (OSError, ValueError, KeyError, TypeError):
+        done = 0
+    if done == 0:
+        return "stopped before the first iteration finished: a rerun starts over"
+    return (
+        f"stopped: {done} of {config.iterations} iterations are in {config.output_dir}; "
+        "rerun the same command to resume from there"
     )
 
 

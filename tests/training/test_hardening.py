@@ -256,3 +256,36 @@ def test_sac_resumes_an_older_checkpoint_with_its_own_replay_buffer(tiny):
         "replay_buffer_120.pkl",
         "replay_buffer_80.pkl",
     ]  # the buffers of the two checkpoints kept
+
+
+def test_interrupted_dagger_and_self_play_say_a_rerun_resumes(tmp_path, capsys, monkeypatch):
+    # both printed only "interrupted", though both resume (per iteration, per stage)
+    import training.cli
+    import training.dagger
+
+    rl = tmp_path / "rl.toml"
+    rl.write_text(
+        f'role = "pursuer"\nopponent = "evader/straight"\noutput_dir = "{tmp_path / "sp"}"\n'
+    )
+    dag = tmp_path / "dag.toml"
+    dag.write_text(
+        'method = "dagger"\nrole = "pursuer"\nexpert = "pursuer/greedy"\n'
+        f'opponent = "evader/straight"\niterations = 5\noutput_dir = "{tmp_path / "dg"}"\n'
+    )
+
+    def stop(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    def stop_after_two(cfg, **kwargs):
+        out = Path(cfg.output_dir)
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "progress.json").write_text('{"samples": [10, 20]}')
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(training.cli, "self_play", stop)
+    assert cli_train([str(rl), "--self-play", "2"]) == 130
+    assert "stopped: rerun the same command to resume" in capsys.readouterr().err
+    monkeypatch.setattr(training.dagger, "dagger", stop_after_two)
+    assert cli_train([str(dag)]) == 130
+    err = capsys.readouterr().err
+    assert f"stopped: 2 of 5 iterations are in {tmp_path / 'dg'}; rerun the same" in err

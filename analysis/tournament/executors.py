@@ -330,7 +330,8 @@ class RayExecutor(Executor):
     Args:
         address: a running cluster (``"auto"``, ``"ray://host:10001"``...); ``None``
             starts a local instance with ``num_cpus`` CPUs (shut down by :meth:`close`).
-        num_cpus: CPUs of a local instance (default: all).
+        num_cpus: CPUs of a local instance (default: all); with ``address``, or when Ray
+            is already initialised, the most CPUs this run's tasks occupy at once.
 
     Up to two tasks per CPU are in flight, so a task may wait in Ray's queue; its deadline
     (its batch at the time limit plus one second a match, plus :data:`KILL_GRACE`) is
@@ -366,11 +367,19 @@ class RayExecutor(Executor):
                 kwargs["num_cpus"] = num_cpus
             ray.init(address=address, **kwargs)
             self.started = True
-        self.cpus = max(1, int(ray.cluster_resources().get("CPU", 1)))
+        self.cluster_cpus = max(1, int(ray.cluster_resources().get("CPU", 1)))
+        # num_cpus also caps the work in flight on a cluster (--address) or on an instance
+        # this process had started: it was ignored there, and every CPU was used
+        self.cpus = self.cluster_cpus if num_cpus is None else min(num_cpus, self.cluster_cpus)
+        # two tasks a CPU keep every CPU fed; under a cap, as many as it allows (a queued
+        # second task would run on a CPU of the cluster's beyond it)
+        self.max_inflight = 2 * self.cpus if self.cpus == self.cluster_cpus else self.cpus
         self.task = ray.remote(num_cpus=1, max_retries=0)(_ray_play)
         self.inflight: dict[Any, tuple[list[Match], float]] = {}  # ref: (batch, deadline)
 
     def describe(self) -> str:
+        if self.cpus < self.cluster_cpus:
+            return f"ray ({self.cpus} of {self.cluster_cpus} CPUs)"
         return f"ray ({self.cpus} CPUs)"
 
     def run(self, matches: Sequence[Match], ctx: Context, stop: threading.Event) -> Iterator[dict]:
@@ -388,7 +397,7 @@ class RayExecutor(Executor):
         batcher = _Batcher(self.cpus)
         solo: set[str] = set()  # matches of a timed-out batch, replayed one by one
         while (todo or self.inflight) and not stop.is_set():
-            while todo and len(self.inflight) < 2 * self.cpus:
+            while todo and len(self.inflight) < self.max_inflight:
                 n = 1 if todo[0].match_id in solo else batcher.size(len(todo))
                 batch = [todo.popleft() for _ in range(min(n, len(todo)))]
                 # a task may wait in Ray's queue until the tasks running now end: at most

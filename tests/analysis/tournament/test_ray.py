@@ -161,3 +161,20 @@ def test_a_deaf_hang_is_killed_and_the_match_queued_behind_it_plays(tmp_path, te
     assert len(deaf) == 2 and all(r["status"] == "error" and "killed" in r["error"] for r in deaf)
     played = [r for r in rows if r["evader"] == "evader/random"]
     assert len(played) == 2 and all(r["status"] == "ok" for r in played), played
+
+
+def test_workers_cap_the_cpus_used_on_an_instance_already_running():
+    # with --address (or a Ray this process had started) --workers was ignored: every
+    # CPU of the cluster was used
+    from analysis.tournament.executors import RayExecutor
+
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    try:
+        ex = RayExecutor(num_cpus=1)
+        assert ex.cpus == 1 and ex.describe() == "ray (1 of 2 CPUs)" and ex.max_inflight == 1
+        assert RayExecutor().describe() == "ray (2 CPUs)"
+        assert RayExecutor(num_cpus=5).cpus == 2
+        ex.close()
+        assert ray.is_initialized()  # not started by the executor: not shut down by it
+    finally:
+        ray.shutdown()

@@ -446,7 +446,11 @@ def train(
             reset_num_timesteps=resumed_from is None,
             progress_bar=progress_bar,
         )
-    _save_model(model, model_path)
+    # model.zip is replaced only beside its provenance, at the end: written first, an
+    # interrupt during the evaluation left an extended run's model beside the shorter
+    # run's provenance, and a rerun at the shorter length returned it as that model
+    pending = out / "model.next.zip"
+    _save_model(model, pending)
     timesteps = int(model.num_timesteps)
     if remaining > 0:  # the final state is a checkpoint too: a longer rerun continues it
         _checkpoint(model, config, out)
@@ -455,7 +459,7 @@ def train(
 
     evaluation = None
     if config.eval_episodes > 0:
-        learner = make_policy(f"{config.role}/sb3:{model_path}", algo=config.algo.upper())
+        learner = make_policy(f"{config.role}/sb3:{pending}", algo=config.algo.upper())
         evaluation = evaluate_model(
             learner,
             config.opponent_policy(),
@@ -499,6 +503,7 @@ def train(
     if previous is not None and not history:  # written before histories were kept
         history = [{k: previous.get(k) for k in segment}]
     provenance["history"] = [*history, segment]
+    os.replace(pending, model_path)
     _atomic_write(prov_path, json.dumps(provenance, indent=2) + "\n")
     return TrainResult(
         config, out, model_path, prov_path, timesteps, wall, resumed_from, evaluation

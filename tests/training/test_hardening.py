@@ -23,7 +23,13 @@ from strategies.policies import make_policy
 from tests.training.test_train import Interrupt
 from training.cli import cli_train
 from training.config import TrainConfig
-from training.train import CheckpointWarning, evaluate_model, latest_checkpoint, train
+from training.train import (
+    CheckpointWarning,
+    evaluate_model,
+    latest_checkpoint,
+    read_provenance,
+    train,
+)
 from training.zoo.__main__ import main as zoo_main
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -289,3 +295,35 @@ def test_interrupted_dagger_and_self_play_say_a_rerun_resumes(tmp_path, capsys, 
     assert cli_train([str(dag)]) == 130
     err = capsys.readouterr().err
     assert f"stopped: 2 of 5 iterations are in {tmp_path / 'dg'}; rerun the same" in err
+
+
+def test_an_extension_interrupted_in_its_evaluation_leaves_model_and_provenance_matched(
+    tiny, monkeypatch
+):
+    # model.zip was replaced before the evaluation: a Ctrl-C there left the 256-step model
+    # beside the 128-step provenance, and a rerun at 128 returned it as the 128-step model
+    import hashlib
+    import importlib
+
+    T = importlib.import_module("training.train")
+    first = train(tiny(total_timesteps=128, eval_episodes=2))
+
+    def digest():
+        return hashlib.sha256(first.model_path.read_bytes()).hexdigest()
+
+    before = digest()
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(T, "evaluate_model", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        train(tiny(total_timesteps=256, eval_episodes=2))
+    monkeypatch.undo()
+    assert digest() == before and read_provenance(first.model_path)["timesteps"] == 128
+    assert train(tiny(total_timesteps=128, eval_episodes=2)).timesteps == 128
+    assert digest() == before
+    longer = train(tiny(total_timesteps=256, eval_episodes=2))  # resumes the final checkpoint
+    assert longer.timesteps == 256 and digest() != before
+    assert read_provenance(first.model_path)["timesteps"] == 256
+    assert not (first.model_path.parent / "model.next.zip").exists()

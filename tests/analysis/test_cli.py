@@ -138,6 +138,7 @@ def test_policies_lists_the_registry_and_play_takes_parameters(tmp_path, capsys)
     out = capsys.readouterr().out
     assert all(name in out for name in policy_names("evader"))
     assert "pursuer/greedy" not in out
+    assert "zoo:NAME (python -m training.zoo list)" in out  # as play takes them (e0e30f8)
     argv = [
         "play",
         "--map",

@@ -36,6 +36,7 @@ from analysis.tournament.worker import Context, play, play_batch
 __all__ = [
     "BACKENDS",
     "KILL_GRACE",
+    "RAY_START_GRACE",
     "TARGET_BATCH_SECONDS",
     "Executor",
     "ProcessExecutor",
@@ -50,6 +51,11 @@ TARGET_BATCH_SECONDS = 1.0
 """Aim for tasks of about this long (fewer messages; Ray's per-task cost is ~ms)."""
 KILL_GRACE = 5.0
 """Seconds past a match's time limit before its worker process is killed."""
+RAY_START_GRACE = 30.0
+"""Seconds a Ray task is also given for a fresh worker's start: the imports and the
+context's unpickling before its first match, 1.2 s on an idle machine (measured), several
+at load 9 on 2 cores; timed from submission, they ate KILL_GRACE and a quick match was
+stored as an overrun. A hang that ignores signals is killed this much later."""
 POLL = 0.1
 """Seconds between checks of the stop event and the deadlines."""
 
@@ -333,16 +339,27 @@ class RayExecutor(Executor):
         num_cpus: CPUs of a local instance (default: all); with ``address``, or when Ray
             is already initialised, the most CPUs this run's tasks occupy at once.
 
+        start_grace: seconds added to every task's deadline for a worker's start
+            (default :data:`RAY_START_GRACE`).
+
     Up to two tasks per CPU are in flight, so a task may wait in Ray's queue; its deadline
-    (its batch at the time limit plus one second a match, plus :data:`KILL_GRACE`) is
-    extended by the longest batch in flight when it was submitted, and restarted for every
-    task in flight when a hung task's worker is killed (a queued task may be waiting for
-    that CPU and a new worker). On a cluster shared with other jobs a wait can be longer.
+    (its batch at the time limit plus one second a match, plus :data:`KILL_GRACE` and
+    ``start_grace``) is extended by the longest batch in flight when it was submitted, and
+    restarted for every task in flight when a hung task's worker is killed (a queued task
+    may be waiting for that CPU and a new worker). On a cluster shared with other jobs a
+    wait can be longer.
     """
 
     name = "ray"
 
-    def __init__(self, address: str | None = None, num_cpus: int | None = None) -> None:
+    def __init__(
+        self,
+        address: str | None = None,
+        num_cpus: int | None = None,
+        *,
+        start_grace: float = RAY_START_GRACE,
+    ) -> None:
+        self.start_grace = float(start_grace)
         if num_cpus is not None:
             from envs.validation import integer
 
@@ -405,6 +422,7 @@ class RayExecutor(Executor):
                 # a match queued behind a hang was killed as an overrun it never made)
                 ahead = max((len(b) for b, _ in self.inflight.values()), default=0)
                 slack = (len(batch) + ahead) * (ctx.time_limit + 1.0) + KILL_GRACE
+                slack += self.start_grace  # the worker it lands on may be starting
                 ref = self.task.remote(batch, box)
                 self.inflight[ref] = (batch, time.monotonic() + slack)
             done, _ = ray.wait(list(self.inflight), num_returns=1, timeout=POLL)
@@ -437,6 +455,7 @@ class RayExecutor(Executor):
                     # in a new worker, so every task in flight gets its full time again
                     for other, (b, d) in self.inflight.items():
                         fresh = now + len(b) * (ctx.time_limit + 1.0) + KILL_GRACE
+                        fresh += self.start_grace
                         self.inflight[other] = (b, max(d, fresh))
                     if len(batch) > 1:  # isolate the hanging match
                         solo.update(m.match_id for m in batch)

@@ -150,7 +150,7 @@ def test_a_deaf_hang_is_killed_and_the_match_queued_behind_it_plays(tmp_path, te
     }
     from analysis.tournament.executors import RayExecutor
 
-    ex = RayExecutor(num_cpus=2)
+    ex = RayExecutor(num_cpus=2, start_grace=10.0)  # the default 30 s: a slower test
     try:
         s = run_tournament(spec_from_dict(d), tmp_path / "r.sqlite", executor=ex, progress=False)
     finally:
@@ -178,3 +178,57 @@ def test_workers_cap_the_cpus_used_on_an_instance_already_running():
         assert ray.is_initialized()  # not started by the executor: not shut down by it
     finally:
         ray.shutdown()
+
+
+def test_a_slow_worker_start_is_not_counted_as_an_overrun(tmp_path, monkeypatch):
+    # A fresh Ray worker imports surveil and unpickles the run's context before its first
+    # match (1.2 s idle, several seconds at load 9 on 2 cores); the deadline counted that
+    # against the match's KILL_GRACE = 5 s, and a 0.1 s match was stored as an overrun
+    # (seen once in a full suite). Simulated: a context that takes 8 s to unpickle.
+    from analysis.tournament.executors import RayExecutor
+    from strategies.policies import registry
+    from strategies.policies.baselines import RandomPolicy
+
+    def slow_rebuild():
+        time.sleep(8.0)
+        return RandomPolicy
+
+    def _slow_factory(rebuild):  # local, like slow_rebuild: shipped by value
+        cls = rebuild()
+
+        def factory(**kwargs):
+            return cls(**kwargs)
+
+        return factory
+
+    class SlowToShip:  # a factory whose unpickling takes 8 s (cloudpickle ships it by value)
+        def __call__(self, **kwargs):
+            return RandomPolicy(**kwargs)
+
+        def __reduce__(self):
+            return (_slow_factory, (slow_rebuild,))
+
+    registry.policy_names()
+    monkeypatch.setitem(
+        registry._REGISTRY,
+        "evader/slow_ship",
+        registry.PolicySpec("evader/slow_ship", SlowToShip(), "slow to unpickle"),
+    )
+    d = {
+        "name": "slow_start",
+        "maps": ["open_room"],
+        "pursuers": ["pursuer/greedy"],
+        "evaders": ["evader/slow_ship"],
+        "seeds": 1,
+        "start": "valid",
+        "time_limit": 1,
+        "env": {"max_cycles": 10},
+    }
+    ex = RayExecutor(num_cpus=1)
+    try:
+        s = run_tournament(spec_from_dict(d), tmp_path / "r.sqlite", executor=ex, progress=False)
+    finally:
+        ex.close()
+    with Store(tmp_path / "r.sqlite") as db:
+        (row,) = db.rows(s.run_id)
+    assert row["status"] == "ok", row["error"]

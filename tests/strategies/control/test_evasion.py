@@ -12,7 +12,13 @@ from scipy.interpolate import CubicSpline
 from scipy.optimize import minimize, minimize_scalar
 
 from envs.errors import InfeasibleError, SurveilValueError
-from strategies.control.evasion import escape_path, greedy_heading, shoot, solve_escape
+from strategies.control.evasion import (
+    capped_step,
+    escape_path,
+    greedy_heading,
+    shoot,
+    solve_escape,
+)
 from strategies.control.hamiltonian import f2
 
 FIG11A = {"theta0": math.pi, "lambda1": -1.0, "lambda2_0": 0.41}
@@ -469,3 +475,64 @@ def test_a_failed_escape_at_a_coarse_step_says_the_step_may_be_why():
     sol = solve_escape(math.pi, 2.0, L=1.0, rho=0.5, step=0.5)
     assert not sol.success
     assert "the step 0.5 is too coarse" in sol.reason and "natural length 0.333" in sol.reason
+
+
+def _counting(monkeypatch):
+    from strategies.control import evasion
+
+    runs = []
+    real = evasion.integrate_reduced
+
+    def counted(*args):
+        runs.append(args[1])
+        return real(*args)
+
+    monkeypatch.setattr(evasion, "integrate_reduced", counted)
+    return runs
+
+
+def test_a_solve_without_an_arc_stops_brent_at_the_jump(monkeypatch):
+    # near rho = 1 the sign changes of y(x_e) are jumps to turned-back arcs (THEORY §4.3);
+    # Brent closed on each to 1e-13, 73 integrations to return None (issue 13)
+    from strategies.control import evasion
+
+    runs = _counting(monkeypatch)
+    step = evasion.capped_step(2.0, 2.0, 0.99)
+    assert escape_path(0.0, 2.0, L=2.0, rho=0.99, branch="+", step=step) is None
+    assert len(runs) <= 40
+    n = len(runs)
+    monkeypatch.setattr(evasion, "_JUMP_WIDTH", 0.0)  # no certificate: Brent to the end
+    assert escape_path(0.0, 2.0, L=2.0, rho=0.99, branch="+", step=step) is None
+    assert len(runs) - n >= 70
+
+
+def test_the_jump_certificate_changes_no_solve(monkeypatch):
+    # the certificate stops only brackets that close on a jump: every solve (the shooting
+    # evader's capped step, rho 0.9-0.99) gives the same arc bit for bit, or None as before
+    from strategies.control import evasion
+
+    runs = _counting(monkeypatch)
+    rng = np.random.default_rng(83)
+    probs = [
+        (rng.uniform(-math.pi, math.pi), rng.uniform(0.3, 3.2), rho, "+-"[rng.integers(2)])
+        for rho in (0.9, 0.95, 0.97, 0.99)
+        for _ in range(8)
+    ]
+    counts, paths = [], []
+    for width in (evasion._JUMP_WIDTH, 0.0):
+        monkeypatch.setattr(evasion, "_JUMP_WIDTH", width)
+        del runs[:]
+        paths.append(
+            [
+                escape_path(th, x_e, L=2.0, rho=rho, branch=b, step=capped_step(x_e, 2.0, rho))
+                for th, x_e, rho, b in probs
+            ]
+        )
+        counts.append(len(runs))
+    found = 0
+    for new, old in zip(*paths, strict=True):
+        assert (new is None) == (old is None)
+        if new is not None:
+            found += 1
+            assert new.tobytes() == old.tobytes()
+    assert 0 < found < len(probs) and counts[0] < counts[1]  # both kinds, and it stopped some

@@ -1,11 +1,6 @@
 """
 # Surveillance (finite sensor range), v0 (retired: use `surveillance_v1`)
 
-v0 sweeps every step along the chord between its two frames, also when a wall stopped
-or deflected a body within the step, where it can miss a break or time it late; v1
-sweeps such a step along the physics' path and is otherwise the same env. v0 stays
-importable so that results recorded with it replay.
-
 | Import               | `from envs import surveillance_v0`                          |
 |----------------------|-------------------------------------------------------------|
 | Registry ids         | `surveil/surveillance-v0` (`"parallel"` and `"aec"`)        |
@@ -18,108 +13,14 @@ importable so that results recorded with it replay.
 | Observation values   | float32 Box, finite bounds (see `observations.py`)          |
 | State shape          | (13,), the `"state"` observation                            |
 
-A pursuer must keep an evader in sight in a polygonal world (Murrieta-Cid et al., IJRR
-2007). Surveillance holds while the segment pursuer-evader (the rod) touches no wall and
-`l_min <= |P - E| <= l_max`. The check is continuous in time: both agents move linearly
-within a step, and a rod that sweeps across an obstacle corner between two frames
-breaks surveillance even if both frames are clear. The evader wins the moment
-surveillance breaks (the episode *terminates* for both agents); the pursuer wins if it
-holds for `max_cycles` steps (the episode is *truncated*).
-
-Both agents are discs of radius `body_radius` simulated with pymunk: static walls, no
-collision between the two agents, velocity commands, sliding along walls, no
-tunnelling, and the disc centres (the rod's ends) never leave free space.
-
-### Actions
-
-A (2,) velocity in units of the agent's speed bound (`v_pursuer`, `v_evader`). Finite
-values outside [-1, 1] are clipped to the Box and then onto the unit disc (the bound is
-on the speed, so a Box corner does not give sqrt(2) times the bound); NaN or inf raise
-`InvalidActionError` naming the agent, as does a wrong shape or a missing action.
-
-### Observations
-
-`observation="state"`: the full state, identical for both agents, laid out as
-`envs.surveillance.observations.STATE_LAYOUT`: positions (map bounds onto [-1, 1]),
-realised velocities (/ speed bound), (cos theta, sin theta) with theta the direction from
-evader to pursuer, distance / l_max, the visibility bit, steps / max_cycles. Decode with
-`envs.surveillance.decode_state(obs, env.config)`.
-
-`observation="lidar"`: `n_rays` egocentric ray distances / lidar range, the other
-agent's relative position / l_max (zeros and a 0 mask bit when surveillance does not
-hold), the agent's realised velocity, the visibility bit, the time fraction
-(`envs.surveillance.lidar_layout(n_rays)`).
-
-`observation="lidar_track"`: the lidar plus the other agent's realised velocity / its speed
-bound, after the relative position (zeros when surveillance does not hold), as a tracker
-locked on the target reports it (`lidar_layout(n_rays, track=True)`). Added in v0 without
-changing the other kinds.
-
-### Rewards
-
-`reward="zero_sum"`: pursuer +1/max_cycles per step with surveillance held throughout,
--1 on escape; `reward="sparse"`: -1 on escape, +1 at the horizon if surveillance held.
-The evader always receives the negation. `info` carries `reward_surveillance`,
-`reward_escape` and `reward_horizon`.
-
-### Infos
-
-Every step: `surveillance` (held throughout the step), `distance`, `theta`, `step`,
-`time`. When surveillance breaks: `cause` (`"occluded"`, `"too_far"`, `"too_close"`),
-`feature` (the occluding wall feature as described by `Map.describe`, else None),
-`break_time` (fraction of the step in [0, 1]) and `break_at` (absolute time).
-
-### Starts
-
-`reset(options={"pursuer": (x, y), "evader": (x, y)})` places the agents exactly
-(`InvalidPlacementError` names the positions and the reason otherwise). Without it the
-start is drawn with the env's generator: evader uniform, theta uniform, L uniform in
-`[l_min + m, l_max - m]`, rejected until both discs fit in free space, the pursuer sees
-the evader and no convex obstacle corner is near the rod, so that a random start
-survives any actions for `spawn_margin_steps` steps.
-
-### Arguments
-
-``` python
-surveillance_v0.parallel_env(map="corridor", l_min=None, l_max=None, v_pursuer=None,
-    v_evader=None, dt=0.1, max_cycles=500, observation="state", n_rays=32,
-    lidar_range=None, reward="zero_sum", body_radius=0.1, spawn_margin_steps=3,
-    render_mode=None)
-```
-
-The three factories share one signature, derived from the fields of
-`envs.surveillance.config.EnvConfig` (`inspect.signature` shows it); a misspelt option is
-a `TypeError` that suggests the closest name.
-
-`map`: a `Map`, a built-in name (`envs.maps.builtin_names()`) or a map file path.
-
-`l_min`, `l_max`: the sensor range, 0 < l_min < l_max.
-
-`v_pursuer`, `v_evader`: speed bounds (> 0); rho = v_evader / v_pursuer. rho > 1 is legal
-but raises a `RhoAboveOneWarning`: escape is then trivial for the evader (Sec. 5).
-
-`None` for `l_min`, `l_max`, `v_pursuer` or `v_evader` takes the value the map recommends:
-a built-in map named by a string brings its own (`envs.maps.builtin_info(name).params()`);
-a `Map` object or a map file gets L_min = 2, L_max = 4, V_p = 1, V_e = 0.5. Explicit
-arguments always win. Every built-in map recommends these same values today (a test says
-so): changing a built-in's recommendation changes this version's behaviour and needs a
-new version.
-
-`dt`: step duration. `max_cycles`: steps before truncation.
-
-`observation`: `"state"`, `"lidar"` or `"lidar_track"`. `n_rays` (at most 4096),
-`lidar_range` (default `l_max`): lidar.
-
-`reward`: `"zero_sum"` or `"sparse"`.
-
-`body_radius`: disc radius, in (0, l_min / 2).
-
-`spawn_margin_steps`: how many steps a random start survives whatever the actions.
-
-`render_mode`: `None`, `"human"` or `"rgb_array"`.
-
-`step()` before `reset()` or after the episode ended raises `EpisodeStateError`; loop
-`while env.agents:`.
+Every argument, space, reward, info and start is v1's: see the card of
+:mod:`envs.surveillance_v1` (same signature: ``surveillance_v0.parallel_env(map="corridor",
+...)``). The one difference: v0's continuous check takes both agents to move linearly
+within a step, so a step in which a wall stopped or deflected a body is swept along the
+chord between its two frames (at dt = 10 on the corridor, a pursuer stopped by a wall
+after 0.4 s had its range break timed at 1.85 s, the truth 1.2 s; at dt = 0.1 an
+occlusion at a middle substep with both frames clear is missed). v0 stays importable so
+that results recorded with it replay.
 
 ### Version History
 

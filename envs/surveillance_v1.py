@@ -118,6 +118,10 @@ new version.
 `step()` before `reset()` or after the episode ended raises `EpisodeStateError`; loop
 `while env.agents:`.
 
+`copy.deepcopy(env)` mid-episode gives an env that continues the episode independently,
+bit for bit as the original would (a lookahead); `pickle` rebuilds the env from its
+arguments (EzPickle), so an unpickled env starts unreset.
+
 ### Version History
 
 * v1: a step in which a wall stopped or deflected a body is swept along the path

@@ -9,6 +9,7 @@ which differs only in how a step in which a wall bent a body's path is swept
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import inspect
 import math
@@ -139,6 +140,27 @@ class parallel_env(ParallelEnv, EzPickle):
         self._ended_at: str | None = None  # why the last episode ended; None before reset
         self._trail: tuple[list, list] = ([], [])
         self._renderer = None
+
+    def __deepcopy__(self, memo: dict) -> parallel_env:
+        """A copy that carries the episode on: positions, the pymunk world (contacts and
+        all, so a contact step continues as in the original), the step count and the
+        generator; stepping both with the same actions gives the same results bit for
+        bit. The map, its kernel and the config are immutable and shared; a window is
+        not copied (the copy opens its own on ``render()``).
+
+        ``pickle`` still rebuilds the env from its arguments (EzPickle, as vector envs
+        and process pools expect): an unpickled env starts unreset. Without this method
+        ``copy.deepcopy`` did the same, so a copy taken mid-episode (a lookahead) raised
+        "step() before reset()".
+        """
+        cls = type(self)
+        new = cls.__new__(cls)
+        memo[id(self)] = new
+        for shared in (self.config, self.map, self.kernel):
+            memo[id(shared)] = shared
+        for key, value in self.__dict__.items():
+            new.__dict__[key] = None if key == "_renderer" else copy.deepcopy(value, memo)
+        return new
 
     # ------------------------------------------------------------------ spaces
     def observation_space(self, agent: str) -> Box:

@@ -168,6 +168,9 @@ class World:
         self._carry = False  # one in the last substep of the previous step
         self._at = (self._pursuer.position, self._evader.position)
         self.space = space
+        # the episode so far, for __deepcopy__: its start and each step's commands
+        self._start = ((float(pursuer[0]), float(pursuer[1])), (float(evader[0]), float(evader[1])))
+        self._commands: list = []
 
     def _touching(self, arbiter, space, data) -> None:
         self._hit = True
@@ -211,6 +214,7 @@ class World:
         # substep would need a Python velocity callback per body and substep (it
         # doubled the step cost) or would discard the solver's correction and push
         # bodies through walls.
+        self._commands.append((pursuer_velocity, evader_velocity, trace is not None))
         pb.velocity = pursuer_velocity
         eb.velocity = evader_velocity
         h = self.substep_dt
@@ -256,6 +260,31 @@ class World:
         e = eb.position
         self._at = (p, e)
         return (p.x, p.y), (e.x, e.y)
+
+    def __deepcopy__(self, memo: dict) -> World:
+        """A world in the same state, rebuilt by replaying the episode's commands from its
+        start (bit for bit: :meth:`reset` builds a fresh space). Copying the pymunk space
+        instead loses what Chipmunk keeps between steps in contact (cached impulses, bias
+        velocities): a copy taken against a wall drifted by 8e-3 within 15 steps.
+        """
+        new = World.__new__(World)
+        memo[id(self)] = new
+        new.__dict__.update(
+            map=self.map,
+            body_radius=self.body_radius,
+            dt=self.dt,
+            n_substeps=self.n_substeps,
+            substep_dt=self.substep_dt,
+            _walls=self._walls,
+            space=None,
+            _pursuer=None,
+            _evader=None,
+        )
+        if self.space is not None:
+            new.reset(*self._start)
+            for pursuer_velocity, evader_velocity, traced in self._commands:
+                new.step(pursuer_velocity, evader_velocity, [] if traced else None)
+        return new
 
     def positions(self) -> tuple[tuple[float, float], tuple[float, float]]:
         """Current pursuer and evader centres."""

@@ -414,3 +414,59 @@ def test_env_pickles_and_replays() -> None:
     a, _ = env.reset(seed=5)
     b, _ = clone.reset(seed=5)
     assert np.array_equal(a[P], b[P]) and np.array_equal(a[E], b[E])
+
+
+def _rollout(env, actions) -> list:
+    """Everything a parallel env returns over ``actions`` (until it ends), as bytes/json."""
+    out = []
+    for a in actions:
+        if not env.agents:
+            break
+        obs, *rest = env.step({P: a, E: a})
+        out.append(([obs[P].tobytes(), obs[E].tobytes()], json.dumps(rest, sort_keys=True)))
+    return out
+
+
+@pytest.mark.parametrize("version", ["v0", "v1"])
+def test_deepcopy_mid_episode_carries_the_episode_on(version: str) -> None:
+    """A deep copy taken in a wall-contact step continues as the original would, bit for
+    bit, and independently of it (deepcopy used to rebuild the env from its arguments,
+    like pickle, so the copy raised "step() before reset()")."""
+    import copy
+
+    from envs import surveillance_v0
+
+    module = {"v0": surveillance_v0, "v1": surveillance_v1}[version]
+    # both agents driven up into the corridor's wall: contacts from step 39 on (seed 0)
+    up = np.array([0.3, 1.0], dtype=np.float32)
+    make = lambda: module.parallel_env(map="corridor", max_cycles=60)
+    reference = make()
+    reference.reset(seed=0)
+    expected = _rollout(reference, [up] * 60)
+    env = make()
+    env.reset(seed=0)
+    head = _rollout(env, [up] * 45)
+    assert env.world._carry  # the copy is taken while a body touches a wall
+    clone = copy.deepcopy(env)
+    assert clone.world.space is not env.world.space and clone.kernel is env.kernel
+    tail = _rollout(clone, [up] * 60)  # the copy first, so a shared state would show
+    assert head + tail == expected and len(tail) == 15
+    assert _rollout(env, [up] * 60) == tail
+
+    def aec_rollout(aec) -> list:
+        out = []
+        for _ in aec.agent_iter():
+            obs, reward, term, trunc, _info = aec.last()
+            out.append((obs.tobytes(), reward, term, trunc))
+            aec.step(None if term or trunc else up)
+        return out
+
+    aec = module.env(map="corridor", max_cycles=60)
+    aec.reset(seed=0)
+    aec_expected = aec_rollout(aec)
+    aec.reset(seed=0)
+    for _ in range(2 * 45):
+        aec.step(up)
+    aec_tail = aec_rollout(copy.deepcopy(aec))
+    assert len(aec_tail) == 2 * 15 + 2  # the 15 remaining steps, then both agents' end
+    assert aec_tail == aec_expected[-len(aec_tail) :]

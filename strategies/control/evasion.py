@@ -543,6 +543,14 @@ def _polished_root(residual, a_lo: float, a_hi: float, coarse: float, turned) ->
     secant steps on the fine one (the two roots differ by the coarse truncation error);
     Brent on the fine grid if the secant misbehaves. None for a jump, not a root.
 
+    The fine integrations (8 times the coarse steps, every row kept) were most of a
+    successful solve near rho = 1 (issue 13). The coarse root is the answer where its
+    fine residual already meets the secant's criterion (1e-14: the arc is the same to
+    that tolerance; common where the arc is nearly straight, RK4 then being exact to
+    rounding at both steps), and the secant's second point is a Newton step on the
+    coarse grid's slope at the coarse root (one coarse integration) instead of a fine
+    integration 1e-7 away, which only gave the slope.
+
     Near rho = 1 most sign changes are jumps (THEORY §4.3): from an arc that reaches ``x_e``
     off the axis to one that turns back first, where the reaching arcs end at a vertical
     tangent. Brent closes on such a jump to 1e-13, ~60 coarse integrations for nothing.
@@ -564,7 +572,18 @@ def _polished_root(residual, a_lo: float, a_hi: float, coarse: float, turned) ->
     if abs(residual(a_c, coarse)) > 1e-6:  # sign change across a turned-back arc
         return None
     a0, r0 = a_c, residual(a_c)
+    if abs(r0) < 1e-14:  # the coarse root is a fine one already (the loop's criterion)
+        return a_c
     a1 = a_c + 1e-7 * (1.0 if a_c < 0.0 else -1.0)
+    # the second point: a Newton step on the coarse grid's slope at a_c (the fine one's
+    # differs by the coarse truncation error), a coarse integration instead of a fine one
+    # at a1; where the coarse arc from a1 turned back, or the step leaves the bracket,
+    # a1 itself
+    r_c1 = residual(a1, coarse)
+    if not turned(a1) and r_c1 != residual(a_c, coarse):
+        a_n = a_c - r0 * (a1 - a_c) / (r_c1 - residual(a_c, coarse))
+        if a_lo <= a_n <= a_hi and a_n != a_c:
+            a1 = a_n
     r1 = residual(a1)
     for _ in range(8):
         if abs(r1) < 1e-14:

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.interpolate import CubicSpline
-from scipy.optimize import minimize, minimize_scalar
+from scipy.optimize import brentq, minimize, minimize_scalar
 
 from envs.errors import InfeasibleError, SurveilValueError
 from strategies.control.evasion import (
@@ -536,3 +536,70 @@ def test_the_jump_certificate_changes_no_solve(monkeypatch):
             found += 1
             assert new.tobytes() == old.tobytes()
     assert 0 < found < len(probs) and counts[0] < counts[1]  # both kinds, and it stopped some
+
+
+def _fine_runs(monkeypatch):
+    from strategies.control import evasion
+
+    fine = []
+    real = evasion.integrate_reduced
+
+    def counted(*args):
+        if args[7]:  # store: the fine grid's integrations (the coarse ones keep the end)
+            fine.append(args[1])
+        return real(*args)
+
+    monkeypatch.setattr(evasion, "integrate_reduced", counted)
+    return fine
+
+
+@pytest.mark.parametrize(
+    ("theta0", "x_e", "rho", "most"),
+    [(-0.3, 0.7, 0.99, 1), (2.8, 1.2, 0.95, 3), (3.0, 3.1, 0.99, 5)],
+)
+def test_a_successful_solve_spends_few_fine_integrations(monkeypatch, theta0, x_e, rho, most):
+    # near rho = 1 a successful solve's fine integrations (8 x the coarse steps, each row
+    # kept) were ~10 of its ~18 ms (issue 13): the coarse root a_c was integrated fine,
+    # then a_c -+ 1e-7 for the secant's slope, then the secant's roots. Now a_c is taken
+    # where its fine residual already meets the root criterion (first case: 3 -> 1), and
+    # the secant's second point is a Newton step on the coarse slope (4 -> 3, 6 -> 5)
+    fine = _fine_runs(monkeypatch)
+    step = capped_step(x_e, 2.0, rho)
+    assert escape_path(theta0, x_e, L=2.0, rho=rho, branch="+", step=step) is not None
+    assert len(fine) <= most
+
+
+def test_a_successful_solve_returns_the_fine_grid_root_arc():
+    # the arc escape_path returns is the fine grid's arc from the root of y(x_e) = 0 found
+    # independently (brentq on the fine residual to 1e-15 next to the solution's heading),
+    # to far below RK4's own error (>= 1e-9 here at a quarter of the step)
+    from strategies.control._integrators import REACHED, integrate_reduced
+
+    rng = np.random.default_rng(85)
+    checked = 0
+    for rho in (0.5, 0.9, 0.95, 0.99):
+        for _ in range(6):
+            th, x_e = rng.uniform(-math.pi, math.pi), rng.uniform(0.3, 3.2)
+            b = "+-"[rng.integers(2)]
+            h = capped_step(x_e, 2.0, rho)
+            sol = solve_escape(th, x_e, L=2.0, rho=rho, branch=b, step=h)
+            path = escape_path(th, x_e, L=2.0, rho=rho, branch=b, step=h)
+            assert sol.success == (path is not None)
+            if path is None:
+                continue
+            s = 1 if b == "+" else -1
+
+            def arc(a0, th=th, x_e=x_e, rho=rho, s=s, h=h):
+                rows, status = integrate_reduced(th, a0, s, 2.0, rho, h, x_e, True, 10**6)
+                assert status == REACHED
+                return np.asarray(rows)[:, 1:3]
+
+            a, w = sol.alpha0, 1e-9
+            while arc(a - w)[-1, 1] * arc(a + w)[-1, 1] > 0.0:
+                w *= 10.0
+            root = brentq(lambda a0: arc(a0)[-1, 1], a - w, a + w, xtol=1e-15, rtol=1e-15)
+            ref = arc(root)
+            assert path.shape == ref.shape
+            assert np.max(np.abs(path - ref)) < 1e-12 * x_e
+            checked += 1
+    assert checked >= 12

@@ -115,8 +115,8 @@ new version.
 
 `render_mode`: `None`, `"human"` or `"rgb_array"`.
 
-`step()` before `reset()` or after the episode ended raises `EpisodeStateError`; loop
-`while env.agents:`.
+`step()` before `reset()` or after the episode ended raises `EpisodeStateError`, as does
+`render()` (with a render mode) before the first `reset()`; loop `while env.agents:`.
 
 `copy.deepcopy(env)` mid-episode gives an env that continues the episode independently,
 bit for bit as the original would (a lookahead); `pickle` rebuilds the env from its

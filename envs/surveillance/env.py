@@ -457,9 +457,16 @@ class parallel_env(ParallelEnv, EzPickle):
         )
 
     def render(self) -> np.ndarray | None:
-        """``"rgb_array"``: an HxWx3 uint8 frame; ``"human"``: draw to a window."""
+        """``"rgb_array"``: an HxWx3 uint8 frame; ``"human"``: draw to a window.
+
+        Raises:
+            EpisodeStateError: before the first ``reset()`` (there is no state to draw: it
+                drew both agents at (0, 0), possibly inside a wall; the AEC env raises too).
+        """
         if self.render_mode is None:
             return None
+        if self._ended_at is None:
+            raise EpisodeStateError("render() before reset(): call reset(seed=...) first")
         if self._renderer is None:
             from envs.surveillance.render import Renderer
 

@@ -397,6 +397,18 @@ def test_rgb_array_frames_show_the_state() -> None:
     env.close()  # idempotent
 
 
+def test_render_before_reset_is_an_error() -> None:
+    """As step() before reset(), and as the AEC env (PettingZoo's OrderEnforcingWrapper):
+    it drew a frame with both agents at (0, 0)."""
+    env = surveillance_v1.parallel_env(map="corridor", render_mode="rgb_array")
+    with pytest.raises(EpisodeStateError, match=r"^render\(\) before reset\(\)"):
+        env.render()
+    env.reset(seed=0)
+    assert env.render().ndim == 3
+    assert surveillance_v1.parallel_env(map="corridor").render() is None  # no render_mode
+    env.close()
+
+
 def test_human_render_runs_headless_and_close_is_idempotent() -> None:
     env = surveillance_v1.parallel_env(map=open_room(), render_mode="human", max_cycles=3)
     env.reset(seed=0)

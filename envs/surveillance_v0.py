@@ -15,12 +15,14 @@
 
 Every argument, space, reward, info and start is v1's: see the card of
 :mod:`envs.surveillance_v1` (same signature: ``surveillance_v0.parallel_env(map="corridor",
-...)``). The one difference: v0's continuous check takes both agents to move linearly
+...)``). The differences: v0's continuous check takes both agents to move linearly
 within a step, so a step in which a wall stopped or deflected a body is swept along the
 chord between its two frames (at dt = 10 on the corridor, a pursuer stopped by a wall
 after 0.4 s had its range break timed at 1.85 s, the truth 1.2 s; at dt = 0.1 an
-occlusion at a middle substep with both frames clear is missed). v0 stays importable so
-that results recorded with it replay.
+occlusion at a middle substep with both frames clear is missed), and it takes one
+physics substep a step up to half a radius of travel, where a body pressed into a wall
+can pass through it (dt = 0.05 at the defaults). v0 stays importable so that results
+recorded with it replay.
 
 ### Version History
 

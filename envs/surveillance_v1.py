@@ -128,8 +128,13 @@ arguments (EzPickle), so an unpickled env starts unreset.
   the physics made, substep by substep, instead of the chord between the step's two
   frames: v0 missed breaks there (the rod blocked mid-step while both frames are clear)
   and timed others late (dt = 10 on the corridor, a pursuer stopped by a wall after
-  0.4 s: range break at 1.85 s, the truth 1.2 s). Steps without a wall contact, the
-  arguments, spaces, rewards and starts are v0's.
+  0.4 s: range break at 1.85 s, the truth 1.2 s). And a step is one physics substep
+  only while a body pressed into a wall stays within half a radius of it (twice the
+  substep's travel plus Chipmunk's slop), else two: with one substep of up to half a
+  radius, v0 let a body pressed into a wall settle at twice that overlap, so at
+  dt = 0.05 with the defaults (or body_radius 0.2 at dt = 0.1) a pursuer driven into a
+  wall passed through it and left the map. The arguments, spaces, rewards and starts
+  are v0's.
 * v0: initial release (continuous-time surveillance check, state and lidar
   observations, zero-sum and sparse rewards). Retired: :mod:`envs.surveillance_v0`
   stays importable so that v0 results replay.

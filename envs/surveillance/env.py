@@ -109,7 +109,13 @@ class parallel_env(ParallelEnv, EzPickle):
         self.agents: list[str] = []
         self.map = cfg.map
         self.kernel = _kernel(cfg.map)
-        self.world = World(cfg.map, cfg.body_radius, cfg.dt, max(cfg.v_pursuer, cfg.v_evader))
+        self.world = World(
+            cfg.map,
+            cfg.body_radius,
+            cfg.dt,
+            max(cfg.v_pursuer, cfg.v_evader),
+            v0_substeps=not self.sweep_path,  # v0's physics too, so that v0 replays
+        )
         self._state_encoder = StateEncoder(cfg)
         self.state_space = state_space(cfg)
         if cfg.observation == "state":

@@ -57,24 +57,44 @@ COLLISION_SLOP_FRACTION = 0.01
 _AGENT_GROUP = 1  # shapes in one non-zero group never collide with each other
 
 
-def substeps_for(max_speed: float, dt: float, body_radius: float) -> int:
+def substeps_for(max_speed: float, dt: float, body_radius: float, *, v0: bool = False) -> int:
     """Number of physics substeps per env step so no body outruns its radius.
+
+    The command is imposed at the start of each step, and Chipmunk removes half of an
+    overlap a substep (``collision_bias``): a body pressed into a wall by a travel t a
+    substep settles at an overlap of t (1/2)^(n-1) / (1 - (1/2)^n) with n substeps a
+    step (the substeps after the first only slide). With n >= 2 that is at most 2t/3,
+    a third of the radius; with n = 1 it is 2t, and at t = half a radius the centre
+    reaches the wall and the body passes through it (dt = 0.05 at the defaults: a
+    pursuer driven into the corridor's wall left the map). So one substep is taken
+    only while 2t plus Chipmunk's slop (:data:`COLLISION_SLOP_FRACTION`) stays within
+    ``MAX_SUBSTEP_TRAVEL * body_radius``, as with two or more, else two. ``v0`` keeps
+    the retired env's rule (one substep up to ``MAX_SUBSTEP_TRAVEL * body_radius``), so
+    that v0 replays.
 
     Args:
         max_speed: the larger of the two speed bounds.
         dt: env step duration.
         body_radius: disc radius of both agents.
+        v0: the retired v0's rule.
 
     Returns:
-        The smallest n >= 1 with ``max_speed * dt / n <= MAX_SUBSTEP_TRAVEL * body_radius``.
+        The smallest n >= 1 with ``max_speed * dt / n <= MAX_SUBSTEP_TRAVEL * body_radius``,
+        and 2 when that is 1 but a pressed body would overlap a wall by more (unless v0).
 
     Examples:
-        >>> substeps_for(1.0, 0.1, 0.1)
-        2
+        >>> substeps_for(1.0, 0.1, 0.1), substeps_for(1.0, 0.05, 0.1), substeps_for(1.0, 0.024, 0.1)
+        (2, 2, 1)
+        >>> substeps_for(1.0, 0.05, 0.1, v0=True)
+        1
     """
     travel = max_speed * dt / (MAX_SUBSTEP_TRAVEL * body_radius)
     # the small relative slack keeps 4.000000000000001 from becoming 5
-    return max(1, math.ceil(travel * (1.0 - 1e-12)))
+    n = max(1, math.ceil(travel * (1.0 - 1e-12)))
+    one = (MAX_SUBSTEP_TRAVEL - COLLISION_SLOP_FRACTION) / (2.0 * MAX_SUBSTEP_TRAVEL)
+    if n == 1 and not v0 and travel * (1.0 - 1e-12) > one:  # at defaults dt > 0.0245
+        return 2
+    return n
 
 
 def check_step(
@@ -120,18 +140,27 @@ class World:
         body_radius: disc radius of both agents.
         dt: env step duration.
         max_speed: the larger speed bound, which fixes the substep count.
+        v0_substeps: count the substeps as the retired v0 did (:func:`substeps_for`).
 
     Raises:
         InvalidConfigError: ``max_speed * dt`` exceeds the map's diameter, or the step
             needs more than :data:`MAX_SUBSTEPS` substeps.
     """
 
-    def __init__(self, world_map: Map, body_radius: float, dt: float, max_speed: float) -> None:
+    def __init__(
+        self,
+        world_map: Map,
+        body_radius: float,
+        dt: float,
+        max_speed: float,
+        *,
+        v0_substeps: bool = False,
+    ) -> None:
         check_step(world_map, dt, max_speed, body_radius)
         self.map = world_map
         self.body_radius = float(body_radius)
         self.dt = float(dt)
-        self.n_substeps = substeps_for(max_speed, dt, body_radius)
+        self.n_substeps = substeps_for(max_speed, dt, body_radius, v0=v0_substeps)
         self.substep_dt = self.dt / self.n_substeps
         # plain Python tuples: pymunk's constructors are faster on them than on arrays
         self._walls = [

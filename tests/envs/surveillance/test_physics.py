@@ -210,3 +210,28 @@ def test_a_break_after_a_body_stopped_at_a_wall_is_timed_on_its_path(dt) -> None
     assert 1.2 - 0.1 - 1e-9 <= break_at(surveillance_v1) <= 1.2 + 1e-9
     if dt == 10.0:  # v0's chord: 3 + 0.5 t + 0.04 t = 4 at t = 1.85
         assert break_at(surveillance_v0) == pytest.approx(1.0 / 0.54)
+
+
+@pytest.mark.parametrize(
+    ("speed", "dt", "radius"),
+    [(1.0, 0.05, 0.1), (1.0, 0.04, 0.1), (1.0, 0.03, 0.1), (1.0, 0.0245, 0.1), (1.0, 0.01, 0.1),
+     (0.5, 0.1, 0.1), (1.0, 0.1, 0.2), (3.0, 0.1, 0.1)],
+)  # fmt: skip
+@pytest.mark.parametrize("heading", [(-1.0, 0.0), (-math.sqrt(0.5), -math.sqrt(0.5))])
+def test_a_body_pressed_into_a_wall_keeps_its_centre_half_a_radius_inside(
+    speed: float, dt: float, radius: float, heading: tuple[float, float]
+) -> None:
+    """Driven into a wall (or a corner) step after step, the disc overlaps it by at most
+    half its radius, also with one substep a step. With one substep the overlap settled
+    at twice a substep's travel: at dt = 0.05 (defaults) the body passed through the wall
+    and left the map; v0 keeps that rule, so that its results replay."""
+    world = World(open_room(), radius, dt, speed)
+    world.reset(np.array([1.0, 1.0]), np.array([5.0, 5.0]))
+    velocity = (speed * heading[0], speed * heading[1])
+    centres = [world.step(velocity, (0.0, 0.0))[0] for _ in range(round(3.0 / dt))]
+    pts = np.array(centres)
+    assert open_room().contains(pts).all()
+    assert open_room().distance_to_walls(pts).min() >= radius * (1 - MAX_SUBSTEP_TRAVEL) - 1e-12
+    assert open_room().distance_to_walls(pts[-1:]).min() <= radius  # it did press
+    if speed * dt <= MAX_SUBSTEP_TRAVEL * radius:  # one substep in v0: the old rule
+        assert World(open_room(), radius, dt, speed, v0_substeps=True).n_substeps == 1

@@ -17,24 +17,29 @@ this run:
 * the per-step decision time of each model against the analytic policy of its role.
 
 The report (``report.html``: tables, heat maps, ratings, replays) is written beside the
-store.
+store. With ``--cards`` each model's ``CARD.md`` is rewritten from the run: its
+"Measured" section names the env version the matches played (``surveillance_v1``), the
+commit they were played at and the command; a ``## Notes`` section written by hand at
+the end of a card is kept.
 
 Usage::
 
     python benchmarks/learned_vs_analytic.py [--seeds 20] [--models NAME ...]
-        [--store out/bench/learned.sqlite] [--workers 2] [--maps MAP ...]
+        [--store out/bench/learned.sqlite] [--workers 2] [--maps MAP ...] [--cards]
 """
 
 from __future__ import annotations
 
 import argparse
 import os
+import shlex
 from collections import defaultdict
 from pathlib import Path
 
 from bench_cli import integer, run
 
 from analysis.tournament import run_tournament, spec_from_dict
+from analysis.tournament.identity import ENV_ID
 from analysis.tournament.report import analyse, write_report
 from analysis.tournament.statistics import wilson_interval
 from training import zoo
@@ -58,12 +63,46 @@ def _fmt(rate, lo, hi, n):
     return f"{rate:5.2f} [{lo:.2f}, {hi:.2f}] n={n}"
 
 
-def card(name: str, role: str, rows, args, decide=None) -> str:
+def measured_at(args) -> dict:
+    """Where a run's figures come from: the env version its matches play, the commit and
+    whether the code differs from it, and the command (without ``--store`` and
+    ``--workers``, which do not change a figure)."""
+    from training.train import _git
+
+    sha = _git("rev-parse", "HEAD")
+    status = _git("status", "--porcelain", "--", "envs", "strategies", "training", "analysis",
+                  "benchmarks", ":(exclude)training/zoo/models")  # fmt: skip
+    words = ["python", "benchmarks/learned_vs_analytic.py", "--seeds", str(args.seeds),
+             "--max-cycles", str(args.max_cycles)]  # fmt: skip
+    if args.models:
+        words += ["--models", *args.models]
+    if args.maps:
+        words += ["--maps", *args.maps]
+    return {"env": ENV_ID, "sha": sha or None, "dirty": None if status is None else bool(status),
+            "command": shlex.join([*words, "--cards"])}  # fmt: skip
+
+
+NOTES = "## Notes"
+"""A card's hand-written last section, kept when the card is rewritten from a run."""
+
+
+def with_notes(new: str, old: str | None) -> str:
+    """Card text ``new`` followed by the ``## Notes`` section of the card it replaces."""
+    if not old or f"\n{NOTES}\n" not in f"\n{old}":
+        return new
+    notes = old[f"\n{old}".index(f"\n{NOTES}\n") :]
+    return new.rstrip("\n") + "\n\n" + notes.rstrip("\n") + "\n"
+
+
+def card(name: str, role: str, rows, args, decide=None, measured=None) -> str:
     """The model card of zoo model ``name``: recipe, training curves, measured rates.
 
     ``decide``: per-step decision times by ``(role, label)`` from the same run, for the
-    model's line beside the analytic policy of its role.
+    model's line beside the analytic policy of its role. ``measured``: :func:`measured_at`
+    of the run (computed here when not given).
     """
+    measured = measured or measured_at(args)
+    trained_on = zoo.trained_env(name) or "an env version git cannot tell"
     prov = zoo.info(name)
     cfg = prov["config"]
     size = zoo.model_path(name).stat().st_size
@@ -94,13 +133,15 @@ def card(name: str, role: str, rows, args, decide=None) -> str:
         f"- labelled states: {prov['samples'][-1] if 'samples' in prov else '-'}; "
         f"wall time {prov.get('wall_seconds', prov.get('wall_time', float('nan'))):.0f} s on "
         "2 cores",
+        f"- trained on `{trained_on}`",
         f"- code: {prov.get('git_sha')} (dirty: {prov.get('git_dirty')}); "
-        f"versions {prov.get('versions')}",
+        f"versions {prov.get('versions') or prov.get('packages')}",
         "",
     ]
     if "disagreement" in prov:
         alone = prov.get("validation") or []
         lines += ["## DAgger curve", "",
+                  f"Measured in training, on `{trained_on}`. "
                   "won: episodes won by the rollout policy, the expert acting with "
                   "probability beta^i (so iteration 0 is the expert alone); alone: won by "
                   "the learner alone in the validation episodes (against "
@@ -114,9 +155,19 @@ def card(name: str, role: str, rows, args, decide=None) -> str:
             v = f"{alone[i]:.2f}" if i < len(alone) and alone[i] is not None else "-"
             lines.append(f"| {i} | {n} | {d:.3f} | {f:.3f} | {h:.2f} | {v} |")
         lines.append("")
+    sha = (measured["sha"] or "an unknown commit")[:12]
+    dirty = " (with uncommitted changes)" if measured["dirty"] else ""
+    if trained_on == measured["env"]:
+        versions = f"Trained and measured on `{measured['env']}`."
+    else:
+        versions = (f"Trained on `{trained_on}`, measured on `{measured['env']}` (what "
+                    f"changed is in `envs/{measured['env']}.py`'s version history; the model "
+                    "was not retrained for it).")  # fmt: skip
     lines += [
-        f"## Measured ({args.seeds} seeded safe starts per map, max_cycles {args.max_cycles}, "
-        "`benchmarks/learned_vs_analytic.py`)",
+        f"## Measured on {measured['env']} ({args.seeds} seeded safe starts per map, "
+        f"max_cycles {args.max_cycles})",
+        "",
+        f"Measured at {sha}{dirty} by `{measured['command']}`. {versions}",
         "",
         "Rates are the model's wins (a pursuer holds, an evader escapes) with Wilson 95 % "
         "intervals; the analytic policy of the model's role is measured in its place on the "
@@ -258,10 +309,12 @@ def main(argv=None) -> int:
                 a_ms, b_ms = 1e3 * sum(t_m) / len(t_m), 1e3 * sum(t_ref) / len(t_ref)
                 print(f"  {m:<44} {a_ms:7.3f} ms vs {ref} {b_ms:7.3f} ms ({b_ms / a_ms:5.2f}x)")
     if args.cards:
+        measured = measured_at(args)
         for role in ("pursuer", "evader"):
             for m in learned[role]:
                 path = zoo.MODELS_DIR / m / "CARD.md"
-                path.write_text(card(m, role, rows, args, decide))
+                old = path.read_text() if path.is_file() else None
+                path.write_text(with_notes(card(m, role, rows, args, decide, measured), old))
                 print(f"card: {path}")
     out = write_report(args.store, Path(args.store).with_suffix("") / "report", replays=False)
     print(f"\nreport: {out.get('html', out)}")

@@ -590,7 +590,7 @@ def dagger(cfg: DaggerConfig, *, verbose: bool = False) -> DaggerResult:
     import torch
     from stable_baselines3 import PPO
 
-    from training.train import _git_state, _versions
+    from training.train import ENV_ID, ENV_NAME, _git_state, _versions
 
     t0 = time.perf_counter()
     torch.set_num_threads(1)
@@ -662,6 +662,8 @@ def dagger(cfg: DaggerConfig, *, verbose: bool = False) -> DaggerResult:
                      if cfg.validation_episodes else "") + ", "
                   f"{time.perf_counter() - t_it:.0f} s", flush=True)  # fmt: skip
     provenance = {
+        "env_id": ENV_NAME,  # the version it trained on (its model card names it)
+        "registry_id": ENV_ID,
         "role": cfg.role,
         "opponent": cfg.opponent if isinstance(cfg.opponent, str) else list(cfg.opponent),
         "algo": "ppo",

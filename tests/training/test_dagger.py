@@ -11,6 +11,7 @@ from envs import surveillance_v1
 from envs.errors import InvalidConfigError
 from strategies.policies import make_policy
 from training.dagger import DaggerConfig, _Rollout, dagger
+from training.train import ENV_ID, ENV_NAME
 
 
 def _cfg(tmp_path, **kw):
@@ -28,6 +29,8 @@ def test_dagger_aggregates_expert_labels_and_fits_them(tmp_path):
     assert r.fit_error[-1] < 0.1
     prov = json.loads((r.model_path.parent / "provenance.json").read_text())
     assert prov["role"] == "pursuer" and prov["method"] == "dagger"
+    # the env version it trained on, as an RL run records it (a model card names it)
+    assert (prov["env_id"], prov["registry_id"]) == (ENV_NAME, ENV_ID)
     # an ordinary SB3 model: it loads by name, declares its observation and plays
     p = make_policy(f"pursuer/sb3:{r.model_path}")
     assert p.observation_options == {"observation": "state"}

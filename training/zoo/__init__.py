@@ -21,6 +21,7 @@ Command line::
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import warnings
 from pathlib import Path
@@ -44,6 +45,7 @@ __all__ = [
     "model_path",
     "policy_name",
     "reproduce",
+    "trained_env",
     "training_maps",
 ]
 
@@ -85,6 +87,27 @@ def info(name: str) -> dict[str, Any]:
 def config(name: str) -> TrainConfig | DaggerConfig:
     """The training config of ``name`` (RL or DAgger, by its ``method``)."""
     return load_any_config(_dir(name) / "config.toml")
+
+
+def trained_env(name: str) -> str | None:
+    """The env version ``name`` was trained on, e.g. ``"surveillance_v0"``.
+
+    Its provenance's ``env_id`` when it has one (RL runs record it; DAgger runs since
+    surveillance_v1); else the latest ``envs/surveillance_vN.py`` at the commit it was
+    trained at (the runner played the latest version then); ``None`` when neither tells (no
+    git, or a commit this clone does not have).
+    """
+    prov = info(name)
+    if prov.get("env_id"):
+        return str(prov["env_id"])
+    from training.train import _git
+
+    sha = prov.get("git_sha")
+    listing = _git("ls-tree", "--name-only", sha, "envs/") if sha else None
+    if not listing:
+        return None
+    found = [int(v) for v in re.findall(r"^envs/surveillance_v(\d+)\.py$", listing, re.M)]
+    return f"surveillance_v{max(found)}" if found else None
 
 
 def training_maps(name: str) -> list[str]:

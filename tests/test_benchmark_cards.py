@@ -1,0 +1,84 @@
+"""Model cards written by ``benchmarks/learned_vs_analytic.py --cards`` say where their
+figures come from: the env version the matches played, the commit, the command, and the
+env version the model trained on (issue 9/13: the shipped models trained on v0)."""
+
+from __future__ import annotations
+
+import importlib
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from analysis.tournament.identity import ENV_ID
+from training import zoo
+from training.train import _git
+
+BENCHMARKS = Path(__file__).resolve().parents[1] / "benchmarks"
+MODEL = "dagger_pursuer_corridor"  # a specialist: one seen map, quick to play
+
+
+@pytest.fixture
+def lva(monkeypatch):
+    monkeypatch.syspath_prepend(str(BENCHMARKS))
+    return importlib.import_module("learned_vs_analytic")
+
+
+@pytest.fixture
+def tmp_zoo(tmp_path, monkeypatch):
+    """A zoo holding a copy of MODEL, so a card written by a test leaves the shipped one."""
+    root = tmp_path / "zoo"
+    shutil.copytree(zoo.MODELS_DIR / MODEL, root / MODEL)
+    monkeypatch.setattr(zoo, "MODELS_DIR", root)
+    return root
+
+
+def test_a_card_from_a_small_run_names_the_env_it_played_the_commit_and_the_command(
+    lva, tmp_zoo, tmp_path, capsys
+):
+    card = tmp_zoo / MODEL / "CARD.md"
+    card.write_text("# old card\n\n## Measured\n\n0.99\n\n## Notes\n\nHand-written.\n")
+    argv = ["--models", MODEL, "--seeds", "1", "--max-cycles", "40", "--maps", "corridor",
+            "--workers", "1", "--store", str(tmp_path / "s.sqlite"), "--cards"]  # fmt: skip
+    assert lva.main(argv) == 0
+    text = card.read_text()
+    assert ENV_ID == "surveillance_v1"
+    assert "## Measured on surveillance_v1 (1 seeded safe starts per map, max_cycles 40)" in text
+    head = _git("rev-parse", "HEAD")
+    if head:
+        assert f"Measured at {head[:12]}" in text
+    command = ("python benchmarks/learned_vs_analytic.py --seeds 1 --max-cycles 40 --models "
+               f"{MODEL} --maps corridor --cards")  # fmt: skip
+    assert f"by `{command}`" in text
+    trained = zoo.trained_env(MODEL)
+    assert f"- trained on `{trained}`" in text
+    if trained == "surveillance_v0":
+        assert "Trained on `surveillance_v0`, measured on `surveillance_v1`" in text
+    assert "| seen: corridor | evader/shooting |" in text
+    # the old figures are gone, the hand-written notes are kept, at the end
+    assert "0.99" not in text and "# old card" not in text
+    assert text.endswith("\n\n## Notes\n\nHand-written.\n")
+
+
+def test_a_card_without_notes_gets_none_and_notes_are_not_doubled(lva):
+    assert lva.with_notes("# card\n", None) == "# card\n"
+    assert lva.with_notes("# card\n", "# old\n\nno notes\n") == "# card\n"
+    old = "# old\n\n## Notes\n\nkeep me\n"
+    once = lva.with_notes("# card\n", old)
+    assert once == "# card\n\n## Notes\n\nkeep me\n"
+    assert lva.with_notes("# card\n", once) == once  # a second rewrite keeps them once
+
+
+def test_trained_env_reads_the_provenance_else_the_training_commit(tmp_zoo):
+    prov_path = tmp_zoo / MODEL / "provenance.json"
+    prov = json.loads(prov_path.read_text())
+    # trained before surveillance_v1 existed, by a DAgger writer that did not record it
+    assert "env_id" not in prov
+    if _git("cat-file", "-e", f"{prov['git_sha']}^{{commit}}") is None:
+        pytest.skip("this clone does not have the model's training commit")
+    assert zoo.trained_env(MODEL) == "surveillance_v0"
+    prov_path.write_text(json.dumps({**prov, "git_sha": "0" * 40}))
+    assert zoo.trained_env(MODEL) is None  # a commit git does not know: it cannot tell
+    prov_path.write_text(json.dumps({**prov, "env_id": "surveillance_v1"}))
+    assert zoo.trained_env(MODEL) == "surveillance_v1"  # a recorded version wins

@@ -571,7 +571,11 @@ def evaluate_model(
 
     ``role``, ``map`` and ``env`` default to those in the ``provenance.json`` beside the
     model (the settings it was trained with, which matter: the observation holds the
-    time as a fraction of ``max_cycles``); ``start`` defaults to ``"safe"``.
+    time as a fraction of ``max_cycles``): an RL recipe's ``map`` and ``env``, a DAgger
+    recipe's ``maps`` (one drawn per episode) and ``env`` with its rollouts'
+    ``max_cycles``. The env gives the model the observation it was trained on (its
+    ``observation_options``: the state for a model with analytic features); ``start``
+    defaults to ``"safe"``.
 
     Args:
         path: the model zip (or an already built Policy, with ``role`` and ``map`` given).
@@ -601,11 +605,19 @@ def evaluate_model(
         if role is None or map is None or env is None:
             if prov is None:
                 read_provenance(path)  # raises, naming the missing file
+            cfg = prov["config"]
             role = role or prov["role"]
-            map = map or prov["config"]["map"]
-            env = prov["config"]["env"] if env is None else env
+            # an RL recipe names one map, a DAgger recipe a list (it had no "map": KeyError)
+            map = map or cfg.get("map") or list(cfg["maps"])
+            if env is None:
+                env = dict(cfg["env"])
+                if "maps" in cfg and "max_cycles" in cfg:  # a DAgger recipe's rollouts
+                    env.setdefault("max_cycles", cfg["max_cycles"])
         learner = load_policy(path, role=role, deterministic=deterministic)
-    game = SingleAgentEnv(role, opponent, map=map, start=start or "safe", **(env or {}))
+    # the observation the model reads (a DAgger recipe keeps it out of "env"; a model with
+    # features builds its input from the state)
+    seen = getattr(learner, "observation_options", None) or {}
+    game = SingleAgentEnv(role, opponent, map=map, start=start or "safe", **{**(env or {}), **seen})
     rng = np.random.default_rng(np.random.SeedSequence(int(seed)).spawn(1)[0])
     successes, times, causes = 0, [], {}
     obs, _ = game.reset(seed=int(seed))

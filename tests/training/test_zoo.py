@@ -227,3 +227,21 @@ def test_a_model_with_analytic_features_plays_a_tournament_as_it_plays_alone(tmp
         alone = run_episode("corridor", zoo.load("dagger_pursuer_table"), "evader/straight",
                             row["seed"], max_cycles=40, start="safe")  # fmt: skip
         assert (row["winner"], row["steps"]) == (alone.winner, alone.steps)
+
+
+@pytest.mark.parametrize(
+    "name, opponent",
+    [
+        ("dagger_pursuer_corridor", "evader/straight"),  # "state", one map
+        ("dagger_evader_generalist", "pursuer/greedy"),  # lidar_track, a list of maps
+        ("dagger_pursuer_table", "evader/straight"),  # analytic features, from the state
+    ],
+)
+def test_python_m_training_zoo_evaluates_a_dagger_model(name, opponent, capsys):
+    """A DAgger recipe names ``maps``, not ``map``, and keeps its observation out of
+    ``env``: ``evaluate`` was a KeyError traceback on every DAgger model of the zoo."""
+    from training.zoo.__main__ import main as zoo_main
+
+    assert zoo_main(["evaluate", name, "--opponent", opponent, "--episodes", "1"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"{zoo.info(name)['role']} vs {opponent}: success ")

@@ -155,11 +155,107 @@ def _local(rows: np.ndarray, kind: np.ndarray, c0: np.ndarray) -> np.ndarray:
     return rows
 
 
+@dataclass(frozen=True)
+class _Locus:
+    """An arc or conchoid of the arrangement: the critical curves ``sources`` (pieces of
+    one locus) over the union ``[t0, t1]`` of their parameter intervals."""
+
+    code: int
+    row: np.ndarray
+    t0: float
+    t1: float
+    params: np.ndarray
+    sources: tuple[int, ...]
+
+
+def _merge_repeats(curves: tuple[CriticalCurve, ...], ks: list[int], tol: Tolerances) -> list:
+    """The arcs and conchoids ``ks``, pieces of one locus that overlap merged into one.
+
+    Two wall vertices at one point (a merged map's obstacles that meet at a corner, or an
+    obstacle touching the boundary at one of its corners) give that point's type-2 arcs,
+    and its type-5 conchoids with an edge, twice: the same locus over overlapping
+    parameter intervals (mostly equal; where they are not, one piece ends where the other
+    goes on). Noded as two curves they bound faces of zero area, their edges dangling
+    (16 dangling edges and 5 pieces matched by overlap only, two boxes meeting at a corner
+    at L = 2); they become one curve over the union of the intervals, standing for both
+    (collinear segments are merged the same way by :mod:`strategies.cspace._collinear`).
+    One locus: the same shape code and data equal to the merge tolerance (an arc's centre
+    and radius; a conchoid's vertex, edge start and direction), found by rounding the
+    data to eight merge tolerances (exact repeats, the case above, always share a key).
+    Overlap: by more than the merge tolerance over L in the parameter (an arc's angle, a
+    conchoid's length along its edge). Everything else is returned as it is, in order, so
+    a map without repeated vertices gets the same arrangement as before, bit for bit.
+    """
+    step = tol.merge
+    groups: dict[tuple, list[int]] = {}
+    order: list[tuple] = []
+    for k in ks:
+        c = curves[k]
+        row = c.row
+        found = None
+        key = (c.code, *np.round(row / (8.0 * step)).astype(np.int64).tolist())
+        for g in groups.get(key, ()):
+            if np.all(np.abs(curves[g[0]].row - row) <= step):
+                found = g
+                break
+        if found is None:
+            found = [k]
+            groups.setdefault(key, []).append(found)
+            order.append((key, len(groups[key]) - 1))
+        else:
+            found.append(k)
+    out = []
+    gap = step / tol.L
+    for key, i in order:
+        members = groups[key][i]
+        if len(members) == 1:
+            c = curves[members[0]]
+            out.append(_Locus(c.code, c.row, c.t0, c.t1, np.asarray(c.params), (members[0],)))
+            continue
+        first = curves[members[0]]
+        period = 2.0 * np.pi if first.shape == "arc" else 0.0
+        spans = []
+        for k in members:
+            c = curves[k]
+            t0 = float(c.t0)
+            shift = 0.0
+            if period:  # arcs: the start in [t0 of the first, + 2 pi)
+                shift = np.floor((t0 - first.t0) / period) * period
+            spans.append((t0 - shift, float(c.t1) - shift, k, shift))
+        spans.sort()
+        runs: list[list] = []
+        for t0, t1, k, shift in spans:
+            if runs and t0 < runs[-1][1] - gap:
+                runs[-1][1] = max(runs[-1][1], t1)
+                runs[-1][2].append((k, shift))
+            else:
+                runs.append([t0, t1, [(k, shift)]])
+        if period and len(runs) > 1 and runs[-1][1] - period > runs[0][0] + gap:
+            last = runs.pop()  # the last run wraps into the first
+            runs[0][0] = last[0] - period
+            runs[0][1] = max(runs[0][1], last[1] - period)
+            runs[0][2] += [(k, shift + period) for k, shift in last[2]]
+        if all(len(ms) == 1 for _, _, ms in runs):  # disjoint pieces (of one vertex): as is
+            for k in members:
+                c = curves[k]
+                out.append(_Locus(c.code, c.row, c.t0, c.t1, np.asarray(c.params), (k,)))
+            continue
+        for t0, t1, ms in runs:
+            params = np.unique(
+                np.concatenate([np.asarray(curves[k].params) - shift for k, shift in ms])
+            )
+            params = np.clip(params, t0, t1)
+            params = np.unique(np.concatenate([[t0], params, [t1]]))
+            srcs = tuple(sorted(k for k, _ in ms))
+            out.append(_Locus(first.code, first.row, t0, t1, params, srcs))
+    return out
+
+
 def _curves(world: Map, curves: tuple[CriticalCurve, ...], tol: Tolerances) -> Curves:
     """The arrangement's curves, in the local frame of :func:`_origin`."""
     c0 = _origin(world)
     seg = [k for k, c in enumerate(curves) if c.shape == "segment"]
-    other = [k for k, c in enumerate(curves) if c.shape != "segment"]
+    other = _merge_repeats(curves, [k for k, c in enumerate(curves) if c.shape != "segment"], tol)
     rows = np.array([curves[k].row for k in seg]).reshape(-1, 6)
     rows[:, 0:2] -= c0
     is_wall = np.array([curves[k].type == 0 for k in seg], dtype=bool)
@@ -173,18 +269,18 @@ def _curves(world: Map, curves: tuple[CriticalCurve, ...], tol: Tolerances) -> C
     )
     seg_arr = np.asarray(seg, dtype=np.intp)
     ns = len(lines.t0)
-    kind = np.concatenate([np.full(ns, SEGMENT), [curves[k].code for k in other]]).astype(int)
+    kind = np.concatenate([np.full(ns, SEGMENT), [c.code for c in other]]).astype(int)
     data = np.zeros((ns + len(other), 6))
     data[:ns, 0:2], data[:ns, 2:4] = lines.o, lines.d
-    for r, k in enumerate(other):
-        data[ns + r] = curves[k].row
+    for r, c in enumerate(other):
+        data[ns + r] = c.row
     data[ns:] = _local(data[ns:], kind[ns:], c0)
-    t0 = np.concatenate([lines.t0, [curves[k].t0 for k in other]])
-    t1 = np.concatenate([lines.t1, [curves[k].t1 for k in other]])
+    t0 = np.concatenate([lines.t0, [c.t0 for c in other]])
+    t1 = np.concatenate([lines.t1, [c.t1 for c in other]])
     sources = [tuple(int(seg_arr[s]) for s in src) for src in lines.sources]
-    sources += [(k,) for k in other]
+    sources += [c.sources for c in other]
     plist = [np.array([a, b]) for a, b in zip(lines.t0, lines.t1, strict=True)]
-    plist += [np.asarray(curves[k].params) for k in other]
+    plist += [c.params for c in other]
     offsets = np.concatenate([[0], np.cumsum([len(p) for p in plist])]).astype(np.intp)
     params = np.concatenate(plist) if plist else np.zeros(0)
     ends = np.stack([points(kind, data, t0, tol.L), points(kind, data, t1, tol.L)], axis=1)

@@ -113,12 +113,22 @@ def _ring(obj: object, source: str, what: str) -> list[list[float]]:
     return obj
 
 
-def _build(source: str, boundary: Any, obstacles: list, *, name: str, merge: bool) -> Map:
-    """Build the map, re-raising validation errors with the file's name in front."""
+_MERGE_REMEDY = "build the map with merge=True"
+"""How :class:`Map` names its remedy for touching polygons: a keyword a file cannot pass."""
+
+
+def _build(
+    source: str, boundary: Any, obstacles: list, *, name: str, merge: bool, remedy: str
+) -> Map:
+    """Build the map, re-raising validation errors with the file's name in front, and
+    Map's ``merge=True`` remedy for touching polygons told as the file's reader can act
+    on it (``remedy``): a ``"merge": true`` member in JSON and GeoJSON; for WKT, which
+    has no room for it, ``read_map(..., merge=True)`` or a JSON copy (``surveil`` has no
+    flag for it)."""
     try:
         return Map(boundary, obstacles, name=name, merge=merge)
     except InvalidMapError as exc:
-        raise _fail(source, str(exc)) from exc
+        raise _fail(source, str(exc).replace(_MERGE_REMEDY, remedy)) from exc
 
 
 def _check_common(d: Mapping[str, Any], source: str) -> tuple[str | None, str, dict, bool | None]:
@@ -184,7 +194,14 @@ def map_from_dict(d: object, *, source: str = "<dict>", merge: bool | None = Non
         raise _fail(source, f'"obstacles" must be a list of polygons, got {obstacles!r:.80}')
     obstacles = [_ring(o, source, f"obstacle {i}") for i, o in enumerate(obstacles)]
     use_merge = bool(file_merge) if merge is None else merge
-    m = _build(source, boundary, obstacles, name=name or _stem(source), merge=use_merge)
+    m = _build(
+        source,
+        boundary,
+        obstacles,
+        name=name or _stem(source),
+        merge=use_merge,
+        remedy='add "merge": true to the map\'s JSON object (or pass merge=True)',
+    )
     return MapDocument(m, description, metadata)
 
 
@@ -324,7 +341,15 @@ def map_from_geojson(
     meta = {**b_props, **(top or {})}
     name, description, metadata, file_merge = _check_common(meta, source)
     use_merge = bool(file_merge) if merge is None else merge
-    m = _build(source, b_rings[0], obstacles, name=name or _stem(source), merge=use_merge)
+    m = _build(
+        source,
+        b_rings[0],
+        obstacles,
+        name=name or _stem(source),
+        merge=use_merge,
+        remedy='add "merge": true to the properties of the collection or the boundary\'s '
+        "feature (or pass merge=True)",
+    )
     return MapDocument(m, description, metadata)
 
 
@@ -418,6 +443,8 @@ def map_from_wkt(
         obstacles,
         name=name or _stem(source),
         merge=merge,
+        remedy="pass merge=True (WKT has no room for the flag; the surveil command has no "
+        'option for it: write the map as .json with "merge": true)',
     )
 
 

@@ -390,3 +390,29 @@ def test_shapely_reads_our_wkt_and_geojson_files_identically(tmp_path):
     np.testing.assert_array_equal(coords(wkt), coords(gj))
     np.testing.assert_array_equal(coords(wkt), np.unique(m.vertices, axis=0))
     assert Path(tmp_path / "a.wkt").read_text().startswith("POLYGON ((")
+
+
+def test_touching_polygons_in_a_file_name_the_file_s_own_remedy(tmp_path):
+    """Map's "build the map with merge=True" is a keyword a file's reader cannot pass (and
+    the surveil command has no option for it): each format names what its author can do."""
+    box = [[2, 2], [4, 2], [4, 4], [2, 4]]
+    other = [[4, 4], [6, 4], [6, 6], [4, 6]]
+    room = [[0, 0], [10, 0], [10, 10], [0, 10]]
+    doc = {"boundary": room, "obstacles": [box, other]}
+    (tmp_path / "t.json").write_text(json.dumps(doc))
+    with pytest.raises(InvalidMapError, match=r'add "merge": true to the map\'s JSON object'):
+        load_map(str(tmp_path / "t.json"))
+    closed = [[*r, r[0]] for r in (room, box[::-1], other[::-1])]
+    gj = {"type": "Polygon", "coordinates": closed}
+    (tmp_path / "t.geojson").write_text(json.dumps(gj))
+    with pytest.raises(InvalidMapError, match=r'add "merge": true to the properties'):
+        load_map(str(tmp_path / "t.geojson"))
+    rings = ", ".join("(" + ", ".join(f"{x} {y}" for x, y in r) + ")" for r in closed)
+    (tmp_path / "t.wkt").write_text(f"POLYGON ({rings})\n")
+    with pytest.raises(InvalidMapError, match=r'write the map as \.json with "merge": true'):
+        load_map(str(tmp_path / "t.wkt"))
+    for suffix in ("json", "geojson", "wkt"):
+        with pytest.raises(InvalidMapError) as err:
+            load_map(str(tmp_path / f"t.{suffix}"))
+        assert "build the map with merge=True" not in str(err.value)
+        assert read_map(tmp_path / f"t.{suffix}", merge=True).map.n_vertices == 12

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 import time
 from pathlib import Path
 
@@ -129,6 +130,7 @@ def run(args: argparse.Namespace) -> int:
     if args.estimate is not None:  # its memory too, before the referee's solve
         with MemoryBudgetError.naming(ESTIMATE_KNOB):
             check_estimate(GameSpec.from_config(cfg), tuple(args.estimate) or ESTIMATE_CPLS)
+    _say_if_long(cfg, args)
     t = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", VacuousBoundWarning)  # the summary says it below
@@ -174,6 +176,44 @@ def run(args: argparse.Namespace) -> int:
         draw_referee(ref, path=Path(out))
         print(f"wrote {out}")
     return 0
+
+
+LONG_SOLVE_SECONDS = 30.0
+"""A solve estimated (an upper bound) to take longer is announced on standard error first."""
+
+
+def _say_if_long(cfg, args: argparse.Namespace) -> None:
+    """Say on standard error what is about to be solved, and how long it may take, when
+    the estimate (:func:`strategies.referee.referee.unsolved_sizes`, an upper bound) is
+    over :data:`LONG_SOLVE_SECONDS`: ``--config '{"dt": 10}'`` on the corridor (the
+    pursuer's step rounded up to 10 s, 1257 moves a step instead of 29) solved for many
+    minutes without a word."""
+    from strategies.referee._budget import duration
+    from strategies.referee.referee import unsolved_sizes
+    from strategies.referee.spec import GameSpec
+
+    spec = GameSpec.from_config(cfg)
+    sizes = unsolved_sizes(spec, args.cells_per_lmin, cache=not args.no_cache, dt=cfg.dt)
+    seconds = sum(s.seconds for s in sizes)
+    if seconds <= LONG_SOLVE_SECONDS:
+        return
+    parts = "; ".join(f"{s.describe()}, a step of {s.tau:g} s, {s.moves} moves" for s in sizes)
+    # the steps without the env's dt: a dt longer than them rounds them up to itself
+    free = {s.what: s for s in unsolved_sizes(spec, args.cells_per_lmin, cache=False)}
+    longer = [s for s in sizes if s.moves > free[s.what].moves]
+    otherwise = ", ".join(f"{free[s.what].tau:g} s for the {s.what} otherwise" for s in longer)
+    why = (
+        f"; each step is a whole number of env steps (dt = {cfg.dt:g}), {otherwise}, and a "
+        "longer step has more moves: a smaller dt is faster"
+        if longer
+        else "; a smaller --cells-per-lmin is faster"
+    )
+    print(
+        f"{cfg.map.name}: solving the referee's bounds ({parts}): up to about "
+        f"{duration(seconds)} (an upper bound, estimated before the solve){why}",
+        file=sys.stderr,
+        flush=True,
+    )
 
 
 def _no_starts(ref, cpl: float, dt: float) -> str:

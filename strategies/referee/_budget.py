@@ -58,7 +58,15 @@ from strategies.cspace._budget import memory_budget
 from strategies.referee.lattice import grid_shape, lattice_vectors, window_half_width
 from strategies.referee.spec import GameSpec, Resolution
 
-__all__ = ["SolveSize", "bound_size", "check_budget", "estimate_size", "memory_budget", "peak"]
+__all__ = [
+    "SolveSize",
+    "bound_size",
+    "check_budget",
+    "duration",
+    "estimate_size",
+    "memory_budget",
+    "peak",
+]
 
 BASE_BYTES = 125e6
 """The interpreter with numpy, scipy and shapely loaded (measured: 121-124 MB)."""
@@ -86,6 +94,18 @@ SECONDS_PER_STATE = {"pursuer": 2e-5, "evader": 4e-7, "estimate": 2.5e-5}
 depend on the game: the pursuer bound took 0.65 us a state on the 16 x 10 room at 16
 cells per L_min and 18 us at 24): an upper bound, said as "up to"."""
 
+PURSUER_SECONDS_PER_STATE_MOVE = 6e-9
+PURSUER_MOVES_POWER = 1.4
+"""The pursuer bound's safe-move tables grow faster than its states when its step is long:
+a table per move, each testing the moves' sweeps against the convex corners near them
+(a longer move, more of them). A step is three lattice spacings (29 moves) unless an env's
+``dt`` rounds it up (``dt = 10`` on the corridor: a 10 s step, 1257 moves), and then the
+tables take nearly all of the time: CPU seconds on the corridor at 8 cells per L_min
+(624 k states) 0.22, 0.38, 6.6 and 42.5 at 29, 49, 317 and 1257 moves (244 of 248 s wall
+in the tables at 1257), 0.8 and 36 at 16 cells per L_min (2.17 M states), 29 and 317
+moves: about ``3e-9 * states * moves ** 1.4``. The estimate is the larger of
+:data:`SECONDS_PER_STATE` and twice that fit, so a default step keeps its estimate."""
+
 
 @dataclass(frozen=True)
 class SolveSize:
@@ -101,6 +121,7 @@ class SolveSize:
         bytes: peak memory of the solve, the interpreter included.
         kept: memory the solved result keeps.
         seconds: build and fixed point, order of magnitude.
+        tau: the step of a bound's certified player (``None`` for the estimate).
     """
 
     what: str
@@ -111,6 +132,7 @@ class SolveSize:
     bytes: float
     kept: float
     seconds: float
+    tau: float | None = None
 
     @property
     def states(self) -> int:
@@ -148,8 +170,11 @@ def bound_size(spec: GameSpec, res: Resolution, role: str) -> SolveSize:
     W = 2 * window_half_width(spec.l_max, res.cell) + 1
     moves = len(lattice_vectors(spec.speed(role) * res.tau, res.spacing))
     states = points * W * W
+    seconds = SECONDS_PER_STATE[role] * states
     if role == "pursuer":
         per = PURSUER_BYTES_PER_STATE + PURSUER_BYTES_PER_STATE_MOVE * moves
+        tables = PURSUER_SECONDS_PER_STATE_MOVE * states * moves**PURSUER_MOVES_POWER
+        seconds = max(seconds, tables)
     else:
         per = EVADER_BYTES_PER_STATE
         if spec.map.vertex_convex.any():
@@ -162,7 +187,8 @@ def bound_size(spec: GameSpec, res: Resolution, role: str) -> SolveSize:
         moves=moves,
         bytes=BASE_BYTES + per * states,
         kept=KEPT_BYTES_PER_STATE[role] * states,
-        seconds=SECONDS_PER_STATE[role] * states,
+        seconds=seconds,
+        tau=res.tau,
     )
 
 
@@ -261,7 +287,7 @@ def check_budget(
     raise MemoryBudgetError(
         f"{call}: the solve would need about {_size(need)} at its peak, during the "
         f"{at.what} ({'; '.join(s.describe() for s in sizes)}; up to about "
-        f"{_duration(total_seconds)} in all), more than the memory budget of "
+        f"{duration(total_seconds)} in all), more than the memory budget of "
         f"{_size(limit)}. " + "; ".join(advice[:-1]) + ", " + advice[-1],
         knob,
         size=f"{more}GB",
@@ -274,9 +300,13 @@ def _size(n: float) -> str:
     return f"{n / 1e9:.1f} GB" if n >= 1e9 else f"{n / 1e6:.0f} MB"
 
 
-def _duration(seconds: float) -> str:
+def duration(seconds: float) -> str:
+    """``seconds`` for a message: ``"40 s"``, ``"12 min"``, ``"2.3 h"``."""
     if seconds < 90:
         return f"{seconds:.0f} s"
     if seconds < 5400:
         return f"{seconds / 60:.0f} min"
     return f"{seconds / 3600:.3g} h"  # 1.08e+14 h, not 107916000064749.6 h
+
+
+_duration = duration  # the name the hindsight module imports

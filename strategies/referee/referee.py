@@ -27,7 +27,7 @@ from envs import validation as V
 from envs.errors import InvalidConfigError, InvalidPlacementError, VacuousBoundWarning
 from envs.geometry import kernel_for
 from strategies.referee._budget import SolveSize, bound_size, check_budget
-from strategies.referee.cache import load_arrays, save_arrays
+from strategies.referee.cache import cache_path, load_arrays, save_arrays
 from strategies.referee.evader_bound import EvaderBound, solve_evader_bound
 from strategies.referee.pursuer_bound import PursuerBound, solve_pursuer_bound
 from strategies.referee.spec import GameSpec, Resolution
@@ -45,6 +45,7 @@ __all__ = [
     "sample_starts",
     "solve",
     "solve_role",
+    "unsolved_sizes",
 ]
 
 LABELS = ("pursuer", "evader", "unknown")
@@ -467,6 +468,34 @@ def _resolution(
     return Resolution.for_role(
         spec, role, cpl, coarse=coarse, steps=steps, sweep_pieces=sweep_pieces, dt=dt
     )
+
+
+def unsolved_sizes(
+    spec: GameSpec,
+    cells_per_lmin: float = 24.0,
+    *,
+    cache: bool = True,
+    cache_dir: str | os.PathLike | None = None,
+    **knobs: Any,
+) -> list[SolveSize]:
+    """The estimated sizes (states, memory, time: :func:`~._budget.bound_size`) of the
+    bounds :func:`solve` would solve with these arguments, leaving out those it would load
+    from the cache: what a caller tells its user before a long solve (``surveil
+    referee``, whose ``dt = 10`` on the corridor solved for many minutes without a word).
+
+    Args:
+        spec, cells_per_lmin, cache, cache_dir: as :func:`solve`.
+        **knobs: :func:`solve`'s ``pursuer_coarse, evader_coarse, pursuer_steps,
+            evader_steps, sweep_pieces, dt``.
+    """
+    cells_per_lmin = V.positive("cells_per_lmin", cells_per_lmin)
+    out = []
+    for role in ("pursuer", "evader"):
+        res = _resolution(spec, role, cells_per_lmin, **knobs)
+        if cache and cache_path(role, spec, res, cache_dir).is_file():
+            continue
+        out.append(bound_size(spec, res, role))
+    return out
 
 
 COARSEST_SCAN_STEP = 2.0**0.125

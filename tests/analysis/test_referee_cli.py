@@ -145,3 +145,23 @@ def test_a_step_the_env_refuses_is_refused_before_the_solve(dt, capsys, monkeypa
     out, err = capsys.readouterr()
     assert out == "" and err.startswith(f"surveil: error: --config: dt = {float(dt)!r} with ")
     assert "i.e. dt <= 16.92" in err
+
+
+def test_a_long_solve_is_announced_with_its_estimate_before_it_starts(capsys, monkeypatch):
+    """``--config '{"dt": 10}'`` on the corridor solved for many minutes without a word:
+    the pursuer's step is rounded up to 10 s (1257 moves, 29 at the default step)."""
+    import strategies.referee as referee
+
+    def stop(*args, **kwargs):
+        raise KeyboardInterrupt  # the solve itself is not under test (Ctrl-C: code 130)
+
+    monkeypatch.setattr(referee, "referee_for", stop)
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", "/nonexistent")
+    assert main(["referee", "corridor", "--config", '{"dt": 10}', "--no-cache"]) == 130
+    err = capsys.readouterr().err
+    assert err.startswith("corridor: solving the referee's bounds (pursuer bound: ")
+    assert "a step of 10 s, 1257 moves" in err and "up to about" in err
+    assert "dt = 10" in err and "1.5 s for the pursuer bound otherwise" in err
+    # a short solve says nothing first
+    assert main(["referee", "corridor", "--cells-per-lmin", "4", "--no-cache"]) == 130
+    assert capsys.readouterr().err == "surveil: interrupted\n"

@@ -163,3 +163,22 @@ def test_a_map_too_large_for_any_resolution_says_so_not_the_interpreter():
     msg = str(err.value)
     assert "No cells_per_lmin fits (even cells_per_lmin = 0.1 needs about " in msg, msg
     assert "interpreter" not in msg and re.search(r"up to about [\d.]+e\+\d+ h in all", msg)
+
+
+def test_a_long_step_s_many_moves_lengthen_the_pursuer_bound_s_estimate():
+    """An env's dt rounds the pursuer's step up (dt = 10 on the corridor: 10 s, 1257 moves
+    instead of 29): the tables per move took nearly all of the time (42.5 s CPU at 8 cells
+    per L_min against 0.22 s at dt = 0.1), which the per-state estimate did not see."""
+    from strategies.referee.referee import _resolution
+    from strategies.runner import map_parameters
+
+    world, params = map_parameters("corridor")
+    sizes = {}
+    for dt in (0.1, 10.0):
+        s = GameSpec.from_config(EnvConfig(map=world, **params, dt=dt))
+        sizes[dt] = bound_size(s, _resolution(s, "pursuer", 8.0, dt=dt), "pursuer")
+    short, long = sizes[0.1], sizes[10.0]
+    assert (short.moves, long.moves) == (29, 1257) and short.states == long.states
+    assert short.seconds == pytest.approx(2e-5 * short.states)  # a default step: as before
+    # an upper bound of the measured 42.5 s (CPU, 8 cells per L_min, 1257 moves)
+    assert long.tau == 10.0 and long.seconds >= 42.5 and long.seconds > 5 * short.seconds

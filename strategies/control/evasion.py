@@ -48,6 +48,7 @@ from strategies.control._integrators import (
     first_return,
     integrate_pmp,
     integrate_reduced,
+    integrate_reduced_end,
 )
 from strategies.control._validate import branch_sign, check_evasion_rho
 from strategies.control.hamiltonian import _kappa_scalar, is_unbounded, solve_stationary
@@ -490,13 +491,18 @@ def _shoot_escape(th0: float, x_e: float, L: float, rho: float, s: int, h: float
         key = (a0, math.copysign(1.0, a0), hh)
         if key in done:
             return done[key][0]
-        fine = hh == h
-        rows, status = integrate_reduced(th0, a0, s, L, rho, hh, x_e, fine, _max_steps(x_e, L, hh))
+        n = _max_steps(x_e, L, hh)
+        if hh == h:
+            rows, status = integrate_reduced(th0, a0, s, L, rho, hh, x_e, True, n)
+            end = rows[-1]
+        else:  # the coarse arcs: y(x_e) and the status only (the same floats, without ln μ)
+            rows = []
+            end, status = integrate_reduced_end(th0, a0, s, L, rho, hh, x_e, n)
         if status != REACHED:  # turned back going up (+1) / down (-1), or wandered (2)
-            r = 10.0 * (status if status != 2 else math.copysign(1.0, rows[-1][2]))
+            r = 10.0 * (status if status != 2 else math.copysign(1.0, end[2]))
         else:
-            r = rows[-1][2] / x_e
-        done[key] = (r, rows if fine else [], status)
+            r = end[2] / x_e
+        done[key] = (r, rows, status)
         return r
 
     def turned(a0: float) -> bool:  # the coarse arc from a0 (evaluated) did not reach x_e

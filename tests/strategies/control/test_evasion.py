@@ -398,6 +398,53 @@ def test_integrate_reduced_is_rk4_of_the_rhs_bit_for_bit():
     assert seen == {-1, 0, 1, 2}
 
 
+def test_integrate_reduced_end_is_integrate_reduced_without_ln_mu():
+    # the coarse integrations (the shooting's bracketing grid and Brent) read y(x_e) and the
+    # status only: integrate_reduced_end is integrate_reduced without ln μ, the same floats
+    # in σ, x, y, θ and α, bit for bit, and the same status, every outcome
+    from strategies.control._integrators import integrate_reduced, integrate_reduced_end
+
+    rng = np.random.default_rng(86)
+    seen = set()
+    for _ in range(400):
+        th0, a0 = float(rng.uniform(-4.0, 4.0)), float(rng.uniform(-1.57, 1.57))
+        L, rho = float(rng.uniform(0.5, 3.0)), float(rng.uniform(0.05, 0.995))
+        step, x_t = float(rng.uniform(0.002, 0.2)), float(rng.uniform(0.05, 3.0))
+        s = int(rng.choice([-1, 1]))
+        budget = (
+            int(rng.integers(1, 40)) if rng.random() < 0.2 else math.ceil(10 * (x_t + L) / step)
+        )
+        rows, status = integrate_reduced(th0, a0, s, L, rho, step, x_t, False, budget)
+        end, status_end = integrate_reduced_end(th0, a0, s, L, rho, step, x_t, budget)
+        assert status_end == status
+        assert repr(end[:5]) == repr(rows[-1][:5]) and math.isnan(end[5])
+        seen.add(status)
+    assert seen == {-1, 0, 1, 2}
+
+
+@pytest.mark.parametrize("rho", [0.5, 0.99])
+def test_the_coarse_integrations_carry_no_ln_mu(monkeypatch, rho):
+    # issue 13: near rho = 1 the coarse integrations are nearly all of a failed solve; they
+    # run integrate_reduced_end (no ln μ, ~13% cheaper), integrate_reduced only at the fine
+    # step (the arc's rows and its μ), with the same arcs as before
+    from strategies.control import evasion
+
+    fine, coarse = [], []
+    for name, runs in (("integrate_reduced", fine), ("integrate_reduced_end", coarse)):
+        real = getattr(evasion, name)
+
+        def counted(*args, real=real, runs=runs):
+            runs.append(args[5])
+            return real(*args)
+
+        monkeypatch.setattr(evasion, name, counted)
+    step = capped_step(2.0, 2.0, rho)
+    for th in (0.0, -0.3, 2.8):
+        escape_path(th, 2.0, L=2.0, rho=rho, branch="+", step=step)
+    assert coarse and set(coarse) == {8.0 * step}
+    assert fine and set(fine) == {step}
+
+
 @pytest.mark.parametrize(
     ("theta0", "x_e", "L", "rho", "branch"),
     [
@@ -417,19 +464,28 @@ def test_escape_path_is_the_solutions_evader_path(theta0, x_e, L, rho, branch):
     assert path.tobytes() == ref.tobytes() and path.flags.c_contiguous
 
 
-def test_solve_escape_integrates_each_heading_once(monkeypatch):
-    # Brent and the polish ask for some headings twice (a bracket's ends, the coarse root)
-    # and the winner's rows were integrated again: each (heading, step) is integrated once
+def _counting(monkeypatch, key=lambda args: args[1]):
+    """Every integration of the shooting, fine (``integrate_reduced``) or coarse
+    (``integrate_reduced_end``), as ``key(args)``."""
     from strategies.control import evasion
 
     runs = []
-    real = evasion.integrate_reduced
+    for name in ("integrate_reduced", "integrate_reduced_end"):
+        real = getattr(evasion, name)
 
-    def counted(theta0, alpha0, s, L, rho, step, *rest):
-        runs.append((alpha0.hex(), step))
-        return real(theta0, alpha0, s, L, rho, step, *rest)
+        def counted(*args, real=real):
+            runs.append(key(args))
+            return real(*args)
 
-    monkeypatch.setattr(evasion, "integrate_reduced", counted)
+        monkeypatch.setattr(evasion, name, counted)
+    return runs
+
+
+def test_solve_escape_integrates_each_heading_once(monkeypatch):
+    # Brent and the polish ask for some headings twice (a bracket's ends, the coarse root)
+    # and the winner's rows were integrated again: each (heading, step) is integrated once
+
+    runs = _counting(monkeypatch, lambda args: (args[1].hex(), args[5]))
     sol = solve_escape(-4.29821055010567, 0.9, L=2.0, rho=0.5, branch="+")
     assert sol.success and sol.candidates == 1
     assert len(runs) == len(set(runs)) == 18  # (it was 23: 18 coarse, 4 fine, 1 stored)
@@ -475,20 +531,6 @@ def test_a_failed_escape_at_a_coarse_step_says_the_step_may_be_why():
     sol = solve_escape(math.pi, 2.0, L=1.0, rho=0.5, step=0.5)
     assert not sol.success
     assert "the step 0.5 is too coarse" in sol.reason and "natural length 0.333" in sol.reason
-
-
-def _counting(monkeypatch):
-    from strategies.control import evasion
-
-    runs = []
-    real = evasion.integrate_reduced
-
-    def counted(*args):
-        runs.append(args[1])
-        return real(*args)
-
-    monkeypatch.setattr(evasion, "integrate_reduced", counted)
-    return runs
 
 
 def test_a_solve_without_an_arc_stops_brent_at_the_jump(monkeypatch):
@@ -545,8 +587,8 @@ def _fine_runs(monkeypatch):
     real = evasion.integrate_reduced
 
     def counted(*args):
-        if args[7]:  # store: the fine grid's integrations (the coarse ones keep the end)
-            fine.append(args[1])
+        if args[7]:  # store: the fine grid's integrations (the coarse ones run
+            fine.append(args[1])  # integrate_reduced_end)
         return real(*args)
 
     monkeypatch.setattr(evasion, "integrate_reduced", counted)

@@ -57,13 +57,14 @@ def test_arcs_near_rho_one_are_integrated_at_the_capped_step(monkeypatch):
     from strategies.control import evasion
 
     steps: list[tuple[float, float]] = []  # (step, x_e) of each integration
-    real = evasion.integrate_reduced
+    for name in ("integrate_reduced", "integrate_reduced_end"):  # fine, coarse
+        real = getattr(evasion, name)
 
-    def counted(theta0, alpha0, s, L, rho, step, x_target, store, max_steps):
-        steps.append((step, x_target))
-        return real(theta0, alpha0, s, L, rho, step, x_target, store, max_steps)
+        def counted(*args, real=real):
+            steps.append((args[5], args[6]))
+            return real(*args)
 
-    monkeypatch.setattr(evasion, "integrate_reduced", counted)
+        monkeypatch.setattr(evasion, name, counted)
     evader = make_policy("evader/shooting")
     run_episode(
         "corridor", "pursuer/greedy", evader, 0, start="safe", max_cycles=100,

@@ -185,6 +185,10 @@ def _near_l_min(config, kernel, rng, judge, tab, angle_margin, escapable=False):
     convex = m.vertices[m.vertex_convex]
     margin_bins = 0 if angle_margin is None else math.ceil(angle_margin / tab.bin_width)
     retreat = retreat_clearance_required(config, length) if admissible else 0.0
+    # no retreat longer than the map's diameter fits anywhere (rho near 1: 24.5 at rho =
+    # 0.99 and L_0 = 2.45), so every proposal in a safe cell would be refused as
+    # unretreatable and the first of them drawn: it is drawn at once
+    hopeless = admissible and angle_margin is not None and retreat > m.diameter
     in_safe_cell = None  # the first proposal refused only as inadmissible or unretreatable
     for _ in range(MAX_BATCHES):
         e = rng.uniform((xmin, ymin), (xmax, ymax), size=(BATCH, 2))
@@ -216,19 +220,31 @@ def _near_l_min(config, kernel, rng, judge, tab, angle_margin, escapable=False):
                 bins = (b + np.arange(-margin_bins, margin_bins + 1)) % tab.n_bins
                 if not tab.safe[row, bins].all():
                     continue
+                # the retreat first: the cheaper test (V is a probe fan per proposal)
                 if admissible and (
-                    judge.orientation_values(e[i])[b] < 0.0
+                    hopeless
                     or not has_retreat_clearance(m, kernel, p[i], e[i], retreat, r)
+                    or judge.orientation_values(e[i])[b] < 0.0
                 ):
                     if in_safe_cell is None:
                         in_safe_cell = _placement(p[i], e[i])
+                    if hopeless:
+                        break
                     continue
             return _placement(p[i], e[i])
+        if hopeless and in_safe_cell is not None:
+            break
     if in_safe_cell is not None:  # nothing admissible (rho near 1): a safe cell, as at rho >= 1
+        why = (
+            f"none can retreat {retreat:.4g} along the rod, more than the map's diameter "
+            f"{m.diameter:.4g}"
+            if hopeless
+            else f"no proposal in a safe cell was admissible (V(theta) >= 0) with a retreat "
+            f"of {retreat:.4g} along the rod"
+        )
         warnings.warn(
-            f"map {m.name!r}, rho = {config.rho:g}: no proposal in a safe cell was admissible "
-            f"(V(theta) >= 0) with a retreat of {retreat:.4g} along the rod; drew one in a "
-            "safe cell only, as at rho >= 1 (the pursuer may not be able to hold from it)",
+            f"map {m.name!r}, rho = {config.rho:g}: {why}; drew one in a safe cell only, as "
+            "at rho >= 1 (the pursuer may not be able to hold from it)",
             RelaxedStartWarning,
             stacklevel=2,
         )

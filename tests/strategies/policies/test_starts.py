@@ -210,3 +210,30 @@ def test_near_one_rho_draws_a_safe_cell_start_as_rho_one_does(rho):
             np.random.default_rng(0),
             kind="safe",
         )
+
+
+def test_a_retreat_longer_than_the_map_draws_the_relaxed_start_at_once(monkeypatch):
+    """At rho = 0.99 the retreat a safe start asks for (24.5 at L_0 = 2.45) is longer than
+    the corridor's diameter (16.9), so no proposal can pass it: the sampler judged all
+    25,600 proposals (about 10,000 probe fans of V(theta), 3 s) before drawing the first
+    one in a safe cell. It draws that one at once, the same start (seeds 0-5 drew the
+    same before and after, /work/scratch/s15/helper-88/starts_*.jsonl)."""
+    from strategies.policies.decomposition import DecompositionPursuer
+
+    calls = []
+    real = DecompositionPursuer.orientation_values
+
+    def counted(self, evader):
+        calls.append(1)
+        return real(self, evader)
+
+    monkeypatch.setattr(DecompositionPursuer, "orientation_values", counted)
+    cfg = surveillance_v1.parallel_env(map="corridor", v_evader=0.99).config
+    with pytest.warns(RelaxedStartWarning, match=r"more than the map's diameter 16\.92"):
+        start = sample_start(cfg, np.random.default_rng(0), kind="safe")
+    assert not calls
+    # drawn before this change from the same seed, after its 25,600 proposals
+    assert start == {
+        "pursuer": (2.949769056304625, -0.13225155478071748),
+        "evader": (4.191386997143269, -2.302132862361297),
+    }

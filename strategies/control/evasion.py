@@ -531,7 +531,10 @@ reaches ``x_e`` off the axis (by :data:`_JUMP_RESIDUAL`) is taken for a jump (se
 :func:`_polished_root`). Measured: in 1,650 random solves at rho 0.9-0.99 (L = 2, x_e
 0.3-3.2, the shooting evader's capped step) no bracket that Brent closed on a root had a
 turned-back end once it was narrower than 4e-4 (the least of 1,119 such brackets), 400
-times this width; all 245 jumps were stopped."""
+times this width; all 245 jumps were stopped. On broader problems (L 0.5-4, x_e to 4 L,
+rho 0.5-0.995, 1,598 solves) one such bracket came to 2.4e-6 (rho 0.8, x_e 3.2 L: the root
+next to the jump), its reaching end's residual 0.0018 there and 0.0008 at 1.2e-6, below
+:data:`_JUMP_RESIDUAL`: that is what kept it from being taken for a jump."""
 
 _JUMP_RESIDUAL = 1e-3
 """Least ``|y(x_e)|/x_e`` of the reaching end for :data:`_JUMP_WIDTH`'s certificate: 1,000
@@ -542,6 +545,21 @@ arcs end at the turned-back arc's vertical tangent, off the axis (in the same so
 
 class _Jump(Exception):
     """The coarse bracket of :func:`_polished_root` has closed on a jump, not a root."""
+
+
+class _Probe(Exception):
+    """Brent's coarse bracket still has a turned-back end after :data:`_PROBE_AFTER`
+    evaluations (args: its ends as ``(α(0), residual)``): bisect it for a jump."""
+
+
+_PROBE_AFTER = 4
+"""Brent evaluations after which a coarse bracket that still has a turned-back end (and a
+reaching one off the axis by :data:`_JUMP_RESIDUAL`) is bisected for a jump (see
+:func:`_polished_root`). A bracket that closes on a root and is bisected costs the
+midpoints up to the first on the other side of the axis, then Brent's own evaluations as
+before. Measured on the shooting evader's solves of ``decision_time.py --rho 0.95 / 0.99``
+(corridor, l_hall): failed solves 36.5 -> 28.9 integrations at 4 (28.0 at 0, 30.3 at 8),
+successful ones 19.1 -> 19.5 (22.7 at 0 and 2); every arc the same, bit for bit."""
 
 
 def _polished_root(residual, a_lo: float, a_hi: float, coarse: float, turned) -> float | None:
@@ -566,15 +584,39 @@ def _polished_root(residual, a_lo: float, a_hi: float, coarse: float, turned) ->
     arc and a reaching one off the axis by :data:`_JUMP_RESIDUAL`, it is a jump. Brent's
     evaluations up to there are the same, so a bracket that closes on a root (none does
     this narrow beside a turned arc, see :data:`_JUMP_WIDTH`) gives the same root.
+
+    Brent closes on a jump slowly: next to a turned arc's residual (10) the reaching end's
+    (~0.2-0.5) makes its interpolations land beside the reaching end, and it halves the
+    bracket only every ~1.5 evaluations (~25 to reach :data:`_JUMP_WIDTH` from a grid
+    bracket). So once Brent has spent :data:`_PROBE_AFTER` evaluations and its bracket
+    still has a turned end, :func:`_bisected_jump` bisects that bracket: one evaluation a
+    halving, each midpoint turning back as the turned end did or reaching on the reaching
+    end's side of the axis, to :data:`_JUMP_WIDTH` (the same certificate). Any other
+    midpoint (an arc reaching the other side: a root lies between) ends the bisection and
+    Brent runs again from the start, its evaluations so far cached, to the same root. The
+    two agree wherever the bracket holds one sign change (the jump); a bracket with a pair
+    of roots besides, on the reaching side, could send Brent to one of them and the
+    bisection past both: in 3,107 random solves (1,907 at rho 0.3-0.995, L 0.5-4, x_e to
+    4 L, the capped and the default step; 1,200 at L 2, rho 0.9-0.99) and every benchmark
+    row, none did (the same arcs, bit for bit, and the same failures).
     """
     if residual(a_lo, coarse) == 0.0:
         a_c = a_lo
     else:
-        f = _jump_watch(residual, a_lo, a_hi, coarse, turned)
+        f = _jump_watch(residual, a_lo, a_hi, coarse, turned, _PROBE_AFTER)
         try:
             a_c = brentq(f, a_lo, a_hi, args=(coarse,), xtol=1e-13, rtol=1e-13)
         except _Jump:
             return None
+        except _Probe as probe:
+            if _bisected_jump(residual, coarse, turned, *probe.args):
+                return None
+            # not a jump by bisection: Brent from the start, its evaluations so far cached
+            f = _jump_watch(residual, a_lo, a_hi, coarse, turned)
+            try:
+                a_c = brentq(f, a_lo, a_hi, args=(coarse,), xtol=1e-13, rtol=1e-13)
+            except _Jump:
+                return None
     if abs(residual(a_c, coarse)) > 1e-6:  # sign change across a turned-back arc
         return None
     a0, r0 = a_c, residual(a_c)
@@ -609,11 +651,16 @@ def _polished_root(residual, a_lo: float, a_hi: float, coarse: float, turned) ->
     return root if abs(residual(root)) < 1e-9 else None
 
 
-def _jump_watch(residual, a_lo: float, a_hi: float, coarse: float, turned):
+def _jump_watch(
+    residual, a_lo: float, a_hi: float, coarse: float, turned, probe_after: int | None = None
+):
     """``residual`` (for Brent on ``[a_lo, a_hi]`` at the ``coarse`` step) that raises
     :class:`_Jump` once the bracket is a jump by :data:`_JUMP_WIDTH` (see
-    :func:`_polished_root`)."""
+    :func:`_polished_root`), and with ``probe_after`` :class:`_Probe` (the bracket) from
+    that many evaluations on while the bracket still has a turned-back end and a reaching
+    one off the axis by :data:`_JUMP_RESIDUAL`."""
     ends = [[a_lo, residual(a_lo, coarse)], [a_hi, residual(a_hi, coarse)]]
+    count = [0]
 
     def watched(a0: float, hh: float) -> float:
         r = residual(a0, hh)
@@ -625,9 +672,36 @@ def _jump_watch(residual, a_lo: float, a_hi: float, coarse: float, turned):
                 t_lo, t_hi = turned(lo[0]), turned(hi[0])
                 if t_lo != t_hi and abs(hi[1] if t_lo else lo[1]) > _JUMP_RESIDUAL:
                     raise _Jump
+        count[0] += 1
+        if probe_after is not None and count[0] >= probe_after and r != 0.0:
+            t_lo, t_hi = turned(lo[0]), turned(hi[0])
+            if t_lo != t_hi and abs(hi[1] if t_lo else lo[1]) > _JUMP_RESIDUAL:
+                raise _Probe(tuple(lo), tuple(hi))
         return r
 
     return watched
+
+
+def _bisected_jump(residual, coarse: float, turned, lo, hi) -> bool:
+    """Whether bisection of the coarse bracket ``lo``, ``hi`` (``(α(0), residual)`` pairs:
+    one end turned back, the other reaching ``x_e`` off the axis) closes on a jump by
+    :data:`_JUMP_WIDTH`: every midpoint either turns back as the turned end did or reaches
+    ``x_e`` on the same side of the axis as the reaching end by :data:`_JUMP_RESIDUAL`.
+    False at the first midpoint that does neither (an arc reaching the axis's other side:
+    a root lies between, Brent finds it)."""
+    (a_t, r_t), (a_e, r_e) = (lo, hi) if turned(lo[0]) else (hi, lo)
+    while abs(a_e - a_t) >= _JUMP_WIDTH:
+        m = a_t + 0.5 * (a_e - a_t)
+        if m in (a_t, a_e):  # (no float between: only with _JUMP_WIDTH 0, no certificate)
+            return False
+        r = residual(m, coarse)
+        if turned(m) and r == r_t:  # turned back the same way (10 x the status)
+            a_t = m
+        elif not turned(m) and (r > 0.0) == (r_e > 0.0) and abs(r) > _JUMP_RESIDUAL:
+            a_e = m
+        else:
+            return False
+    return True
 
 
 # ------------------------------------------------------------------------------ greedy

@@ -580,6 +580,59 @@ def test_the_jump_certificate_changes_no_solve(monkeypatch):
     assert 0 < found < len(probs) and counts[0] < counts[1]  # both kinds, and it stopped some
 
 
+def test_a_failed_solve_bisects_the_jump(monkeypatch):
+    # issue 13: Brent closes on a jump at about 1.5 evaluations a halving (next to a
+    # turned-back arc's residual 10 its interpolations land by the reaching end); after
+    # _PROBE_AFTER of them the bracket is bisected, one evaluation a halving: 38 -> 29
+    # integrations for this failed solve (the grid's 9 included)
+    from strategies.control import evasion
+
+    runs = _counting(monkeypatch)
+    step = capped_step(2.0, 2.0, 0.99)
+    assert escape_path(0.0, 2.0, L=2.0, rho=0.99, branch="+", step=step) is None
+    assert len(runs) <= 30
+    n = len(runs)
+    monkeypatch.setattr(evasion, "_PROBE_AFTER", 10**9)  # never bisected: Brent alone
+    assert escape_path(0.0, 2.0, L=2.0, rho=0.99, branch="+", step=step) is None
+    assert len(runs) - n >= 36
+
+
+def test_the_bisection_changes_no_solve(monkeypatch):
+    # the bisection stops only brackets that close on a jump; any other bracket goes back to
+    # Brent from the start: every solve (the evader's capped step, rho 0.5-0.99, and the
+    # default step up to 0.95) gives the same arc bit for bit, or None as before
+    from strategies.control import evasion
+
+    runs = _counting(monkeypatch)
+    rng = np.random.default_rng(86)
+    probs = [
+        (rng.uniform(-math.pi, math.pi), rng.uniform(0.2, 3.6), rho, "+-"[rng.integers(2)], mode)
+        for rho in (0.5, 0.9, 0.95, 0.97, 0.99)
+        for mode in ("capped", "default")
+        for _ in range(6)
+        if mode == "capped" or rho <= 0.95
+    ]
+    steps = {"capped": lambda x_e, rho: capped_step(x_e, 2.0, rho), "default": lambda *_: None}
+    counts, paths = [], []
+    for after in (evasion._PROBE_AFTER, 10**9):
+        monkeypatch.setattr(evasion, "_PROBE_AFTER", after)
+        del runs[:]
+        paths.append(
+            [
+                escape_path(th, x_e, L=2.0, rho=rho, branch=b, step=steps[mode](x_e, rho))
+                for th, x_e, rho, b, mode in probs
+            ]
+        )
+        counts.append(len(runs))
+    found = 0
+    for new, old in zip(*paths, strict=True):
+        assert (new is None) == (old is None)
+        if new is not None:
+            found += 1
+            assert new.tobytes() == old.tobytes()
+    assert 0 < found < len(probs) and counts[0] < counts[1]  # both kinds, and it cut some
+
+
 def _fine_runs(monkeypatch):
     from strategies.control import evasion
 

@@ -46,7 +46,7 @@ __all__ = [
     "write_cache_file",
 ]
 
-FORMAT_VERSION = 9  # 9: repeated arcs and conchoids merged (8: thin clockwise cycles are faces)
+FORMAT_VERSION = 10  # 10: edges ordered on one circle (9: repeated arcs merged)
 """Bump when the decomposition's content or the file layout changes."""
 
 MAGIC = b"SURVEIL-CSPACE-DECOMPOSITION\n"

@@ -285,3 +285,25 @@ def test_wall_vertices_at_one_point_give_an_exact_arrangement(name, L):
     # not congruent and its near-degeneracies differ)
     moved = decompose(similar(world, 0.0, 1e3, (1e6, -1e6)), L * 1e3)
     assert fingerprint(moved) == fingerprint(dec)
+
+
+@pytest.mark.parametrize("L", [1.5, 2.0005407597773552, 3.0])
+@pytest.mark.parametrize("step", [1e-2, 1e-3, 1e-4, 1e-5])
+def test_a_tiny_step_on_an_obstacle_s_corner_gives_an_exact_arrangement(step, L):
+    """A step ``step`` high and deep cut into an obstacle's corner: the conchoid of the
+    corner (body) and the step's short top edge (tip) leaves the corner of the type-3
+    line with the type-2 arc of the step's outer corner, 0.2 degrees apart, at 200 times
+    the rod's speed there and a third less soon after; the faces at that vertex were
+    ordered by chords of unequal lengths, and the conchoid, the arc and the type-3 line
+    dangled (at L = 2.00054, the map's diagonal / 8.6: 3-6 dangling edges, 3-5 pieces
+    matched by overlap only, at every step)."""
+    h = step / 2
+    world = Map(
+        _box(0, 0, 14, 10),
+        [[(5, 5), (9, 5), (9, 5 + h), (9 + h, 5 + h), (9 + h, 6), (5, 6)]],
+    )
+    dec = decompose(world, L)
+    assert dec.exact and dec.stats["dangling"] == 0 and dec.unresolved == 0, dec.stats
+    n, bad = stops_constant(dec, np.random.default_rng(5), per_region=4)
+    assert not bad, bad[:5]
+    assert n > 2 * len(dec.regions)

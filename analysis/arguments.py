@@ -59,6 +59,13 @@ class Parser(argparse.ArgumentParser):
         self.exit(2, f"{PROG}: error: {message} (see '{self.prog} --help')\n")
 
 
+MAP_HELP = (
+    "a built-in name (surveil maps), a map file (.json, .geojson or .wkt: see "
+    "envs/maps/io.py) or a seeded random map, random:SEED or random:KIND:SEED"
+)
+"""What a map argument takes (every command reads it with :func:`envs.maps.load_map`)."""
+
+
 def integer(minimum: int, maximum: int | None = None) -> Callable[[str], int]:
     """An argparse ``type=``: an integer in [minimum, maximum]."""
     expected = (

@@ -17,6 +17,7 @@ from pathlib import Path
 
 from analysis import referee_cli
 from analysis.arguments import (
+    MAP_HELP,
     Parser,
     integer,
     json_object,
@@ -269,7 +270,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", required=True)
 
-    p = sub.add_parser("maps", help="list the built-in maps")
+    p = sub.add_parser(
+        "maps",
+        help="list the built-in maps",
+        description="List the built-in maps. Wherever a command takes a map it also takes "
+        f"{MAP_HELP.removeprefix('a built-in name (surveil maps), ')}.",
+    )
     p.add_argument(
         "--plot",
         metavar="DIR",
@@ -287,7 +293,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--map",
         default="corridor",
         type=path_text("a built-in map name or a map file"),
-        help="built-in name or map file (default: corridor)",
+        help=f"{MAP_HELP} (default: corridor)",
     )
     p.add_argument(
         "--pursuer",
@@ -325,9 +331,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_play)
 
     p = sub.add_parser("analyze", help="draw the critical curves, regions and graph G_L")
-    p.add_argument(
-        "map", type=path_text("a built-in map name or a map file"), help="built-in name or map file"
-    )
+    p.add_argument("map", type=path_text("a built-in map name or a map file"), help=MAP_HELP)
     p.add_argument(
         "--length", type=real(0.0), default=None, help="rod length L (default: a built-in's L_min)"
     )

@@ -21,7 +21,7 @@ import sys
 import time
 from pathlib import Path
 
-from analysis.arguments import integer, json_object, output_file, path_text, real
+from analysis.arguments import MAP_HELP, integer, json_object, output_file, path_text, real
 
 __all__ = ["add_parser", "run"]
 
@@ -41,9 +41,7 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
         "the starts the pursuer provably holds from, those the evader provably escapes from, "
         "and the gap between them (the resolution error).",
     )
-    p.add_argument(
-        "map", type=path_text("a built-in map name or a map file"), help="built-in name or map file"
-    )
+    p.add_argument("map", type=path_text("a built-in map name or a map file"), help=MAP_HELP)
     p.add_argument("--config", help=f"env overrides as JSON, e.g. {CONFIG_EXAMPLE}")
     p.add_argument(
         "--cells-per-lmin",

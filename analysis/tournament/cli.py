@@ -16,6 +16,7 @@ from importlib import resources
 from pathlib import Path
 
 from analysis.arguments import (
+    MAP_HELP,
     integer,
     json_object,
     output_file,
@@ -298,7 +299,8 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "evaluate", help="quick matchup table from flags (a one-off tournament spec)"
     )
-    p.add_argument("--maps", nargs="+", default=["corridor", "two_rooms"])
+    p.add_argument("--maps", nargs="+", default=["corridor", "two_rooms"],
+                   help=f"each {MAP_HELP}")  # fmt: skip
     roster = "policy names, zoo:NAME (a shipped model) or a model .zip"
     p.add_argument("--pursuers", nargs="+", default=["pursuer/decomposition", "pursuer/greedy"],
                    help=roster)  # fmt: skip

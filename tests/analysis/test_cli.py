@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 from PIL import Image
 
 from analysis.cli import main
@@ -199,3 +200,20 @@ def test_play_takes_a_shipped_model_or_a_model_file_as_evaluate_does(tmp_path, c
         assert main(["play", *argv, *fast]) == 0
         out = capsys.readouterr().out
         assert "sb3:" in out and ("kept surveillance" in out or "escaped" in out)
+
+
+@pytest.mark.parametrize(
+    ("command", "flag"),
+    [("play", "--map"), ("analyze", "map"), ("referee", "map"), ("evaluate", "--maps")],
+)
+def test_every_map_argument_says_what_it_takes(command, flag, capsys):
+    """A new user's first question: how do I give my own world? The help said 'built-in
+    name or map file' (no formats, no random:SEED, which every command takes) or nothing
+    (evaluate --maps); ``surveil maps`` named the built-ins only."""
+    assert main([command, "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    at = text.index(f" {flag} ", text.index("options:") if flag.startswith("-") else 0)
+    assert "(.json, .geojson or .wkt" in text[at:] and "random:SEED" in text[at:]
+    assert main(["maps", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert "a map file (.json, .geojson or .wkt" in text and "random:KIND:SEED" in text

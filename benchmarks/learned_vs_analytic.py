@@ -119,6 +119,14 @@ def card(name: str, role: str, rows, args, decide=None, measured=None) -> str:
             "(a learned policy with analytic features: each step it reads the state and "
             "computes them from the map, see `strategies/policies/learner_inputs.py`)"
         )
+    # a DAgger run records its network and size; an RL recipe names the net in its
+    # policy_kwargs or keeps SB3's default (the card said "None (None parameters)")
+    net = prov.get("net_arch") or (cfg.get("policy_kwargs") or {}).get("net_arch")
+    network = f"{net}" if net else f"{str(prov.get('algo', 'SB3')).upper()}'s default MLP"
+    if prov.get("parameters"):
+        network += f" ({prov['parameters']} parameters)"
+    amount = (f"labelled states: {prov['samples'][-1]}" if "samples" in prov
+              else f"timesteps: {prov.get('timesteps', '-')}")  # fmt: skip
     lines = [
         f"# {name}",
         "",
@@ -128,11 +136,9 @@ def card(name: str, role: str, rows, args, decide=None, measured=None) -> str:
         "this card.",
         "",
         f"- training maps: {', '.join(trained)}",
-        f"- network: {prov.get('net_arch')} ({prov.get('parameters')} parameters), "
-        f"model file {size / 1024:.0f} KiB",
-        f"- labelled states: {prov['samples'][-1] if 'samples' in prov else '-'}; "
-        f"wall time {prov.get('wall_seconds', prov.get('wall_time', float('nan'))):.0f} s on "
-        "2 cores",
+        f"- network: {network}, model file {size / 1024:.0f} KiB",
+        f"- {amount}; wall time "
+        f"{prov.get('wall_seconds', prov.get('wall_time', float('nan'))):.0f} s on 2 cores",
         f"- trained on `{trained_on}`",
         f"- code: {prov.get('git_sha')} (dirty: {prov.get('git_dirty')}); "
         f"versions {prov.get('versions') or prov.get('packages')}",

@@ -82,3 +82,20 @@ def test_trained_env_reads_the_provenance_else_the_training_commit(tmp_zoo):
     assert zoo.trained_env(MODEL) is None  # a commit git does not know: it cannot tell
     prov_path.write_text(json.dumps({**prov, "env_id": "surveillance_v1"}))
     assert zoo.trained_env(MODEL) == "surveillance_v1"  # a recorded version wins
+
+
+def test_an_rl_models_card_names_its_network_and_timesteps(lva):
+    """An RL run's provenance has no net_arch, parameters or samples: the card said
+    "network: None (None parameters)" and "labelled states: -"."""
+    import argparse
+
+    name = "ppo_pursuer_vs_straight_open_room"
+    args = argparse.Namespace(seeds=1, max_cycles=300, models=[name], maps=None)
+    measured = {"env": ENV_ID, "sha": "0" * 40, "dirty": False, "command": "python x"}
+    text = lva.card(name, "pursuer", [], args, measured=measured)
+    assert "network: None" not in text and "None parameters" not in text
+    assert "- network: PPO's default MLP, model file" in text
+    assert f"- timesteps: {zoo.info(name)['timesteps']}; wall time" in text
+    general = lva.card("dagger_pursuer_generalist", "pursuer", [], args, measured=measured)
+    assert "- network: [128, 128] (43909 parameters)" in general
+    assert "- labelled states: 62809; wall time" in general

@@ -307,3 +307,25 @@ def test_a_tiny_step_on_an_obstacle_s_corner_gives_an_exact_arrangement(step, L)
     n, bad = stops_constant(dec, np.random.default_rng(5), per_region=4)
     assert not bad, bad[:5]
     assert n > 2 * len(dec.regions)
+
+
+@pytest.mark.parametrize("angle", [0.0, 3.0905])
+@pytest.mark.parametrize("L", [1.0, 1.0082])
+def test_a_conchoid_of_a_sub_millimetre_edge_is_ordered_against_its_arc(angle, L):
+    """A step 0.135 mm high and 0.338 mm deep: the conchoid of the corner (body) and the
+    step's top edge (tip) and the type-2 arc of the step's outer corner leave the type-3
+    line's end 5e-4 radians apart on the ordering circle; with chords rescaled to within
+    0.1 % of its radius (at most six steps) the conchoid's angle read 1e-4 off and the
+    two were swapped (3 dangling edges, 2 pieces matched by overlap only; found by a
+    random search over stepped corners: 9 of 80 inexact, 8 after this)."""
+    x0, y0, x1, y1, st, sd = 5.9248, 2.1959, 9.7658, 3.6692, 1.35e-4, 3.38e-4
+    obstacles = [
+        [(x0, y0), (x1, y0), (x1, y0 + st), (x1 + sd, y0 + st), (x1 + sd, y1), (x0, y1)],
+        _box(x1 + 1.5, y1 + 0.5, x1 + 2.5, y1 + 1.5),
+    ]
+    world = similar(Map(_box(0, 0, 16, 12), obstacles), angle, 1.0, (0.0, 0.0))
+    dec = decompose(world, L)
+    assert dec.exact and dec.stats["dangling"] == 0 and dec.unresolved == 0, dec.stats
+    n, bad = stops_constant(dec, np.random.default_rng(11), per_region=4)
+    assert not bad, bad[:5]
+    assert n > 2 * len(dec.regions)

@@ -13,6 +13,7 @@ Usage::
 
     python benchmarks/pursuer_holds.py [--seeds 10] [--rho 0.3 0.5] [--workers 2]
         [--max-cycles 600] [--worlds corridor corner ...] [--no-greedy] [--results F.jsonl]
+        [--referee CPL] [--hindsight CELL]
 
 Each loss is printed as it happens, and a progress line every 25 episodes. With
 ``--results F.jsonl`` every episode is appended to F as it completes (JSON lines,
@@ -36,6 +37,15 @@ A certified *evader* start is one no pursuer can hold (on a world whose safe sta
 all such, "held" only measures the evaders' weakness); a loss from a certified *pursuer*
 start is a weakness of the policy (its regret); "unknown" is the referee's resolution gap.
 Solutions are cached on disk (minutes per world the first time).
+
+``--hindsight CELL`` labels every loss to an *open-loop* evader (``evader/straight``,
+``evader/wall_hugging``, ``evader/random``: their paths do not depend on the pursuer) with
+:func:`strategies.referee.hindsight.hindsight` at cell side CELL, against the evader's path
+recorded from the episode and extended alone to ``--max-cycles`` steps (the bodies' radius
+as played): ``evader`` (no pursuer of speed V_p holds to the horizon: unavoidable),
+``pursuer`` (some pursuer holds: the policy's regret) or ``unknown`` (``not solved``: the
+grid would exceed the memory budget); beside each such loss, and over them (as
+``unseen_worlds.py --hindsight``).
 """
 
 from __future__ import annotations
@@ -45,6 +55,7 @@ import contextlib
 import math
 import os
 import time
+import warnings
 
 import episode_rows
 import numpy as np
@@ -52,7 +63,9 @@ import referee_labels
 from bench_cli import integer, path_text, real, run, worker_pool
 from referee_labels import similarity_back
 
+from envs.errors import InfeasibleError, LongRunWarning, MemoryBudgetError
 from envs.maps import builtin_info, builtin_names
+from strategies.referee.hindsight import hindsight, record_evader_path
 from strategies.runner import run_episode
 
 EVADERS = [
@@ -63,6 +76,8 @@ EVADERS = [
     "evader/wall_hugging",
     "evader/random",
 ]
+OPEN_LOOP = ("evader/straight", "evader/wall_hugging", "evader/random")
+"""The evaders of :data:`EVADERS` whose path does not depend on the pursuer."""
 WORLDS = ["corridor", "corner", "l_hall", "open_room"]
 PURSUERS = ("pursuer/decomposition", "pursuer/greedy")
 # (label, rotation in radians, scale, offset)
@@ -94,8 +109,8 @@ def _evader(label: str):
     return label
 
 
-def _play(job):
-    world, variant, rho, evader, seed, max_cycles, pursuers, l_min = job
+def _game(world: str, variant, rho: float, l_min: float | None) -> tuple:
+    """The map and env overrides an episode of ``world``'s ``variant`` plays."""
     _, rot, scale, offset = variant
     m, params = _world(world, rot, scale, offset)
     if l_min is not None:  # the world's L_max / L_min kept
@@ -103,6 +118,12 @@ def _play(job):
         params["l_min"] = l_min * scale
     params["v_evader"] = rho * params["v_pursuer"]
     params["body_radius"] = 0.2 * scale
+    return m, params
+
+
+def _play(job):
+    world, variant, rho, evader, seed, max_cycles, pursuers, l_min = job
+    m, params = _game(world, variant, rho, l_min)
     out = {}
     for pursuer in pursuers:
         r = run_episode(
@@ -124,6 +145,41 @@ def _job_values(job) -> list:
 
 def _row_key(row: dict) -> str:
     return episode_rows.key(row[k] for k in _KEY)
+
+
+def hindsight_verdict(row: dict, cell: float):
+    """The hindsight (cell side ``cell``) against the evader's path of an episode row,
+    recorded from its episode and extended alone to the episode's horizon."""
+    from envs.surveillance.config import EnvConfig
+
+    variant = next(v for v in VARIANTS if v[0] == row["variant"])
+    m, params = _game(row["world"], variant, row["rho"], row["l_min"])
+    cycles = row["max_cycles"]
+    path = record_evader_path(m, _evader(row["evader"]), row["seed"],
+                              pursuers=("pursuer/decomposition",), overrides=params,
+                              max_cycles=cycles, extend_to=cycles)  # fmt: skip
+    return hindsight(EnvConfig(map=m, **params), path, path.pursuer_start, cell)
+
+
+def _hindsight_label(row: dict, cell: float) -> str:
+    """:func:`hindsight_verdict`'s verdict, printed with the grids' times and its cost;
+    ``not solved`` over the memory budget (the reason printed)."""
+    what = (f"  hindsight (cell {cell:g}) {row['world']} [{row['variant']}] rho={row['rho']} "
+            f"{row['evader']} seed={row['seed']}: ")  # fmt: skip
+    try:
+        with MemoryBudgetError.naming("--hindsight CELL"), warnings.catch_warnings():
+            # a long estimate is a line of the report, printed before the run
+            warnings.simplefilter("always", LongRunWarning)
+            warnings.showwarning = lambda message, *_: print(f"{what}{message}", flush=True)
+            h = hindsight_verdict(row, cell)
+    except InfeasibleError as exc:  # over the memory budget: the others still run
+        print(f"{what}not solved ({exc})", flush=True)
+        return "not solved"
+    empty = "never" if h.optimistic_empty is None else f"{h.optimistic_empty:.1f} s"
+    print(f"{what}{h.verdict} (optimistic empty {empty}, pessimistic until "
+          f"{h.pessimistic_until:.1f} s of {h.horizon:.1f}; {h.seconds:.1f} s, estimated up "
+          f"to {h.estimated_seconds:.1f} s)", flush=True)  # fmt: skip
+    return h.verdict
 
 
 def _referee_label(world: str, variant_label: str, rho: float, start, cpl: float) -> str:
@@ -153,6 +209,9 @@ def main(argv=None) -> int:
         default=None,
         help="label every start with the referee at CPL cells per L_min",
     )
+    ap.add_argument("--hindsight", type=real(0), metavar="CELL", default=None,
+                    help="label every loss to an open-loop evader by hindsight at cell "
+                    "side CELL (see above)")  # fmt: skip
     ap.add_argument("--results", metavar="FILE", default=None, type=path_text("a file"),
                     help="append each episode to FILE (JSON lines) as it completes; a rerun "
                     "with the same FILE plays only the episodes missing from it")  # fmt: skip
@@ -193,9 +252,14 @@ def main(argv=None) -> int:
                       flush=True)  # fmt: skip
     wall = time.perf_counter() - t0
     results = []
+    hind: dict[tuple, str] = {}  # (world, variant, rho, evader, seed) -> the hindsight's label
     for j in jobs:
         r = done[episode_rows.key(_job_values(j))]
         results.append((r["world"], r["variant"], r["rho"], r["evader"], r["seed"], r["out"]))
+        won = r["out"]["pursuer/decomposition"][0] == "pursuer"
+        if args.hindsight and not won and r["evader"] in OPEN_LOOP:
+            key = (r["world"], r["variant"], r["rho"], r["evader"], r["seed"])
+            hind[key] = _hindsight_label(r, args.hindsight)
     held: dict[tuple, list[int]] = {}
     losses = []
     decide = {p: [] for p in pursuers}
@@ -251,10 +315,14 @@ def main(argv=None) -> int:
             v = labels[(world, label, rho, seed)]
             verdicts_of_losses.append(v)
             ref = f"; referee: {v}"
+        if (world, label, rho, evader, seed) in hind:
+            ref += f"; hindsight: {hind[(world, label, rho, evader, seed)]}"
         print(f"  lost: {world} [{label}] rho={rho} {evader} seed={seed}: {cause} at {t}{ref}")
     if args.referee and losses:
         distinct = {(w, label, rho, seed) for w, label, rho, _, seed, *_ in losses}
         print(referee_labels.summary(args.referee, verdicts_of_losses, len(distinct)))
+    if args.hindsight:
+        print(referee_labels.hindsight_summary(args.hindsight, hind.values()))
     return 0
 
 

@@ -30,6 +30,7 @@ def _run(script: str, *args: str, **kwargs) -> subprocess.CompletedProcess:
     [
         ("pursuer_holds.py", ["--worlds", "nope"], "--worlds: invalid choice: 'nope'"),
         ("pursuer_holds.py", ["--rho", "nan"], "'nan': expected a finite number > 0"),
+        ("pursuer_holds.py", ["--hindsight", "0"], "'0': expected a finite number > 0"),
         ("decision_time.py", ["--maps", "nope"], "'nope': expected a built-in map"),
         ("decision_time.py", ["--seeds", "0"], "'0': expected an integer >= 1"),
         ("decision_time.py", ["--rho", "0"], "'0': expected a finite number > 0"),

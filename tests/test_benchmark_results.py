@@ -108,6 +108,36 @@ def test_pursuer_holds_writes_each_episode_and_resumes(bench, tmp_path, capsys):
     assert summary and summary[0] in second  # the same report over all six
 
 
+def test_pursuer_holds_hindsight_labels_the_losses_to_open_loop_evaders(bench, tmp_path, capsys):
+    """``--hindsight CELL``: a loss to an open-loop evader gets the hindsight's verdict
+    against its recorded path (bodies 0.2 as played); a closed-loop evader's loss gets
+    none. The episodes are in fact held over the horizon (played here), so no verdict but
+    ``pursuer`` is right; two rows are rewritten as losses to be labelled."""
+    holds = bench("pursuer_holds")
+    out = tmp_path / "holds.jsonl"
+    argv = ["--worlds", "open_room", "--variants", "as is", "--rho", "0.3", "--seeds", "1",
+            "--no-greedy", "--workers", "1", "--max-cycles", "30",
+            "--results", str(out)]  # fmt: skip
+    assert holds.main(argv) == 0
+    rows = [json.loads(line) for line in _lines(out)]
+    assert all(r["out"]["pursuer/decomposition"][0] == "pursuer" for r in rows)  # the oracle
+    for r in rows:
+        if r["evader"] in ("evader/straight", "evader/toward_away"):
+            r["out"]["pursuer/decomposition"][:3] = ["evader", "too_close", 2.0]
+    out.write_text("".join(json.dumps(r) + "\n" for r in rows))
+    capsys.readouterr()
+    assert holds.main([*argv, "--hindsight", "0.1"]) == 0
+    text = capsys.readouterr().out
+    assert "hindsight (cell 0.1) open_room [as is] rho=0.3 evader/straight seed=0: pursuer" in text
+    assert "of 3.0; " in text  # the path extended to the horizon, 30 steps
+    assert "evader/straight seed=0: too_close at 2.0; hindsight: pursuer" in text
+    assert "evader/toward_away seed=0: too_close at 2.0\n" in text  # closed loop: no label
+    assert (
+        "hindsight (cell 0.1) on the 1 losses to open-loop evaders: 0 evader (unavoidable), "
+        "1 pursuer (the policy's regret), 0 unknown (the hindsight's resolution gap)" in text
+    )
+
+
 def test_evader_escapes_writes_each_job_and_resumes(bench, tmp_path, capsys):
     escapes = bench("evader_escapes")
     out = tmp_path / "escapes.jsonl"

@@ -10,6 +10,7 @@ figures of the paper, and play tournaments between policies (``surveil tournamen
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 import warnings
 from collections.abc import Sequence
@@ -155,7 +156,12 @@ def _cmd_play(args: argparse.Namespace) -> int:
             if exc.args[1] != VALID_START:
                 raise
             raise exc.named("--start valid") from None
-        print(result.summary())
+        shown = {  # a model as the user named it, not the sb3:PATH it was loaded from
+            role: f"{role}/{name}"
+            for role, name in (("pursuer", args.pursuer), ("evader", args.evader))
+            if name.startswith("zoo:") or name.endswith(".zip")
+        }
+        print(dataclasses.replace(result, **shown).summary())
         if stream is not None and shading:  # redraw under the overlay, one frame at a time
             from analysis.replay import iter_trajectory_frames
 

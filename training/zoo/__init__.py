@@ -149,13 +149,21 @@ def reproduce(
         progress_bar: show SB3's progress bar.
     """
     cfg = config(name).replace(output_dir=os.fspath(output_dir or Path("out/zoo") / name))
+    from training.train import ENV_NAME
+
     changed = code_changed_since(info(name).get("git_sha"))
+    was = trained_env(name)
     if changed:
+        env = (
+            f"it trained on {was} and training now plays {ENV_NAME}, whose episodes differ; "
+            if was is not None and was != ENV_NAME
+            else ""
+        )
         warnings.warn(
-            f"{name} was trained at {info(name)['git_sha'][:12]}; the code it trains with "
-            f"has changed since ({', '.join(changed[:5])}{', ...' if len(changed) > 5 else ''}), "
-            "so the retrained model may differ: check that commit out to reproduce it bit "
-            "for bit",
+            f"{name} was trained at {info(name)['git_sha'][:12]}; {env}the code it trains "
+            f"with has changed since ({', '.join(changed[:5])}"
+            f"{', ...' if len(changed) > 5 else ''}), so the retrained model may differ: "
+            "check that commit out to reproduce it bit for bit",
             ReproducibilityWarning,
             stacklevel=2,
         )

@@ -31,12 +31,11 @@ from multiprocessing.connection import Connection, wait
 from typing import Any
 
 from analysis.tournament.identity import Match
-from analysis.tournament.worker import Context, play, play_batch
+from analysis.tournament.worker import Context, play, warm_up
 
 __all__ = [
     "BACKENDS",
     "KILL_GRACE",
-    "RAY_START_GRACE",
     "TARGET_BATCH_SECONDS",
     "Executor",
     "ProcessExecutor",
@@ -51,11 +50,6 @@ TARGET_BATCH_SECONDS = 1.0
 """Aim for tasks of about this long (fewer messages; Ray's per-task cost is ~ms)."""
 KILL_GRACE = 5.0
 """Seconds past a match's time limit before its worker process is killed."""
-RAY_START_GRACE = 30.0
-"""Seconds a Ray task is also given for a fresh worker's start: the imports and the
-context's unpickling before its first match, 1.2 s on an idle machine (measured), several
-at load 9 on 2 cores; timed from submission, they ate KILL_GRACE and a quick match was
-stored as an overrun. A hang that ignores signals is killed this much later."""
 POLL = 0.1
 """Seconds between checks of the stop event and the deadlines."""
 
@@ -289,8 +283,13 @@ class ProcessExecutor(Executor):
 _RAY_CONTEXTS: dict[str, Context] = {}
 
 
-def _ray_play(batch: list[Match], ctx_box: list[Any]) -> list[dict]:
-    """A Ray task: fetch the run's context once per worker process, play the batch."""
+def _ray_play(batch: list[Match], ctx_box: list[Any]) -> Iterator[tuple[str, Any]]:
+    """A Ray task (a generator): fetch the run's context once per worker process, play.
+
+    Yields ``("start", match_id)`` and ``("done", outcome)`` for each match, so that the
+    driver times each match from its own start, as the process backend does (not the wait
+    in Ray's queue, the worker's start or the context's fetching before it).
+    """
     import ray
 
     ref = ctx_box[0]
@@ -299,8 +298,11 @@ def _ray_play(batch: list[Match], ctx_box: list[Any]) -> list[dict]:
         _RAY_CONTEXTS.clear()
         ctx, registrations = ray.get(ref)
         _register_missing(registrations)
+        warm_up()
         _RAY_CONTEXTS[key] = ctx
-    return play_batch(batch, _RAY_CONTEXTS[key])
+    for m in batch:
+        yield ("start", m.match_id)
+        yield ("done", play(m, _RAY_CONTEXTS[key]))
 
 
 def _roster_registrations(ctx: Context) -> dict[str, tuple[Any, str]]:
@@ -330,6 +332,23 @@ def _register_missing(registrations: dict[str, tuple[Any, str]]) -> None:
             register_policy(name, factory, description)
 
 
+class _RayTask:
+    """The driver's view of one Ray task: its batch and what it has reported."""
+
+    def __init__(self, batch: list[Match]) -> None:
+        self.batch = batch
+        self.pending = collections.deque(batch)  # not started yet
+        self.current: Match | None = None  # in play
+        self.played = 0
+        self.since: float | None = None  # the driver's clock at its last match report
+
+    def deadline(self, time_limit: float) -> float | None:
+        """When to kill it: ``None`` until it starts a match (queued, or its worker starting)."""
+        if self.since is None:
+            return None
+        return self.since + time_limit + 1.0 + KILL_GRACE
+
+
 class RayExecutor(Executor):
     """Ray core tasks, each a batch of matches.
 
@@ -339,15 +358,16 @@ class RayExecutor(Executor):
         num_cpus: CPUs of a local instance (default: all); with ``address``, or when Ray
             is already initialised, the most CPUs this run's tasks occupy at once.
 
-        start_grace: seconds added to every task's deadline for a worker's start
-            (default :data:`RAY_START_GRACE`).
-
-    Up to two tasks per CPU are in flight, so a task may wait in Ray's queue; its deadline
-    (its batch at the time limit plus one second a match, plus :data:`KILL_GRACE` and
-    ``start_grace``) is extended by the longest batch in flight when it was submitted, and
-    restarted for every task in flight when a hung task's worker is killed (a queued task
-    may be waiting for that CPU and a new worker). On a cluster shared with other jobs a
-    wait can be longer.
+    Up to two tasks per CPU are in flight, so a task may wait in Ray's queue. A task
+    reports when it starts each match (it is a generator, see :func:`_ray_play`), and the
+    driver kills its worker when a match runs past the time limit plus one second (the
+    worker's own alarm) plus :data:`KILL_GRACE`, timed from that report, as the process
+    backend does. A wait in Ray's queue, a worker's start and its fetching of the context
+    are no match's time and are not timed: timed from the submission, with a guessed
+    allowance (30 s), they outran it at load 14 on 2 cores (a worker's start 23 s, the
+    context 14 s more) and matches that never overran were stored as overruns. A hang
+    there (a policy whose unpickling hangs with signals blocked) is not killed; ``stop``
+    still ends the run.
     """
 
     name = "ray"
@@ -356,10 +376,7 @@ class RayExecutor(Executor):
         self,
         address: str | None = None,
         num_cpus: int | None = None,
-        *,
-        start_grace: float = RAY_START_GRACE,
     ) -> None:
-        self.start_grace = float(start_grace)
         if num_cpus is not None:
             from envs.validation import integer
 
@@ -392,7 +409,7 @@ class RayExecutor(Executor):
         # second task would run on a CPU of the cluster's beyond it)
         self.max_inflight = 2 * self.cpus if self.cpus == self.cluster_cpus else self.cpus
         self.task = ray.remote(num_cpus=1, max_retries=0)(_ray_play)
-        self.inflight: dict[Any, tuple[list[Match], float]] = {}  # ref: (batch, deadline)
+        self.inflight: dict[Any, _RayTask] = {}  # task (an ObjectRefGenerator): its state
 
     def describe(self) -> str:
         if self.cpus < self.cluster_cpus:
@@ -412,60 +429,71 @@ class RayExecutor(Executor):
             ) from exc
         todo = collections.deque(matches)
         batcher = _Batcher(self.cpus)
-        solo: set[str] = set()  # matches of a timed-out batch, replayed one by one
+        solo: set[str] = set()  # matches of a task that died before it started one
         while (todo or self.inflight) and not stop.is_set():
             while todo and len(self.inflight) < self.max_inflight:
                 n = 1 if todo[0].match_id in solo else batcher.size(len(todo))
                 batch = [todo.popleft() for _ in range(min(n, len(todo)))]
-                # a task may wait in Ray's queue until the tasks running now end: at most
-                # the longest batch in flight at its time limits (timed from submission,
-                # a match queued behind a hang was killed as an overrun it never made)
-                ahead = max((len(b) for b, _ in self.inflight.values()), default=0)
-                slack = (len(batch) + ahead) * (ctx.time_limit + 1.0) + KILL_GRACE
-                slack += self.start_grace  # the worker it lands on may be starting
-                ref = self.task.remote(batch, box)
-                self.inflight[ref] = (batch, time.monotonic() + slack)
-            done, _ = ray.wait(list(self.inflight), num_returns=1, timeout=POLL)
-            for ref in done:
-                batch, _ = self.inflight.pop(ref)
-                try:
-                    outcomes = ray.get(ref)
-                except Exception as exc:  # the task's worker died
-                    if len(batch) > 1:
-                        solo.update(m.match_id for m in batch)
-                        todo.extendleft(reversed(batch))
-                        continue
-                    outcomes = [
-                        {
-                            "match_id": batch[0].match_id,
-                            "status": "error",
-                            "error": f"Ray task failed: {type(exc).__name__}: {exc}",
-                        }
-                    ]
-                for out in outcomes:
-                    batcher.observe(out)
-                    yield out
+                self.inflight[self.task.remote(batch, box)] = _RayTask(batch)
+            ready, _ = ray.wait(list(self.inflight), num_returns=1, timeout=POLL)
+            for gen in ready:
+                yield from self._drain(gen, todo, solo, batcher)
+                if stop.is_set():
+                    return
             now = time.monotonic()
-            for ref in list(self.inflight):
-                batch, deadline = self.inflight[ref]  # as extended by a kill before it
-                if now > deadline:
-                    ray.cancel(ref, force=True)
-                    self.inflight.pop(ref)
-                    # its worker is killed: a task queued for that CPU starts only now,
-                    # in a new worker, so every task in flight gets its full time again
-                    for other, (b, d) in self.inflight.items():
-                        fresh = now + len(b) * (ctx.time_limit + 1.0) + KILL_GRACE
-                        fresh += self.start_grace
-                        self.inflight[other] = (b, max(d, fresh))
-                    if len(batch) > 1:  # isolate the hanging match
-                        solo.update(m.match_id for m in batch)
-                        todo.extendleft(reversed(batch))
-                    else:
-                        yield {
-                            "match_id": batch[0].match_id,
-                            "status": "error",
-                            "error": "killed: the Ray task overran the time limit",
-                        }
+            for gen, task in list(self.inflight.items()):
+                deadline = task.deadline(ctx.time_limit)
+                if deadline is not None and now > deadline:
+                    ray.cancel(gen, force=True)
+                    del self.inflight[gen]
+                    why = (
+                        f"killed: no answer {ctx.time_limit + 1.0 + KILL_GRACE:g} s into "
+                        "the match (the Ray task overran the time limit)"
+                    )
+                    yield from self._lost(task, todo, solo, why)
+
+    def _drain(
+        self, gen: Any, todo: collections.deque, solo: set[str], batcher: _Batcher
+    ) -> Iterator[dict]:
+        """Consume what task ``gen`` has yielded so far; yield its outcomes."""
+        ray = self.ray
+        task = self.inflight[gen]
+        while True:
+            try:
+                kind, value = ray.get(next(gen))
+            except StopIteration:
+                del self.inflight[gen]
+                return
+            except Exception as exc:  # the task's worker died
+                del self.inflight[gen]
+                yield from self._lost(
+                    task, todo, solo, f"Ray task failed: {type(exc).__name__}: {exc}"
+                )
+                return
+            task.since = time.monotonic()
+            if kind == "start":
+                task.current = task.pending.popleft()
+            elif kind == "done":
+                task.current = None
+                task.played += 1
+                batcher.observe(value)
+                yield value
+            if not ray.wait([gen], num_returns=1, timeout=0)[0]:
+                return
+
+    @staticmethod
+    def _lost(task: _RayTask, todo: collections.deque, solo: set[str], why: str) -> Iterator[dict]:
+        """A task killed or dead: its match in play is an error, the rest is replayed."""
+        rest = list(task.pending)
+        if task.current is not None:
+            yield {"match_id": task.current.match_id, "status": "error", "error": why}
+        elif task.played == 0 and len(task.batch) == 1 and task.batch[0].match_id in solo:
+            # a worker that never started this match, already alone in its task: give up
+            yield {"match_id": rest[0].match_id, "status": "error", "error": why}
+            return
+        elif task.played == 0:  # the start failed: retry these one by one
+            solo.update(m.match_id for m in rest)
+        todo.extendleft(reversed(rest))
 
     def close(self) -> None:
         for ref in list(self.inflight):

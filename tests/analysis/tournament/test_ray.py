@@ -96,7 +96,10 @@ def test_a_match_queued_behind_a_hang_is_not_killed_as_an_overrun(
     # The driver timed each Ray task from its submission: a task queued behind one whose
     # match hung until the alarm (time limit + 1 s) had KILL_GRACE = 5 s left for its own
     # match, and a 5.5 s match (time limit 6 s) was stored as an error, "killed: the Ray
-    # task overran the time limit", though it never overran.
+    # task overran the time limit", though it never overran. The slow match keeps 3 s of its
+    # limit for its own work (0.5 s was too little at load 14 on 2 cores: a forfeit), and
+    # a deadline from submission (time limit + 6 s) still falls before the hang's time
+    # limit + 1 s and the slow decision end.
     import threading
 
     from analysis.tournament.executors import RayExecutor
@@ -105,10 +108,10 @@ def test_a_match_queued_behind_a_hang_is_not_killed_as_an_overrun(
     from strategies.policies import registry
     from strategies.policies.baselines import RandomPolicy
 
-    class Slow(RandomPolicy):  # one 5.5 s decision: slow, within the time limit
+    class Slow(RandomPolicy):  # one 6 s decision: slow, within the time limit of 9 s
         def _decide(self, snap):
             if self._steps == 1:
-                time.sleep(5.5)
+                time.sleep(6.0)
             return super()._decide(snap)
 
     monkeypatch.setitem(
@@ -120,7 +123,7 @@ def test_a_match_queued_behind_a_hang_is_not_killed_as_an_overrun(
         "evaders": ["evader/test_hanging", "evader/slow"],
         "seeds": 1,
         "start": "valid",
-        "time_limit": 6,
+        "time_limit": 9,
         "env": {"max_cycles": 20},
     }
     spec = spec_from_dict(d)
@@ -150,7 +153,7 @@ def test_a_deaf_hang_is_killed_and_the_match_queued_behind_it_plays(tmp_path, te
     }
     from analysis.tournament.executors import RayExecutor
 
-    ex = RayExecutor(num_cpus=2, start_grace=10.0)  # the default 30 s: a slower test
+    ex = RayExecutor(num_cpus=2)
     try:
         s = run_tournament(spec_from_dict(d), tmp_path / "r.sqlite", executor=ex, progress=False)
     finally:
@@ -184,14 +187,35 @@ def test_a_slow_worker_start_is_not_counted_as_an_overrun(tmp_path, monkeypatch)
     # A fresh Ray worker imports surveil and unpickles the run's context before its first
     # match (1.2 s idle, several seconds at load 9 on 2 cores); the deadline counted that
     # against the match's KILL_GRACE = 5 s, and a 0.1 s match was stored as an overrun
-    # (seen once in a full suite). Simulated: a context that takes 8 s to unpickle.
-    from analysis.tournament.executors import RayExecutor
+    # (seen once in a full suite). Simulated: a context that takes 12 s to unpickle. At load
+    # 14 the start took longer than the 30 s its deadline allowed from the task's submission
+    # (23 s to start the worker, 14 s more into the unpickling): the driver now times a
+    # match from its start, which the task reports. And the first match imported the env
+    # (PettingZoo), the start sampler and the observers on its own clock (1.2 s at load 6,
+    # time limit 1 s): "MatchTimeout: no answer within the time limit (+1 s)".
+    import sys
+
+    from analysis.tournament.executors import KILL_GRACE, RayExecutor
     from strategies.policies import registry
     from strategies.policies.baselines import RandomPolicy
 
+    class CountsImports(RandomPolicy):  # built on the match's clock, before run_episode
+        def __init__(self, **kwargs):
+            super().__init__(**kwargs)
+            self._modules = set(sys.modules)
+
+        def _decide(self, snap):
+            new = sorted(set(sys.modules) - self._modules)
+            if self._steps == 0 and new:
+                raise ImportError(f"imported on the match's clock: {new}")
+            return super()._decide(snap)
+
+    limit = 4.0  # the match's own time: ~0.04 s idle, past 1 s at load 14 (measured)
+    delay = limit + 1.0 + KILL_GRACE + 2.0  # past a deadline from submission: fails before
+
     def slow_rebuild():
-        time.sleep(8.0)
-        return RandomPolicy
+        time.sleep(delay)
+        return CountsImports
 
     def _slow_factory(rebuild):  # local, like slow_rebuild: shipped by value
         cls = rebuild()
@@ -201,7 +225,7 @@ def test_a_slow_worker_start_is_not_counted_as_an_overrun(tmp_path, monkeypatch)
 
         return factory
 
-    class SlowToShip:  # a factory whose unpickling takes 8 s (cloudpickle ships it by value)
+    class SlowToShip:  # a factory slow to unpickle (cloudpickle ships it by value)
         def __call__(self, **kwargs):
             return RandomPolicy(**kwargs)
 
@@ -221,7 +245,7 @@ def test_a_slow_worker_start_is_not_counted_as_an_overrun(tmp_path, monkeypatch)
         "evaders": ["evader/slow_ship"],
         "seeds": 1,
         "start": "valid",
-        "time_limit": 1,
+        "time_limit": limit,
         "env": {"max_cycles": 10},
     }
     ex = RayExecutor(num_cpus=1)

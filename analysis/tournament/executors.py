@@ -146,6 +146,7 @@ def _worker_main(conn: Connection, ctx: Context, parent: int) -> None:
     _die_with_parent(parent)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the driver's business
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    warm_up()  # before the first match's clock starts, as a Ray worker does
     while True:
         try:
             batch = conn.recv()

@@ -279,3 +279,51 @@ def test_sigterm_stops_quickly_says_how_to_resume_and_leaves_no_orphans(tmp_path
     with Store(store) as db:
         assert db.run(slow_spec.run_id)["status"] == "interrupted"
         assert len(db.rows(slow_spec.run_id)) < 40  # it did not play the run out
+
+
+_WARM = textwrap.dedent(
+    """
+    import sys
+    from analysis.tournament import Store, run_tournament, spec_from_dict
+    from analysis.tournament.executors import ProcessExecutor
+    from strategies.policies import register_policy
+    from strategies.policies.baselines import RandomPolicy
+
+    class CountsImports(RandomPolicy):  # built on the match's clock, before the episode
+        def __init__(self, **kwargs):
+            super().__init__(**kwargs)
+            self._modules = set(sys.modules)
+
+        def _decide(self, snap):
+            new = sorted(set(sys.modules) - self._modules)
+            if self._steps == 0 and new:
+                raise ImportError(f"imported on the match's clock: {new[:5]}")
+            return super()._decide(snap)
+
+    register_policy("evader/test_counts_imports", CountsImports, "test only")
+    d = {"name": "warm", "maps": ["open_room"], "pursuers": ["pursuer/greedy"],
+         "evaders": ["evader/test_counts_imports"], "seeds": 1, "start": "valid",
+         "time_limit": 30, "env": {"max_cycles": 10}}
+    s = run_tournament(spec_from_dict(d), sys.argv[1], executor=ProcessExecutor(1),
+                       progress=False)
+    with Store(sys.argv[1]) as db:
+        (row,) = db.rows(s.run_id)
+    print(row["status"], row["error"])
+    """
+)
+
+
+def test_a_process_worker_imports_what_a_match_needs_before_its_first_match(tmp_path):
+    # A forked worker of a fresh driver (`surveil tournament` imports no env before it
+    # forks) imported the env, PettingZoo, the start sampler and the observers inside its
+    # first match, on that match's clock (1.2 s at load 6 on 2 cores, against time limits a
+    # short tournament sets to 1 s): the Ray workers' fault of 8a29b16, in the process
+    # backend. A fresh interpreter: this test process has imported all of it long ago.
+    script = tmp_path / "warm.py"
+    script.write_text(_WARM)
+    out = subprocess.run(
+        [sys.executable, str(script), str(tmp_path / "w.sqlite")],
+        capture_output=True, text=True, timeout=120, cwd=Path(__file__).resolve().parents[3],
+    )  # fmt: skip
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.split() == ["ok", "None"], out.stdout

@@ -61,7 +61,9 @@ class Parser(argparse.ArgumentParser):
 
 MAP_HELP = (
     "a built-in name (surveil maps), a map file (.json, .geojson or .wkt: see "
-    "envs/maps/io.py) or a seeded random map, random:SEED or random:KIND:SEED"
+    "envs/maps/io.py) or a seeded random map, random:SEED or random:KIND:SEED; any of "
+    "these + ~[xS][rotR][off(X,Y)] is it scaled by S, rotated R rad, shifted (e.g. "
+    "corner~x10rot1.1)"
 )
 """What a map argument takes (every command reads it with :func:`envs.maps.load_map`)."""
 

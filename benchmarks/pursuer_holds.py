@@ -5,9 +5,9 @@ rho <= 0.5, the decomposition pursuer holds every episode against every evader i
 registry, on rotated, rescaled and off-centre variants of the paper's worlds. This plays
 seeded episodes through the shared runner (:func:`strategies.runner.run_episode`) on
 each variant against each evader and prints the held rate per world and evader, every
-loss (seed, cause, time: replay it with ``surveil play``), and the decomposition
-pursuer's decision time per step against the greedy pursuer's (a reference measured in
-the same run).
+loss (seed, cause, time, and the ``surveil play`` command that replays it with its GIF),
+and the decomposition pursuer's decision time per step against the greedy pursuer's (a
+reference measured in the same run).
 
 Usage::
 
@@ -52,8 +52,10 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import json
 import math
 import os
+import shlex
 import time
 import warnings
 
@@ -65,6 +67,7 @@ from referee_labels import similarity_back
 
 from envs.errors import InfeasibleError, LongRunWarning, MemoryBudgetError
 from envs.maps import builtin_info, builtin_names
+from envs.maps.io import Similarity
 from strategies.referee.hindsight import hindsight, record_evader_path
 from strategies.runner import run_episode
 
@@ -119,6 +122,29 @@ def _game(world: str, variant, rho: float, l_min: float | None) -> tuple:
     params["v_evader"] = rho * params["v_pursuer"]
     params["body_radius"] = 0.2 * scale
     return m, params
+
+
+REPLAY_PARAMETERS = ("l_min", "l_max", "v_pursuer", "v_evader", "body_radius")
+
+
+def replay_command(world: str, variant_label: str, rho: float, evader: str, seed: int,
+                   max_cycles: int, l_min: float | None = None) -> str:  # fmt: skip
+    """The ``surveil play`` command that plays this episode of the decomposition pursuer
+    again, with its replay: the variant as a map name ``WORLD~[xS][rotR][off(X,Y)]``
+    (:func:`envs.maps.load_map`) and the episode's lengths, speeds and bodies spelled out."""
+    variant = next(v for v in VARIANTS if v[0] == variant_label)
+    _, rot, scale, offset = variant
+    _, params = _game(world, variant, rho, l_min)
+    suffix = Similarity(scale, rot, offset).label()
+    name, _, mode = evader.partition(":")
+    words = ["surveil", "play", "--map", f"{world}~{suffix}" if suffix else world,
+             "--pursuer", "pursuer/decomposition", "--evader", name]  # fmt: skip
+    if mode:
+        words += ["--evader-params", json.dumps({"mode": mode})]
+    config = json.dumps({k: params[k] for k in REPLAY_PARAMETERS})
+    words += ["--seed", str(seed), "--start", "safe", "--max-cycles", str(max_cycles)]
+    words += ["--config", config, "--out", f"out/{world}_{name.split('/')[1]}_{seed}.gif"]
+    return shlex.join(words)
 
 
 def _play(job):
@@ -318,6 +344,8 @@ def main(argv=None) -> int:
         if (world, label, rho, evader, seed) in hind:
             ref += f"; hindsight: {hind[(world, label, rho, evader, seed)]}"
         print(f"  lost: {world} [{label}] rho={rho} {evader} seed={seed}: {cause} at {t}{ref}")
+        again = replay_command(world, label, rho, evader, seed, args.max_cycles, args.l_min)
+        print(f"    replay: {again}")
     if args.referee and losses:
         distinct = {(w, label, rho, seed) for w, label, rho, _, seed, *_ in losses}
         print(referee_labels.summary(args.referee, verdicts_of_losses, len(distinct)))

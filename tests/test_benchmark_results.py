@@ -172,3 +172,31 @@ def test_referee_scaling_prints_each_resolution_with_the_budget_s_estimate():
     assert [r[0] for r in rows] == ["4", "6"]
     for r in rows:  # est MB (the 11th column) within a factor of 2 of the peak (the 9th)
         assert 0.5 < float(r[10]) / float(r[8]) < 2.0
+
+
+def test_pursuer_holds_prints_a_surveil_play_command_that_replays_a_variant_loss(
+    bench, tmp_path, capsys
+):
+    """A loss on a rotated corner (toward_away seed 2: too_close at 3.18 s) is printed with
+    a ``surveil play`` command; that command, run, plays the same episode (the same
+    outcome, cause and time to the step) on the map it names (``corner~rot0.37``) and
+    writes its GIF."""
+    import shlex
+
+    from analysis.cli import main as surveil
+
+    holds = bench("pursuer_holds")
+    row = holds._play(("corner", holds.VARIANTS[1], 0.5, "evader/toward_away", 2, 600,
+                       ("pursuer/decomposition",), None))  # fmt: skip
+    winner, cause, t = row["out"]["pursuer/decomposition"][:3]
+    assert (winner, cause) == ("evader", "too_close")
+    command = holds.replay_command("corner", "rot 0.37", 0.5, "evader/toward_away", 2, 600)
+    words = shlex.split(command)
+    assert words[:3] == ["surveil", "play", "--map"] and words[3] == "corner~rot0.37"
+    gif = tmp_path / "loss.gif"
+    words[words.index("--out") + 1] = str(gif)
+    capsys.readouterr()
+    assert surveil(words[1:]) == 0
+    printed = capsys.readouterr().out
+    assert f"evader escaped at t = {t:.3f} s ({cause})" in printed, printed
+    assert gif.stat().st_size > 0

@@ -41,7 +41,9 @@ and what is wrong with it.
 from __future__ import annotations
 
 import json
+import math
 import os
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -539,6 +541,72 @@ def _random_by_name(name: str) -> Map:
     return random_map(int(seed_text), kind=kind)
 
 
+TRANSFORM_SEPARATOR = "~"
+"""``MAP~[xS][rotR][off(X,Y)]`` names ``MAP`` (any name :func:`load_map` takes) under a
+similarity: scaled by S about the origin, rotated by R radians, then shifted by (X, Y)."""
+_NUMBER = r"-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?"
+_TRANSFORM = re.compile(
+    rf"(?:x(?P<s>{_NUMBER}))?(?:rot(?P<r>{_NUMBER}))?(?:off\((?P<x>{_NUMBER}),(?P<y>{_NUMBER})\))?"
+)
+
+
+@dataclass(frozen=True)
+class Similarity:
+    """``x -> scale * R(rotation) @ x + offset``, the transform of a ``MAP~...`` name."""
+
+    scale: float = 1.0
+    rotation: float = 0.0
+    offset: tuple[float, float] = (0.0, 0.0)
+
+    @property
+    def matrix(self) -> np.ndarray:
+        """The linear part, ``scale`` times the rotation by ``rotation`` radians."""
+        c, s = math.cos(self.rotation), math.sin(self.rotation)
+        return self.scale * np.array([[c, -s], [s, c]])
+
+    def label(self) -> str:
+        """The suffix after ``~`` that names this transform (empty for the identity);
+        every number written so it reads back as the same float."""
+        parts = []
+        if self.scale != 1.0:
+            parts.append(f"x{self.scale!r}")
+        if self.rotation != 0.0:
+            parts.append(f"rot{self.rotation!r}")
+        if self.offset != (0.0, 0.0):
+            parts.append(f"off({float(self.offset[0])!r},{float(self.offset[1])!r})")
+        return "".join(parts)
+
+
+def split_transform(name: str) -> tuple[str, Similarity | None]:
+    """``(MAP, transform)`` of a name ``MAP~[xS][rotR][off(X,Y)]``; ``(name, None)`` when
+    the name has no such suffix (a file whose path holds a ``~`` stays a file).
+
+    Raises:
+        InvalidConfigError: a suffix that parses but scales by S <= 0 (or not finite).
+
+    Examples:
+        >>> split_transform("corner~x10rot1.1")
+        ('corner', Similarity(scale=10.0, rotation=1.1, offset=(0.0, 0.0)))
+        >>> split_transform("~/maps/a.json")
+        ('~/maps/a.json', None)
+    """
+    base, sep, spec = name.rpartition(TRANSFORM_SEPARATOR)
+    m = _TRANSFORM.fullmatch(spec) if sep and spec else None
+    if not base or m is None or Path(name).is_file():
+        return name, None
+    scale = float(m["s"]) if m["s"] else 1.0
+    rotation = float(m["r"]) if m["r"] else 0.0
+    offset = (float(m["x"]), float(m["y"])) if m["x"] else (0.0, 0.0)
+    if not (math.isfinite(scale) and scale > 0) or not all(
+        math.isfinite(v) for v in (rotation, *offset)
+    ):
+        raise InvalidConfigError(
+            f"map: {name!r} transforms {base!r} by scale {scale!r}, rotation {rotation!r}, "
+            f"offset {offset!r}: expected a finite scale > 0 and finite rotation and offset"
+        )
+    return base, Similarity(scale, rotation, offset)
+
+
 def load_map(path_or_name: str | os.PathLike[str], *, merge: bool | None = None) -> Map:
     """Load a map from a file (by suffix), a built-in map by name, or a seeded random map.
 
@@ -549,12 +617,17 @@ def load_map(path_or_name: str | os.PathLike[str], *, merge: bool | None = None)
             defaults (``KIND`` one of its ``KINDS``, default ``"polygons"``): a whole
             family of worlds by name, for training on many maps and testing on held-out
             seeds.
+            Any of these followed by ``~[xS][rotR][off(X,Y)]`` is that map scaled by S,
+            rotated by R radians about the origin, then shifted by (X, Y) (e.g.
+            ``corner~rot0.37``, ``maze~x10rot1.1off(3,-2)``: the benchmarks' transformed
+            worlds); a built-in's recommended lengths and speeds scale with it
+            (:func:`envs.surveillance.config.map_recommendations`).
         merge: for files, override the file's merge flag (see :func:`read_map`).
 
     Raises:
         UnknownNameError: for a name that is neither a built-in nor a map file.
         InvalidMapError: naming the file and the problem (a missing file included).
-        InvalidConfigError: a malformed ``random:`` name.
+        InvalidConfigError: a malformed ``random:`` name, a transform scaling by S <= 0.
 
     Examples:
         >>> load_map("corridor").n_vertices
@@ -564,6 +637,14 @@ def load_map(path_or_name: str | os.PathLike[str], *, merge: bool | None = None)
     """
     from envs.maps.builtin import builtin_map, builtin_names
 
+    if isinstance(path_or_name, str) and TRANSFORM_SEPARATOR in path_or_name:
+        base, similarity = split_transform(path_or_name)
+        if similarity is not None:
+            try:
+                m = load_map(base, merge=merge)
+            except UnknownNameError as exc:
+                raise UnknownNameError(f"map {path_or_name!r}: {exc}") from None
+            return m.transformed(similarity.matrix, similarity.offset, name=path_or_name)
     if isinstance(path_or_name, str) and path_or_name.startswith(RANDOM_PREFIX):
         return _random_by_name(path_or_name)
 
@@ -583,8 +664,9 @@ def load_map(path_or_name: str | os.PathLike[str], *, merge: bool | None = None)
             raise _fail(path_or_name, "is a directory, expected a map file or a built-in name")
         if not Path(path_or_name).is_file():
             raise UnknownNameError(
-                f"unknown map {path_or_name!r}: expected a built-in name {builtin_names()} "
-                f"or a map file ending in one of {sorted(FORMATS)}"
+                f"unknown map {path_or_name!r}: expected a built-in name {builtin_names()}, "
+                f"a map file ending in one of {sorted(FORMATS)}, 'random:[KIND:]SEED', or "
+                "one of these followed by '~[xS][rotR][off(X,Y)]' (scaled, rotated, shifted)"
             )
     return read_map(path_or_name, merge=merge).map
 

@@ -428,12 +428,19 @@ class Map:
         return (_rebuild, (json.dumps(self.to_dict()),))
 
     # ------------------------------------------------------------------ transforms
-    def transformed(self, matrix: np.ndarray | Sequence[Sequence[float]], offset=(0.0, 0.0)) -> Map:
-        """Return the map under ``x -> matrix @ x + offset`` (a similarity, for tests).
+    def transformed(
+        self,
+        matrix: np.ndarray | Sequence[Sequence[float]],
+        offset=(0.0, 0.0),
+        *,
+        name: str | None = None,
+    ) -> Map:
+        """Return the map under ``x -> matrix @ x + offset`` (a similarity).
 
         Args:
             matrix: 2x2 linear part (rotation times uniform scale; a reflection is allowed).
             offset: translation.
+            name: the new map's name (default: this map's).
         """
         try:
             m = validation.finite_array("transformed matrix", matrix, shape=(2, 2))
@@ -442,7 +449,10 @@ class Map:
             raise InvalidMapError(str(exc)) from None
         f = lambda r: r @ m.T + o
         return Map(
-            f(self.boundary), [f(q) for q in self.obstacles], name=self.name, merge=self.merged
+            f(self.boundary),
+            [f(q) for q in self.obstacles],
+            name=self.name if name is None else name,
+            merge=self.merged,
         )
 
 

@@ -20,6 +20,7 @@ from typing import Any
 from envs import validation as v
 from envs.errors import InvalidConfigError, RhoAboveOneWarning
 from envs.maps import Map, builtin_info, builtin_names, load_map
+from envs.maps.io import split_transform
 
 __all__ = [
     "GLOBAL_DEFAULTS",
@@ -76,15 +77,23 @@ GLOBAL_DEFAULTS: dict[str, float] = {"l_min": 2.0, "l_max": 4.0, "v_pursuer": 1.
 def map_recommendations(value: Any) -> dict[str, float]:
     """The recommended :data:`MAP_PARAMETERS` for the map argument ``value``.
 
-    A built-in map *named by a string* brings its own (``envs.maps.builtin_info``); a
-    :class:`Map` object or a map file path gets :data:`GLOBAL_DEFAULTS`.
+    A built-in map *named by a string* brings its own (``envs.maps.builtin_info``), scaled
+    by S when the name transforms it (``NAME~xS...``: lengths and speeds scale alike, so
+    the game is the same up to the similarity); a :class:`Map` object, a map file path
+    or a random map gets :data:`GLOBAL_DEFAULTS`.
 
     Examples:
         >>> map_recommendations("corridor")
         {'l_min': 2.0, 'l_max': 4.0, 'v_pursuer': 1.0, 'v_evader': 0.5}
+        >>> map_recommendations("corridor~x10rot0.3")
+        {'l_min': 20.0, 'l_max': 40.0, 'v_pursuer': 10.0, 'v_evader': 5.0}
     """
     if isinstance(value, str) and value in builtin_names():
         return builtin_info(value).params()
+    if isinstance(value, str):
+        base, similarity = split_transform(value)
+        if similarity is not None and base in builtin_names():
+            return {k: x * similarity.scale for k, x in builtin_info(base).params().items()}
     return dict(GLOBAL_DEFAULTS)
 
 

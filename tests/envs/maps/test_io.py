@@ -416,3 +416,62 @@ def test_touching_polygons_in_a_file_name_the_file_s_own_remedy(tmp_path):
             load_map(str(tmp_path / f"t.{suffix}"))
         assert "build the map with merge=True" not in str(err.value)
         assert read_map(tmp_path / f"t.{suffix}", merge=True).map.n_vertices == 12
+
+
+# ------------------------------------------------------------------ transformed map names
+@pytest.mark.parametrize(
+    ("name", "base", "scale", "rot", "offset"),
+    [
+        ("corner~rot0.37", "corner", 1.0, 0.37, (0.0, 0.0)),
+        ("maze~x10rot1.1off(3,-2.5)", "maze", 10.0, 1.1, (3.0, -2.5)),
+        ("office~x1e-3", "office", 1e-3, 0.0, (0.0, 0.0)),
+        ("random:rectangles:3~off(1.5,-2)", "random:rectangles:3", 1.0, 0.0, (1.5, -2.0)),
+    ],
+)
+def test_a_transformed_name_is_its_map_under_the_similarity(name, base, scale, rot, offset):
+    """``MAP~[xS][rotR][off(X,Y)]``: every vertex is scale * R(rot) @ v + offset of the
+    untransformed map's (the benchmarks' variant worlds by name)."""
+    m, ref = load_map(name), load_map(base)
+    c, s = np.cos(rot), np.sin(rot)
+    for got, want in zip(m.rings, ref.rings, strict=True):
+        x, y = np.asarray(want, dtype=float).T
+        expected = np.stack([scale * (c * x - s * y), scale * (s * x + c * y)], axis=1) + offset
+        got = np.asarray(got, dtype=float)
+        first = int(np.argmin(np.linalg.norm(got - expected[0], axis=1)))  # rings start anywhere
+        np.testing.assert_allclose(
+            np.roll(got, -first, axis=0), expected, rtol=1e-12, atol=1e-12 * max(1.0, scale)
+        )
+    assert m.name == name
+    # a similarity keeps areas up to scale^2 (shapely: independent of our vertices' maths)
+    area = Polygon(m.boundary).area
+    assert area == pytest.approx(scale**2 * Polygon(ref.boundary).area, rel=1e-9)
+
+
+def test_a_transformed_built_in_recommends_its_lengths_and_speeds_scaled():
+    from envs.surveillance.config import map_recommendations
+
+    base = map_recommendations("corner")
+    assert map_recommendations("corner~x10rot1.1") == {k: 10 * v for k, v in base.items()}
+    assert map_recommendations("corner~rot0.3off(4,5)") == base
+    assert map_recommendations("random:3~x2") == map_recommendations("random:3")
+
+
+@pytest.mark.parametrize(
+    ("name", "error", "pattern"),
+    [
+        ("corner~x0", InvalidConfigError, r"'corner~x0' transforms 'corner' by scale 0\.0"),
+        ("corner~x1e400", InvalidConfigError, "expected a finite scale > 0"),
+        ("nosuch~rot1", UnknownNameError, r"map 'nosuch~rot1': unknown map 'nosuch'"),
+        ("corner~sideways", UnknownNameError, r"'~\[xS\]\[rotR\]\[off\(X,Y\)\]'"),
+    ],
+)
+def test_a_bad_transformed_name_says_what_a_name_can_be(name, error, pattern):
+    with pytest.raises(error, match=pattern):
+        load_map(name)
+
+
+def test_a_file_whose_path_holds_a_tilde_is_read_as_the_file(tmp_path):
+    d = tmp_path / "maps~x2"
+    d.mkdir()
+    path = save_map(MAPS["plain"], d / "room.json")
+    assert load_map(str(path)).to_dict() == MAPS["plain"].to_dict()

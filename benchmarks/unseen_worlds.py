@@ -112,6 +112,7 @@ from unseen_opponents import make_opponent
 from envs.errors import InfeasibleError, InvalidConfigError, LongRunWarning, MemoryBudgetError
 from envs.maps import Map, builtin_info, builtin_names, load_map
 from envs.maps.floor_plans import floor_plan
+from envs.maps.io import split_transform
 from envs.maps.junctions import crossroads, t_junction
 from envs.maps.random_maps import random_map
 from strategies.referee.hindsight import hindsight, record_evader_path
@@ -207,9 +208,6 @@ PILLARS = {
 
 # ------------------------------------------------------------------ world labels
 _NUM = r"-?\d+(?:\.\d+)?"
-_TRANSFORM = re.compile(
-    rf"(?:x(?P<s>{_NUM}))?(?:rot(?P<r>{_NUM}))?(?:off\((?P<x>{_NUM}),(?P<y>{_NUM})\))?"
-)
 _JUNCTION = re.compile(rf"(?P<kind>plus|tee)_w(?P<w>{_NUM})(?:a(?P<a>{_NUM}))?")
 _L_ROOM = re.compile(rf"L_(?P<a>{_NUM})x(?P<w>{_NUM})")
 _U_ROOM = re.compile(rf"U_(?P<w>{_NUM})x(?P<h>{_NUM})x(?P<a>{_NUM})x(?P<b>{_NUM})")
@@ -223,15 +221,13 @@ def _unknown(key: str) -> InvalidConfigError:
 
 def transform_of(key: str) -> tuple[str, float, float, tuple[float, float]]:
     """(built-in name, rotation, scale, offset) of a label ``NAME~[xS][rotR][off(X,Y)]``."""
-    name, _, spec = key.partition("~")
-    m = _TRANSFORM.fullmatch(spec)
-    if name not in builtin_names() or m is None or not spec:
+    try:
+        name, sim = split_transform(key)  # the grammar envs.maps.load_map reads
+    except InvalidConfigError:  # a scale <= 0
+        raise _unknown(key) from None
+    if sim is None or name not in builtin_names():
         raise _unknown(key)
-    scale = float(m["s"]) if m["s"] else 1.0
-    if scale <= 0:
-        raise _unknown(key)
-    offset = (float(m["x"]), float(m["y"])) if m["x"] else (0.0, 0.0)
-    return name, float(m["r"] or 0.0), scale, offset
+    return name, sim.rotation, sim.scale, sim.offset
 
 
 def room_map(key: str, role: str = "pursuer") -> Map:

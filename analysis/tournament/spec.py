@@ -381,33 +381,49 @@ def _list(name: str, value: Any, where: str) -> list[Any]:
     return list(value)
 
 
-def _maps(value: Any, source: str, base: Path) -> tuple[MapEntry, ...]:
+def _map_entry(text: str, where: str, base: Path) -> MapEntry:
+    """A built-in name, ``random:...``, a file relative to ``base``, or any of these
+    followed by ``~[xS][rotR][off(X,Y)]`` (:func:`envs.maps.io.split_transform`)."""
     from envs.maps import builtin_info, builtin_names, load_map
+    from envs.maps.io import split_transform
 
+    if text in builtin_names():
+        info = builtin_info(text)
+        return MapEntry(text, f"builtin:{text}", info.map, dict(info.params()))
+    if text.startswith("random:") and "~" not in text:  # a seeded random map, by its seed
+        try:
+            return MapEntry(text, text, load_map(text), {})
+        except ValueError as exc:
+            raise InvalidConfigError(f"{where}: {exc}") from exc
+    path = (base / text).resolve()
+    if not path.is_file():
+        try:
+            name, sim = split_transform(text)
+        except ValueError as exc:
+            raise InvalidConfigError(f"{where}: {exc}") from exc
+        if sim is not None:  # the map it transforms, then the similarity
+            inner = _map_entry(name, where, base)
+            world = inner.map.transformed(sim.matrix, sim.offset, name=text)
+            params = {k: v * sim.scale for k, v in inner.params.items()}
+            return MapEntry(text, f"{inner.source}~{sim.label()}", world, params)
+        raise InvalidConfigError(
+            f"{where}: map = {text!r}: neither a built-in map {builtin_names()}, "
+            f"'random:[KIND:]SEED', nor a map file (looked for {path}), nor one of these "
+            "followed by '~[xS][rotR][off(X,Y)]'"
+        )
+    try:
+        world = load_map(path)
+    except (ValueError, OSError) as exc:
+        raise InvalidConfigError(f"{where}: map = {text!r}: {exc}") from exc
+    return MapEntry(text, str(path), world, {})
+
+
+def _maps(value: Any, source: str, base: Path) -> tuple[MapEntry, ...]:
     out: dict[str, MapEntry] = {}
     for i, item in enumerate(_list("maps", value, source)):
         where = f"{source} [maps #{i + 1}]"
         text = string("map", item, where=where)
-        if text in builtin_names():
-            info = builtin_info(text)
-            entry = MapEntry(text, f"builtin:{text}", info.map, dict(info.params()))
-        elif text.startswith("random:"):  # a seeded random map, named by its seed
-            try:
-                entry = MapEntry(text, text, load_map(text), {})
-            except ValueError as exc:
-                raise InvalidConfigError(f"{where}: {exc}") from exc
-        else:
-            path = (base / text).resolve()
-            if not path.is_file():
-                raise InvalidConfigError(
-                    f"{where}: map = {text!r}: neither a built-in map {builtin_names()} nor a "
-                    f"map file (looked for {path})"
-                )
-            try:
-                world = load_map(path)
-            except (ValueError, OSError) as exc:
-                raise InvalidConfigError(f"{where}: map = {text!r}: {exc}") from exc
-            entry = MapEntry(text, str(path), world, {})
+        entry = _map_entry(text, where, base)
         if entry.label in out:
             warnings.warn(f"{where}: map {text!r} is listed twice; playing it once", stacklevel=3)
             continue

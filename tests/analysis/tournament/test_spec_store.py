@@ -94,6 +94,32 @@ def test_toml_spec_and_relative_map_files(tmp_path):
         load_spec(tmp_path / "bad.toml")
 
 
+def test_a_spec_takes_transformed_maps_as_load_map_does(tmp_path):
+    """``MAP~[xS][rotR][off(X,Y)]`` of a built-in, a random map or a file beside the spec:
+    the same world as :func:`envs.maps.load_map` builds, a built-in's parameters scaled;
+    a malformed transform names the map entry."""
+    from envs.maps import load_map, save_map
+
+    (tmp_path / "worlds").mkdir()
+    save_map(load_map("pillars"), tmp_path / "worlds" / "p.json")
+    names = ["corner~x10rot1.1", "random:rectangles:3~off(1.5,-2)", "worlds/p.json~rot0.5"]
+    (tmp_path / "t.toml").write_text(
+        f"maps = {json.dumps(names)}\npursuers = ['pursuer/greedy']\n"
+        "evaders = ['evader/random']\nseeds = 1\n"
+    )
+    spec = load_spec(tmp_path / "t.toml")
+    assert [m.label for m in spec.maps] == names
+    for entry, name in zip(spec.maps, names, strict=True):
+        path = tmp_path / name if name.startswith("worlds") else None
+        want = load_map(str(path) if path else name)
+        assert entry.map.digest == want.digest, name
+    corner = spec.env_config(spec.maps[0], spec.variants[0])
+    assert (corner["l_min"], corner["v_pursuer"]) == (20.0, 10.0)  # corner's 2 and 1, x10
+    with pytest.raises(InvalidConfigError, match=r"\[maps #1\].*scale 0\.0"):
+        spec_from_dict({"maps": ["corner~x0"], "pursuers": ["pursuer/greedy"],
+                        "evaders": ["evader/random"], "seeds": 1})  # fmt: skip
+
+
 def test_duplicate_roster_entries_are_merged_or_rejected(small_spec):
     with pytest.warns(UserWarning, match="merged"):
         spec = spec_from_dict({**small_spec, "pursuers": ["pursuer/greedy", "pursuer/greedy"]})

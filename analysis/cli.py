@@ -75,7 +75,7 @@ def _cmd_policies(args: argparse.Namespace) -> int:
 
 def _env_config(flag_map: str, map_: str, overrides: dict, where: str):
     """The env config of a run, validated before the run (names the flag at fault)."""
-    from envs.maps import builtin_names
+    from envs.maps.io import builtin_parameters
     from envs.surveillance.config import EnvConfig, env_parameters, resolve_map
 
     allowed = [k for k in env_parameters() if k not in ("map", "render_mode")]
@@ -88,8 +88,9 @@ def _env_config(flag_map: str, map_: str, overrides: dict, where: str):
         world = resolve_map(map_)
     except SurveilValueError as exc:
         raise type(exc)(f"{flag_map}: {exc}") from None
-    try:  # a built-in by name, so that its recommended parameters apply
-        return EnvConfig(map=map_ if map_ in builtin_names() else world, **overrides)
+    try:  # a built-in by name (transformed or not), so that its recommended parameters apply
+        named = builtin_parameters(map_) is not None
+        return EnvConfig(map=map_ if named else world, **overrides)
     except SurveilValueError as exc:
         raise type(exc)(f"{where}: {exc}") from None
 
@@ -183,7 +184,8 @@ def _cmd_play(args: argparse.Namespace) -> int:
 
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
-    from envs.maps import builtin_info, builtin_names, load_map
+    from envs.maps import load_map
+    from envs.maps.io import builtin_parameters
 
     try:
         world = load_map(args.map)
@@ -191,12 +193,12 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
         raise type(exc)(f"map: {exc}") from None
     length = args.length
     if length is None:
-        if args.map not in builtin_names():
+        if (params := builtin_parameters(args.map)) is None:
             raise InvalidConfigError(
                 f"--length is required for map {args.map!r}: only built-in maps recommend "
                 "a rod length (their L_min)"
             )
-        length = builtin_info(args.map).l_min
+        length = params["l_min"]
     diameter = world.diameter
     if length > diameter:
         raise InvalidConfigError(

@@ -199,24 +199,22 @@ def map_parameters(map_: Any) -> tuple[Any, dict[str, float]]:
     """The :class:`Map` of ``map_`` and the recommended parameters of a built-in name.
 
     Args:
-        map_: a built-in map name, a map file path or a :class:`~envs.maps.Map`.
+        map_: a map name (``envs.maps.load_map``), a map file path or a
+            :class:`~envs.maps.Map`.
 
     Returns:
         ``(map, params)`` with ``params`` the built-in's ``l_min``, ``l_max``,
-        ``v_pursuer`` and ``v_evader`` (``{}`` for files and Map objects: the env's
-        defaults apply).
+        ``v_pursuer`` and ``v_evader``, scaled for a transformed built-in
+        (``NAME~xS...``); ``{}`` for files, random maps and Map objects: the env's
+        defaults apply.
     """
-    from envs.maps import Map, builtin_info, builtin_names
+    from envs.maps import Map, builtin_info, builtin_names, load_map
+    from envs.maps.io import builtin_parameters
 
     if isinstance(map_, str) and map_ in builtin_names():
-        info = builtin_info(map_)
-        rec = {
-            "l_min": info.l_min,
-            "l_max": info.l_max,
-            "v_pursuer": info.v_pursuer,
-            "v_evader": info.v_evader,
-        }
-        return info.map, rec
+        return builtin_info(map_).map, builtin_info(map_).params()
+    if (rec := builtin_parameters(map_)) is not None:
+        return load_map(map_), rec
     if isinstance(map_, Map):
         return map_, {}
     from envs.surveillance.config import resolve_map

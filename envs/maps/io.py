@@ -607,6 +607,28 @@ def split_transform(name: str) -> tuple[str, Similarity | None]:
     return base, Similarity(scale, rotation, offset)
 
 
+def builtin_parameters(name: Any) -> dict[str, float] | None:
+    """The recommended ``l_min``, ``l_max``, ``v_pursuer``, ``v_evader`` of a map *name*
+    that is a built-in or a built-in transformed (``NAME~xS...``: lengths and speeds times
+    S, the same game up to the similarity); ``None`` for anything else (files, random
+    maps, :class:`Map` objects: no recommendation).
+
+    Examples:
+        >>> builtin_parameters("corridor~x10rot0.3")
+        {'l_min': 20.0, 'l_max': 40.0, 'v_pursuer': 10.0, 'v_evader': 5.0}
+    """
+    from envs.maps.builtin import builtin_info, builtin_names
+
+    if not isinstance(name, str):
+        return None
+    if name in builtin_names():
+        return builtin_info(name).params()
+    base, similarity = split_transform(name) if TRANSFORM_SEPARATOR in name else (name, None)
+    if similarity is None or base not in builtin_names():
+        return None
+    return {k: v * similarity.scale for k, v in builtin_info(base).params().items()}
+
+
 def load_map(path_or_name: str | os.PathLike[str], *, merge: bool | None = None) -> Map:
     """Load a map from a file (by suffix), a built-in map by name, or a seeded random map.
 

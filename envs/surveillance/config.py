@@ -19,8 +19,8 @@ from typing import Any
 
 from envs import validation as v
 from envs.errors import InvalidConfigError, RhoAboveOneWarning
-from envs.maps import Map, builtin_info, builtin_names, load_map
-from envs.maps.io import split_transform
+from envs.maps import Map, load_map
+from envs.maps.io import builtin_parameters
 
 __all__ = [
     "GLOBAL_DEFAULTS",
@@ -88,13 +88,8 @@ def map_recommendations(value: Any) -> dict[str, float]:
         >>> map_recommendations("corridor~x10rot0.3")
         {'l_min': 20.0, 'l_max': 40.0, 'v_pursuer': 10.0, 'v_evader': 5.0}
     """
-    if isinstance(value, str) and value in builtin_names():
-        return builtin_info(value).params()
-    if isinstance(value, str):
-        base, similarity = split_transform(value)
-        if similarity is not None and base in builtin_names():
-            return {k: x * similarity.scale for k, x in builtin_info(base).params().items()}
-    return dict(GLOBAL_DEFAULTS)
+    params = builtin_parameters(value)
+    return dict(GLOBAL_DEFAULTS) if params is None else params
 
 
 @dataclass(frozen=True)

@@ -294,12 +294,10 @@ def _builtin_name(source):
 
 
 def _builtin_params(name) -> dict[str, float]:
-    from envs.maps import builtin_info, builtin_names
+    """A built-in's recommended parameters (scaled for ``NAME~xS...``), else none."""
+    from envs.maps.io import builtin_parameters
 
-    name = _builtin_name(name)
-    if isinstance(name, str) and name in builtin_names():
-        return builtin_info(name).params()
-    return {}
+    return builtin_parameters(_builtin_name(name)) or {}
 
 
 def _map_of(source, digest, maps, geometry) -> Map:

@@ -85,6 +85,18 @@ def test_analyze_writes_the_decomposition_picture(tmp_path, capsys):
         assert img.size[0] > 400 and img.size[1] > 200
 
 
+def test_analyze_a_transformed_built_in_at_its_scaled_length(tmp_path, capsys):
+    """``corner~x2rot1`` recommends twice the corner's L_min (no --length needed), and the
+    decomposition of a similar world at the similar rod is the same one (its counts)."""
+    counts = []
+    for name in ("corner", "corner~x2rot1"):
+        assert main(["analyze", name, "--no-graph", "--out", str(tmp_path / "a.png")]) == 0
+        text = capsys.readouterr().out
+        counts.append([line for line in text.splitlines() if "regions" in line])
+        assert f"'{name}' at L = {2 if name == 'corner' else 4}" in text
+    assert counts[0] == counts[1] and counts[0]
+
+
 def test_figure_tractrix(tmp_path):
     out = tmp_path / "tractrix.png"
     assert main(["figure", "tractrix", "--out", str(out)]) == 0

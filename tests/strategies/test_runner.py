@@ -179,3 +179,20 @@ def test_a_bad_time_limit_is_refused_not_blamed_on_a_policy(limit):
     with pytest.raises(InvalidConfigError, match=r"time_limit = .*expected a finite number > 0"):
         run_episode(MAP, "pursuer/greedy", "evader/straight", seed=0, max_cycles=5,
                     time_limit=limit)  # fmt: skip
+
+
+def test_a_transformed_built_in_plays_at_its_scaled_recommendations():
+    """``run_episode("corridor~x10rot0.3", ...)``: the env plays the rotated corridor at ten
+    times the corridor's L_min, L_max and speeds (its recommendation scaled with it), as
+    the env built from the name does; a user's overrides still win."""
+    from envs.surveillance.config import EnvConfig
+    from strategies.runner import map_parameters
+
+    world, params = map_parameters("corridor~x10rot0.3")
+    assert params == {"l_min": 20.0, "l_max": 40.0, "v_pursuer": 10.0, "v_evader": 5.0}
+    assert world.digest == EnvConfig(map="corridor~x10rot0.3").map.digest
+    r = run_episode("corridor~x10rot0.3", "pursuer/greedy", "evader/random", 0, max_cycles=5)
+    assert (r.config.l_min, r.config.l_max, r.config.v_pursuer) == (20.0, 40.0, 10.0)
+    r = run_episode("corridor~x10", "pursuer/greedy", "evader/random", 0, max_cycles=5,
+                    overrides={"l_min": 15.0})  # fmt: skip
+    assert (r.config.l_min, r.config.l_max) == (15.0, 40.0)

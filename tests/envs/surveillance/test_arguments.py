@@ -64,11 +64,11 @@ def test_every_builtin_recommends_the_global_defaults() -> None:
 
 def test_recommendations_follow_the_map_metadata(monkeypatch) -> None:
     """The env reads the map's metadata (not a copy of the defaults), explicit values win."""
-    import envs.surveillance.config as config
+    import envs.maps.builtin as builtin
 
     info = builtin_info("two_rooms")
     changed = dataclasses.replace(info, l_min=1.5, l_max=5.0, v_evader=0.25)
-    monkeypatch.setattr(config, "builtin_info", lambda name: changed)
+    monkeypatch.setattr(builtin, "builtin_info", lambda name: changed)
     cfg = EnvConfig(map="two_rooms")
     assert (cfg.l_min, cfg.l_max, cfg.v_pursuer, cfg.v_evader) == (1.5, 5.0, 1.0, 0.25)
     cfg = EnvConfig(map="two_rooms", l_max=3.0, v_evader=0.5)

@@ -36,7 +36,7 @@ from analysis.tournament.identity import Match
 from analysis.tournament.spec import PolicyEntry, Spec
 from envs.errors import RhoAboveOneWarning
 
-__all__ = ["Context", "MatchTimeout", "context_for", "play", "play_batch", "warm_up"]
+__all__ = ["Context", "MatchTimeout", "context_for", "play", "warm_up"]
 
 ALARM_GRACE = 1.0
 """Seconds past the time limit before ``SIGALRM`` interrupts a policy inside one call."""
@@ -210,8 +210,3 @@ def play(match: Match, ctx: Context) -> dict[str, Any]:
         record=json.dumps(rec, sort_keys=True, default=str),
     )
     return out
-
-
-def play_batch(batch: list[Match], ctx: Context) -> list[dict[str, Any]]:
-    """Play matches in order (the unit of work of the Ray backend)."""
-    return [play(m, ctx) for m in batch]

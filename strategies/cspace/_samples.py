@@ -23,11 +23,19 @@ __all__ = ["ray_samples"]
 _SAMPLES = 32  # conchoid samples per parametrisation
 
 
-def _first_hits(cv: Curves, L: float, o: np.ndarray, d: np.ndarray, reach: np.ndarray, touch):
-    """Distance along each ray ``o + s d`` (``s`` in ``(0, reach]``) to its first curve."""
+def _first_hits(
+    cv: Curves, L: float, o: np.ndarray, d: np.ndarray, reach: np.ndarray, touch, pad: float
+):
+    """Distance along each ray ``o + s d`` (``s`` in ``(0, reach]``) to its first curve.
+
+    The curves are looked up by their polylines' boxes grown by ``pad``: an arc or a
+    conchoid bulges out of its polyline's box by up to the chord tolerance (its extreme
+    point lies between two vertices), so unpadded boxes miss a ray that meets the curve
+    only there (a ray across a face between two nearly concentric arcs, near their
+    common extreme)."""
     n = len(o)
     best = np.full(n, np.inf)
-    lo, hi = _boxes(cv, L, 0.0)
+    lo, hi = _boxes(cv, L, pad)
     tree = shapely.STRtree(shapely.box(lo[:, 0], lo[:, 1], hi[:, 0], hi[:, 1]))
     rays = shapely.linestrings(np.stack([o, o + reach[:, None] * d], axis=1))
     r, c = tree.query(rays)
@@ -76,6 +84,7 @@ def ray_samples(
     sign: np.ndarray,
     reach: np.ndarray,
     touch: float,
+    pad: float,
 ) -> tuple[np.ndarray, np.ndarray]:
     """One point inside each face (local frame) and its distance to the boundary along
     the ray (``inf`` if the ray met nothing: the caller falls back).
@@ -87,6 +96,8 @@ def ray_samples(
         sign: +1 if the face lies on the left of the edge as its parameter grows.
         reach: per face, an upper bound on the ray length (its polygon's diameter).
         touch: the tangency tolerance.
+        pad: how far an exact curve may lie outside its polyline's box (the chord
+            tolerance and the merge radius, as the noding's candidate pairs).
     """
     t = 0.5 * (ta + tb)
     kind, data = cv.kind[edge_curve], cv.data[edge_curve]
@@ -94,6 +105,6 @@ def ray_samples(
     d1, _ = derivatives(kind, data, t, L)
     tan = d1 / np.hypot(d1[:, 0], d1[:, 1])[:, None]
     n = sign[:, None] * np.stack([-tan[:, 1], tan[:, 0]], axis=1)
-    s = _first_hits(cv, L, p, n, reach, touch)
+    s = _first_hits(cv, L, p, n, reach, touch, pad)
     half = np.where(np.isfinite(s), 0.5 * s, np.nan)
     return p + half[:, None] * n, half

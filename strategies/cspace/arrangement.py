@@ -588,7 +588,8 @@ def _face_samples(arr: Arrangement, sel: np.ndarray):
         face_h[fh], weights=e_len[np.flatnonzero(fh) // 2], minlength=len(arr.faces)
     )
     reach = 0.5 * perim[sel[has]] + tol.merge
-    pts, d = ray_samples(cv, tol.L, nd.curve[k], nd.ta[k], nd.tb[k], sign, reach, tol.touch)
+    pad = tol.chord + tol.merge
+    pts, d = ray_samples(cv, tol.L, nd.curve[k], nd.ta[k], nd.tb[k], sign, reach, tol.touch, pad)
     out[has], depth[has] = pts, d
     return out, depth
 

@@ -46,7 +46,7 @@ __all__ = [
     "write_cache_file",
 ]
 
-FORMAT_VERSION = 11  # 11: that circle to 1e-9 (10: edges ordered on one circle)
+FORMAT_VERSION = 12  # 12: thin faces' points, sliver chains, rods beside a vertex
 """Bump when the decomposition's content or the file layout changes."""
 
 MAGIC = b"SURVEIL-CSPACE-DECOMPOSITION\n"

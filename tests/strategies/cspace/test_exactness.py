@@ -329,3 +329,99 @@ def test_a_conchoid_of_a_sub_millimetre_edge_is_ordered_against_its_arc(angle, L
     n, bad = stops_constant(dec, np.random.default_rng(11), per_region=4)
     assert not bad, bad[:5]
     assert n > 2 * len(dec.regions)
+
+
+def _stepped_corner(x0, y0, w, h, st, sd, two, angle):
+    """helper-88's random stepped corner (randsteps.py): an obstacle with a step ``st``
+    high and ``sd`` deep cut into a corner, maybe a second box, the room rotated."""
+    x1, y1 = x0 + w, y0 + h
+    obstacles = [[(x0, y0), (x1, y0), (x1, y0 + st), (x1 + sd, y0 + st), (x1 + sd, y1), (x0, y1)]]
+    if two:
+        obstacles.append(_box(x1 + 1.5, y1 + 0.5, x1 + 2.5, y1 + 1.5))
+    return similar(Map(_box(0, 0, 16, 12), obstacles), angle, 1.0, (0.0, 0.0))
+
+
+def _stepped(k: int) -> tuple[Map, float]:
+    rng = np.random.default_rng(1)
+    for _ in range(k + 1):
+        w, h = rng.uniform(1, 4), rng.uniform(0.5, 2)
+        x0, y0 = rng.uniform(3, 8), rng.uniform(2, 5)
+        st, sd = 10 ** rng.uniform(-4, -1.5), 10 ** rng.uniform(-4, -1.5)
+        two = bool(rng.random() < 0.5)
+        angle = rng.uniform(0, np.pi)
+        L = float(rng.uniform(1.0, 4.0))
+    return _stepped_corner(x0, y0, w, h, st, sd, two, angle), L
+
+
+def _assert_exact(world, L, seed):
+    dec = decompose(world, L)
+    assert dec.exact and dec.stats["dangling"] == 0 and dec.unresolved == 0, dec.stats
+    assert dec.stats["slivers_unresolved"] == 0, dec.stats
+    n, bad = stops_constant(dec, np.random.default_rng(seed), per_region=4)
+    assert not bad, bad[:5]
+    assert n > 2 * len(dec.regions)
+    return dec
+
+
+@pytest.mark.parametrize("k", [41, 54, 66])
+def test_a_face_between_two_nearly_concentric_arcs_gets_its_point_inside(k):
+    """The type-2 arcs of a step's two corners (0.76 mm apart, L = 3.31) bound a crescent
+    0.73 long and at most 1.7e-4 wide; its point is cast from its longest edge along the
+    normal to the first curve the ray meets, and the ray looked curves up by their
+    polylines' boxes, which an arc leaves by up to the chord tolerance near its extreme:
+    the ray missed the other arc, the point landed outside both circles, the crescent
+    took a neighbour's stops and was merged into it (1-3 pieces matched by overlap only
+    on 3 of helper-88's 80 random stepped corners). Oracle: the kernel's stops at random
+    points of every region."""
+    world, L = _stepped(k)
+    dec = _assert_exact(world, L, k)
+    assert len(dec.regions) > 50
+
+
+@pytest.mark.parametrize("k", [19, 28])
+def test_a_probe_across_a_chain_of_slivers_finds_the_region_beyond(k):
+    """Two type-2 arcs of a step's corners cross at 1e-3 radians (a step 0.11 mm deep,
+    1.8 mm high, L = 1.86): two slivers 4e-7 wide meet along one arc, and a probe across
+    both lands in a face 1e-4 wide whose polygon (within the chord tolerance, 1.9e-4) lies
+    0.03 away; the region beyond was looked up by polygons only, found none, and the
+    pieces along the slivers were dropped (2-4 unresolved). Now the regions next to the
+    chain of slivers (on the arrangement's pieces) are candidates too."""
+    world, L = _stepped(k)
+    _assert_exact(world, L, k)
+
+
+TOOTH = 2.0005407597773552  # the rod length of helper-88's tooth worlds (notch.py)
+
+
+def _tooth(h: float) -> Map:
+    return Map([(0, 0), (7, 0), (7, h), (7 + h, h), (7 + h, 0), (14, 0), (14, 10), (0, 10)])
+
+
+def test_a_rod_passing_beside_a_corner_of_a_tiny_tooth_is_semi_free():
+    """A tooth 1e-4 wide on the floor: the rod with its body on the tooth's left corner
+    and its tip on the floor beyond (a type-5 conchoid) passes the right corner 5e-9 to
+    3e-8 above, within the length tolerance, at 1e-4 radians to the tooth's top: the
+    wedge test (the rod through that corner enters the obstacle) dropped the conchoid's
+    middle, and the faces on either side of it were one (4 pieces matched by overlap
+    only). Oracle: shapely, the length of the rod inside the tooth and the floor."""
+    from shapely.geometry import LineString, box
+
+    from strategies.cspace._rod import rods_semifree
+
+    h = 1e-4
+    world = _tooth(h)
+    solid = box(7, -1, 7 + h, h).union(box(-1, -1, 15, 0))
+    corner = np.array([7.0, h])
+    for target, x in [(corner, x) for x in np.linspace(5.1, 6.95, 8)] + [
+        (np.array([7 + h, h - 1e-7]), x) for x in np.linspace(5.1, 6.95, 4)
+    ]:
+        tip = np.array([x, 0.0])
+        u = (target - tip) / np.hypot(*(target - tip))
+        P = tip + TOOTH * u
+        inside = LineString([P, tip]).intersection(solid).length
+        assert rods_semifree(world, P[None], tip[None])[0] == (inside < 1e-12), (x, inside)
+
+
+@pytest.mark.parametrize("h", [1e-1, 1e-3, 1e-4])
+def test_a_tiny_tooth_on_an_outer_wall_gives_an_exact_arrangement(h):
+    _assert_exact(_tooth(h), TOOTH, 3)

@@ -217,7 +217,9 @@ def build_decomposition(
         ok = np.isfinite(at[:, 0])
         if ok.any():
             s_hash[thin[ok]] = signature_hashes(free_arcs_batch(world, at[ok], L))
-    probed, lost = probe_pieces(world, arr, group, sig_r, region_cells, width, r_hash, s_hash)
+    probed, lost = probe_pieces(
+        world, arr, group, sig_r, region_cells, width, r_hash, s_hash, curves
+    )
     boundaries = tuple(
         Boundary(
             i,

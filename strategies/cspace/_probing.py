@@ -28,11 +28,20 @@ import numpy as np
 import shapely
 
 from envs.maps.map import Map
+from envs.tolerances import ANGLE_TOL
 from strategies.cspace._arcs import OVERLAP_TOL
 from strategies.cspace._batch_arcs import ArcBatch, free_arcs_batch
 from strategies.cspace.arrangement import Arrangement
 
-__all__ = ["PROBE_AT", "PROBE_EDGES", "PROBE_SHRINK", "Probed", "probe_pieces", "signature_hashes"]
+__all__ = [
+    "CUSP_MARGIN",
+    "PROBE_AT",
+    "PROBE_EDGES",
+    "PROBE_SHRINK",
+    "Probed",
+    "probe_pieces",
+    "signature_hashes",
+]
 
 PROBE_EDGES = 4
 """Edges of a piece tried (longest first)."""
@@ -130,6 +139,7 @@ def probe_pieces(
     width: np.ndarray,
     region_hash: np.ndarray | None = None,
     sliver_hash: np.ndarray | None = None,
+    curves: tuple | None = None,
 ) -> tuple[list[Probed], int]:
     """Probe every piece separating two regions (or a region and a sliver).
 
@@ -145,6 +155,9 @@ def probe_pieces(
         sliver_hash: per face, the hash of the stops inside it if it is a sliver: a probe
             that never gets out of the sliver (an end of it, seen along its length) means
             the piece is that end, which separates nothing once the sliver is collapsed.
+        curves: the critical curves (``Piece.curves`` index them): a side of a type-4
+            piece that no probe matched gets one more probe past the kernel's cusp
+            (:func:`_cusp_offset`).
 
     Returns:
         The probed pieces and the number of pieces along slivers that could not be
@@ -268,8 +281,75 @@ def probe_pieces(
             (np.repeat(jj, cnt), np.repeat(ss, cnt), batch.code_lo[arc], batch.code_hi[arc],
              batch.lo[arc], batch.hi[arc])
         )  # fmt: skip
+    if curves is not None:
+        _past_cusps(world, arr, curves, job, regs, found, offs, edge_tab, sign_tab, width,
+                    sig_hash, hits, hit_p, hit_n)  # fmt: skip
     found[(found == -2) & inside] = -1  # the end of a sliver: nothing beyond to adjoin
     return _finish(world, arr, job, regs, found, hits, hit_p, hit_n, first_p, first_n, cells)
+
+
+CUSP_MARGIN = 2.0
+"""A probe past a type-4 cusp sits this many times the cusp's half-width from the piece:
+e's blocked arc is then twice ANGLE_TOL wide, kept and not tied with its neighbour's."""
+
+
+def _cusp_offset(L: float, d: np.ndarray) -> np.ndarray:
+    """Half-width of the kernel's cusp beside a type-4 segment at distance ``d`` from its
+    vertex (``d < L``).
+
+    At a point ``eps`` off the segment (the rod along edge e, its body on e's end v), e's
+    blocked arc runs from the direction of v (distance d) to that of e's point at reach
+    L, ``L - d`` past v: ``eps (L - d) / (d L)`` radians wide. The kernel drops a
+    blocked arc narrower than ``ANGLE_TOL``, so it labels the stop by whatever lies
+    beyond (the body on v, not the tip on e) within ``ANGLE_TOL d L / (L - d)`` of the
+    segment: at ``L - d`` = 1e-6 and L = 3.5, 1.2e-5, wider than a probe of a piece
+    2e-6 long may go. Beyond it the kernel's labels are the exact ones.
+    """
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(d < L, ANGLE_TOL * d * L / (L - d), np.inf)
+
+
+def _past_cusps(world, arr, curves, job, regs, found, offs, edge_tab, sign_tab, width,
+                sig_hash, hits, hit_p, hit_n) -> None:  # fmt: skip
+    """One more probe for each unmatched region side of a type-4 piece: at the middle of
+    its longest edge, ``CUSP_MARGIN`` cusp half-widths off (:func:`_cusp_offset`), if
+    that is farther than every offset tried and within a quarter of the side's region's
+    width. Matches are recorded as in the main rounds."""
+    L = arr.tol.L
+    todo_j, todo_s = np.nonzero((found == -2) & (regs >= 0) & (edge_tab[:, :1] >= 0))
+    rows = []
+    for j, s in zip(todo_j.tolist(), todo_s.tolist(), strict=True):
+        vs = [c.features[0].index for c in (curves[k] for k in arr.pieces[job[j]].curves)
+              if c.type == 4]  # fmt: skip
+        if vs:
+            rows.append((j, s, vs[0]))
+    if not rows:
+        return
+    jj = np.array([r[0] for r in rows], dtype=np.intp)
+    ss = np.array([r[1] for r in rows], dtype=np.intp)
+    vv = np.array([r[2] for r in rows], dtype=np.intp)
+    p, n = arr.probes(edge_tab[jj, 0], sign_tab[jj, 0], 0.5)
+    d = np.hypot(*(p - world.vertices[vv]).T)
+    eps = CUSP_MARGIN * _cusp_offset(L, d)
+    tried = np.nanmax(np.where(np.isfinite(offs[jj, ss]), offs[jj, ss], 0.0), axis=1)
+    ok = np.isfinite(eps) & (eps > tried) & (eps <= 0.25 * width[regs[jj, ss]])
+    if not ok.any():
+        return
+    jj, ss, p, n, eps = jj[ok], ss[ok], p[ok], n[ok], eps[ok]
+    q = p + (np.where(ss == 0, 1.0, -1.0) * eps)[:, None] * n
+    batch = free_arcs_batch(world, q, L)
+    got = np.flatnonzero(signature_hashes(batch) == sig_hash[regs[jj, ss]])
+    if len(got) == 0:
+        return
+    jj, ss = jj[got], ss[got]
+    found[jj, ss] = regs[jj, ss]
+    hit_p[jj, ss], hit_n[jj, ss] = p[got], n[got]
+    cnt = np.diff(batch.offsets)[got]
+    arc = np.repeat(batch.offsets[got], cnt) + _rank(np.repeat(np.arange(len(got)), cnt))
+    hits.append(
+        (np.repeat(jj, cnt), np.repeat(ss, cnt), batch.code_lo[arc], batch.code_hi[arc],
+         batch.lo[arc], batch.hi[arc])
+    )  # fmt: skip
 
 
 class _Beyond:

@@ -425,3 +425,49 @@ def test_a_rod_passing_beside_a_corner_of_a_tiny_tooth_is_semi_free():
 @pytest.mark.parametrize("h", [1e-1, 1e-3, 1e-4])
 def test_a_tiny_tooth_on_an_outer_wall_gives_an_exact_arrangement(h):
     _assert_exact(_tooth(h), TOOTH, 3)
+
+
+@pytest.mark.parametrize("k", [4, 31, 52])
+def test_a_short_type4_piece_near_its_arc_is_probed_past_the_kernel_s_cusp(k):
+    """A type-4 piece 1.6-2.3e-6 long ends 0.8-1.1e-6 from the type-2 arc where the
+    rod's tip reaches its own vertex: within ANGLE_TOL d L / (L - d) of it (1.2e-5 here)
+    the kernel drops the edge's blocked arc (narrower than ANGLE_TOL) and labels the
+    stop by the body on the vertex, so every probe the piece's length allows saw the
+    other side's stops (1 piece matched by overlap only on 3 of the 80 random corners).
+    Oracle for the cusp's width: the kernel's labels at the piece's middle, half and
+    twice that width off."""
+    world, L = _stepped(k)
+    _assert_exact(world, L, k)
+
+    from envs.geometry.types import Stop
+    from envs.maps.map import Feature
+    from strategies.cspace._batch_arcs import free_arcs_batch, stop_code
+    from strategies.cspace._probing import _cusp_offset
+    from strategies.cspace.arrangement import arrange
+    from strategies.cspace.curves import _curves
+    from strategies.cspace.tolerances import Tolerances
+
+    tol = Tolerances.of(world, L)
+    curves = _curves(world, L, tol.chord, True)
+    arr = arrange(world, curves, tol)
+    checked = 0
+    for piece in arr.pieces:
+        four = [curves[c] for c in piece.curves if curves[c].type == 4]
+        e = int(piece.edges[np.argmax(arr.edge_length[piece.edges])])
+        if not four or arr.edge_length[e] > 1e-5:
+            continue
+        v, edge = four[0].features[0].index, four[0].features[1].index
+        p, n = arr.probes(np.array([e]), np.array([1.0]), 0.5)
+        d = float(np.hypot(*(p[0] - world.vertices[v])))
+        h = float(_cusp_offset(L, np.array([d]))[0])
+        tip = stop_code(Stop("tip", Feature("edge", edge)))
+        body = stop_code(Stop("body", Feature("vertex", v)))
+        for side in (1.0, -1.0):
+            near = free_arcs_batch(world, p + side * 0.5 * h * n, L)
+            far = free_arcs_batch(world, p + side * 2.0 * h * n, L)
+            codes_near = set(near.code_lo.tolist()) | set(near.code_hi.tolist())
+            codes_far = set(far.code_lo.tolist()) | set(far.code_hi.tolist())
+            if tip in codes_far:  # the side where the tip on the edge is a stop
+                assert tip not in codes_near and body in codes_near
+                checked += 1
+    assert checked == 1

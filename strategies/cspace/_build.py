@@ -25,8 +25,9 @@ import numpy as np
 import shapely
 
 from envs.maps.map import Map
+from envs.tolerances import REL_LENGTH_TOL
 from strategies.cspace._batch_arcs import ArcBatch, free_arcs_batch, stop_of
-from strategies.cspace._probing import probe_pieces, signature_hashes
+from strategies.cspace._probing import PROBE_FLOOR, probe_pieces, signature_hashes
 from strategies.cspace._progress import Progress
 from strategies.cspace.arrangement import Arrangement, arrange
 from strategies.cspace.curves import _curves, _walls
@@ -262,10 +263,10 @@ def build_decomposition(
     stats["faces"] = len(faces)
     stats["merged_faces"] = merged
     stats["noncritical_violations"] = len(violations)
-    stats["slivers_unresolved"] = lost
+    stats["slivers_unresolved"] = len(lost)
     dec = Decomposition(world, L, curves, regions, cells, boundaries, tol.chord, stats)
     dec.timings = progress.close()
-    _warn(dec, violations)
+    _warn(dec, violations, lost)
     return dec
 
 
@@ -286,8 +287,27 @@ def _cells(batch: ArcBatch, rep_face: np.ndarray, keys: list):
     return cells_tmp, region_cells, region_ids
 
 
-def _warn(dec: Decomposition, violations) -> None:
-    """One warning naming what went wrong, if anything did (never silent)."""
+def _tip_ties(dec: Decomposition, points: list[np.ndarray]) -> tuple[np.ndarray, list[int]] | None:
+    """The first point at which two or more wall vertices lie at distance L to within
+    the smallest probe offset (``PROBE_FLOOR`` kernel length tolerances), and those
+    vertices (None if no point has any). The kernel takes a vertex within its length
+    tolerance of distance L for the rod's tip touching it (``envs.geometry``'s
+    tip-at-vertex test), so near such a point it cannot tell which of them the tip
+    touches, and the probes there (whose distances to the vertices change by less than
+    their offsets) see tied stops, not the exact arrangement's."""
+    world, L = dec.map, dec.L
+    eps = PROBE_FLOOR * REL_LENGTH_TOL * world.scale
+    for p in points:
+        d = np.hypot(*(world.vertices - np.asarray(p)).T)
+        tied = np.flatnonzero(np.abs(d - L) <= eps)
+        if len(tied) >= 2:
+            return np.asarray(p), tied.tolist()
+    return None
+
+
+def _warn(dec: Decomposition, violations, lost: np.ndarray) -> None:
+    """One warning naming what went wrong, if anything did (never silent), and, where
+    the cause is a tie the kernel cannot break at floating point, which one."""
     problems = []
     if dec.unresolved:
         problems.append(f"{dec.unresolved} boundary pieces matched by overlap only")
@@ -303,11 +323,34 @@ def _warn(dec: Decomposition, violations) -> None:
         problems.append(f"{dec.stats['slivers_unresolved']} pieces along slivers unresolved")
     if dec.stats.get("orphan_holes"):
         problems.append(f"{dec.stats['orphan_holes']} curve components outside every face")
-    if problems:
-        warnings.warn(
-            f"decompose({dec.map.name!r}, L={dec.L:g}): the arrangement is not exact: "
-            + "; ".join(problems)
-            + ". Please report this map and L.",
-            RuntimeWarning,
-            stacklevel=3,
+    if not problems:
+        return
+    where = [b.point for b in dec.boundaries if not b.resolved]
+    where += [np.asarray(p) for _, p in violations] + list(lost)
+    tie = _tip_ties(dec, where)
+    if tie is None:
+        advice = ". Please report this map and L."
+    else:
+        (x, y), tied = tie
+        names = "vertices " + ", ".join(map(str, tied[:-1])) + f" and {tied[-1]}"
+        gap = min(
+            float(np.hypot(*(dec.map.vertices[a] - dec.map.vertices[b])))
+            for a in tied
+            for b in tied
+            if a < b
         )
+        advice = (
+            f". Near ({x:.6g}, {y:.6g}) {names} lie at distance L from one point to within "
+            f"{PROBE_FLOOR * REL_LENGTH_TOL * dec.map.scale:.2g} ({PROBE_FLOOR:g} times the "
+            "geometry kernel's length tolerance): the kernel cannot tell which of them the "
+            "rod's tip touches there (its stops tie), a degeneracy of this map at floating "
+            "point, not a fault of the decomposition. Moving those vertices farther apart "
+            f"(the nearest two are {gap:.2g} apart) removes it."
+        )
+    warnings.warn(
+        f"decompose({dec.map.name!r}, L={dec.L:g}): the arrangement is not exact: "
+        + "; ".join(problems)
+        + advice,
+        RuntimeWarning,
+        stacklevel=3,
+    )

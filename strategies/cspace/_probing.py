@@ -37,6 +37,7 @@ __all__ = [
     "CUSP_MARGIN",
     "PROBE_AT",
     "PROBE_EDGES",
+    "PROBE_FLOOR",
     "PROBE_SHRINK",
     "Probed",
     "probe_pieces",
@@ -52,6 +53,9 @@ PROBE_SHRINK = (1.0, 0.1, 0.01, 1e-3)
 PROBE_AT = (0.5, 0.25, 0.75, 0.1, 0.9)
 """Points of an edge probed, as fractions of its parameter interval: the middle first
 (every edge and offset), then the others, nearer and nearer to its ends."""
+
+PROBE_FLOOR = 4.0
+"""The smallest probe offset, in the kernel's length tolerances."""
 
 _THIN_STEPS = (2.0, 4.0, 10.0, 30.0)  # offsets past a sliver, times the sliver tolerance
 _TWO_PI = 2.0 * math.pi
@@ -108,7 +112,7 @@ def _offsets(
     none): a fraction of the edge (half the distance to its nearer end) and of the
     regions (``width``) shrinking to the kernel's resolution, then a few sliver widths;
     across a sliver (``over``) only the sliver widths."""
-    floor = 4.0 * tol.kernel
+    floor = PROBE_FLOOR * tol.kernel
     reach = 0.5 * min(at, 1.0 - at) * length
     eps0 = np.maximum(np.minimum(np.minimum(tol.probe, reach), 0.25 * width), floor)
     shrink = np.maximum(eps0[:, None] * np.asarray(PROBE_SHRINK)[None, :], floor)
@@ -160,8 +164,8 @@ def probe_pieces(
             (:func:`_cusp_offset`).
 
     Returns:
-        The probed pieces and the number of pieces along slivers that could not be
-        resolved (dropped, counted).
+        The probed pieces and, per piece along a sliver that could not be resolved
+        (dropped, counted), a point of it (k, 2).
     """
     tol = arr.tol
     L = tol.L
@@ -440,7 +444,7 @@ def _finish(world, arr, job, regs, found, hits, hit_p, hit_n, first_p, first_n, 
                     cells[found[j, 1]][(int(clo[b]), int(chi[b]))])  # fmt: skip
             adjacent.setdefault(j, []).append(pair)
     out = []
-    lost = 0
+    lost = []
     for j in range(n_jobs):
         i = int(job[j])
         a, b = int(found[j, 0]), int(found[j, 1])
@@ -452,11 +456,11 @@ def _finish(world, arr, job, regs, found, hits, hit_p, hit_n, first_p, first_n, 
         if a == -1 or b == -1:
             continue  # a sliver between a region and a wall, or its end: no boundary
         if regs[j, 0] < 0 or regs[j, 1] < 0:
-            lost += 1
+            lost.append(first_p[j])
             continue
         pn = (first_p[j], first_n[j])
         out.append(_fallback(world, arr, i, (int(regs[j, 0]), int(regs[j, 1])), pn, cells))
-    return out, lost
+    return out, np.array(lost, dtype=float).reshape(-1, 2)
 
 
 def _fallback(world, arr, i, regions, pn, cells) -> Probed:

@@ -698,3 +698,93 @@ def test_a_successful_solve_returns_the_fine_grid_root_arc():
             assert np.max(np.abs(path - ref)) < 1e-12 * x_e
             checked += 1
     assert checked >= 12
+
+
+def test_a_failed_solve_skips_the_steep_headings_proven_on_one_side(monkeypatch):
+    # issue 13: the shooting evader's failed solve on the maze at rho 0.99 (decision_time.py):
+    # the grid's headings 0.9 and 1.3 reach x_e high above the axis (arclength 7.8 and 19.8
+    # for x_e = 4.8, a fifth of the solve), next to headings of the same sign, so no bracket
+    # reads them; _slow_side proves their sign and they are no longer integrated
+    from strategies.control import evasion
+
+    runs = _counting(monkeypatch)
+    th0, x_e = -0.0586, 4.8
+    step = capped_step(x_e, 2.0, 0.99)
+    assert escape_path(th0, x_e, L=2.0, rho=0.99, branch="+", step=step) is None
+    assert 0.9 not in runs and 1.3 not in runs
+    n = len(runs)
+    assert escape_path(-th0, x_e, L=2.0, rho=0.99, branch="-", step=step) is None  # mirrored
+    assert -0.9 not in runs[n:] and -1.3 not in runs[n:] and len(runs) == 2 * n
+    monkeypatch.setattr(evasion, "_slow_side", lambda *args: 0)  # every heading integrated
+    assert escape_path(th0, x_e, L=2.0, rho=0.99, branch="+", step=step) is None
+    assert 0.9 in runs[2 * n :] and 1.3 in runs[2 * n :] and len(runs) == 3 * n + 2  # 27 -> 29
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_the_slow_side_is_the_coarse_residuals_sign(seed):
+    # _slow_side's proof is of the ODE: the coarse RK4 arc from every heading it proves
+    # (the capped and the default step, rho 0.3-0.995) ends on that side of the axis, or
+    # turns back or runs long on it, as the shooting's residual reads it
+    from strategies.control import evasion
+    from strategies.control._integrators import REACHED, integrate_reduced_end
+
+    rng = np.random.default_rng(seed)
+    proven = 0
+    for _ in range(150):
+        rho = float(rng.choice([0.3, 0.7, 0.9, 0.95, 0.98, 0.99, 0.995]))
+        L = float(rng.uniform(0.5, 4.0))
+        x_e = float(rng.uniform(0.05, 4.0)) * L
+        th0, s = float(rng.uniform(-2 * math.pi, 2 * math.pi)), int(rng.choice([1, -1]))
+        for h in (capped_step(x_e, L, rho), evasion.default_step(x_e, L, rho)):
+            if h is None or x_e / h > 4000:
+                continue
+            for a0 in evasion._ALPHA_GRID:
+                side = evasion._slow_side(a0, th0, x_e, L, rho, s)
+                if not side:
+                    continue
+                end, status = integrate_reduced_end(
+                    th0, a0, s, L, rho, 8.0 * h, x_e, evasion._max_steps(x_e, L, 8.0 * h)
+                )
+                y = end[2] if status in (REACHED, 2) else status
+                assert y * side > 0.0, (rho, L, x_e, th0, s, a0)
+                proven += 1
+    assert proven >= 100
+    # (no proof where rho * rho underflows; the solve goes on as before)
+    assert evasion._slow_side(1.3, 0.0, 1.0, 1.0, 1e-200, 1) == 0
+    assert escape_path(0.5, 1.0, L=1.0, rho=1e-200, step=0.1) is None
+
+
+def test_the_slow_side_changes_no_solve(monkeypatch):
+    # headings proven on one side are integrated only next to a heading not proven on that
+    # side, so every bracket is the same: every solve (the capped step, rho 0.5-0.995, and
+    # the default step up to 0.95) gives the same arc bit for bit, or None as before
+    from strategies.control import evasion
+
+    runs = _counting(monkeypatch)
+    rng = np.random.default_rng(91)
+    probs = [
+        (rng.uniform(-math.pi, math.pi), rng.uniform(0.2, 3.6), rho, "+-"[rng.integers(2)], mode)
+        for rho in (0.5, 0.9, 0.95, 0.97, 0.99, 0.995)
+        for mode in ("capped", "default")
+        for _ in range(6)
+        if mode == "capped" or rho <= 0.95
+    ]
+    steps = {"capped": lambda x_e, rho: capped_step(x_e, 2.0, rho), "default": lambda *_: None}
+    counts, paths = [], []
+    for proof in (evasion._slow_side, lambda *args: 0):
+        monkeypatch.setattr(evasion, "_slow_side", proof)
+        del runs[:]
+        paths.append(
+            [
+                escape_path(th, x_e, L=2.0, rho=rho, branch=b, step=steps[mode](x_e, rho))
+                for th, x_e, rho, b, mode in probs
+            ]
+        )
+        counts.append(len(runs))
+    found = 0
+    for new, old in zip(*paths, strict=True):
+        assert (new is None) == (old is None)
+        if new is not None:
+            found += 1
+            assert new.tobytes() == old.tobytes()
+    assert 0 < found < len(probs) and counts[0] < counts[1]  # both kinds, and it cut some

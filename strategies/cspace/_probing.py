@@ -31,6 +31,7 @@ from envs.maps.map import Map
 from envs.tolerances import ANGLE_TOL
 from strategies.cspace._arcs import OVERLAP_TOL
 from strategies.cspace._batch_arcs import ArcBatch, free_arcs_batch
+from strategies.cspace._samples import _first_hits
 from strategies.cspace.arrangement import Arrangement
 
 __all__ = [
@@ -286,8 +287,8 @@ def probe_pieces(
              batch.lo[arc], batch.hi[arc])
         )  # fmt: skip
     if curves is not None:
-        _past_cusps(world, arr, curves, job, regs, found, offs, edge_tab, sign_tab, width,
-                    sig_hash, hits, hit_p, hit_n)  # fmt: skip
+        _past_cusps(world, arr, curves, job, regs, found, offs, edge_tab, sign_tab, sig_hash,
+                    hits, hit_p, hit_n)  # fmt: skip
     found[(found == -2) & inside] = -1  # the end of a sliver: nothing beyond to adjoin
     return _finish(world, arr, job, regs, found, hits, hit_p, hit_n, first_p, first_n, cells)
 
@@ -313,12 +314,14 @@ def _cusp_offset(L: float, d: np.ndarray) -> np.ndarray:
         return np.where(d < L, ANGLE_TOL * d * L / (L - d), np.inf)
 
 
-def _past_cusps(world, arr, curves, job, regs, found, offs, edge_tab, sign_tab, width,
-                sig_hash, hits, hit_p, hit_n) -> None:  # fmt: skip
+def _past_cusps(world, arr, curves, job, regs, found, offs, edge_tab, sign_tab, sig_hash,
+                hits, hit_p, hit_n) -> None:  # fmt: skip
     """One more probe for each unmatched region side of a type-4 piece: at the middle of
     its longest edge, ``CUSP_MARGIN`` cusp half-widths off (:func:`_cusp_offset`), if
-    that is farther than every offset tried and within a quarter of the side's region's
-    width. Matches are recorded as in the main rounds."""
+    that is farther than every offset tried and nearer than the first curve a ray from
+    there along the normal meets (found on the exact curves, as faces' points are:
+    the probe lies in the face on that side, however thin its polygon says it is).
+    Matches are recorded as in the main rounds."""
     L = arr.tol.L
     todo_j, todo_s = np.nonzero((found == -2) & (regs >= 0) & (edge_tab[:, :1] >= 0))
     rows = []
@@ -336,11 +339,20 @@ def _past_cusps(world, arr, curves, job, regs, found, offs, edge_tab, sign_tab, 
     d = np.hypot(*(p - world.vertices[vv]).T)
     eps = CUSP_MARGIN * _cusp_offset(L, d)
     tried = np.nanmax(np.where(np.isfinite(offs[jj, ss]), offs[jj, ss], 0.0), axis=1)
-    ok = np.isfinite(eps) & (eps > tried) & (eps <= 0.25 * width[regs[jj, ss]])
+    ok = np.isfinite(eps) & (eps > tried)
     if not ok.any():
         return
     jj, ss, p, n, eps = jj[ok], ss[ok], p[ok], n[ok], eps[ok]
-    q = p + (np.where(ss == 0, 1.0, -1.0) * eps)[:, None] * n
+    out = np.where(ss == 0, 1.0, -1.0)[:, None] * n
+    tol = arr.tol
+    first = _first_hits(
+        arr.curves, L, p - arr.origin, out, 2.0 * eps, tol.touch, tol.chord + tol.merge
+    )
+    ok = first > eps
+    if not ok.any():
+        return
+    jj, ss, p, n, eps, out = jj[ok], ss[ok], p[ok], n[ok], eps[ok], out[ok]
+    q = p + eps[:, None] * out
     batch = free_arcs_batch(world, q, L)
     got = np.flatnonzero(signature_hashes(batch) == sig_hash[regs[jj, ss]])
     if len(got) == 0:

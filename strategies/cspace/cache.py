@@ -46,7 +46,7 @@ __all__ = [
     "write_cache_file",
 ]
 
-FORMAT_VERSION = 13  # 13: type-4 cusps (12: thin faces' points, sliver chains, rods)
+FORMAT_VERSION = 14  # 14: cusp probes bounded by a ray (13: type-4 cusps)
 """Bump when the decomposition's content or the file layout changes."""
 
 MAGIC = b"SURVEIL-CSPACE-DECOMPOSITION\n"

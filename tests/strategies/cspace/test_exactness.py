@@ -497,3 +497,37 @@ def test_a_tooth_below_the_kernel_s_resolution_is_named_not_reported(h, L):
     d = np.hypot(*(world.vertices[[2, 3]] - p).T)
     assert np.all(np.abs(d - L) < 1e-6 * L), d - L  # (the point is printed to 6 digits)
     assert f"{h:.2g} apart" in text
+
+
+def _tooth_room(x, w, h, angle, with_box):
+    """A room with a tooth ``w`` wide and ``h`` high on its floor, maybe a box, rotated."""
+    c, s = math.cos(angle), math.sin(angle)
+    rot = np.array([[c, -s], [s, c]])
+    ring = [(0, 0), (x, 0), (x, h), (x + w, h), (x + w, 0), (14, 0), (14, 10), (0, 10)]
+    box = [np.array(_box(5, 4, 8, 6), dtype=float) @ rot.T] if with_box else []
+    return Map(np.array(ring, dtype=float) @ rot.T, box)
+
+
+@pytest.mark.parametrize(
+    "x, w, h, angle, with_box, L",
+    [
+        (7.228714106080173, 0.004668644649330412, 1.440029890095114e-06, 0.19587697981166452,
+         False, 3.4842149346822984),
+        (10.012296771332643, 0.0026357723460416864, 0.0027869808508118174, 0.8609484043969781,
+         True, 2.760023134512317),
+        (3.134618277441704, 6.872649099505543e-06, 0.004168792542663163, 3.1385323726549434,
+         True, 3.471655826507452),
+        (8.542897858681787, 0.004583878254411805, 0.0004799838080286795, 0.07504892249880801,
+         True, 3.8756146905612505),
+    ],
+)  # fmt: skip
+def test_a_type4_cusp_beside_a_thin_face_is_probed_as_far_as_the_face_reaches(
+    x, w, h, angle, with_box, L
+):
+    """Teeth on a floor (random search, teeth.py seed 1: k = 5, 8, 26, 41): the type-4
+    cusp is 2.2-2.4e-5 wide where the face beside it is 0.7-4.7e-5 wide by its polygon
+    (twice its area over its perimeter), so a bound by that width refused the probe past
+    the cusp; the face reaches farther along the normal than its polygon says. The bound
+    is now the first curve a ray from the piece along the normal meets, on the exact
+    curves."""
+    _assert_exact(_tooth_room(x, w, h, angle, with_box), L, 13)

@@ -61,6 +61,25 @@ def test_dagger_models_files_card_and_provenance(name):
     assert name in card and "held out" in card
 
 
+# retrained on surveillance_v1 from their recipes (helper-93); the others trained on v0
+RETRAINED = ["dagger_evader_generalist"]
+
+
+@pytest.mark.parametrize("name", RETRAINED)
+def test_a_retrained_model_records_the_env_version_and_commit_it_trained_on(name):
+    """The provenance names the env version played in training and a clean commit, so the
+    card says "trained and measured on surveillance_v1" and ``reproduce`` plays that env
+    (the v0 models' DAgger provenance had no env_id: the version was guessed from git)."""
+    prov = zoo.info(name)
+    assert prov["env_id"] == "surveillance_v1" == zoo.trained_env(name)
+    assert prov["registry_id"] == "surveil/surveillance-v1"
+    assert prov["git_dirty"] is False and len(prov["git_sha"]) == 40
+    card = (zoo.MODELS_DIR / name / "CARD.md").read_text()
+    assert "- trained on `surveillance_v1`" in card
+    assert "Trained and measured on `surveillance_v1`." in card
+    assert f"- code: {prov['git_sha']} (dirty: False)" in card
+
+
 @pytest.mark.parametrize("name", SPECIALISTS)
 def test_specialists_files_card_and_provenance(name):
     assert zoo.model_path(name).stat().st_size < 1_000_000

@@ -624,9 +624,14 @@ def builtin_parameters(name: Any) -> dict[str, float] | None:
     if name in builtin_names():
         return builtin_info(name).params()
     base, similarity = split_transform(name) if TRANSFORM_SEPARATOR in name else (name, None)
-    if similarity is None or base not in builtin_names():
+    if similarity is None:
         return None
-    return {k: v * similarity.scale for k, v in builtin_info(base).params().items()}
+    # the base may be transformed itself (``corner~x2~rot1``, which load_map reads as the
+    # built-in under both similarities): its recommendation scales again
+    recommended = builtin_parameters(base)
+    if recommended is None:
+        return None
+    return {k: v * similarity.scale for k, v in recommended.items()}
 
 
 def load_map(path_or_name: str | os.PathLike[str], *, merge: bool | None = None) -> Map:

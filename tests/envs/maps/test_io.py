@@ -456,6 +456,19 @@ def test_a_transformed_built_in_recommends_its_lengths_and_speeds_scaled():
     assert map_recommendations("random:3~x2") == map_recommendations("random:3")
 
 
+def test_a_twice_transformed_built_in_recommends_its_lengths_scaled_twice():
+    """``corner~x2~rot1`` is the corner under two similarities (load_map reads the base
+    ``corner~x2`` first); its recommendation scales as the map does, not the defaults."""
+    from envs.surveillance.config import map_recommendations
+
+    base = map_recommendations("corner")
+    assert Polygon(load_map("corner~x2~x3rot1").boundary).area == pytest.approx(
+        36 * Polygon(load_map("corner").boundary).area, rel=1e-9
+    )
+    assert map_recommendations("corner~x2~x3rot1") == {k: 6 * v for k, v in base.items()}
+    assert map_recommendations("corner~x2~rot1") == map_recommendations("corner~x2")
+
+
 @pytest.mark.parametrize(
     ("name", "error", "pattern"),
     [

@@ -76,6 +76,10 @@ def _as_ring(points: object, what: str) -> np.ndarray:
     return arr
 
 
+_EPS = float(np.finfo(float).eps)
+"""Relative rounding of a float64 coordinate."""
+
+
 def _clean_ring(ring: np.ndarray, scale: float, what: str) -> np.ndarray:
     """Drop repeated and straight (collinear) vertices; reject degenerate rings."""
     keep = np.linalg.norm(ring - np.roll(ring, 1, axis=0), axis=1) > REL_LENGTH_TOL * scale
@@ -156,6 +160,18 @@ class Map:
         span = float(np.linalg.norm(b.max(axis=0) - b.min(axis=0)))
         if span <= 0:
             raise InvalidMapError("boundary: degenerate polygon (zero extent)")
+        far = float(np.abs(b).max())
+        if far * _EPS > REL_LENGTH_TOL * span:
+            # a coordinate rounds by more than the geometry's length tolerance: walls,
+            # line of sight and the decomposition cannot resolve the map any more
+            raise InvalidMapError(
+                f"boundary: a vertex lies {far:.4g} from the origin, {far / span:.3g} times "
+                f"the map's size {span:.4g}: its coordinates round by {far * _EPS:.2g}, more "
+                f"than the geometry's length tolerance {REL_LENGTH_TOL:g} x size = "
+                f"{REL_LENGTH_TOL * span:.2g}; expected a map within "
+                f"{REL_LENGTH_TOL / _EPS:.3g} times its size of the origin (shift it nearer, "
+                "e.g. NAME~off(X,Y))"
+            )
         self.scale = span
         b = _clean_ring(b, span, "boundary")
         if isinstance(obstacles, (str, bytes)) or not hasattr(obstacles, "__iter__"):

@@ -160,6 +160,22 @@ def test_errors_are_value_errors():
         Map(ROOM, [box(1, 1, 3, 3), box(2, 2, 4, 4)])
 
 
+def test_a_map_too_far_from_the_origin_for_its_size_is_refused():
+    """A float64 coordinate X rounds by eps |X|; beyond REL_LENGTH_TOL / eps (4.5e6) sizes
+    from the origin that exceeds the length tolerance every geometry test uses (the corner
+    at rot 0.3 decomposes exactly at offset 1e7, is inexact at 1e8 and the decomposition
+    raised a bare ValueError at 1e9)."""
+    from envs.maps.io import load_map
+
+    square = np.array(box(0, 0, 10, 10), dtype=float)
+    assert Map(square + 1e6).scale == pytest.approx(Map(square).scale)  # 7e4 sizes: fine
+    with pytest.raises(InvalidMapError, match=r"lies 1e\+08 from the origin.*shift it"):
+        Map(square + 1e8)
+    assert load_map("corner~rot0.3off(1e7,1e7)").n_vertices == load_map("corner").n_vertices
+    with pytest.raises(InvalidMapError, match="from the origin"):
+        load_map("corner~rot0.3off(1e9,1e9)")
+
+
 def test_gap_just_above_tolerance_is_accepted():
     scale = math.hypot(10, 10)
     gap = 10 * REL_GAP_TOL * scale

@@ -62,7 +62,7 @@ def test_dagger_models_files_card_and_provenance(name):
 
 
 # retrained on surveillance_v1 from their recipes (helper-93); the others trained on v0
-RETRAINED = ["dagger_evader_generalist"]
+RETRAINED = ["dagger_evader_generalist", "dagger_evader_two_rooms"]
 
 
 @pytest.mark.parametrize("name", RETRAINED)

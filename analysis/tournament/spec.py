@@ -403,7 +403,12 @@ def _map_entry(text: str, where: str, base: Path) -> MapEntry:
             raise InvalidConfigError(f"{where}: {exc}") from exc
         if sim is not None:  # the map it transforms, then the similarity
             inner = _map_entry(name, where, base)
-            world = inner.map.transformed(sim.matrix, sim.offset, name=text)
+            try:
+                world = inner.map.transformed(sim.matrix, sim.offset, name=text)
+            except ValueError as exc:
+                raise InvalidConfigError(
+                    f"{where}: map = {text!r}: {name!r} under that transform is no valid map: {exc}"
+                ) from exc
             params = {k: v * sim.scale for k, v in inner.params.items()}
             return MapEntry(text, f"{inner.source}~{sim.label()}", world, params)
         raise InvalidConfigError(

@@ -671,7 +671,12 @@ def load_map(path_or_name: str | os.PathLike[str], *, merge: bool | None = None)
                 m = load_map(base, merge=merge)
             except UnknownNameError as exc:
                 raise UnknownNameError(f"map {path_or_name!r}: {exc}") from None
-            return m.transformed(similarity.matrix, similarity.offset, name=path_or_name)
+            try:
+                return m.transformed(similarity.matrix, similarity.offset, name=path_or_name)
+            except InvalidMapError as exc:
+                raise InvalidMapError(
+                    f"map {path_or_name!r}: {base!r} under that transform is no valid map: {exc}"
+                ) from None
     if isinstance(path_or_name, str) and path_or_name.startswith(RANDOM_PREFIX):
         return _random_by_name(path_or_name)
 

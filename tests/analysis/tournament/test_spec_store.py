@@ -120,6 +120,15 @@ def test_a_spec_takes_transformed_maps_as_load_map_does(tmp_path):
                         "evaders": ["evader/random"], "seeds": 1})  # fmt: skip
 
 
+@pytest.mark.parametrize("name", ["corner~x1e-300", "random:3~rot1~x1e-300"])
+def test_a_transform_that_leaves_no_valid_map_names_the_map_entry(name):
+    """A well-formed transform whose result no map can be (scaled to nothing): one error
+    naming the spec entry and the map, not a bare 'boundary: degenerate polygon'."""
+    with pytest.raises(InvalidConfigError, match=rf"\[maps #1\]: map = '{re.escape(name)}'.*zero"):
+        spec_from_dict({"maps": [name], "pursuers": ["pursuer/greedy"],
+                        "evaders": ["evader/random"], "seeds": 1})  # fmt: skip
+
+
 def test_duplicate_roster_entries_are_merged_or_rejected(small_spec):
     with pytest.warns(UserWarning, match="merged"):
         spec = spec_from_dict({**small_spec, "pursuers": ["pursuer/greedy", "pursuer/greedy"]})

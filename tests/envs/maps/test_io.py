@@ -476,6 +476,7 @@ def test_a_twice_transformed_built_in_recommends_its_lengths_scaled_twice():
         ("corner~x1e400", InvalidConfigError, "expected a finite scale > 0"),
         ("nosuch~rot1", UnknownNameError, r"map 'nosuch~rot1': unknown map 'nosuch'"),
         ("corner~sideways", UnknownNameError, r"'~\[xS\]\[rotR\]\[off\(X,Y\)\]'"),
+        ("corner~x1e-300", InvalidMapError, r"map 'corner~x1e-300': 'corner' under .*zero"),
     ],
 )
 def test_a_bad_transformed_name_says_what_a_name_can_be(name, error, pattern):

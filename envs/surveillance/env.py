@@ -20,7 +20,8 @@ import numpy as np
 from gymnasium.spaces import Box
 from gymnasium.utils import EzPickle, seeding
 from pettingzoo import AECEnv, ParallelEnv
-from pettingzoo.utils.conversions import parallel_to_aec
+from pettingzoo.utils.conversions import parallel_to_aec_wrapper
+from pettingzoo.utils.wrappers import OrderEnforcingWrapper
 
 from envs import validation
 from envs.errors import (
@@ -508,6 +509,28 @@ def _env_factory(fn):
     """
     fn.__signature__ = env_signature(AECEnv)
     return fn
+
+
+class _aec_wrapper(parallel_to_aec_wrapper):
+    """PettingZoo's ``parallel_to_aec_wrapper``, checking each action on its agent's turn.
+
+    The conversion only buffers an action until the last agent of the cycle has acted, so
+    a NaN given by the pursuer was refused on the evader's turn, and stayed in the buffer:
+    every later step raised the same error until a reset. Checked here (the parallel env's
+    own check, :meth:`parallel_env._command`), a bad action is refused on the call that
+    gave it and leaves the env as it was; a valid one goes through unchanged.
+    """
+
+    def step(self, action: Any) -> None:
+        agent = self.agent_selection
+        if not (self.terminations[agent] or self.truncations[agent]):
+            self.env._command(agent, action)  # raises InvalidActionError naming the agent
+        super().step(action)
+
+
+def parallel_to_aec(par_env: parallel_env) -> AECEnv:
+    """``pettingzoo.utils.conversions.parallel_to_aec`` with actions checked on their turn."""
+    return OrderEnforcingWrapper(_aec_wrapper(par_env))
 
 
 @_env_factory

@@ -83,3 +83,22 @@ def test_an_action_for_an_unknown_agent_is_refused_naming_it(env):
     with pytest.raises(UnknownNameError, match=r"unknown agent\(s\) \['pursuer_1'\]"):
         env.step(actions)
     assert env._step == 0  # refused before anything moved
+
+
+@pytest.mark.parametrize("make", [surveillance_v1.env, surveillance_v1.raw_env])
+def test_the_aec_env_refuses_a_bad_action_on_its_own_turn_and_goes_on(make):
+    """The AEC conversion buffered the pursuer's NaN until the evader's turn, refused it
+    there, and kept it: every later step raised the same error until a reset."""
+    e, ref = make(map="corner"), make(map="corner")
+    e.reset(seed=0)
+    ref.reset(seed=0)
+    with pytest.raises(InvalidActionError, match=r"pursuer_0: action must be finite"):
+        e.step(np.array([np.nan, 0.0]))
+    assert e.agent_selection == "pursuer_0"  # the turn is still the pursuer's
+    for env_ in (e, ref):  # the same cycle, played after the refusal and without it
+        env_.step(np.array([0.5, 0.0], dtype=np.float32))
+        env_.step(np.array([0.0, 0.5], dtype=np.float32))
+    np.testing.assert_array_equal(e.observe("pursuer_0"), ref.observe("pursuer_0"))
+    assert e.infos == ref.infos
+    e.close()
+    ref.close()

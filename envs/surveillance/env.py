@@ -527,6 +527,13 @@ class _aec_wrapper(parallel_to_aec_wrapper):
             self.env._command(agent, action)  # raises InvalidActionError naming the agent
         super().step(action)
 
+    def observe(self, agent: str) -> Any:
+        """``agent``'s observation; an unknown name is an :class:`UnknownNameError` naming
+        the agents (the conversion's bare ``KeyError`` said only the name)."""
+        if agent not in self.possible_agents:
+            self.env._space(self.env._observation_spaces, agent)  # raises, naming them
+        return super().observe(agent)
+
 
 def parallel_to_aec(par_env: parallel_env) -> AECEnv:
     """``pettingzoo.utils.conversions.parallel_to_aec`` with actions checked on their turn."""

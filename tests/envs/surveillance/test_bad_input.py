@@ -77,6 +77,15 @@ def test_an_unknown_agent_is_a_project_error_naming_it(make, space):
     e.close()
 
 
+def test_the_aec_env_observing_an_unknown_agent_is_a_project_error_naming_it():
+    e = surveillance_v1.env(map="corner")
+    e.reset(seed=0)
+    with pytest.raises(UnknownNameError, match=r"agent = 'nobody': expected one of \['pursuer_0'"):
+        e.observe("nobody")
+    assert e.observe("evader_0").shape == e.observation_space("evader_0").shape
+    e.close()
+
+
 def test_an_action_for_an_unknown_agent_is_refused_naming_it(env):
     """A misspelt agent's action was ignored silently (the episode went on without it)."""
     actions = {"pursuer_0": [1.0, 0.0], "evader_0": [0.0, 0.0], "pursuer_1": [0.0, 1.0]}

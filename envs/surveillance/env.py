@@ -535,9 +535,40 @@ class _aec_wrapper(parallel_to_aec_wrapper):
         return super().observe(agent)
 
 
+class _order_enforcing(OrderEnforcingWrapper):
+    """PettingZoo's ``OrderEnforcingWrapper``, whose calls before ``reset()`` raised a bare
+    ``AssertionError`` (gone under ``python -O``), raising the parallel env's
+    :class:`EpisodeStateError` instead."""
+
+    def _require_reset(self, call: str) -> None:
+        if not self._has_reset:
+            raise EpisodeStateError(f"{call}() before reset(): call reset(seed=...) first")
+
+    def step(self, action: Any) -> None:
+        self._require_reset("step")
+        super().step(action)
+
+    def observe(self, agent: str) -> Any:
+        self._require_reset("observe")
+        return super().observe(agent)
+
+    def render(self) -> Any:
+        self._require_reset("render")
+        return super().render()
+
+    def state(self) -> np.ndarray:
+        self._require_reset("state")
+        return super().state()
+
+    def agent_iter(self, max_iter: int = 2**63) -> Any:
+        self._require_reset("agent_iter")
+        return super().agent_iter(max_iter)
+
+
 def parallel_to_aec(par_env: parallel_env) -> AECEnv:
-    """``pettingzoo.utils.conversions.parallel_to_aec`` with actions checked on their turn."""
-    return OrderEnforcingWrapper(_aec_wrapper(par_env))
+    """``pettingzoo.utils.conversions.parallel_to_aec`` with actions checked on their turn
+    and calls before ``reset()`` refused with :class:`EpisodeStateError`."""
+    return _order_enforcing(_aec_wrapper(par_env))
 
 
 @_env_factory

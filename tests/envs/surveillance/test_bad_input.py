@@ -7,6 +7,7 @@ import pytest
 
 from envs import surveillance_v1
 from envs.errors import (
+    EpisodeStateError,
     InvalidActionError,
     InvalidConfigError,
     InvalidPlacementError,
@@ -111,3 +112,16 @@ def test_the_aec_env_refuses_a_bad_action_on_its_own_turn_and_goes_on(make):
     assert e.infos == ref.infos
     e.close()
     ref.close()
+
+
+@pytest.mark.parametrize("call", ["step", "observe", "render", "state", "agent_iter"])
+def test_the_aec_env_before_reset_is_an_episode_state_error(call):
+    """PettingZoo's order wrapper raised a bare AssertionError here (none under -O)."""
+    e = surveillance_v1.env(map="corner", render_mode="rgb_array")
+    args = {"step": (np.zeros(2),), "observe": ("pursuer_0",)}.get(call, ())
+    with pytest.raises(EpisodeStateError, match=rf"{call}\(\) before reset\(\)"):
+        getattr(e, call)(*args)
+    e.reset(seed=0)
+    e.observe("pursuer_0")
+    e.step(np.zeros(2))
+    e.close()

@@ -9,19 +9,62 @@ it: every row is written with its newline) is dropped (that episode is played ag
 never glued to the next row; any other line that is not a row of this script (not JSON, or
 a row of another script, without the fields of its key) is refused before anything is
 played or appended.
+
+Each row records the code that played it (``"code"``: the commit, and a digest of the
+uncommitted changes to the package's sources when there are any; :func:`code_version`).
+A rerun reuses rows whatever code played them, since an episode's key does not name the
+code; :func:`read` says how many of the rows it found were played by other code, so a
+changed policy is not measured by yesterday's rows unnoticed (a new ``--results`` file
+plays them with this code).
 """
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import json
 import os
+import subprocess
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from typing import IO, Any
 
 from envs.errors import InvalidConfigError
 
-__all__ = ["appending", "key", "read"]
+__all__ = ["appending", "code_version", "key", "read"]
+
+SOURCES = ("envs", "strategies", "analysis", "training", "benchmarks")
+"""The folders whose code plays an episode (their uncommitted changes count too)."""
+
+
+def _git(*args: str) -> str | None:
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    try:
+        out = subprocess.run(["git", *args], cwd=root, capture_output=True, text=True, timeout=20)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return out.stdout if out.returncode == 0 else None
+
+
+@functools.cache
+def code_version() -> str | None:
+    """``SHA`` of HEAD (12 digits), ``SHA+DIGEST`` when :data:`SOURCES` differ from it
+    (DIGEST: 8 hex digits of the diff and of the untracked files' names and contents),
+    ``None`` outside a git checkout."""
+    sha = _git("rev-parse", "HEAD")
+    if not sha:
+        return None
+    diff = _git("diff", "HEAD", "--", *SOURCES) or ""
+    untracked = (_git("ls-files", "--others", "--exclude-standard", "--", *SOURCES) or "").split()
+    if not diff and not untracked:
+        return sha.strip()[:12]
+    h = hashlib.sha256(diff.encode())
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    for name in sorted(untracked):
+        h.update(name.encode())
+        with open(os.path.join(root, name), "rb") as f:
+            h.update(f.read())
+    return f"{sha.strip()[:12]}+{h.hexdigest()[:8]}"
 
 
 def key(values: Iterable[Any]) -> str:
@@ -64,6 +107,13 @@ def read(path: str | os.PathLike, key_of: Callable[[dict], str]) -> dict[str, di
             raise InvalidConfigError(
                 f"{os.fspath(path)}, line {i + 1}: the row has no field {exc}; {expected}"
             ) from None
+    other = [r.get("code") for r in rows.values() if r.get("code") != code_version()]
+    if other and code_version() is not None:
+        seen = sorted({str(c) for c in other if c}) + ["not recorded"] * (None in other)
+        print(f"note: {len(other)} of the {len(rows)} rows in {os.fspath(path)} were played by "
+              f"other code ({', '.join(seen[:3])}{', ...' if len(seen) > 3 else ''}; this is "
+              f"{code_version()}) and are reused as they are; a new --results file plays them "
+              "with this code", flush=True)  # fmt: skip
     return rows
 
 
@@ -82,7 +132,7 @@ def appending(path: str | os.PathLike) -> Iterator[Callable[[dict], None]]:
     with open(path, "a") as f:
 
         def write(row: dict) -> None:
-            _write(f, row)
+            _write(f, row if "code" in row else {**row, "code": code_version()})
 
         yield write
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib
 import json
+import re
 import signal
 from pathlib import Path
 
@@ -33,7 +34,39 @@ def test_a_row_cut_short_by_a_kill_is_dropped_and_not_glued_to_the_next(bench, t
     assert set(rows.read(path, key)) == {"1", "2"}
     with rows.appending(path) as write:
         write({"id": 3})
-    assert [json.loads(line) for line in _lines(path)] == [{"id": 1}, {"id": 2}, {"id": 3}]
+    assert [json.loads(line)["id"] for line in _lines(path)] == [1, 2, 3]
+
+
+def test_rows_record_their_code_and_a_rerun_says_which_were_played_by_other_code(
+    bench, tmp_path, monkeypatch, capsys
+):
+    """A row is written with the code that played it; reading rows back notes how many
+    were played by other code (a changed policy must not be measured by old rows
+    unnoticed), and says nothing when all are this code's."""
+    rows = bench("episode_rows")
+    path = tmp_path / "r.jsonl"
+    monkeypatch.setattr(rows, "code_version", lambda: "aaaaaaaaaaaa")
+    with rows.appending(path) as write:
+        write({"id": 1})
+        write({"id": 2})
+    assert [json.loads(line)["code"] for line in _lines(path)] == ["aaaaaaaaaaaa"] * 2
+    capsys.readouterr()
+    assert set(rows.read(path, lambda r: str(r["id"]))) == {"1", "2"}
+    assert capsys.readouterr().out == ""
+    monkeypatch.setattr(rows, "code_version", lambda: "bbbbbbbbbbbb+0123abcd")
+    with rows.appending(path) as write:
+        write({"id": 3})
+    path.write_text(path.read_text() + '{"id": 4}\n')  # a row of a file older than the field
+    rows.read(path, lambda r: str(r["id"]))
+    out = capsys.readouterr().out
+    assert "3 of the 4 rows in" in out
+    assert "other code (aaaaaaaaaaaa, not recorded; this is bbbbbbbbbbbb+0123abcd)" in out, out
+
+
+def test_the_code_version_is_the_commit_and_a_digest_of_changes(bench):
+    rows = bench("episode_rows")
+    version = rows.code_version()
+    assert version is None or re.fullmatch(r"[0-9a-f]{12}(\+[0-9a-f]{8})?", version), version
 
 
 def test_a_file_that_is_not_json_lines_is_refused_naming_the_line(bench, tmp_path):

@@ -169,6 +169,13 @@ class parallel_env(ParallelEnv, EzPickle):
             new.__dict__[key] = None if key == "_renderer" else copy.deepcopy(value, memo)
         return new
 
+    def __copy__(self) -> parallel_env:
+        """``copy.copy`` is :meth:`__deepcopy__`: a shallow copy would share the pymunk
+        world and the generator (a step of one would move the other), and EzPickle's
+        default rebuilt an unreset env, so a copy taken mid-episode raised "step()
+        before reset()"."""
+        return copy.deepcopy(self)
+
     # ------------------------------------------------------------------ spaces
     def observation_space(self, agent: str) -> Box:
         """The observation Box of ``agent`` (the same object on every call)."""

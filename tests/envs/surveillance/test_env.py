@@ -482,3 +482,22 @@ def test_deepcopy_mid_episode_carries_the_episode_on(version: str) -> None:
     aec_tail = aec_rollout(copy.deepcopy(aec))
     assert len(aec_tail) == 2 * 15 + 2  # the 15 remaining steps, then both agents' end
     assert aec_tail == aec_expected[-len(aec_tail) :]
+
+
+def test_a_shallow_copy_mid_episode_carries_the_episode_on_independently() -> None:
+    """copy.copy went through EzPickle and rebuilt an unreset env ("step() before
+    reset()" on a copy of a running episode); it is a deep copy now."""
+    import copy
+
+    up = np.array([0.3, 1.0], dtype=np.float32)
+    reference = surveillance_v1.parallel_env(map="corridor", max_cycles=30)
+    reference.reset(seed=0)
+    expected = _rollout(reference, [up] * 30)
+    env = surveillance_v1.parallel_env(map="corridor", max_cycles=30)
+    env.reset(seed=0)
+    head = _rollout(env, [up] * 10)
+    clone = copy.copy(env)
+    assert clone.world.space is not env.world.space
+    tail = _rollout(clone, [up] * 30)
+    assert head + tail == expected
+    assert _rollout(env, [up] * 30) == tail

@@ -205,7 +205,10 @@ def output_file(
             if len(suffixes) < 3
             else (f"{', '.join(suffixes[:-1])} or {suffixes[-1]}")
         )
-        raise InvalidConfigError(f"{flag} = {text!r}: expected a file ending in {listed}")
+        hint = ""
+        if not path.suffix:  # 'replays', meant as a directory that does not exist yet
+            hint = f", or a directory: an existing one, or {text.rstrip('/') + '/'!r} to create it"
+        raise InvalidConfigError(f"{flag} = {text!r}: expected a file ending in {listed}{hint}")
     _writable_dir(flag, text, path.parent)
     return path
 

@@ -90,6 +90,20 @@ def test_an_output_with_a_wrong_suffix(capsys, tmp_path):
     assert_fails(capsys, ["play", *FAST, "--out", str(tmp_path / "r.mp4")], "--out", ".gif or .png")
 
 
+def test_a_new_directory_without_a_slash_is_refused_with_the_remedy(capsys, tmp_path):
+    """README: `--out DIR` writes DIR/play.gif. A DIR that does not exist yet has no suffix
+    and was refused as 'expected a file ending in .gif or .png', naming no directory."""
+    new_dir = str(tmp_path / "replays")
+    err = assert_fails(capsys, ["play", *FAST, "--out", new_dir], "--out", ".gif or .png")
+    assert f"or a directory: an existing one, or '{new_dir}/' to create it" in err
+    assert not (tmp_path / "replays").exists()
+    assert main(["play", *FAST, "--out", new_dir + "/"]) == 0  # the remedy works
+    assert (tmp_path / "replays" / "play.gif").exists()
+    capsys.readouterr()
+    err = assert_fails(capsys, ["play", *FAST, "--out", "x.mp4"], "--out")
+    assert err.endswith("--out = 'x.mp4': expected a file ending in .gif or .png")  # as README
+
+
 def test_a_directory_as_the_output_holds_the_default_name(capsys, tmp_path):
     assert main(["play", "--map", "open_room", *FAST, "--out", str(tmp_path)]) == 0
     with Image.open(tmp_path / "play.gif") as gif:

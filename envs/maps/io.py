@@ -535,7 +535,7 @@ def _random_by_name(name: str) -> Map:
     kind, seed_text = ("polygons", parts[0]) if len(parts) == 1 else (parts[0], parts[-1])
     if len(parts) > 2 or kind not in KINDS or not seed_text.isdigit():
         raise InvalidConfigError(
-            f"map: {name!r} is not a random map name; expected 'random:SEED' or "
+            f"{name!r} is not a random map name; expected 'random:SEED' or "
             f"'random:KIND:SEED' with SEED an integer >= 0 and KIND one of {list(KINDS)}"
         )
     return random_map(int(seed_text), kind=kind)
@@ -601,7 +601,7 @@ def split_transform(name: str) -> tuple[str, Similarity | None]:
         math.isfinite(v) for v in (rotation, *offset)
     ):
         raise InvalidConfigError(
-            f"map: {name!r} transforms {base!r} by scale {scale!r}, rotation {rotation!r}, "
+            f"{name!r} transforms {base!r} by scale {scale!r}, rotation {rotation!r}, "
             f"offset {offset!r}: expected a finite scale > 0 and finite rotation and offset"
         )
     return base, Similarity(scale, rotation, offset)

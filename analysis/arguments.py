@@ -272,3 +272,19 @@ def user_error(exc: BaseException) -> str | None:
     if isinstance(exc, PolicyFailure) and cause is not None and user_error(cause) is not None:
         return str(exc)
     return None
+
+
+def set_from_flag(config: dict[str, Any], key: str, flag: str, value: Any) -> None:
+    """``config[key] = value`` for a flag given beside ``--config``; a ``--config`` that
+    sets ``key`` to something else is refused (which one the user meant is unknown).
+
+    Raises:
+        InvalidConfigError: both set ``key``, to different values (naming both).
+    """
+    if value is None:
+        return
+    if key in config and config[key] != value:
+        raise InvalidConfigError(
+            f"{flag} {value!r} and --config {key} = {config[key]!r}: give {key} once"
+        )
+    config[key] = value

@@ -26,6 +26,7 @@ from analysis.arguments import (
     output_file,
     path_text,
     real,
+    set_from_flag,
     user_error,
 )
 from analysis.figures import cli as figures_cli
@@ -124,8 +125,7 @@ def _cmd_play(args: argparse.Namespace) -> int:
 
     # everything is checked before the episode: options, policies, the output file
     overrides = json_object("--config", args.config, example=CONFIG_EXAMPLE)
-    if args.max_cycles is not None:
-        overrides["max_cycles"] = args.max_cycles
+    set_from_flag(overrides, "max_cycles", "--max-cycles", args.max_cycles)
     config = _env_config("--map", args.map, overrides, "--config")
     pursuer = _policy("--pursuer", args.pursuer, "--pursuer-params", args.pursuer_params)
     evader = _policy("--evader", args.evader, "--evader-params", args.evader_params)

@@ -21,6 +21,7 @@ from analysis.arguments import (
     json_object,
     output_file,
     path_text,
+    set_from_flag,
     why_not_a_file,
 )
 from envs.errors import InvalidConfigError
@@ -197,8 +198,7 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     from analysis.tournament.spec import spec_from_dict
 
     env = json_object("--config", args.config, example=CONFIG_EXAMPLE)
-    if args.max_cycles is not None:
-        env["max_cycles"] = args.max_cycles
+    set_from_flag(env, "max_cycles", "--max-cycles", args.max_cycles)
     plot = None  # checked now, drawn after the run
     if args.plot:
         plot = output_file("--plot", args.plot, suffixes=(".png",), default_name="evaluate.png")

@@ -97,6 +97,16 @@ def test_analyze_a_transformed_built_in_at_its_scaled_length(tmp_path, capsys):
     assert counts[0] == counts[1] and counts[0]
 
 
+@pytest.mark.parametrize("command", [["play", "--no-gif"], ["evaluate", "--maps", "corridor"]])
+def test_max_cycles_given_twice_differently_is_refused(command, capsys):
+    """``--max-cycles 10`` beside ``--config '{"max_cycles": 20}'``: which one was meant is
+    unknown, so neither wins silently (the flag did); the same value twice is fine."""
+    argv = [*command, "--max-cycles", "10", "--config", '{"max_cycles": 20}']
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "--max-cycles 10 and --config max_cycles = 20: give max_cycles once" in err
+
+
 def test_figure_tractrix(tmp_path):
     out = tmp_path / "tractrix.png"
     assert main(["figure", "tractrix", "--out", str(out)]) == 0

@@ -21,7 +21,8 @@ if [ ! -x "$VENV/bin/python" ]; then
 fi
 "$VENV/bin/python" -m pip install --quiet --upgrade pip
 if ! "$VENV/bin/python" -c "import torch" 2>/dev/null; then
-    "$VENV/bin/python" -m pip install --quiet "torch==2.13.0"
+    "$VENV/bin/python" -m pip install --quiet --index-url https://download.pytorch.org/whl/cpu \
+        "torch==2.13.0"
 fi
 CONSTRAINTS="$VENV/min-constraints.txt"
 # every extra's bounds too (render, analysis, train, bench, test); tomli reads

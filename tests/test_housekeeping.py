@@ -22,6 +22,22 @@ def test_ci_runs_the_linter_the_formatter_and_the_lower_bounds() -> None:
     assert (ROOT / "scripts" / "check_min_versions.sh").exists()
 
 
+def test_the_set_up_scripts_take_torch_from_the_cpu_index() -> None:
+    """The README: scripts/setup.sh installs the CPU build of torch first. A bare
+    ``pip install torch==2.13.0`` takes PyPI's, which on Linux is the CUDA build (a 527 MB
+    wheel needing the nvidia-*-cu13 wheels); only a pip configured with a local CPU wheel
+    (this project's own machines) got the CPU one. Both scripts pin the same version."""
+    import re
+
+    lines = []
+    for script in ("setup.sh", "check_min_versions.sh"):
+        text = (ROOT / "scripts" / script).read_text().replace("\\\n", " ")
+        (line,) = [x for x in text.splitlines() if "pip install" in x and "torch==" in x]
+        assert "--index-url https://download.pytorch.org/whl/cpu" in line, (script, line)
+        lines.append(re.search(r"torch==[0-9.]+", line).group())
+    assert lines[0] == lines[1], lines
+
+
 def test_every_user_of_the_env_names_the_current_version() -> None:
     """The runner (hence evaluate, tournaments, benchmarks), the tournament's match
     identity and training's provenance all name the latest registered version: a new

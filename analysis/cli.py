@@ -102,6 +102,13 @@ def _policy(flag: str, name: str, params_flag: str, params_text: str | None):
 
     params = json_object(params_flag, params_text, example=PARAMS_EXAMPLE)
     role = flag.lstrip("-")
+    if name.startswith(f"{role}/sb3:"):  # the registry's name of a model file (surveil policies)
+        name = name.removeprefix(f"{role}/sb3:")
+    elif name.startswith(("pursuer/sb3:", "evader/sb3:")):
+        raise InvalidConfigError(
+            f"{flag} = {name!r}: expected a policy name of the form '{role}/KIND' "
+            "(see surveil policies)"
+        )
     if name.startswith("zoo:") or name.endswith(".zip"):  # as surveil evaluate takes them
         from analysis.tournament.spec import model_file
 
@@ -158,7 +165,7 @@ def _cmd_play(args: argparse.Namespace) -> int:
                 raise
             raise exc.named("--start valid") from None
         shown = {  # a model as the user named it, not the sb3:PATH it was loaded from
-            role: f"{role}/{name}"
+            role: name if name.startswith(f"{role}/") else f"{role}/{name}"
             for role, name in (("pursuer", args.pursuer), ("evader", args.evader))
             if name.startswith("zoo:") or name.endswith(".zip")
         }

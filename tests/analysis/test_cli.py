@@ -229,6 +229,28 @@ def test_play_takes_a_shipped_model_or_a_model_file_as_evaluate_does(tmp_path, c
         assert "sb3:" not in out
 
 
+def test_play_and_evaluate_take_the_registry_name_of_a_model_file(tmp_path, capsys):
+    """README (Policies) and surveil policies: trained models are ROLE/sb3:PATH. play and
+    evaluate read any name ending in .zip as a file path and looked for the file
+    'pursuer/sb3:PATH' ("no such file (/cwd/pursuer/sb3:...)")."""
+    from analysis.tournament.spec import zoo_dir
+
+    model = zoo_dir() / "ppo_pursuer_vs_straight_open_room" / "model.zip"
+    fast = ["--map", "open_room", "--max-cycles", "5", "--no-gif"]
+    assert main(["play", "--pursuer", f"pursuer/sb3:{model}", *fast]) == 0
+    out = capsys.readouterr().out
+    assert f"open_room: pursuer/sb3:{model} vs evader/shooting" in out  # as it was named
+    assert "kept surveillance" in out
+    argv = ["evaluate", "--maps", "open_room", "--seeds", "1", "--max-cycles", "5"]
+    argv += ["--pursuers", f"pursuer/sb3:{model}", "--evaders", "evader/straight"]
+    assert main([*argv, "--results", str(tmp_path / "e.sqlite"), "--no-progress"]) == 0
+    assert "1 of 1 matches stored" in capsys.readouterr().out
+    # the other role's name is refused, one line, naming the flag
+    assert main(["play", "--pursuer", f"evader/sb3:{model}", *fast]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--pursuer" in err[0] and "'pursuer/KIND'" in err[0]
+
+
 @pytest.mark.parametrize(
     ("command", "flag"),
     [("play", "--map"), ("analyze", "map"), ("referee", "map"), ("evaluate", "--maps")],

@@ -788,3 +788,142 @@ def test_the_slow_side_changes_no_solve(monkeypatch):
             found += 1
             assert new.tobytes() == old.tobytes()
     assert 0 < found < len(probs) and counts[0] < counts[1]  # both kinds, and it cut some
+
+
+def test_a_failed_solve_needs_no_jump_search_where_its_bracket_is_proven_root_free(
+    monkeypatch,
+):
+    # issue 13: decision_time.py's failed solves at rho 0.99 (the maze, s = +1, and l_hall,
+    # s = -1) have one grid bracket, an arc turning back next to one reaching x_e far off
+    # the axis; Brent and the bisection spent 20 coarse integrations on it to find a jump.
+    # _root_free proves no extremal from that bracket reaches (x_e, 0): 7 integrations, the
+    # grid's (27 before)
+    from strategies.control import evasion
+
+    runs = _counting(monkeypatch)
+    cases = [(-0.0586368977823013, 4.8, "+"), (-0.07374376093329116, 5.1, "-")]
+    for th0, x_e, b in cases:
+        step = capped_step(x_e, 2.0, 0.99)
+        del runs[:]
+        assert escape_path(th0, x_e, L=2.0, rho=0.99, branch=b, step=step) is None
+        assert len(runs) == 7 and set(runs) <= set(evasion._ALPHA_GRID)
+    monkeypatch.setattr(evasion, "_root_free", lambda *args: False)  # as before
+    for th0, x_e, b in cases:
+        del runs[:]
+        step = capped_step(x_e, 2.0, 0.99)
+        assert escape_path(th0, x_e, L=2.0, rho=0.99, branch=b, step=step) is None
+        assert len(runs) == 27
+
+
+@pytest.mark.parametrize("rho", [0.9, 0.99])
+def test_the_phi_tables_bound_the_reduced_odes_arcs(rho):
+    # _phi_tables against an independent integration (integrate_reduced in arclength, a
+    # fine step): the arclength to phi = 0 and from phi = 0 to the turn back are at most
+    # the tables' at the next table point (as _root_free takes them) and near the one
+    # before, and the drop of y past the first negative heading is at most the table's
+    from strategies.control import evasion
+    from strategies.control._integrators import integrate_reduced
+
+    L, tabs = 2.0, evasion._phi_tables(rho)
+    checked = 0
+    for th0, a0 in [(-0.06, 0.0), (-0.06, 0.01), (-0.2, 0.05), (-0.3, 0.2), (0.05, 0.1)]:
+        h = evasion._natural_length(L, rho) / 256.0
+        rows, status = integrate_reduced(th0, a0, 1, L, rho, h, 50.0, True, 10**7)
+        r = np.asarray(rows)
+        assert status == -1  # turned back downward
+        sig, y, a = r[:, 0], r[:, 2], r[:, 4]
+        phi = a - r[:, 3]
+        k = int(np.argmax(phi <= 0.0))
+        phi0 = a0 - th0
+        if phi0 > 0.0:
+            j = math.ceil(phi0 / tabs.slow_step)
+            assert L * tabs.slow_len[j - 1] - h <= sig[k] <= L * tabs.slow_len[j] + h
+        apk = a[k]
+        i = math.ceil(apk / tabs.alpha_step)
+        post = sig[-1] - sig[k]
+        assert 0.98 * L * tabs.post_len[max(i - 1, 0)] <= post <= L * tabs.post_len[i] + 2 * h
+        z = k + int(np.argmax(a[k:] < 0.0))
+        assert y[z] - y[z:].min() <= L * tabs.post_drop[i]
+        checked += 1
+    assert checked == 5
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_a_root_free_bracket_holds_no_coarse_root(seed):
+    # _root_free's proof is of the ODE: in every grid bracket it proves root-free (random
+    # problems, rho 0.8-0.995, the capped and the default step), coarse RK4 arcs from 60
+    # headings each turn back or reach x_e off the axis by more than _JUMP_RESIDUAL, so the
+    # shooting would have found no root there
+    from strategies.control import evasion
+    from strategies.control._integrators import REACHED, integrate_reduced_end
+
+    rng = np.random.default_rng(seed)
+    proven = 0
+    for _ in range(200):
+        rho = float(rng.choice([0.8, 0.9, 0.95, 0.98, 0.99, 0.995]))
+        L = float(rng.choice([0.5, 2.0, 4.0]))
+        x_e = float(rng.uniform(0.15, 4.0)) * L
+        th0, s = float(rng.uniform(-math.pi, math.pi)), int(rng.choice([1, -1]))
+        h = capped_step(x_e, L, rho)
+        if h is not None and rng.random() < 0.2 and x_e / evasion.default_step(x_e, L, rho) < 4000:
+            h = evasion.default_step(x_e, L, rho)
+        if h is None:
+            continue
+        coarse = 8.0 * h
+        n = evasion._max_steps(x_e, L, coarse)
+        for a_lo, a_hi in zip(evasion._ALPHA_GRID, evasion._ALPHA_GRID[1:], strict=False):
+            if not evasion._root_free(a_lo, a_hi, th0, x_e, L, rho, s):
+                continue
+            proven += 1
+            for a0 in np.linspace(a_lo, a_hi, 60):
+                end, status = integrate_reduced_end(th0, float(a0), s, L, rho, coarse, x_e, n)
+                if status == REACHED:
+                    assert s * end[2] / x_e > evasion._JUMP_RESIDUAL, (rho, L, x_e, th0, s, a0)
+    assert proven >= 10
+
+
+def test_root_free_brackets_change_no_solve(monkeypatch):
+    # a bracket proven root-free is not polished: every solve (the capped step, rho
+    # 0.9-0.995, and the default step up to 0.95) gives the same arc bit for bit, or None
+    # as before, with fewer integrations
+    from strategies.control import evasion
+
+    runs = _counting(monkeypatch)
+    rng = np.random.default_rng(95)
+    probs = [
+        (rng.uniform(-math.pi, math.pi), rng.uniform(0.3, 5.5), rho, "+-"[rng.integers(2)], mode)
+        for rho in (0.9, 0.95, 0.97, 0.99, 0.995)
+        for mode in ("capped", "default")
+        for _ in range(8)
+        if mode == "capped" or rho <= 0.95
+    ]
+    steps = {"capped": lambda x_e, rho: capped_step(x_e, 2.0, rho), "default": lambda *_: None}
+    counts, paths = [], []
+    for proof in (evasion._root_free, lambda *args: False):
+        monkeypatch.setattr(evasion, "_root_free", proof)
+        del runs[:]
+        paths.append(
+            [
+                escape_path(th, x_e, L=2.0, rho=rho, branch=b, step=steps[mode](x_e, rho))
+                for th, x_e, rho, b, mode in probs
+            ]
+        )
+        counts.append(len(runs))
+    found = 0
+    for new, old in zip(*paths, strict=True):
+        assert (new is None) == (old is None)
+        if new is not None:
+            found += 1
+            assert new.tobytes() == old.tobytes()
+    assert 0 < found < len(probs) and counts[0] < counts[1]
+
+
+def test_no_root_free_proof_where_the_arcs_need_not_turn_back():
+    # at rho 0.5 an arc from phi = 0 need not turn back by phi = -pi (no proof), and near
+    # rho = 1 the tables would need too many steps (none is built)
+    from strategies.control import evasion
+
+    assert not evasion._root_free(0.0, 0.45, -0.06, 4.0, 2.0, 0.5, 1)
+    assert evasion._phi_tables(1.0 - 1e-12) is None
+    assert not evasion._root_free(0.0, 0.45, -0.06, 4.0, 2.0, 1.0 - 1e-12, 1)
+    assert not evasion._root_free(0.0, 0.45, -0.06, 4.0, 2.0, 1e-320, 1)

@@ -70,7 +70,7 @@ def test_arcs_near_rho_one_are_integrated_at_the_capped_step(monkeypatch):
         "corridor", "pursuer/greedy", evader, 0, start="safe", max_cycles=100,
         overrides={"v_evader": 0.99},
     )  # fmt: skip
-    assert len(steps) > 100
+    assert len(steps) > 20  # (108 before evasion._root_free skipped the jump searches: 28)
     natural = evasion._natural_length(2.0, 0.99)
     for h, x_e in steps:
         want = max(evasion.default_step(x_e, 2.0, 0.99), min(natural / 4, x_e / 1024))

@@ -20,10 +20,7 @@ if [ ! -x "$VENV/bin/python" ]; then
     "$PY" -m venv "$VENV"
 fi
 "$VENV/bin/python" -m pip install --quiet --upgrade pip
-if ! "$VENV/bin/python" -c "import torch" 2>/dev/null; then
-    "$VENV/bin/python" -m pip install --quiet --index-url https://download.pytorch.org/whl/cpu \
-        "torch==2.13.0"
-fi
+bash scripts/install_torch.sh "$VENV/bin/python"
 CONSTRAINTS="$VENV/min-constraints.txt"
 # every extra's bounds too (render, analysis, train, bench, test); tomli reads
 # pyproject.toml on Python 3.10

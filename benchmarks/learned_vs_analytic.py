@@ -262,6 +262,10 @@ def main(argv=None) -> int:
     for m in learned["pursuer"]:
         # a map specialist is judged on the target maps it trained on
         own = [x for x in SEEN_PURSUER if x in zoo.training_maps(m)] or SEEN_PURSUER
+        if not played & set(own):
+            print(f"  {m}: its target maps ({', '.join(own)}) were not played in this run "
+                  "(--maps): no verdict")  # fmt: skip
+            continue
         r_l = _rate(rows, m, "evader/shooting", own)[0]
         r_d = _rate(rows, "pursuer/decomposition", "evader/shooting", own)[0]
         h_l = _rate(rows, m, "evader/shooting", HELD_OUT)[0]
@@ -276,7 +280,7 @@ def main(argv=None) -> int:
         print(f"  {m}: seen ({', '.join(own)}) held {r_l:.2f} / decomposition {r_d:.2f} = "
               f"{ratio:.2f} (target >= 0.9: {verdict}){held_out}")  # fmt: skip
     team = {x: [m for m in learned["pursuer"] if zoo.training_maps(m) == [x]] for x in SEEN_PURSUER}
-    if all(team.values()):  # one specialist per target map: the target for the team
+    if all(team.values()) and set(SEEN_PURSUER) <= played:  # one specialist per target map
         got = [_rate(rows, team[x][0], "evader/shooting", [x]) for x in SEEN_PURSUER]
         held = sum(r * n for r, _, _, n in got)
         n = sum(n for *_, n in got)
@@ -288,6 +292,10 @@ def main(argv=None) -> int:
     for m in learned["evader"]:
         # a map specialist is judged on the target maps it trained on, as for the pursuer
         own = [x for x in SEEN_EVADER if x in zoo.training_maps(m)] or SEEN_EVADER
+        if not played & set(own):
+            print(f"  {m}: its target maps ({', '.join(own)}) were not played in this run "
+                  "(--maps): no verdict")  # fmt: skip
+            continue
         e_l = 1 - _rate(rows, "pursuer/decomposition", m, own)[0]
         e_s = 1 - _rate(rows, "pursuer/decomposition", "evader/shooting", own)[0]
         h_l = 1 - _rate(rows, "pursuer/decomposition", m, HELD_OUT)[0]

@@ -99,3 +99,15 @@ def test_an_rl_models_card_names_its_network_and_timesteps(lva):
     general = lva.card("dagger_pursuer_generalist", "pursuer", [], args, measured=measured)
     assert "- network: [128, 128] (43909 parameters)" in general
     assert "- labelled states: 62809; wall time" in general
+
+
+def test_a_run_that_leaves_out_a_models_target_maps_gives_no_verdict_not_nan(lva, tmp_path, capsys):
+    """``--maps open_room`` for the corridor specialist: its target map was not played, so
+    the targets line says so (it printed 'held nan / decomposition nan = nan ... NOT met')."""
+    argv = ["--models", MODEL, "--seeds", "1", "--max-cycles", "20", "--maps", "open_room",
+            "--workers", "1", "--store", str(tmp_path / "s.sqlite")]  # fmt: skip
+    assert lva.main(argv) == 0
+    out = capsys.readouterr().out
+    targets = out[out.index("targets (ratios measured in this run)") :]
+    assert "nan" not in targets and "NOT met" not in targets
+    assert f"{MODEL}: its target maps (corridor) were not played in this run" in targets

@@ -80,7 +80,7 @@ survives any actions for `spawn_margin_steps` steps.
 ``` python
 surveillance_v1.parallel_env(map="corridor", l_min=None, l_max=None, v_pursuer=None,
     v_evader=None, dt=0.1, max_cycles=500, observation="state", n_rays=32,
-    lidar_range=None, reward="zero_sum", body_radius=0.1, spawn_margin_steps=3,
+    lidar_range=None, reward="zero_sum", body_radius=None, spawn_margin_steps=3,
     render_mode=None)
 ```
 
@@ -96,7 +96,8 @@ a `TypeError` that suggests the closest name.
 but raises a `RhoAboveOneWarning`: escape is then trivial for the evader (Sec. 5).
 
 `None` for `l_min`, `l_max`, `v_pursuer` or `v_evader` takes the value the map recommends:
-a built-in map named by a string brings its own (`envs.maps.builtin_info(name).params()`);
+a built-in map named by a string brings its own (`envs.maps.builtin_info(name).params()`),
+times S for a transformed one (`NAME~xS[rotR][off(X,Y)]`, see `envs.maps.load_map`);
 a `Map` object or a map file gets L_min = 2, L_max = 4, V_p = 1, V_e = 0.5. Explicit
 arguments always win. Every built-in map recommends these same values today (a test says
 so): changing a built-in's recommendation changes this version's behaviour and needs a
@@ -109,7 +110,8 @@ new version.
 
 `reward`: `"zero_sum"` or `"sparse"`.
 
-`body_radius`: disc radius, in (0, l_min / 2).
+`body_radius`: disc radius, in (0, l_min / 2). `None`: 0.1, times S on a transformed
+built-in `NAME~xS...` (so that its game is the built-in's up to the similarity).
 
 `spawn_margin_steps`: how many steps a random start survives whatever the actions.
 

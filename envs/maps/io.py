@@ -607,15 +607,20 @@ def split_transform(name: str) -> tuple[str, Similarity | None]:
     return base, Similarity(scale, rotation, offset)
 
 
+BODY_RADIUS = 0.1
+"""The agents' disc radius the built-ins are played with (the env's default)."""
+
+
 def builtin_parameters(name: Any) -> dict[str, float] | None:
     """The recommended ``l_min``, ``l_max``, ``v_pursuer``, ``v_evader`` of a map *name*
-    that is a built-in or a built-in transformed (``NAME~xS...``: lengths and speeds times
-    S, the same game up to the similarity); ``None`` for anything else (files, random
-    maps, :class:`Map` objects: no recommendation).
+    that is a built-in, or a built-in transformed (``NAME~xS...``: lengths and speeds
+    times S, and ``body_radius`` = S times :data:`BODY_RADIUS`, so the game is the same
+    up to the similarity); ``None`` for anything else (files, random maps, :class:`Map`
+    objects: no recommendation).
 
     Examples:
         >>> builtin_parameters("corridor~x10rot0.3")
-        {'l_min': 20.0, 'l_max': 40.0, 'v_pursuer': 10.0, 'v_evader': 5.0}
+        {'l_min': 20.0, 'l_max': 40.0, 'v_pursuer': 10.0, 'v_evader': 5.0, 'body_radius': 1.0}
     """
     from envs.maps.builtin import builtin_info, builtin_names
 
@@ -631,6 +636,7 @@ def builtin_parameters(name: Any) -> dict[str, float] | None:
     recommended = builtin_parameters(base)
     if recommended is None:
         return None
+    recommended.setdefault("body_radius", BODY_RADIUS)
     return {k: v * similarity.scale for k, v in recommended.items()}
 
 

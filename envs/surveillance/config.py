@@ -20,7 +20,7 @@ from typing import Any
 from envs import validation as v
 from envs.errors import InvalidConfigError, RhoAboveOneWarning
 from envs.maps import Map, load_map
-from envs.maps.io import builtin_parameters
+from envs.maps.io import BODY_RADIUS, builtin_parameters
 
 __all__ = [
     "GLOBAL_DEFAULTS",
@@ -78,15 +78,15 @@ def map_recommendations(value: Any) -> dict[str, float]:
     """The recommended :data:`MAP_PARAMETERS` for the map argument ``value``.
 
     A built-in map *named by a string* brings its own (``envs.maps.builtin_info``), scaled
-    by S when the name transforms it (``NAME~xS...``: lengths and speeds scale alike, so
-    the game is the same up to the similarity); a :class:`Map` object, a map file path
-    or a random map gets :data:`GLOBAL_DEFAULTS`.
+    by S when the name transforms it (``NAME~xS...``: lengths, speeds and the agents'
+    ``body_radius`` scale alike, so the game is the same up to the similarity); a
+    :class:`Map` object, a map file path or a random map gets :data:`GLOBAL_DEFAULTS`.
 
     Examples:
         >>> map_recommendations("corridor")
         {'l_min': 2.0, 'l_max': 4.0, 'v_pursuer': 1.0, 'v_evader': 0.5}
         >>> map_recommendations("corridor~x10rot0.3")
-        {'l_min': 20.0, 'l_max': 40.0, 'v_pursuer': 10.0, 'v_evader': 5.0}
+        {'l_min': 20.0, 'l_max': 40.0, 'v_pursuer': 10.0, 'v_evader': 5.0, 'body_radius': 1.0}
     """
     params = builtin_parameters(value)
     return dict(GLOBAL_DEFAULTS) if params is None else params
@@ -117,7 +117,9 @@ class EnvConfig:
         n_rays: lidar rays per agent (in [1, MAX_RAYS]; used by the lidar kinds only).
         lidar_range: range at which lidar rays saturate (> 0); ``None`` means ``l_max``.
         reward: ``"zero_sum"`` or ``"sparse"`` (see :mod:`.rules`).
-        body_radius: radius of both agents' discs, in (0, l_min / 2).
+        body_radius: radius of both agents' discs, in (0, l_min / 2). ``None``:
+            :data:`envs.maps.io.BODY_RADIUS` (0.1), times S on a transformed built-in
+            ``NAME~xS...`` (so that game is the built-in's up to the similarity).
         spawn_margin_steps: random starts survive any actions for at least this many
             steps (>= 0; see ``parallel_env.reset``).
         render_mode: ``None``, ``"human"`` or ``"rgb_array"``.
@@ -134,7 +136,7 @@ class EnvConfig:
     n_rays: int = 32
     lidar_range: float | None = None
     reward: str = "zero_sum"
-    body_radius: float = 0.1
+    body_radius: float | None = None
     spawn_margin_steps: int = 3
     render_mode: str | None = None
 
@@ -164,6 +166,8 @@ class EnvConfig:
         if self.lidar_range is not None:
             put("lidar_range", v.positive("lidar_range", self.lidar_range))
         put("reward", v.choice("reward", self.reward, REWARD_KINDS))
+        if self.body_radius is None:  # the built-ins' body, scaled with a transformed one
+            put("body_radius", recommended.get("body_radius", BODY_RADIUS))
         put("body_radius", v.positive("body_radius", self.body_radius))
         if self.body_radius >= 0.5 * self.l_min:
             raise InvalidConfigError(

@@ -189,10 +189,15 @@ def test_a_transformed_built_in_plays_at_its_scaled_recommendations():
     from strategies.runner import map_parameters
 
     world, params = map_parameters("corridor~x10rot0.3")
-    assert params == {"l_min": 20.0, "l_max": 40.0, "v_pursuer": 10.0, "v_evader": 5.0}
+    assert params == {
+        "l_min": 20.0, "l_max": 40.0, "v_pursuer": 10.0, "v_evader": 5.0, "body_radius": 1.0
+    }  # fmt: skip
     assert world.digest == EnvConfig(map="corridor~x10rot0.3").map.digest
+    assert EnvConfig(map="corridor~x10rot0.3").body_radius == 1.0
+    assert EnvConfig(map="corridor").body_radius == EnvConfig(map=world).body_radius == 0.1
     r = run_episode("corridor~x10rot0.3", "pursuer/greedy", "evader/random", 0, max_cycles=5)
     assert (r.config.l_min, r.config.l_max, r.config.v_pursuer) == (20.0, 40.0, 10.0)
+    assert r.config.body_radius == 1.0
     r = run_episode("corridor~x10", "pursuer/greedy", "evader/random", 0, max_cycles=5,
                     overrides={"l_min": 15.0})  # fmt: skip
     assert (r.config.l_min, r.config.l_max) == (15.0, 40.0)

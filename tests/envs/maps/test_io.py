@@ -451,8 +451,11 @@ def test_a_transformed_built_in_recommends_its_lengths_and_speeds_scaled():
     from envs.surveillance.config import map_recommendations
 
     base = map_recommendations("corner")
-    assert map_recommendations("corner~x10rot1.1") == {k: 10 * v for k, v in base.items()}
-    assert map_recommendations("corner~rot0.3off(4,5)") == base
+    body = {"body_radius": 0.1}  # the built-ins' bodies, scaled too: the same game
+    assert map_recommendations("corner~x10rot1.1") == {
+        k: 10 * v for k, v in {**base, **body}.items()
+    }
+    assert map_recommendations("corner~rot0.3off(4,5)") == {**base, **body}
     assert map_recommendations("random:3~x2") == map_recommendations("random:3")
 
 
@@ -465,7 +468,9 @@ def test_a_twice_transformed_built_in_recommends_its_lengths_scaled_twice():
     assert Polygon(load_map("corner~x2~x3rot1").boundary).area == pytest.approx(
         36 * Polygon(load_map("corner").boundary).area, rel=1e-9
     )
-    assert map_recommendations("corner~x2~x3rot1") == {k: 6 * v for k, v in base.items()}
+    assert map_recommendations("corner~x2~x3rot1") == {
+        k: 6 * v for k, v in {**base, "body_radius": 0.1}.items()
+    }
     assert map_recommendations("corner~x2~rot1") == map_recommendations("corner~x2")
 
 

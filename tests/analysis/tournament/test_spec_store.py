@@ -115,6 +115,8 @@ def test_a_spec_takes_transformed_maps_as_load_map_does(tmp_path):
         assert entry.map.digest == want.digest, name
     corner = spec.env_config(spec.maps[0], spec.variants[0])
     assert (corner["l_min"], corner["v_pursuer"]) == (20.0, 10.0)  # corner's 2 and 1, x10
+    assert corner["body_radius"] == 1.0  # the bodies too: the corner's game, x10
+    assert spec.env_config(spec.maps[1], spec.variants[0])["body_radius"] == 0.1
     with pytest.raises(InvalidConfigError, match=r"\[maps #1\].*scale 0\.0"):
         spec_from_dict({"maps": ["corner~x0"], "pursuers": ["pursuer/greedy"],
                         "evaders": ["evader/random"], "seeds": 1})  # fmt: skip

@@ -200,7 +200,16 @@ def refine_about(kind_a, data_a, owner, t, centre, sweep, L: float, floor: float
 
 
 def sampled_roots(
-    kind_a, data_a, owner, t, kind_b, data_b, L: float, touch: float
+    kind_a,
+    data_a,
+    owner,
+    t,
+    kind_b,
+    data_b,
+    L: float,
+    touch: float,
+    rounding: float = 0.0,
+    merge: float = np.inf,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Zeros of ``g(t) = F_B(P_A(t))`` along sampled curves A (pairs ``owner``).
 
@@ -211,6 +220,17 @@ def sampled_roots(
         kind_b, data_b: per pair, the curve B whose implicit function is followed.
         L: rod length.
         touch: extrema of |g| at most this are tangencies (one root at the extremum).
+        rounding, merge: |g| at most ``rounding`` is zero to rounding, its sign noise. A
+            sign change that rests on such a value at A's end (the end lies on B, and the
+            noding records it there), from that end to the next sample or past an
+            extremum of g that small, is no second crossing: bisecting the noise put one
+            wherever the curves stay within rounding of each other (a type-5 conchoid
+            tangent to the type-2 arc of a notch's corner, curvatures equal within 1e-4:
+            1.5e-6 to 7.9e-6 from the end, two edges no rotation can order). Such a root
+            is dropped unless g half-way between it and that end has, by more than
+            ``rounding``, the sign opposite to the bracket's other end (a sign change
+            beyond noise: the curve leaves B the other way and crosses back), or it lies
+            within ``merge`` of that end (the end's vertex anyway: the same to the bit).
 
     Returns:
         ``(pair, tA, touching)``: roots on A and whether each is a tangency.
@@ -235,8 +255,15 @@ def sampled_roots(
     zero = np.flatnonzero(fin & (val == 0.0))
     # brackets [t_k, t_k+1] with a sign change
     lo_i, hi_i = left, left + 1
-    brackets = [(owner[lo_i], t[lo_i], t[hi_i], val[lo_i])]
-    brackets += _end_brackets(owner, t, val, fin, touch, g, dg)
+    # the end a sign change rests on when g there is zero to rounding (nan: none)
+    first = np.concatenate([[True], owner[1:] != owner[:-1]])
+    last = np.concatenate([owner[1:] != owner[:-1], [True]])
+    at_lo = first[lo_i] & (np.abs(val[lo_i]) <= rounding)
+    at_hi = last[hi_i] & (np.abs(val[hi_i]) <= rounding)
+    rest = np.where(at_lo, t[lo_i], np.where(at_hi, t[hi_i], np.nan))
+    beyond = np.sign(np.where(at_lo, val[hi_i], val[lo_i]))  # g's sign at the other sample
+    brackets = [(owner[lo_i], t[lo_i], t[hi_i], val[lo_i], rest, beyond)]
+    brackets += _end_brackets(owner, t, val, fin, touch, g, dg, rounding)
     # local extrema of |g| between samples of one sign: refine, then split or touch
     mid = (
         np.flatnonzero(
@@ -268,8 +295,9 @@ def sampled_roots(
         dips = np.flatnonzero(fm < 0)  # two crossings around the extremum
         if len(dips):
             m = mid[dips]
-            brackets.append((owner[m], t[m - 1], tm[dips], val[m - 1]))
-            brackets.append((owner[m], tm[dips], t[m + 1], -val[m + 1]))
+            none = np.full(len(dips), np.nan)
+            brackets.append((owner[m], t[m - 1], tm[dips], val[m - 1], none, none))
+            brackets.append((owner[m], tm[dips], t[m + 1], -val[m + 1], none, none))
         near = np.flatnonzero((fm >= 0) & (fm <= touch))
         touch_pair = owner[mid[near]]
         touch_t = tm[near]
@@ -277,6 +305,8 @@ def sampled_roots(
     ba = np.concatenate([b[1] for b in brackets])
     bb = np.concatenate([b[2] for b in brackets])
     bs = np.sign(np.concatenate([b[3] for b in brackets]))  # sign of g at ba
+    rest = np.concatenate([b[4] for b in brackets])
+    beyond = np.concatenate([b[5] for b in brackets])
     if len(bp):
         sel = _sample_index(owner, bp)
         for _ in range(_BISECT):
@@ -284,6 +314,18 @@ def sampled_roots(
             same_sign = np.sign(g(sel, m)) == bs
             ba = np.where(same_sign, m, ba)
             bb = np.where(same_sign, bb, m)
+        noisy = np.flatnonzero(np.isfinite(rest))
+        if len(noisy):  # a root is certified by g beyond rounding between it and the end
+            s = sel[noisy]
+            root = 0.5 * (ba + bb)[noisy]
+            far = np.hypot(
+                *(points(ka[s], da[s], root, L) - points(ka[s], da[s], rest[noisy], L)).T
+            )
+            half = g(s, 0.5 * (root + rest[noisy]))
+            real = (np.abs(half) > rounding) & (np.sign(half) == -beyond[noisy])
+            keep = np.ones(len(bp), dtype=bool)
+            keep[noisy[(far > merge) & ~real]] = False
+            bp, ba, bb = bp[keep], ba[keep], bb[keep]
     pair = np.concatenate([bp, owner[zero], touch_pair])
     tA = np.concatenate([0.5 * (ba + bb), t[zero], touch_t])
     touching = np.concatenate(
@@ -292,10 +334,12 @@ def sampled_roots(
     return pair.astype(np.intp), tA, touching
 
 
-def _end_brackets(owner, t, val, fin, touch, g, dg):
+def _end_brackets(owner, t, val, fin, touch, g, dg, rounding=0.0):
     """A curve ending on B may cross B again before its next sample: g is zero at the end
     and has one sign at the next sample, but leaves the end the other way. Bracket that
-    second root: between the extremum (a zero of g', bisected) and the next sample."""
+    second root: between the extremum (a zero of g', bisected) and the next sample. The
+    end (its parameter; nan if not) is where the sign change rests when g at the
+    extremum is at most ``rounding`` (see :func:`sampled_roots`)."""
     out = []
     n = len(t)
     first = np.flatnonzero(np.concatenate([[True], owner[1:] != owner[:-1]]))
@@ -328,7 +372,8 @@ def _end_brackets(owner, t, val, fin, touch, g, dg):
         lo = np.minimum(ext, t[nb])[cross]
         hi = np.maximum(ext, t[nb])[cross]
         glo = np.where(ext < t[nb], gext, val[nb])[cross]
-        out.append((owner[end[cross]], lo, hi, glo))
+        rest = np.where(np.abs(gext) <= rounding, t[end], np.nan)[cross]
+        out.append((owner[end[cross]], lo, hi, glo, rest, s_nb[cross]))
     return out
 
 

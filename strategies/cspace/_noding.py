@@ -136,7 +136,7 @@ def _clamp(cv: Curves, idx: np.ndarray, t: np.ndarray) -> np.ndarray:
     return np.clip(t, t0, t1)
 
 
-def _records(cv: Curves, L: float, tol: Tolerances, i, j):
+def _records(cv: Curves, L: float, tol: Tolerances, i, j, rounding: float = 0.0):
     """(curve a, param a, curve b, param b, point) of every crossing and end-on point."""
     ki, kj = cv.kind[i], cv.kind[j]
     di, dj = cv.data[i], cv.data[j]
@@ -181,7 +181,16 @@ def _records(cv: Curves, L: float, tol: Tolerances, i, j):
                 cv.kind[a_], cv.data[a_], owner, ts, centre, sweep, L, tol.merge
             )
         pair, tr, _ = sampled_roots(
-            cv.kind[a_], cv.data[a_], owner, ts, cv.kind[b_], cv.data[b_], L, tol.touch
+            cv.kind[a_],
+            cv.data[a_],
+            owner,
+            ts,
+            cv.kind[b_],
+            cv.data[b_],
+            L,
+            tol.touch,
+            rounding,
+            tol.merge,
         )
         x = points(CONCHOID, cv.data[a_[pair]], tr, L)
         tb = project(cv.kind[b_[pair]], cv.data[b_[pair]], x, cv.t0[b_[pair]])
@@ -207,13 +216,17 @@ def _records(cv: Curves, L: float, tol: Tolerances, i, j):
     return a[close], ta[close], b[close], tb[close], 0.5 * (pa + pb)[close]
 
 
-def node(cv: Curves, L: float, tol: Tolerances, exact_points: np.ndarray) -> Noded:
+def node(
+    cv: Curves, L: float, tol: Tolerances, exact_points: np.ndarray, rounding: float = 0.0
+) -> Noded:
     """Vertices and edges of the arrangement of ``cv`` (see the module docstring).
 
     ``exact_points`` (the map's vertices) keep their coordinates when they are noded.
+    ``rounding``: an implicit function this small at a curve's end that lies on another
+    curve has the sign of noise (see :func:`strategies.cspace._intersect.sampled_roots`).
     """
     i, j = _candidate_pairs(cv, L, tol.chord + tol.merge)
-    a, ta, b, tb, x = _records(cv, L, tol, i, j)
+    a, ta, b, tb, x = _records(cv, L, tol, i, j, rounding)
     m = len(cv)
     # every point: the curves' ends (exact map vertices first), then the records
     end_pts = cv.ends.reshape(-1, 2)

@@ -40,6 +40,7 @@ from shapely.geometry import Polygon
 from envs.maps.map import Map
 from strategies.cspace._collinear import merge_collinear
 from strategies.cspace._noding import Curves, Noded, node
+from strategies.cspace._rod import ROUNDING_REL
 from strategies.cspace._samples import ray_samples
 from strategies.cspace._shapes import SEGMENT, SHAPE_CODES, derivatives, points
 from strategies.cspace.curves import CriticalCurve
@@ -440,7 +441,9 @@ def arrange(world: Map, curves: tuple[CriticalCurve, ...], tol: Tolerances) -> A
     L = tol.L
     cv = _curves(world, curves, tol)
     c0 = _origin(world)
-    nd = node(cv, L, tol, world.vertices - c0)
+    # a point computed from the map's coordinates is known to rounding of their magnitude
+    rounding = ROUNDING_REL * (world.scale + float(np.abs(world.vertices).max()))
+    nd = node(cv, L, tol, world.vertices - c0, rounding)
     ne = len(nd.curve)
     offsets, pts = _edge_polylines(cv, nd, L)
     # signed area and length of every edge's polyline (local frame: no cancellation)

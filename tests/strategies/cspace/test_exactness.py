@@ -531,3 +531,92 @@ def test_a_type4_cusp_beside_a_thin_face_is_probed_as_far_as_the_face_reaches(
     is now the first curve a ray from the piece along the normal meets, on the exact
     curves."""
     _assert_exact(_tooth_room(x, w, h, angle, with_box), L, 13)
+
+
+NOTCHES = [
+    (4.15327690175707, 0.00011150298626945475, -0.006336578001821514, 0.9796473987943792,
+     True, 3.396959078371546),
+    (4.570375080918027, 2.3290504488705807e-05, -0.0001495123813262058, 0.7640839159041878,
+     True, 0.7561652533683809),
+    (10.6583549380283, 0.00014056859961495693, -6.370236331749678e-05, 2.5024234088931445,
+     False, 3.4575808204892127),
+    (4.679968040093796, 1.4261511548314925e-06, -2.327335255978752e-06, 2.282130309984672,
+     False, 0.673193246228508),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize("x, w, h, angle, with_box, L", NOTCHES)
+def test_a_notch_s_conchoid_tangent_to_its_corner_s_arc_gets_no_false_crossing(
+    x, w, h, angle, with_box, L
+):
+    """Notches cut into a floor (teeth.py seed 1: k = 0, 15, 33, 59): the rod with its
+    tip on one side of the notch and its body on the far corner (a type-5 conchoid) ends
+    with the rod along the floor, square to that side, so the conchoid is tangent there
+    to the arc of the corner the tip reaches, curvatures equal within 1e-4: the two stay
+    within rounding (1e-16) of each other for 1e-5 from the corner. Sampling found a
+    sign change of that noise at the conchoid's end and bisected it to a 'crossing'
+    1.5-7.9e-6 away; the two edges between it and the corner could not be ordered at
+    either end and both dangled (Please report this map). Oracle: the kernel's stops at
+    random points of every region (8 a region: a third of the regions are slivers too
+    thin to draw points in)."""
+    dec = decompose(_tooth_room(x, w, h, angle, with_box), L)
+    assert dec.exact and dec.stats["dangling"] == 0 and dec.unresolved == 0, dec.stats
+    assert dec.stats["slivers_unresolved"] == 0, dec.stats
+    n, bad = stops_constant(dec, np.random.default_rng(17), per_region=8)
+    assert not bad, bad[:5]
+    assert n > 2 * len(dec.regions)
+
+
+def test_a_notch_s_conchoid_and_arc_meet_only_at_their_corner():
+    """The same tangency on the smallest notch (1.4e-6 x 2.3e-6, L = 0.67): in exact
+    arithmetic (mpmath, 50 digits) the conchoid (body on corner 6, tip on edge 3) stays
+    inside the arc of corner 3 along its whole length past 1e-14 of its start, so every
+    vertex of the arrangement on both lies where they meet, at the floor's corner (before:
+    one more 1.5e-6 from it)."""
+    mp = pytest.importorskip("mpmath")
+    from strategies.cspace._shapes import ARC, CONCHOID, points
+    from strategies.cspace.arrangement import arrange
+    from strategies.cspace.curves import _curves
+    from strategies.cspace.tolerances import Tolerances
+
+    mp.mp.dps = 50
+    x, w, h, angle, with_box, L = NOTCHES[3]
+    world = _tooth_room(x, w, h, angle, with_box)
+    tol = Tolerances.of(world, L)
+    curves = _curves(world, L, tol.chord, True)
+    arr = arrange(world, curves, tol)
+    cv, nd = arr.curves, arr.noded
+
+    def named(kind, typ, feats):
+        return [
+            c
+            for c in range(len(cv))
+            if cv.kind[c] == kind
+            and any(
+                curves[s].type == typ and [str(f) for f in curves[s].features] == feats
+                for s in cv.sources[c]
+            )
+        ]
+
+    (arc,) = named(ARC, 2, ["vertex 3"])
+    (con,) = named(CONCHOID, 5, ["vertex 6", "edge 3"])
+    # the oracle: the arc's signed distance along the exact conchoid
+    cx, cy, R = (mp.mpf(float(z)) for z in cv.data[arc][:3])
+    vx, vy, ax, ay, ux, uy = (mp.mpf(float(z)) for z in cv.data[con])
+
+    def g(s):
+        qx, qy = ax + s * ux, ay + s * uy
+        n = mp.sqrt((vx - qx) ** 2 + (vy - qy) ** 2)
+        px, py = qx + L * (vx - qx) / n, qy + L * (vy - qy) / n
+        return mp.sqrt((px - cx) ** 2 + (py - cy) ** 2) - R
+
+    s1 = float(cv.t1[con])
+    assert cv.t0[con] == 0.0
+    for s in np.geomspace(1e-14, s1, 400):
+        assert g(mp.mpf(float(s))) < 0, s
+    start = points(CONCHOID, cv.data[con], np.array([0.0]), L)[0]
+    near = float(np.hypot(*(points(CONCHOID, cv.data[con], np.array([1e-14]), L)[0] - start)))
+    on = {c: set(nd.u[nd.curve == c]) | set(nd.v[nd.curve == c]) for c in (arc, con)}
+    both = sorted(on[arc] & on[con])
+    dist = np.hypot(*(nd.vertices[both] - start).T)
+    assert len(both) >= 1 and np.all(dist <= max(near, tol.merge)), dist

@@ -335,7 +335,9 @@ def _edge_polylines(cv: Curves, nd: Noded, L: float) -> tuple[np.ndarray, np.nda
     return offsets, pts
 
 
-def _rotation(cv: Curves, nd: Noded, L: float, e_len: np.ndarray) -> np.ndarray:
+def _rotation(
+    cv: Curves, nd: Noded, L: float, e_len: np.ndarray, rounding: float = 0.0
+) -> np.ndarray:
     """``next`` of every half-edge (2k: u -> v, 2k + 1: v -> u) for faces on the left.
 
     At each vertex the half-edges leave in the order of the directions from the vertex
@@ -345,7 +347,12 @@ def _rotation(cv: Curves, nd: Noded, L: float, e_len: np.ndarray) -> np.ndarray:
     stands for every point within the merge tolerance, and two curves merged there may
     pass each other in an order their tangents do not tell). No two incident edges cross
     that close to the vertex, so the order in which they cross that circle is the
-    arrangement's.
+    arrangement's. Half-edges whose directions there differ by no more than rounding
+    (``rounding`` at both chords' ends: two curves tangent at the vertex with curvatures
+    equal within 1e-6, as a notch's type-5 conchoid and its corner's type-2 arc, 1e-19
+    apart at a quarter of a 2.8e-6 edge) are ordered among themselves farther out, a
+    quarter of the shortest of their own edges: edges of the arrangement do not cross,
+    so their order is the same on every circle they cross once.
     """
     ne = len(nd.curve)
     k = np.repeat(np.arange(ne), 2)
@@ -364,6 +371,70 @@ def _rotation(cv: Curves, nd: Noded, L: float, e_len: np.ndarray) -> np.ndarray:
     np.maximum.at(spread, origin, off)
     reach = np.maximum(0.25 * short[origin], 16.0 * spread[origin])
     most = 0.5 * (nd.tb - nd.ta)[k]
+    centre = nd.vertices[origin]
+    ang = _chord_angles(kind, data, t, fwd, centre, reach, speed, most, L)
+    order = np.lexsort((ang, origin))
+    start = np.searchsorted(origin[order], np.arange(len(nd.vertices) + 1))
+    deg = np.diff(start)
+    if rounding > 0.0:
+        order = _untie(
+            order, start, ang, reach, rounding, e_len[k], kind, data, t, fwd, centre, speed, most, L
+        )
+    pos = np.empty(2 * ne, dtype=np.intp)
+    pos[order] = np.arange(2 * ne)
+    twin = np.arange(2 * ne) ^ 1
+    v = origin[twin]
+    p = pos[twin] - start[v]
+    return order[start[v] + (p - 1) % deg[v]]
+
+
+def _untie(order, start, ang, reach, rounding, h_len, kind, data, t, fwd, centre, speed, most, L):
+    """``order`` with each run of half-edges at one vertex whose chord angles differ by
+    at most ``2 rounding / reach`` reordered by their angles a quarter of the run's
+    shortest edge out (see :func:`_rotation`)."""
+    a = ang[order]
+    thr = 2.0 * rounding / reach[order]
+    close = np.zeros(len(order), dtype=bool)  # close[i]: order[i] ties with order[i - 1]
+    close[1:] = a[1:] - a[:-1] <= thr[1:]
+    deg = np.diff(start)
+    first, last = start[:-1][deg >= 2], start[1:][deg >= 2] - 1
+    close[start[:-1][deg >= 1]] = False
+    wrap = a[first] + 2.0 * np.pi - a[last] <= thr[first]
+    close[first[wrap]] = True  # the run through the -pi/pi cut
+    tied = np.flatnonzero(close)
+    if len(tied) == 0:
+        return order
+    order = order.copy()
+    vert = np.searchsorted(start, tied, side="right") - 1
+    for vx in np.unique(vert).tolist():
+        lo, hi = int(start[vx]), int(start[vx + 1])
+        idx = np.arange(lo, hi)
+        gaps = np.diff(np.concatenate([a[idx], [a[lo] + 2.0 * np.pi]]))
+        tie = gaps <= thr[np.concatenate([idx[1:], [lo]])]
+        if tie.all():
+            continue  # every direction within rounding: nothing to anchor a run on
+        # runs of ties, read circularly from just after a real gap
+        cut = int(np.flatnonzero(~tie)[-1]) + 1
+        seq = np.roll(idx, -cut)
+        links = np.roll(tie, -cut)[:-1]
+        runs = np.split(seq, np.flatnonzero(~links) + 1)
+        for run in runs:
+            if len(run) < 2:
+                continue
+            h = order[run]
+            far = np.full(len(h), 0.25 * float(h_len[h].min()))
+            far = np.maximum(far, reach[h])
+            new = _chord_angles(
+                kind[h], data[h], t[h], fwd[h], centre[h], far, speed[h], most[h], L
+            )
+            rel = (new - a[run[0]] + np.pi) % (2.0 * np.pi)
+            order[run] = h[np.argsort(rel, kind="stable")]
+    return order
+
+
+def _chord_angles(kind, data, t, fwd, centre, reach, speed, most, L):
+    """Directions from ``centre`` to the curves' points at distance ``reach`` (or their
+    half-way points if nearer; see :func:`_rotation`)."""
     dt = np.minimum(reach / speed, most)
     # the chords' ends on one circle about the vertex (where the edges cross it is their
     # order): a curve whose speed changes fast near the vertex (a conchoid whose tip edge
@@ -373,11 +444,11 @@ def _rotation(cv: Curves, nd: Noded, L: float, e_len: np.ndarray) -> np.ndarray:
     # three dangling edges). The parameter step is rescaled by reach / chord until the
     # chord is within 1e-9 of the reach (within 0.1 %, a conchoid's angle read 1e-4 off,
     # a fifth of its gap to the arc it leaves a vertex with: a 0.3 mm step, L = 1)
-    ang = np.empty(2 * ne)
-    todo = np.arange(2 * ne)
+    ang = np.empty(len(t))
+    todo = np.arange(len(t))
     for _ in range(60):
         tt = np.where(fwd[todo], t[todo] + dt[todo], t[todo] - dt[todo])
-        chord = points(kind[todo], data[todo], tt, L) - nd.vertices[origin[todo]]
+        chord = points(kind[todo], data[todo], tt, L) - centre[todo]
         ang[todo] = np.arctan2(chord[:, 1], chord[:, 0])
         size = np.hypot(chord[:, 0], chord[:, 1])
         scale = np.divide(reach[todo], size, out=np.ones_like(size), where=size > 0)
@@ -386,15 +457,7 @@ def _rotation(cv: Curves, nd: Noded, L: float, e_len: np.ndarray) -> np.ndarray:
         if len(todo) == 0:
             break
         dt[todo] = np.minimum(dt[todo] * scale[~done], most[todo])
-    order = np.lexsort((ang, origin))
-    start = np.searchsorted(origin[order], np.arange(len(nd.vertices) + 1))
-    deg = np.diff(start)
-    pos = np.empty(2 * ne, dtype=np.intp)
-    pos[order] = np.arange(2 * ne)
-    twin = np.arange(2 * ne) ^ 1
-    v = origin[twin]
-    p = pos[twin] - start[v]
-    return order[start[v] + (p - 1) % deg[v]]
+    return ang
 
 
 def _valid(poly: Polygon) -> Polygon:
@@ -453,7 +516,7 @@ def arrange(world: Map, curves: tuple[CriticalCurve, ...], tol: Tolerances) -> A
     cross = rel[a_i, 0] * rel[a_i + 1, 1] - rel[a_i + 1, 0] * rel[a_i, 1]
     e_area = 0.5 * np.bincount(seg_owner, weights=cross, minlength=ne)
     e_len = np.bincount(seg_owner, weights=np.hypot(*(pts[a_i + 1] - pts[a_i]).T), minlength=ne)
-    nxt = _rotation(cv, nd, L, e_len)
+    nxt = _rotation(cv, nd, L, e_len, rounding)
     cyc, walks = _cycles(nxt)
     nc = len(walks)
     h_edge = np.arange(2 * ne) // 2

@@ -46,7 +46,7 @@ __all__ = [
     "write_cache_file",
 ]
 
-FORMAT_VERSION = 15  # 15: no noise roots at a tangent end (14: cusp probes by a ray)
+FORMAT_VERSION = 16  # 16: tied directions ordered farther out (15: noise roots)
 """Bump when the decomposition's content or the file layout changes."""
 
 MAGIC = b"SURVEIL-CSPACE-DECOMPOSITION\n"

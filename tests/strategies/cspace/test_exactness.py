@@ -620,3 +620,37 @@ def test_a_notch_s_conchoid_and_arc_meet_only_at_their_corner():
     both = sorted(on[arc] & on[con])
     dist = np.hypot(*(nd.vertices[both] - start).T)
     assert len(both) >= 1 and np.all(dist <= max(near, tol.merge)), dist
+
+
+@pytest.mark.parametrize(
+    "x, w, h, angle, with_box, L",
+    [
+        (10.845897598409909, 1.3232290658008061e-05, -8.72496910346526e-05, 2.2769947533299146,
+         False, 1.4691192141587979),
+        (7.320089640771753, 1.99914570051983e-06, -0.007103269852241764, 1.6626024845637037,
+         False, 0.6186228768077718),
+        (7.475017500359012, 1.4995148403402758e-06, -0.0033944593435775816, 0.6050549597690364,
+         False, 1.5124727344267173),
+        (3.525633804828895, 2.7993677335805504e-06, -6.068117951712899e-06, 3.0247840346683086,
+         True, 3.2623877535505152),
+        (6.057717292161038, 4.0225513754651155e-05, -1.2062664712935757e-05, 0.5073472513048682,
+         True, 2.810177616418833),
+    ],
+)  # fmt: skip
+def test_curves_tangent_at_a_notch_s_corner_are_ordered_where_they_part(
+    x, w, h, angle, with_box, L
+):
+    """Notches (teeth.py seed 1 k 3, 30; seed 2 k 19, 26; seed 3 k 31): the conchoid and
+    the arc tangent at the notch's corner (above) leave it together, 1e-19 apart a
+    quarter of the notch's 2.8e-6 floor out (seed 2 k 26: curvatures 0.3065245 and
+    0.3065240), so their chord directions there were noise (4.9e-10 rad apart, rounding
+    allows 1.4e-6) and the two edges dangled when the noise had them the wrong way round.
+    Directions within rounding of each other are now compared a quarter of the tied
+    edges' own length out (0.19 here: 5e-8 rad apart). Oracle: the kernel's stops at
+    random points of every region."""
+    dec = decompose(_tooth_room(x, w, h, angle, with_box), L)
+    assert dec.exact and dec.stats["dangling"] == 0 and dec.unresolved == 0, dec.stats
+    assert dec.stats["slivers_unresolved"] == 0, dec.stats
+    n, bad = stops_constant(dec, np.random.default_rng(19), per_region=8)
+    assert not bad, bad[:5]
+    assert n > 2 * len(dec.regions)

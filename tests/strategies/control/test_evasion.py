@@ -548,26 +548,32 @@ def test_a_solve_without_an_arc_stops_brent_at_the_jump(monkeypatch):
     assert len(runs) - n >= 70
 
 
-def test_the_jump_certificate_changes_no_solve(monkeypatch):
-    # the certificate stops only brackets that close on a jump: every solve (the shooting
-    # evader's capped step, rho 0.9-0.99) gives the same arc bit for bit, or None as before
+def _assert_no_solve_changes(monkeypatch, name, off, *, seed, rhos, x_e, per,
+                             modes=("capped", "default")):  # fmt: skip
+    """Every solve of seeded random problems (theta0, x_e, rho, branch; the shooting
+    evader's capped step, and the default step up to rho 0.95) gives the same arc bit for
+    bit, or None, with ``evasion.<name>`` as it is and set to ``off``; and as it is, it
+    spares integrations (it cut some, and both outcomes occur)."""
     from strategies.control import evasion
 
     runs = _counting(monkeypatch)
-    rng = np.random.default_rng(83)
+    rng = np.random.default_rng(seed)
     probs = [
-        (rng.uniform(-math.pi, math.pi), rng.uniform(0.3, 3.2), rho, "+-"[rng.integers(2)])
-        for rho in (0.9, 0.95, 0.97, 0.99)
-        for _ in range(8)
+        (rng.uniform(-math.pi, math.pi), rng.uniform(*x_e), rho, "+-"[rng.integers(2)], mode)
+        for rho in rhos
+        for mode in modes
+        for _ in range(per)
+        if mode == "capped" or rho <= 0.95
     ]
+    steps = {"capped": lambda x_e, rho: capped_step(x_e, 2.0, rho), "default": lambda *_: None}
     counts, paths = [], []
-    for width in (evasion._JUMP_WIDTH, 0.0):
-        monkeypatch.setattr(evasion, "_JUMP_WIDTH", width)
+    for value in (getattr(evasion, name), off):
+        monkeypatch.setattr(evasion, name, value)
         del runs[:]
         paths.append(
             [
-                escape_path(th, x_e, L=2.0, rho=rho, branch=b, step=capped_step(x_e, 2.0, rho))
-                for th, x_e, rho, b in probs
+                escape_path(th, x_e, L=2.0, rho=rho, branch=b, step=steps[mode](x_e, rho))
+                for th, x_e, rho, b, mode in probs
             ]
         )
         counts.append(len(runs))
@@ -577,7 +583,22 @@ def test_the_jump_certificate_changes_no_solve(monkeypatch):
         if new is not None:
             found += 1
             assert new.tobytes() == old.tobytes()
-    assert 0 < found < len(probs) and counts[0] < counts[1]  # both kinds, and it stopped some
+    assert 0 < found < len(probs) and counts[0] < counts[1]
+
+
+def test_the_jump_certificate_changes_no_solve(monkeypatch):
+    # the certificate stops only brackets that close on a jump: every solve (the shooting
+    # evader's capped step, rho 0.9-0.99) gives the same arc bit for bit, or None as before
+    _assert_no_solve_changes(
+        monkeypatch,
+        "_JUMP_WIDTH",
+        0.0,
+        seed=83,
+        rhos=(0.9, 0.95, 0.97, 0.99),
+        x_e=(0.3, 3.2),
+        per=8,
+        modes=("capped",),
+    )
 
 
 def test_a_failed_solve_bisects_the_jump(monkeypatch):
@@ -601,36 +622,15 @@ def test_the_bisection_changes_no_solve(monkeypatch):
     # the bisection stops only brackets that close on a jump; any other bracket goes back to
     # Brent from the start: every solve (the evader's capped step, rho 0.5-0.99, and the
     # default step up to 0.95) gives the same arc bit for bit, or None as before
-    from strategies.control import evasion
-
-    runs = _counting(monkeypatch)
-    rng = np.random.default_rng(86)
-    probs = [
-        (rng.uniform(-math.pi, math.pi), rng.uniform(0.2, 3.6), rho, "+-"[rng.integers(2)], mode)
-        for rho in (0.5, 0.9, 0.95, 0.97, 0.99)
-        for mode in ("capped", "default")
-        for _ in range(6)
-        if mode == "capped" or rho <= 0.95
-    ]
-    steps = {"capped": lambda x_e, rho: capped_step(x_e, 2.0, rho), "default": lambda *_: None}
-    counts, paths = [], []
-    for after in (evasion._PROBE_AFTER, 10**9):
-        monkeypatch.setattr(evasion, "_PROBE_AFTER", after)
-        del runs[:]
-        paths.append(
-            [
-                escape_path(th, x_e, L=2.0, rho=rho, branch=b, step=steps[mode](x_e, rho))
-                for th, x_e, rho, b, mode in probs
-            ]
-        )
-        counts.append(len(runs))
-    found = 0
-    for new, old in zip(*paths, strict=True):
-        assert (new is None) == (old is None)
-        if new is not None:
-            found += 1
-            assert new.tobytes() == old.tobytes()
-    assert 0 < found < len(probs) and counts[0] < counts[1]  # both kinds, and it cut some
+    _assert_no_solve_changes(
+        monkeypatch,
+        "_PROBE_AFTER",
+        10**9,
+        seed=86,
+        rhos=(0.5, 0.9, 0.95, 0.97, 0.99),
+        x_e=(0.2, 3.6),
+        per=6,
+    )
 
 
 def _fine_runs(monkeypatch):
@@ -758,36 +758,15 @@ def test_the_slow_side_changes_no_solve(monkeypatch):
     # headings proven on one side are integrated only next to a heading not proven on that
     # side, so every bracket is the same: every solve (the capped step, rho 0.5-0.995, and
     # the default step up to 0.95) gives the same arc bit for bit, or None as before
-    from strategies.control import evasion
-
-    runs = _counting(monkeypatch)
-    rng = np.random.default_rng(91)
-    probs = [
-        (rng.uniform(-math.pi, math.pi), rng.uniform(0.2, 3.6), rho, "+-"[rng.integers(2)], mode)
-        for rho in (0.5, 0.9, 0.95, 0.97, 0.99, 0.995)
-        for mode in ("capped", "default")
-        for _ in range(6)
-        if mode == "capped" or rho <= 0.95
-    ]
-    steps = {"capped": lambda x_e, rho: capped_step(x_e, 2.0, rho), "default": lambda *_: None}
-    counts, paths = [], []
-    for proof in (evasion._slow_side, lambda *args: 0):
-        monkeypatch.setattr(evasion, "_slow_side", proof)
-        del runs[:]
-        paths.append(
-            [
-                escape_path(th, x_e, L=2.0, rho=rho, branch=b, step=steps[mode](x_e, rho))
-                for th, x_e, rho, b, mode in probs
-            ]
-        )
-        counts.append(len(runs))
-    found = 0
-    for new, old in zip(*paths, strict=True):
-        assert (new is None) == (old is None)
-        if new is not None:
-            found += 1
-            assert new.tobytes() == old.tobytes()
-    assert 0 < found < len(probs) and counts[0] < counts[1]  # both kinds, and it cut some
+    _assert_no_solve_changes(
+        monkeypatch,
+        "_slow_side",
+        lambda *args: 0,
+        seed=91,
+        rhos=(0.5, 0.9, 0.95, 0.97, 0.99, 0.995),
+        x_e=(0.2, 3.6),
+        per=6,
+    )
 
 
 def test_a_failed_solve_needs_no_jump_search_where_its_bracket_is_proven_root_free(
@@ -886,36 +865,15 @@ def test_root_free_brackets_change_no_solve(monkeypatch):
     # a bracket proven root-free is not polished: every solve (the capped step, rho
     # 0.9-0.995, and the default step up to 0.95) gives the same arc bit for bit, or None
     # as before, with fewer integrations
-    from strategies.control import evasion
-
-    runs = _counting(monkeypatch)
-    rng = np.random.default_rng(95)
-    probs = [
-        (rng.uniform(-math.pi, math.pi), rng.uniform(0.3, 5.5), rho, "+-"[rng.integers(2)], mode)
-        for rho in (0.9, 0.95, 0.97, 0.99, 0.995)
-        for mode in ("capped", "default")
-        for _ in range(8)
-        if mode == "capped" or rho <= 0.95
-    ]
-    steps = {"capped": lambda x_e, rho: capped_step(x_e, 2.0, rho), "default": lambda *_: None}
-    counts, paths = [], []
-    for proof in (evasion._root_free, lambda *args: False):
-        monkeypatch.setattr(evasion, "_root_free", proof)
-        del runs[:]
-        paths.append(
-            [
-                escape_path(th, x_e, L=2.0, rho=rho, branch=b, step=steps[mode](x_e, rho))
-                for th, x_e, rho, b, mode in probs
-            ]
-        )
-        counts.append(len(runs))
-    found = 0
-    for new, old in zip(*paths, strict=True):
-        assert (new is None) == (old is None)
-        if new is not None:
-            found += 1
-            assert new.tobytes() == old.tobytes()
-    assert 0 < found < len(probs) and counts[0] < counts[1]
+    _assert_no_solve_changes(
+        monkeypatch,
+        "_root_free",
+        lambda *args: False,
+        seed=95,
+        rhos=(0.9, 0.95, 0.97, 0.99, 0.995),
+        x_e=(0.3, 5.5),
+        per=8,
+    )
 
 
 def test_no_root_free_proof_where_the_arcs_need_not_turn_back():

@@ -279,13 +279,7 @@ def probe_pieces(
             continue
         jj, ss = todo_j[got], todo_s[got]
         found[jj, ss] = match[got]
-        hit_p[jj, ss], hit_n[jj, ss] = p[got], n[got]
-        cnt = np.diff(batch.offsets)[got]
-        arc = np.repeat(batch.offsets[got], cnt) + _rank(np.repeat(np.arange(len(got)), cnt))
-        hits.append(
-            (np.repeat(jj, cnt), np.repeat(ss, cnt), batch.code_lo[arc], batch.code_hi[arc],
-             batch.lo[arc], batch.hi[arc])
-        )  # fmt: skip
+        _keep_hits(batch, got, jj, ss, p, n, hits, hit_p, hit_n)
     if curves is not None:
         _past_cusps(world, arr, curves, job, regs, found, offs, edge_tab, sign_tab, sig_hash,
                     hits, hit_p, hit_n)  # fmt: skip
@@ -359,13 +353,7 @@ def _past_cusps(world, arr, curves, job, regs, found, offs, edge_tab, sign_tab, 
         return
     jj, ss = jj[got], ss[got]
     found[jj, ss] = regs[jj, ss]
-    hit_p[jj, ss], hit_n[jj, ss] = p[got], n[got]
-    cnt = np.diff(batch.offsets)[got]
-    arc = np.repeat(batch.offsets[got], cnt) + _rank(np.repeat(np.arange(len(got)), cnt))
-    hits.append(
-        (np.repeat(jj, cnt), np.repeat(ss, cnt), batch.code_lo[arc], batch.code_hi[arc],
-         batch.lo[arc], batch.hi[arc])
-    )  # fmt: skip
+    _keep_hits(batch, got, jj, ss, p, n, hits, hit_p, hit_n)
 
 
 class _Beyond:
@@ -404,6 +392,18 @@ class _Beyond:
             if self._sliver[g]:
                 self._memo[g] = out
         return out
+
+
+def _keep_hits(batch, got, jj, ss, p, n, hits, hit_p, hit_n) -> None:
+    """Record the probes ``got`` of ``batch`` that found their region (piece ``jj``, side
+    ``ss``): where they landed (``hit_p``, ``hit_n``) and their free arcs (``hits``)."""
+    hit_p[jj, ss], hit_n[jj, ss] = p[got], n[got]
+    cnt = np.diff(batch.offsets)[got]
+    arc = np.repeat(batch.offsets[got], cnt) + _rank(np.repeat(np.arange(len(got)), cnt))
+    hits.append(
+        (np.repeat(jj, cnt), np.repeat(ss, cnt), batch.code_lo[arc], batch.code_hi[arc],
+         batch.lo[arc], batch.hi[arc])
+    )  # fmt: skip
 
 
 def _rank(g: np.ndarray) -> np.ndarray:

@@ -197,6 +197,27 @@ def test_reproduce_is_bit_for_bit(tmp_path, monkeypatch, method):
     assert _same(_weights(run / "model.zip"), _weights(again.model_path))
 
 
+def test_reproduce_install_keeps_the_shipped_recipe(tmp_path, monkeypatch):
+    """``reproduce --install`` replaces the model and provenance but keeps the shipped
+    config.toml: it overwrote it with the run's copy, whose output_dir is out/zoo/NAME (or
+    the --output-dir given) instead of the recipe's own (helper-93)."""
+    from training.dagger import dagger
+
+    monkeypatch.setattr(zoo, "MODELS_DIR", tmp_path / "zoo")
+    run = tmp_path / "run"
+    cfg = DaggerConfig(role="pursuer", expert="pursuer/greedy", opponent="evader/straight",
+                       maps=("open_room",), iterations=1, episodes=1, max_cycles=10, epochs=1,
+                       output_dir=str(run))  # fmt: skip
+    dagger(cfg)
+    zoo.install("tiny", run)
+    recipe = (tmp_path / "zoo" / "tiny" / "config.toml").read_bytes()
+    assert str(run) in recipe.decode()
+    zoo.reproduce("tiny", tmp_path / "again", install_result=True)
+    assert (tmp_path / "zoo" / "tiny" / "config.toml").read_bytes() == recipe
+    installed = (tmp_path / "zoo" / "tiny" / "model.zip").read_bytes()
+    assert installed == (tmp_path / "again" / "model.zip").read_bytes()
+
+
 def test_reproduce_warns_when_the_code_has_changed_since_training(tmp_path, monkeypatch):
     """The provenance names the commit; code changed since then may train another model."""
     from training.train import _git

@@ -145,7 +145,9 @@ def reproduce(
     Args:
         name: a zoo model.
         output_dir: where to train (default ``out/zoo/<name>``); resumes if interrupted.
-        install_result: replace the shipped model with the retrained one.
+        install_result: replace the shipped model and provenance with the retrained ones
+            (the shipped recipe, config.toml, is kept: it is what was retrained, and the
+            run's copy differs only in ``output_dir``).
         progress_bar: show SB3's progress bar.
     """
     cfg = config(name).replace(output_dir=os.fspath(output_dir or Path("out/zoo") / name))
@@ -170,11 +172,11 @@ def reproduce(
     if isinstance(cfg, DaggerConfig):
         result = dagger(cfg, verbose=progress_bar)
         if install_result:
-            install(name, cfg.output_dir)
+            install(name, cfg.output_dir, keep_config=True)
         return result
     result = train(cfg, progress_bar=progress_bar)
     if install_result:
-        install(name, result.output_dir)
+        install(name, result.output_dir, keep_config=True)
     return result
 
 
@@ -195,8 +197,12 @@ def code_changed_since(sha: str | None) -> list[str]:
     return [] if not out else out.splitlines()
 
 
-def install(name: str, run_dir: str | os.PathLike[str]) -> Path:
+def install(name: str, run_dir: str | os.PathLike[str], *, keep_config: bool = False) -> Path:
     """Copy a finished run's model, config and provenance into the zoo as ``name``.
+
+    Args:
+        keep_config: keep the zoo's own ``config.toml`` where ``name`` has one (a
+            reproduced run: the same recipe, the run's copy naming its own output_dir).
 
     Raises:
         UnknownNameError: the run directory lacks one of the files.
@@ -208,5 +214,7 @@ def install(name: str, run_dir: str | os.PathLike[str]) -> Path:
     dst = MODELS_DIR / name
     dst.mkdir(parents=True, exist_ok=True)
     for f in _FILES:
+        if keep_config and f == "config.toml" and (dst / f).is_file():
+            continue
         shutil.copyfile(src / f, dst / f)
     return dst

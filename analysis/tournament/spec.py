@@ -385,7 +385,7 @@ def _map_entry(text: str, where: str, base: Path) -> MapEntry:
     """A built-in name, ``random:...``, a file relative to ``base``, or any of these
     followed by ``~[xS][rotR][off(X,Y)]`` (:func:`envs.maps.io.split_transform`)."""
     from envs.maps import builtin_info, builtin_names, load_map
-    from envs.maps.io import BODY_RADIUS, split_transform
+    from envs.maps.io import builtin_parameters, split_transform
 
     if text in builtin_names():
         info = builtin_info(text)
@@ -409,10 +409,9 @@ def _map_entry(text: str, where: str, base: Path) -> MapEntry:
                 raise InvalidConfigError(
                     f"{where}: map = {text!r}: {name!r} under that transform is no valid map: {exc}"
                 ) from exc
-            # a built-in's recommendation scales with it, the bodies too (as load_map's
-            # name does in EnvConfig: envs.maps.io.builtin_parameters)
-            base_params = {"body_radius": BODY_RADIUS, **inner.params} if inner.params else {}
-            params = {k: v * sim.scale for k, v in base_params.items()}
+            # a transformed built-in's recommendation, bodies included, as EnvConfig reads
+            # the name (files and random maps: none)
+            params = builtin_parameters(text) or {}
             return MapEntry(text, f"{inner.source}~{sim.label()}", world, params)
         raise InvalidConfigError(
             f"{where}: map = {text!r}: neither a built-in map {builtin_names()}, "

@@ -197,18 +197,22 @@ def test_reproduce_is_bit_for_bit(tmp_path, monkeypatch, method):
     assert _same(_weights(run / "model.zip"), _weights(again.model_path))
 
 
+def _tiny_dagger_run(run):
+    """A finished one-iteration DAgger run in ``run`` (a second or two)."""
+    from training.dagger import dagger
+
+    dagger(DaggerConfig(role="pursuer", expert="pursuer/greedy", opponent="evader/straight",
+                        maps=("open_room",), iterations=1, episodes=1, max_cycles=10, epochs=1,
+                        output_dir=str(run)))  # fmt: skip
+    return run
+
+
 def test_reproduce_install_keeps_the_shipped_recipe(tmp_path, monkeypatch):
     """``reproduce --install`` replaces the model and provenance but keeps the shipped
     config.toml: it overwrote it with the run's copy, whose output_dir is out/zoo/NAME (or
     the --output-dir given) instead of the recipe's own (helper-93)."""
-    from training.dagger import dagger
-
     monkeypatch.setattr(zoo, "MODELS_DIR", tmp_path / "zoo")
-    run = tmp_path / "run"
-    cfg = DaggerConfig(role="pursuer", expert="pursuer/greedy", opponent="evader/straight",
-                       maps=("open_room",), iterations=1, episodes=1, max_cycles=10, epochs=1,
-                       output_dir=str(run))  # fmt: skip
-    dagger(cfg)
+    run = _tiny_dagger_run(tmp_path / "run")
     zoo.install("tiny", run)
     recipe = (tmp_path / "zoo" / "tiny" / "config.toml").read_bytes()
     assert str(run) in recipe.decode()
@@ -229,13 +233,7 @@ def test_reproduce_warns_when_the_code_has_changed_since_training(tmp_path, monk
     assert any(p.startswith("envs/") for p in changed)
     assert zoo.code_changed_since(None) == [] and zoo.code_changed_since("0" * 40) == []
     monkeypatch.setattr(zoo, "MODELS_DIR", tmp_path / "zoo")
-    run = tmp_path / "run"
-    cfg = DaggerConfig(role="pursuer", expert="pursuer/greedy", opponent="evader/straight",
-                       maps=("open_room",), iterations=1, episodes=1, max_cycles=10, epochs=1,
-                       output_dir=str(run))  # fmt: skip
-    from training.dagger import dagger
-
-    dagger(cfg)
+    run = _tiny_dagger_run(tmp_path / "run")
     prov = run / "provenance.json"
     import json
 

@@ -12,8 +12,11 @@ reference measured in the same run).
 Usage::
 
     python benchmarks/pursuer_holds.py [--seeds 10] [--rho 0.3 0.5] [--workers 2]
-        [--max-cycles 600] [--worlds corridor corner ...] [--no-greedy] [--results F.jsonl]
-        [--referee CPL] [--hindsight CELL]
+        [--max-cycles 600] [--worlds corridor corner ...] [--evaders E ...] [--no-greedy]
+        [--results F.jsonl] [--referee CPL] [--hindsight CELL]
+
+The evaders are every evader of the registry (:data:`EVADERS`; ``--evaders`` plays a
+subset): the referee's evader solves its world once (cached on disk, seconds per world).
 
 Each loss is printed as it happens, and a progress line every 25 episodes. With
 ``--results F.jsonl`` every episode is appended to F as it completes (JSON lines,
@@ -39,13 +42,13 @@ start is a weakness of the policy (its regret); "unknown" is the referee's resol
 Solutions are cached on disk (minutes per world the first time).
 
 ``--hindsight CELL`` labels every loss to an *open-loop* evader (``evader/straight``,
-``evader/wall_hugging``, ``evader/random``: their paths do not depend on the pursuer) with
-:func:`strategies.referee.hindsight.hindsight` at cell side CELL, against the evader's path
-recorded from the episode and extended alone to ``--max-cycles`` steps (the bodies' radius
-as played): ``evader`` (no pursuer of speed V_p holds to the horizon: unavoidable),
-``pursuer`` (some pursuer holds: the policy's regret) or ``unknown`` (``not solved``: the
-grid would exceed the memory budget); beside each such loss, and over them (as
-``unseen_worlds.py --hindsight``).
+``evader/wall_hugging``, ``evader/random``, ``evader/orbit``: their paths do not depend on
+the pursuer) with :func:`strategies.referee.hindsight.hindsight` at cell side CELL,
+against the evader's path recorded from the episode and extended alone to ``--max-cycles``
+steps (the bodies' radius as played): ``evader`` (no pursuer of speed V_p holds to the
+horizon: unavoidable), ``pursuer`` (some pursuer holds: the policy's regret) or
+``unknown`` (``not solved``: the grid would exceed the memory budget); beside each such
+loss, and over them (as ``unseen_worlds.py --hindsight``).
 """
 
 from __future__ import annotations
@@ -78,8 +81,12 @@ EVADERS = [
     "evader/toward_away:away",
     "evader/wall_hugging",
     "evader/random",
+    "evader/orbit",
+    "evader/referee",
 ]
-OPEN_LOOP = ("evader/straight", "evader/wall_hugging", "evader/random")
+"""Every evader of the registry (checked by a test), with the toward-away evader in both
+modes; ``--evaders`` plays a subset."""
+OPEN_LOOP = ("evader/straight", "evader/wall_hugging", "evader/random", "evader/orbit")
 """The evaders of :data:`EVADERS` whose path does not depend on the pursuer."""
 WORLDS = ["corridor", "corner", "l_hall", "open_room"]
 PURSUERS = ("pursuer/decomposition", "pursuer/greedy")
@@ -226,6 +233,13 @@ def main(argv=None) -> int:
     ap.add_argument("--worlds", nargs="+", choices=builtin_names(), default=WORLDS)
     ap.add_argument("--variants", nargs="+", choices=[v[0] for v in VARIANTS],
                     default=[v[0] for v in VARIANTS])  # fmt: skip
+    ap.add_argument(
+        "--evaders",
+        nargs="+",
+        choices=EVADERS,
+        default=EVADERS,
+        help="play these evaders only (default: every evader of the registry)",
+    )
     ap.add_argument("--no-greedy", action="store_true", help="skip the greedy reference")
     ap.add_argument("--l-min", type=real(0), default=None, help="play at this L_min (see above)")
     ap.add_argument(
@@ -252,7 +266,7 @@ def main(argv=None) -> int:
         for w in args.worlds
         for v in variants
         for rho in args.rho
-        for e in EVADERS
+        for e in args.evaders
         for s in range(args.seeds)
     ]
     done = episode_rows.read(args.results, _row_key) if args.results else {}

@@ -11,8 +11,9 @@ registered policies live in ``benchmarks/unseen_opponents.py``):
   off-centre in ways ``pursuer_holds.py`` does not, rooms with one pillar, L- and
   U-shapes, a T-junction, two crossroads, random maps; at (rho, L_max / L_min, L_min) =
   (0.5, 2, 2), (0.3, 1.5, 2) and (0.5, 1.5, 1) (``--combos 3``: (0.3, 2, 1); the paper
-  variants scale their own L_min by L_min / 2); against 17
-  evaders: the registered ones (some with other parameters), a zig-zag, a herder that
+  variants scale their own L_min by L_min / 2); against 18
+  evaders: the registered ones (some with other parameters; the referee's evader solves
+  each world at reset, cached on disk), a zig-zag, a herder that
   pins the pursuer to its nearest wall (or concave corner), a corner darter and a random
   walk with momentum. One seed (101). Horizon ``--max-cycles`` steps (600: 60 s).
 * ``--role evader``: the shooting evader on 49 evader-win (world, L_min) pairs (Prop. 2
@@ -142,7 +143,7 @@ EVADERS = ["evader/shooting", "evader/straight", "evader/toward_away:toward",
            "evader/toward_away:away", "evader/toward_away:alternate", "evader/wall_hugging",
            "evader/random", "evader/orbit:1:0.5", "evader/orbit:-1:0.5", "evader/orbit:1:0.25",
            "evader/orbit:-1:1.0", "zigzag:1.1:1", "zigzag:0.6:0.5", "herder", "herder:corner",
-           "darter", "momentum:0.7"]  # fmt: skip
+           "darter", "momentum:0.7", "evader/referee"]  # fmt: skip
 # (rho, L_max / L_min, L_min); the default run plays the first three
 PURSUER_COMBOS = [(0.5, 2.0, 2.0), (0.3, 1.5, 2.0), (0.5, 1.5, 1.0), (0.3, 2.0, 1.0)]
 PURSUER_DEFAULT_COMBOS = [0, 1, 2]

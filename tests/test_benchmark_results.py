@@ -119,8 +119,8 @@ def test_a_bad_results_file_is_one_line_and_exit_2_and_left_as_it_was(bench, tmp
 
 
 def test_pursuer_holds_writes_each_episode_and_resumes(bench, tmp_path, capsys):
-    """Six episodes are written as rows; after losing two (and a row cut short), the same
-    command plays only those two and reports over all six."""
+    """Eight episodes (one per evader) are written as rows; after losing two (and a row cut
+    short), the same command plays only those two and reports over all eight."""
     holds = bench("pursuer_holds")
     out = tmp_path / "holds.jsonl"
     argv = ["--worlds", "open_room", "--variants", "as is", "--rho", "0.3", "--seeds", "1",
@@ -129,16 +129,30 @@ def test_pursuer_holds_writes_each_episode_and_resumes(bench, tmp_path, capsys):
     assert holds.main(argv) == 0
     first = capsys.readouterr().out
     rows = [json.loads(line) for line in _lines(out)]
-    assert len(rows) == 6
+    assert len(rows) == 8
     assert {r["evader"] for r in rows} == set(holds.EVADERS)
     assert all(r["out"]["pursuer/decomposition"][0] in ("pursuer", "evader") for r in rows)
-    out.write_text("\n".join(_lines(out)[:4]) + '\n{"world": "open_')
+    out.write_text("\n".join(_lines(out)[:6]) + '\n{"world": "open_')
     assert holds.main(argv) == 0
     second = capsys.readouterr().out
-    assert "6 episodes selected, 2 to play" in second
-    assert len(_lines(out)) == 6
-    summary = [line for line in first.splitlines() if "held" in line and "/6" in line]
-    assert summary and summary[0] in second  # the same report over all six
+    assert "8 episodes selected, 2 to play" in second
+    assert len(_lines(out)) == 8
+    summary = [line for line in first.splitlines() if "held" in line and "/8" in line]
+    assert summary and summary[0] in second  # the same report over all eight
+
+
+def test_the_pursuer_benchmarks_play_every_evader_of_the_registry_by_default(bench):
+    """Issue 13's goal is against every evader of the registry: the default roster holds
+    each (the toward-away evader in both modes), so a policy added to the registry is
+    benchmarked without anyone remembering to add it here."""
+    holds = bench("pursuer_holds")
+    from strategies.policies import policy_names
+
+    assert {e.split(":")[0] for e in holds.EVADERS} == set(policy_names("evader"))
+    assert "evader/toward_away:away" in holds.EVADERS
+    unseen = bench("unseen_worlds")  # the pursuer role of the unseen-worlds benchmark too
+    registered = {e.split(":")[0] for e in unseen.EVADERS if e.startswith("evader/")}
+    assert registered == set(policy_names("evader"))
 
 
 def test_pursuer_holds_hindsight_labels_the_losses_to_open_loop_evaders(bench, tmp_path, capsys):

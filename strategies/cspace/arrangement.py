@@ -12,7 +12,8 @@ Built from the exact curves, not from their polylines:
 4. faces are classified: a cycle with an obstacle on its left is not free space; the
    counter-clockwise cycles are the faces' outer boundaries, the clockwise ones their
    holes (assigned to the smallest face around them);
-5. a face narrower than the sliver tolerance (twice its area over its perimeter) is a
+5. a face narrower than the sliver tolerance (twice its area over its perimeter, or, if
+   its polygon is wider, no disc of that diameter fitting in it on the exact curves) is a
    sliver of a near-degeneracy the geometry kernel cannot resolve: it is marked, and the
    decomposition steps over it (:mod:`strategies.cspace._build`); a face of perimeter
    below twice the collapse tolerance is a speck, a point pulled apart by a
@@ -29,6 +30,7 @@ along it, so one probe pair decides it.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -42,7 +44,15 @@ from strategies.cspace._collinear import merge_collinear
 from strategies.cspace._noding import Curves, Noded, node
 from strategies.cspace._rod import ROUNDING_REL
 from strategies.cspace._samples import ray_samples
-from strategies.cspace._shapes import SEGMENT, SHAPE_CODES, derivatives, points
+from strategies.cspace._shapes import (
+    ARC,
+    CONCHOID,
+    SEGMENT,
+    SHAPE_CODES,
+    derivatives,
+    points,
+    polyline_params,
+)
 from strategies.cspace.curves import CriticalCurve
 from strategies.cspace.tolerances import Tolerances
 
@@ -91,7 +101,8 @@ class Arrangement:
         bridge: per edge, whether it has the same face on both sides.
         tol: the tolerances it was built with.
         sliver: (F,) faces narrower than the sliver tolerance (twice their area over
-            their perimeter): a near-degeneracy the kernel cannot resolve; they carry no
+            their perimeter, or thinner everywhere on the exact curves when their polygon
+            is wider): a near-degeneracy the kernel cannot resolve; they carry no
             cells and the boundaries across them are found by stepping over them.
         speck: (F,) faces whose perimeter is below twice the collapse tolerance (so
             their diameter is below it; also slivers): the faces around one meet at a
@@ -588,9 +599,31 @@ def arrange(world: Map, curves: tuple[CriticalCurve, ...], tol: Tolerances) -> A
     # the same vertices are one chord twice): a face thin on its polygon is a sliver only
     # if it is thin on the exact curves too (twice the depth of its exact sample point)
     cand = np.flatnonzero(sliver)
+    # a face thin on the exact curves but not on its polygon (below): the polygon gains
+    # area only where a polyline lies outside its face, between a chord and its curve (a
+    # conchoid's either side, an arc's only when the face is outside its circle, on the
+    # right of the arc as its angle grows; a segment never), by at most chord x length
+    h_all = np.flatnonzero(has)
+    kind_h = cv.kind[nd.curve[h_edge[h_all]]]
+    out_h = (kind_h == CONCHOID) | ((kind_h == ARC) & ~h_fwd[h_all])
+    gain = tol.chord * np.bincount(
+        face_h[h_all], weights=np.where(out_h, e_len[h_edge[h_all]], 0.0), minlength=nf
+    )
+    wide = np.flatnonzero(~sliver & (2.0 * f_area < tol.thin * f_perim + 2.0 * gain))
     if len(cand):
         _, depth = arr.exact_samples(cand)
         sliver[cand[np.isfinite(depth) & (2.0 * depth > tol.thin)]] = False
+    # and a face wide on its polygon may be thin on the exact curves (the lens between a
+    # notch's type-2 arc and the type-5 conchoid tangent to it at the notch's corner:
+    # 3e-8 wide, 1e-4 by its polygon, one chord and two). Its polygon's area exceeds the
+    # face's by at most its gain (above), so only a face whose polygon's twice area is
+    # below thin x perimeter + twice its gain can be one; such a face is a sliver if it
+    # is thin everywhere: no disc of diameter thin fits in it on the exact curves (a face
+    # thin only on average, a lens between a type-1 line and the type-2 arc tangent to it
+    # at its end, is probed where it is wide, as before)
+    if len(wide):
+        thin_all = _thin_everywhere(cv, nd, L, walks, outer[wide], bridge, h_edge, h_fwd, tol.thin)
+        sliver[wide[thin_all]] = True
     sliver |= speck
     stats = {
         "vertices": len(nd.vertices),
@@ -604,6 +637,14 @@ def arrange(world: Map, curves: tuple[CriticalCurve, ...], tol: Tolerances) -> A
     return Arrangement(
         tuple(faces), pieces, cv, nd, e_len, c0, sliver, speck, face_h, bridge, tol, stats
     )
+
+
+FINE_STEPS = (1.0, 1.0 / 8.0, 1.0 / 64.0)
+"""The polylines that tell whether a face wide on its polygon is thinner than the sliver
+tolerance everywhere lie within these times the sliver tolerance of the exact curves,
+coarse first; a face is decided as soon as the bounds allow (:func:`_thin_everywhere`)."""
+
+_QUAD_SEGS = 8  # shapely's buffer: segments per quarter circle of an offset's rounded joins
 
 
 def _not_outer(nd: Noded, walks, h_edge, h_fwd, c_area) -> np.ndarray:
@@ -626,6 +667,65 @@ def _not_outer(nd: Noded, walks, h_edge, h_fwd, c_area) -> np.ndarray:
     first = np.concatenate([[True], c_comp[order][1:] != c_comp[order][:-1]])
     out = np.ones(len(walks), dtype=bool)
     out[order[first]] = False
+    return out
+
+
+def _fine_rings(cv, nd, L, walks, cycles, bridge, h_edge, h_fwd, chord) -> list[Polygon]:
+    """The polygons of the given cycles with each edge drawn within ``chord`` of its curve
+    (ends at the arrangement's vertices, as the faces' polygons; holes left out)."""
+    need = np.zeros(len(nd.curve), dtype=bool)
+    need[h_edge[np.concatenate([walks[c] for c in cycles.tolist()])]] = True
+    edges = np.flatnonzero(need)
+    k = nd.curve[edges]
+    off_k, params = polyline_params(cv.kind[k], cv.data[k], nd.ta[edges], nd.tb[edges], L, chord)
+    counts = np.full(len(nd.curve), 2, dtype=np.intp)
+    counts[edges] = np.diff(off_k)
+    offsets = np.concatenate([[0], np.cumsum(counts)]).astype(np.intp)
+    pts = np.empty((offsets[-1], 2))
+    owner = np.repeat(k, counts[edges])
+    at = np.arange(len(owner)) + np.repeat(offsets[edges] - off_k[:-1], counts[edges])
+    pts[at] = points(cv.kind[owner], cv.data[owner], params, L)
+    pts[offsets[:-1]] = nd.vertices[nd.u]
+    pts[offsets[1:] - 1] = nd.vertices[nd.v]
+    sub = [walks[c] for c in cycles.tolist()]
+    xy, off = _rings(sub, bridge, h_edge, h_fwd, offsets, pts)
+    return _polygons(xy, off, np.arange(len(sub)))
+
+
+def _thin_everywhere(cv, nd, L, walks, cycles, bridge, h_edge, h_fwd, thin) -> np.ndarray:
+    """Per cycle, whether no disc of diameter ``thin`` fits inside it on the exact curves
+    (holes left out, which can only make a face thinner: a face is marked only when shown).
+
+    On polylines within c of the curves, the polygon's largest disc radius r bounds the
+    exact face's R: r - c <= R <= r + c. Eroding the polygon by rho (a negative buffer)
+    leaves nothing iff r <= rho; the buffer's rounded joins are chords of arcs of radius
+    rho (_QUAD_SEGS a quarter), inside them by at most rho (1 - cos(pi / (4 _QUAD_SEGS))),
+    so the eroded polygon is at least the exact one and within that of it. So R < thin / 2
+    if eroding by thin / 2 - c leaves nothing, and R >= thin / 2 if eroding by
+    (thin / 2 + c) / cos(pi / (4 _QUAD_SEGS)) leaves something; otherwise the next, finer
+    step decides (:data:`FINE_STEPS`); a face undecided by the last is not thin everywhere
+    (its R is within about thin / 64 of thin / 2)."""
+    out = np.zeros(len(cycles), dtype=bool)
+    todo = np.arange(len(cycles))
+    slack = 1.0 / math.cos(math.pi / (4 * _QUAD_SEGS))
+    for step in FINE_STEPS:
+        if len(todo) == 0:
+            break
+        c = step * thin
+        rings = _fine_rings(cv, nd, L, walks, cycles[todo], bridge, h_edge, h_fwd, c)
+        polys = np.array(rings, dtype=object)
+        polys = shapely.make_valid(polys)  # rings within c of a lens thinner than 2 c cross
+        wide = ~shapely.is_empty(
+            shapely.buffer(polys, -(0.5 * thin + c) * slack, quad_segs=_QUAD_SEGS)
+        )
+        todo = todo[~wide]
+        polys = polys[~wide]
+        if 0.5 * thin > c and len(todo):
+            thin_all = shapely.is_empty(
+                shapely.buffer(polys, -(0.5 * thin - c), quad_segs=_QUAD_SEGS)
+            )
+            out[todo[thin_all]] = True
+            todo = todo[~thin_all]
     return out
 
 

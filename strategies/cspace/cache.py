@@ -46,7 +46,7 @@ __all__ = [
     "write_cache_file",
 ]
 
-FORMAT_VERSION = 16  # 16: tied directions ordered farther out (15: noise roots)
+FORMAT_VERSION = 17  # 17: faces thin everywhere are slivers (16: tied directions)
 """Bump when the decomposition's content or the file layout changes."""
 
 MAGIC = b"SURVEIL-CSPACE-DECOMPOSITION\n"

@@ -654,3 +654,57 @@ def test_curves_tangent_at_a_notch_s_corner_are_ordered_where_they_part(
     n, bad = stops_constant(dec, np.random.default_rng(19), per_region=8)
     assert not bad, bad[:5]
     assert n > 2 * len(dec.regions)
+
+
+@pytest.mark.parametrize(
+    "x, w, h, angle, with_box, L",
+    [
+        (10.226623415910492, 6.712441082448412e-05, -0.0004728931620063339, 2.493656181825113,
+         True, 3.918227726522656),
+        (10.01031929795083, 2.04697111086974e-06, -0.0029225172763122577, 0.4262437716162167,
+         True, 3.6290764981252495),
+    ],
+)  # fmt: skip
+def test_a_lens_thin_on_the_exact_curves_is_a_sliver_however_wide_its_polygon(
+    x, w, h, angle, with_box, L
+):
+    """Notches (teeth.py seed 2 k 16, seed 3 k 30): the lens between the far corner's
+    type-2 arc and the type-5 conchoid tangent to it at that corner (above) is 3e-8 wide
+    0.08 from the corner (seed 2 k 16), but its polygon is one chord and two (the arc's
+    chord 2e-4 off it): 1e-4 wide by its polygon, so it was no sliver, and its probes
+    (4e-5 and down to 4e-7 to each side) all landed beyond it: 'Please report this map'.
+    A face wide on its polygon is now a sliver if no disc of diameter thin fits in it on
+    the exact curves. Oracle: the arc's signed distance |P - c| - R along the exact
+    conchoid (closed-form points), whose largest value over a lens bounds the diameter of
+    any disc in it; every lens narrower than the sliver tolerance (less the measuring
+    polylines' own slack, thin / 16) is a sliver, and the decomposition is exact."""
+    from strategies.cspace._shapes import ARC, CONCHOID, points
+    from strategies.cspace.arrangement import FINE_STEPS, arrange
+    from strategies.cspace.curves import _curves
+    from strategies.cspace.tolerances import Tolerances
+
+    world = _tooth_room(x, w, h, angle, with_box)
+    tol = Tolerances.of(world, L)
+    arr = arrange(world, _curves(world, L, tol.chord, True), tol)
+    cv, nd, fh = arr.curves, arr.noded, arr.face_of_half_edge
+    lenses = 0
+    for f in range(len(arr.faces)):
+        edges = np.flatnonzero(fh == f) // 2
+        kinds = cv.kind[nd.curve[edges]]
+        if len(set(nd.curve[edges].tolist())) != 2 or set(kinds.tolist()) != {ARC, CONCHOID}:
+            continue
+        arc = nd.curve[edges[kinds == ARC][0]]
+        con = edges[kinds == CONCHOID]
+        s = np.concatenate([np.linspace(nd.ta[k], nd.tb[k], 50) for k in con])
+        p = points(CONCHOID, cv.data[nd.curve[con[0]]], s, L)
+        width = np.abs(np.hypot(*(p - cv.data[arc][:2]).T) - cv.data[arc][2]).max()
+        if width < tol.thin * (1.0 - 4.0 * FINE_STEPS[-1]):
+            lenses += 1
+            assert arr.sliver[f], (f, width, tol.thin)
+    assert lenses >= 1
+    dec = decompose(world, L)
+    assert dec.exact and dec.stats["dangling"] == 0 and dec.unresolved == 0, dec.stats
+    assert dec.stats["slivers_unresolved"] == 0, dec.stats
+    n, bad = stops_constant(dec, np.random.default_rng(23), per_region=8)
+    assert not bad, bad[:5]
+    assert n > 2 * len(dec.regions)

@@ -534,9 +534,16 @@ def _random_by_name(name: str) -> Map:
     parts = name[len(RANDOM_PREFIX) :].split(":")
     kind, seed_text = ("polygons", parts[0]) if len(parts) == 1 else (parts[0], parts[-1])
     if len(parts) > 2 or kind not in KINDS or not seed_text.isdigit():
+        # a '~' here is a suffix split_transform could not read (e.g. rot before x)
+        suffix = (
+            f", optionally followed by '{TRANSFORM_SEPARATOR}[xS][rotR][off(X,Y)]' (in that order)"
+            if TRANSFORM_SEPARATOR in name
+            else ""
+        )
         raise InvalidConfigError(
             f"{name!r} is not a random map name; expected 'random:SEED' or "
             f"'random:KIND:SEED' with SEED an integer >= 0 and KIND one of {list(KINDS)}"
+            f"{suffix}"
         )
     return random_map(int(seed_text), kind=kind)
 

@@ -482,6 +482,9 @@ def test_a_twice_transformed_built_in_recommends_its_lengths_scaled_twice():
         ("nosuch~rot1", UnknownNameError, r"map 'nosuch~rot1': unknown map 'nosuch'"),
         ("corner~sideways", UnknownNameError, r"'~\[xS\]\[rotR\]\[off\(X,Y\)\]'"),
         ("corner~x1e-300", InvalidMapError, r"map 'corner~x1e-300': 'corner' under .*zero"),
+        # a random map's malformed suffix (rot before x) names the suffix grammar too
+        ("random:star:3~rot0.3x0.5", InvalidConfigError, r"'~\[xS\]\[rotR\]\[off\(X,Y\)\]'"),
+        ("random:3~", InvalidConfigError, r"'random:3~'.*'~\[xS\]\[rotR\]"),
     ],
 )
 def test_a_bad_transformed_name_says_what_a_name_can_be(name, error, pattern):

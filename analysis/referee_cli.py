@@ -114,7 +114,12 @@ def run(args: argparse.Namespace) -> int:
     try:  # a step the env refuses: dt = 1e4 hung in the budget's move count (4e8 vectors)
         check_step(cfg.map, cfg.dt, max(cfg.v_pursuer, cfg.v_evader), cfg.body_radius)
     except SurveilValueError as exc:
-        raise type(exc)(f"--config: {exc}") from None
+        # blame --config only when it set one of the step's numbers; else the map's defaults
+        if overrides.keys() & {"dt", "v_pursuer", "v_evader", "body_radius"}:
+            raise type(exc)(f"--config: {exc}") from None
+        raise type(exc)(
+            f"map {args.map!r} at its default step: {exc} (set dt or the speeds with --config)"
+        ) from None
     if args.classify is not None:
         try:
             check_start(cfg, tuple(args.classify[:2]), tuple(args.classify[2:]))

@@ -147,6 +147,22 @@ def test_a_step_the_env_refuses_is_refused_before_the_solve(dt, capsys, monkeypa
     assert "i.e. dt <= 16.92" in err
 
 
+def test_a_step_refused_at_the_map_s_defaults_does_not_blame_config(capsys, monkeypatch, tmp_path):
+    """A map file 0.05 wide at the default dt = 0.1 and speed 1: the step crosses it. The
+    message said '--config: dt = 0.1 ...' although no --config was given (or one that set
+    only l_max); it names the map and says where dt is set."""
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", "/nonexistent")
+    tiny = tmp_path / "tiny.json"
+    tiny.write_text(json.dumps({"boundary": [[0, 0], [0.05, 0], [0.05, 0.03], [0, 0.03]]}))
+    for extra in ([], ["--config", '{"l_max": 5}']):
+        assert main(["referee", str(tiny), "--no-cache", *extra]) == 2
+        out, err = capsys.readouterr()
+        assert out == "" and err.startswith(f"surveil: error: map {str(tiny)!r} at its default ")
+        assert "dt = 0.1 with " in err and "(set dt or the speeds with --config)" in err
+    assert main(["referee", str(tiny), "--no-cache", "--config", '{"dt": 0.2}']) == 2
+    assert capsys.readouterr().err.startswith("surveil: error: --config: dt = 0.2 with ")
+
+
 def test_a_long_solve_is_announced_with_its_estimate_before_it_starts(capsys, monkeypatch):
     """``--config '{"dt": 10}'`` on the corridor solved for many minutes without a word:
     the pursuer's step is rounded up to 10 s (1257 moves, 29 at the default step)."""

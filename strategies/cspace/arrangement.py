@@ -52,6 +52,7 @@ from strategies.cspace._shapes import (
     derivatives,
     points,
     polyline_params,
+    project,
 )
 from strategies.cspace.curves import CriticalCurve
 from strategies.cspace.tolerances import Tolerances
@@ -518,17 +519,31 @@ def arrange(world: Map, curves: tuple[CriticalCurve, ...], tol: Tolerances) -> A
     # a point computed from the map's coordinates is known to rounding of their magnitude
     rounding = ROUNDING_REL * (world.scale + float(np.abs(world.vertices).max()))
     nd = node(cv, L, tol, world.vertices - c0, rounding)
-    ne = len(nd.curve)
-    offsets, pts = _edge_polylines(cv, nd, L)
-    # signed area and length of every edge's polyline (local frame: no cancellation)
-    rel = pts
-    seg_owner = np.repeat(np.arange(ne), np.diff(offsets) - 1)
-    a_i = np.delete(np.arange(len(pts)), offsets[1:] - 1)
-    cross = rel[a_i, 0] * rel[a_i + 1, 1] - rel[a_i + 1, 0] * rel[a_i, 1]
-    e_area = 0.5 * np.bincount(seg_owner, weights=cross, minlength=ne)
-    e_len = np.bincount(seg_owner, weights=np.hypot(*(pts[a_i + 1] - pts[a_i]).T), minlength=ne)
-    nxt = _rotation(cv, nd, L, e_len, rounding)
-    cyc, walks = _cycles(nxt)
+    for attempt in range(2):
+        ne = len(nd.curve)
+        offsets, pts = _edge_polylines(cv, nd, L)
+        # signed area and length of every edge's polyline (local frame: no cancellation)
+        rel = pts
+        seg_owner = np.repeat(np.arange(ne), np.diff(offsets) - 1)
+        a_i = np.delete(np.arange(len(pts)), offsets[1:] - 1)
+        cross = rel[a_i, 0] * rel[a_i + 1, 1] - rel[a_i + 1, 0] * rel[a_i, 1]
+        e_area = 0.5 * np.bincount(seg_owner, weights=cross, minlength=ne)
+        e_len = np.bincount(seg_owner, weights=np.hypot(*(pts[a_i + 1] - pts[a_i]).T), minlength=ne)
+        nxt = _rotation(cv, nd, L, e_len, rounding)
+        cyc, walks = _cycles(nxt)
+        # two dangling edges between the same two vertices, within their curves' rounding
+        # of each other, are one edge at floating point (they cross within it, so their
+        # orders at the two ends disagree and neither bounds a face): keep one, trace again
+        bridge = cyc[0::2] == cyc[1::2]
+        twins = _twin_bridges(cv, nd, L, bridge, rounding) if attempt == 0 else []
+        if len(twins) == 0:
+            break
+        keep = np.ones(ne, dtype=bool)
+        keep[twins] = False
+        nd = Noded(
+            nd.vertices, nd.curve[keep], nd.ta[keep], nd.tb[keep], nd.u[keep], nd.v[keep],
+            nd.n_points, nd.n_clusters_wide,
+        )  # fmt: skip
     nc = len(walks)
     h_edge = np.arange(2 * ne) // 2
     h_fwd = np.arange(2 * ne) % 2 == 0
@@ -668,6 +683,57 @@ def _not_outer(nd: Noded, walks, h_edge, h_fwd, c_area) -> np.ndarray:
     out = np.ones(len(walks), dtype=bool)
     out[order[first]] = False
     return out
+
+
+_TWIN_AT = (0.25, 0.5, 0.75)  # where two dangling edges are compared (fractions of each)
+
+
+def _twin_bridges(cv, nd, L, bridge, rounding) -> np.ndarray:
+    """Dangling edges to drop: of two with the same end vertices (next to each other in
+    the order of their indices) whose points at :data:`_TWIN_AT` lie within the curves'
+    own rounding of the other's curve (each to the other), the later."""
+    br = np.flatnonzero(bridge & (nd.u != nd.v))
+    lo, hi = np.minimum(nd.u[br], nd.v[br]), np.maximum(nd.u[br], nd.v[br])
+    order = np.lexsort((br, hi, lo))
+    br, lo, hi = br[order], lo[order], hi[order]
+    same = (lo[1:] == lo[:-1]) & (hi[1:] == hi[:-1])
+    drop: list[int] = []
+    for i in np.flatnonzero(same).tolist():  # consecutive pairs in a group of equal ends
+        a, b = int(br[i]), int(br[i + 1])
+        if a in drop:
+            continue
+        if _within(cv, nd, L, a, b, rounding) and _within(cv, nd, L, b, a, rounding):
+            drop.append(b)
+    return np.array(drop, dtype=np.intp)
+
+
+def _known_to(cv, c, t, L, rounding) -> np.ndarray:
+    """How far the points of curve ``c`` at parameters ``t`` may lie off the exact curve:
+    ``rounding`` (the map's coordinates'), and for a conchoid P = Q + L (v - Q) / |v - Q|
+    also L times the direction's error, up to 2 rounding / |v - Q| (3.7e-9 near the top
+    of a conchoid whose pivot is 6.3e-4 from its tip's edge, L = 2.1)."""
+    if cv.kind[c] != CONCHOID:
+        return np.full(len(t), rounding)
+    v, a, u = cv.data[c, 0:2], cv.data[c, 2:4], cv.data[c, 4:6]
+    q = a + t[:, None] * u
+    return rounding * (1.0 + 2.0 * L / np.hypot(*(v - q).T))
+
+
+def _within(cv, nd, L, a, b, rounding) -> bool:
+    """Whether edge ``a``'s points at :data:`_TWIN_AT` lie within both curves' rounding of
+    edge ``b``'s curve (across it, at parameters inside ``b``'s range)."""
+    ca, cb = nd.curve[a], nd.curve[b]
+    t = nd.ta[a] + np.array(_TWIN_AT) * (nd.tb[a] - nd.ta[a])
+    x = points(cv.kind[ca], cv.data[ca], t, L)
+    tb = project(cv.kind[cb], cv.data[cb], x, nd.ta[b] if cv.kind[cb] == ARC else None)
+    if not np.all((tb >= nd.ta[b]) & (tb <= nd.tb[b])):
+        return False
+    y = points(cv.kind[cb], cv.data[cb], tb, L)
+    d1, _ = derivatives(cv.kind[cb], cv.data[cb], tb, L)
+    r = x - y
+    across = np.abs(d1[:, 0] * r[:, 1] - d1[:, 1] * r[:, 0]) / np.hypot(*d1.T)
+    known = _known_to(cv, ca, t, L, rounding) + _known_to(cv, cb, tb, L, rounding)
+    return bool(np.all(across <= known))
 
 
 def _fine_rings(cv, nd, L, walks, cycles, bridge, h_edge, h_fwd, chord) -> list[Polygon]:

@@ -46,7 +46,7 @@ __all__ = [
     "write_cache_file",
 ]
 
-FORMAT_VERSION = 17  # 17: faces thin everywhere are slivers (16: tied directions)
+FORMAT_VERSION = 18  # 18: twin dangling edges are one (17: thin everywhere)
 """Bump when the decomposition's content or the file layout changes."""
 
 MAGIC = b"SURVEIL-CSPACE-DECOMPOSITION\n"

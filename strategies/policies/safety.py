@@ -52,7 +52,7 @@ __all__ = [
 NO_PATH = 255
 """Entry of the rotation tables meaning "no safe orientation at this point"."""
 
-TABLE_VERSION = 17  # follows the decomposition cache (FORMAT_VERSION 17)
+TABLE_VERSION = 18  # follows the decomposition cache (FORMAT_VERSION 18)
 
 SOURCE = "decomposition"
 """What the table is built from (part of the cache key): the exact cells of K_L."""

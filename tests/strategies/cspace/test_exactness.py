@@ -708,3 +708,44 @@ def test_a_lens_thin_on_the_exact_curves_is_a_sliver_however_wide_its_polygon(
     n, bad = stops_constant(dec, np.random.default_rng(23), per_region=8)
     assert not bad, bad[:5]
     assert n > 2 * len(dec.regions)
+
+
+def test_two_dangling_conchoids_within_their_rounding_of_each_other_are_one_edge():
+    """A tooth 1.5e-6 wide and 6.3e-4 high (teeth.py seed 2 k 28, L = 2.14): the type-5
+    conchoids with the body on one top corner and the tip on the floor beyond the other
+    side top out at distance L over the tooth's two sides, where each meets the other's
+    type-4 line; between those two vertices (1.5e-6 apart) the two run within 5e-13 of
+    each other and cross half-way (1.3e-13 below), while a conchoid point there is known
+    only to L x 2 rounding / |v - Q| = 3.7e-9 (its pivot 6.3e-4 above its tip's edge).
+    Ordered by that noise, the two edges disagreed at their two ends and both dangled
+    (the strip between the type-4 lines and the face below were one: 2 pieces matched by
+    overlap only, and no tie named: 'Please report'). Two dangling edges between the same
+    vertices within their curves' rounding of each other are now one. Oracle: the
+    kernel's stops at random points of every region."""
+    from strategies.cspace._rod import ROUNDING_REL
+    from strategies.cspace.arrangement import _known_to, arrange
+    from strategies.cspace.curves import _curves
+    from strategies.cspace.tolerances import Tolerances
+
+    x, w, h, L = 5.267699717618924, 1.475203335304854e-06, 0.0006286050311259655, 2.1391353364985037
+    world = _tooth_room(x, w, h, 2.8008340066339708, True)
+    tol = Tolerances.of(world, L)
+    arr = arrange(world, _curves(world, L, tol.chord, True), tol)
+    assert arr.stats["dangling"] == 0, arr.stats
+    # the bound: a conchoid point at its top over the tooth is known to 3.7e-9, far above
+    # the two curves' 5e-13 separation (closed form: w^2 / 2L)
+    rounding = ROUNDING_REL * (world.scale + float(np.abs(world.vertices).max()))
+    cv = arr.curves
+    con = [c for c in range(len(cv)) if cv.kind[c] == 2 and abs(cv.t1[c] - cv.t0[c]) > 0]
+    tops = [
+        float(_known_to(cv, c, np.array([t]), L, rounding)[0])
+        for c in con
+        for t in (cv.t0[c], cv.t1[c])
+        if np.hypot(*(cv.data[c, 0:2] - cv.data[c, 2:4] - t * cv.data[c, 4:6])) < 2 * h
+    ]
+    assert tops and min(tops) > 1e3 * w * w / (2 * L), tops
+    dec = decompose(world, L)
+    assert dec.exact and dec.unresolved == 0 and dec.stats["dangling"] == 0, dec.stats
+    n, bad = stops_constant(dec, np.random.default_rng(29), per_region=8)
+    assert not bad, bad[:5]
+    assert n > 2 * len(dec.regions)

@@ -70,10 +70,16 @@ def test_cli_tournament_report_export_and_errors(tmp_path, capsys):
     assert main([*argv, "--no-report"]) == 0
     out = capsys.readouterr().out
     assert "4 of 4 matches stored" in out and "evader/straight" in out
-    assert main([*argv, "--no-report"]) == 0  # resumes: nothing to play
-    assert "4 reused, 0 played" in capsys.readouterr().out
+    # resumes: nothing to play; the report's regret table solves referee games, which
+    # took 13 minutes without a word: it is announced on stderr before it starts
+    assert main([*argv, "--report", str(tmp_path / "r0"), "--no-replays"]) == 0
+    out, err = capsys.readouterr()
+    assert "4 reused, 0 played" in out and f"report written to {tmp_path / 'r0'}" in out
+    assert err.startswith(f"writing the report to {tmp_path / 'r0'}: its regret table solves")
+    assert "(16 cells per L_min; cached" in err and err.rstrip().endswith("--no-report skips it")
     assert main(["report", str(store), "--out", str(tmp_path / "r"), "--no-replays"]) == 0
     assert (tmp_path / "r" / "report.html").is_file()
+    assert capsys.readouterr().err.startswith(f"writing the report to {tmp_path / 'r'}: ")
     assert main(["export", str(store), str(tmp_path / "x.csv")]) == 0
     assert len((tmp_path / "x.csv").read_text().splitlines()) == 5
     assert main(["tournament", "--list"]) == 0

@@ -23,12 +23,36 @@ import math
 import numpy as np
 import shapely
 
+from envs.errors import InvalidConfigError
 from envs.maps.map import Map
 from envs.tolerances import REL_LENGTH_TOL
 
-__all__ = ["grid_axis", "grid_points", "grid_size"]
+__all__ = ["check_grid_spacing", "grid_axis", "grid_points", "grid_size"]
 
 _CHUNK = 1 << 20  # points per vectorised membership test
+
+
+def check_grid_spacing(world: Map, resolution: float, where: str) -> None:
+    """Refuse a grid spacing so fine that the grid's node count is no finite float (the
+    memory estimates then overflowed: ``resolution = 1e-300`` ended in an OverflowError
+    or ZeroDivisionError instead of a message). Such a spacing lies far below the map's
+    length tolerance (``REL_LENGTH_TOL`` x its scale), which the message names; coarser
+    ones go on to the memory budget's checks, which name a spacing that fits.
+
+    Raises:
+        InvalidConfigError: naming the value, the map and its length tolerance.
+    """
+    try:
+        nodes = (world.scale / resolution) ** 2
+    except (OverflowError, ZeroDivisionError):
+        nodes = math.inf
+    if math.isfinite(nodes):
+        return
+    raise InvalidConfigError(
+        f"{where}(map {world.name!r}): resolution = {resolution:g}: expected a grid spacing "
+        f"no finer than the map's length tolerance {REL_LENGTH_TOL * world.scale:.3g} "
+        f"(REL_LENGTH_TOL x its scale {world.scale:g}); this grid's node count overflows"
+    )
 
 
 def grid_size(lo: float, hi: float, resolution: float) -> int:

@@ -59,7 +59,7 @@ from strategies.policies.base import (
 )
 from strategies.policies.baselines import nearest_wall_point
 from strategies.policies.lazy_table import LazySafetyTable
-from strategies.policies.safety import NO_PATH, SafetyTable, safety_table
+from strategies.policies.safety import NO_PATH, SafetyTable, _points_at, safety_table
 
 __all__ = ["DecompositionPursuer", "crossable_steps", "reachable_steps"]
 
@@ -160,7 +160,7 @@ class DecompositionPursuer(BasePolicy):
         res = self.resolution if self.resolution is not None else c.l_min / 20.0
         kind = self.table_kind
         if kind == "auto":
-            points = c.map.free_region.area / res**2
+            points = _points_at(c.map.free_region.area, res)
             kind = "eager" if points <= self.EAGER_TABLE_POINTS else "distinct"
             kind = "lazy" if points > self.DISTINCT_TABLE_POINTS else kind
         if kind == "lazy":

@@ -34,7 +34,7 @@ from envs.errors import MemoryBudgetError
 from envs.maps import Map
 from envs.tolerances import REL_LENGTH_TOL
 from strategies.cspace._budget import memory_budget
-from strategies.cspace.grids import grid_axis, grid_size
+from strategies.cspace.grids import check_grid_spacing, grid_axis, grid_size
 from strategies.policies._batch_classify import classify_points
 from strategies.policies.safety import SafetyTable, _circular_distance
 
@@ -99,6 +99,7 @@ class LazySafetyTable:
         self.L = float(L)
         self.resolution = float(resolution)
         self.n_bins = int(n_bins)
+        check_grid_spacing(world, self.resolution, "LazySafetyTable")
         xmin, ymin, xmax, ymax = world.bounds
         self.shape = (
             grid_size(xmin, xmax, self.resolution),

@@ -32,11 +32,11 @@ from pathlib import Path
 import numpy as np
 
 from envs import validation
-from envs.errors import MemoryBudgetError
+from envs.errors import InvalidConfigError, MemoryBudgetError
 from envs.maps import Map
 from strategies.cspace import _budget
 from strategies.cspace.cache import CacheWarning, resolve_cache_dir, write_cache_file
-from strategies.cspace.grids import grid_points
+from strategies.cspace.grids import check_grid_spacing, grid_points
 
 __all__ = [
     "NO_PATH",
@@ -236,8 +236,8 @@ def _build(
 
     from strategies.cspace import decompose
 
+    origin, cell, pts = _free_grid(world, L, resolution)
     dec = decompose(world, L, cache=True)
-    origin, cell, pts = grid_points(world, resolution)
     centres = -math.pi + (np.arange(n_bins) + 0.5) * (2.0 * math.pi / n_bins)
     free = np.zeros((len(pts), n_bins), dtype=bool)
     safe = np.zeros_like(free)
@@ -269,8 +269,8 @@ def _build_distinct(
     from strategies.cspace import decompose
     from strategies.policies._batch_classify import distinct_rows
 
+    origin, cell, pts = _free_grid(world, L, resolution)
     dec = decompose(world, L, cache=True)
-    origin, cell, pts = grid_points(world, resolution)
     centres = -math.pi + (np.arange(n_bins) + 0.5) * (2.0 * math.pi / n_bins)
     show = progress if progress is not None else (None if len(pts) > _PROGRESS_POINTS else False)
     with tqdm(
@@ -283,6 +283,21 @@ def _build_distinct(
         ids, free, safe, guaranteed = distinct_rows(dec, pts, resolution, centres, bar.update)
     cell = np.where(cell >= 0, ids[np.maximum(cell, 0)], -1).astype(np.int32)
     return _table(origin, cell, L, resolution, free, safe, guaranteed)
+
+
+def _free_grid(world: Map, L: float, resolution: float):
+    """:func:`grid_points`, refusing a grid with no node in the free region (a resolution
+    wider than the map's rooms: at 8 on the corner world the build failed with numpy's
+    IndexError, the policies' reset with it)."""
+    origin, cell, pts = grid_points(world, resolution)
+    if len(pts) == 0:
+        raise InvalidConfigError(
+            f"safety_table(map {world.name!r}, L = {L:g}): resolution = {resolution:g} leaves "
+            f"no node of its {cell.shape[0]} x {cell.shape[1]} grid inside the free region; "
+            f"expected a grid spacing well below the width of the map's free space (the "
+            f"default is L / 20 = {default_resolution(L):g})"
+        )
+    return origin, cell, pts
 
 
 def _table(origin, cell, L, resolution, free, safe, guaranteed) -> SafetyTable:
@@ -313,6 +328,18 @@ def default_resolution(L: float) -> float:
     return float(L) / 20.0
 
 
+def _points_at(area: float, resolution: float) -> float:
+    """``area / resolution**2``, the grid points of a free region, also where the square
+    overflows (resolution 1e155: OverflowError) or underflows to 0 (1e-300:
+    ZeroDivisionError); ``**`` kept, not ``*``: they differ in the last bit for some
+    spacings, and the tables' kind is chosen by this count."""
+    try:
+        sq = resolution**2
+    except OverflowError:
+        return 0.0
+    return area / sq if sq > 0.0 else math.inf
+
+
 def table_bytes(world: Map, resolution: float, n_bins: int, distinct: bool = False) -> float:
     """Estimated memory of a table: free-region grid points x (4 bytes per bin + 9).
 
@@ -325,7 +352,7 @@ def table_bytes(world: Map, resolution: float, n_bins: int, distinct: bool = Fal
 
     x0, y0, x1, y1 = world.bounds
     nodes = max(1.0, (x1 - x0) / resolution) * max(1.0, (y1 - y0) / resolution)
-    points = world.free_region.area / resolution**2
+    points = _points_at(world.free_region.area, resolution)
     if distinct:
         points = min(points, CHUNK)
     return points * (4 * n_bins + 9) + 4 * nodes
@@ -375,6 +402,7 @@ def safety_table(
     if resolution is None:
         resolution = default_resolution(L)
     resolution = validation.positive("resolution", resolution, where=where)
+    check_grid_spacing(world, resolution, where)
     n_bins = validation.integer("n_bins", n_bins, minimum=8, maximum=NO_PATH - 1, where=where)
     budget = _budget.memory_budget(memory_budget)
     need = table_bytes(world, resolution, n_bins, distinct)

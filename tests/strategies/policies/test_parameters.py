@@ -105,3 +105,32 @@ def test_a_bad_observation_is_an_observation_error(name, box_config) -> None:
         pol.act(np.zeros(5))
     with pytest.raises(InvalidObservationError, match="real numbers"):
         pol.act(["a"] * obs.size)
+
+
+@pytest.mark.parametrize("name", ["pursuer/decomposition", "evader/shooting"])
+@pytest.mark.parametrize(
+    ("resolution", "pattern"),
+    [
+        # no grid node in the free region: numpy's IndexError at reset
+        (8.0, r"resolution = 8 leaves no node of its 1 x 1 grid inside the free region"),
+        # free area / res**2 overflowed: OverflowError at reset
+        (1e155, r"resolution = 1e\+155 leaves no node of its 1 x 1 grid"),
+        # res**2 underflowed to 0: ZeroDivisionError; then inf memory estimates overflowed
+        (
+            1e-300,
+            r"resolution = 1e-300: expected a grid spacing no finer than the map's "
+            r"length tolerance 1.98e-08",
+        ),
+        (5e-324, r"resolution = 4.94066e-324: expected a grid spacing no finer than"),
+    ],
+)
+def test_a_table_resolution_no_grid_can_have_is_refused_naming_it(name, resolution, pattern):
+    """The decomposition pursuer's and shooting evader's ``resolution`` (their safety
+    table's grid spacing) at 8, 1e155 or 1e-300 on the corner world failed at reset with
+    a bare IndexError / OverflowError / ZeroDivisionError (a PolicyFailure of the run)."""
+    from envs.surveillance.config import EnvConfig
+
+    cfg = EnvConfig(map="corner")
+    policy = make_policy(name, resolution=resolution)
+    with pytest.raises(InvalidConfigError, match=pattern):
+        policy.reset(role=name.split("/")[0], map=cfg.map, config=cfg, seed=0)

@@ -256,7 +256,10 @@ def _replay(db: Store, run: dict[str, Any], row: dict[str, Any]) -> Replay | Non
         if result.winner == "evader"
         else f"held {result.steps} steps"
     )
-    title = f"{row['map']}: {row['pursuer']} vs {row['evader']}, seed {row['seed']}: {outcome}"
+    # the variant too (a [grid] run has one scope per map and value: two 'u.wkt' replays
+    # at rho = 0.1 and 1.5 were captioned alike)
+    where = f"{row['map']} | {row['variant']}" if row.get("variant") else row["map"]
+    title = f"{where}: {row['pursuer']} vs {row['evader']}, seed {row['seed']}: {outcome}"
     return Replay(title, _gif(result), consistent)
 
 

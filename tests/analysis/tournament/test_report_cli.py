@@ -212,3 +212,27 @@ def test_a_report_directory_that_is_a_file_is_refused_before_the_run(tmp_path, c
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert "--out = " in err and "notes.txt' is a file, expected a directory" in err
+
+
+def test_replay_captions_name_the_grid_value(tmp_path, monkeypatch):
+    """A spec with ``[grid] rho = [...]`` has one scope per map and value, and a replay for
+    each; their captions said only the map ('u.wkt: ... seed 0', twice), not which rho."""
+    import analysis.tournament.report as report
+
+    monkeypatch.setattr(report, "_regret_section", lambda a: ("-", "<p>-</p>"))  # no solves
+    spec = {
+        "name": "grid",
+        "maps": ["open_room"],
+        "pursuers": ["pursuer/greedy"],
+        "evaders": ["evader/straight"],
+        "seeds": 1,
+        "start": "valid",
+        "env": {"max_cycles": 20},
+        "grid": {"rho": [0.3, 0.6]},
+    }
+    store = tmp_path / "g.sqlite"
+    run_tournament(spec_from_dict(spec), store, backend="serial", progress=False)
+    md = write_report(store, tmp_path / "rep")["markdown"].read_text()
+    replays = md.split("## Replays", 1)[1].split("\n## ", 1)[0]
+    for rho in ("0.3", "0.6"):
+        assert f"![open_room | rho={rho}: pursuer/greedy vs evader/straight, seed 0: " in replays

@@ -313,16 +313,10 @@ def _gif(result: Any) -> bytes:
 
 # --------------------------------------------------------------------------- writing
 def _regret_section(a: Analysis) -> tuple[str, str]:
-    """The referee's regret table (Markdown, HTML), or a note saying where it will come."""
-    try:
-        from strategies.referee import tournament_regret  # type: ignore[attr-defined]
-    except ImportError:
-        text = (
-            "Not available yet: the referee (`strategies.referee`) will report each policy's "
-            "regret here, the fraction of certified-winnable starts it loses."
-        )
-        return text, f"<p>{html.escape(text)}</p>"
+    """The referee's regret table (Markdown, HTML), or a note saying why it is missing
+    (its games' solves, a bar over them on a terminal, would exceed the memory budget)."""
     from envs.errors import MemoryBudgetError
+    from strategies.referee import tournament_regret
     from strategies.referee.regrets import DEFAULT_CELLS_PER_LMIN
 
     geometry = {d: g for d, g in a.geometry.items() if g is not None}

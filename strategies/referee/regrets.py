@@ -89,6 +89,7 @@ def regret(
     referees: dict | None = None,
     cache: bool = True,
     cache_dir: str | os.PathLike | None = None,
+    progress: bool | None = None,
 ) -> list[Regret]:
     """Regret of every policy in ``matches``.
 
@@ -102,6 +103,9 @@ def regret(
         referees: a dict to reuse referees across calls (filled in place), keyed by game.
         cache: use the referees' on-disk cache.
         cache_dir: its directory.
+        progress: a bar over the games to solve on standard error: shown (``True``),
+            hidden (``False``) or, by default, on a terminal only (a solve not cached
+            takes seconds to minutes).
 
     Returns:
         One :class:`Regret` per (role, policy), pursuers first, sorted by name.
@@ -110,18 +114,28 @@ def regret(
         InvalidConfigError: a match lacks a field or has a bad value (named).
     """
     referees = {} if referees is None else referees
-    tally: dict[tuple[str, str], list[int]] = {}
-    for i, m in enumerate(matches):
-        where = f"match {i}"
-        world, params, start, winner, horizon = _read_match(m, where)
+    # every match is read first, so a bad one is refused before any solve (minutes each)
+    read = [(_read_match(m, f"match {i}"), m) for i, m in enumerate(matches)]
+    games: dict[tuple, tuple] = {}  # the games to solve, in the order first played
+    for (world, params, *_), _ in read:
         key = _game_key(world, params)
-        ref = referees.get(key)
-        if ref is None:
+        if key not in referees and key not in games:
+            games[key] = (world, params)
+    from tqdm import tqdm
+
+    bar = tqdm(total=len(games), desc="referee: solving the games played", unit="game",
+               disable=None if progress is None else not progress, leave=False)  # fmt: skip
+    with bar:
+        for key, (world, params) in games.items():
             spec = GameSpec(world, params["l_min"], params["l_max"], params["v_pursuer"],
                             params["v_evader"], body_radius=params["body_radius"])  # fmt: skip
-            ref = referees[key] = solve(
+            referees[key] = solve(
                 spec, cells_per_lmin, dt=params["dt"], cache=cache, cache_dir=cache_dir
             )
+            bar.update()
+    tally: dict[tuple[str, str], list[int]] = {}
+    for (world, params, start, winner, horizon), m in read:
+        ref = referees[_game_key(world, params)]
         label, escape = _label(ref, start)
         for role in ("pursuer", "evader"):
             t = tally.setdefault((role, str(m[role])), [0, 0, 0, 0, 0])
@@ -195,6 +209,7 @@ def tournament_regret(
     cache: bool = True,
     cache_dir: str | os.PathLike | None = None,
     strict: bool = False,
+    progress: bool | None = None,
 ) -> list[list[str]]:
     """The regret table of a tournament run, for its report.
 
@@ -214,6 +229,7 @@ def tournament_regret(
         strict: raise on a match whose game cannot be rebuilt (a map not found or
             changed since the run); by default such matches are left out and a last row
             says how many and why, so a report still renders.
+        progress: :func:`regret`'s bar over the games to solve (by default on a terminal).
 
     Returns:
         :func:`regret_table`'s rows (only matches played out, status ``"ok"``), then a
@@ -241,7 +257,8 @@ def tournament_regret(
             skipped.append(str(exc))
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", VacuousBoundWarning)
-        results = regret(matches, cells_per_lmin=cells_per_lmin, cache=cache, cache_dir=cache_dir)
+        results = regret(matches, cells_per_lmin=cells_per_lmin, cache=cache,
+                         cache_dir=cache_dir, progress=progress)  # fmt: skip
     for w in caught:  # other warnings go on as they came
         if not issubclass(w.category, VacuousBoundWarning):
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)

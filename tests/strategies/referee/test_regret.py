@@ -70,6 +70,31 @@ def test_regret_rejects_malformed_matches(corridor_half):
         regret([{**good, "dt": -0.1}])
 
 
+def test_regret_refuses_a_bad_match_before_solving_any_game(corridor_half, monkeypatch):
+    """A solve takes seconds to minutes: a malformed match anywhere in the list is named
+    before the first one starts (it was found only after the games before it were solved)."""
+    good = _match(corridor_half, {"pursuer": (-2.2, 0.0), "evader": (-0.9, 0.0)}, "p", "e",
+                  "evader")  # fmt: skip
+
+    def no_solve(*args, **kwargs):
+        raise AssertionError("a game was solved before the matches were checked")
+
+    monkeypatch.setattr("strategies.referee.regrets.solve", no_solve)
+    with pytest.raises(InvalidConfigError, match=r"match 1: missing \['winner'\]"):
+        regret([good, {k: v for k, v in good.items() if k != "winner"}], cache=False)
+
+
+def test_regret_shows_a_bar_over_the_games_it_solves(corridor_half, capsys):
+    start = {"pursuer": (-2.2, 0.0), "evader": (-0.9, 0.0)}
+    matches = [_match(corridor_half, start, "p", "e", w) for w in ("evader", "pursuer")]
+    rows = regret(matches, cells_per_lmin=4, cache=False, progress=True)
+    assert {r.policy for r in rows} == {"p", "e"}
+    err = capsys.readouterr().err
+    assert "referee: solving the games played" in err and "0/1" in err  # two matches, one game
+    regret(matches, referees={}, cells_per_lmin=4, cache=False, progress=False)
+    assert capsys.readouterr().err == ""
+
+
 def test_tournament_regret_from_runner_records(corridor_half):
     """Rows carrying the shared runner's record: its start and parameters are used."""
     world = corridor_half.spec.map

@@ -165,6 +165,19 @@ def rotated_room() -> Map:
     )
 
 
+def assert_exact(dec, seed: int, per_region: int, slivers: bool = True) -> None:
+    """Assert ``dec`` is exact (no dangling edge, nothing unresolved; with ``slivers`` no
+    unresolved sliver either) and that the kernel's stops are constant over each region
+    at ``per_region`` random points (:func:`stops_constant`, generator seeded ``seed``),
+    with more than two points a region checked on average."""
+    assert dec.exact and dec.stats["dangling"] == 0 and dec.unresolved == 0, dec.stats
+    if slivers:
+        assert dec.stats["slivers_unresolved"] == 0, dec.stats
+    n, bad = stops_constant(dec, np.random.default_rng(seed), per_region=per_region)
+    assert not bad, bad[:5]
+    assert n > 2 * len(dec.regions)
+
+
 def stops_constant(dec, rng, per_region: int = 6, inset: float | None = None) -> tuple[int, list]:
     """Check that the kernel's stop pairs are the region's at random points of each region.
 

@@ -17,6 +17,7 @@ import pytest
 from envs.maps import Map, random_map
 from strategies.cspace import decompose
 from tests.strategies.cspace._oracle import (
+    assert_exact,
     brute_free,
     circular_runs,
     fingerprint,
@@ -262,10 +263,7 @@ def test_wall_vertices_at_one_point_give_an_exact_arrangement(name, L):
     world = SHARED_VERTICES[name]
     assert len({tuple(v) for v in world.vertices.tolist()}) < world.n_vertices
     dec = decompose(world, L)
-    assert dec.exact and dec.stats["dangling"] == 0 and dec.unresolved == 0, dec.stats
-    n, bad = stops_constant(dec, np.random.default_rng(7), per_region=4)
-    assert not bad, bad[:5]
-    assert n > 2 * len(dec.regions)
+    assert_exact(dec, 7, per_region=4, slivers=False)
     checked = 0
     for r in dec.regions:
         arcs = [dec.cells[c].arc for c in r.cells]
@@ -303,10 +301,7 @@ def test_a_tiny_step_on_an_obstacle_s_corner_gives_an_exact_arrangement(step, L)
         [[(5, 5), (9, 5), (9, 5 + h), (9 + h, 5 + h), (9 + h, 6), (5, 6)]],
     )
     dec = decompose(world, L)
-    assert dec.exact and dec.stats["dangling"] == 0 and dec.unresolved == 0, dec.stats
-    n, bad = stops_constant(dec, np.random.default_rng(5), per_region=4)
-    assert not bad, bad[:5]
-    assert n > 2 * len(dec.regions)
+    assert_exact(dec, 5, per_region=4, slivers=False)
 
 
 @pytest.mark.parametrize("angle", [0.0, 3.0905])
@@ -325,10 +320,7 @@ def test_a_conchoid_of_a_sub_millimetre_edge_is_ordered_against_its_arc(angle, L
     ]
     world = similar(Map(_box(0, 0, 16, 12), obstacles), angle, 1.0, (0.0, 0.0))
     dec = decompose(world, L)
-    assert dec.exact and dec.stats["dangling"] == 0 and dec.unresolved == 0, dec.stats
-    n, bad = stops_constant(dec, np.random.default_rng(11), per_region=4)
-    assert not bad, bad[:5]
-    assert n > 2 * len(dec.regions)
+    assert_exact(dec, 11, per_region=4, slivers=False)
 
 
 def _stepped_corner(x0, y0, w, h, st, sd, two, angle):
@@ -355,11 +347,7 @@ def _stepped(k: int) -> tuple[Map, float]:
 
 def _assert_exact(world, L, seed):
     dec = decompose(world, L)
-    assert dec.exact and dec.stats["dangling"] == 0 and dec.unresolved == 0, dec.stats
-    assert dec.stats["slivers_unresolved"] == 0, dec.stats
-    n, bad = stops_constant(dec, np.random.default_rng(seed), per_region=4)
-    assert not bad, bad[:5]
-    assert n > 2 * len(dec.regions)
+    assert_exact(dec, seed, per_region=4)
     return dec
 
 
@@ -560,11 +548,7 @@ def test_a_notch_s_conchoid_tangent_to_its_corner_s_arc_gets_no_false_crossing(
     random points of every region (8 a region: a third of the regions are slivers too
     thin to draw points in)."""
     dec = decompose(_tooth_room(x, w, h, angle, with_box), L)
-    assert dec.exact and dec.stats["dangling"] == 0 and dec.unresolved == 0, dec.stats
-    assert dec.stats["slivers_unresolved"] == 0, dec.stats
-    n, bad = stops_constant(dec, np.random.default_rng(17), per_region=8)
-    assert not bad, bad[:5]
-    assert n > 2 * len(dec.regions)
+    assert_exact(dec, 17, per_region=8)
 
 
 def test_a_notch_s_conchoid_and_arc_meet_only_at_their_corner():
@@ -649,11 +633,7 @@ def test_curves_tangent_at_a_notch_s_corner_are_ordered_where_they_part(
     edges' own length out (0.19 here: 5e-8 rad apart). Oracle: the kernel's stops at
     random points of every region."""
     dec = decompose(_tooth_room(x, w, h, angle, with_box), L)
-    assert dec.exact and dec.stats["dangling"] == 0 and dec.unresolved == 0, dec.stats
-    assert dec.stats["slivers_unresolved"] == 0, dec.stats
-    n, bad = stops_constant(dec, np.random.default_rng(19), per_region=8)
-    assert not bad, bad[:5]
-    assert n > 2 * len(dec.regions)
+    assert_exact(dec, 19, per_region=8)
 
 
 @pytest.mark.parametrize(
@@ -703,11 +683,7 @@ def test_a_lens_thin_on_the_exact_curves_is_a_sliver_however_wide_its_polygon(
             assert arr.sliver[f], (f, width, tol.thin)
     assert lenses >= 1
     dec = decompose(world, L)
-    assert dec.exact and dec.stats["dangling"] == 0 and dec.unresolved == 0, dec.stats
-    assert dec.stats["slivers_unresolved"] == 0, dec.stats
-    n, bad = stops_constant(dec, np.random.default_rng(23), per_region=8)
-    assert not bad, bad[:5]
-    assert n > 2 * len(dec.regions)
+    assert_exact(dec, 23, per_region=8)
 
 
 def test_two_dangling_conchoids_within_their_rounding_of_each_other_are_one_edge():

@@ -63,6 +63,56 @@ displacement every step. Two regimes follow (:func:`vacuity` names them, and
   tried; below it, it can be vacuous at some lattices (solve() also warns when the solved
   bound certifies no state at all). Its 0 % then means "unknown", not "the evader wins":
   only the evader bound certifies evader wins.
+
+* **Narrow passages, far below** :data:`VACUOUS_RHO` (measured). Re-localised in its cell,
+  the bound's evader may end every step in a neighbouring cell's far side: it covers
+  ``(V_e tau + sqrt(2) h) / (V_p tau)`` of the pursuer's step (0.22 at rho = 0.1 at the
+  default lattice, 0.13 at rho = 0.01), so the bound's pursuer cannot pass it where the
+  real one passes it with little to spare. The evader then herds it into a dead end and
+  the erosion spreads to every state. A real pursuer circling the evader at L_min passes
+  it in a hall of width w (body radius r) whenever ``rho (pi / 2) L_min / (sqrt(1 -
+  rho^2) - rho) <= (w - 2 r) / 2 - L_min`` (the evader gains at most that much across the
+  hall during the quarter turn that brings the pursuer abreast): in the corner world's 5
+  wide arms (L_min = 2, r = 0.1) up to rho = 0.112, at rho = 0.1 with 5 cm to spare. On
+  the corner world at rho = 0.1 and 8 cells per L_min the first states lost are the
+  pursuer's in a room corner, e.g. pursuer at (0.5, 0.5), evader's cell (2.75, 1.0): its
+  only safe move is 1.5 up the wall, after which the evader's diagonal neighbour cell
+  (2.5, 1.25), 0.35 from its cell although the evader moved 0.15, lies 2.14 from the
+  pursuer, so its disc comes within L_min (a real pursuer sliding up the wall keeps its
+  range). At 16 cells per L_min the losses run up each arm from its end, the evader's
+  cells within about 0.75 of the arm's centre line beating every pursuer point between
+  them and the dead end (sweeps 7-37); then the junction square falls and with it every
+  state (82 sweeps). Which lattice certifies depends on where its rows fall against the
+  walls and on its step (fraction of the states, :meth:`PursuerBound.fraction`, at 16
+  cells per L_min unless said; L in [2, 4]):
+
+  ========================  ============  ============================  ==============
+  map                       rho           pursuer lattice: coarse, tau  certified
+  ========================  ============  ============================  ==============
+  corner (arms 5 wide)      0.01 - 0.05   4, 1.5 s (the default)        93.0 - 92.7 %
+  corner                    0.1           4, 1.5 s (the default);       0 %
+                                          5, 1.875 s; at 8 and 12
+                                          cells per L_min coarse 1,
+                                          2, 3, 4, 6 x 2 or 3
+                                          spacings a step
+  corner                    0.1           3, 1.125 s / 6, 2.25 s        93.2 / 91.8 %
+  corner                    0.2           3, 4, 5, 6 (3 spacings)       0 %
+  hall 14 x 5 (dead ends)   0.01 - 0.1    4, 1.5 s (the default)        0 %
+  hall 14 x 6               0.01 / 0.05   4, 1.5 s (the default)        99.8 / 99.8 %
+  hall 14 x 6 / 14 x 7      0.1           4, 1.5 s (the default)        0 / 99.7 %
+  l_hall (2 m pillar 3      0.01 / 0.05   4, 1.5 s (the default)        97.2 / 96.9 %
+  from two walls)
+  l_hall                    0.1           4 (the default), 5, 6         0 %
+  l_hall                    0.1           3, 1.125 s                    96.1 %
+  l_hall                    0.2           3, 4, 5, 6 (3 spacings)       0 %
+  20 m room, 2 m pillar     0.1           4, 1.5 s (the default)        0 % (3.5 from
+  3 from a wall                                                         it: 98.2 %)
+  ========================  ============  ============================  ==============
+
+  So 0 % on such a map at low rho is this abstraction's blind spot, not a finding about
+  the game; ``solve(..., pursuer_coarse=3)`` may certify where the default does not, at
+  about the default's cost (its pursuer bound 2.6 s on the corner, 3.5 s on l_hall at
+  rho = 0.1).
 """
 
 from __future__ import annotations

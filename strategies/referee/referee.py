@@ -375,7 +375,9 @@ def solve(
     The pursuer bound is vacuous (it certifies nothing, although the real game may well be a
     pursuer win) when its range band is used up, from rho = 0.35 at every resolution
     tried, and at some lattices below that (the empty 10 m room at rho = 0.3: 0 % at the
-    default lattice, tau = 1.5 s; 98 % with ``pursuer_coarse=2``, tau = 0.8 s); see
+    default lattice, tau = 1.5 s; 98 % with ``pursuer_coarse=2``, tau = 0.8 s), and far
+    below it where the pursuer must pass the evader in a narrow passage (the corner world's
+    5 m arms at rho = 0.1: 0 % at the default lattice, 93 % with ``pursuer_coarse=3``); see
     :mod:`strategies.referee.pursuer_bound`. Then its pursuer wins mean "unknown", and
     :class:`~envs.errors.VacuousBoundWarning` says so, with the numbers.
 

@@ -11,9 +11,10 @@ import numpy as np
 import pytest
 
 from envs.errors import VacuousBoundWarning
-from envs.maps import Map
+from envs.maps import Map, builtin_map
 from strategies.referee import GameSpec, Resolution, solve
 from strategies.referee.pursuer_bound import VACUOUS_RHO, range_band, vacuity
+from strategies.referee.referee import solve_role
 from tests.strategies.referee.conftest import DT, open_room, spec
 
 ROOM10 = Map([(0, 0), (10, 0), (10, 10), (0, 10)], name="room10")
@@ -76,3 +77,18 @@ def test_a_bound_that_won_nothing_says_so(open_slow):
     empty = dataclasses.replace(pb, win=np.zeros_like(pb.win))
     why = empty.vacuity()
     assert why is not None and "certified no state" in why and "rho = 0.2" in why
+
+
+def test_narrow_passages_at_low_rho_and_the_lattice_that_certifies():
+    """pursuer_bound's docstring and the README: far below VACUOUS_RHO the bound certifies
+    nothing on the corner world (arms 5 wide, which a real pursuer circling the evader at
+    L_min passes up to rho = 0.112) at rho = 0.1 at the default lattice, and warns so;
+    pursuer_coarse=3 certifies 93 % of the states there (helper-105's measurements)."""
+    corner = GameSpec(builtin_map("corner"), 2.0, 4.0, 1.0, 0.1, body_radius=0.1)
+    with pytest.warns(VacuousBoundWarning, match="certified no state"):
+        default = solve_role(corner, "pursuer", 16, cache=False)
+    assert default.res.coarse == 4 and default.fraction() == 0.0
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", VacuousBoundWarning)
+        coarse3 = solve_role(corner, "pursuer", 16, pursuer_coarse=3, cache=False)
+    assert coarse3.fraction() == pytest.approx(0.932, abs=0.005)

@@ -551,7 +551,6 @@ def arrange(world: Map, curves: tuple[CriticalCurve, ...], tol: Tolerances) -> A
     ws = cv.wall_sign[nd.curve[h_edge]]
     blocked_h = (h_fwd & (ws < 0)) | (~h_fwd & (ws > 0))
     blocked = np.bincount(cyc, weights=blocked_h, minlength=nc) > 0
-    bridge = cyc[0::2] == cyc[1::2]
     area_tol = tol.merge**2
     all_bridges = np.bincount(cyc, weights=~bridge[h_edge], minlength=nc) == 0
     # faces: counter-clockwise cycles, and degenerate ones (zero area but not a tree of

@@ -27,10 +27,12 @@ streams): the same seed gives the same episode, bit for bit. A policy with a
 the concrete policy of the episode with its role's seed.
 
 **Failures.** An exception raised by a policy's ``act`` (or a non-``ValueError`` one from
-its ``reset``) becomes a :class:`PolicyFailure` naming the role, the policy and the step
-(the original exception is its ``__cause__``); a ``time_limit`` overrun is an
-:class:`EpisodeTimeout` blaming the role that spent more time deciding. Configuration
-errors (``ValueError`` subclasses, see :mod:`envs.errors`) propagate unchanged.
+its ``reset``), or an action the env refuses (NaN, inf, a wrong shape, not numbers: the
+env's :class:`~envs.errors.InvalidActionError`), becomes a :class:`PolicyFailure` naming
+the role, the policy and the step (the original exception is its ``__cause__``); a
+``time_limit`` overrun is an :class:`EpisodeTimeout` blaming the role that spent more time
+deciding. Configuration errors (``ValueError`` subclasses, see :mod:`envs.errors`)
+propagate unchanged.
 
 Examples:
     >>> r = run_episode("open_room", "pursuer/greedy", "evader/straight", seed=3, max_cycles=20)
@@ -48,7 +50,7 @@ from typing import Any
 
 import numpy as np
 
-from envs.errors import InvalidConfigError, MemoryBudgetError
+from envs.errors import InvalidActionError, InvalidConfigError, MemoryBudgetError
 
 __all__ = [
     "OBSERVATION_OPTIONS",
@@ -410,7 +412,8 @@ def run_episode(
         The :class:`EpisodeResult`.
 
     Raises:
-        PolicyFailure: a policy raised while playing (its role forfeits).
+        PolicyFailure: a policy raised while playing, or returned an action the env
+            refuses (its role forfeits).
         EpisodeTimeout: ``time_limit`` was exceeded.
         InvalidConfigError: bad arguments (names, overrides, start, observations,
             time_limit).
@@ -488,6 +491,10 @@ def run_episode(
                 except Exception as exc:
                     raise PolicyFailure(role, _name(pol), steps, _describe(exc)) from exc
                 dt = time.perf_counter() - t0
+                try:  # an action the env refuses (NaN, wrong shape...) is the policy's fault
+                    env._command(AGENT[role], actions[role])
+                except InvalidActionError as exc:
+                    raise PolicyFailure(role, _name(pol), steps, _describe(exc)) from exc
                 spent[role] += dt
                 slowest[role] = max(slowest[role], dt)
             obs, _, _, _, infos = env.step({AGENT[r]: a for r, a in actions.items()})

@@ -132,6 +132,37 @@ def test_a_raising_policy_is_blamed_by_role_and_step():
         run_episode(MAP, Probe(fail_reset=InvalidConfigError("bad")), "evader/random", 0)
 
 
+class _Returns(BasePolicy):
+    """A user's policy that overrides ``act`` and returns ``action`` from step 2 on."""
+
+    def __init__(self, action):
+        super().__init__(name="user")
+        self.action = action
+
+    def act(self, observation):
+        self._steps += 1
+        return self.action if self._steps > 2 else np.zeros(2)
+
+
+@pytest.mark.parametrize(
+    "action", [[np.nan, 0.0], [0.0, np.inf], np.zeros(3), np.zeros((1, 2)), None, "up"]
+)
+def test_an_action_the_env_refuses_is_the_policys_failure(action):
+    # it escaped run_episode as the env's InvalidActionError naming only 'evader_0', so a
+    # tournament stored the match as an error (nobody played) instead of a forfeit
+    with pytest.raises(PolicyFailure) as info:
+        run_episode(MAP, "pursuer/greedy", _Returns(action), seed=0, max_cycles=20)
+    assert info.value.role == "evader" and info.value.policy == "user" and info.value.step == 2
+    assert "InvalidActionError" in info.value.error
+
+
+def test_actions_the_env_accepts_still_play():
+    # lists, ints and out-of-box values are clipped by the env, not refused
+    for action in ([0.5, 0.5], (1, 0), np.array([1, 0]), np.array([1e300, -1e300])):
+        r = run_episode(MAP, "pursuer/greedy", _Returns(action), seed=0, max_cycles=10)
+        assert r.steps >= 1
+
+
 def test_time_limit_blames_the_slow_side():
     with pytest.raises(EpisodeTimeout) as info:
         run_episode(

@@ -9,6 +9,7 @@ from __future__ import annotations
 import signal
 import time
 
+import numpy as np
 import pytest
 
 from strategies.policies import registry
@@ -51,8 +52,17 @@ class SlowPursuer(RandomPolicy):
         return super()._decide(snap)
 
 
+class NanEvader(RandomPolicy):
+    """Returns a NaN action at step 3 (a user's policy overriding ``act``)."""
+
+    def act(self, observation):
+        action = super().act(observation)
+        return np.array([np.nan, 0.0]) if self._steps == 4 else action
+
+
 TEST_POLICIES = {
     "evader/test_raising": RaisingEvader,
+    "evader/test_nan": NanEvader,
     "evader/test_hanging": HangingEvader,
     "evader/test_deaf": DeafHangingEvader,
     "pursuer/test_slow": SlowPursuer,

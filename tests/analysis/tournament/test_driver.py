@@ -118,6 +118,28 @@ def test_raising_and_hanging_policies_forfeit_and_the_run_goes_on(tmp_path, test
     assert len(errors) == 4 and {e["kind"] for e in errors} == {"forfeit"}
 
 
+def test_a_policy_returning_a_nan_action_forfeits(tmp_path, test_policies):
+    # the env refused the action outside the policy's own call, so the match was stored as
+    # an 'error' (nobody played: left out of every table) and the NaN policy lost nothing
+    d = {
+        "maps": ["open_room"],
+        "pursuers": ["pursuer/greedy"],
+        "evaders": ["evader/test_nan", "evader/random"],
+        "seeds": 2,
+        "start": "valid",
+        "env": {"max_cycles": 40},
+    }
+    s = run_tournament(spec_from_dict(d), tmp_path / "s.sqlite", backend="serial", progress=False)
+    assert s.played == 4 and s.forfeits == 2 and s.errors == 0
+    with Store(tmp_path / "s.sqlite") as db:
+        rows = {(r["evader"], r["seed"]): r for r in db.rows(s.run_id)}
+    for seed in (0, 1):
+        nan = rows[("evader/test_nan", seed)]
+        assert nan["status"] == "forfeit" and nan["blame"] == "evader", nan["error"]
+        assert nan["winner"] == "pursuer" and "step 3" in nan["error"]
+        assert "InvalidActionError" in nan["error"] and "finite" in nan["error"]
+
+
 def test_a_hang_that_ignores_signals_is_killed(tmp_path, test_policies):
     d = {
         "maps": ["open_room"],

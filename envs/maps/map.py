@@ -79,6 +79,11 @@ def _as_ring(points: object, what: str) -> np.ndarray:
 _EPS = float(np.finfo(float).eps)
 """Relative rounding of a float64 coordinate."""
 
+_PAIRS = 1 << 20
+"""(point, edge) pairs per batch of ``Map.contains`` / ``Map.distance_to_walls``: about
+100 MB of temporaries at the peak. Unbatched, the shooting evader's reset on a 60 x 56 room with 210
+pillars (844 edges) asked for 315,000 points at once: over 20 GB, killed by the OOM killer."""
+
 
 def _clean_ring(ring: np.ndarray, scale: float, what: str) -> np.ndarray:
     """Drop repeated and straight (collinear) vertices; reject degenerate rings."""
@@ -376,6 +381,9 @@ class Map:
             (k,) bool array.
         """
         p = np.atleast_2d(np.asarray(points, dtype=float))
+        step = self._chunk()
+        if len(p) > step:  # bounded memory: (points x edges) temporaries a chunk at a time
+            return np.concatenate([self.contains(p[s : s + step]) for s in range(0, len(p), step)])
         a = self.edge_start[None, :, :]
         b = self.edge_end[None, :, :]
         px = p[:, None, 0]
@@ -386,9 +394,20 @@ class Map:
         inside = np.count_nonzero(cond & (px < xint), axis=1) % 2 == 1
         return inside | (self.distance_to_walls(p) <= REL_LENGTH_TOL * self.scale)
 
+    def _chunk(self) -> int:
+        """Points per batch of :meth:`contains` / :meth:`distance_to_walls`: each builds a
+        few (points x edges) float arrays, so a batch holds at most :data:`_PAIRS` pairs
+        (the results are per point, so batching changes no value)."""
+        return max(1, _PAIRS // len(self.edge_start))
+
     def distance_to_walls(self, points: np.ndarray | Sequence[Sequence[float]]) -> np.ndarray:
         """Euclidean distance from each point to the nearest wall edge."""
         p = np.atleast_2d(np.asarray(points, dtype=float))
+        step = self._chunk()
+        if len(p) > step:  # bounded memory (see _chunk)
+            return np.concatenate(
+                [self.distance_to_walls(p[s : s + step]) for s in range(0, len(p), step)]
+            )
         rel = p[:, None, :] - self.edge_start[None, :, :]
         t = np.clip(np.einsum("kej,ej->ke", rel, self.edge_dir), 0.0, self.edge_length)
         closest = self.edge_start[None] + t[..., None] * self.edge_dir[None]

@@ -170,6 +170,11 @@ def json_object(flag: str, text: str | None, *, example: str) -> dict[str, Any]:
             f"{flag} = {text!r}: not valid JSON: {exc.msg} at column {exc.colno} "
             f"(near {near!r}); expected an object such as {example}"
         ) from None
+    except RecursionError:  # the decoder recurses once per nested [ or {
+        raise InvalidConfigError(
+            f"{flag} = {text[:40]!r}...: JSON nested too deeply to read; expected an object "
+            f"such as {example}"
+        ) from None
     if not isinstance(obj, dict):
         raise InvalidConfigError(
             f"{flag} = {text!r}: expected a JSON object such as {example}, "

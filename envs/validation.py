@@ -27,6 +27,7 @@ Examples:
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Iterable, Mapping
 from typing import Any
 
@@ -47,6 +48,7 @@ __all__ = [
     "points",
     "positive",
     "real",
+    "shown",
     "string",
     "unit_interval",
 ]
@@ -56,15 +58,19 @@ def _where(name: str, where: str | None) -> str:
     return f"{where}: {name}" if where else name
 
 
+def shown(value: Any, limit: int = 80) -> str:
+    """``repr(value)`` on one line (a numpy array's repr spans lines), cut to ``limit``."""
+    text = re.sub(r"\s*\n\s*", " ", repr(value))
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
 def _fail(name: str, value: Any, expected: str, where: str | None) -> InvalidConfigError:
     kind = type(value).__name__
-    shown = repr(value)
-    if len(shown) > 80:
-        shown = shown[:77] + "..."
+    shown_ = shown(value)
     suffix = (
         "" if isinstance(value, (int, float)) and not isinstance(value, bool) else f", got {kind}"
     )
-    return InvalidConfigError(f"{_where(name, where)} = {shown}: expected {expected}{suffix}")
+    return InvalidConfigError(f"{_where(name, where)} = {shown_}: expected {expected}{suffix}")
 
 
 def is_real(value: Any) -> bool:
@@ -221,12 +227,9 @@ def finite_array(
     if not finite.all():
         bad = np.argwhere(~finite)[0]
         at = int(bad[0]) if len(bad) == 1 else tuple(int(i) for i in bad)
-        shown = repr(value)
-        if len(shown) > 80:
-            shown = shown[:77] + "..."
         raise InvalidConfigError(
-            f"{_where(name, where)} = {shown}: expected finite values, got {arr[tuple(bad)]} "
-            f"at index {at}"
+            f"{_where(name, where)} = {shown(value)}: expected finite values, got "
+            f"{arr[tuple(bad)]} at index {at}"
         )
     return arr
 

@@ -310,8 +310,12 @@ def read_toml(path: str | os.PathLike[str]) -> dict[str, Any]:
             return tomllib.load(fh)
     except FileNotFoundError:
         raise InvalidConfigError(f"config: no such file {str(p)!r}") from None
-    except tomllib.TOMLDecodeError as exc:
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise InvalidConfigError(f"config: {str(p)!r} is not valid TOML ({exc})") from exc
+    except RecursionError:  # the parser recurses once per nested array or table
+        raise InvalidConfigError(
+            f"config: {str(p)!r} is not valid TOML (nested too deeply to read)"
+        ) from None
 
 
 def load_config(path: str | os.PathLike[str], **overrides: Any) -> TrainConfig:
@@ -344,7 +348,7 @@ def load_any_config(path: str | os.PathLike[str], **overrides: Any):
     try:
         with p.open("rb") as fh:
             method = tomllib.load(fh).get("method", "rl")
-    except (OSError, tomllib.TOMLDecodeError):
+    except (OSError, tomllib.TOMLDecodeError, UnicodeDecodeError, RecursionError):
         method = "rl"  # load_config reports the problem
     if method == "dagger":
         from training.dagger import load_dagger_config

@@ -267,6 +267,8 @@ def load_spec(path: str | os.PathLike[str]) -> Spec:
         data = tomllib.loads(p.read_text(encoding="utf-8"))
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise InvalidConfigError(f"{p}: not valid TOML ({exc})") from exc
+    except RecursionError:  # the parser recurses once per nested array or table
+        raise InvalidConfigError(f"{p}: not valid TOML (nested too deeply to read)") from None
     return spec_from_dict(data, source=str(p), base_dir=p.parent, default_name=p.stem)
 
 

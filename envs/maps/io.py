@@ -413,7 +413,8 @@ def map_from_wkt(
     if not isinstance(text, str):
         raise _fail(source, f"expected WKT text, got {type(text).__name__} {text!r}")
     try:
-        geom = shapely.from_wkt(text.strip())
+        with np.errstate(invalid="ignore"):  # NaN coordinates: refused below, in one line
+            geom = shapely.from_wkt(text.strip())
     except (ShapelyError, TypeError, ValueError) as exc:
         raise _fail(source, f"not valid WKT ({exc})") from exc
     if geom is None or geom.is_empty:
@@ -519,6 +520,10 @@ def read_map(path: str | os.PathLike[str], *, merge: bool | None = None) -> MapD
         obj = json.loads(text)
     except json.JSONDecodeError as exc:
         raise _fail(source, f"not valid JSON ({exc})") from exc
+    except RecursionError:  # the decoder recurses once per nested [ or {
+        raise _fail(
+            source, "JSON nested too deeply to read (no map nests beyond a few levels)"
+        ) from None
     if fmt == "geojson" or (isinstance(obj, dict) and "type" in obj and "boundary" not in obj):
         return map_from_geojson(obj, source=source, merge=merge)
     return map_from_dict(obj, source=source, merge=merge)

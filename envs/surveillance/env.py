@@ -264,7 +264,8 @@ class parallel_env(ParallelEnv, EzPickle):
                 a = a.astype(np.float64)
             except (TypeError, ValueError) as exc:
                 raise InvalidActionError(
-                    f"{agent}: expected an action of shape (2,) with finite values, got {action!r}"
+                    f"{agent}: expected an action of shape (2,) with finite values, got "
+                    f"{validation.shown(action)}"
                 ) from exc
             if a.shape != (2,):
                 raise InvalidActionError(

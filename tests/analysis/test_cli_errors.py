@@ -65,13 +65,45 @@ def test_a_directory_given_as_a_map(capsys, tmp_path):
         (b'{"boundary": [[0, 0], [10, 0], [10, "ten"], [0, 10]]}', "vertex 2"),
         (b'{"boundary": [[0, 0], [10, 0], [0, 0]]}', "boundary"),
         (b"[1, 2, 3]", "room.json"),
+        (b'{"boundary": ' + b"[" * 5000 + b"]" * 5000 + b"}", "nested too deeply"),
+        (b'{"boundary": [[0, 0], [10, 0], [10, NaN], [0, 10]]}', "got nan at index (2, 1)"),
     ],
-    ids=["empty", "truncated", "binary", "string-coordinate", "degenerate", "not-an-object"],
+    ids=[
+        "empty",
+        "truncated",
+        "binary",
+        "string-coordinate",
+        "degenerate",
+        "not-an-object",
+        "deep",  # a RecursionError traceback before
+        "nan",
+    ],
 )
 def test_a_broken_map_file_of_each_kind(capsys, tmp_path, content, needle):
     path = tmp_path / "room.json"
     path.write_bytes(content)
     assert_fails(capsys, ["play", "--map", str(path), "--no-gif"], "--map", str(path), needle)
+
+
+def test_a_wkt_map_with_a_nan_is_refused_on_one_line(capsys, tmp_path):
+    # the message held the coordinates' numpy repr, which spans lines
+    path = tmp_path / "room.wkt"
+    path.write_text("POLYGON ((0 0, 12 0, 12 nan, 0 8, 0 0))")
+    line = assert_fails(capsys, ["play", "--map", str(path), "--no-gif"], "got nan at index (2, 1)")
+    assert "array([[ 0.,  0.], [12.,  0.], [12., nan]" in line
+
+
+@pytest.mark.parametrize(
+    ("content", "needle"),
+    [(b'x = "caf\xe9"\n', "not valid TOML"), (b"x = " + b"[" * 5000 + b"]" * 5000, "too deeply")],
+    ids=["latin-1", "deep"],  # UnicodeDecodeError / RecursionError tracebacks before
+)
+def test_a_broken_training_config_is_refused_on_one_line(capsys, tmp_path, content, needle):
+    path = tmp_path / "c.toml"
+    path.write_bytes(content)
+    out = tmp_path / "out"
+    assert_fails(capsys, ["train", str(path), "--output-dir", str(out)], "c.toml", needle)
+    assert_fails(capsys, ["tournament", str(path)], "c.toml", needle)
 
 
 # ---------------------------------------------------------------------- outputs
@@ -128,6 +160,7 @@ def test_a_directory_as_the_output_holds_the_default_name(capsys, tmp_path):
         ('{"l_min": -1}', ["--config: l_min = -1: expected a finite number > 0"]),
         ('{"v_evader": "fast"}', ["--config: v_evader = 'fast'", "got str"]),
         ('{"n_rays": true}', ["--config: n_rays = True", "got bool"]),
+        ("[" * 3000 + "]" * 3000, ["--config", "nested too deeply"]),  # a traceback before
     ],
 )
 def test_bad_config(capsys, text, needles):

@@ -89,6 +89,16 @@ def test_long_values_are_shortened_in_messages():
     assert len(str(info.value)) < 200
 
 
+def test_messages_show_arrays_on_one_line():
+    # a numpy array's repr spans lines: the message did too
+    ring = np.array([[0.0, 0.0], [12.0, 0.0], [12.0, np.nan], [0.0, 8.0]])
+    for call in (lambda: v.finite_array("ring", ring), lambda: v.positive("x", ring)):
+        with pytest.raises(InvalidConfigError) as info:
+            call()
+        assert "\n" not in str(info.value) and "[12., nan]" in str(info.value)
+    assert v.shown("a  b") == "'a  b'"  # spaces inside a value are kept
+
+
 def test_arrays_refuse_bools_hidden_in_lists_and_name_the_bad_entry():
     with pytest.raises(InvalidConfigError, match=r"^p = \[True, 2.0\]: expected an array of shape"):
         v.point("p", [True, 2.0])

@@ -61,6 +61,18 @@ def test_step_rejects_non_real_actions(env, action):
         env.step({"pursuer_0": action, "evader_0": [0.0, 0.0]})
 
 
+@pytest.mark.parametrize(
+    "action",
+    [[10**400, 0], np.array([[True] * 50] * 50), ["x" * 1000, "y"]],
+    ids=["huge-int", "bool-array", "long-strings"],
+)
+def test_a_refused_action_is_shown_on_one_short_line(env, action):
+    # the message held the action's whole repr (400 digits; a numpy array over many lines)
+    with pytest.raises(InvalidActionError, match="pursuer_0") as info:
+        env.step({"pursuer_0": action, "evader_0": [0.0, 0.0]})
+    assert "\n" not in str(info.value) and len(str(info.value)) < 200
+
+
 def test_integer_and_list_actions_are_accepted(env):
     env.step({"pursuer_0": np.array([1, 0]), "evader_0": [0, 0]})
     assert env._step == 1

@@ -111,7 +111,8 @@ class EnvConfig:
         v_pursuer: V_p, the pursuer's speed bound (> 0).
         v_evader: V_e, the evader's speed bound (> 0); rho = V_e / V_p. rho > 1 is legal
             but warned about: the evader then wins by charging (Sec. 5).
-        dt: duration of one env step (> 0).
+        dt: duration of one env step (> 0, and large enough that each speed bound times
+            dt exceeds the rounding of the map's coordinates: a step moves a body).
         max_cycles: steps before the episode is truncated (>= 1).
         observation: ``"state"``, ``"lidar"`` or ``"lidar_track"`` (see :mod:`.observations`).
         n_rays: lidar rays per agent (in [1, MAX_RAYS]; used by the lidar kinds only).
@@ -160,6 +161,7 @@ class EnvConfig:
                 stacklevel=_caller_stacklevel(),
             )
         put("dt", v.positive("dt", self.dt))
+        self._check_step_moves()
         put("max_cycles", v.integer("max_cycles", self.max_cycles, minimum=1))
         put("observation", v.choice("observation", self.observation, OBSERVATION_KINDS))
         put("n_rays", v.integer("n_rays", self.n_rays, minimum=1, maximum=MAX_RAYS))
@@ -180,6 +182,24 @@ class EnvConfig:
         )
         if self.render_mode is not None:
             put("render_mode", v.choice("render_mode", self.render_mode, RENDER_MODES))
+
+    def _check_step_moves(self) -> None:
+        """Refuse a step in which a body at full speed could not move: ``V dt`` at or below
+        the rounding of the map's coordinates. There the position plus ``V dt`` is the
+        position (the game is no game), a subnormal ``dt`` made ``1 / dt`` infinite (NaN
+        velocities in every observation from step 1: dt = 1e-310), and an underflowing
+        ``V dt`` divided by zero (the shooting evader's reset: dt = 5e-324)."""
+        x0, y0, x1, y1 = self.map.bounds
+        rounding = sys.float_info.epsilon * max(abs(x0), abs(y0), abs(x1), abs(y1))
+        for name in ("v_pursuer", "v_evader"):
+            speed = getattr(self, name)
+            if speed * self.dt <= rounding:
+                raise InvalidConfigError(
+                    f"dt = {self.dt!r} with {name} = {speed!r}: a step of {name} dt = "
+                    f"{speed * self.dt:.3g} would not move a body on map {self.map.name!r}, "
+                    f"whose coordinates round by {rounding:.2g}; expected {name} dt > "
+                    f"{rounding:.2g} (a larger dt or {name})"
+                )
 
     # ---------------------------------------------------------------- derived values
     @property

@@ -137,3 +137,27 @@ def test_the_aec_env_before_reset_is_an_episode_state_error(call):
     e.observe("pursuer_0")
     e.step(np.zeros(2))
     e.close()
+
+
+@pytest.mark.parametrize(
+    ("over", "name"),
+    [
+        ({"dt": 1e-310}, "v_pursuer"),  # 1 / dt overflowed: NaN velocities from step 1
+        ({"dt": 5e-324}, "v_pursuer"),  # V dt underflowed: the shooting evader's reset / 0
+        ({"v_evader": 1e-300}, "v_evader"),  # the evader could not move at all
+        ({"map": "corridor~off(1e6,0)", "dt": 1e-12}, "v_pursuer"),  # rounding 2.2e-10 there
+    ],
+)
+def test_a_step_that_moves_no_body_is_refused(over, name):
+    with pytest.raises(InvalidConfigError, match=rf"with {name} = .* would not move a body"):
+        parallel_env(**over)
+
+
+def test_small_steps_and_speeds_that_move_a_body_still_play():
+    from strategies.runner import run_episode
+
+    for over in ({"dt": 1e-9}, {"v_evader": 1e-12}, {"dt": 1e-5, "v_pursuer": 1e-6}):
+        result = run_episode(
+            "corridor", "pursuer/greedy", "evader/shooting", 0, max_cycles=5, overrides=over
+        )
+        assert result.steps == 5, over

@@ -286,6 +286,11 @@ def spec_from_dict(
         raise InvalidConfigError(f"{source}: unknown field(s) {unknown}; a spec has {sorted(_TOP)}")
     base = Path(base_dir) if base_dir is not None else Path.cwd()
     name = string("name", d.get("name", default_name), where=source)
+    if name in (".", "..") or "/" in name or "\\" in name:  # it names files under out/
+        raise InvalidConfigError(
+            f"{source}: name = {name!r}: expected a plain name without '/' or '\\' (the "
+            "default store is out/tournaments/NAME.sqlite); to store elsewhere pass --store"
+        )
     description = string("description", d.get("description", ""), where=source, nonempty=False)
     for required in ("maps", "pursuers", "evaders"):
         if required not in d:

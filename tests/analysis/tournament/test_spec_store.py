@@ -45,6 +45,11 @@ from .conftest import comparable
         ({"env": {"body_radius": 1e-12}}, r"\[env\] on map .*: body_radius = 1e-12 .* substeps"),
         ({"grid": {"dt": [0.1, 1e9]}}, r"\[grid\] dt=1e\+09 on map .*: dt = 1000000000.0 "),
         ({"time_limit": 0}, r"time_limit = 0"),
+        # the default store out/tournaments/NAME.sqlite was ./escape.sqlite, outside out/
+        ({"name": "../../escape"}, r"name = '\.\./\.\./escape': expected a plain name"),
+        ({"name": "a\\b"}, r"expected a plain name"),
+        ({"name": ".."}, r"expected a plain name"),
+        ({"env": {"dt": 1e-310}}, r"dt = 1e-310 with v_pursuer = .* would not move a body"),
         ({"colour": "red"}, r"unknown field.*colour"),
         ({"evaders": [{"model": "zoo:no_such_model"}]}, r"no zoo model 'no_such_model'"),
         ({"sprt": {"role": "pursuer", "candidate": "pursuer/greedy"}}, r"\[sprt\].*baseline"),

@@ -33,9 +33,9 @@ For rho > 1 it runs straight at the pursuer (footnote 4; see :meth:`ShootingEvad
 4. Otherwise **pressure**: move straight at the pursuer (Sec. 6.1, a heading
    minimising max |theta_dot|); against a wall, slide along it perpendicular to the rod,
    the way that does not press straight into the wall. After ``HERD_AFTER`` D / V_e of it
-   (D the map's diameter), from the first step the pursuer comes within L_min of a
-   concave corner, herd instead: get to the far side of the pursuer from that corner,
-   then charge, pinning it there.
+   (D the map's diameter), from the first step the pursuer comes within L_max of a
+   concave corner, herd instead: get to the far side of the pursuer from that corner
+   (sliding along a wall in the way), then charge, pinning it there.
 """
 
 from __future__ import annotations
@@ -390,18 +390,28 @@ class ShootingEvader(BasePolicy):
             # the charge made no end of it: pin the pursuer into its nearest concave
             # corner, where it cannot back off (issue 13: random:star:11 at rho 0.3
             # against the decomposition pursuer, 4,700 steps of charging in the open).
-            # Only from a step where the corner lies within a rod's length (L_min) of the
-            # pursuer: from farther off the pursuer, faster, slips round the evader, and the
-            # herd dragged it along the walls round the whole map until the plan escaped
-            # (random:star:11, seed 507: herding from wherever the pursuer was after
-            # 2,500 steps or 3 D / V_e, occluded at 6.54 or 7.10 D / V_e; from within L_min
-            # of a corner, pinned there, too close, at 5.54; seeds 600 and 601 likewise,
-            # 6.67 -> 5.67, 6.48 -> 5.48)
+            # Only from a step where the corner lies within the rod's longest reach
+            # (L_max) of the pursuer: from farther off the pursuer, faster, slips round
+            # the evader, and the herd dragged it along the walls round the whole map
+            # until the plan escaped (random:star:11, seed 507: herding from wherever the
+            # pursuer was after 2,500 steps or 3 D / V_e, occluded at 6.54 or 7.10
+            # D / V_e). Within L_min, as before, was luck: on that episode the charge
+            # settles into a loop, the pursuer orbiting the evader at up to L_max, and
+            # whether the orbit passes within L_min of a corner depends on the path that
+            # led there (it did at 5.54 D / V_e; with the longer trail below, never)
             if not self._herding:
                 d = self._concave - snap.pursuer
-                self._herding = float(np.einsum("ij,ij->i", d, d).min()) <= c.l_min**2
+                self._herding = float(np.einsum("ij,ij->i", d, d).min()) <= c.l_max**2
             if self._herding:
-                return c.v_evader * self._herd(e, snap.pursuer, u, float(snap.L))
+                h = self._herd(e, snap.pursuer, u, float(snap.L))
+                if self._near_wall(e, c.body_radius + 2.0 * c.v_evader * c.dt):
+                    # pressed to a wall, as the charge below, the push is lost: the
+                    # herd's target (the far side of the pursuer from the corner) can lie
+                    # across a wall. Slide along it (issue 13: office at half scale, rho
+                    # 0.3, seed 909 with the longer trail, 270 s pressed to a wall below
+                    # a door with the pursuer in the door, to the end of the horizon)
+                    h = self._along_wall(e, h, u)
+                return c.v_evader * h
         if self._near_wall(e, c.body_radius + 2.0 * c.v_evader * c.dt):
             # against a wall the push is lost: slide along it, perpendicular to the rod
             # (which turns the rod fastest); the other way round where this one presses
@@ -447,6 +457,26 @@ class ShootingEvader(BasePolicy):
             return u
         to = p - L * n - e
         return unit(to) if math.hypot(float(to[0]), float(to[1])) > 1e-9 else u
+
+    def _along_wall(self, e: np.ndarray, h: np.ndarray, u: np.ndarray) -> np.ndarray:
+        """Heading ``h`` with its component into the nearest wall removed (``e`` within a
+        step or two of it); where nothing is left (``h`` along the wall's normal), the
+        pressure's slide perpendicular to the rod ``u``."""
+        m = self.map
+        rel = e[None, :] - m.edge_start
+        t = np.clip(np.einsum("ej,ej->e", rel, m.edge_dir), 0.0, m.edge_length)
+        off = rel - t[:, None] * m.edge_dir  # from each edge's nearest point to e
+        k = int(np.argmin(np.einsum("ej,ej->e", off, off)))
+        n = unit(off[k])
+        into = float(h @ n)
+        if into >= 0.0:
+            return h
+        s = h - into * n
+        ns = math.hypot(float(s[0]), float(s[1]))
+        if ns > 1e-9:
+            return s / ns
+        s = np.array([-u[1], u[0]])
+        return s if float(s @ n) >= 0.0 else -s
 
     def _near_wall(self, e: np.ndarray, r: float) -> bool:
         """Whether ``e`` lies within ``r`` of a wall (``Map.distance_to_walls``), from the
@@ -503,9 +533,12 @@ class ShootingEvader(BasePolicy):
                     # crossing of the cycle made progress, so all of them are out
                     for c_, b_ in self._trail[back[-1] :]:
                         self._excluded.setdefault(c_, set()).add(b_)
-                # (16 crossings, not 4: random:polygons:0 vs the decomposition pursuer
-                # went round longer cycles for the whole horizon, issue 13)
-                del self._trail[:-16]
+                # n_cells + 1 crossings: among that many in a row some cell is entered
+                # twice (pigeonhole), so a cycle of any length is caught. (A fixed 4, then
+                # 16, were outrun on random:polygons:0: longer cycles against the
+                # decomposition pursuer, then an exact 21-crossing loop for the rest of
+                # the horizon against a stronger pursuer, issue 13)
+                del self._trail[: -(len(self.plan.rank) + 1)]
             self._plan_cell = cell
             self._new_witness(cell, e)
         elif self._witness is not None:

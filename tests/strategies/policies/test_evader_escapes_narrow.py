@@ -11,10 +11,13 @@ falls back. Each episode was held for the whole 8 D / V_e horizon before:
   region; the charge escapes in 0.35 D / V_e.
 * ``random:star:11``, rho = 0.3, L_max = 1.5 L_min, against the decomposition pursuer
   (seed 507): 4,700 steps of charging in the open, the pursuer backing off. After
-  ``HERD_AFTER`` D / V_e of it, from the first step the pursuer is within L_min of a
-  concave corner, the evader herds it into that corner and pins it there (too close).
-  Herding from wherever the pursuer was after 2,500 steps dragged it round the map and
-  escaped (occluded) 1 D / V_e later. The trigger is game time, not steps: at twice the
+  ``HERD_AFTER`` D / V_e of it, from the first step the pursuer is within L_max of a
+  concave corner, the evader herds it toward that corner, and escapes (occluded, at
+  6.13 D / V_e). Herding from wherever the pursuer was after 2,500 steps dragged it
+  round the map and escaped (occluded) 1 D / V_e later than herding from within L_min
+  (pinned in the corner, too close, 5.54 D / V_e); but whether the pursuer came within
+  L_min of a corner was luck, and with the trail of n_cells + 1 crossings it never did
+  (test_evader_herd.py). The trigger is game time, not steps: at twice the
   step (dt 0.2 s) 2,500 steps of charging came after the 8 D / V_e horizon and the
   pursuer held.
 """
@@ -61,8 +64,7 @@ def test_herds_the_pursuer_into_a_corner_after_a_long_charge():
     r = run_episode(m, "pursuer/decomposition", ev, 507, start="safe", overrides=params,
                     max_cycles=_horizon(m, 0.3, 7.0))  # fmt: skip
     assert r.winner == "evader", r.summary()
-    assert r.cause == "too_close", r.summary()  # pinned in the corner
-    assert ev._pressed > ev._herd_after  # it escaped herding
+    assert ev._herding and ev._pressed > ev._herd_after  # it escaped herding
 
 
 def test_herds_after_a_charge_of_three_crossings_in_game_time():

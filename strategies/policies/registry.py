@@ -65,12 +65,25 @@ class PolicySpec:
 _REGISTRY: dict[str, PolicySpec] = {}
 
 
+_FACTORY_SHAPE = (
+    "a class or function called as factory(name=NAME, **params), e.g. a BasePolicy "
+    "subclass with def __init__(self, *, name=None, gain: float = 1.0)"
+)
+
+
 def register_policy(name: str, factory: Callable[..., BasePolicy], description: str) -> None:
     """Register ``factory`` under ``name`` (``ROLE/KIND``).
 
+    :func:`make_policy` calls ``factory(name=NAME, **params)``: the factory takes ``name``
+    by keyword (or ``**kwargs``), and its parameters are its keyword-only ones, each with a
+    default (their annotations or defaults give the types :func:`make_policy` checks).
+
     Raises:
-        InvalidConfigError: malformed or duplicate name.
+        InvalidConfigError: malformed or duplicate name; a factory that is not callable,
+            does not take ``name=``, or has a parameter without a default (it could not be
+            built by name).
     """
+    name = validation.string("policy name", name)
     role, _, kind = name.partition("/")
     if role not in ROLES or not kind or SB3_PREFIX in kind:
         raise InvalidConfigError(
@@ -78,14 +91,44 @@ def register_policy(name: str, factory: Callable[..., BasePolicy], description: 
         )
     if name in _REGISTRY:
         raise InvalidConfigError(f"policy {name!r} is already registered")
+    if not callable(factory):
+        raise InvalidConfigError(
+            f"policy {name!r}: factory = {factory!r}: expected {_FACTORY_SHAPE}"
+        )
     try:
         sig = inspect.signature(factory, eval_str=True)
     except (NameError, TypeError):  # an annotation that cannot be evaluated here
         sig = inspect.signature(factory)
+    _check_factory(name, factory, sig)
     keyword = [p for k, p in sig.parameters.items() if p.kind is p.KEYWORD_ONLY and k != "name"]
     params = {p.name: p.default for p in keyword}
     kinds = {p.name: _declared_type(p) for p in keyword}
     _REGISTRY[name] = PolicySpec(name, factory, description, params, kinds)
+
+
+def _check_factory(name: str, factory: Any, sig: inspect.Signature) -> None:
+    """Refuse a factory that :func:`make_policy` could not call (see :func:`register_policy`):
+    it was registered, and every ``make_policy(name)`` then raised a bare ``TypeError``."""
+    ps = sig.parameters.values()
+    takes_name = any(p.kind is p.VAR_KEYWORD for p in ps) or (
+        "name" in sig.parameters
+        and sig.parameters["name"].kind is not inspect.Parameter.POSITIONAL_ONLY
+    )
+    required = [
+        p.name
+        for p in ps
+        if p.default is p.empty
+        and p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD)
+        and p.name != "name"
+    ]
+    if not takes_name or required:
+        why = (
+            "does not take name=" if not takes_name else f"parameter(s) {required} have no default"
+        )
+        raise InvalidConfigError(
+            f"policy {name!r}: factory {getattr(factory, '__qualname__', factory)}{sig} {why}; "
+            f"expected {_FACTORY_SHAPE}"
+        )
 
 
 _CHECKABLE = (bool, int, float, str)
@@ -191,6 +234,11 @@ def make_policy(name: str, **params: Any) -> BasePolicy:
         if str(exc).startswith(f"policy {name!r}"):
             raise
         raise InvalidConfigError(f"policy {name!r}: {exc}") from None
+    if not (callable(getattr(policy, "reset", None)) and callable(getattr(policy, "act", None))):
+        raise InvalidConfigError(
+            f"policy {name!r}: its factory returned {type(policy).__name__} {policy!r:.60}, "
+            "not a policy (expected reset() and act() methods, e.g. a BasePolicy subclass)"
+        )
     policy.roles = (spec.role,)
     return policy
 

@@ -7,6 +7,7 @@ import pytest
 
 from envs.errors import InvalidConfigError, UnknownNameError
 from strategies.policies import Policy, describe_policy, make_policy, policy_names
+from strategies.policies.base import BasePolicy
 from tests.strategies.policies.conftest import state_observations
 
 ALL = policy_names()
@@ -122,3 +123,48 @@ def test_every_policy_class_is_registered_and_exercised():
     registered = {policy_spec(n).factory for n in ALL}
     assert classes <= registered, classes - registered
     assert {n.split("/")[0] for n in ALL} == {"pursuer", "evader"}
+
+
+class _UserPolicy(BasePolicy):
+    def _decide(self, snap):
+        return np.zeros(2)
+
+
+class _NoName(_UserPolicy):
+    def __init__(self):  # forgets name=
+        super().__init__()
+
+
+class _Required(_UserPolicy):
+    def __init__(self, gain, *, name=None):
+        super().__init__(name=name)
+
+
+class _NotAPolicy:
+    def __init__(self, *, name=None):
+        self.name = name
+
+
+def test_a_factory_make_policy_could_not_call_is_refused_when_registered(monkeypatch):
+    # each was registered, then every make_policy(name) raised a bare TypeError (a
+    # tournament naming it died with a traceback); a non-str name raised AttributeError
+    from strategies.policies import registry
+
+    monkeypatch.setattr(registry, "_REGISTRY", dict(registry._REGISTRY))
+    cases = [
+        ("evader/u1", lambda: _UserPolicy(), "does not take name="),
+        ("evader/u2", _NoName, "does not take name="),
+        ("evader/u3", _Required, r"parameter\(s\) \['gain'\] have no default"),
+        ("evader/u4", 5, "factory = 5: expected a class or function"),
+        (5, _UserPolicy, "policy name = 5: expected a non-empty string"),
+    ]
+    for name, factory, message in cases:
+        with pytest.raises(InvalidConfigError, match=message):
+            registry.register_policy(name, factory, "a user's policy")
+    registry.register_policy("evader/u5", _NotAPolicy, "a user's non-policy")
+    with pytest.raises(InvalidConfigError, match=r"returned _NotAPolicy .* not a policy"):
+        make_policy("evader/u5")
+    # the documented shapes register and build
+    registry.register_policy("evader/u6", _UserPolicy, "a user's policy")
+    registry.register_policy("evader/u7", lambda **kw: _UserPolicy(**kw), "a lambda")
+    assert make_policy("evader/u6").name == "evader/u6" and make_policy("evader/u7")

@@ -74,6 +74,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
         "cells per L_min (default 6 8) and print its shares and its contested share (the "
         "resolution error); with --classify, the start's estimated label too",
     )
+    p.add_argument(
+        "--no-pursuer-fallback",
+        action="store_true",
+        help="keep the default pursuer lattice even when it certifies nothing (by default "
+        "the pursuer bound is then solved once more one cell finer, and kept if it certifies; "
+        "rho < 0.35 only)",
+    )
     p.add_argument("--no-cache", action="store_true", help="neither read nor write the cache")
     p.set_defaults(func=run)
     return p
@@ -138,7 +145,12 @@ def run(args: argparse.Namespace) -> int:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", VacuousBoundWarning)  # the summary says it below
         with MemoryBudgetError.naming("--cells-per-lmin"):  # this command's flag
-            ref = referee_for(cfg, args.cells_per_lmin, cache=not args.no_cache)
+            ref = referee_for(
+                cfg,
+                args.cells_per_lmin,
+                cache=not args.no_cache,
+                pursuer_fallback=not args.no_pursuer_fallback,
+            )
     s = ref.summary()
     if s["starts"] == 0:  # nothing to report, classify or sample: say what resolution has some
         raise InvalidConfigError(_no_starts(ref, args.cells_per_lmin, cfg.dt))
@@ -157,6 +169,12 @@ def run(args: argparse.Namespace) -> int:
             f"{b['tau']:.4g} s, {b['states']} states, {b['iterations']} sweeps, "
             f"{b['seconds']['build'] + b['seconds']['solve']:.1f} s"
         )
+        fell = b.get("fallback_from")
+        if fell is not None:
+            print(
+                f"    (the default lattice {fell['spacing']:.4g}, step {fell['tau']:.4g} s, "
+                f"certified no state: this is the fallback, pursuer_coarse = {b['coarse']})"
+            )
     vacuous = s["pursuer_bound"]["vacuous"]
     if vacuous is not None:
         print(f"  the pursuer wins above say nothing: {vacuous}")

@@ -107,15 +107,75 @@ displacement every step. Two regimes follow (:func:`vacuity` names them, and
   l_hall                    0.2           3, 4, 5, 6 (3 spacings)       0 %
   20 m room, 2 m pillar     0.1           4, 1.5 s (the default)        0 % (3.5 from
   3 from a wall                                                         it: 98.2 %)
-  maze, office, pillars,    0.1 / 0.2 /   4 (the default), 3            0 %
-  two_rooms (passages 1-3)  0.3
+  maze, office, pillars,    0.1 / 0.2 /   4 (the default), 2, 3; at 8   0 %
+  two_rooms (passages 1-3)  0.3           cells per L_min 2 (the
+                                          default), 3
+  pillars, the room grown   0.1           4, 1.5 s (the default)        92.5 % (by 1: 0 %)
+  by 2 on every side
+  maze scaled x3, L kept    0.1           8 cells per L_min, 2, 1.5 s   92.0 % (x2: 0 %)
   corridor / open_room      0.1           4, 1.5 s (the default)        97.4 / 99.7 %
   ========================  ============  ============================  ==============
 
-  So 0 % on such a map at low rho is this abstraction's blind spot, not a finding about
-  the game; ``solve(..., pursuer_coarse=3)`` may certify where the default does not, at
-  about the default's cost (its pursuer bound 2.6 s on the corner, 3.5 s on l_hall at
-  rho = 0.1).
+  The four maps at the foot of the table are not one case (helper-107):
+
+  * **two_rooms: the game's answer.** Its corridor (6 long, 1 wide, below L_min) lets the
+    evader stand 3 deep; a pursuer within L_max = 4 must then follow it in, behind it, and
+    the evader rounds a mouth corner within its body radius 0.1 of the vertex, where the
+    pursuer would need ``V_e (L - l) / l`` = 1.9 V_p at rho = 0.1, L = 2 (it holds the
+    contact only if ``l >= rho L / (1 + rho)``, 0.18; THEORY.md 3 and 5.4). The shooting
+    evader escapes every two_rooms and office episode of the benchmarks (rho 0.3 - 0.95).
+  * **office** (doors 2 wide in walls 0.3 thick): at rho = 0.3 consistent with the game
+    (those episodes); at rho = 0.1 undecided.
+  * **pillars: the blind spot.** Its pillars stand 2.5 - 3 from the walls (one pillar 3
+    from a wall certifies nothing, 3.5 from it 98 %); grown by 2 on every side, the same
+    pillars certify 92.5 %. The first states lost are the evader's cells near a pillar's
+    vertex, e.g. pursuer (2.5, 6), evader's cell (2.5, 9.5), 0.5 below the diamond's left
+    vertex: every move's successor cell (2.5, 9.75) holds the vertex in its disc (0.25
+    from its centre, radius 0.18 + 0.15), and the wedge behind the vertex, from which no
+    rod grazes it, is 2.8 away (two steps). The real evader needs three steps to reach
+    the vertex. A pursuer strategy that holds at rho = 0.5 holds at 0.1 (the slower
+    evader is one of the faster one's options): the decomposition pursuer holds 63 of
+    bench (1)'s 64 pillars episodes at rho = 0.5.
+  * **maze** (corridors 2.5 wide): narrower than ``2 L_min + 2 r``, so no pursuer, real
+    or the bound's, passes the evader there; scaled x3 with L kept it certifies 92 %, and
+    the decomposition pursuer holds 60 of bench (1)'s 64 maze episodes at rho = 0.5. Likely
+    the blind spot; not proven.
+
+  So 0 % on such a map at low rho is this abstraction's blind spot or the game's answer,
+  never a finding by itself. :func:`~strategies.referee.referee.solve` falls back to
+  ``pursuer_coarse`` one less when the default lattice certifies no state at ``rho <``
+  :data:`VACUOUS_RHO` (``pursuer_fallback``, on by default; the bound it keeps names the
+  default in ``fallback_from``). Measured (16 cells per L_min, dt = 0.1 as the policies
+  and ``surveil referee`` solve, the pursuer bound's seconds on a shared machine):
+
+  ===================  =====  ==================  =====================  ===========
+  map                  rho    default: 4, 1.5 s   fallback: 3, 1.2 s     its solve /
+                              (solve)             (solve)                the default's
+  ===================  =====  ==================  =====================  ===========
+  corner               0.1    0 % (5.2 s)         93.5 % (6.6 s), kept   1.26
+  l_hall               0.1    0 % (10.4 s)        96.2 % (7.0 s), kept   0.67
+  open_room            0.3    0 % (2.4 s)         98.1 % (1.5 s), kept   0.60
+  corridor             0.3    0 % (3.3 s)         92.2 % (3.6 s), kept   1.10
+  open_room, corridor  0.1    99.7, 97.4 %        not solved             0
+  corner / l_hall      0.3    0 % (3.1 / 7.7 s)   0 % (6.6 / 17.5 s)     2.13 / 2.28
+  two_rooms            0.1 /  0 % (6.9 / 5.6 s)   0 % (23.4 / 13.0 s)    3.40 / 2.30
+                       0.3
+  pillars              0.1 /  0 % (16.5 / 9.8)    0 % (46.9 / 20.4)      2.85 / 2.08
+                       0.3
+  maze                 0.1 /  0 % (22.3 / 20.1)   0 % (45.0 / 30.6)      2.02 / 1.53
+                       0.3
+  office               0.1 /  0 % (29.2 / 26.7)   0 % (60.9 / 46.2)      2.09 / 1.73
+                       0.3
+  every map            0.5    any (rho >= 0.35)   not solved             0
+  ===================  =====  ==================  =====================  ===========
+
+  So where it certifies it costs about the default's solve; where it does not, 1.5 - 3.4
+  times it, once (both are cached). At 24 cells per L_min (:func:`solve`'s own default)
+  it does not help the corner at rho = 0.1: coarse 6 (the default), 5 and 4 all certify
+  0 %. From a default of 2 cells (8 cells per L_min) it is not tried: coarse 1 has four
+  times the points, and its solve took 4 - 12 times the default's on the corner, l_hall,
+  corridor and two_rooms (rho 0.1 / 0.3) for nothing; it certified only the open room at
+  rho = 0.3 (98 %).
 """
 
 from __future__ import annotations
@@ -157,6 +217,9 @@ class PursuerBound(SolvedBound):
         choice: (n_points, W, W) int16, a winning move of each winning state (-1 elsewhere).
         iterations: fixed-point sweeps until nothing changed.
         seconds: wall time of the build and of the fixed point.
+        fallback_from: the resolution of the default lattice when it certified no state and
+            :func:`~strategies.referee.referee.solve` fell back to this bound's finer one
+            (``pursuer_fallback``); None when this is the lattice asked for. Not cached.
     """
 
     role: ClassVar[str] = "pursuer"
@@ -166,6 +229,7 @@ class PursuerBound(SolvedBound):
     choice: np.ndarray
     iterations: int
     seconds: dict[str, float]
+    fallback_from: Resolution | None = None
 
     # ------------------------------------------------------------------ queries
     @property

@@ -18,18 +18,23 @@ import math
 import os
 import warnings
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 
 from envs import validation as V
-from envs.errors import InvalidConfigError, InvalidPlacementError, VacuousBoundWarning
+from envs.errors import (
+    InvalidConfigError,
+    InvalidPlacementError,
+    MemoryBudgetError,
+    VacuousBoundWarning,
+)
 from envs.geometry import kernel_for
 from strategies.referee._budget import SolveSize, bound_size, check_budget
 from strategies.referee.cache import cache_path, load_arrays, save_arrays
 from strategies.referee.evader_bound import EvaderBound, solve_evader_bound
-from strategies.referee.pursuer_bound import PursuerBound, solve_pursuer_bound
+from strategies.referee.pursuer_bound import VACUOUS_RHO, PursuerBound, solve_pursuer_bound
 from strategies.referee.spec import GameSpec, Resolution
 
 __all__ = [
@@ -41,6 +46,7 @@ __all__ = [
     "check_start",
     "coarsest_with_starts",
     "label_starts",
+    "pursuer_fallback_resolution",
     "referee_for",
     "sample_starts",
     "solve",
@@ -278,7 +284,10 @@ class Referee:
         ``gap`` is the fraction of starts neither bound certifies: the resolution error.
         ``pursuer_bound["vacuous"]`` says why the pursuer wins say nothing here (the range
         band is used up, rho is in the regime where the bound was measured to certify
-        nothing, or it certified no state; :meth:`PursuerBound.vacuity`), None otherwise.
+        nothing, or it certified no state; :meth:`PursuerBound.vacuity`), None otherwise;
+        ``pursuer_bound["fallback_from"]`` is the default lattice (``coarse, spacing,
+        tau``) when it certified no state and :func:`solve` fell back to a finer one
+        (``pursuer_fallback``), None otherwise.
         """
         starts = self.lattice_starts(margin=margin)
         fr = starts.fractions()
@@ -298,6 +307,14 @@ class Referee:
                 "iterations": pb.iterations,
                 "seconds": dict(pb.seconds),
                 "vacuous": pb.vacuity(),
+                "coarse": pb.res.coarse,
+                "fallback_from": None
+                if pb.fallback_from is None
+                else {
+                    "coarse": pb.fallback_from.coarse,
+                    "spacing": pb.fallback_from.spacing,
+                    "tau": pb.fallback_from.tau,
+                },
             },
             "evader_bound": {
                 "cell": eb.res.cell,
@@ -348,6 +365,7 @@ def solve(
     evader_steps: float = 2.0,
     sweep_pieces: int = 2,
     dt: float | None = None,
+    pursuer_fallback: bool = True,
     cache: bool = True,
     cache_dir: str | os.PathLike | None = None,
     progress: bool = False,
@@ -378,7 +396,11 @@ def solve(
     default lattice, tau = 1.5 s; 98 % with ``pursuer_coarse=2``, tau = 0.8 s), and far
     below it where the pursuer must pass the evader in a narrow passage (the corner world's
     5 m arms at rho = 0.1: 0 % at the default lattice, 93 % with ``pursuer_coarse=3``); see
-    :mod:`strategies.referee.pursuer_bound`. Then its pursuer wins mean "unknown", and
+    :mod:`strategies.referee.pursuer_bound`. When the default lattice certifies no state at
+    rho < :data:`VACUOUS_RHO`, the pursuer bound is solved once more one cell finer
+    (``pursuer_fallback``) and kept if it certifies some state: at 16 cells per L_min it
+    recovers the corner and the l_hall at rho = 0.1 and the open room at rho = 0.3. A pursuer
+    bound that still certifies nothing means "unknown", and
     :class:`~envs.errors.VacuousBoundWarning` says so, with the numbers.
 
     Args:
@@ -392,6 +414,11 @@ def solve(
         evader_steps: lattice spacings the evader covers per step (evader bound).
         sweep_pieces: pieces per step of the pursuer bound's sweep test.
         dt: round each ``tau`` up to a whole number of this env step (for referee policies).
+        pursuer_fallback: when the default pursuer lattice (``pursuer_coarse=None``, 3
+            cells or more) certifies no state at ``rho <`` :data:`VACUOUS_RHO`, solve the
+            pursuer bound once more with ``pursuer_coarse`` one less (finer, a shorter step) and
+            keep it if it certifies some state (:func:`pursuer_fallback_resolution`; its
+            ``fallback_from`` names the default lattice). False: the default lattice only.
         cache: read and write the on-disk cache.
         cache_dir: cache directory (default ``$SURVEIL_CACHE_DIR`` or ``~/.cache/surveil``).
         progress: print the fixed points' progress.
@@ -410,6 +437,7 @@ def solve(
     if not isinstance(spec, GameSpec):
         raise InvalidConfigError(f"solve: expected a GameSpec, got {type(spec).__name__}")
     cells_per_lmin = V.positive("cells_per_lmin", cells_per_lmin)
+    pursuer_fallback = V.boolean("pursuer_fallback", pursuer_fallback)
     knobs = dict(pursuer_coarse=pursuer_coarse, evader_coarse=evader_coarse,
                  pursuer_steps=pursuer_steps, evader_steps=evader_steps,
                  sweep_pieces=sweep_pieces, dt=dt)  # fmt: skip
@@ -431,15 +459,81 @@ def solve(
         cells_per_lmin=cells_per_lmin,
     )
     kw = dict(cache=cache, cache_dir=cache_dir, progress=progress, memory_budget=budget)
-    ref = Referee(
-        spec=spec,
-        pursuer=cached_pursuer_bound(spec, rp, **kw),
-        evader=cached_evader_bound(spec, re, **kw),
+    pursuer, tried = _pursuer_bound(
+        spec, rp, cells_per_lmin, knobs, kw, pursuer_fallback, [bound_size(spec, re, "evader")]
     )
-    reason = ref.pursuer.vacuity()
-    if reason is not None:
-        warnings.warn(f"map {spec.map.name!r}: {reason}", VacuousBoundWarning, stacklevel=2)
+    ref = Referee(spec=spec, pursuer=pursuer, evader=cached_evader_bound(spec, re, **kw))
+    _warn_vacuous(spec, pursuer, tried)
     return ref
+
+
+def pursuer_fallback_resolution(
+    spec: GameSpec, bound: PursuerBound, cells_per_lmin: float, **knobs: Any
+) -> Resolution | None:
+    """The pursuer lattice :func:`solve` retries when ``bound``, solved at its default
+    lattice, certified no state: ``pursuer_coarse`` one less (spacing ``(c - 1) h``, step
+    ``tau`` shorter in proportion). None when no retry applies: ``knobs`` set
+    ``pursuer_coarse`` (a lattice asked for is kept), the bound certified some state,
+    ``rho >=`` :data:`VACUOUS_RHO` (where every lattice tried certified nothing), or the
+    default lattice is two cells or fewer (coarse 1 has four times the points: at 8 cells
+    per L_min its solve took 4 - 12 times the default's, and certified only the open room
+    at rho = 0.2 / 0.3 of the built-in maps tried).
+
+    Why one less: where the evader must be passed in a passage (the corner world's 5 m arms,
+    the l_hall's pillar at rho = 0.1) or herds the pursuer in the open (the empty room at
+    rho = 0.3), the default lattice certifies nothing and ``pursuer_coarse`` one less
+    certifies 92-98 % at 16 cells per L_min, for about the default's solve time (0.6 -
+    1.3 times it); maps where neither certifies pay 1.5 - 3.4 times it for nothing, once
+    (:mod:`strategies.referee.pursuer_bound`'s tables).
+
+    Args:
+        spec, cells_per_lmin: as :func:`solve`.
+        bound: the pursuer bound solved at the default lattice.
+        **knobs: :func:`solve`'s ``pursuer_coarse, pursuer_steps, sweep_pieces, dt``.
+    """
+    if knobs.get("pursuer_coarse") is not None or bound.win.any():
+        return None
+    if spec.rho >= VACUOUS_RHO or bound.res.coarse <= 2:
+        return None
+    knobs = {**knobs, "pursuer_coarse": bound.res.coarse - 1}
+    return _resolution(spec, "pursuer", cells_per_lmin, **knobs)
+
+
+def _pursuer_bound(spec, res, cpl, knobs, kw, fallback, after=()):
+    """The pursuer bound at ``res`` and, when it certifies nothing and ``fallback``
+    allows, at :func:`pursuer_fallback_resolution` (kept if it certifies some state).
+
+    Returns:
+        ``(bound, tried)``: when the fallback was not kept, ``tried`` is its resolution and
+        why (it certified nothing, or its solve would exceed the memory budget with
+        ``after``, the sizes of the solves that follow it), else None.
+    """
+    bound = cached_pursuer_bound(spec, res, **kw)
+    alt = pursuer_fallback_resolution(spec, bound, cpl, **knobs) if fallback else None
+    if alt is None:
+        return bound, None
+    try:
+        check_budget("the pursuer bound's fallback", [bound_size(spec, alt, "pursuer"), *after],
+                     kw["memory_budget"])  # fmt: skip
+    except MemoryBudgetError:  # the default's 0 % stands, as without the fallback
+        return bound, (alt, "its solve would exceed the memory budget")
+    other = cached_pursuer_bound(spec, alt, **kw)
+    if not other.win.any():
+        return bound, (alt, "it certified no state either")
+    return replace(other, fallback_from=bound.res), None
+
+
+def _warn_vacuous(spec: GameSpec, bound: PursuerBound, tried) -> None:
+    reason = bound.vacuity()
+    if reason is None:
+        return
+    if tried is not None:
+        alt, why = tried
+        reason += (
+            f"; the fallback lattice (pursuer_coarse = {alt.coarse}, spacing "
+            f"{alt.spacing:.4g}, step {alt.tau:.4g} s) was not kept: {why}"
+        )
+    warnings.warn(f"map {spec.map.name!r}: {reason}", VacuousBoundWarning, stacklevel=3)
 
 
 def _resolution(
@@ -547,6 +641,7 @@ def solve_role(
     cells_per_lmin: float = 24.0,
     *,
     dt: float | None = None,
+    pursuer_fallback: bool = True,
     cache: bool = True,
     cache_dir: str | os.PathLike | None = None,
     progress: bool = False,
@@ -558,7 +653,8 @@ def solve_role(
     at the resolution :func:`solve` gives it, from the same cache.
 
     Args:
-        spec, cells_per_lmin, dt, cache, cache_dir, progress: as :func:`solve`.
+        spec, cells_per_lmin, dt, pursuer_fallback, cache, cache_dir, progress: as
+            :func:`solve` (the pursuer bound falls back as there).
         role: ``"pursuer"`` or ``"evader"``.
         memory_budget: as :func:`solve`, for this one solve.
         **knobs: :func:`solve`'s ``pursuer_coarse, evader_coarse, pursuer_steps,
@@ -576,6 +672,7 @@ def solve_role(
     if role not in ("pursuer", "evader"):
         raise InvalidConfigError(f"role = {role!r}: expected 'pursuer' or 'evader'")
     cells_per_lmin = V.positive("cells_per_lmin", cells_per_lmin)
+    pursuer_fallback = V.boolean("pursuer_fallback", pursuer_fallback)
 
     def sizes(cpl: float) -> list[SolveSize]:
         return [bound_size(spec, _resolution(spec, role, cpl, dt=dt, **knobs), role)]
@@ -592,10 +689,10 @@ def solve_role(
     kw = dict(cache=cache, cache_dir=cache_dir, progress=progress, memory_budget=budget)
     if role == "evader":
         return cached_evader_bound(spec, res, **kw)
-    bound = cached_pursuer_bound(spec, res, **kw)
-    reason = bound.vacuity()
-    if reason is not None:
-        warnings.warn(f"map {spec.map.name!r}: {reason}", VacuousBoundWarning, stacklevel=2)
+    bound, tried = _pursuer_bound(
+        spec, res, cells_per_lmin, {**knobs, "dt": dt}, kw, pursuer_fallback
+    )
+    _warn_vacuous(spec, bound, tried)
     return bound
 
 

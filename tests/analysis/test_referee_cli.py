@@ -41,6 +41,28 @@ def test_referee_summary_flags_a_pursuer_bound_that_certified_nothing(capsys, mo
     assert "pursuer wins 0.0%" in text and "say nothing" in text and "certified no state" in text
 
 
+def test_referee_summary_names_the_pursuer_lattice_it_fell_back_to(capsys, monkeypatch):
+    """At 16 cells per L_min the default pursuer lattice (spacing 0.5, step 1.5 s) certifies
+    no state of the open room at rho = 0.3; the fallback one cell finer (0.375, 1.2 s)
+    certifies most starts, and the summary says which lattice it is;
+    --no-pursuer-fallback keeps the default's 0 %, with its note."""
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", "/nonexistent")
+    base = ["referee", "open_room", "--config", '{"v_evader": 0.3}', "--no-cache"]
+    assert main(base) == 0
+    text = capsys.readouterr().out.splitlines()
+    assert "pursuer wins 89.6%" in text[1]
+    assert text[2].startswith("  pursuer bound: cell 0.125, lattice 0.375, step 1.2 s")
+    assert text[3] == (
+        "    (the default lattice 0.5, step 1.5 s, certified no state: this is the fallback, "
+        "pursuer_coarse = 3)"
+    )
+    assert "say nothing" not in "\n".join(text)
+    assert main([*base, "--no-pursuer-fallback"]) == 0
+    text = capsys.readouterr().out
+    assert "pursuer wins 0.0%" in text and "lattice 0.5, step 1.5 s" in text
+    assert "say nothing" in text and "fallback" not in text
+
+
 def test_referee_estimate_is_printed_beside_the_certificates(capsys, monkeypatch):
     monkeypatch.setenv("SURVEIL_CACHE_DIR", "/nonexistent")
     argv = ["referee", "open_room", "--config", '{"v_evader": 0.2}', "--cells-per-lmin", "8",

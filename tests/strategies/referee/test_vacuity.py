@@ -83,12 +83,14 @@ def test_narrow_passages_at_low_rho_and_the_lattice_that_certifies():
     """pursuer_bound's docstring and the README: far below VACUOUS_RHO the bound certifies
     nothing on the corner world (arms 5 wide, which a real pursuer circling the evader at
     L_min passes up to rho = 0.112) at rho = 0.1 at the default lattice, and warns so;
-    pursuer_coarse=3 certifies 93 % of the states there (helper-105's measurements)."""
+    pursuer_coarse=3 certifies 93 % of the states there (helper-105's measurements), and
+    is what solve falls back to (pursuer_fallback, on by default)."""
     corner = GameSpec(builtin_map("corner"), 2.0, 4.0, 1.0, 0.1, body_radius=0.1)
     with pytest.warns(VacuousBoundWarning, match="certified no state"):
-        default = solve_role(corner, "pursuer", 16, cache=False)
+        default = solve_role(corner, "pursuer", 16, cache=False, pursuer_fallback=False)
     assert default.res.coarse == 4 and default.fraction() == 0.0
     with warnings.catch_warnings():
         warnings.simplefilter("error", VacuousBoundWarning)
-        coarse3 = solve_role(corner, "pursuer", 16, pursuer_coarse=3, cache=False)
-    assert coarse3.fraction() == pytest.approx(0.932, abs=0.005)
+        fallen = solve_role(corner, "pursuer", 16, cache=False)
+    assert fallen.res.coarse == 3 and fallen.fallback_from == default.res
+    assert fallen.fraction() == pytest.approx(0.932, abs=0.005)

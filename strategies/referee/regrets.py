@@ -236,7 +236,9 @@ def tournament_regret(
         note row when a game's pursuer bound is vacuous (a
         :class:`~envs.errors.VacuousBoundWarning`: at rho = 0.5 its pursuer rows count no
         certified start because the bound certifies none, not because none is winnable),
-        then one when matches were left out.
+        then one when a game's pursuer bound is the fallback lattice (the default one
+        certified no state; :func:`~strategies.referee.referee.solve`'s
+        ``pursuer_fallback``), then one when matches were left out.
 
     Raises:
         InvalidConfigError: with ``strict``, a match whose game cannot be rebuilt.
@@ -255,10 +257,11 @@ def tournament_regret(
             if strict:
                 raise
             skipped.append(str(exc))
+    referees: dict = {}
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", VacuousBoundWarning)
-        results = regret(matches, cells_per_lmin=cells_per_lmin, cache=cache,
-                         cache_dir=cache_dir, progress=progress)  # fmt: skip
+        results = regret(matches, cells_per_lmin=cells_per_lmin, referees=referees,
+                         cache=cache, cache_dir=cache_dir, progress=progress)  # fmt: skip
     for w in caught:  # other warnings go on as they came
         if not issubclass(w.category, VacuousBoundWarning):
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
@@ -269,6 +272,16 @@ def tournament_regret(
         note = (f"pursuer regret: in {len(vacuous)} game(s) the pursuer bound certifies "
                 f"nothing informative, so their starts count as unknown, not as winnable: "
                 f"{vacuous[0]}")  # fmt: skip
+        table.append(["-", note, *[""] * (len(table[0]) - 2)])
+    fell = [ref.pursuer for ref in referees.values() if ref.pursuer.fallback_from is not None]
+    if fell:
+        pb = fell[0]
+        note = (f"pursuer regret: in {len(fell)} game(s) the default pursuer lattice certified "
+                f"no state and the referee's is one cell finer (solve's pursuer_fallback), e.g. "
+                f"map {pb.spec.map.name!r} at rho = {pb.spec.rho:.3g}: pursuer_coarse = "
+                f"{pb.res.coarse} (spacing {pb.res.spacing:.4g}, step {pb.res.tau:.4g} s) for "
+                f"{pb.fallback_from.coarse} (spacing {pb.fallback_from.spacing:.4g}, step "
+                f"{pb.fallback_from.tau:.4g} s)")  # fmt: skip
         table.append(["-", note, *[""] * (len(table[0]) - 2)])
     if skipped:
         note = f"{len(skipped)} matches not counted: {skipped[0]}"

@@ -153,6 +153,27 @@ def test_tournament_regret_redraws_the_runners_start_from_the_seed(monkeypatch):
     assert len(table) == 4 and "certified no state" in table[3][1]
 
 
+def test_tournament_regret_names_a_pursuer_lattice_the_referee_fell_back_to():
+    """The open room at rho = 0.3, 16 cells per L_min: the default pursuer lattice
+    certifies no state, solve falls back to one cell finer (98 %), and a note row says
+    which lattice the pursuer rows were counted on."""
+    rows = []
+    for seed in (0, 1):
+        r = run_episode("open_room", "pursuer/greedy", "evader/straight", seed, max_cycles=50,
+                        overrides={"v_evader": 0.3}, start="valid")  # fmt: skip
+        rows.append({"status": "ok", "winner": r.winner, "pursuer": r.pursuer,
+                     "evader": r.evader, "record": json.dumps(r.to_record())})  # fmt: skip
+    spec = {"maps": [{"label": "open_room", "source": "open_room"}]}
+    table = tournament_regret(spec, rows, cells_per_lmin=16, cache=False)
+    notes = [row[1] for row in table if row[0] == "-"]
+    assert notes == [
+        "pursuer regret: in 1 game(s) the default pursuer lattice certified no state and the "
+        "referee's is one cell finer (solve's pursuer_fallback), e.g. map 'open_room' at "
+        "rho = 0.3: pursuer_coarse = 3 (spacing 0.375, step 1.2 s) for 4 (spacing 0.5, "
+        "step 1.5 s)"
+    ]
+
+
 def test_tournament_regret_refuses_a_changed_map(corridor_half):
     rows = [{"status": "ok", "winner": "pursuer", "pursuer": "a", "evader": "b",
              "map": "m", "variant": "", "start": "valid", "seed": 0}]  # fmt: skip

@@ -168,3 +168,16 @@ def test_a_factory_make_policy_could_not_call_is_refused_when_registered(monkeyp
     registry.register_policy("evader/u6", _UserPolicy, "a user's policy")
     registry.register_policy("evader/u7", lambda **kw: _UserPolicy(**kw), "a lambda")
     assert make_policy("evader/u6").name == "evader/u6" and make_policy("evader/u7")
+
+
+def test_the_readmes_own_policy_example_runs(monkeypatch, capsys):
+    """README, Policies: the example of a user's policy registers and plays as written."""
+    from pathlib import Path
+
+    from strategies.policies import registry
+
+    text = (Path(__file__).parents[3] / "README.md").read_text(encoding="utf-8")
+    start = text.index("```python", text.index("Your own policy:")) + len("```python")
+    monkeypatch.setattr(registry, "_REGISTRY", dict(registry._REGISTRY))
+    exec(compile(text[start : text.index("```", start)], "README.md", "exec"), {})
+    assert "corridor: pursuer/decomposition vs evader/away (seed 0)" in capsys.readouterr().out

@@ -34,8 +34,9 @@ For rho > 1 it runs straight at the pursuer (footnote 4; see :meth:`ShootingEvad
    minimising max |theta_dot|); against a wall, slide along it perpendicular to the rod,
    the way that does not press straight into the wall. After ``HERD_AFTER`` D / V_e of it
    (D the map's diameter), from the first step the pursuer comes within L_max of a
-   concave corner, herd instead: get to the far side of the pursuer from that corner
-   (sliding along a wall in the way), then charge, pinning it there.
+   concave corner, herd instead: get to the far side of the pursuer from the nearest
+   concave corner for which that point is in sight (sliding along a wall it grazes),
+   then charge, pinning it there; with no such corner, charge.
 """
 
 from __future__ import annotations
@@ -402,8 +403,9 @@ class ShootingEvader(BasePolicy):
             if not self._herding:
                 d = self._concave - snap.pursuer
                 self._herding = float(np.einsum("ij,ij->i", d, d).min()) <= c.l_max**2
-            if self._herding:
-                h = self._herd(e, snap.pursuer, u, float(snap.L))
+            # (no corner whose far side is in sight: charge)
+            h = self._herd(e, snap.pursuer, u, float(snap.L)) if self._herding else None
+            if h is not None:
                 if self._near_wall(e, c.body_radius + 2.0 * c.v_evader * c.dt):
                     # pressed to a wall, as the charge below, the push is lost: the
                     # herd's target (the far side of the pursuer from the corner) can lie
@@ -445,18 +447,28 @@ class ShootingEvader(BasePolicy):
         nxt = plan.region_next[row]
         return unit(plan.points[nxt] - e) if nxt >= 0 else None
 
-    def _herd(self, e: np.ndarray, p: np.ndarray, u: np.ndarray, L: float) -> np.ndarray:
-        """Heading that pins the pursuer at ``p`` into its nearest concave corner: toward
-        the point at range ``L`` on the far side of the pursuer from the corner, and
-        straight at the pursuer (``u``) once the rod points within 18 degrees of the
-        corner."""
+    def _herd(self, e: np.ndarray, p: np.ndarray, u: np.ndarray, L: float) -> np.ndarray | None:
+        """Heading that pins the pursuer at ``p`` into a concave corner: toward the point at
+        range ``L`` on the far side of the pursuer from the corner, and straight at the
+        pursuer (``u``) once the rod points within 18 degrees of the corner. The nearest
+        corner for which that point is in sight of ``e``; ``None`` if none is.
+
+        A point out of sight is across a wall: heading for it pressed the evader to the
+        wall for the rest of the horizon (issue 13: office at half scale, rho 0.3, seed
+        909, the pursuer in a door and the evader against the wall beside it).
+        """
         d = self._concave - p
-        q = d[int(np.argmin(np.einsum("ij,ij->i", d, d)))]
-        n = unit(q)
-        if float(u @ n) > 0.95:
-            return u
-        to = p - L * n - e
-        return unit(to) if math.hypot(float(to[0]), float(to[1])) > 1e-9 else u
+        for i in np.argsort(np.einsum("ij,ij->i", d, d), kind="stable").tolist():
+            n = unit(d[i])
+            if float(u @ n) > 0.95:
+                return u
+            q = p - L * n
+            to = q - e
+            if math.hypot(float(to[0]), float(to[1])) <= 1e-9:
+                return u
+            if self.kernel.line_of_sight((float(e[0]), float(e[1])), (float(q[0]), float(q[1]))):
+                return unit(to)
+        return None
 
     def _along_wall(self, e: np.ndarray, h: np.ndarray, u: np.ndarray) -> np.ndarray:
         """Heading ``h`` with its component into the nearest wall removed (``e`` within a

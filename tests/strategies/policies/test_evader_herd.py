@@ -4,17 +4,20 @@ With the trail of ``n_cells + 1`` crossings (test_evader_escapes_trail.py) the e
 loses two escapes of the unseen-worlds benchmark that its charge and herd had won by
 luck, each against the decomposition pursuer at rho 0.3:
 
-* ``random:star:11`` [0.3, 1.5, 2] seed 507: from ~160 s the charge settles into a loop
-  (period ~51 s) in the open, the pursuer orbiting the evader; the herd started only
-  from a step where the pursuer came within L_min of a concave corner, which the old
-  path's orbit happened to do at ~360 s and the new one never does. Now it starts from
-  within L_max (the pursuer's leash): escaped 465.0 s (6.13 D / V_e).
+* ``random:star:11`` [0.3, 1.5, 2] seed 507: from ~170 s the charge settles into a loop
+  (period ~51 s, exact to 3e-4) in the open, the pursuer orbiting the evader; the herd
+  started only from a step where the pursuer came within L_min of a concave corner,
+  which the old path's orbit happened to do at ~360 s and the new one never does. Now
+  it starts within L_max (the rod's longest reach): escaped 465.0 s (6.13 D / V_e).
 * ``office`` at half scale [0.3, 2, 2] seed 909: the herd froze for the last 270 s of
-  the horizon with the evader pressed against a wall, its target (the far side of the
-  pursuer from the corner) across that wall. Now a herd heading into a wall slides
-  along it, as the charge does: escaped 531.9 s (5.53 D / V_e).
+  the horizon with the evader pressed against a wall below a door, the pursuer in the
+  door, the herd's target (the far side of the pursuer from the corner) across that
+  wall. A herd heading into a wall now slides along it (escaped 531.9 s, 5.53 D / V_e),
+  and the herd heads only for such a point in sight (the nearest corner that has one;
+  none: charge): escaped 469.7 s (4.89 D / V_e; the base's 227.1 s came from plan
+  crossings the trail now excludes).
 
-Both are decisions of the pressure branch, tested here from the frozen states.
+The decisions of the pressure branch are tested here from the frozen states.
 """
 
 from __future__ import annotations
@@ -30,15 +33,15 @@ from strategies.policies.base import Snapshot
 from strategies.policies.shooting import ShootingEvader
 
 
-def _pressing(m, params, seed=0) -> ShootingEvader:
-    """A shooting evader past its charge (``HERD_AFTER``) with no plan, shot or walk
-    (the pressure branch decides)."""
+def _pressing(m, params, seed=0, after=True) -> ShootingEvader:
+    """A shooting evader with no plan, shot or walk (the pressure branch decides), past
+    its charge (``HERD_AFTER``) if ``after``."""
     ev = ShootingEvader()
     ev.reset(role="evader", map=m, config=EnvConfig(map=m, **params), seed=seed)
     ev._plan_heading = lambda e, theta: None
     ev._best_candidate = lambda e, theta, in_sight=False: None
     ev._region_walk = lambda e: None
-    ev._pressed = math.ceil(ev._herd_after) + 1
+    ev._pressed = math.ceil(ev._herd_after) + 1 if after else 0
     return ev
 
 
@@ -49,22 +52,26 @@ def _snap(e, p) -> Snapshot:
 def test_a_herd_into_a_wall_slides_along_it():
     # office~x0.5, seed 909 with the n_cells + 1 trail, from 500 s to the horizon: the
     # evader at the west face (x = 5.925) of a wall below a door, the pursuer in the
-    # door, the herd's target east of the wall
+    # door, the herd's target east of the wall (now the herd heads only for a point in
+    # sight, test below; the slide remains for a disc that grazes a wall on its way)
     m = builtin_info("office").map.transformed(0.5 * np.eye(2))
     params = {"l_min": 1.0, "l_max": 2.0, "v_pursuer": 0.5, "v_evader": 0.15,
               "body_radius": 0.05}  # fmt: skip
     ev = _pressing(m, params)
-    ev._herding = True
     e, p = np.array([5.88, 5.935]), np.array([6.177, 6.933])
-    to = ev._herd(e, p, (p - e) / np.linalg.norm(p - e), float(np.linalg.norm(p - e)))
-    assert to[0] > 0.9  # the herd heads into the wall
-    v = ev._decide(_snap(e, p))
+    u = (p - e) / np.linalg.norm(p - e)
+    q = p - float(np.linalg.norm(p - e)) * np.array([-0.1, 1.067]) / math.hypot(-0.1, 1.067)
+    to = (q - e) / np.linalg.norm(q - e)
+    assert to[0] > 0.9  # heads into the wall
+    v = 0.15 * ev._along_wall(e, to, u)
     assert math.hypot(*v) == pytest.approx(0.15)
     assert v[0] <= 1e-12  # not into the wall (its face is x = 5.925)
     assert abs(v[1]) == pytest.approx(0.15)  # along it
     # the step keeps the evader's clearance (brute force: the distance to the walls)
     d0, d1 = m.distance_to_walls(np.stack([e, e + 0.1 * v]))
     assert d1 >= d0 - 1e-12
+    # a heading away from the wall is kept
+    assert np.array_equal(ev._along_wall(e, -to, u), -to)
 
 
 def test_the_herd_starts_within_l_max_of_a_concave_corner():
@@ -90,3 +97,32 @@ def test_the_herd_starts_within_l_max_of_a_concave_corner():
     v = ev._decide(_snap(e, p))
     assert not ev._herding
     assert np.allclose(v, [0.0, -0.3])
+
+
+def test_the_herd_heads_only_for_a_point_in_sight():
+    # office~x0.5, seed 909, with the herd started earlier (as soon as the charge loops,
+    # at 30 s; branch shooting-herd-loop): the evader north of the wall y = 3.075 beside a
+    # door (x 1.5-2.5), the pursuer in the door; the far side of the pursuer from its
+    # nearest corner, (0, 2.925), lies south of the wall, and the evader stayed at the
+    # wall for the rest of the horizon
+    m = builtin_info("office").map.transformed(0.5 * np.eye(2))
+    params = {"l_min": 1.0, "l_max": 2.0, "v_pursuer": 0.5, "v_evader": 0.15,
+              "body_radius": 0.05}  # fmt: skip
+    ev = _pressing(m, params)
+    e, p = np.array([2.5724, 3.147]), np.array([1.6021, 2.8386])
+    L = float(np.linalg.norm(p - e))
+    u = (p - e) / L
+    concave = m.vertices[~m.vertex_convex]
+    d = concave - p
+    n0 = d[np.argmin(np.einsum("ij,ij->i", d, d))]
+    n0 = n0 / np.linalg.norm(n0)
+    q0 = p - L * n0
+    assert not ev.kernel.line_of_sight(tuple(e), tuple(q0))  # across the wall
+    h = ev._herd(e, p, u, L)
+    assert h is None or not np.allclose(h, (q0 - e) / np.linalg.norm(q0 - e))
+    if h is not None:  # toward the far side of the pursuer from another corner, in sight
+        assert any(
+            np.allclose(h, (q - e) / np.linalg.norm(q - e))
+            and ev.kernel.line_of_sight(tuple(e), tuple(q))
+            for q in p - L * (concave - p) / np.linalg.norm(concave - p, axis=1)[:, None]
+        ) or np.allclose(h, u)

@@ -114,7 +114,8 @@ class Transition:
         step: index of the step (0 for the first).
         observations: ``{"pursuer": obs, "evader": obs}``, what each policy saw.
         state: the env's ``state()`` vector before the step (the ``"state"`` layout).
-        actions: ``{"pursuer": action, "evader": action}`` the policies returned.
+        actions: ``{"pursuer": action, "evader": action}`` the policies returned (float
+            copies, so a policy reusing its buffer does not rewrite earlier records).
         info: the env's info of the pursuer after the step (surveillance, distance...).
         done: the episode ended with this step.
     """
@@ -506,8 +507,9 @@ def run_episode(
             if not visible:
                 cause, feature = info.get("cause"), info.get("feature")
                 escape = float(info["break_at"])
-            if on_step is not None:
-                on_step(Transition(steps - 1, seen, state, actions, info, not env.agents))
+            if on_step is not None:  # copies: a policy may reuse its action's buffer
+                taken = {r: np.array(a, dtype=float) for r, a in actions.items()}
+                on_step(Transition(steps - 1, seen, state, taken, info, not env.agents))
             if time_limit is not None and env.agents:
                 if time.perf_counter() - t_start > time_limit:
                     blame = max(spent, key=spent.get)

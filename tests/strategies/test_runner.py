@@ -163,6 +163,29 @@ def test_actions_the_env_accepts_still_play():
         assert r.steps >= 1
 
 
+class _OneBuffer(BasePolicy):
+    """A user's policy that writes every action into the same array."""
+
+    def __init__(self):
+        super().__init__(name="one-buffer")
+        self.buf = np.zeros(2)
+
+    def act(self, observation):
+        self._steps += 1
+        self.buf[:] = (np.cos(self._steps), np.sin(self._steps))
+        return self.buf
+
+
+def test_recorded_actions_are_copies_of_what_each_step_took():
+    # a policy reusing its buffer made every recorded action the last one (DAgger datasets
+    # and other on_step consumers read corrupted actions without a word)
+    seen = []
+    r = run_episode(MAP, "pursuer/greedy", _OneBuffer(), seed=0, max_cycles=6, on_step=seen.append)
+    assert len(seen) == r.steps >= 3
+    for k, t in enumerate(seen):
+        assert np.allclose(t.actions["evader"], (np.cos(k + 1), np.sin(k + 1)))
+
+
 def test_time_limit_blames_the_slow_side():
     with pytest.raises(EpisodeTimeout) as info:
         run_episode(

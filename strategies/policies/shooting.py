@@ -200,6 +200,9 @@ class ShootingEvader(BasePolicy):
         self._forgiven = 0  # retries so far (each waits twice as long as the last)
         self._pressed = 0  # pressure steps so far
         self._herding = False  # herding the pursuer into a corner (from then on)
+        # the concave corner the herd headed for on the last step (-1: none, or that step
+        # did not herd)
+        self._herd_corner, self._herd_step = -1, -1
         # shots before the plan in cells whose rank guarantees nothing (from a dead end of
         # the plan until a shot has no candidate or the rank is a guarantee again)
         self._shoot_first = False
@@ -456,9 +459,26 @@ class ShootingEvader(BasePolicy):
         A point out of sight is across a wall: heading for it pressed the evader to the
         wall for the rest of the horizon (issue 13: office at half scale, rho 0.3, seed
         909, the pursuer in a door and the evader against the wall beside it).
+
+        The corner the herd headed for on the step before comes first while its point is
+        in sight: the nearest corner changes where the pursuer crosses the bisector of
+        two, and a herd pushing it toward one corner's far side pushed it across that
+        bisector, so a nearest-first choice each step flipped between the two and held
+        the pursuer on the bisector, away from both (issue 13: the same episode with the
+        decomposition pursuer of b78a617, from 560 s to the horizon on the midline of a
+        room between (12, 5.075) and (12, 8), the target flipping every 3 steps; keeping
+        the corner escaped at 538.9 s). A step that did not herd forgets it.
         """
         d = self._concave - p
-        for i in np.argsort(np.einsum("ij,ij->i", d, d), kind="stable").tolist():
+        order = np.argsort(np.einsum("ij,ij->i", d, d), kind="stable").tolist()
+        if self._herd_step != self._steps - 1:
+            self._herd_corner = -1
+        self._herd_step = self._steps
+        if self._herd_corner >= 0:
+            order.remove(self._herd_corner)
+            order.insert(0, self._herd_corner)
+        for i in order:
+            self._herd_corner = i
             n = unit(d[i])
             if float(u @ n) > 0.95:
                 return u
@@ -468,6 +488,7 @@ class ShootingEvader(BasePolicy):
                 return u
             if self.kernel.line_of_sight((float(e[0]), float(e[1])), (float(q[0]), float(q[1]))):
                 return unit(to)
+        self._herd_corner = -1
         return None
 
     def _along_wall(self, e: np.ndarray, h: np.ndarray, u: np.ndarray) -> np.ndarray:

@@ -126,3 +126,44 @@ def test_the_herd_heads_only_for_a_point_in_sight():
             and ev.kernel.line_of_sight(tuple(e), tuple(q))
             for q in p - L * (concave - p) / np.linalg.norm(concave - p, axis=1)[:, None]
         ) or np.allclose(h, u)
+
+
+def test_the_herd_keeps_its_corner_across_the_bisector():
+    # office~x0.5, seed 909 with f505ab4, 00e2260 and b78a617 together: from 560 s to the
+    # horizon the herd re-chose the nearest concave corner every step, and the pursuer
+    # sat on the room's midline y = 6.5375, halfway between the corners (12, 5.075) and
+    # (12, 8): each herd step toward the far side of the pursuer from one corner pushed
+    # it across the midline, nearer the other, and the target flipped every 3 steps
+    # (pursuer held to the horizon, 7692 steps). A herd now keeps the corner it headed
+    # for on the step before while that corner's point is in sight
+    m = builtin_info("office").map.transformed(0.5 * np.eye(2))
+    params = {"l_min": 1.0, "l_max": 2.0, "v_pursuer": 0.5, "v_evader": 0.15,
+              "body_radius": 0.05}  # fmt: skip
+    low, high = np.array([12.0, 5.075]), np.array([12.0, 8.0])
+    concave = m.vertices[~m.vertex_convex]
+    assert any(np.allclose(c, low) for c in concave) and any(np.allclose(c, high) for c in concave)
+
+    def toward(e, p, corner):
+        L = float(np.linalg.norm(p - e))
+        q = p - L * (corner - p) / np.linalg.norm(corner - p)
+        return 0.15 * (q - e) / np.linalg.norm(q - e)
+
+    def nearest(p):
+        return concave[int(np.argmin(np.linalg.norm(concave - p, axis=1)))]
+
+    e1, p1 = np.array([9.56, 6.37]), np.array([10.59, 6.53])  # below the midline
+    e2, p2 = np.array([9.58, 6.42]), np.array([10.61, 6.55])  # above it
+    assert np.allclose(nearest(p1), low) and np.allclose(nearest(p2), high)
+    ev = _pressing(m, params)
+    ev._herding = True
+    assert np.allclose(ev._decide(_snap(e1, p1)), toward(e1, p1, low))
+    ev._steps += 1  # the next step (BasePolicy.act counts them)
+    v = ev._decide(_snap(e2, p2))
+    assert np.allclose(v, toward(e2, p2, low))  # before: toward(e2, p2, high)
+    assert not np.allclose(v, toward(e2, p2, high))
+    # a herd that did not herd on the step before starts from the nearest corner again
+    ev = _pressing(m, params)
+    ev._herding = True
+    ev._decide(_snap(e1, p1))
+    ev._steps += 2
+    assert np.allclose(ev._decide(_snap(e2, p2)), toward(e2, p2, high))

@@ -58,6 +58,7 @@ from strategies.policies.base import (
     positive_param,
     unit,
 )
+from strategies.policies.baselines import nearest_wall_point
 from strategies.policies.escape_plan import escape_plan
 from strategies.policies.safety import NO_PATH, safety_table
 
@@ -495,12 +496,8 @@ class ShootingEvader(BasePolicy):
         """Heading ``h`` with its component into the nearest wall removed (``e`` within a
         step or two of it); where nothing is left (``h`` along the wall's normal), the
         pressure's slide perpendicular to the rod ``u``."""
-        m = self.map
-        rel = e[None, :] - m.edge_start
-        t = np.clip(np.einsum("ej,ej->e", rel, m.edge_dir), 0.0, m.edge_length)
-        off = rel - t[:, None] * m.edge_dir  # from each edge's nearest point to e
-        k = int(np.argmin(np.einsum("ej,ej->e", off, off)))
-        n = unit(off[k])
+        q, _ = nearest_wall_point(self.map, e)
+        n = unit(e - q)
         into = float(h @ n)
         if into >= 0.0:
             return h

@@ -31,9 +31,9 @@ def add_train_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentPar
     parser.add_argument(
         "--self-play",
         type=int,
-        default=0,
+        default=None,
         metavar="ROUNDS",
-        help="alternate ROUNDS rounds of pursuer/evader training instead of one run",
+        help="alternate ROUNDS (>= 1) rounds of pursuer/evader training instead of one run",
     )
     parser.add_argument("--progress", action="store_true", help="show SB3's progress bar")
     return parser
@@ -50,7 +50,8 @@ def run_train(args: argparse.Namespace) -> int:
         validation.integer("--timesteps", args.timesteps, minimum=1)
     if args.seed is not None:
         validation.integer("--seed", args.seed, minimum=0)
-    validation.integer("--self-play", args.self_play, minimum=0)
+    if args.self_play is not None:  # 0 ran one plain run without a word
+        validation.integer("--self-play", args.self_play, minimum=1)
     overrides = {}
     if args.output_dir is not None:
         overrides["output_dir"] = args.output_dir
@@ -59,7 +60,7 @@ def run_train(args: argparse.Namespace) -> int:
     config = load_any_config(args.config, **overrides)
     _check_output_dir(os.fspath(config.output_dir))
     if not isinstance(config, TrainConfig):  # a DAgger recipe
-        if args.timesteps is not None or args.self_play:
+        if args.timesteps is not None or args.self_play is not None:
             raise InvalidConfigError(
                 f"{args.config}: --timesteps and --self-play apply to RL configs; this is a "
                 "DAgger config (set iterations and episodes in the file)"
@@ -76,7 +77,7 @@ def run_train(args: argparse.Namespace) -> int:
         return 0
     if args.timesteps is not None:
         config = config.replace(total_timesteps=args.timesteps)
-    if args.self_play:
+    if args.self_play is not None:
         try:
             results = self_play(config, args.self_play, progress_bar=args.progress).stages
         except KeyboardInterrupt:

@@ -181,7 +181,8 @@ def test_config_values_are_checked_before_sb3_sees_them():
     [
         (["--timesteps", "0"], "--timesteps = 0: expected an integer >= 1"),
         (["--seed", "-3"], "--seed = -3: expected an integer >= 0"),
-        (["--self-play", "-1"], "--self-play = -1: expected an integer >= 0"),
+        (["--self-play", "-1"], "--self-play = -1: expected an integer >= 1"),
+        (["--self-play", "0"], "--self-play = 0: expected an integer >= 1"),  # ran one run
     ],
 )
 def test_a_bad_flag_is_named_as_the_flag_not_as_a_config_field(tmp_path, capsys, flags, message):

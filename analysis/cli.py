@@ -164,8 +164,9 @@ def _cmd_play(args: argparse.Namespace) -> int:
             if exc.args[1] != VALID_START:
                 raise
             raise exc.named("--start valid") from None
-        shown = {  # a model as the user named it, not the sb3:PATH it was loaded from
-            role: name if name.startswith(f"{role}/") else f"{role}/{name}"
+        shown = {  # a model as the user named it (as evaluate's and tournament's labels do),
+            # not the sb3:PATH it was loaded from nor 'pursuer//abs/path/model.zip'
+            role: name
             for role, name in (("pursuer", args.pursuer), ("evader", args.evader))
             if name.startswith("zoo:") or name.endswith(".zip")
         }

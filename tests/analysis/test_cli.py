@@ -218,15 +218,16 @@ def test_play_takes_a_shipped_model_or_a_model_file_as_evaluate_does(tmp_path, c
     for argv, named in (
         (
             ["--pursuer", "zoo:ppo_pursuer_vs_straight_open_room", "--evader", "evader/straight"],
-            "pursuer/zoo:ppo_pursuer_vs_straight_open_room vs evader/straight",
+            "open_room: zoo:ppo_pursuer_vs_straight_open_room vs evader/straight",
         ),
-        (["--pursuer", "pursuer/greedy", "--evader", str(model)], f"vs evader/{model} ("),
+        (["--pursuer", "pursuer/greedy", "--evader", str(model)], f"greedy vs {model} ("),
     ):
         assert main(["play", *argv, *fast]) == 0
         out = capsys.readouterr().out
-        # the outcome names the model as it was given (it said pursuer/sb3:/abs/path/model.zip)
+        # the outcome names the model as it was given, as evaluate's and tournament's tables
+        # label it (it said pursuer/sb3:/abs/path/model.zip, then evader//abs/path/model.zip)
         assert named in out and ("kept surveillance" in out or "escaped" in out)
-        assert "sb3:" not in out
+        assert "sb3:" not in out and "//" not in out
 
 
 def test_play_and_evaluate_take_the_registry_name_of_a_model_file(tmp_path, capsys):

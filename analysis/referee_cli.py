@@ -210,13 +210,16 @@ def _say_if_long(cfg, args: argparse.Namespace) -> None:
     pursuer's step rounded up to 10 s, 1257 moves a step instead of 29) solved for many
     minutes without a word."""
     from strategies.referee._budget import duration
-    from strategies.referee.referee import unsolved_sizes
+    from strategies.referee.referee import fallback_size, unsolved_sizes
     from strategies.referee.spec import GameSpec
 
     spec = GameSpec.from_config(cfg)
     sizes = unsolved_sizes(spec, args.cells_per_lmin, cache=not args.no_cache, dt=cfg.dt)
     seconds = sum(s.seconds for s in sizes)
-    if seconds <= LONG_SOLVE_SECONDS:
+    retry = None  # the pursuer bound's retry one cell finer, solved only if the default fails
+    if not args.no_pursuer_fallback:
+        retry = fallback_size(spec, args.cells_per_lmin, cache=not args.no_cache, dt=cfg.dt)
+    if seconds + (retry.seconds if retry is not None else 0.0) <= LONG_SOLVE_SECONDS:
         return
     parts = "; ".join(f"{s.describe()}, a step of {s.tau:g} s, {s.moves} moves" for s in sizes)
     # the steps without the env's dt: a dt longer than them rounds them up to itself
@@ -229,9 +232,16 @@ def _say_if_long(cfg, args: argparse.Namespace) -> None:
         if longer
         else "; a smaller --cells-per-lmin is faster"
     )
+    more = ""
+    if retry is not None:  # afac520's fallback: a second pursuer solve when the first is 0 %
+        more = (
+            f", or {duration(seconds + retry.seconds)} if the default pursuer lattice "
+            f"certifies no state and the solve retries it one cell finer ({retry.describe()}, "
+            f"a step of {retry.tau:g} s, {retry.moves} moves; --no-pursuer-fallback skips it)"
+        )
     print(
         f"{cfg.map.name}: solving the referee's bounds ({parts}): up to about "
-        f"{duration(seconds)} (an upper bound, estimated before the solve){why}",
+        f"{duration(seconds)}{more} (an upper bound, estimated before the solve){why}",
         file=sys.stderr,
         flush=True,
     )

@@ -45,6 +45,7 @@ __all__ = [
     "cached_pursuer_bound",
     "check_start",
     "coarsest_with_starts",
+    "fallback_size",
     "label_starts",
     "pursuer_fallback_resolution",
     "referee_for",
@@ -491,11 +492,21 @@ def pursuer_fallback_resolution(
         bound: the pursuer bound solved at the default lattice.
         **knobs: :func:`solve`'s ``pursuer_coarse, pursuer_steps, sweep_pieces, dt``.
     """
-    if knobs.get("pursuer_coarse") is not None or bound.win.any():
+    if bound.win.any():
         return None
-    if spec.rho >= VACUOUS_RHO or bound.res.coarse <= 2:
+    return _fallback_resolution(spec, bound.res, cells_per_lmin, knobs)
+
+
+def _fallback_resolution(
+    spec: GameSpec, res: Resolution, cells_per_lmin: float, knobs: Mapping[str, Any]
+) -> Resolution | None:
+    """:func:`pursuer_fallback_resolution` whatever the default lattice certifies: the
+    lattice retried after a default pursuer lattice ``res`` that certifies nothing."""
+    if knobs.get("pursuer_coarse") is not None:
         return None
-    knobs = {**knobs, "pursuer_coarse": bound.res.coarse - 1}
+    if spec.rho >= VACUOUS_RHO or res.coarse <= 2:
+        return None
+    knobs = {**knobs, "pursuer_coarse": res.coarse - 1}
     return _resolution(spec, "pursuer", cells_per_lmin, **knobs)
 
 
@@ -592,6 +603,33 @@ def unsolved_sizes(
             continue
         out.append(bound_size(spec, res, role))
     return out
+
+
+def fallback_size(
+    spec: GameSpec,
+    cells_per_lmin: float = 24.0,
+    *,
+    cache: bool = True,
+    cache_dir: str | os.PathLike | None = None,
+    **knobs: Any,
+) -> SolveSize | None:
+    """The estimated size of the pursuer bound's retry one cell finer that :func:`solve`
+    (``pursuer_fallback=True``) adds when the default pursuer lattice certifies no state
+    (:func:`pursuer_fallback_resolution`), or None when no retry can happen with these
+    arguments (an explicit ``pursuer_coarse``, ``rho >=`` :data:`VACUOUS_RHO`, a default
+    of two cells or fewer) or its result is cached. Whether the default certifies nothing
+    is known only after its solve: a caller announcing :func:`unsolved_sizes` adds this as
+    what the solve *may* add (``surveil referee``'s announcement did not count it).
+
+    Args:
+        spec, cells_per_lmin, cache, cache_dir, knobs: as :func:`unsolved_sizes`.
+    """
+    cells_per_lmin = V.positive("cells_per_lmin", cells_per_lmin)
+    res = _resolution(spec, "pursuer", cells_per_lmin, **knobs)
+    alt = _fallback_resolution(spec, res, cells_per_lmin, knobs)
+    if alt is None or (cache and cache_path("pursuer", spec, alt, cache_dir).is_file()):
+        return None
+    return replace(bound_size(spec, alt, "pursuer"), what="pursuer bound's fallback")
 
 
 COARSEST_SCAN_STEP = 2.0**0.125

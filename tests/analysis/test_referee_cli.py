@@ -203,3 +203,37 @@ def test_a_long_solve_is_announced_with_its_estimate_before_it_starts(capsys, mo
     # a short solve says nothing first
     assert main(["referee", "corridor", "--cells-per-lmin", "4", "--no-cache"]) == 130
     assert capsys.readouterr().err == "surveil: interrupted\n"
+
+
+def test_a_long_solve_s_announcement_counts_the_pursuer_bound_s_fallback(capsys, monkeypatch):
+    """At rho < VACUOUS_RHO a pursuer bound certifying nothing is solved once more one cell
+    finer (afac520): the announcement gave the first solve's time only (here 5 min of up to
+    23), and says nothing of a retry where none can happen (rho 0.5, or the flag off)."""
+    import strategies.referee as referee
+    from envs.surveillance.config import EnvConfig
+    from strategies.referee.referee import fallback_size, unsolved_sizes
+    from strategies.referee.spec import GameSpec
+
+    def stop(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(referee, "referee_for", stop)
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", "/nonexistent")
+    slow = ["referee", "corridor", "--config", '{"dt": 10, "v_evader": 0.1}', "--no-cache"]
+    assert main(slow) == 130
+    err = capsys.readouterr().err
+    assert "if the default pursuer lattice certifies no state and the solve retries it" in err
+    assert "(pursuer bound's fallback: " in err and "a step of 10 s, 2233 moves" in err
+    assert main([*slow, "--no-pursuer-fallback"]) == 130
+    err = capsys.readouterr().err
+    assert "up to about" in err and "fallback" not in err
+    assert main(["referee", "corridor", "--config", '{"dt": 10}', "--no-cache"]) == 130
+    assert "fallback" not in capsys.readouterr().err  # rho 0.5: no retry
+    # the retry is the lattice solve() falls back to: pursuer_coarse one less than the default
+    cfg = EnvConfig(map="corridor", v_evader=0.1)
+    spec = GameSpec.from_config(cfg)
+    (default,) = (s for s in unsolved_sizes(spec, 16, cache=False) if s.kind == "pursuer")
+    retry = fallback_size(spec, 16, cache=False)
+    assert retry.kind == "pursuer" and retry.tau < default.tau and retry.points > default.points
+    assert fallback_size(spec, 16, cache=False, pursuer_coarse=4) is None  # asked for: kept
+    assert fallback_size(GameSpec.from_config(EnvConfig(map="corridor")), 16) is None

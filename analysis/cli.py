@@ -76,7 +76,7 @@ def _cmd_policies(args: argparse.Namespace) -> int:
 
 def _env_config(flag_map: str, map_: str, overrides: dict, where: str):
     """The env config of a run, validated before the run (names the flag at fault)."""
-    from envs.maps.io import builtin_parameters
+    from envs.maps.io import recommended_parameters
     from envs.surveillance.config import EnvConfig, env_parameters, resolve_map
 
     allowed = [k for k in env_parameters() if k not in ("map", "render_mode")]
@@ -87,10 +87,11 @@ def _env_config(flag_map: str, map_: str, overrides: dict, where: str):
         )
     try:
         world = resolve_map(map_)
+        # a built-in or a file by name (transformed or not): its recommendations apply
+        named = recommended_parameters(map_) is not None
     except SurveilValueError as exc:
         raise type(exc)(f"{flag_map}: {exc}") from None
-    try:  # a built-in by name (transformed or not), so that its recommended parameters apply
-        named = builtin_parameters(map_) is not None
+    try:
         return EnvConfig(map=map_ if named else world, **overrides)
     except SurveilValueError as exc:
         raise type(exc)(f"{where}: {exc}") from None
@@ -193,18 +194,19 @@ def _cmd_play(args: argparse.Namespace) -> int:
 
 def _cmd_analyze(args: argparse.Namespace) -> int:
     from envs.maps import load_map
-    from envs.maps.io import builtin_parameters
+    from envs.maps.io import recommended_parameters
 
     try:
         world = load_map(args.map)
+        params = recommended_parameters(args.map)
     except SurveilValueError as exc:
         raise type(exc)(f"map: {exc}") from None
     length = args.length
     if length is None:
-        if (params := builtin_parameters(args.map)) is None:
+        if params is None:
             raise InvalidConfigError(
-                f"--length is required for map {args.map!r}: only built-in maps recommend "
-                "a rod length (their L_min)"
+                f"--length is required for map {args.map!r}: only built-in maps and map "
+                "files whose metadata recommends parameters give a rod length (their L_min)"
             )
         length = params["l_min"]
     diameter = world.diameter

@@ -97,8 +97,11 @@ but raises a `RhoAboveOneWarning`: escape is then trivial for the evader (Sec. 5
 
 `None` for `l_min`, `l_max`, `v_pursuer` or `v_evader` takes the value the map recommends:
 a built-in map named by a string brings its own (`envs.maps.builtin_info(name).params()`),
-times S for a transformed one (`NAME~xS[rotR][off(X,Y)]`, see `envs.maps.load_map`);
-a `Map` object or a map file gets L_min = 2, L_max = 4, V_p = 1, V_e = 0.5. Explicit
+and a map file named by its path the `l_min`, `l_max`, `v_pursuer`, `v_evader` and
+`body_radius` its `metadata` gives (`envs.maps.io.file_parameters`; before 2026-11 such
+files got the defaults below), each times S for a transformed one
+(`NAME~xS[rotR][off(X,Y)]`, see `envs.maps.load_map`); a `Map` object, a random map or a
+file recommending nothing gets L_min = 2, L_max = 4, V_p = 1, V_e = 0.5. Explicit
 arguments always win. Every built-in map recommends these same values today (a test says
 so): changing a built-in's recommendation changes this version's behaviour and needs a
 new version.

@@ -207,16 +207,17 @@ def map_parameters(map_: Any) -> tuple[Any, dict[str, float]]:
 
     Returns:
         ``(map, params)`` with ``params`` the built-in's ``l_min``, ``l_max``,
-        ``v_pursuer`` and ``v_evader``, scaled for a transformed built-in
-        (``NAME~xS...``); ``{}`` for files, random maps and Map objects: the env's
-        defaults apply.
+        ``v_pursuer`` and ``v_evader``, or those a map file's metadata recommends
+        (:func:`envs.maps.io.recommended_parameters`), scaled for a transformed one
+        (``NAME~xS...``); ``{}`` for random maps, Map objects and files recommending
+        nothing: the env's defaults apply.
     """
     from envs.maps import Map, builtin_info, builtin_names, load_map
-    from envs.maps.io import builtin_parameters
+    from envs.maps.io import recommended_parameters
 
     if isinstance(map_, str) and map_ in builtin_names():
         return builtin_info(map_).map, builtin_info(map_).params()
-    if (rec := builtin_parameters(map_)) is not None:
+    if (rec := recommended_parameters(map_)) is not None:
         return load_map(map_), rec
     if isinstance(map_, Map):
         return map_, {}
@@ -233,8 +234,8 @@ def build_env(
 ):
     """A ``surveillance_v1`` parallel env on ``map_``.
 
-    A built-in map's recommended ``l_min``, ``l_max`` and speeds apply unless
-    ``overrides`` sets them.
+    A built-in map's (or a map file's) recommended ``l_min``, ``l_max`` and speeds apply
+    unless ``overrides`` sets them.
 
     Raises:
         InvalidConfigError: an override is not an env argument or is out of range.

@@ -139,7 +139,8 @@ class PolicyEntry:
 
 @dataclass(frozen=True)
 class MapEntry:
-    """One map: its label, where it came from, the Map and the built-in parameters."""
+    """One map: its label, where it came from, the Map and the recommended parameters (a
+    built-in's or a map file's metadata; none for random maps)."""
 
     label: str
     source: str
@@ -218,7 +219,7 @@ class Spec:
         return {
             "name": self.name,
             "description": self.description,
-            "maps": [{"label": m.label, "source": m.source, "digest": m.digest} for m in self.maps],
+            "maps": [_map_dict(m) for m in self.maps],
             "pursuers": [_entry_dict(p) for p in self.pursuers],
             "evaders": [_entry_dict(p) for p in self.evaders],
             "seeds": list(self.seeds),
@@ -235,6 +236,15 @@ class Spec:
         """Content hash of the normalised spec: the same spec resumes the same run."""
         text = json.dumps(self.to_dict(), sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def _map_dict(m: MapEntry) -> dict[str, Any]:
+    d = {"label": m.label, "source": m.source, "digest": m.digest}
+    if m.params and not m.source.startswith("builtin:"):
+        # a file's recommendations (its metadata, not in the geometry digest) are part of
+        # the run: editing them is a new run, not new matches added to the old one's rows
+        d["params"] = m.params
+    return d
 
 
 def _entry_dict(p: PolicyEntry) -> dict[str, Any]:
@@ -392,7 +402,7 @@ def _map_entry(text: str, where: str, base: Path) -> MapEntry:
     """A built-in name, ``random:...``, a file relative to ``base``, or any of these
     followed by ``~[xS][rotR][off(X,Y)]`` (:func:`envs.maps.io.split_transform`)."""
     from envs.maps import builtin_info, builtin_names, load_map
-    from envs.maps.io import builtin_parameters, split_transform
+    from envs.maps.io import recommended_parameters, scaled_parameters, split_transform
 
     if text in builtin_names():
         info = builtin_info(text)
@@ -416,9 +426,9 @@ def _map_entry(text: str, where: str, base: Path) -> MapEntry:
                 raise InvalidConfigError(
                     f"{where}: map = {text!r}: {name!r} under that transform is no valid map: {exc}"
                 ) from exc
-            # a transformed built-in's recommendation, bodies included, as EnvConfig reads
-            # the name (files and random maps: none)
-            params = builtin_parameters(text) or {}
+            # a transformed built-in's or file's recommendation, bodies included, as
+            # EnvConfig reads the name (random maps and files recommending nothing: none)
+            params = scaled_parameters(inner.params, sim.scale) if inner.params else {}
             return MapEntry(text, f"{inner.source}~{sim.label()}", world, params)
         raise InvalidConfigError(
             f"{where}: map = {text!r}: neither a built-in map {builtin_names()}, "
@@ -427,9 +437,10 @@ def _map_entry(text: str, where: str, base: Path) -> MapEntry:
         )
     try:
         world = load_map(path)
+        params = recommended_parameters(path) or {}  # the file's metadata, as EnvConfig reads it
     except (ValueError, OSError) as exc:
         raise InvalidConfigError(f"{where}: map = {text!r}: {exc}") from exc
-    return MapEntry(text, str(path), world, {})
+    return MapEntry(text, str(path), world, params)
 
 
 def _maps(value: Any, source: str, base: Path) -> tuple[MapEntry, ...]:

@@ -8,10 +8,11 @@ Formats
      "merge": false, "description": "...", "metadata": {"l_min": 2.0, ...}}
 
 ``boundary`` is required; ``obstacles`` (default none), ``merge`` (default false),
-``name`` (default: the file stem), ``description`` and ``metadata`` (any JSON object,
-e.g. recommended parameters) are optional. Unknown keys are rejected, so a misspelt key
-is an error instead of a silently empty map. A ``.json`` file holding a GeoJSON object
-(it has a ``"type"`` member) is read as GeoJSON.
+``name`` (default: the file stem), ``description`` and ``metadata`` (any JSON object;
+its ``l_min``, ``l_max``, ``v_pursuer``, ``v_evader`` and ``body_radius`` are the map's
+recommended parameters, :func:`file_parameters`) are optional. Unknown keys are
+rejected, so a misspelt key is an error instead of a silently empty map. A ``.json``
+file holding a GeoJSON object (it has a ``"type"`` member) is read as GeoJSON.
 
 **GeoJSON** (``.geojson``, RFC 7946): a ``Feature``, a ``FeatureCollection`` or a bare
 geometry, made of ``Polygon`` and ``MultiPolygon`` geometries.
@@ -62,6 +63,7 @@ __all__ = [
     "FORMATS",
     "RANDOM_PREFIX",
     "MapDocument",
+    "file_parameters",
     "load_map",
     "map_from_dict",
     "map_from_geojson",
@@ -70,6 +72,7 @@ __all__ = [
     "map_to_geojson",
     "map_to_wkt",
     "read_map",
+    "recommended_parameters",
     "save_map",
 ]
 
@@ -622,6 +625,83 @@ def split_transform(name: str) -> tuple[str, Similarity | None]:
 BODY_RADIUS = 0.1
 """The agents' disc radius the built-ins are played with (the env's default)."""
 
+GLOBAL_DEFAULTS: dict[str, float] = {"l_min": 2.0, "l_max": 4.0, "v_pursuer": 1.0, "v_evader": 0.5}
+"""The recommended ``l_min``, ``l_max``, ``v_pursuer``, ``v_evader`` of a map without its own
+(a :class:`Map` object, a random map, a map file whose metadata recommends none)."""
+
+FILE_RECOMMENDATIONS = ("l_min", "l_max", "v_pursuer", "v_evader", "body_radius")
+"""The keys of a map file's ``metadata`` that are applied as recommended parameters."""
+
+
+def file_parameters(path: str | os.PathLike[str]) -> dict[str, float] | None:
+    """The recommended parameters in map file ``path``'s ``metadata``: those of
+    :data:`FILE_RECOMMENDATIONS` it gives, the rest of ``l_min``, ``l_max``, ``v_pursuer``,
+    ``v_evader`` from :data:`GLOBAL_DEFAULTS`; ``None`` when it gives none of them (or
+    ``path`` names no file: :func:`load_map` says why). Other metadata keys are free-form.
+
+    Raises:
+        InvalidMapError: a recommended value that is not a finite number > 0 (naming the
+            file and the key), or ``l_max`` not above ``l_min``.
+    """
+    p = Path(path)
+    if p.suffix.lower() not in FORMATS or not p.is_file():
+        return None
+    metadata = read_map(p).metadata
+    given = {k: metadata[k] for k in FILE_RECOMMENDATIONS if k in metadata}
+    if not given:
+        return None
+    out = dict(GLOBAL_DEFAULTS)
+    for key, value in given.items():
+        try:
+            out[key] = validation.positive(key, value, where=f"{p} metadata")
+        except InvalidConfigError as exc:
+            raise InvalidMapError(str(exc)) from None
+    if out["l_max"] <= out["l_min"]:
+        said = {  # as the file wrote it, or the default it left
+            k: f"{given[k]!r}"
+            if k in given
+            else f"{out[k]!r} (the default; add it to the metadata)"
+            for k in ("l_min", "l_max")
+        }
+        raise InvalidMapError(
+            f"{p} metadata: l_max = {said['l_max']}: expected a value > l_min = {said['l_min']}"
+        )
+    return out
+
+
+def scaled_parameters(params: Mapping[str, float], scale: float) -> dict[str, float]:
+    """Recommended parameters for a map scaled by ``scale``: lengths, speeds and the body
+    radius (:data:`BODY_RADIUS` unless given) times ``scale``, the same game up to the
+    similarity."""
+    out = dict(params)
+    out.setdefault("body_radius", BODY_RADIUS)
+    return {k: v * scale for k, v in out.items()}
+
+
+def recommended_parameters(name: Any) -> dict[str, float] | None:
+    """The recommended parameters of a map argument: a built-in's
+    (:func:`builtin_parameters`), a map file's (:func:`file_parameters`), either scaled by
+    S when transformed (``NAME~xS...``, :func:`scaled_parameters`); ``None`` for a random
+    map, a :class:`Map` object or a file recommending nothing (the env's
+    :data:`GLOBAL_DEFAULTS` apply)."""
+    from envs.maps.builtin import builtin_info, builtin_names
+
+    if isinstance(name, str):
+        if name in builtin_names():
+            return builtin_info(name).params()
+        if TRANSFORM_SEPARATOR in name:
+            base, similarity = split_transform(name)
+            if similarity is not None:
+                recommended = recommended_parameters(base)
+                if recommended is None:
+                    return None
+                return scaled_parameters(recommended, similarity.scale)
+        if name.startswith(RANDOM_PREFIX):
+            return None
+    if isinstance(name, (str, os.PathLike)):
+        return file_parameters(name)
+    return None
+
 
 def builtin_parameters(name: Any) -> dict[str, float] | None:
     """The recommended ``l_min``, ``l_max``, ``v_pursuer``, ``v_evader`` of a map *name*
@@ -648,8 +728,7 @@ def builtin_parameters(name: Any) -> dict[str, float] | None:
     recommended = builtin_parameters(base)
     if recommended is None:
         return None
-    recommended.setdefault("body_radius", BODY_RADIUS)
-    return {k: v * similarity.scale for k, v in recommended.items()}
+    return scaled_parameters(recommended, similarity.scale)
 
 
 def load_map(path_or_name: str | os.PathLike[str], *, merge: bool | None = None) -> Map:

@@ -20,7 +20,8 @@ from typing import Any
 from envs import validation as v
 from envs.errors import InvalidConfigError, RhoAboveOneWarning
 from envs.maps import Map, load_map
-from envs.maps.io import BODY_RADIUS, builtin_parameters
+from envs.maps.io import BODY_RADIUS, recommended_parameters
+from envs.maps.io import GLOBAL_DEFAULTS as _GLOBAL_DEFAULTS
 
 __all__ = [
     "GLOBAL_DEFAULTS",
@@ -70,17 +71,22 @@ def resolve_map(value: Map | str | os.PathLike[str]) -> Map:
 MAP_PARAMETERS = ("l_min", "l_max", "v_pursuer", "v_evader")
 """The parameters a built-in map recommends (``envs.maps.builtin_info(name).params()``)."""
 
-GLOBAL_DEFAULTS: dict[str, float] = {"l_min": 2.0, "l_max": 4.0, "v_pursuer": 1.0, "v_evader": 0.5}
-"""Values of :data:`MAP_PARAMETERS` for a Map object or a map file (no recommendation)."""
+GLOBAL_DEFAULTS = _GLOBAL_DEFAULTS
+"""Values of :data:`MAP_PARAMETERS` for a Map object, a random map or a map file whose
+metadata recommends none."""
 
 
 def map_recommendations(value: Any) -> dict[str, float]:
     """The recommended :data:`MAP_PARAMETERS` for the map argument ``value``.
 
-    A built-in map *named by a string* brings its own (``envs.maps.builtin_info``), scaled
-    by S when the name transforms it (``NAME~xS...``: lengths, speeds and the agents'
-    ``body_radius`` scale alike, so the game is the same up to the similarity); a
-    :class:`Map` object, a map file path or a random map gets :data:`GLOBAL_DEFAULTS`.
+    A built-in map *named by a string* brings its own (``envs.maps.builtin_info``), and so
+    does a map file named by its path: the ``l_min``, ``l_max``, ``v_pursuer``,
+    ``v_evader`` and ``body_radius`` its ``metadata`` gives, the first four defaulting to
+    :data:`GLOBAL_DEFAULTS` (``envs.maps.io.file_parameters``). Either is scaled by S when
+    the name transforms it (``NAME~xS...``: lengths, speeds and the agents'
+    ``body_radius`` scale alike, so the game is the same up to the similarity). A
+    :class:`Map` object, a random map or a file recommending nothing gets
+    :data:`GLOBAL_DEFAULTS`.
 
     Examples:
         >>> map_recommendations("corridor")
@@ -88,7 +94,7 @@ def map_recommendations(value: Any) -> dict[str, float]:
         >>> map_recommendations("corridor~x10rot0.3")
         {'l_min': 20.0, 'l_max': 40.0, 'v_pursuer': 10.0, 'v_evader': 5.0, 'body_radius': 1.0}
     """
-    params = builtin_parameters(value)
+    params = recommended_parameters(value)
     return dict(GLOBAL_DEFAULTS) if params is None else params
 
 

@@ -305,7 +305,9 @@ def _match_of(row, spec, maps, variants, geometry) -> dict[str, Any]:
         source = entry.get("source", row["map"])
         world = _map_of(source, entry.get("digest"), maps, geometry)
         variant = variants.get(row.get("variant", ""), {})
-        params = {**_builtin_params(source), **dict(spec.get("env") or {}),
+        # a file map's recommendations as the spec stored them (the file may have changed)
+        recommended = entry["params"] if "params" in entry else _builtin_params(source)
+        params = {**recommended, **dict(spec.get("env") or {}),
                   **dict(variant.get("overrides") or {})}  # fmt: skip
         cfg = _config(world, params, variant.get("rho"))
         start = _redraw_start(cfg, row)

@@ -332,3 +332,41 @@ def test_more_matches_than_the_memory_budget_can_plan_are_refused(small_spec, mo
     with pytest.raises(MemoryBudgetError):
         spec_from_dict({**small_spec, "seeds": list(range(fit + 1))})
     assert len(spec_from_dict({**small_spec, "seeds": fit}).seeds) == fit
+
+
+def test_a_map_file_s_recommendations_apply_and_editing_them_is_a_new_run(tmp_path):
+    """A map file's metadata (l_min, l_max, speeds, body radius) applies as a built-in's
+    does, as EnvConfig(map=path) and surveil play read it. The map's digest is its geometry
+    only, so the spec's hash (the run) names the file's recommendations: an edited
+    recommendation is a new run whose matches are played, not rows added to the old
+    run's (its report would count both)."""
+    from envs.maps import load_map, save_map
+
+    room = tmp_path / "room.json"
+    save_map(load_map("open_room"), room, metadata={"l_min": 1.5, "l_max": 3.0})
+    plain = tmp_path / "plain.json"
+    save_map(load_map("corner"), plain, metadata={"author": "anyone"})
+    d = {"maps": ["room.json", "plain.json", "room.json~x2", "corridor"], "seeds": 2,
+         "pursuers": ["pursuer/greedy"], "evaders": ["evader/straight"],
+         "env": {"max_cycles": 20}}  # fmt: skip
+    spec = spec_from_dict(d, base_dir=tmp_path)
+    v = spec.variants[0]
+    got = [spec.env_config(m, v) for m in spec.maps]
+    assert (got[0]["l_min"], got[0]["l_max"], got[0]["v_evader"]) == (1.5, 3.0, 0.5)
+    assert (got[1]["l_min"], got[1]["l_max"]) == (2.0, 4.0)  # recommends nothing
+    assert (got[2]["l_min"], got[2]["l_max"], got[2]["body_radius"]) == (3.0, 6.0, 0.2)
+    maps = spec.to_dict()["maps"]  # a built-in's and a plain file's entry as before
+    assert [("params" in m) for m in maps] == [True, False, True, False]
+    store = tmp_path / "s.sqlite"
+    first = run_tournament(spec, store, backend="serial", progress=False)
+    assert (first.planned, first.played) == (8, 8)
+    save_map(load_map("open_room"), room, metadata={"l_min": 1.0, "l_max": 3.0})
+    edited = spec_from_dict(d, base_dir=tmp_path)
+    assert edited.env_config(edited.maps[0], v)["l_min"] == 1.0
+    again = run_tournament(edited, store, backend="serial", progress=False)
+    assert again.run_id != first.run_id and (again.reused, again.played) == (4, 4)
+    with Store(store) as db:
+        assert len(db.rows(again.run_id)) == 8 and len(db.rows(first.run_id)) == 8
+    with pytest.raises(InvalidConfigError, match=r"\[maps #1\]: map = 'room.json': .*l_min"):
+        save_map(load_map("open_room"), room, metadata={"l_min": "1"})
+        spec_from_dict(d, base_dir=tmp_path)

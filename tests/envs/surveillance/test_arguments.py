@@ -78,11 +78,59 @@ def test_recommendations_follow_the_map_metadata(monkeypatch) -> None:
     assert map_recommendations(builtin_map("two_rooms")) == GLOBAL_DEFAULTS
 
 
-def test_a_map_file_uses_the_global_defaults(tmp_path) -> None:
+def test_a_map_file_brings_its_metadata_recommendations_as_a_built_in_does(tmp_path) -> None:
+    """A file's metadata l_min / l_max / speeds were ignored (a user's 1.4 m room with
+    l_min 0.2 was refused at L = 2, a larger one played at 2-4 against its own advice)."""
     path = tmp_path / "room.json"
-    save_map(open_room(), path, metadata={"l_min": 1.0, "l_max": 2.0})
+    save_map(open_room(), path, metadata={"l_min": 1.0, "l_max": 2.0, "author": "anyone"})
     cfg = EnvConfig(map=str(path))
-    assert {k: getattr(cfg, k) for k in MAP_PARAMETERS} == GLOBAL_DEFAULTS
+    assert (cfg.l_min, cfg.l_max, cfg.v_pursuer, cfg.v_evader, cfg.body_radius) == (
+        1.0, 2.0, 1.0, 0.5, 0.1,
+    )  # fmt: skip
+    assert EnvConfig(map=path).l_min == 1.0  # a Path too
+    assert map_recommendations(str(path)) == {**GLOBAL_DEFAULTS, "l_min": 1.0, "l_max": 2.0}
+    cfg = EnvConfig(map=str(path), l_min=0.5, v_evader=0.25)  # explicit values win
+    assert (cfg.l_min, cfg.l_max, cfg.v_evader) == (0.5, 2.0, 0.25)
+    scaled = EnvConfig(map=f"{path}~x3rot0.5")  # scaled with the map, bodies included
+    assert (scaled.l_min, scaled.l_max, scaled.v_pursuer) == (3.0, 6.0, 3.0)
+    assert scaled.body_radius == pytest.approx(0.3)
+    small = tmp_path / "small.json"
+    save_map(open_room().transformed(((0.1, 0), (0, 0.1)), (0, 0), name="small"), small,
+             metadata={"l_min": 0.2, "l_max": 0.4, "v_pursuer": 0.1, "v_evader": 0.05,
+                       "body_radius": 0.01})  # fmt: skip
+    cfg = EnvConfig(map=str(small))
+    assert (cfg.l_min, cfg.body_radius, cfg.dt) == (0.2, 0.01, 0.1)
+    surveillance_v1.parallel_env(map=str(small)).reset(seed=0)  # was refused at L = 2
+    # nothing recommended (free-form keys only, also transformed; a Map object): the defaults
+    plain = tmp_path / "plain.json"
+    save_map(open_room(), plain, metadata={"author": "anyone"})
+    for m in (str(plain), f"{plain}~x3", open_room()):
+        cfg = EnvConfig(map=m)
+        assert {k: getattr(cfg, k) for k in MAP_PARAMETERS} == GLOBAL_DEFAULTS
+        assert cfg.body_radius == 0.1
+
+
+@pytest.mark.parametrize(
+    ("metadata", "message"),
+    [
+        ({"l_min": "2"}, r"room.json metadata: l_min = '2': expected a finite number > 0"),
+        ({"v_evader": -1}, r"room.json metadata: v_evader = -1: expected a finite number > 0"),
+        ({"l_max": True}, r"room.json metadata: l_max = True: expected a finite number > 0"),
+        (
+            {"l_min": 5},
+            r"l_max = 4.0 \(the default; add it to the metadata\): expected a "
+            r"value > l_min = 5",
+        ),
+        ({"l_min": 3, "l_max": 3}, r"metadata: l_max = 3: expected a value > l_min = 3$"),
+    ],
+)
+def test_a_map_file_s_bad_recommendation_is_one_line_naming_the_key(tmp_path, metadata, message):
+    from envs.errors import InvalidMapError
+
+    path = tmp_path / "room.json"
+    save_map(open_room(), path, metadata=metadata)
+    with pytest.raises(InvalidMapError, match=message):
+        EnvConfig(map=str(path))
 
 
 def test_pickling_replays_the_given_arguments() -> None:

@@ -4,6 +4,9 @@
 trains on the CPU with one torch thread, and writes into ``config.output_dir``:
 
 * ``config.toml`` -- the config of the run (a resumed run must match it);
+* ``env.json`` -- the env configs the run plays, one per map, resolved (the map's
+  geometry digest and its recommended parameters included): a resumed run must play the
+  same (a map file edited in between is refused, not trained on without a word);
 * ``checkpoints/ckpt_<timesteps>.zip`` -- written as it goes (atomically, the last two
   kept); a rerun of an interrupted run continues from the newest one with the
   remaining timesteps;
@@ -258,6 +261,46 @@ def _check_resumable(config: TrainConfig, out: Path) -> None:
         )
 
 
+def _env_records(vec_env) -> list[dict[str, Any]]:
+    """The resolved env config of every map of the run (JSON-ready)."""
+    single = vec_env.envs[0].unwrapped
+    out = []
+    for env in single.envs:
+        d = env.config.to_dict()
+        d.pop("render_mode", None)
+        out.append(json.loads(json.dumps(d)))
+    return out
+
+
+def _check_same_envs(vec_env, out: Path) -> None:
+    """Refuse to resume a run whose maps now resolve to other games (``config.toml`` names a
+    map file by its path: its geometry or recommended parameters may have changed since);
+    record them for the first segment (and for a run of a surveil without ``env.json``)."""
+    now = _env_records(vec_env)
+    stored = out / "env.json"
+    if stored.is_file() and _latest_checkpoint_exists(out):
+        try:
+            before = json.loads(stored.read_text())
+        except ValueError:  # a torn write: nothing to compare with
+            before = now
+        if isinstance(before, list) and len(before) == len(now):
+            for a, b in zip(before, now, strict=True):
+                diff = sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))
+                if diff:
+                    raise InvalidConfigError(
+                        f"output_dir {str(out)!r} holds a run on another game: map "
+                        f"{b.get('map')!r} resolves to {[b.get(k) for k in diff]} for {diff} "
+                        f"now, {[a.get(k) for k in diff]} when the run started (its map file "
+                        "or the file's metadata changed); use another output_dir or delete "
+                        "that one"
+                    )
+    _atomic_write(stored, json.dumps(now, indent=1, sort_keys=True))
+
+
+def _latest_checkpoint_exists(out: Path) -> bool:
+    return latest_checkpoint(out) is not None or (out / "model.zip").is_file()
+
+
 def _make_vec_env(config: TrainConfig):
     from stable_baselines3.common.monitor import Monitor
     from stable_baselines3.common.vec_env import DummyVecEnv
@@ -414,6 +457,7 @@ def train(
     # the envs first: an opponent that does not resolve (a misspelt name) must not leave a
     # config.toml behind, which would refuse the corrected rerun as "a different config"
     vec_env = _make_vec_env(config)
+    _check_same_envs(vec_env, out)
     _atomic_write(out / "config.toml", config.to_toml())
     cls = _algo_class(config.algo)
     ckpt = _load_checkpoint(out, cls, vec_env)

@@ -328,3 +328,28 @@ def test_an_extension_interrupted_in_its_evaluation_leaves_model_and_provenance_
     assert longer.timesteps == 256 and digest() != before
     assert read_provenance(first.model_path)["timesteps"] == 256
     assert not (first.model_path.parent / "model.next.zip").exists()
+
+
+def test_a_resumed_run_whose_map_file_changed_is_refused(tiny, tmp_path):
+    """config.toml names a map file by its path: a run interrupted, its file's geometry or
+    recommended parameters (metadata) edited, then rerun trained on on the other game
+    without a word. The resolved env configs are kept in env.json and compared."""
+    from envs.maps import load_map, save_map
+
+    world = tmp_path / "room.json"
+    save_map(load_map("open_room"), world, metadata={"l_min": 1.5, "l_max": 3.0})
+    config = tiny(map=str(world))
+    with pytest.raises(KeyboardInterrupt):
+        train(config, callbacks=[Interrupt(at=150)])
+    out = Path(config.output_dir)
+    recorded = json.loads((out / "env.json").read_text())
+    assert [(r["l_min"], r["l_max"]) for r in recorded] == [(1.5, 3.0)]
+    save_map(load_map("open_room"), world, metadata={"l_min": 1.0, "l_max": 3.0})
+    with pytest.raises(InvalidConfigError, match=r"another game: map 'open_room' resolves to "
+                       r"\[1\.0\] for \['l_min'\] now, \[1\.5\] when the run started"):  # fmt: skip
+        train(config)
+    save_map(load_map("corner"), world, metadata={"l_min": 1.5, "l_max": 3.0})
+    with pytest.raises(InvalidConfigError, match=r"\['map', 'map_digest'\]"):
+        train(config)
+    save_map(load_map("open_room"), world, metadata={"l_min": 1.5, "l_max": 3.0})
+    assert train(config).timesteps == 256  # the same game again: resumed

@@ -227,6 +227,9 @@ def random_start(
     raise InfeasibleError(
         f"random start: no valid surveillance configuration found on map {m.name!r} in "
         f"{MAX_BATCHES * BATCH} proposals (L in [{l_lo:.6g}, {l_hi:.6g}], body radius {r:g}, "
-        f"rod clearance {rod_clearance:.6g} from convex vertices); lower spawn_margin_steps "
-        "or body_radius, or place the agents with reset(options={'pursuer': ..., 'evader': ...})"
+        f"rod clearance {rod_clearance:.6g} from convex vertices = spawn_margin_steps "
+        f"{config.spawn_margin_steps} x the faster speed "
+        f"{max(config.v_pursuer, config.v_evader):g} x dt {config.dt:g}); lower "
+        "spawn_margin_steps, dt or body_radius, or place the agents with "
+        "reset(options={'pursuer': ..., 'evader': ...})"
     )

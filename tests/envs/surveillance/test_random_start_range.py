@@ -61,3 +61,16 @@ def test_a_map_too_narrow_for_the_rod_says_so_up_front() -> None:
     with pytest.raises(InfeasibleError, match=r"map 'slot' cannot hold the rod: .* L = 0.9 "
                        r"apart \(at most 0.806"):  # fmt: skip
         env.reset(seed=0)
+
+
+def test_a_random_start_the_margins_rule_out_names_their_factors():
+    """pettingzoo's api_test on the maze at dt = 2 (helper-114): 'rod clearance 6 from
+    convex vertices); lower spawn_margin_steps or body_radius', without saying that the 6
+    is spawn_margin_steps x speed x dt (a dt the user had just set), as the safe start's
+    message does."""
+    env = surveillance_v1.parallel_env(map="maze", dt=2.0)
+    with pytest.raises(InfeasibleError, match=r"rod clearance 6 from convex vertices = "
+                       r"spawn_margin_steps 3 x the faster speed 1 x dt 2\); lower "
+                       r"spawn_margin_steps, dt or body_radius"):  # fmt: skip
+        env.reset(seed=0)
+    surveillance_v1.parallel_env(map="maze", dt=2.0, spawn_margin_steps=0).reset(seed=0)

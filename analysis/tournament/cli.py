@@ -203,7 +203,14 @@ def _cmd_export(args: argparse.Namespace) -> int:
     with Store(args.store, create=False) as db:
         run = db.run(args.run)
         path = db.export(run["run_id"], out)
-        print(f"{len(db.rows(run['run_id']))} matches of run {run['run_id']} written to {path}")
+        line = f"{len(db.rows(run['run_id']))} matches of run {run['run_id']} written to {path}"
+        if run["done"] < run["planned"] and run["status"] != "decided":  # said nothing
+            line += (
+                f"; the run is {run['status']} with {run['done']} of its {run['planned']} "
+                "planned matches stored: these are not its results (rerun its tournament to "
+                "finish it)"
+            )
+        print(line)
     return 0
 
 

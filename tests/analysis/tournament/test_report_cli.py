@@ -236,3 +236,32 @@ def test_replay_captions_name_the_grid_value(tmp_path, monkeypatch):
     replays = md.split("## Replays", 1)[1].split("\n## ", 1)[0]
     for rho in ("0.3", "0.6"):
         assert f"![open_room | rho={rho}: pursuer/greedy vs evader/straight, seed 0: " in replays
+
+
+def test_exporting_an_unfinished_run_says_so(tmp_path, capsys):
+    """``surveil export`` of a run still playing (or interrupted) wrote its stored rows and
+    said only 'N matches of run R written', as if they were the run's results (the report
+    says 'running: 79 of 240 matches stored')."""
+    import sqlite3
+
+    spec = tmp_path / "mini.toml"
+    spec.write_text(
+        'maps = ["open_room"]\npursuers = ["pursuer/greedy"]\n'
+        'evaders = ["evader/random", "evader/straight"]\nseeds = 2\n[env]\nmax_cycles = 20\n'
+    )
+    store = tmp_path / "mini.sqlite"
+    argv = ["tournament", str(spec), "--store", str(store), "--no-progress", "--backend", "serial"]
+    assert main([*argv, "--no-report"]) == 0
+    capsys.readouterr()
+    assert main(["export", str(store), str(tmp_path / "all.csv")]) == 0
+    assert capsys.readouterr().out.strip().endswith("all.csv")  # finished: nothing added
+    with sqlite3.connect(store) as c:  # as a run interrupted after three of its matches
+        c.execute("DELETE FROM results WHERE match_id = (SELECT match_id FROM run_matches "
+                  "ORDER BY seq DESC LIMIT 1)")  # fmt: skip
+        c.execute("UPDATE runs SET status = 'interrupted'")
+    assert main(["export", str(store), str(tmp_path / "part.csv")]) == 0
+    out = capsys.readouterr().out
+    assert "3 matches of run " in out and out.strip().endswith(
+        "; the run is interrupted with 3 of its 4 planned matches stored: these are not its "
+        "results (rerun its tournament to finish it)"
+    )

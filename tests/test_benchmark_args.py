@@ -36,6 +36,8 @@ def _run(script: str, *args: str, **kwargs) -> subprocess.CompletedProcess:
         ("decision_time.py", ["--rho", "0"], "'0': expected a finite number > 0"),
         ("evader_escapes.py", ["--seeds", "0"], "'0': expected an integer >= 1"),
         ("referee_scaling.py", ["--cpl", "0"], "'0': expected a finite number > 0"),
+        ("reset_scaling.py", ["--worlds", "nope"], "--worlds: invalid choice: 'nope'"),
+        ("reset_scaling.py", ["--timeout", "0"], "'0': expected a finite number > 0"),
         ("analytic_matchups.py", ["--workers", "0"], "'0': expected an integer >= 1"),
         ("hindsight_maze.py", ["--cells", "0"], "'0': expected a finite number > 0"),
         ("finetune_curve.py", ["--steps", "100", "--every", "1000"], "--every 1000 > --steps 100"),

@@ -67,7 +67,7 @@ from strategies.policies.base import (
     positive_param,
 )
 from strategies.policies.baselines import nearest_wall_point
-from strategies.policies.lazy_table import LazySafetyTable
+from strategies.policies.lazy_table import LAZY_POINTS, LazySafetyTable
 from strategies.policies.safety import NO_PATH, SafetyTable, _points_at, safety_table
 
 __all__ = ["DecompositionPursuer", "crossable_steps", "reachable_steps"]
@@ -126,7 +126,7 @@ class DecompositionPursuer(BasePolicy):
     # distinct build gives the same rows about 13x faster in a tenth of the memory
     # (pillar room at L_min 1: 1.4 s, 6.5 MB against 18 s, 61 MB); "eager" stays on call
     EAGER_TABLE_POINTS = 0
-    DISTINCT_TABLE_POINTS = 1_000_000  # grid points above which "auto" fills it lazily
+    DISTINCT_TABLE_POINTS = LAZY_POINTS  # grid points above which "auto" fills it lazily
     CLOSING = 0.3  # share of V_p kept for closing in while L exceeds its target
     ORBIT_LOOKAHEAD = 1.0  # seconds of the charge a candidate rate is followed for
     ORBIT_REACH = 0.3  # a circle short of room by less than this x L is worth turning for

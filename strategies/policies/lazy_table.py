@@ -38,7 +38,13 @@ from strategies.cspace.grids import check_grid_spacing, grid_axis, grid_size
 from strategies.policies._batch_classify import classify_points
 from strategies.policies.safety import SafetyTable, _circular_distance
 
-__all__ = ["LazySafetyTable"]
+__all__ = ["LAZY_POINTS", "LazySafetyTable"]
+
+LAZY_POINTS = 1_000_000
+"""Free-region grid points above which a policy's ``table="auto"`` fills its safety table
+lazily (``DecompositionPursuer.DISTINCT_TABLE_POINTS``, ``ShootingEvader``'s): the built-in
+maps at L_min = 0.5 (the paper's worlds scaled x3) stay tabulated, a 200 m floor plan or
+``corner~x100`` at L_min 2 (115 million points) do not."""
 
 _UNKNOWN = -2  # a grid node not classified yet (-1: outside the free region)
 

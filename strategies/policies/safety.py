@@ -36,7 +36,8 @@ from envs.errors import InvalidConfigError, MemoryBudgetError
 from envs.maps import Map
 from strategies.cspace import _budget
 from strategies.cspace.cache import CacheWarning, resolve_cache_dir, write_cache_file
-from strategies.cspace.grids import check_grid_spacing, grid_points
+from strategies.cspace.grids import check_grid_spacing, grid_bytes, grid_points
+from strategies.cspace.grids import points_at as _points_at
 
 __all__ = [
     "NO_PATH",
@@ -281,8 +282,18 @@ def _build_distinct(
         leave=False,
     ) as bar:
         ids, free, safe, guaranteed = distinct_rows(dec, pts, resolution, centres, bar.update)
-    cell = np.where(cell >= 0, ids[np.maximum(cell, 0)], -1).astype(np.int32)
+    # the nodes pointed at their distinct rows in place, a chunk at a time: the whole
+    # grid's temporaries (mask, clipped index, gathered rows, np.where's result and its
+    # int32 copy) took 13 bytes a node, 2.5 GB on corner~x100's 196-million-node grid
+    flat = cell.reshape(-1)
+    for s in range(0, len(flat), _REMAP_NODES):
+        part = flat[s : s + _REMAP_NODES]
+        free_at = part >= 0
+        part[free_at] = ids[part[free_at]]
     return _table(origin, cell, L, resolution, free, safe, guaranteed)
+
+
+_REMAP_NODES = 1 << 20  # grid nodes per chunk of _build_distinct's remap
 
 
 def _free_grid(world: Map, L: float, resolution: float):
@@ -328,34 +339,25 @@ def default_resolution(L: float) -> float:
     return float(L) / 20.0
 
 
-def _points_at(area: float, resolution: float) -> float:
-    """``area / resolution**2``, the grid points of a free region, also where the square
-    overflows (resolution 1e155: OverflowError) or underflows to 0 (1e-300:
-    ZeroDivisionError); ``**`` kept, not ``*``: they differ in the last bit for some
-    spacings, and the tables' kind is chosen by this count."""
-    try:
-        sq = resolution**2
-    except OverflowError:
-        return 0.0
-    return area / sq if sq > 0.0 else math.inf
-
-
 def table_bytes(world: Map, resolution: float, n_bins: int, distinct: bool = False) -> float:
-    """Estimated memory of a table: free-region grid points x (4 bytes per bin + 9).
+    """Estimated memory of building a table: its grid's arrays
+    (:func:`~strategies.cspace.grids.grid_bytes`: 5 bytes a node of the bounding box, 24
+    a free point, one chunk's temporaries) and its rows, free-region grid points x (4
+    bytes per bin + 9).
 
-    Each point holds ``free``, ``safe`` (bool), ``ccw``, ``cw`` (uint8) per bin, a row
-    index and a flag; the grid's index array adds 4 bytes per node of the bounding box.
-    A ``distinct`` table holds its distinct rows only (bounded here by a chunk of
-    classification, ``_batch_classify.CHUNK`` points, which its build holds at once).
+    Each row holds ``free``, ``safe`` (bool), ``ccw``, ``cw`` (uint8) per bin, a row
+    index and a flag. A ``distinct`` table holds its distinct rows only (bounded here by
+    a chunk of classification, ``_batch_classify.CHUNK`` points, which its build holds
+    at once). (The grid was left out but for a 4-byte index a node: on corner~x100 at
+    L_min 2, 196 million nodes, a distinct table was estimated at 0.8 GB and its build
+    took 4-7 GB.)
     """
     from strategies.policies._batch_classify import CHUNK
 
-    x0, y0, x1, y1 = world.bounds
-    nodes = max(1.0, (x1 - x0) / resolution) * max(1.0, (y1 - y0) / resolution)
     points = _points_at(world.free_region.area, resolution)
     if distinct:
         points = min(points, CHUNK)
-    return points * (4 * n_bins + 9) + 4 * nodes
+    return grid_bytes(world, resolution) + points * (4 * n_bins + 9)
 
 
 @functools.lru_cache(maxsize=16)
@@ -408,6 +410,10 @@ def safety_table(
     need = table_bytes(world, resolution, n_bins, distinct)
     if need > budget:
         fit = resolution * math.sqrt(need / budget) * 1.05
+        for _ in range(100):  # the chunks' terms do not shrink as 1 / resolution^2
+            if table_bytes(world, fit, n_bins, distinct) <= budget:
+                break
+            fit *= 1.05
         raise MemoryBudgetError(  # its knobs named late: a policy's caller has others
             f"safety_table(map {world.name!r}, L = {L:g}, resolution = {resolution:g}): the "
             f"table would need about {need / 1e9:.3g} GB, more than the memory budget of "

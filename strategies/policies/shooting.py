@@ -60,11 +60,13 @@ from strategies.policies.base import (
 )
 from strategies.policies.baselines import nearest_wall_point
 from strategies.policies.escape_plan import escape_plan
-from strategies.policies.safety import NO_PATH, safety_table
+from strategies.policies.lazy_table import LAZY_POINTS, LazySafetyTable
+from strategies.policies.safety import NO_PATH, _points_at, safety_table
 
 __all__ = ["ShootingEvader"]
 
 _EULER = 8  # sub-steps of the straight-path rotation estimate
+_N_BINS = 144  # orientation bins of the safety table (safety_table's default)
 _WALL_TOL = 1e-9  # beyond the rounding of a distance to the walls
 _PRESSING = 2.0 * math.sin(math.radians(80.0))  # see ShootingEvader._decide's slide
 # the moves tried, in order, to keep a walk inside a region: the heading turned by 0, 5,
@@ -89,9 +91,21 @@ class ShootingEvader(BasePolicy):
             :mod:`strategies.policies.plan_features` describes; a DAgger labeller whose
             labels do not depend on who steered before). It can loop where the evader
             with memory does not (issue 13).
+        table: the safety table at L_eff: ``"distinct"`` (the whole map's, each distinct
+            row stored once, built once per map and cached on disk), ``"lazy"``
+            (:class:`~strategies.policies.lazy_table.LazySafetyTable`: a grid point is
+            classified the first time a candidate lands on it; ready as soon as the
+            decomposition is, memory grows with the area visited; the same entries, so
+            the same decisions) or ``"auto"`` (distinct up to
+            :attr:`DISTINCT_TABLE_POINTS` grid points, lazy above, as the decomposition
+            pursuer's).
     """
 
     roles = ("evader",)
+    # grid points above which "auto" fills the table lazily (the decomposition pursuer's
+    # threshold): corner~x100 at L_min 2 has 115 million, whose distinct table took
+    # minutes and gigabytes in reset (issue 13)
+    DISTINCT_TABLE_POINTS = LAZY_POINTS
 
     def __init__(
         self,
@@ -102,6 +116,7 @@ class ShootingEvader(BasePolicy):
         replan: int = 5,
         shoot: bool = True,
         memory: bool = True,
+        table: str = "auto",
         name: str | None = None,
     ) -> None:
         super().__init__(name=name)
@@ -111,6 +126,7 @@ class ShootingEvader(BasePolicy):
         self.replan = validation.integer("replan", replan, minimum=1)
         self.shoot = flag_param("shoot", shoot)
         self.memory = flag_param("memory", memory)
+        self.table_kind = validation.choice("table", table, ("auto", "distinct", "lazy"))
 
     STALL_STEPS = 10  # steps without getting closer to a crossing before giving it up
     FORGIVE_STEPS = 20  # steps without a crossing in an escapable cell before a retry
@@ -130,8 +146,17 @@ class ShootingEvader(BasePolicy):
         self.L_eff = round(c.l_min + c.body_radius, 6)
         res = self.resolution if self.resolution is not None else c.l_min / 20.0
         # distinct rows: the eager table's lookups at every node, built in about a tenth of
-        # the time (corridor at L_min 0.5: 22 s -> 2 s, issue 13)
-        self.table = safety_table(c.map, self.L_eff, res, distinct=True)
+        # the time (corridor at L_min 0.5: 22 s -> 2 s, issue 13); on larger maps filled
+        # lazily, where the candidates land (_candidates)
+        kind = self.table_kind
+        if kind == "auto":
+            points = _points_at(c.map.free_region.area, res)
+            kind = "lazy" if points > self.DISTINCT_TABLE_POINTS else "distinct"
+        self._lazy = kind == "lazy"
+        if self._lazy:
+            self.table = LazySafetyTable(c.map, self.L_eff, res, _N_BINS)
+        else:
+            self.table = safety_table(c.map, self.L_eff, res, _N_BINS, distinct=True)
         # a rotation table entry (uint8 bins) in radians, the whole turn for NO_PATH
         bins = np.arange(256).astype(float)
         self._radians = np.where(bins >= NO_PATH, 2 * math.pi, bins * self.table.bin_width)
@@ -217,18 +242,27 @@ class ShootingEvader(BasePolicy):
         # tab.rows(e + self._offsets), one coordinate at a time (the same operations)
         x = float(e[0]) + self._off_x
         y = float(e[1]) + self._off_y
-        ix = np.rint((x - tab.origin[0]) / tab.resolution).astype(np.int64)
-        iy = np.rint((y - tab.origin[1]) / tab.resolution).astype(np.int64)
-        nx, ny = tab.shape
-        ok = (ix.view(np.uint64) < nx) & (iy.view(np.uint64) < ny)  # negatives wrap high
-        rows = np.where(ok, tab.cell.reshape(-1).take(np.where(ok, ix * ny + iy, 0)), -1)
-        reach = np.cumsum(rows.reshape(self.rays, self._n_r) < 0, axis=1) == 0
+        if self._lazy:
+            # which probes are in the free region (memoised membership, no classification)
+            # up to each ray's first one off it; only the candidates among them are
+            # classified (LazySafetyTable.rows): the same probes and entries as a table of
+            # the whole map
+            off = ~tab.inside(np.stack([x, y], axis=1))
+        else:
+            ix = np.rint((x - tab.origin[0]) / tab.resolution).astype(np.int64)
+            iy = np.rint((y - tab.origin[1]) / tab.resolution).astype(np.int64)
+            nx, ny = tab.shape
+            ok = (ix.view(np.uint64) < nx) & (iy.view(np.uint64) < ny)  # negatives wrap high
+            rows = np.where(ok, tab.cell.reshape(-1).take(np.where(ok, ix * ny + iy, 0)), -1)
+            off = rows < 0
+        reach = np.cumsum(off.reshape(self.rays, self._n_r), axis=1) == 0
         pick = self._col_index[reach[:, self._cols]]
         cand = np.empty((len(pick), 2))
         cand[:, 0] = x[pick]
         cand[:, 1] = y[pick]
+        picked = tab.rows(cand) if self._lazy else rows[pick].astype(np.int64)
         near = np.linalg.norm(self._corner_points - e, axis=1) <= self._n_r * tab.resolution
-        return cand, rows[pick].astype(np.int64), self._corner_points[near], self._corner_rows[near]
+        return cand, picked, self._corner_points[near], self._corner_rows[near]
 
     def _best_candidate(
         self, e: np.ndarray, theta: float, in_sight: bool = False
@@ -288,6 +322,10 @@ class ShootingEvader(BasePolicy):
         c, tab = self.config, self.table
         rows = tab.rows(cand) if rows is None else rows
         ok = rows >= 0
+        margin = np.full(len(cand), -np.inf)
+        branch = np.full(len(cand), "-")
+        if not ok.any():  # (a lazy table may have no row yet to read a 0 from)
+            return margin, branch
         b = tab.bin_of(theta)
         # bins to turn each way (0 off the grid), in radians through a lookup of the
         # 256 uint8 values: 2 pi for NO_PATH, else bins * bin width
@@ -295,8 +333,6 @@ class ShootingEvader(BasePolicy):
         if not ok.all():
             bins_ccw, bins_cw = np.where(ok, bins_ccw, 0), np.where(ok, bins_cw, 0)
         need_ccw, need_cw = self._radians[bins_ccw], self._radians[bins_cw]
-        margin = np.full(len(cand), -np.inf)
-        branch = np.full(len(cand), "-")
         live = np.flatnonzero((bins_ccw > 0) | (bins_cw > 0))
         if not len(live):
             return margin, branch

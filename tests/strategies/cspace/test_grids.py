@@ -42,3 +42,28 @@ def test_grid_points_hold_no_array_over_the_whole_grid_beyond_their_results(monk
         tracemalloc.stop()
     results = cell.nbytes + pts.nbytes + cell.size + 8 * len(pts)  # + keep and idx
     assert peak < 1.25 * results, (peak / 1e6, results / 1e6)
+
+
+def _peak(world, resolution):
+    tracemalloc.start()
+    try:
+        grids.grid_points(world, resolution)
+        return tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+
+
+def test_grid_bytes_bounds_the_measured_peak_of_grid_points(monkeypatch):
+    """safety.table_bytes counted 4 bytes a node of the grid and nothing of its build
+    (the memory budget's check of the shooting evader's table on corner~x100 at L_min 2:
+    0.8 GB estimated, 4-7 GB taken). grid_bytes counts the build's arrays and one chunk's
+    temporaries: measured peaks (tracemalloc) lie within it and above 3/4 of it, where
+    the chunk's temporaries dominate (a grid smaller than a chunk) and where the whole
+    grid's arrays do."""
+    m = load_map("corner~x3")
+    grids.grid_points(m, 1.0)  # the map's prepared geometry made before measuring
+    ratios = []
+    for chunk, h in ((1 << 20, 0.05), (1 << 16, 0.025), (1 << 14, 0.05)):
+        monkeypatch.setattr(grids, "_CHUNK", chunk)
+        ratios.append(_peak(m, h) / grids.grid_bytes(m, h))
+    assert all(0.75 < r <= 1.0 for r in ratios), ratios

@@ -10,7 +10,7 @@ import pytest
 from envs.maps import builtin_map
 from strategies.policies import make_policy
 from strategies.policies.lazy_table import LazySafetyTable
-from strategies.policies.safety import safety_table
+from strategies.policies.safety import grid_points, safety_table
 from strategies.runner import run_episode
 
 
@@ -101,3 +101,44 @@ def test_a_huge_map_is_refused_before_its_grid_axes_are_made(monkeypatch):
     with pytest.raises(MemoryBudgetError, match=r"10,000,000,000 x 10,000,000,000 nodes"):
         LazySafetyTable(huge, 2.0, 0.1, 36)
     assert made == []
+
+
+def test_the_shooting_evader_shoots_the_same_with_a_lazy_table():
+    """The shooting evader's lazy table (maps above ``DISTINCT_TABLE_POINTS``: it
+    tabulated the whole map, corner~x100 at L_min 2 spent minutes and gigabytes in its
+    reset) reads the same entries as its distinct table: the same episode, shots included
+    (l_hall at rho 0.9, seed 0: 25 shots against the decomposition pursuer)."""
+    world = builtin_map("l_hall")
+    runs, modes = [], []
+    for table in ("distinct", "lazy"):
+        ev = make_policy("evader/shooting", table=table)
+        seen: list[str] = []
+        modes.append(seen)
+
+        def record(_, seen=seen, ev=ev):
+            seen.append(ev.mode)
+
+        r = run_episode(world, "pursuer/decomposition", ev, 0, max_cycles=150, start="safe",
+                        overrides={"v_evader": 0.9}, on_step=record)  # fmt: skip
+        runs.append(r)
+        assert type(ev.table).__name__ == ("LazySafetyTable" if table == "lazy" else "SafetyTable")
+    assert modes[0].count("shoot") >= 10 and modes[0] == modes[1]
+    assert np.array_equal(runs[0].trajectory, runs[1].trajectory)
+    assert runs[0].winner == runs[1].winner == "evader"
+    lazy = ev.table  # classified only where candidates landed (here 54 % of a small map)
+    assert 0 < lazy.classified < len(grid_points(world, lazy.resolution)[2])
+
+
+def test_the_shooting_evaders_table_is_lazy_above_the_pursuers_threshold(monkeypatch):
+    from envs.surveillance.config import EnvConfig
+    from strategies.policies.shooting import ShootingEvader
+
+    assert ShootingEvader.DISTINCT_TABLE_POINTS == 1_000_000  # the pursuer's threshold
+    config = EnvConfig(map=builtin_map("corner"))
+    kinds = []
+    for limit in (1_000_000, 1000):
+        monkeypatch.setattr(ShootingEvader, "DISTINCT_TABLE_POINTS", limit)
+        ev = make_policy("evader/shooting")
+        ev.reset(role="evader", map=config.map, config=config, seed=0)
+        kinds.append(type(ev.table).__name__)
+    assert kinds == ["SafetyTable", "LazySafetyTable"]

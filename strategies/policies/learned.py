@@ -107,6 +107,7 @@ class SB3Policy(BasePolicy):
         self.deterministic = bool(deterministic)
         self.model: Any = None
         self._warned: set[str] = set()
+        self._digests: set[str] | None = None
         self.provenance = _provenance(self.path)
         trained = None if self.provenance is None else self.provenance.get("role")
         if trained is not None and trained != role:
@@ -183,7 +184,13 @@ class SB3Policy(BasePolicy):
         cfg = prov.get("config") or {}
         trained = cfg.get("maps") or ([cfg["map"]] if cfg.get("map") else [])
         here = getattr(self.map, "name", None)
-        if not trained or here is None or here in trained or here in self._warned:
+        if not trained or here is None or here in self._warned:
+            return
+        # by geometry, not by name: a map file is named by its path in the config and by
+        # its own name (the file's "name" or stem) on the map, so the very file trained on
+        # was "not seen"; and a user's map called "l_hall" is not the l_hall trained on
+        digest = getattr(self.map, "digest", None)
+        if (here in trained) if digest is None else (digest in self._trained_digests(trained)):
             return
         self._warned.add(here)
         warnings.warn(
@@ -193,6 +200,22 @@ class SB3Policy(BasePolicy):
             UnseenMapWarning,
             stacklevel=3,
         )
+
+    def _trained_digests(self, trained: list[Any]) -> set[str]:
+        """Geometry digests of the maps the model trained on, as they load now (those that
+        do not load, e.g. a file moved since, are left out), and the one its provenance
+        recorded; computed once."""
+        if self._digests is None:
+            from envs.maps import load_map
+
+            found = {(self.provenance.get("env_config") or {}).get("map_digest")}
+            for name in trained:
+                try:
+                    found.add(load_map(str(name)).digest)
+                except (ValueError, OSError):
+                    pass
+            self._digests = {d for d in found if d}
+        return self._digests
 
     def act(self, observation: np.ndarray) -> np.ndarray:
         """The model's action for one observation, clipped to [-1, 1].

@@ -291,3 +291,29 @@ def test_python_m_training_zoo_evaluates_a_dagger_model(name, opponent, capsys):
     assert zoo_main(["evaluate", name, "--opponent", opponent, "--episodes", "1"]) == 0
     out = capsys.readouterr().out
     assert out.startswith(f"{zoo.info(name)['role']} vs {opponent}: success ")
+
+
+def test_a_specialist_knows_its_map_by_geometry_not_by_name(tmp_path):
+    """A model trained on a map file (config map = the path) warned 'trained on
+    /x/room.json; it plays 'room', a map it has not seen' on that very file; a user's map
+    called 'l_hall' with other walls passed as the l_hall the model trained on."""
+    import warnings
+
+    from envs.maps import load_map, save_map
+    from strategies.policies.learned import UnseenMapWarning
+
+    policy = zoo.load("dagger_pursuer_l_hall")
+    own = tmp_path / "mine.json"
+    same = load_map("l_hall").transformed(((1, 0), (0, 1)), (0, 0), name="mine")
+    save_map(same, own)  # the same walls, another name, named by a path
+    other = tmp_path / "l_hall.json"
+    save_map(load_map("corner").transformed(((1, 0), (0, 1)), (0, 0), name="l_hall"), other)
+    for path, warns in ((own, False), (other, True)):
+        world = load_map(str(path))
+        assert world.name == path.stem
+        env = surveillance_v1.parallel_env(map=world)
+        with warnings.catch_warnings(record=True) as got:
+            warnings.simplefilter("always")
+            policy.reset(role="pursuer", map=world, config=env.config, seed=0)
+        said = [w for w in got if issubclass(w.category, UnseenMapWarning)]
+        assert len(said) == warns, (path, [str(w.message) for w in said])

@@ -444,7 +444,14 @@ class parallel_env(ParallelEnv, EzPickle):
         }
 
     def state(self) -> np.ndarray:
-        """The global state (the ``"state"`` observation vector) for centralised critics."""
+        """The global state (the ``"state"`` observation vector) for centralised critics.
+
+        Raises:
+            EpisodeStateError: before the first ``reset()`` (it returned the state of both
+                agents at (0, 0), possibly inside a wall; the AEC env raises too).
+        """
+        if self._ended_at is None:
+            raise EpisodeStateError("state() before reset(): call reset(seed=...) first")
         return self._state_encoder.encode(
             self._pursuer, self._vp, self._evader, self._ve, self._visible, self._step
         )

@@ -409,6 +409,19 @@ def test_render_before_reset_is_an_error() -> None:
     env.close()
 
 
+def test_state_before_reset_is_an_error() -> None:
+    """As step() and render() before reset(), and as the AEC env: it returned a state
+    vector of both agents at (0, 0) (in the corridor's wall) without a word."""
+    env = surveillance_v1.parallel_env(map="corridor", max_cycles=3)
+    with pytest.raises(EpisodeStateError, match=r"^state\(\) before reset\(\)"):
+        env.state()
+    obs, _ = env.reset(seed=0)
+    assert np.array_equal(env.state(), obs[P])
+    while env.agents:
+        obs, *_ = env.step({P: np.zeros(2), E: np.zeros(2)})
+    assert np.array_equal(env.state(), obs[P])  # after the end: the last state, as before
+
+
 def test_human_render_runs_headless_and_close_is_idempotent() -> None:
     env = surveillance_v1.parallel_env(map=open_room(), render_mode="human", max_cycles=3)
     env.reset(seed=0)

@@ -85,6 +85,16 @@ _PAIRS = 1 << 20
 pillars (844 edges) asked for 315,000 points at once: over 20 GB, killed by the OOM killer."""
 
 
+_NEAR_EDGES = 128
+"""Maps with at least this many wall edges measure the distance to the walls of many
+points through a spatial index of the edges (:meth:`Map._near_distances`): brute force
+costs about 0.2 us a (point, edge) pair, the index about 12 us a point whatever the
+edges (measured on 300,000 points: equal at about 60 edges; the pillar room's 844: 54 s
+brute force, 3.5 s indexed). The values are the same either way."""
+_NEAR_POINTS = 256  # ... and calls with at least this many points (fewer: brute force)
+_NEAR_CHUNK = 1 << 16  # points per batch of the indexed distances
+
+
 def _clean_ring(ring: np.ndarray, scale: float, what: str) -> np.ndarray:
     """Drop repeated and straight (collinear) vertices; reject degenerate rings."""
     keep = np.linalg.norm(ring - np.roll(ring, 1, axis=0), axis=1) > REL_LENGTH_TOL * scale
@@ -403,6 +413,8 @@ class Map:
     def distance_to_walls(self, points: np.ndarray | Sequence[Sequence[float]]) -> np.ndarray:
         """Euclidean distance from each point to the nearest wall edge."""
         p = np.atleast_2d(np.asarray(points, dtype=float))
+        if len(p) >= _NEAR_POINTS and self.n_edges >= _NEAR_EDGES and np.isfinite(p).all():
+            return self._near_distances(p)
         step = self._chunk()
         if len(p) > step:  # bounded memory (see _chunk)
             return np.concatenate(
@@ -412,6 +424,44 @@ class Map:
         t = np.clip(np.einsum("kej,ej->ke", rel, self.edge_dir), 0.0, self.edge_length)
         closest = self.edge_start[None] + t[..., None] * self.edge_dir[None]
         return np.linalg.norm(p[:, None, :] - closest, axis=2).min(axis=1)
+
+    @functools.cached_property
+    def _edge_tree(self) -> shapely.STRtree:
+        """The wall edges in a spatial index (their order: edge ids)."""
+        ends = np.stack([self.edge_start, self.edge_end], axis=1)
+        return shapely.STRtree(shapely.linestrings(ends))
+
+    def _pair_distances(self, p: np.ndarray, e: np.ndarray) -> np.ndarray:
+        """Distance from each point ``p[k]`` to edge ``e[k]``: :meth:`distance_to_walls`'
+        formula, operation for operation (the same floats)."""
+        rel = p - self.edge_start[e]
+        t = np.clip(np.einsum("kj,kj->k", rel, self.edge_dir[e]), 0.0, self.edge_length[e])
+        closest = self.edge_start[e] + t[:, None] * self.edge_dir[e]
+        return np.linalg.norm(p - closest, axis=1)
+
+    def _near_distances(self, p: np.ndarray) -> np.ndarray:
+        """:meth:`distance_to_walls` of (n, 2) points through the edges' index: for each
+        point, the distance ``u`` to the edge the index finds nearest (by the same
+        formula) bounds the least one, and every edge nearer lies in the box of half side
+        ``u`` round the point; the least over the edges the index gives for that box (a
+        few, not all) is the least over all edges, the same float (a minimum of the same
+        values)."""
+        tree = self._edge_tree
+        # beyond the rounding of u (a few ulps of the coordinates)
+        slack = 1e-9 * (self.scale + float(np.abs(self.edge_start).max()))
+        out = np.empty(len(p))
+        for s in range(0, len(p), _NEAR_CHUNK):
+            q = p[s : s + _NEAR_CHUNK]
+            i, j = tree.query_nearest(shapely.points(q), all_matches=False)
+            r = np.empty(len(q))
+            r[i] = self._pair_distances(q[i], j)
+            r += slack
+            boxes = shapely.box(q[:, 0] - r, q[:, 1] - r, q[:, 0] + r, q[:, 1] + r)
+            a, e = tree.query(boxes)  # the edges whose bounding boxes meet the box
+            least = np.full(len(q), np.inf)
+            np.minimum.at(least, a, self._pair_distances(q[a], e))
+            out[s : s + _NEAR_CHUNK] = least
+        return out
 
     def describe(self, feature: Feature) -> str:
         """Human-readable description of a wall feature, e.g. ``"convex vertex 3 (1, 2)"``."""

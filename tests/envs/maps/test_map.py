@@ -495,3 +495,49 @@ def test_name_merge_and_transforms_follow_the_number_rule():
     with pytest.raises(InvalidMapError, match=r"transformed matrix = .*: expected finite"):
         m.transformed([[np.nan, 0], [0, 1]])
     assert m.transformed(np.eye(2), (1, 2)).bounds == (1.0, 2.0, 5.0, 6.0)
+
+
+def test_wall_distances_of_many_points_read_few_edges_and_keep_every_float(monkeypatch):
+    """The shooting evader's reset measures the walls' distance of 10^5-10^6 points (its
+    escape plan's crossings and grid walk): against every edge, 113 of the 163 s of its
+    reset on a 200 m floor plan at L_min 3, 54 s for 300,000 points of the 844-edge pillar
+    room. Through the edges' spatial index: the same floats as against every edge, each
+    point measured against a few edges."""
+    import envs.maps.map as map_module
+
+    room = Map(
+        box(0, 0, 60, 56),
+        [
+            box(4 * i + 1.6, 4 * j + 1.6, 4 * i + 2.4, 4 * j + 2.4)
+            for i in range(15)
+            for j in range(14)
+        ],
+    )
+    turned = room.transformed(np.array([[0.6, -0.8], [0.8, 0.6]]) * 1e3, (5e5, -3e5))
+    rng = np.random.default_rng(11)
+    for m in (room, turned):
+        x0, y0, x1, y1 = m.bounds
+        k = rng.integers(0, m.n_edges, 3000)
+        on = m.edge_start[k] + rng.uniform(size=(3000, 1)) * (m.edge_end[k] - m.edge_start[k])
+        pts = np.concatenate(
+            [
+                rng.uniform([x0 - 1, y0 - 1], [x1 + 1, y1 + 1], size=(20000, 2)),
+                on,  # on the walls, and within rounding of them
+                on + rng.normal(scale=1e-9 * m.scale, size=on.shape),
+                m.vertices,
+            ]
+        )
+        pairs = []
+        measure = Map._pair_distances
+
+        def counted(self, p, e, pairs=pairs, measure=measure):
+            pairs.append(len(e))
+            return measure(self, p, e)
+
+        monkeypatch.setattr(Map, "_pair_distances", counted)
+        got = m.distance_to_walls(pts)
+        monkeypatch.undo()
+        assert sum(pairs) < 0.05 * len(pts) * m.n_edges, sum(pairs) / len(pts)
+        monkeypatch.setattr(map_module, "_NEAR_EDGES", 10**9)  # every edge
+        assert np.array_equal(got, m.distance_to_walls(pts))
+        monkeypatch.undo()

@@ -20,12 +20,15 @@ code 2, no traceback, and is found before any long work starts:
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import re
+import signal
 import stat
 import tempfile
-from collections.abc import Callable, Sequence
+import threading
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -39,6 +42,7 @@ __all__ = [
     "output_file",
     "path_text",
     "real",
+    "sigterm_as_interrupt",
     "user_error",
     "why_not_a_file",
 ]
@@ -293,3 +297,24 @@ def set_from_flag(config: dict[str, Any], key: str, flag: str, value: Any) -> No
             f"{flag} {value!r} and --config {key} = {config[key]!r}: give {key} once"
         )
     config[key] = value
+
+
+def _raise_sigterm(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt("SIGTERM")
+
+
+@contextlib.contextmanager
+def sigterm_as_interrupt() -> Iterator[None]:
+    """Within the block, SIGTERM (``kill``, ``timeout``) raises ``KeyboardInterrupt("SIGTERM")``
+    in the main thread, so a command stops as on Ctrl-C: its cleanup runs (a replay's
+    temporary file removed, a training run's resume note printed). It was the default
+    action: ``surveil play`` killed so left ``.NAME.gif.PID.tmp`` beside its output. The
+    previous handler is restored on leaving (tournaments install their own inside)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _raise_sigterm)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)

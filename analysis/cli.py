@@ -27,6 +27,7 @@ from analysis.arguments import (
     path_text,
     real,
     set_from_flag,
+    sigterm_as_interrupt,
     user_error,
 )
 from analysis.figures import cli as figures_cli
@@ -407,7 +408,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     Returns:
         0 on success, 2 for a user error (one line on stderr: ``surveil: error: ...``
         naming the value, what was expected and where it came from), 130 when
-        interrupted. A traceback means a bug.
+        interrupted (Ctrl-C), 143 when stopped by SIGTERM (cleaning up as on Ctrl-C). A
+        traceback means a bug.
     """
     try:
         args = build_parser().parse_args(argv)  # imports for seconds: Ctrl-C lands here too
@@ -416,11 +418,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("surveil: interrupted", file=sys.stderr)
         return 130
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(), sigterm_as_interrupt():
         warnings.showwarning = _OneLineWarnings(warnings.showwarning)
         try:
             return int(args.func(args) or 0)
-        except KeyboardInterrupt:
+        except KeyboardInterrupt as exc:
+            if str(exc) == "SIGTERM":
+                print("surveil: stopped by SIGTERM", file=sys.stderr)
+                return 143
             print("surveil: interrupted", file=sys.stderr)
             return 130
         except Exception as exc:

@@ -9,7 +9,9 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import signal
 import sys
+import threading
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -164,13 +166,20 @@ def run_cli(prog: str, func: Callable[[], int]) -> int:
 
     User errors (the project's ``SurveilValueError``, files that cannot be read or
     written) print one line ``PROG: error: ...`` and return 2; Ctrl-C returns 130;
-    argparse's own exits pass through; anything else is a bug and keeps its traceback.
+    SIGTERM returns 143 (cleaning up as on Ctrl-C); argparse's own exits pass through;
+    anything else is a bug and keeps its traceback.
     """
+    previous = None
+    if threading.current_thread() is threading.main_thread():  # SIGTERM stops as Ctrl-C does
+        previous = signal.signal(signal.SIGTERM, _raise_sigterm)
     try:
         return int(func() or 0)
     except SystemExit as exc:  # argparse: --help (0) or a usage error (2, already printed)
         return exc.code if isinstance(exc.code, int) else 2
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
+        if str(exc) == "SIGTERM":
+            print(f"{prog}: stopped by SIGTERM", file=sys.stderr)
+            return 143
         print(f"{prog}: interrupted", file=sys.stderr)
         return 130
     except (SurveilValueError, OSError) as exc:
@@ -180,6 +189,15 @@ def run_cli(prog: str, func: Callable[[], int]) -> int:
             message = str(exc) or type(exc).__name__
         print(f"{prog}: error: {message}", file=sys.stderr)
         return 2
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _raise_sigterm(signum: int, frame: object) -> None:
+    """SIGTERM (``kill``, ``timeout``) as a KeyboardInterrupt: the resume note is printed
+    and temporary files are cleaned up, as on Ctrl-C (it was the default action: no word)."""
+    raise KeyboardInterrupt("SIGTERM")
 
 
 def summary(result: TrainResult) -> str:

@@ -267,3 +267,64 @@ def test_every_map_argument_says_what_it_takes(command, flag, capsys):
     assert main(["maps", "--help"]) == 0
     text = " ".join(capsys.readouterr().out.split())
     assert "a map file (.json, .geojson or .wkt" in text and "random:KIND:SEED" in text
+
+
+def test_sigterm_stops_a_command_as_ctrl_c_does(tmp_path, capsys, monkeypatch):
+    """``kill`` / ``timeout`` sent SIGTERM's default action: surveil play died at once and
+    left its hidden temporary replay (.play.gif.PID.tmp) beside the output, and surveil
+    train printed no resume note. Now it stops as on Ctrl-C (exit 143)."""
+    import os
+    import signal
+
+    import analysis.replay
+
+    frames = []
+    add = analysis.replay.GifStream.add
+
+    def add_then_kill(self, frame):
+        frames.append(1)
+        if len(frames) == 3:
+            os.kill(os.getpid(), signal.SIGTERM)
+        add(self, frame)
+
+    monkeypatch.setattr(analysis.replay.GifStream, "add", add_then_kill)
+    monkeypatch.setattr(analysis.replay.GifStream, "__call__", add_then_kill)
+
+    def ignore(signum, frame):  # the caller's handler (without the fix: pytest survives)
+        pass
+
+    outer = signal.signal(signal.SIGTERM, ignore)
+    try:
+        out = tmp_path / "x.gif"
+        assert main(["play", "--max-cycles", "50", "--out", str(out)]) == 143
+        assert signal.getsignal(signal.SIGTERM) is ignore  # restored for the caller
+    finally:
+        signal.signal(signal.SIGTERM, outer)
+    assert capsys.readouterr().err == "surveil: stopped by SIGTERM\n"
+    assert list(tmp_path.iterdir()) == []  # neither the replay nor its temporary file
+
+
+def test_sigterm_stops_python_m_training_with_its_resume_note(tmp_path, capsys, monkeypatch):
+    import os
+    import signal
+
+    import training.cli
+    from training.cli import cli_train
+
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(f'role = "pursuer"\nopponent = "evader/straight"\noutput_dir = "{tmp_path}/r"\n')
+
+    def killed(config, progress_bar=False):
+        os.kill(os.getpid(), signal.SIGTERM)
+        raise ValueError("not stopped")  # a SurveilValueError would be exit code 2
+
+    monkeypatch.setattr(training.cli, "train", killed)
+    outer = signal.signal(signal.SIGTERM, lambda signum, frame: None)  # as above
+    try:
+        assert cli_train([str(cfg)]) == 143
+    finally:
+        signal.signal(signal.SIGTERM, outer)
+    err = capsys.readouterr().err
+    assert err.startswith("stopped before the first checkpoint") and err.endswith(
+        "python -m training: stopped by SIGTERM\n"
+    )

@@ -641,7 +641,8 @@ def file_parameters(path: str | os.PathLike[str]) -> dict[str, float] | None:
 
     Raises:
         InvalidMapError: a recommended value that is not a finite number > 0 (naming the
-            file and the key), or ``l_max`` not above ``l_min``.
+            file and the key), ``l_max`` not above ``l_min``, or a body radius (given, or
+            the default 0.1) not below ``l_min / 2``.
     """
     p = Path(path)
     if p.suffix.lower() not in FORMATS or not p.is_file():
@@ -665,6 +666,14 @@ def file_parameters(path: str | os.PathLike[str]) -> dict[str, float] | None:
         }
         raise InvalidMapError(
             f"{p} metadata: l_max = {said['l_max']}: expected a value > l_min = {said['l_min']}"
+        )
+    body = out.get("body_radius", BODY_RADIUS)
+    if body >= 0.5 * out["l_min"]:  # the env's own bound, said of the file (not of --config)
+        said = f"{given['body_radius']!r}" if "body_radius" in given else f"{body!r} (the default"
+        said += "" if "body_radius" in given else "; add body_radius to the metadata)"
+        raise InvalidMapError(
+            f"{p} metadata: body_radius = {said}: expected a value in (0, l_min / 2 = "
+            f"{0.5 * out['l_min']:g})"
         )
     return out
 

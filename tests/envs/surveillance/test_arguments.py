@@ -122,6 +122,9 @@ def test_a_map_file_brings_its_metadata_recommendations_as_a_built_in_does(tmp_p
             r"value > l_min = 5",
         ),
         ({"l_min": 3, "l_max": 3}, r"metadata: l_max = 3: expected a value > l_min = 3$"),
+        # was "--config: body_radius = 0.6: ..." from surveil play, without any --config
+        ({"l_min": 1, "body_radius": 0.6}, r"body_radius = 0.6: expected a value in \(0, l_min"),
+        ({"l_min": 0.15, "l_max": 1}, r"body_radius = 0.1 \(the default; add body_radius to "),
     ],
 )
 def test_a_map_file_s_bad_recommendation_is_one_line_naming_the_key(tmp_path, metadata, message):

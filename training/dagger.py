@@ -488,6 +488,16 @@ def _resume(cfg: DaggerConfig, out: Path, env) -> tuple[Any, dict[str, Any], lis
             f"{diff}: {[before[k] for k in diff]} there, {[now[k] for k in diff]} now); "
             "use another output_dir or delete that one"
         )
+    if "maps" in progress:  # (a run of an older surveil has none)
+        now_maps = _map_fingerprints(cfg)
+        changed = sorted(m for m in now_maps if progress["maps"].get(m, now_maps[m]) != now_maps[m])
+        if changed:
+            m = changed[0]
+            raise InvalidConfigError(
+                f"output_dir {str(out)!r} holds a DAgger run on other maps: {m!r} resolves to "
+                f"{now_maps[m]} now, {progress['maps'][m]} when the run started (its map file "
+                "or the file's metadata changed); use another output_dir or delete that one"
+            )
     _settle(out, len(progress["samples"]) - 1)
     try:
         last = out / "model_last.zip"
@@ -505,6 +515,19 @@ def _resume(cfg: DaggerConfig, out: Path, env) -> tuple[Any, dict[str, Any], lis
             f"progress.json {progress['samples'][-1]}; delete the directory to start over"
         )
     return model, progress, obs, act
+
+
+def _map_fingerprints(cfg: DaggerConfig) -> dict[str, dict[str, Any]]:
+    """Every map the run plays (curriculum stages included), by name: its geometry digest
+    and recommended parameters as they resolve now. A config names a map file by its path,
+    so an edit between an interruption and the rerun is seen only here."""
+    from envs.maps import load_map
+    from envs.surveillance.config import map_recommendations
+
+    names: set[str] = set()
+    for it in range(cfg.iterations):
+        names.update(str(m) for m in cfg.stage(it)[0])
+    return {n: {"digest": load_map(n).digest, **map_recommendations(n)} for n in sorted(names)}
 
 
 def _write_iteration(out: Path, model, obs, act, progress: dict[str, Any], best: bool) -> None:
@@ -604,6 +627,7 @@ def dagger(cfg: DaggerConfig, *, verbose: bool = False) -> DaggerResult:
                     seed=cfg.seed, device="cpu", verbose=0)  # fmt: skip
         progress: dict[str, Any] = {
             "config": cfg.to_dict(),
+            "maps": _map_fingerprints(cfg),
             "disagreement": [], "samples": [], "held": [], "fit_error": [], "episodes": [],
             "wall_seconds": 0.0,
         }  # fmt: skip
@@ -612,6 +636,7 @@ def dagger(cfg: DaggerConfig, *, verbose: bool = False) -> DaggerResult:
     else:
         model, progress, data_obs, data_act = resumed
         progress["config"] = cfg.to_dict()
+        progress["maps"] = _map_fingerprints(cfg)  # checked by _resume; a new stage's too
     opponent = cfg.opponent_policy()
     for it in range(len(progress["samples"]), cfg.iterations):
         t_it = time.perf_counter()

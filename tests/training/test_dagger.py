@@ -118,6 +118,25 @@ def test_an_interrupted_run_resumes_to_the_same_model_bit_for_bit(tmp_path):
     assert all(torch.equal(a[k], b[k]) for k in a)
 
 
+def test_a_dagger_run_whose_map_file_changed_is_not_resumed(tmp_path):
+    """The config names a map file by its path: a run stopped after iteration 0, the
+    file's walls or recommended parameters edited, then rerun aggregated labels of the
+    other game into the first one's dataset without a word (as surveil train did)."""
+    from envs.maps import load_map, save_map
+
+    world = tmp_path / "room.json"
+    save_map(load_map("open_room"), world, metadata={"l_min": 1.5, "l_max": 3.0})
+    dagger(_cfg(tmp_path, maps=(str(world),), iterations=1, epochs=5))
+    progress = json.loads((tmp_path / "dagger" / "progress.json").read_text())
+    assert progress["maps"][str(world)]["l_min"] == 1.5
+    save_map(load_map("open_room"), world, metadata={"l_min": 1.0, "l_max": 3.0})
+    with pytest.raises(InvalidConfigError, match=r"holds a DAgger run on other maps: .*room"
+                       r"\.json' resolves to .*'l_min': 1\.0.* now, .*'l_min': 1\.5"):  # fmt: skip
+        dagger(_cfg(tmp_path, maps=(str(world),), epochs=5))
+    save_map(load_map("open_room"), world, metadata={"l_min": 1.5, "l_max": 3.0})
+    assert len(dagger(_cfg(tmp_path, maps=(str(world),), epochs=5)).samples) == 2  # resumed
+
+
 @pytest.mark.parametrize("where", ["savez_compressed", "_settle"])
 def test_a_ctrl_c_while_an_iteration_is_written_resumes_to_the_same_model(
     tmp_path, monkeypatch, where

@@ -636,8 +636,9 @@ FILE_RECOMMENDATIONS = ("l_min", "l_max", "v_pursuer", "v_evader", "body_radius"
 def file_parameters(path: str | os.PathLike[str]) -> dict[str, float] | None:
     """The recommended parameters in map file ``path``'s ``metadata``: those of
     :data:`FILE_RECOMMENDATIONS` it gives, the rest of ``l_min``, ``l_max``, ``v_pursuer``,
-    ``v_evader`` from :data:`GLOBAL_DEFAULTS`; ``None`` when it gives none of them (or
-    ``path`` names no file: :func:`load_map` says why). Other metadata keys are free-form.
+    ``v_evader`` from :data:`GLOBAL_DEFAULTS`; ``None`` when it gives none of them (a
+    ``null`` gives none; or ``path`` names no file: :func:`load_map` says why). Other
+    metadata keys are free-form.
 
     Raises:
         InvalidMapError: a recommended value that is not a finite number > 0 (naming the
@@ -648,7 +649,8 @@ def file_parameters(path: str | os.PathLike[str]) -> dict[str, float] | None:
     if p.suffix.lower() not in FORMATS or not p.is_file():
         return None
     metadata = read_map(p).metadata
-    given = {k: metadata[k] for k in FILE_RECOMMENDATIONS if k in metadata}
+    # a null is no recommendation (as the env's own None for these parameters)
+    given = {k: metadata[k] for k in FILE_RECOMMENDATIONS if metadata.get(k) is not None}
     if not given:
         return None
     out = dict(GLOBAL_DEFAULTS)

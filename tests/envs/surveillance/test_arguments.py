@@ -101,9 +101,9 @@ def test_a_map_file_brings_its_metadata_recommendations_as_a_built_in_does(tmp_p
     cfg = EnvConfig(map=str(small))
     assert (cfg.l_min, cfg.body_radius, cfg.dt) == (0.2, 0.01, 0.1)
     surveillance_v1.parallel_env(map=str(small)).reset(seed=0)  # was refused at L = 2
-    # nothing recommended (free-form keys only, also transformed; a Map object): the defaults
+    # nothing recommended (free-form keys and nulls, also transformed; a Map object): defaults
     plain = tmp_path / "plain.json"
-    save_map(open_room(), plain, metadata={"author": "anyone"})
+    save_map(open_room(), plain, metadata={"author": "anyone", "l_min": None})
     for m in (str(plain), f"{plain}~x3", open_room()):
         cfg = EnvConfig(map=m)
         assert {k: getattr(cfg, k) for k in MAP_PARAMETERS} == GLOBAL_DEFAULTS

@@ -115,7 +115,7 @@ def main(argv=None) -> int:
             seconds, peak, kind, points = got
             ref = ref or (seconds, peak)
             print(
-                f"{spec:<18}{points:>10.3g}{name:>23}{seconds:>9.1f}{peak:>9.2f}"
+                f"{spec:<18}{points:>10.3g}{name:>23}{seconds:>9.2f}{peak:>9.2f}"
                 f"{seconds / ref[0]:>7.2f}{peak / ref[1]:>8.2f}  {kind}",
                 flush=True,
             )

@@ -52,12 +52,17 @@ _UNKNOWN = -2  # a grid node not classified yet (-1: outside the free region)
 _BYTES_PER_NODE = 5
 """The grid's per-node arrays: the row index (int32) and the membership flag (int8)."""
 
+_TILE = 64
+"""Grid nodes a side of a tile: the per-node arrays are allocated a tile at a time, where
+lookups first touch the grid (the whole grid's were 0.98 GB on corner~x100 at L_min 2,
+196 million nodes, for a few thousand nodes looked at in an episode)."""
+
 
 def _check_grid(world: Map, resolution: float, shape: tuple[int, int]) -> None:
-    """Refuse a grid whose per-node arrays exceed the memory budget (``$SURVEIL_MEMORY_
-    BUDGET`` or half the RAM, as the decompositions'), before allocating them: at
-    ``resolution = 1e-6`` the corridor's grid asked numpy for 582 TiB (a MemoryError
-    traceback through the pursuer's reset).
+    """Refuse a grid whose per-node arrays, were every tile looked up, would exceed the
+    memory budget (``$SURVEIL_MEMORY_BUDGET`` or half the RAM, as the decompositions'),
+    before allocating anything: at ``resolution = 1e-6`` the corridor's grid asked numpy
+    for 582 TiB (a MemoryError traceback through the pursuer's reset).
 
     Raises:
         MemoryBudgetError: naming the estimate and the resolution that fits.
@@ -117,8 +122,14 @@ class LazySafetyTable:
         self._ys = grid_axis(ymin, ymax, self.resolution)
         self.origin = np.array([self._xs[0], self._ys[0]])
         self.decomposition = decompose(world, self.L, cache=True)
-        self._cell = np.full(self.shape, _UNKNOWN, dtype=np.int32)
-        self._member = np.zeros(self.shape, dtype=np.int8)  # 0 unknown, 1 inside, 2 not
+        # node (i, j) is entry (i % _TILE, j % _TILE) of slab _tiles[i // _TILE, j // _TILE]
+        # of _cell (its row, _UNKNOWN, or -1) and _member (0 unknown, 1 inside, 2 not)
+        self._tiles = np.full(
+            (-(-self.shape[0] // _TILE), -(-self.shape[1] // _TILE)), -1, dtype=np.int32
+        )
+        self._cell = np.full((1, _TILE, _TILE), _UNKNOWN, dtype=np.int32)
+        self._member = np.zeros((1, _TILE, _TILE), dtype=np.int8)
+        self._n_tiles = 0
         self._centres = -math.pi + (np.arange(self.n_bins) + 0.5) * self.bin_width
         self._walls = shapely.boundary(world.free_region)
         shapely.prepare(self._walls)
@@ -153,13 +164,34 @@ class LazySafetyTable:
         """
         idx, ok = self.grid_index(points)
         out = np.zeros(len(idx), dtype=bool)
-        member = self._member[idx[ok, 0], idx[ok, 1]]
+        at = self._slots(idx[ok])
+        member = self._member[at]
         if (member == 0).any():
             todo = np.unique(idx[ok][member == 0], axis=0)
             self._membership(todo)
-            member = self._member[idx[ok, 0], idx[ok, 1]]
+            member = self._member[at]
         out[ok] = member == 1
         return out
+
+    def _slots(self, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Where grid nodes (k, 2) are kept in ``_cell`` and ``_member`` (an index
+        tuple), their tiles allocated first (unknown nodes)."""
+        ti, tj = nodes[:, 0] // _TILE, nodes[:, 1] // _TILE
+        slab = self._tiles[ti, tj]
+        if (slab < 0).any():
+            new = np.unique(np.stack([ti[slab < 0], tj[slab < 0]], axis=1), axis=0)
+            n = self._n_tiles + len(new)
+            if n > len(self._cell):
+                cap = max(n, 2 * len(self._cell))
+                cell = np.full((cap, _TILE, _TILE), _UNKNOWN, dtype=np.int32)
+                member = np.zeros((cap, _TILE, _TILE), dtype=np.int8)
+                cell[: self._n_tiles] = self._cell[: self._n_tiles]
+                member[: self._n_tiles] = self._member[: self._n_tiles]
+                self._cell, self._member = cell, member
+            self._tiles[new[:, 0], new[:, 1]] = np.arange(self._n_tiles, n)
+            self._n_tiles = n
+            slab = self._tiles[ti, tj]
+        return slab, nodes[:, 0] % _TILE, nodes[:, 1] % _TILE
 
     def _membership(self, nodes: np.ndarray) -> np.ndarray:
         """Decide (and memoise) which grid nodes (k, 2) lie in the free region."""
@@ -167,29 +199,31 @@ class LazySafetyTable:
         inside = shapely.contains_xy(self.map.prepared_free_region, x, y)
         at = np.flatnonzero(inside)
         inside[at] = ~shapely.dwithin(self._walls, shapely.points(x[at], y[at]), self._eps)
-        self._member[nodes[:, 0], nodes[:, 1]] = np.where(inside, 1, 2)
+        self._member[self._slots(nodes)] = np.where(inside, 1, 2)
         return inside
 
     def rows(self, points: np.ndarray) -> np.ndarray:
         """Table rows of the grid points nearest to (k, 2) points (-1 outside)."""
         idx, ok = self.grid_index(points)
         out = np.full(len(idx), -1, dtype=np.int64)
-        vals = self._cell[idx[ok, 0], idx[ok, 1]]
+        at = self._slots(idx[ok])
+        vals = self._cell[at]
         if (vals == _UNKNOWN).any():
             todo = np.unique(idx[ok][vals == _UNKNOWN], axis=0)
             self._classify(todo)
-            vals = self._cell[idx[ok, 0], idx[ok, 1]]
+            vals = self._cell[at]
         out[ok] = vals
         return out
 
     def _classify(self, nodes: np.ndarray) -> None:
         """Classify grid nodes (k, 2) as the eager table's build does."""
         x, y = self._xs[nodes[:, 0]], self._ys[nodes[:, 1]]
-        member = self._member[nodes[:, 0], nodes[:, 1]]
+        at = self._slots(nodes)
+        member = self._member[at]
         inside = member == 1
         if (member == 0).any():
             inside[member == 0] = self._membership(nodes[member == 0])
-        self._cell[nodes[~inside, 0], nodes[~inside, 1]] = -1
+        self._cell[tuple(a[~inside] for a in at)] = -1
         new = nodes[inside]
         if not len(new):
             return
@@ -205,7 +239,7 @@ class LazySafetyTable:
         self._ccw[sl] = _circular_distance(self._safe[sl], +1)
         self._cw[sl] = _circular_distance(self._safe[sl], -1)
         self._need[sl] = np.minimum(self._ccw[sl], self._cw[sl])
-        self._cell[new[:, 0], new[:, 1]] = np.arange(self._n, self._n + len(new))
+        self._cell[tuple(a[inside] for a in at)] = np.arange(self._n, self._n + len(new))
         self._n += len(new)
 
     def _grow(self, n: int) -> None:

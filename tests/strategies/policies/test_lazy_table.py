@@ -142,3 +142,40 @@ def test_the_shooting_evaders_table_is_lazy_above_the_pursuers_threshold(monkeyp
         ev.reset(role="evader", map=config.map, config=config, seed=0)
         kinds.append(type(ev.table).__name__)
     assert kinds == ["SafetyTable", "LazySafetyTable"]
+
+
+def test_a_lazy_tables_grid_is_allocated_where_it_is_looked_up():
+    """The per-node arrays (5 bytes a node) were allocated for the whole grid: 0.98 GB on
+    corner~x100 at L_min 2 for each policy, whatever the evader visits. Now a tile at a
+    time where lookups land (corner~x30 at 0.1: 88 MB of per-node arrays, 94 MB at the
+    peak before, 6 MB now), with the same answers across many tiles."""
+    import tracemalloc
+
+    from envs.maps import load_map
+
+    world = load_map("corner~x30")
+    LazySafetyTable(world, 2.2, 1.0, 36)  # its decomposition made (and kept) first
+    rng = np.random.default_rng(0)
+    pts = rng.uniform((30, 30), (40, 40), size=(2000, 2))
+    tracemalloc.start()
+    try:
+        lazy = LazySafetyTable(world, 2.2, 0.1, 36)
+        rows = lazy.rows(pts)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert (rows >= 0).all() and peak < 0.15 * 5 * lazy.shape[0] * lazy.shape[1]
+    # the same entries as the distinct table over a grid of many tiles (rotated l_hall:
+    # 5 x 4 tiles of 64 x 64 nodes), membership alone first
+    world = _world("l_hall", 0.61)
+    lazy, ref = (
+        LazySafetyTable(world, 2.2, 0.1, 48),
+        safety_table(world, 2.2, 0.1, 48, distinct=True),
+    )
+    x0, y0, x1, y1 = world.bounds
+    pts = rng.uniform((x0 - 1, y0 - 1), (x1 + 1, y1 + 1), size=(3000, 2))
+    assert np.array_equal(lazy.inside(pts), ref.rows(pts) >= 0)
+    rl, rr = lazy.rows(pts), ref.rows(pts)
+    assert np.array_equal(rl < 0, rr < 0) and (rr >= 0).sum() > 1000
+    for name_ in ("free", "safe", "guaranteed", "ccw", "cw"):
+        assert np.array_equal(getattr(lazy, name_)[rl[rl >= 0]], getattr(ref, name_)[rr[rr >= 0]])

@@ -543,19 +543,24 @@ def _narrow(dec: Decomposition, clearance: float) -> frozenset[int]:
     sample along the piece (:meth:`EscapePlan.witness`'s samples) does.
 
     A piece whose middle vertex keeps ``clearance`` is not narrow: only the others are
-    sampled (a few percent of them).
+    sampled (a few percent of them), their samples measured in one call (one a piece
+    spent 22 s of the shooting evader's 74 s reset on a 200 m floor plan at L_min 3,
+    below the walls' spatial index's batch size: the same distances).
     """
     if clearance <= 0.0 or not dec.boundaries:
         return frozenset()
     world = dec.map
     mid = np.array([b.segments[len(b.segments) // 2, 0] for b in dec.boundaries])
-    near = np.flatnonzero(world.distance_to_walls(mid) < clearance)
+    near = np.flatnonzero(world.distance_to_walls(mid) < clearance).tolist()
+    samples = [_samples(dec.boundaries[i].segments, dec.chord_tol)[4] for i in near]
+    if not samples:
+        return frozenset()
+    counts = [len(s) for s in samples]
+    clear = world.distance_to_walls(np.concatenate(samples).reshape(-1, 2))
     out = []
-    for i in near.tolist():
-        b = dec.boundaries[i]
-        s = _samples(b.segments, dec.chord_tol)[4]
-        if not len(s) or world.distance_to_walls(s).max() < clearance:
-            out.append(b.id)
+    for i, n, d in zip(near, counts, np.split(clear, np.cumsum(counts)[:-1]), strict=True):
+        if not n or d.max() < clearance:
+            out.append(dec.boundaries[i].id)
     return frozenset(out)
 
 

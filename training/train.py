@@ -4,6 +4,7 @@
 trains on the CPU with one torch thread, and writes into ``config.output_dir``:
 
 * ``config.toml`` -- the config of the run (a resumed run must match it);
+* ``train.lock`` -- held while a process trains there (a second one is refused);
 * ``env.json`` -- the env configs the run plays, one per map, resolved (the map's
   geometry digest and its recommended parameters included): a resumed run must play the
   same (a map file edited in between is refused, not trained on without a word);
@@ -437,7 +438,8 @@ def train(
         least ``total_timesteps``, it is returned as is, without training.
 
     Raises:
-        InvalidConfigError: ``output_dir`` holds a run with another config.
+        InvalidConfigError: ``output_dir`` holds a run with another config, or another
+            process is training there now.
     """
     import torch
 
@@ -445,6 +447,51 @@ def train(
     torch.set_num_threads(1)
     out = Path(config.output_dir)
     out.mkdir(parents=True, exist_ok=True)
+    with _output_dir_lock(out):
+        return _train(config, out, t0, init_model, callbacks, progress_bar)
+
+
+def _output_dir_lock(out: Path):
+    """Hold ``out/train.lock`` while a run trains there, or refuse naming the holder: two
+    runs in one ``output_dir`` at once both trained, writing each other's checkpoints and
+    model (identical configs: identical files; other timesteps: interleaved). A POSIX
+    record lock, released by the kernel however the holder dies (as a tournament store's)."""
+    import contextlib
+    import fcntl
+    import socket
+
+    @contextlib.contextmanager
+    def held():
+        f = open(out.resolve() / "train.lock", "a+", encoding="utf-8")
+        try:
+            fcntl.lockf(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            f.seek(0)
+            holder = f.read().strip() or "another process"
+            f.close()
+            raise InvalidConfigError(
+                f"output_dir {str(out)!r} is being trained by {holder}; wait for that run "
+                "to finish (or stop it), or use another output_dir"
+            ) from None
+        try:
+            f.seek(0)
+            f.truncate()
+            f.write(f"pid {os.getpid()} on {socket.gethostname()} since "
+                    f"{time.strftime('%Y-%m-%d %H:%M:%S')}")  # fmt: skip
+            f.flush()
+            yield
+        finally:
+            with contextlib.suppress(OSError, ValueError):
+                f.truncate(0)
+                f.flush()
+                fcntl.lockf(f.fileno(), fcntl.LOCK_UN)
+            f.close()
+
+    return held()
+
+
+def _train(config, out, t0, init_model, callbacks, progress_bar) -> TrainResult:
+    """:func:`train`'s body, with ``output_dir``'s lock held."""
     _check_resumable(config, out)
     model_path, prov_path = out / "model.zip", out / "provenance.json"
     previous = None

@@ -353,3 +353,33 @@ def test_a_resumed_run_whose_map_file_changed_is_refused(tiny, tmp_path):
         train(config)
     save_map(load_map("open_room"), world, metadata={"l_min": 1.5, "l_max": 3.0})
     assert train(config).timesteps == 256  # the same game again: resumed
+
+
+def test_a_second_run_in_a_busy_output_dir_is_refused_naming_the_first(tiny):
+    """Two runs in one output_dir at once both trained, each writing checkpoints, model and
+    provenance over the other's (the tournament store has had a lock)."""
+    config = tiny()
+    out = Path(config.output_dir)
+    out.mkdir(parents=True)
+    holder = subprocess.Popen(  # another process training there: it holds the lock
+        [sys.executable, "-c", (
+            "import fcntl, sys, time\n"
+            f"f = open({str(out / 'train.lock')!r}, 'a+')\n"
+            "fcntl.lockf(f.fileno(), fcntl.LOCK_EX)\n"
+            "f.write('pid 4242 on elsewhere since 2026-01-01 00:00:00'); f.flush()\n"
+            "print('locked', flush=True)\n"
+            "sys.stdin.read()\n"
+        )],
+        stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        with pytest.raises(InvalidConfigError, match=r"is being trained by pid 4242 on "
+                           r"elsewhere since 2026-01-01 00:00:00; wait for that run"):  # fmt: skip
+            train(config)
+        assert not (out / "config.toml").exists()  # nothing written
+    finally:
+        holder.stdin.close()
+        holder.wait(timeout=30)
+    assert train(config).timesteps == 256  # the lock is released with its holder
+    assert (out / "train.lock").read_text() == ""  # and ours when the run ends

@@ -607,18 +607,27 @@ def dagger(cfg: DaggerConfig, *, verbose: bool = False) -> DaggerResult:
         verbose: print one line per iteration (and the episodes as they end).
 
     Raises:
-        InvalidConfigError: bad names, maps or env parameters (before any rollout), or an
-            ``output_dir`` holding a different run.
+        InvalidConfigError: bad names, maps or env parameters (before any rollout), an
+            ``output_dir`` holding a different run, or one another process runs in now
+            (``output_dir/train.lock``, as :func:`training.train.train`).
     """
+    from training.train import _output_dir_lock
+
+    t0 = time.perf_counter()
+    out = Path(cfg.output_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    with _output_dir_lock(out):
+        return _dagger(cfg, out, t0, verbose)
+
+
+def _dagger(cfg: DaggerConfig, out: Path, t0: float, verbose: bool) -> DaggerResult:
+    """:func:`dagger`'s body, with ``output_dir``'s lock held."""
     import torch
     from stable_baselines3 import PPO
 
     from training.train import ENV_ID, ENV_NAME, _git_state, _versions
 
-    t0 = time.perf_counter()
     torch.set_num_threads(1)
-    out = Path(cfg.output_dir)
-    out.mkdir(parents=True, exist_ok=True)
     env = _learner_env(cfg)
     resumed = _resume(cfg, out, env)
     if resumed is None:

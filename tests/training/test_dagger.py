@@ -137,6 +137,36 @@ def test_a_dagger_run_whose_map_file_changed_is_not_resumed(tmp_path):
     assert len(dagger(_cfg(tmp_path, maps=(str(world),), epochs=5)).samples) == 2  # resumed
 
 
+def test_a_dagger_run_in_a_busy_output_dir_is_refused(tmp_path):
+    """As surveil train (5653e95): two DAgger runs in one output_dir at once both wrote
+    dataset, models and progress.json over each other's."""
+    import subprocess
+    import sys
+
+    out = tmp_path / "dagger"
+    out.mkdir()
+    holder = subprocess.Popen(
+        [sys.executable, "-c", (
+            "import fcntl, sys\n"
+            f"f = open({str(out / 'train.lock')!r}, 'a+')\n"
+            "fcntl.lockf(f.fileno(), fcntl.LOCK_EX)\n"
+            "f.write('pid 4242 on elsewhere since 2026-01-01 00:00:00'); f.flush()\n"
+            "print('locked', flush=True)\n"
+            "sys.stdin.read()\n"
+        )],
+        stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        with pytest.raises(InvalidConfigError, match=r"is being trained by pid 4242 on "):
+            dagger(_cfg(tmp_path, iterations=1, epochs=5))
+        assert not (out / "progress.json").exists()
+    finally:
+        holder.stdin.close()
+        holder.wait(timeout=30)
+    assert len(dagger(_cfg(tmp_path, iterations=1, epochs=5)).samples) == 1
+
+
 @pytest.mark.parametrize("where", ["savez_compressed", "_settle"])
 def test_a_ctrl_c_while_an_iteration_is_written_resumes_to_the_same_model(
     tmp_path, monkeypatch, where

@@ -22,6 +22,7 @@ for bit the run that was never interrupted (the rollout in progress is lost).
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -37,6 +38,7 @@ from typing import Any
 
 import numpy as np
 
+from envs import pidlock
 from envs.errors import InvalidConfigError
 from envs.surveillance_v1 import ENV_ID
 from strategies.policies import Policy, make_policy
@@ -451,43 +453,23 @@ def train(
         return _train(config, out, t0, init_model, callbacks, progress_bar)
 
 
+@contextlib.contextmanager
 def _output_dir_lock(out: Path):
     """Hold ``out/train.lock`` while a run trains there, or refuse naming the holder: two
     runs in one ``output_dir`` at once both trained, writing each other's checkpoints and
     model (identical configs: identical files; other timesteps: interleaved). A POSIX
-    record lock, released by the kernel however the holder dies (as a tournament store's)."""
-    import contextlib
-    import fcntl
-    import socket
-
-    @contextlib.contextmanager
-    def held():
-        f = open(out.resolve() / "train.lock", "a+", encoding="utf-8")
-        try:
-            fcntl.lockf(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            f.seek(0)
-            holder = f.read().strip() or "another process"
-            f.close()
-            raise InvalidConfigError(
-                f"output_dir {str(out)!r} is being trained by {holder}; wait for that run "
-                "to finish (or stop it), or use another output_dir"
-            ) from None
-        try:
-            f.seek(0)
-            f.truncate()
-            f.write(f"pid {os.getpid()} on {socket.gethostname()} since "
-                    f"{time.strftime('%Y-%m-%d %H:%M:%S')}")  # fmt: skip
-            f.flush()
-            yield
-        finally:
-            with contextlib.suppress(OSError, ValueError):
-                f.truncate(0)
-                f.flush()
-                fcntl.lockf(f.fileno(), fcntl.LOCK_UN)
-            f.close()
-
-    return held()
+    record lock (:mod:`envs.pidlock`, as a tournament store's)."""
+    try:
+        f = pidlock.acquire(out.resolve() / "train.lock")
+    except pidlock.LockHeldError as e:
+        raise InvalidConfigError(
+            f"output_dir {str(out)!r} is being trained by {e.holder}; wait for that run "
+            "to finish (or stop it), or use another output_dir"
+        ) from None
+    try:
+        yield
+    finally:
+        pidlock.release(f)
 
 
 def _train(config, out, t0, init_model, callbacks, progress_bar) -> TrainResult:

@@ -30,7 +30,6 @@ import contextlib
 import csv
 import json
 import os
-import socket
 import sqlite3
 import time
 from collections.abc import Iterable, Iterator, Mapping
@@ -38,6 +37,7 @@ from pathlib import Path
 from typing import Any
 
 from analysis.arguments import why_not_a_file
+from envs import pidlock
 from envs.errors import InvalidConfigError, SurveilValueError
 
 __all__ = ["RESULT_FIELDS", "SCHEMA_VERSION", "Store", "StoreBusyError"]
@@ -97,10 +97,6 @@ ROW_FIELDS = (
     "seed",
     *RESULT_FIELDS[:-1],
 )
-
-
-_HELD: set[str] = set()
-"""Lock files held by this process (POSIX locks do not conflict within a process)."""
 
 
 class StoreBusyError(SurveilValueError):
@@ -205,49 +201,22 @@ class Store:
         when the driver dies, however it dies, and forked workers do not inherit it. Within one
         process a registry of held stores plays the same part.
         """
-        import fcntl
-
         # beside the file the path resolves to: a symlink to the store (or another
         # spelling of its path) takes the same lock, not one of its own
         real = self.path.resolve()
-        lock_path = real.with_name(real.name + ".lock")
-        key = str(lock_path)
-        f = open(lock_path, "a+", encoding="utf-8")  # held until unlock()
         try:
-            if key in _HELD:
-                raise BlockingIOError
-            fcntl.lockf(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            f.seek(0)
-            holder = f.read().strip() or "another process"
-            f.close()
+            self._lock_file = pidlock.acquire(real.with_name(real.name + ".lock"))
+        except pidlock.LockHeldError as e:
             raise StoreBusyError(
-                f"store {self.path} is being written by {holder}; wait for that run to "
+                f"store {self.path} is being written by {e.holder}; wait for that run to "
                 "finish (or stop it) before starting another on this store, or use --store "
                 "with another file"
             ) from None
-        _HELD.add(key)
-        f.seek(0)
-        f.truncate()
-        f.write(
-            f"pid {os.getpid()} on {socket.gethostname()} since "
-            f"{time.strftime('%Y-%m-%d %H:%M:%S')}"
-        )
-        f.flush()
-        self._lock_file = (f, key)
 
     def unlock(self) -> None:
         """Release the write lock (idempotent)."""
         if self._lock_file is not None:
-            import fcntl
-
-            f, key = self._lock_file
-            with contextlib.suppress(OSError, ValueError):
-                f.truncate(0)
-                f.flush()
-                fcntl.lockf(f.fileno(), fcntl.LOCK_UN)
-            f.close()
-            _HELD.discard(key)
+            pidlock.release(self._lock_file)
             self._lock_file = None
 
     # ---------------------------------------------------------------- runs

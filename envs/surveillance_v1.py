@@ -139,7 +139,13 @@ arguments (EzPickle), so an unpickled env starts unreset.
   radius, v0 let a body pressed into a wall settle at twice that overlap, so at
   dt = 0.05 with the defaults (or body_radius 0.2 at dt = 0.1) a pursuer driven into a
   wall passed through it and left the map. The arguments, spaces, rewards and starts
-  are v0's.
+  are v0's. Amended within v1 (2026-11, not bumped): a map file named by its path
+  brings the `l_min`, `l_max`, `v_pursuer`, `v_evader` and `body_radius` its `metadata`
+  recommends, as a built-in does (before, map files got the global defaults and their
+  metadata was documented as ignored). Only files whose metadata gives these keys play
+  otherwise; no shipped map, benchmark, model or result uses one, a tournament's run id
+  names a file's recommendations (so stored runs never mix the two) and `surveil train`
+  refuses to resume a run whose maps now resolve otherwise.
 * v0: initial release (continuous-time surveillance check, state and lidar
   observations, zero-sum and sparse rewards). Retired: :mod:`envs.surveillance_v0`
   stays importable so that v0 results replay.

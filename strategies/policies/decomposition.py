@@ -32,7 +32,9 @@ steps the table reads the rod's own orientation as blocked, :func:`crossable_ste
    (:meth:`DecompositionPursuer._keep_orbit`). Where no circle is even nearly free, it
    at least turns the way whose path stays clear of walls for a while, if the one it
    settled on meets one. An evader walking at the wall behind the pursuer without
-   charging gets the same check (:meth:`DecompositionPursuer._avoid_pin`). Against a
+   charging gets the same check (:meth:`DecompositionPursuer._avoid_pin`), unless it
+   reversed its velocity on each of the last two steps: the check extrapolates that
+   velocity, and such an evader keeps none (a herder at a corner's bisector). Against a
    charge, the wall-path check does not turn the rod back toward the normal of a wall
    within L when the rod lies within ``asin(rho)`` of it and the decomposition turns it
    away: there the charge closes in on a pursuer sliding along the wall
@@ -245,6 +247,8 @@ class DecompositionPursuer(BasePolicy):
         self._crossings: deque[tuple[float, float] | None] = deque(
             maxlen=max(1, round(self.ORBIT_LOOKAHEAD / c.dt))
         )
+        # the evader's velocity estimates of the last two steps (:meth:`_chatters`)
+        self._velocities: deque[tuple[float, float]] = deque(maxlen=2)
         self._orbit_pad = c.body_radius + h  # + a grid step: the margin is read on the grid
         self._wall_times = np.arange(1, round(self.WALL_HORIZON / self.WALL_STEP) + 1) * (
             self.WALL_STEP
@@ -706,8 +710,20 @@ class DecompositionPursuer(BasePolicy):
         ``rate`` whose path stays clear wins (else ``rate`` stands). Without the two
         conditions the override fired in the maze's narrow corridors, where the wall the
         path meets is no pin, and lost an episode (maze, straight evader, seed 1).
+
+        The path check assumes the evader keeps its velocity for ``WALL_HORIZON``
+        seconds; an evader that keeps it not even for a step (:meth:`_chatters`) gives
+        no such premise, and the override stands down. At a concave corner's bisector
+        the herder (benchmarks/unseen_opponents.py) reads the pursuer's nearest wall
+        point alternately on the two walls and reverses its velocity every step; the
+        override then fired on every other step (on one wall's reading the path met a
+        wall, on the other's it was clear) and undid the decomposition's turn in
+        between, the rod stood still for seconds and the herder walked the pursuer into
+        the corner (fresh rand:rectangles:3005:3.0, 36 steps; pillar_tri at rho 0.3).
         """
         if self._time_to_wall(snap, rate, L, False) == math.inf:
+            return rate
+        if self._chatters(snap.evader_velocity):
             return rate
         q, _ = nearest_wall_point(self.config.map, np.asarray(snap.pursuer, dtype=np.float64))
         nx, ny = float(snap.pursuer[0]) - float(q[0]), float(snap.pursuer[1]) - float(q[1])
@@ -719,6 +735,17 @@ class DecompositionPursuer(BasePolicy):
             if self._time_to_wall(snap, r, L, False) == math.inf:
                 return r
         return rate
+
+    def _chatters(self, ve: np.ndarray) -> bool:
+        """Whether the evader reversed its velocity on each of the last two steps: the
+        one-step estimates ``ve`` (now) and the two before it have negative dot products
+        in turn. A zig-zag that flips its heading every period reverses it on one step,
+        not on two running; a walk that keeps its velocity not at all."""
+        if len(self._velocities) < 2:
+            return False
+        (a0, a1), (b0, b1) = self._velocities
+        v0, v1 = float(ve[0]), float(ve[1])
+        return a0 * b0 + a1 * b1 < 0.0 and b0 * v0 + b1 * v1 < 0.0
 
     def _off_the_normal(
         self, snap: Snapshot, own: float, pick: float, L: float, herding: bool = False
@@ -894,6 +921,7 @@ class DecompositionPursuer(BasePolicy):
                 cmd_rate = self._keep_orbit(snap, cmd_rate, hi, lo, L)
             elif speed > 0.0:
                 cmd_rate = self._avoid_pin(snap, cmd_rate, hi, lo, L)
+        self._velocities.append((float(ve[0]), float(ve[1])))
         cmd = _holding_range(
             np.asarray(ve, dtype=np.float64),
             snap.theta,

@@ -10,6 +10,7 @@ import pytest
 from envs import surveillance_v1
 from envs.errors import InvalidConfigError
 from strategies.policies import make_policy
+from tests.training.conftest import lock_held_elsewhere
 from training.dagger import DaggerConfig, _Rollout, dagger
 from training.train import ENV_ID, ENV_NAME
 
@@ -140,30 +141,12 @@ def test_a_dagger_run_whose_map_file_changed_is_not_resumed(tmp_path):
 def test_a_dagger_run_in_a_busy_output_dir_is_refused(tmp_path):
     """As surveil train (5653e95): two DAgger runs in one output_dir at once both wrote
     dataset, models and progress.json over each other's."""
-    import subprocess
-    import sys
-
     out = tmp_path / "dagger"
     out.mkdir()
-    holder = subprocess.Popen(
-        [sys.executable, "-c", (
-            "import fcntl, sys\n"
-            f"f = open({str(out / 'train.lock')!r}, 'a+')\n"
-            "fcntl.lockf(f.fileno(), fcntl.LOCK_EX)\n"
-            "f.write('pid 4242 on elsewhere since 2026-01-01 00:00:00'); f.flush()\n"
-            "print('locked', flush=True)\n"
-            "sys.stdin.read()\n"
-        )],
-        stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
-    )  # fmt: skip
-    try:
-        assert holder.stdout.readline().strip() == "locked"
+    with lock_held_elsewhere(out / "train.lock"):
         with pytest.raises(InvalidConfigError, match=r"is being trained by pid 4242 on "):
             dagger(_cfg(tmp_path, iterations=1, epochs=5))
         assert not (out / "progress.json").exists()
-    finally:
-        holder.stdin.close()
-        holder.wait(timeout=30)
     assert len(dagger(_cfg(tmp_path, iterations=1, epochs=5)).samples) == 1
 
 

@@ -20,6 +20,7 @@ import pytest
 from envs import surveillance_v1
 from envs.errors import InvalidConfigError, InvalidObservationError
 from strategies.policies import make_policy
+from tests.training.conftest import lock_held_elsewhere
 from tests.training.test_train import Interrupt
 from training.cli import cli_train
 from training.config import TrainConfig
@@ -361,25 +362,10 @@ def test_a_second_run_in_a_busy_output_dir_is_refused_naming_the_first(tiny):
     config = tiny()
     out = Path(config.output_dir)
     out.mkdir(parents=True)
-    holder = subprocess.Popen(  # another process training there: it holds the lock
-        [sys.executable, "-c", (
-            "import fcntl, sys, time\n"
-            f"f = open({str(out / 'train.lock')!r}, 'a+')\n"
-            "fcntl.lockf(f.fileno(), fcntl.LOCK_EX)\n"
-            "f.write('pid 4242 on elsewhere since 2026-01-01 00:00:00'); f.flush()\n"
-            "print('locked', flush=True)\n"
-            "sys.stdin.read()\n"
-        )],
-        stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
-    )  # fmt: skip
-    try:
-        assert holder.stdout.readline().strip() == "locked"
+    with lock_held_elsewhere(out / "train.lock"):  # another process training there
         with pytest.raises(InvalidConfigError, match=r"is being trained by pid 4242 on "
                            r"elsewhere since 2026-01-01 00:00:00; wait for that run"):  # fmt: skip
             train(config)
         assert not (out / "config.toml").exists()  # nothing written
-    finally:
-        holder.stdin.close()
-        holder.wait(timeout=30)
     assert train(config).timesteps == 256  # the lock is released with its holder
     assert (out / "train.lock").read_text() == ""  # and ours when the run ends

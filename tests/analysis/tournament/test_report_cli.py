@@ -59,7 +59,9 @@ def test_report_renders_with_heat_maps_ratings_and_replays(tmp_path, small_spec)
     assert re.search(r"\| pursuer \| pursuer/greedy \| 12 \|", regret)
 
 
-def test_cli_tournament_report_export_and_errors(tmp_path, capsys):
+def _mini_tournament(tmp_path):
+    """(store, argv) of a 4-match tournament on the open room (greedy pursuer, two evaders,
+    two seeds, 20 steps), played serially without progress bars."""
     spec = tmp_path / "mini.toml"
     spec.write_text(
         'maps = ["open_room"]\npursuers = ["pursuer/greedy"]\n'
@@ -67,6 +69,11 @@ def test_cli_tournament_report_export_and_errors(tmp_path, capsys):
     )
     store = tmp_path / "mini.sqlite"
     argv = ["tournament", str(spec), "--store", str(store), "--no-progress", "--backend", "serial"]
+    return store, argv
+
+
+def test_cli_tournament_report_export_and_errors(tmp_path, capsys):
+    store, argv = _mini_tournament(tmp_path)
     assert main([*argv, "--no-report"]) == 0
     out = capsys.readouterr().out
     assert "4 of 4 matches stored" in out and "evader/straight" in out
@@ -244,13 +251,7 @@ def test_exporting_an_unfinished_run_says_so(tmp_path, capsys):
     says 'running: 79 of 240 matches stored')."""
     import sqlite3
 
-    spec = tmp_path / "mini.toml"
-    spec.write_text(
-        'maps = ["open_room"]\npursuers = ["pursuer/greedy"]\n'
-        'evaders = ["evader/random", "evader/straight"]\nseeds = 2\n[env]\nmax_cycles = 20\n'
-    )
-    store = tmp_path / "mini.sqlite"
-    argv = ["tournament", str(spec), "--store", str(store), "--no-progress", "--backend", "serial"]
+    store, argv = _mini_tournament(tmp_path)
     assert main([*argv, "--no-report"]) == 0
     capsys.readouterr()
     assert main(["export", str(store), str(tmp_path / "all.csv")]) == 0

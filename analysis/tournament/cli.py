@@ -214,19 +214,6 @@ def _cmd_export(args: argparse.Namespace) -> int:
     return 0
 
 
-def _roster_entry(item: str, role: str) -> str | dict[str, str]:
-    """A ``--pursuers``/``--evaders`` item as a spec entry: ``zoo:NAME``, ``*.zip`` and
-    ``ROLE/sb3:PATH`` (the registry's name, surveil policies) are learned models
-    (``{"model": ...}``), anything else a registered policy name."""
-    if item.startswith(f"{role}/sb3:"):
-        return {"model": item.removeprefix(f"{role}/sb3:")}
-    if item.startswith(("pursuer/sb3:", "evader/sb3:")):
-        return item  # the other role's: refused by the spec as a name of the wrong role
-    if item.startswith("zoo:") or item.lower().endswith(".zip"):
-        return {"model": item}
-    return item
-
-
 def _cmd_evaluate(args: argparse.Namespace) -> int:
     from analysis.tournament.driver import run_tournament
     from analysis.tournament.spec import spec_from_dict
@@ -246,8 +233,8 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
         {
             "name": "evaluate",
             "maps": args.maps,
-            "pursuers": [_roster_entry(x, "pursuer") for x in args.pursuers],
-            "evaders": [_roster_entry(x, "evader") for x in args.evaders],
+            "pursuers": list(args.pursuers),
+            "evaders": list(args.evaders),
             "seeds": args.seeds,
             "start": args.start,
             "env": env,

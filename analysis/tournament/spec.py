@@ -483,11 +483,27 @@ def _roster(value: Any, role: str, source: str, base: Path) -> tuple[PolicyEntry
     return tuple(merged.values())
 
 
+def _roster_item(item: str, role: str) -> str | dict[str, str]:
+    """A roster item given as one string, as a spec entry: ``zoo:NAME``, ``*.zip`` and
+    ``ROLE/sb3:PATH`` (the registry's name, surveil policies) are learned models
+    (``{"model": ...}``: the file's content is then part of each match's identity),
+    anything else a registered policy name."""
+    if item.startswith(f"{role}/sb3:"):
+        return {"model": item.removeprefix(f"{role}/sb3:")}
+    if item.startswith(("pursuer/sb3:", "evader/sb3:")):
+        return item  # the other role's: refused as a name of the wrong role
+    if item.startswith("zoo:") or item.lower().endswith(".zip"):
+        return {"model": item}
+    return item
+
+
 def _entry(item: Any, role: str, where: str, base: Path) -> PolicyEntry:
     from strategies.policies import make_policy
 
     if isinstance(item, str):
-        item = {"policy": item}
+        item = _roster_item(item, role)
+        if isinstance(item, str):
+            item = {"policy": item}
     d = mapping("entry", item, where=where)
     unknown = sorted(set(d) - _ENTRY_KEYS)
     if unknown:
@@ -497,6 +513,17 @@ def _entry(item: Any, role: str, where: str, base: Path) -> PolicyEntry:
     if ("policy" in d) == ("model" in d):
         raise InvalidConfigError(
             f"{where}: give exactly one of 'policy' (a name) or 'model' (a file)"
+        )
+    if "model" in d and "params" in d:
+        raise InvalidConfigError(
+            f"{where}: 'params' applies to 'policy' entries only; a 'model' entry takes "
+            "'algo' and 'deterministic'"
+        )
+    if "policy" in d and isinstance(d["policy"], str) and d["policy"].startswith(f"{role}/sb3:"):
+        model = d["policy"].removeprefix(f"{role}/sb3:")
+        raise InvalidConfigError(
+            f"{where}: policy = {d['policy']!r} names a model file: write model = {model!r} "
+            "(its content is then part of each match's identity)"
         )
     observation = None
     if "observation" in d:

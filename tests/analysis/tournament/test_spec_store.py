@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import hashlib
 import json
 import re
 import shutil
@@ -213,6 +214,31 @@ def test_a_changed_model_file_makes_new_matches(tmp_path):
         spec_from_dict(d, base_dir=tmp_path), store, backend="serial", progress=False
     )
     assert s2.run_id != s1.run_id and s2.reused == 0
+
+
+def test_a_model_named_as_a_string_is_a_model_entry(tmp_path):
+    # "pursuer/sb3:PATH" (the registry's name, README) was taken as a policy name: the
+    # match identity held the path but not the file's content, so a retrained model's
+    # old matches were reused without a word; "zoo:NAME" and "m.zip" were refused as
+    # names (surveil evaluate takes all three); a model entry's 'params' were ignored
+    shutil.copytree(zoo_dir() / "ppo_pursuer_vs_straight_open_room", tmp_path / "m")
+    digest = hashlib.sha256((tmp_path / "m" / "model.zip").read_bytes()).hexdigest()
+    base = {"maps": ["open_room"], "evaders": ["evader/straight"], "seeds": 1}
+
+    def entry(item):
+        return spec_from_dict({**base, "pursuers": [item]}, base_dir=tmp_path).pursuers[0]
+
+    as_table = entry({"model": "m/model.zip"})
+    for text in ("pursuer/sb3:m/model.zip", "m/model.zip"):
+        got = entry(text)
+        assert got.model_sha256 == digest and got.name == "pursuer/sb3"
+        assert got.identity() == as_table.identity()
+    assert entry("zoo:ppo_pursuer_vs_straight_open_room").model_sha256 == digest
+    with pytest.raises(InvalidConfigError, match=r"#1\]: policy = 'pursuer/sb3:m/model.zip' "
+                       r"names a model file: write model = 'm/model.zip'"):  # fmt: skip
+        entry({"policy": "pursuer/sb3:m/model.zip", "label": "ppo"})
+    with pytest.raises(InvalidConfigError, match=r"'params' applies to 'policy' entries"):
+        entry({"model": "m/model.zip", "params": {"deterministic": False}})
 
 
 def test_store_lock_refuses_a_second_writer(tmp_path, small_spec):

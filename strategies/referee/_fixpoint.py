@@ -46,15 +46,23 @@ def reach_rectangles(
     """
     r = reach / h
     K = math.floor(r + 1e-9)
-    widths = [math.floor(math.sqrt(max(r * r - k * k, 0.0)) + 1e-9) for k in range(K + 1)]
-    exact: list[tuple[int, int]] = []
-    for k, w in enumerate(widths):
-        if exact and exact[-1][1] == w + 1:
-            exact[-1] = (k + 1, w + 1)  # the previous rectangle lies inside this one
-        else:
-            exact.append((k + 1, w + 1))
-    if max_rects is None or len(exact) <= max_rects:
-        return exact
+
+    def width(k: int) -> int:
+        return math.floor(math.sqrt(max(r * r - k * k, 0.0)) + 1e-9)
+
+    # For k >= r / sqrt(2) the width falls by at least 1 a row, so the exact union has
+    # more than K (1 - 1/sqrt(2)) - 1 rectangles: from K = 4 (max_rects + 1) on, more than
+    # max_rects, and its K + 1 rows (4e9 for a step of 2e9 s at rho 1e-9) are not listed.
+    if max_rects is None or K < 4 * (max_rects + 1):
+        exact: list[tuple[int, int]] = []
+        for k in range(K + 1):
+            w = width(k)
+            if exact and exact[-1][1] == w + 1:
+                exact[-1] = (k + 1, w + 1)  # the previous rectangle lies inside this one
+            else:
+                exact.append((k + 1, w + 1))
+        if max_rects is None or len(exact) <= max_rects:
+            return exact
     # rows k_1 < ... < k_m = K spread in angle; rectangle j reaches row k_j with the width
     # of the first row after k_{j-1}, so it covers every exact rectangle in between
     rows = sorted(
@@ -66,7 +74,7 @@ def reach_rectangles(
     )
     out, prev = [], -1
     for k in rows:
-        out.append((k + 1, widths[prev + 1] + 1))
+        out.append((k + 1, width(prev + 1) + 1))
         prev = k
     return out
 
@@ -89,6 +97,9 @@ def erode(X: np.ndarray, rects: list[tuple[int, int]], border: bool) -> np.ndarr
     cval = int(bool(border))
     out = None
     for hx, hy in rects:
+        # a half-side of the window's width or more covers the whole axis and the border
+        # from every cell: the same minimum, without a filter as long as the stencil
+        hx, hy = min(hx, X.shape[1]), min(hy, X.shape[2])
         y = minimum_filter1d(u, 2 * hx + 1, axis=1, mode="constant", cval=cval)
         y = minimum_filter1d(y, 2 * hy + 1, axis=2, mode="constant", cval=cval)
         out = y if out is None else np.minimum(out, y, out=out)

@@ -46,6 +46,83 @@ def test_large_stencils_are_covered_by_few_rectangles(r):
     assert len(got) <= 1.06 * len(exact)
 
 
+def _old_reach_rectangles(r, max_rects):
+    """reach_rectangles as it was before it stopped listing every row: the reference."""
+    K = math.floor(r + 1e-9)
+    widths = [math.floor(math.sqrt(max(r * r - k * k, 0.0)) + 1e-9) for k in range(K + 1)]
+    exact = []
+    for k, w in enumerate(widths):
+        if exact and exact[-1][1] == w + 1:
+            exact[-1] = (k + 1, w + 1)
+        else:
+            exact.append((k + 1, w + 1))
+    if max_rects is None or len(exact) <= max_rects:
+        return exact
+    rows = sorted({min(K, round(r * math.sin(0.5 * math.pi * j / max_rects)))
+                   for j in range(1, max_rects + 1)} | {K})  # fmt: skip
+    out, prev = [], -1
+    for k in rows:
+        out.append((k + 1, widths[prev + 1] + 1))
+        prev = k
+    return out
+
+
+def test_a_huge_reach_is_covered_without_listing_its_rows(monkeypatch):
+    # surveil referee MAP --config '{"v_evader": 1e-9}': the evader bound's step is 2e9 s,
+    # the pursuer's reach 4e9 cells, and the stencil listed 4e9 rows (67 s at rho 1e-5,
+    # no answer in 5 min at 1e-9); beyond 4 (max_rects + 1) rows the exact union has more
+    # than max_rects rectangles, so only the covering rows are computed
+    from strategies.referee import _fixpoint
+
+    calls = []
+
+    class CountingMath:
+        def __getattr__(self, name):
+            return getattr(math, name)
+
+        def sqrt(self, x):
+            calls.append(x)
+            assert len(calls) < 10_000, "listed every row of the stencil"
+            return math.sqrt(x)
+
+    monkeypatch.setattr(_fixpoint, "math", CountingMath())
+    rects = reach_rectangles(2e9, 0.5)
+    assert len(rects) == 8 and max(max(r) for r in rects) == 4_000_000_001
+    monkeypatch.undo()
+    rng = np.random.default_rng(0)
+    for r in [*np.arange(0.0, 120.0, 0.05), *rng.uniform(0.0, 3e4, 300)]:
+        for m in (1, 8, None):
+            assert reach_rectangles(float(r), 1.0, m) == _old_reach_rectangles(float(r), m)
+
+
+def test_erode_with_a_stencil_wider_than_the_window_filters_the_window_only(monkeypatch):
+    # a half-side of 1e8 ran a min-filter 2e8 + 1 wide over a 9-cell axis (23 s)
+    from strategies.referee import _fixpoint
+
+    sizes = []
+    real = _fixpoint.minimum_filter1d
+
+    def recording(u, size, **kw):
+        sizes.append(size)
+        return real(u, size, **kw)
+
+    monkeypatch.setattr(_fixpoint, "minimum_filter1d", recording)
+    rng = np.random.default_rng(1)
+    X = rng.random((4, 9, 9)) > 0.05
+    st = _stencil([(12, 3), (2, 12)])  # 12 > 9: as wide as 1e8 on a 9-cell window
+    for border in (True, False):
+        got = erode(X, [(10**8, 3), (2, 10**8)], border)
+        for k in range(4):
+            for a in range(9):
+                for b in range(9):
+                    want = all(
+                        X[k, a + i, b + j] if (0 <= a + i < 9 and 0 <= b + j < 9) else border
+                        for i, j in st
+                    )
+                    assert got[k, a, b] == want
+    assert max(sizes) <= 2 * 9 + 1
+
+
 @pytest.mark.parametrize("border", [True, False])
 def test_erode_matches_brute_force(border):
     rng = np.random.default_rng(0)

@@ -187,6 +187,22 @@ def json_object(flag: str, text: str | None, *, example: str) -> dict[str, Any]:
     return obj
 
 
+def check_env_options(overrides: dict[str, Any], where: str) -> None:
+    """Refuse env overrides (``--config``) that name no env parameter, listing them.
+
+    Raises:
+        InvalidConfigError: ``"WHERE: unknown env option(s) ['bogus']; options are ..."``.
+    """
+    from envs.surveillance.config import env_parameters
+
+    allowed = [k for k in env_parameters() if k not in ("map", "render_mode")]
+    unknown = sorted(set(overrides) - set(allowed))
+    if unknown:
+        raise InvalidConfigError(
+            f"{where}: unknown env option(s) {unknown}; options are {', '.join(allowed)}"
+        )
+
+
 def _json_kind(obj: Any) -> str:
     names = {list: "array", str: "string", bool: "boolean", int: "number", float: "number"}
     return "null" if obj is None else names.get(type(obj), type(obj).__name__)

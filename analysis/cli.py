@@ -20,6 +20,7 @@ from analysis import referee_cli
 from analysis.arguments import (
     MAP_HELP,
     Parser,
+    check_env_options,
     integer,
     json_object,
     output_dir,
@@ -78,14 +79,9 @@ def _cmd_policies(args: argparse.Namespace) -> int:
 def _env_config(flag_map: str, map_: str, overrides: dict, where: str):
     """The env config of a run, validated before the run (names the flag at fault)."""
     from envs.maps.io import recommended_parameters
-    from envs.surveillance.config import EnvConfig, env_parameters, resolve_map
+    from envs.surveillance.config import EnvConfig, resolve_map
 
-    allowed = [k for k in env_parameters() if k not in ("map", "render_mode")]
-    unknown = sorted(set(overrides) - set(allowed))
-    if unknown:
-        raise InvalidConfigError(
-            f"{where}: unknown env option(s) {unknown}; options are {', '.join(allowed)}"
-        )
+    check_env_options(overrides, where)
     try:
         world = resolve_map(map_)
         # a built-in or a file by name (transformed or not): its recommendations apply

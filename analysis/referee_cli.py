@@ -21,7 +21,15 @@ import sys
 import time
 from pathlib import Path
 
-from analysis.arguments import MAP_HELP, integer, json_object, output_file, path_text, real
+from analysis.arguments import (
+    MAP_HELP,
+    check_env_options,
+    integer,
+    json_object,
+    output_file,
+    path_text,
+    real,
+)
 
 __all__ = ["add_parser", "run"]
 
@@ -116,7 +124,11 @@ def run(args: argparse.Namespace) -> int:
         world, params = map_parameters(args.map)
     except SurveilValueError as exc:
         raise type(exc)(f"map: {exc}") from None
-    cfg = EnvConfig(map=world, **{**params, **overrides})
+    check_env_options(overrides, "--config")
+    try:
+        cfg = EnvConfig(map=world, **{**params, **overrides})
+    except SurveilValueError as exc:  # the map's own parameters were checked above
+        raise type(exc)(f"--config: {exc}") from None
     # what the solve cannot change is checked before it (it can take minutes)
     try:  # a step the env refuses: dt = 1e4 hung in the budget's move count (4e8 vectors)
         check_step(cfg.map, cfg.dt, max(cfg.v_pursuer, cfg.v_evader), cfg.body_radius)

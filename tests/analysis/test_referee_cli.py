@@ -86,6 +86,11 @@ def test_referee_estimate_is_printed_beside_the_certificates(capsys, monkeypatch
     [
         (["referee", "nowhere"], "map: unknown map 'nowhere'"),
         (["referee", "open_room", "--config", "[1]"], "--config = '[1]': expected a JSON object"),
+        # a TypeError traceback, and a value refused without naming --config (play named it)
+        (["referee", "open_room", "--config", '{"bogus": 1}'],
+         "--config: unknown env option(s) ['bogus']; options are l_min, "),
+        (["referee", "open_room", "--config", '{"v_evader": 0}'],
+         "error: --config: v_evader = 0: expected a finite number > 0"),
         (["referee", "open_room", "--cells-per-lmin", "-2"], "--cells-per-lmin = '-2'"),
         (["referee", "open_room", "--cells-per-lmin", "4", "--classify", "1", "1", "9", "9"],
          "distance 11.3137 outside [l_min, l_max] = [2, 4]"),

@@ -5,7 +5,10 @@ and the tables are built, not read), and the process's peak memory is read after
 reset. The reference, measured in the same run on the same map, is the decomposition
 pursuer's reset (its own decomposition at its rod length and its safety table, filled
 lazily above ``DecompositionPursuer.DISTINCT_TABLE_POINTS`` grid points); the ratios
-are machine independent.
+are machine independent. Each reset's CPU time (the process's, all threads) is given
+too, with its ratio: on a loaded machine the wall-clock ratios scatter (the shooting
+evader on floor_plan:0:200 at one commit: 2.9x and 6.5x in two runs at load ~5), its CPU
+time less (16.6 s in both of two other runs).
 
 Worlds (``--worlds``, default all): ``corner~x100`` (the corner world scaled x100 at its
 L_min 2: 115 million grid points at L_min / 20, which the evader's distinct table used to
@@ -72,12 +75,12 @@ def _measure(spec: str, name: str, table: str, q) -> None:
         # (the default unnamed: the script runs on commits before the evader's option)
         kw = {"table": table} if name == "evader/shooting" and table != "auto" else {}
         policy = make_policy(name, **kw)
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         policy.reset(role=name.split("/")[0], map=m, config=config, seed=0)
-        seconds = time.perf_counter() - t0
+        seconds, cpu = time.perf_counter() - t0, time.process_time() - c0
         peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6
         points = m.free_region.area / (config.l_min / 20.0) ** 2
-        q.put((seconds, peak, type(policy.table).__name__, points))
+        q.put((seconds, cpu, peak, type(policy.table).__name__, points))
 
 
 def _run(spec: str, name: str, table: str, timeout: float):
@@ -102,8 +105,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     print(f"load average: {os.getloadavg()}; shooting evader's table: {args.table}")
     print(
-        f"{'world':<18}{'points':>10}{'policy':>23}{'reset s':>9}{'peak GB':>9}"
-        f"{'s/ref':>7}{'GB/ref':>8}  table"
+        f"{'world':<18}{'points':>10}{'policy':>23}{'reset s':>9}{'cpu s':>8}{'peak GB':>9}"
+        f"{'s/ref':>7}{'cpu/ref':>8}{'GB/ref':>8}  table"
     )
     for spec in args.worlds:
         ref = None
@@ -112,11 +115,11 @@ def main(argv=None) -> int:
             if got is None:
                 print(f"{spec:<18}{'':>10}{name:>23}  over {args.timeout:g} s (killed)")
                 continue
-            seconds, peak, kind, points = got
-            ref = ref or (seconds, peak)
+            seconds, cpu, peak, kind, points = got
+            ref = ref or (seconds, max(cpu, 1e-9), peak)
             print(
-                f"{spec:<18}{points:>10.3g}{name:>23}{seconds:>9.2f}{peak:>9.2f}"
-                f"{seconds / ref[0]:>7.2f}{peak / ref[1]:>8.2f}  {kind}",
+                f"{spec:<18}{points:>10.3g}{name:>23}{seconds:>9.2f}{cpu:>8.2f}{peak:>9.2f}"
+                f"{seconds / ref[0]:>7.2f}{cpu / ref[1]:>8.2f}{peak / ref[2]:>8.2f}  {kind}",
                 flush=True,
             )
     print("(peak: the resetting process's maximum resident set, imports included)")

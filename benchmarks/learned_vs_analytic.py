@@ -325,9 +325,19 @@ def main(argv=None) -> int:
                       f"({a_ms / b_ms:5.2f}x its time)")  # fmt: skip
     if args.cards:
         measured = measured_at(args)
+        played = {r["map"] for r in rows}
         for role in ("pursuer", "evader"):
             for m in learned[role]:
                 path = zoo.MODELS_DIR / m / "CARD.md"
+                if not played & {*zoo.training_maps(m), *HELD_OUT}:
+                    # its card's table has a row for its seen maps and for the held-out
+                    # ones: a run of neither wrote a card without a single rate over it
+                    print(
+                        f"card: {path} left as it was: this run played none of the "
+                        f"maps {m} trained on ({', '.join(zoo.training_maps(m))}) nor "
+                        f"the held-out ones ({', '.join(HELD_OUT)})"
+                    )
+                    continue
                 old = path.read_text() if path.is_file() else None
                 path.write_text(with_notes(card(m, role, rows, args, decide, measured), old))
                 print(f"card: {path}")

@@ -113,3 +113,17 @@ def test_a_run_that_leaves_out_a_models_target_maps_gives_no_verdict_not_nan(lva
     targets = out[out.index("targets (ratios measured in this run)") :]
     assert "nan" not in targets and "NOT met" not in targets
     assert f"{MODEL}: its target maps (corridor) were not played in this run" in targets
+
+
+def test_a_run_on_none_of_a_models_card_maps_leaves_its_card(lva, tmp_zoo, tmp_path, capsys):
+    """``--maps 'corner~rot0.4' --cards`` replaced the shipped card (20 seeds, eight rows)
+    by one whose table had no row: neither a map the model trained on nor a held-out one
+    was played."""
+    card = tmp_zoo / MODEL / "CARD.md"
+    before = card.read_text()
+    argv = ["--models", MODEL, "--seeds", "1", "--max-cycles", "20", "--maps", "corner~rot0.4",
+            "--workers", "1", "--store", str(tmp_path / "s.sqlite"), "--cards"]  # fmt: skip
+    assert lva.main(argv) == 0
+    assert card.read_text() == before
+    out = capsys.readouterr().out
+    assert f"card: {card} left as it was: this run played none of the maps {MODEL} " in out

@@ -269,9 +269,10 @@ def tournament_regret(
     vacuous = sorted({str(w.message) for w in caught
                       if issubclass(w.category, VacuousBoundWarning)})  # fmt: skip
     if vacuous:
+        eg = "e.g. " if len(vacuous) > 1 else ""  # one game's reason stands for all
         note = (f"pursuer regret: in {len(vacuous)} game(s) the pursuer bound certifies "
                 f"nothing informative, so their starts count as unknown, not as winnable: "
-                f"{vacuous[0]}")  # fmt: skip
+                f"{eg}{vacuous[0]}")  # fmt: skip
         table.append(["-", note, *[""] * (len(table[0]) - 2)])
     fell = [ref.pursuer for ref in referees.values() if ref.pursuer.fallback_from is not None]
     if fell:

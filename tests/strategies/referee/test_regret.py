@@ -187,3 +187,22 @@ def test_tournament_regret_refuses_a_changed_map(corridor_half):
     spec = {"maps": [{"label": "m", "source": "/nonexistent/map.json"}]}
     with pytest.raises(InvalidConfigError, match="cannot find the map"):
         tournament_regret(spec, rows, cache=False, strict=True)
+
+
+def test_the_vacuity_note_of_several_games_gives_one_as_an_example(monkeypatch):
+    """A report's regret table said 'in 2 game(s) ...: map 'corridor': ...' and named only
+    the first game, as if its reason were the whole list (the fallback's note says e.g.)."""
+    import warnings
+
+    from envs.errors import VacuousBoundWarning
+    from strategies.referee import regrets
+
+    def two_vacuous(matches, **kw):
+        warnings.warn("map 'corridor': the first reason", VacuousBoundWarning, stacklevel=1)
+        warnings.warn("map 'open_room': the second reason", VacuousBoundWarning, stacklevel=1)
+        return []
+
+    monkeypatch.setattr(regrets, "regret", two_vacuous)
+    *_, note = tournament_regret(json.dumps({"maps": []}), [], cache=False)
+    assert note[1].startswith("pursuer regret: in 2 game(s) the pursuer bound certifies")
+    assert note[1].endswith("not as winnable: e.g. map 'corridor': the first reason")

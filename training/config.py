@@ -128,8 +128,10 @@ class TrainConfig:
         for name in pool:
             check.string("opponent", name)
             if name.partition("/")[0] != other:
+                article = "an" if self.role == "evader" else "a"
                 raise InvalidConfigError(
-                    f"opponent: a {self.role} learner needs an '{other}/KIND' policy, got {name!r}"
+                    f"opponent: {article} {self.role} learner needs a '{other}/KIND' policy "
+                    f"(a model: '{other}/sb3:PATH'), got {name!r}"
                 )
         put("opponent", pool[0] if len(pool) == 1 and isinstance(self.opponent, str) else pool)
         put("opponent_weights", tuple(self.opponent_weights))

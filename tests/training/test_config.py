@@ -41,6 +41,11 @@ def test_a_pool_of_opponents_round_trips_and_is_checked(tmp_path):
         TrainConfig(role="pursuer", opponent=("evader/straight", "pursuer/greedy"))
     with pytest.raises(InvalidConfigError, match="opponent pool"):
         TrainConfig(role="pursuer", opponent=("evader/straight",), opponent_weights=(1.0, 2.0))
+    # 'a evader learner needs an 'pursuer/KIND' policy', and a zoo model was not named
+    want = (r"^opponent: an evader learner needs a 'pursuer/KIND' policy "
+            r"\(a model: 'pursuer/sb3:PATH'\), got 'zoo:x'$")  # fmt: skip
+    with pytest.raises(InvalidConfigError, match=want):
+        TrainConfig(role="evader", opponent="zoo:x")
 
 
 def test_overrides_and_defaults(tmp_path):

@@ -824,13 +824,16 @@ def save_map(
         map: the map.
         path: a ``.json``, ``.geojson`` or ``.wkt`` file (parent directories must exist).
         description: one line stored with JSON and GeoJSON (WKT has no room for it).
-        metadata: a JSON-serialisable mapping stored with JSON and GeoJSON.
+        metadata: a JSON-serialisable mapping stored with JSON and GeoJSON (a ``.wkt``
+            file is refused metadata recommending parameters other than the defaults it
+            would play at: it could not keep them).
 
     Returns:
         The path written.
 
     Raises:
-        InvalidConfigError: for an unsupported suffix or metadata that is not JSON.
+        InvalidConfigError: for an unsupported suffix, metadata that is not JSON, or a
+            ``.wkt`` file with metadata recommending parameters other than the defaults.
     """
     p = Path(path)
     fmt = _format_of(p, for_writing=True)
@@ -842,6 +845,17 @@ def save_map(
                 f"metadata {metadata!r:.80} is not JSON-serialisable ({exc})"
             ) from exc
     if fmt == "wkt":
+        # the file plays at the global defaults: a recommendation of another value is lost
+        defaults = {**GLOBAL_DEFAULTS, "body_radius": BODY_RADIUS}
+        lost = [k for k in FILE_RECOMMENDATIONS
+                if (metadata or {}).get(k) not in (None, defaults[k])]  # fmt: skip
+        if lost:
+            raise InvalidConfigError(
+                f"{p}: metadata recommends {', '.join(f'{k} = {metadata[k]!r}' for k in lost)}, "
+                "and WKT has no room for metadata (the file would play at the defaults "
+                f"{', '.join(f'{k} = {defaults[k]:g}' for k in lost)}); save it as .json or "
+                ".geojson"
+            )
         text = map_to_wkt(map)
     elif fmt == "geojson":
         text = (

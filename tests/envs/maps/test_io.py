@@ -86,6 +86,19 @@ def test_wkt_round_trip_keeps_the_walls(tmp_path, key):
     assert back.name == "w" and not back.merged
 
 
+def test_wkt_refuses_metadata_that_recommends_parameters(tmp_path):
+    # the file loaded back without them and played at L 2-4, V_e 0.5 (a 1.4 m room whose
+    # metadata said l_min 0.2 was then refused; a larger one played another game)
+    m = MAPS["plain"]
+    with pytest.raises(InvalidConfigError, match=r"w\.wkt: metadata recommends l_max = 4\.5, "
+                       r"v_evader = 0\.2, and WKT has no room for metadata \(the file would "
+                       r"play at the defaults l_max = 4, v_evader = 0\.5\)"):  # fmt: skip
+        save_map(m, tmp_path / "w.wkt", metadata={**META, "v_evader": 0.2})
+    assert not (tmp_path / "w.wkt").exists()
+    # free-form keys, nulls and the defaults themselves (a built-in's) lose no game
+    save_map(m, tmp_path / "w.wkt", metadata={"note": "x", "l_min": None, "l_max": 4.0})
+
+
 def test_geojson_output_follows_rfc7946(tmp_path):
     m = MAPS["plain"]
     obj = json.loads(save_map(m, tmp_path / "w.geojson").read_text())

@@ -30,9 +30,11 @@ from dataclasses import dataclass
 import numpy as np
 import shapely
 
+from envs.errors import InvalidConfigError
 from envs.maps import Map
 from strategies.cspace import Decomposition, decompose
 from strategies.cspace.decomposition import largest_first
+from strategies.cspace.tolerances import Tolerances
 from strategies.policies.safety import SafetyTable, grid_points
 
 __all__ = ["CROSS_REL", "EscapePlan", "Witness", "escape_plan", "escape_ranks"]
@@ -642,20 +644,64 @@ def body_witness_regions(dec: Decomposition, clearance: float) -> tuple[int, ...
     return largest_first(r for r in dec.regions if all(ok[c] for c in r.cells))
 
 
-@functools.lru_cache(maxsize=8)
-def escape_plan(
-    world: Map, L: float, resolution: float = 0.1, clearance: float = 0.0
-) -> EscapePlan:
-    """The :class:`EscapePlan` of ``world`` for a rod of length ``L`` (cached in memory).
+class _Held:
+    """A decomposition handed to :func:`escape_plan`, equal to any other: not part of the
+    plan cache's key (the plan of a map and rod length is the same whichever copy of its
+    decomposition it is built on)."""
 
-    The decomposition comes from :func:`strategies.cspace.decompose` (cached on disk);
-    the grid is the safety table's at the same ``resolution``. With ``clearance`` (the
-    evader's body radius) the vias avoid the pieces no crossing of which keeps that
-    distance from the walls wherever a route without them exists
-    (:func:`escape_ranks`'s ``narrow``; issue 13: a rank-1 cell of random:polygons:0
-    whose only via runs within 0.094 of a wall, where the pursuer pinned the evader).
+    __slots__ = ("dec",)
+
+    def __init__(self, dec: Decomposition | None) -> None:
+        self.dec = dec
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, _Held)
+
+    def __hash__(self) -> int:
+        return 0
+
+
+def escape_plan(
+    world: Map,
+    L: float,
+    resolution: float = 0.1,
+    clearance: float = 0.0,
+    dec: Decomposition | None = None,
+) -> EscapePlan:
+    """The :class:`EscapePlan` of ``world`` for a rod of length ``L`` (cached in memory,
+    on the other arguments than ``dec``).
+
+    The decomposition comes from :func:`strategies.cspace.decompose` (cached on disk), or
+    is ``dec`` where the caller holds it already (the shooting evader's lazy table's: read
+    back from the disk cache it took 0.9 s of the reset on a 200 m floor plan at L_min 3,
+    with a second point-location grid, and a second copy in memory); the same plan (the
+    cache's round trip is exact). The grid is the safety table's at the same
+    ``resolution``. With ``clearance`` (the evader's body radius) the vias avoid the
+    pieces no crossing of which keeps that distance from the walls wherever a route
+    without them exists (:func:`escape_ranks`'s ``narrow``; issue 13: a rank-1 cell of
+    random:polygons:0 whose only via runs within 0.094 of a wall, where the pursuer
+    pinned the evader).
+
+    Raises:
+        InvalidConfigError: ``dec`` is not the decomposition of ``world`` at ``L`` (with
+            the default polyline tolerance), naming what differs.
     """
-    dec = decompose(world, L, cache=True)
+    if dec is not None:
+        chord = Tolerances.of(world, L).chord
+        if dec.map != world or dec.L != L or dec.chord_tol != chord:
+            raise InvalidConfigError(
+                f"escape_plan(dec=...): the decomposition of map {dec.map.name!r} at L = "
+                f"{dec.L:g}, chord_tol = {dec.chord_tol:g}: expected that of map "
+                f"{world.name!r} at L = {L:g}, chord_tol = {chord:g}"
+            )
+    return _escape_plan(world, L, resolution, clearance, _Held(dec))
+
+
+@functools.lru_cache(maxsize=8)
+def _escape_plan(
+    world: Map, L: float, resolution: float, clearance: float, held: _Held
+) -> EscapePlan:
+    dec = held.dec if held.dec is not None else decompose(world, L, cache=True)
     dec.region_grid()  # the point-location grid of cell_at, built here rather than mid-episode
     rank, vias = escape_ranks(dec, _narrow(dec, clearance))
     if not dec.witness_regions:
@@ -671,6 +717,9 @@ def escape_plan(
         nxt = np.full(len(pts), -1, dtype=np.int64)
     grid = _PlanGrid(origin, float(resolution), (int(cell.shape[0]), int(cell.shape[1])), cell)
     return EscapePlan(dec, rank, vias, pts, region, nxt, grid)
+
+
+escape_plan.cache_clear = _escape_plan.cache_clear  # (tests: a plan no earlier one filled)
 
 
 @dataclass(frozen=True, eq=False)

@@ -160,7 +160,9 @@ class ShootingEvader(BasePolicy):
         # a rotation table entry (uint8 bins) in radians, the whole turn for NO_PATH
         bins = np.arange(256).astype(float)
         self._radians = np.where(bins >= NO_PATH, 2 * math.pi, bins * self.table.bin_width)
-        self.plan = escape_plan(c.map, self.L_eff, res, c.body_radius)
+        # (the lazy table's decomposition: not read again from the disk cache)
+        held = self.table.decomposition if self._lazy else None
+        self.plan = escape_plan(c.map, self.L_eff, res, c.body_radius, held)
         # the plan's crossings and region tests, built here rather than mid-episode
         # (margins: those of _new_witness)
         self.plan.prepare(c.body_radius, (c.v_evader * c.dt, 0.0))

@@ -98,3 +98,57 @@ def test_the_walk_to_a_witness_region_looks_up_the_plans_own_grid_points():
             assert np.array_equal(got, unit(plan.points[plan.region_next[j]] - p))
             walked += 1
     assert walked == 300
+
+
+def test_a_lazy_tables_decomposition_is_the_plans(monkeypatch):
+    """With a lazy table the plan is built on the table's decomposition, not on a second
+    copy read back from the disk cache (0.9 s of the reset on a 200 m floor plan at
+    L_min 3), and it is the plan built on the copy read back (the cache's round trip is
+    exact): the same ranks, walk and crossings."""
+    import dataclasses
+
+    import numpy as np
+
+    import strategies.cspace.cache as cache
+    from strategies.runner import build_env
+
+    config = build_env("two_rooms", {}).config  # witness regions: a walk grid
+    escape_plan.cache_clear()
+    reads = []
+    read = cache._read
+    monkeypatch.setattr(cache, "_read", lambda *a: reads.append(a) or read(*a))
+    evader = make_policy("evader/shooting", table="lazy")
+    evader.reset(role="evader", map=config.map, config=config, seed=0)
+    monkeypatch.undo()
+    assert evader.plan.dec is evader.table.decomposition
+    assert len(reads) == 1  # the table's (built or read), not the plan's
+    escape_plan.cache_clear()
+    again = escape_plan(config.map, evader.L_eff, evader.table.resolution, config.body_radius)
+    assert again.dec is not evader.plan.dec  # read back from the disk cache
+    assert np.array_equal(again.rank, evader.plan.rank) and again.vias == evader.plan.vias
+    for field in ("points", "region", "region_next"):
+        assert np.array_equal(getattr(again, field), getattr(evader.plan, field)), field
+    mine, other = dataclasses.replace(evader.plan), dataclasses.replace(again)
+    for plan in (mine, other):
+        plan.prepare(config.body_radius, (config.v_evader * config.dt, 0.0))
+    for key, want in other._spans.items():
+        got = mine._spans[key]
+        for g, w in zip(got or (), want or (), strict=True):
+            assert np.asarray(g).tobytes() == np.asarray(w).tobytes()
+
+
+def test_a_decomposition_of_another_map_or_length_is_refused():
+    import pytest
+
+    from envs.errors import InvalidConfigError
+    from envs.maps import builtin_map
+    from strategies.cspace import decompose
+
+    world = builtin_map("two_rooms")
+    dec = decompose(world, 2.1, cache=True)
+    with pytest.raises(
+        InvalidConfigError, match=r"at L = 2.1.*expected that of map 'two_rooms' at L = 2.2"
+    ):
+        escape_plan(world, 2.2, 0.5, 0.1, dec)
+    with pytest.raises(InvalidConfigError, match="expected that of map 'corridor'"):
+        escape_plan(builtin_map("corridor"), 2.1, 0.5, 0.1, dec)

@@ -539,26 +539,33 @@ def test_prepare_builds_what_witness_would_build():
     assert {k: len(v) for k, v in ready.__dict__.items() if k.startswith("_")} == built
 
 
+def _count_measures(monkeypatch) -> list[int]:
+    """The number of points of each ``Map.distance_to_walls`` call from now on (until
+    ``monkeypatch.undo()``), in a list filled as they come."""
+    from envs.maps import Map
+
+    calls = []
+    measure = Map.distance_to_walls
+
+    def counted(self, points):
+        calls.append(len(points))
+        return measure(self, points)
+
+    monkeypatch.setattr(Map, "distance_to_walls", counted)
+    return calls
+
+
 def test_prepare_measures_each_segment_end_once(monkeypatch):
     """A via piece's segments share their ends (one's end is the next one's start):
     prepare measured both, twice the points (285,892 for 140,122 on a 200 m floor plan at
     L_min 3, 2.7 s of the shooting evader's reset); the distances are the same
     (test_prepare_builds_what_witness_would_build)."""
-    from envs.maps import Map
-
     plan = escape_plan(load_map("random:polygons:0"), L, 0.5, 0.1)
     vias = sorted({b for c in np.flatnonzero(plan.rank >= 0) for b in plan.vias[c]})
     ends = np.concatenate(
         [x for b in vias for x in (plan._piece(b)[0], plan._piece(b)[0] + plan._piece(b)[1])]
     )
-    calls = []
-    measure = Map.distance_to_walls
-
-    def counted(self, points, calls=calls, measure=measure):
-        calls.append(len(points))
-        return measure(self, points)
-
-    monkeypatch.setattr(Map, "distance_to_walls", counted)
+    calls = _count_measures(monkeypatch)
     dataclasses.replace(plan).prepare(0.1, (0.05, 0.0))
     monkeypatch.undo()
     assert len(np.unique(ends, axis=0)) in calls
@@ -570,18 +577,9 @@ def test_narrow_pieces_are_measured_in_one_call(monkeypatch):
     spatial index's batch size: 22 s of the shooting evader's 74 s reset on a 200 m floor
     plan at L_min 3. One call for all of them now; the same pieces as the shapely oracle
     of test_disc_plan_avoids_the_pieces_its_disc_cannot_cross finds."""
-    from envs.maps import Map
-
     world, radius = load_map("random:polygons:0"), 0.1
     dec = escape_plan(world, L, 0.5).dec
-    calls = []
-    measure = Map.distance_to_walls
-
-    def counted(self, points, calls=calls, measure=measure):
-        calls.append(len(points))
-        return measure(self, points)
-
-    monkeypatch.setattr(Map, "distance_to_walls", counted)
+    calls = _count_measures(monkeypatch)
     narrow = _narrow(dec, radius)
     monkeypatch.undo()
     assert len(calls) == 2 and calls[1] > 100  # the pieces' middles, then their samples

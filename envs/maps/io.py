@@ -22,7 +22,9 @@ geometry, made of ``Polygon`` and ``MultiPolygon`` geometries.
   boundary, or else the one with the largest exterior among those not marked
   ``"role": "obstacle"``; the boundary's holes and every other polygon are obstacles.
 * ``name``, ``description``, ``metadata`` and ``merge`` are read from the
-  collection's top-level ``"properties"`` member, then from the boundary's feature.
+  collection's top-level ``"properties"`` member, then from the boundary's feature. A
+  recommended parameter (``l_min``, ...) given there beside them, not in ``metadata``,
+  is refused: it would not be read.
 
 **WKT** (``.wkt``): a ``POLYGON`` with holes (boundary and obstacles), or a
 ``MULTIPOLYGON`` / ``GEOMETRYCOLLECTION`` of polygons whose first member is the boundary
@@ -344,6 +346,14 @@ def map_from_geojson(
             )
         obstacles.append(rings[0])
     meta = {**b_props, **(top or {})}
+    flat = [k for k in FILE_RECOMMENDATIONS if k in meta]
+    if flat:  # GeoJSON properties are free-form: these would be ignored without a word
+        where = {k: meta[k] for k in flat}
+        raise _fail(
+            source,
+            f"properties {where} are not read: a map's recommended parameters go in its "
+            f'"metadata" property (e.g. "properties": {{"metadata": {json.dumps(where)}}})',
+        )
     name, description, metadata, file_merge = _check_common(meta, source)
     use_merge = bool(file_merge) if merge is None else merge
     m = _build(

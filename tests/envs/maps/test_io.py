@@ -99,6 +99,19 @@ def test_wkt_refuses_metadata_that_recommends_parameters(tmp_path):
     save_map(m, tmp_path / "w.wkt", metadata={"note": "x", "l_min": None, "l_max": 4.0})
 
 
+def test_geojson_recommendations_outside_metadata_are_refused(tmp_path):
+    # "properties": {"l_min": 1.0} (GeoJSON's flat properties) was ignored: the map played
+    # at L 2-4 without a word; only properties.metadata is read
+    obj = map_to_geojson(MAPS["plain"])
+    obj["properties"]["l_min"] = 1.0
+    with pytest.raises(InvalidMapError, match=r"properties \{'l_min': 1\.0\} are not read: "
+                       r'.*"properties": \{"metadata": \{"l_min": 1\.0\}\}'):  # fmt: skip
+        map_from_geojson(obj, source="f.geojson")
+    del obj["properties"]["l_min"]
+    obj["properties"]["metadata"] = {"l_min": 1.0}
+    assert map_from_geojson(obj).metadata == {"l_min": 1.0}
+
+
 def test_geojson_output_follows_rfc7946(tmp_path):
     m = MAPS["plain"]
     obj = json.loads(save_map(m, tmp_path / "w.geojson").read_text())

@@ -110,7 +110,7 @@ def run(args: argparse.Namespace) -> int:
     from envs.surveillance.physics import check_step
     from strategies.referee import referee_for
     from strategies.referee.estimates import check_cpls, check_estimate
-    from strategies.referee.referee import check_start
+    from strategies.referee.referee import check_solve_budget, check_start
     from strategies.referee.spec import GameSpec
     from strategies.runner import map_parameters
 
@@ -152,6 +152,8 @@ def run(args: argparse.Namespace) -> int:
     if args.estimate is not None:  # its memory too, before the referee's solve
         with MemoryBudgetError.naming(ESTIMATE_KNOB):
             check_estimate(GameSpec.from_config(cfg), tuple(args.estimate) or ESTIMATE_CPLS)
+    with MemoryBudgetError.naming("--cells-per-lmin"):  # a refusal before any announcement
+        check_solve_budget(GameSpec.from_config(cfg), args.cells_per_lmin, dt=cfg.dt)
     _say_if_long(cfg, args)
     t = time.perf_counter()
     with warnings.catch_warnings():

@@ -54,7 +54,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from envs.errors import MemoryBudgetError
-from strategies.cspace._budget import memory_budget
+from strategies.cspace._budget import _physical_memory, memory_budget
 from strategies.referee.lattice import grid_shape, lattice_vectors, window_half_width
 from strategies.referee.spec import GameSpec, Resolution
 
@@ -282,7 +282,14 @@ def check_budget(
             coarsest = peak(resize(0.1))[0]
             advice.append(f"No {K} fits (even {K} = 0.1 needs about {_size(coarsest)})")
     more = math.ceil(1.2 * need / 1e9)
-    advice.append(f"{'raise' if advice else 'Raise'} the budget with {MemoryBudgetError.BUDGET}")
+    ram = _physical_memory()
+    if need <= ram:
+        advice.append(
+            f"{'raise' if advice else 'Raise'} the budget with {MemoryBudgetError.BUDGET}"
+        )
+    else:  # "SURVEIL_MEMORY_BUDGET=3712723138027099136GB": no budget this machine can give
+        advice.append(f"{'no' if advice else 'No'} budget on this machine fits (it has "
+                      f"{_size(ram)} of memory)")  # fmt: skip
     advice.append("or solve a smaller map or a smaller L_max / L_min")
     raise MemoryBudgetError(
         f"{call}: the solve would need about {_size(need)} at its peak, during the "

@@ -43,6 +43,7 @@ __all__ = [
     "StartSet",
     "cached_evader_bound",
     "cached_pursuer_bound",
+    "check_solve_budget",
     "check_start",
     "coarsest_with_starts",
     "fallback_size",
@@ -443,22 +444,9 @@ def solve(
                  pursuer_steps=pursuer_steps, evader_steps=evader_steps,
                  sweep_pieces=sweep_pieces, dt=dt)  # fmt: skip
 
-    def resolutions(cpl: float) -> tuple[Resolution, Resolution]:
-        return _resolution(spec, "pursuer", cpl, **knobs), _resolution(spec, "evader", cpl, **knobs)
-
-    def sizes(cpl: float) -> list[SolveSize]:
-        rp, re = resolutions(cpl)
-        return [bound_size(spec, rp, "pursuer"), bound_size(spec, re, "evader")]
-
-    rp, re = resolutions(cells_per_lmin)
-    budget = check_budget(
-        f"solve(map {spec.map.name!r}, L in [{spec.l_min:g}, {spec.l_max:g}], "
-        f"{cells_per_lmin:g} cells per L_min)",
-        sizes(cells_per_lmin),
-        memory_budget,
-        resize=sizes,
-        cells_per_lmin=cells_per_lmin,
-    )
+    budget = check_solve_budget(spec, cells_per_lmin, memory_budget=memory_budget, **knobs)
+    rp = _resolution(spec, "pursuer", cells_per_lmin, **knobs)
+    re = _resolution(spec, "evader", cells_per_lmin, **knobs)
     kw = dict(cache=cache, cache_dir=cache_dir, progress=progress, memory_budget=budget)
     pursuer, tried = _pursuer_bound(
         spec, rp, cells_per_lmin, knobs, kw, pursuer_fallback, [bound_size(spec, re, "evader")]
@@ -466,6 +454,40 @@ def solve(
     ref = Referee(spec=spec, pursuer=pursuer, evader=cached_evader_bound(spec, re, **kw))
     _warn_vacuous(spec, pursuer, tried)
     return ref
+
+
+def check_solve_budget(
+    spec: GameSpec, cells_per_lmin: float = 24.0, *, memory_budget: object = None, **knobs: Any
+) -> float:
+    """The memory budget in bytes, after checking that :func:`solve` with these arguments
+    fits in it: the check :func:`solve` makes first, for a caller that must refuse before
+    it says anything else (``surveil referee`` announced a solve of "up to about 1.08e+19
+    h" and then refused it).
+
+    Args:
+        spec, cells_per_lmin, memory_budget: as :func:`solve`.
+        **knobs: :func:`solve`'s ``pursuer_coarse, evader_coarse, pursuer_steps,
+            evader_steps, sweep_pieces, dt``.
+
+    Raises:
+        MemoryBudgetError: as :func:`solve`.
+    """
+    cells_per_lmin = V.positive("cells_per_lmin", cells_per_lmin)
+
+    def sizes(cpl: float) -> list[SolveSize]:
+        return [
+            bound_size(spec, _resolution(spec, role, cpl, **knobs), role)
+            for role in ("pursuer", "evader")
+        ]
+
+    return check_budget(
+        f"solve(map {spec.map.name!r}, L in [{spec.l_min:g}, {spec.l_max:g}], "
+        f"{cells_per_lmin:g} cells per L_min)",
+        sizes(cells_per_lmin),
+        memory_budget,
+        resize=sizes,
+        cells_per_lmin=cells_per_lmin,
+    )
 
 
 def pursuer_fallback_resolution(

@@ -145,6 +145,18 @@ def test_a_solve_over_the_budget_names_this_command_s_flags(capsys, monkeypatch)
     assert "cpls" not in err.split("):", 1)[1] and "memory_budget=" not in err
 
 
+def test_a_solve_over_the_budget_is_refused_before_its_announcement(capsys, monkeypatch):
+    """``--cells-per-lmin 100000`` announced "up to about 1.08e+19 h" and then refused the
+    solve for its memory: the refusal comes first and alone."""
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", "/nonexistent")
+    monkeypatch.setenv("SURVEIL_MEMORY_BUDGET", "200MB")
+    # dt = 10: a long solve (announced at any budget), over 200 MB at 16 cells per L_min
+    assert main(["referee", "corridor", "--config", '{"dt": 10}', "--no-cache"]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.startswith("surveil: error: solve(map 'corridor'"), err
+    assert "Use --cells-per-lmin <= " in err and "solving the referee's bounds" not in err
+
+
 @pytest.mark.parametrize(("cpl", "fit"), [("1e-09", "1"), ("0.9", "1")])
 def test_a_resolution_with_no_lattice_start_is_refused_naming_one_that_has(
     cpl, fit, capsys, monkeypatch

@@ -124,6 +124,25 @@ def test_a_budget_error_renames_its_knobs_and_survives_pickling():
     assert "\x00" not in renamed
 
 
+def test_a_solve_larger_than_the_machine_names_no_budget(monkeypatch):
+    """``surveil referee corridor --cells-per-lmin 100000`` advised
+    "SURVEIL_MEMORY_BUDGET=3712723138027099136GB": no budget fits a solve larger than the
+    machine's memory; the message says so and names the resolution that fits instead."""
+    import strategies.referee._budget as budget
+
+    s = spec(open_room(), 0.5)
+    with pytest.raises(MemoryBudgetError) as err:
+        solve(s, 40, cache=False, memory_budget="200MB")
+    need = float(re.search(r"would need about ([\d.]+) GB", str(err.value)).group(1)) * 1e9
+    assert need > 1e9  # a machine of 1 GB cannot give it
+    monkeypatch.setattr(budget, "_physical_memory", lambda: 1e9)
+    with pytest.raises(MemoryBudgetError) as err:
+        solve(s, 40, cache=False, memory_budget="200MB")
+    msg = str(err.value)
+    assert "Use cells_per_lmin <= " in msg and "memory_budget=" not in msg, msg
+    assert "no budget on this machine fits (it has 1.0 GB of memory)" in msg, msg
+
+
 def test_each_solver_checks_its_own_budget():
     s = spec(open_room(), 0.5)
     res = Resolution.for_role(s, "pursuer", 12, coarse=3)

@@ -77,7 +77,9 @@ def format_cells(cells, scope: str | None = None) -> str:
     return "\n".join([line(head), line(["-" * w for w in widths]), *map(line, body)])
 
 
-def _print_outcome(summary, store: Path, report: str | None, replays: bool) -> int:
+def _print_outcome(
+    summary, store: Path, report: str | None, replays: bool, regret: bool = True
+) -> int:
     from analysis.tournament import statistics as st
     from analysis.tournament.report import write_report
     from analysis.tournament.store import Store
@@ -90,8 +92,10 @@ def _print_outcome(summary, store: Path, report: str | None, replays: bool) -> i
         scopes = {c.scope for c in cells}
         print(format_cells(cells, st.OVERALL if st.OVERALL in scopes else None))
         if report:
-            _announce_report(report, replays, skip="--no-report skips it")
-            files = write_report(db, report, run_id=summary.run_id, replays=replays)
+            _announce_report(report, replays, regret, skip="--no-report skips it")
+            files = write_report(
+                db, report, run_id=summary.run_id, replays=replays, regret=regret, say=_say
+            )
             print(f"report written to {files['html']} and {files['markdown']}")
     if summary.interrupted:
         return EXIT_SIGNAL.get(summary.interrupted, 130)
@@ -147,24 +151,28 @@ def _cmd_tournament(args: argparse.Namespace) -> int:
     report = args.report
     if report is None and not summary.interrupted and args.report_default:
         report = str(store.with_name(store.stem + "_report"))
-    return _print_outcome(summary, store, report, not args.no_replays)
+    return _print_outcome(summary, store, report, not args.no_replays, not args.no_regret)
 
 
-def _announce_report(out: str, replays: bool, skip: str = "") -> None:
+def _say(text: str) -> None:
+    print(text, file=sys.stderr, flush=True)
+
+
+def _announce_report(out: str, replays: bool, regret: bool = True, skip: str = "") -> None:
     """Say on stderr what the report is about to do: its regret table solves the referee's
     game of every map and parameter set the run played (a tournament's report sat silent
     for 13 minutes after its table: 9 games at 16 cells per L_min, under load)."""
     from strategies.referee.regrets import DEFAULT_CELLS_PER_LMIN
 
     extra = "; the replays re-simulate the decisive matches" if replays else ""
-    print(
-        f"writing the report to {out}: its regret table solves the referee's game of each "
-        f"map and parameter set played ({DEFAULT_CELLS_PER_LMIN:g} cells per L_min; cached, "
-        f"so it can take minutes the first time and seconds after){extra}"
-        + (f"; {skip}" if skip else ""),
-        file=sys.stderr,
-        flush=True,
+    what = (
+        "its regret table solves the referee's game of each map and parameter set played "
+        f"({DEFAULT_CELLS_PER_LMIN:g} cells per L_min; cached, so it can take minutes the "
+        "first time and seconds after; --no-regret skips it)"
+        if regret
+        else "without the regret table (--no-regret)"
     )
+    _say(f"writing the report to {out}: {what}{extra}" + (f"; {skip}" if skip else ""))
 
 
 def _report_dir_possible(flag: str, text: str, alternative: str = "") -> None:
@@ -188,8 +196,11 @@ def _cmd_report(args: argparse.Namespace) -> int:
     _report_dir_possible("--out", out)  # was "x: File exists" from the mkdir
     with Store(store, create=False) as db:
         db.run(args.run)  # a bad store or run is refused before the announcement
-        _announce_report(out, not args.no_replays)
-        files = write_report(db, out, run_id=args.run, replays=not args.no_replays)
+        regret = not args.no_regret
+        _announce_report(out, not args.no_replays, regret)
+        files = write_report(
+            db, out, run_id=args.run, replays=not args.no_replays, regret=regret, say=_say
+        )
     print(f"report written to {files['html']} and {files['markdown']}")
     return 0
 
@@ -262,6 +273,12 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
     return code
 
 
+NO_REGRET_HELP = (
+    "report without the regret table (it solves the referee's game of each map and "
+    "parameter set played: seconds to hours the first time, cached after)"
+)
+
+
 def add_parsers(sub: argparse._SubParsersAction) -> None:
     """Add ``tournament``, ``report``, ``export`` and ``evaluate`` to the ``surveil`` CLI."""
     p = sub.add_parser(
@@ -293,6 +310,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
         help="do not write the report beside the store when the run completes",
     )
     p.add_argument("--no-replays", action="store_true", help="report without GIF replays")
+    p.add_argument("--no-regret", action="store_true", help=NO_REGRET_HELP)
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.set_defaults(func=_cmd_tournament)
 
@@ -305,6 +323,7 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
         help="directory (default: STORE_report beside the store)",
     )
     p.add_argument("--no-replays", action="store_true", help="skip the GIF replays")
+    p.add_argument("--no-regret", action="store_true", help=NO_REGRET_HELP)
     p.set_defaults(func=_cmd_report)
 
     p = sub.add_parser("export", help="export a tournament's results as CSV or JSON lines")

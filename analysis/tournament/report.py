@@ -24,6 +24,7 @@ import io
 import json
 import math
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -312,21 +313,60 @@ def _gif(result: Any) -> bytes:
 
 
 # --------------------------------------------------------------------------- writing
-def _regret_section(a: Analysis) -> tuple[str, str]:
+NO_REGRET = (
+    "Not computed: the report was written with --no-regret (the table solves the referee's "
+    "game of each map and parameter set played; the solves are cached, so paid once)"
+)
+"""The regret section of a report written with ``regret=False``."""
+
+
+def _regret_section(a: Analysis, say: Callable[[str], None] | None = None) -> tuple[str, str]:
     """The referee's regret table (Markdown, HTML), or a note saying why it is missing
-    (its games' solves, a bar over them on a terminal, would exceed the memory budget)."""
+    (its games' solves, a bar over them on a terminal, would exceed the memory budget).
+    ``say`` is told the estimate first when the solves not cached may take longer than
+    :data:`analysis.referee_cli.LONG_SOLVE_SECONDS` (a report solved for over 9 minutes
+    without a word under ``--no-progress``)."""
     from envs.errors import MemoryBudgetError
     from strategies.referee import tournament_regret
     from strategies.referee.regrets import DEFAULT_CELLS_PER_LMIN
 
     geometry = {d: g for d, g in a.geometry.items() if g is not None}
+    before = None if say is None else (lambda sizes: _say_if_long(sizes, say))
     try:
-        table = tournament_regret(a.run["spec"], a.rows, geometry=geometry)
+        table = tournament_regret(a.run["spec"], a.rows, geometry=geometry, before_solve=before)
     except MemoryBudgetError as exc:  # one table, not the whole report (it stopped there)
         knob = f"the resolution (the report's is {DEFAULT_CELLS_PER_LMIN:g} cells per L_min)"
         text = f"Not solved: {exc.named(knob, MemoryBudgetError.ENV_BUDGET)}"
         return text, f"<p>{html.escape(text)}</p>"
     return _md_table(table), _html_table(table)
+
+
+def _say_if_long(sizes: list, say: Callable[[str], None]) -> None:
+    """Tell ``say`` the regret table's solves (:func:`~strategies.referee.regrets.regret`'s
+    ``before_solve`` sizes) and their time, an upper bound, when it is long: the estimate
+    ``surveil referee`` announces (:func:`strategies.referee._budget.duration`)."""
+    from analysis.referee_cli import LONG_SOLVE_SECONDS
+    from strategies.referee._budget import duration
+    from strategies.referee.regrets import DEFAULT_CELLS_PER_LMIN
+
+    first = [s for s in sizes if s.what != "pursuer bound's fallback"]
+    seconds = sum(s.seconds for s in first)
+    retry = sum(s.seconds for s in sizes) - seconds
+    if seconds + retry <= LONG_SOLVE_SECONDS:
+        return
+    states = sum(s.states for s in first)
+    more = (
+        f", or {duration(seconds + retry)} if pursuer bounds certify no state and are "
+        "solved again one cell finer"
+        if retry
+        else ""
+    )
+    say(
+        f"the regret table: solving {len(first)} referee bound(s) not in the cache "
+        f"({DEFAULT_CELLS_PER_LMIN:g} cells per L_min, {states / 1e6:.3g} M states): up to "
+        f"about {duration(seconds)}{more} (an upper bound, estimated before the solve); "
+        "--no-regret skips the table"
+    )
 
 
 def _fmt(x: float, digits: int = 2) -> str:
@@ -434,8 +474,17 @@ def write_report(
     *,
     run_id: str | None = None,
     replays: bool = True,
+    regret: bool = True,
+    say: Callable[[str], None] | None = None,
 ) -> dict[str, Path]:
     """Write ``report.md``, ``report.html`` and the pictures of a run into ``out_dir``.
+
+    Args:
+        store, out_dir, run_id: the store, the directory, the run (default: the latest).
+        replays: re-simulate the decisive matches as GIFs.
+        regret: the regret table (the referee solves each game played, seconds to hours
+            the first time); False writes :data:`NO_REGRET` in its place.
+        say: told, before a long regret solve, what it solves and its estimated time.
 
     Returns:
         ``{"markdown": path, "html": path, ...}`` of every file written.
@@ -469,7 +518,10 @@ def write_report(
         (out / name).write_bytes(data)
         files[name] = out / name
     tables = _tables(a)
-    regret_md, regret_html = _regret_section(a)
+    if regret:
+        regret_md, regret_html = _regret_section(a, say)
+    else:
+        regret_md, regret_html = NO_REGRET, f"<p>{html.escape(NO_REGRET)}</p>"
     files["markdown"] = out / "report.md"
     files["markdown"].write_text(_markdown(a, tables, images, regret_md), encoding="utf-8")
     files["html"] = out / "report.html"

@@ -21,7 +21,7 @@ import json
 import math
 import os
 import warnings
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -29,9 +29,21 @@ import numpy as np
 from scipy.stats import binomtest
 
 from envs import validation as V
-from envs.errors import InvalidConfigError, InvalidPlacementError, VacuousBoundWarning
+from envs.errors import (
+    InvalidConfigError,
+    InvalidPlacementError,
+    MemoryBudgetError,
+    VacuousBoundWarning,
+)
 from envs.maps import Map
-from strategies.referee.referee import Referee, solve
+from strategies.referee._budget import SolveSize
+from strategies.referee.referee import (
+    Referee,
+    check_solve_budget,
+    fallback_size,
+    solve,
+    unsolved_sizes,
+)
 from strategies.referee.spec import GameSpec
 
 __all__ = ["Regret", "regret", "regret_table", "tournament_regret"]
@@ -90,6 +102,7 @@ def regret(
     cache: bool = True,
     cache_dir: str | os.PathLike | None = None,
     progress: bool | None = None,
+    before_solve: Callable[[list[SolveSize]], None] | None = None,
 ) -> list[Regret]:
     """Regret of every policy in ``matches``.
 
@@ -106,6 +119,12 @@ def regret(
         progress: a bar over the games to solve on standard error: shown (``True``),
             hidden (``False``) or, by default, on a terminal only (a solve not cached
             takes seconds to minutes).
+        before_solve: called once before any game is solved with the estimated sizes
+            (:func:`~strategies.referee.referee.unsolved_sizes`, time an upper bound) of
+            the bounds to solve, games over the memory budget left out (their solve is
+            refused at once), then those of the pursuer bounds' possible retries one cell
+            finer (:func:`~strategies.referee.referee.fallback_size`, ``what`` ``"pursuer
+            bound's fallback"``): what a caller tells its user before a long solve.
 
     Returns:
         One :class:`Regret` per (role, policy), pursuers first, sorted by name.
@@ -121,14 +140,15 @@ def regret(
         key = _game_key(world, params)
         if key not in referees and key not in games:
             games[key] = (world, params)
+    if before_solve is not None:
+        before_solve(_sizes(games, cells_per_lmin, cache, cache_dir))
     from tqdm import tqdm
 
     bar = tqdm(total=len(games), desc="referee: solving the games played", unit="game",
                disable=None if progress is None else not progress, leave=False)  # fmt: skip
     with bar:
         for key, (world, params) in games.items():
-            spec = GameSpec(world, params["l_min"], params["l_max"], params["v_pursuer"],
-                            params["v_evader"], body_radius=params["body_radius"])  # fmt: skip
+            spec = _spec(world, params)
             referees[key] = solve(
                 spec, cells_per_lmin, dt=params["dt"], cache=cache, cache_dir=cache_dir
             )
@@ -151,6 +171,27 @@ def regret(
                 t[3] += 1
     rows = [Regret(r, p, *v) for (r, p), v in tally.items()]
     return sorted(rows, key=lambda x: (x.role != "pursuer", x.policy))
+
+
+def _spec(world: Map, params: Mapping[str, float]) -> GameSpec:
+    return GameSpec(world, params["l_min"], params["l_max"], params["v_pursuer"],
+                    params["v_evader"], body_radius=params["body_radius"])  # fmt: skip
+
+
+def _sizes(games, cells_per_lmin, cache, cache_dir) -> list[SolveSize]:
+    """The bounds :func:`regret` will solve for ``games`` (those within the memory
+    budget), then the pursuer bounds' possible retries (see its ``before_solve``)."""
+    sizes, retries = [], []
+    for world, params in games.values():
+        spec, kw = _spec(world, params), dict(cache=cache, cache_dir=cache_dir, dt=params["dt"])
+        try:
+            check_solve_budget(spec, cells_per_lmin, dt=params["dt"])
+        except MemoryBudgetError:
+            continue  # refused before it starts: no time to announce
+        sizes += unsolved_sizes(spec, cells_per_lmin, **kw)
+        retry = fallback_size(spec, cells_per_lmin, **kw)
+        retries += [] if retry is None else [retry]
+    return sizes + retries
 
 
 def _read_match(m: Mapping[str, Any], where: str):
@@ -210,6 +251,7 @@ def tournament_regret(
     cache_dir: str | os.PathLike | None = None,
     strict: bool = False,
     progress: bool | None = None,
+    before_solve: Callable[[list[SolveSize]], None] | None = None,
 ) -> list[list[str]]:
     """The regret table of a tournament run, for its report.
 
@@ -230,6 +272,7 @@ def tournament_regret(
             changed since the run); by default such matches are left out and a last row
             says how many and why, so a report still renders.
         progress: :func:`regret`'s bar over the games to solve (by default on a terminal).
+        before_solve: :func:`regret`'s, called with the estimated sizes of what it solves.
 
     Returns:
         :func:`regret_table`'s rows (only matches played out, status ``"ok"``), then a
@@ -261,7 +304,8 @@ def tournament_regret(
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", VacuousBoundWarning)
         results = regret(matches, cells_per_lmin=cells_per_lmin, referees=referees,
-                         cache=cache, cache_dir=cache_dir, progress=progress)  # fmt: skip
+                         cache=cache, cache_dir=cache_dir, progress=progress,
+                         before_solve=before_solve)  # fmt: skip
     for w in caught:  # other warnings go on as they came
         if not issubclass(w.category, VacuousBoundWarning):
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)

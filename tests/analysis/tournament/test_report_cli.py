@@ -226,7 +226,7 @@ def test_replay_captions_name_the_grid_value(tmp_path, monkeypatch):
     each; their captions said only the map ('u.wkt: ... seed 0', twice), not which rho."""
     import analysis.tournament.report as report
 
-    monkeypatch.setattr(report, "_regret_section", lambda a: ("-", "<p>-</p>"))  # no solves
+    monkeypatch.setattr(report, "_regret_section", lambda a, say=None: ("-", "<p>-</p>"))
     spec = {
         "name": "grid",
         "maps": ["open_room"],
@@ -266,3 +266,57 @@ def test_exporting_an_unfinished_run_says_so(tmp_path, capsys):
         "; the run is interrupted with 3 of its 4 planned matches stored: these are not its "
         "results (rerun its tournament to finish it)"
     )
+
+
+def test_a_report_can_skip_its_regret_table(tmp_path, capsys, monkeypatch):
+    """A report's regret table solved referee games for over 9 minutes (no output under
+    --no-progress) and could not be skipped: `surveil report --no-regret` (and `surveil
+    tournament --no-regret`) write the report without a solve, saying so in its place."""
+    import strategies.referee.regrets as regrets
+
+    def no_solve(*args, **kwargs):
+        raise AssertionError("--no-regret solved a referee game")
+
+    monkeypatch.setattr(regrets, "solve", no_solve)
+    store, argv = _mini_tournament(tmp_path)
+    assert main([*argv, "--report", str(tmp_path / "r0"), "--no-replays", "--no-regret"]) == 0
+    assert "without the regret table (--no-regret)" in capsys.readouterr().err
+    assert main(["report", str(store), "--out", str(tmp_path / "r1"), "--no-regret"]) == 0
+    err = capsys.readouterr().err
+    assert err.startswith(f"writing the report to {tmp_path / 'r1'}: without the regret table")
+    for rep in ("r0", "r1"):
+        md = (tmp_path / rep / "report.md").read_text()
+        regret = md.split("## Regret", 1)[1].split("\n## ", 1)[0]
+        assert "Not computed: the report was written with --no-regret" in regret, regret
+        assert (
+            "<p>Not computed: the report was written with --no-regret"
+            in (tmp_path / rep / "report.html").read_text()
+        )
+
+
+def test_a_long_regret_solve_is_announced_with_its_estimate(tmp_path, capsys, monkeypatch):
+    """The report said only "can take minutes the first time": before a long solve it now
+    gives the estimate `surveil referee` gives (unsolved_sizes, an upper bound). dt = 10 on
+    the corridor: the pursuer's 10 s step has 1257 moves, up to about 5 min."""
+    import strategies.referee.regrets as regrets
+
+    def stop(*args, **kwargs):
+        raise KeyboardInterrupt  # the solve itself is not under test (Ctrl-C: code 130)
+
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", str(tmp_path / "cache"))
+    spec = tmp_path / "slow.toml"
+    spec.write_text(
+        'maps = ["corridor"]\npursuers = ["pursuer/greedy"]\nevaders = ["evader/straight"]\n'
+        'seeds = 1\nstart = "valid"\n[env]\nmax_cycles = 5\ndt = 10\nspawn_margin_steps = 0\n'
+    )
+    store = tmp_path / "slow.sqlite"
+    argv = ["tournament", str(spec), "--store", str(store), "--no-progress", "--backend", "serial"]
+    assert main([*argv, "--no-report"]) == 0
+    capsys.readouterr()
+    monkeypatch.setattr(regrets, "solve", stop)
+    assert main(["report", str(store), "--no-replays"]) == 130
+    err = capsys.readouterr().err
+    line = next(x for x in err.splitlines() if x.startswith("the regret table: "))
+    assert line.startswith("the regret table: solving 2 referee bound(s) not in the cache "
+                           "(16 cells per L_min, ")  # fmt: skip
+    assert "up to about 5 min (an upper bound" in line and "--no-regret skips" in line

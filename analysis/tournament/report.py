@@ -2,7 +2,10 @@
 
 :func:`write_report` reads a run from a store and writes ``report.md``, ``report.html``
 (images embedded as data URIs: the page can be mailed on its own) and the pictures
-(``heatmaps.png``, ``ratings.png``, ``replay_*.gif``) into a directory. Sections:
+(``heatmaps-HASH.png``, ``ratings-HASH.png``, ``replay_K-HASH.gif``, each named by its
+content) into a directory. Nothing is written until everything is computed, then the
+pictures, then the pages, each through a rename; the previous report's pictures are
+removed last: an interrupted report leaves the previous one whole. Sections:
 
 1. the run (spec, counts, forfeits and errors);
 2. payoff matrices per map and overall as heat maps and tables (held rate with its
@@ -19,11 +22,13 @@
 from __future__ import annotations
 
 import base64
+import hashlib
 import html
 import io
 import json
 import math
 import os
+import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -492,15 +497,13 @@ def write_report(
     db = store if isinstance(store, Store) else Store(store, create=False)
     a = analyse(db, run_id)
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    files: dict[str, Path] = {}
     images: list[tuple[str, str, bytes, str]] = []  # (section, file, bytes, caption)
     if a.matrices:
         images.append(
-            ("matrices", "heatmaps.png", heatmaps_png(a.matrices, a.cells), "held rate per pairing")
+            ("matrices", "heatmaps", heatmaps_png(a.matrices, a.cells), "held rate per pairing")
         )
     if a.ratings:
-        images.append(("ratings", "ratings.png", ratings_png(a.ratings), "ratings"))
+        images.append(("ratings", "ratings", ratings_png(a.ratings), "ratings"))
     if replays:
         for k, row in enumerate(_decisive(a)):
             rep = _replay(db, a.run, row)
@@ -513,20 +516,65 @@ def write_report(
                     "outcome: the code changed since it was played (set the spec's "
                     "salt to replay everything)"
                 )
-            images.append(("replays", f"replay_{k}.gif", rep.gif, rep.title))
-    for _, name, data, _ in images:
-        (out / name).write_bytes(data)
-        files[name] = out / name
+            images.append(("replays", f"replay_{k}", rep.gif, rep.title))
+    # each picture is named by its content: one written beside an older report.md never
+    # replaces a picture that report shows
+    images = [(sec, _image_name(stem, data), data, cap) for sec, stem, data, cap in images]
     tables = _tables(a)
     if regret:
         regret_md, regret_html = _regret_section(a, say)
     else:
         regret_md, regret_html = NO_REGRET, f"<p>{html.escape(NO_REGRET)}</p>"
-    files["markdown"] = out / "report.md"
-    files["markdown"].write_text(_markdown(a, tables, images, regret_md), encoding="utf-8")
-    files["html"] = out / "report.html"
-    files["html"].write_text(_html(a, tables, images, regret_html), encoding="utf-8")
+    # nothing is written before everything is computed (the regret table can take hours):
+    # an interrupted report leaves the previous one as it was, its pictures included
+    markdown = _markdown(a, tables, images, regret_md)
+    page = _html(a, tables, images, regret_html)
+    out.mkdir(parents=True, exist_ok=True)
+    before = _pictures_of(out / "report.md")
+    files: dict[str, Path] = {}
+    for _, name, data, _ in images:
+        files[name] = _write_atomically(out / name, data)
+    files["html"] = _write_atomically(out / "report.html", page.encode("utf-8"))
+    files["markdown"] = _write_atomically(out / "report.md", markdown.encode("utf-8"))
+    # then the pictures no report shows: the previous report's, and those of a report
+    # interrupted while it wrote them
+    strays = {p.name for p in out.iterdir() if _HASHED.fullmatch(p.name)}
+    for name in (before | strays) - files.keys():
+        (out / name).unlink(missing_ok=True)
     return files
+
+
+_PICTURE = re.compile(r"(heatmaps|ratings|replay_\d+)(-[0-9a-f]{12})?\.(png|gif)")
+"""The names of the pictures a report writes (and wrote, without the hash, before they had
+one)."""
+_HASHED = re.compile(r"(heatmaps|ratings|replay_\d+)-[0-9a-f]{12}\.(png|gif)")
+
+
+def _image_name(stem: str, data: bytes) -> str:
+    """``heatmaps-0123456789ab.png``: the stem, the content's hash and its type."""
+    suffix = ".gif" if data[:4] == b"GIF8" else ".png"
+    return f"{stem}-{hashlib.sha256(data).hexdigest()[:12]}{suffix}"
+
+
+def _pictures_of(markdown: Path) -> set[str]:
+    """The report's pictures that ``markdown`` (a report.md, if there is one) shows."""
+    try:
+        text = markdown.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return set()
+    return {m for m in re.findall(r"!\[[^\]]*\]\(([^)/\\]+)\)", text) if _PICTURE.fullmatch(m)}
+
+
+def _write_atomically(path: Path, data: bytes) -> Path:
+    """Write ``path`` through a temporary file beside it and a rename: a reader (or an
+    interruption) sees the old file or the new one, never half of one."""
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        tmp.write_bytes(data)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return path
 
 
 def _header(a: Analysis) -> list[str]:

@@ -320,3 +320,50 @@ def test_a_long_regret_solve_is_announced_with_its_estimate(tmp_path, capsys, mo
     assert line.startswith("the regret table: solving 2 referee bound(s) not in the cache "
                            "(16 cells per L_min, ")  # fmt: skip
     assert "up to about 5 min (an upper bound" in line and "--no-regret skips" in line
+
+
+def test_an_interrupted_report_leaves_the_previous_one_whole(tmp_path, monkeypatch):
+    """A report killed in its regret solve left new pictures beside the older report.md
+    (heatmaps.png replaced under it). Now nothing is written before everything is computed,
+    pictures are named by their content and the pages replaced by a rename: the old report
+    stays whole; a finished one removes the pictures of the one before, nothing else."""
+    import analysis.tournament.report as report
+
+    def snapshot(d):
+        return {p.name: p.read_bytes() for p in d.iterdir()}
+
+    def shown(d):
+        return set(re.findall(r"\]\(([^)]+)\)", (d / "report.md").read_text()))
+
+    rep = tmp_path / "rep"
+    rep.mkdir()
+    (rep / "notes.txt").write_text("the user's")
+    (rep / "heatmaps.png").write_bytes(b"an older report's picture")
+    (rep / "report.md").write_text("# old\n\n![held rate per pairing](heatmaps.png)\n")
+    store, argv = _mini_tournament(tmp_path)
+    assert main([*argv, "--no-report"]) == 0
+    first = write_report(store, rep, replays=False, regret=False)
+    assert not (rep / "heatmaps.png").exists() and (rep / "notes.txt").exists()
+    assert set(snapshot(rep)) == shown(rep) | {"report.md", "report.html", "notes.txt"}
+    assert {p.name for p in first.values()} == set(snapshot(rep)) - {"notes.txt"}
+    # another run (other evaders: another heat map), interrupted in its regret solve
+    other = tmp_path / "other.sqlite"
+    spec = {"name": "other", "maps": ["open_room"], "pursuers": ["pursuer/greedy"],
+            "evaders": ["evader/straight"], "seeds": 3, "env": {"max_cycles": 20}}  # fmt: skip
+    run_tournament(spec_from_dict(spec), other, backend="serial", progress=False)
+    before = snapshot(rep)
+
+    def interrupted(a, say=None):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(report, "_regret_section", interrupted)
+    try:
+        write_report(other, rep, replays=False)
+    except KeyboardInterrupt:
+        pass
+    assert snapshot(rep) == before
+    monkeypatch.undo()
+    second = write_report(other, rep, replays=False, regret=False)
+    assert set(snapshot(rep)) == shown(rep) | {"report.md", "report.html", "notes.txt"}
+    assert second["markdown"].read_text() != before["report.md"].decode()
+    assert {p.name for p in second.values()} == set(snapshot(rep)) - {"notes.txt"}

@@ -512,8 +512,8 @@ def check_backend(backend: str, *, workers: int | None = None, address: str | No
     """Refuse a backend, worker count or address :func:`make_executor` cannot use.
 
     Raises:
-        InvalidConfigError: an unknown backend, ``address`` without Ray, or ``workers``
-            not an integer >= 1.
+        InvalidConfigError: an unknown backend, ``address`` without Ray, ``workers``
+            not an integer >= 1, or more than one worker for the serial backend.
     """
     from envs.errors import InvalidConfigError
     from envs.validation import integer
@@ -524,6 +524,11 @@ def check_backend(backend: str, *, workers: int | None = None, address: str | No
         raise InvalidConfigError(f"--address applies to the ray backend, not {backend!r}")
     if workers is not None:
         integer("workers", workers, minimum=1)
+        if backend == "serial" and workers != 1:  # it was ignored without a word
+            raise InvalidConfigError(
+                f"workers = {workers}: the serial backend plays one match at a time in this "
+                "process; use the process or ray backend for more"
+            )
 
 
 def make_executor(

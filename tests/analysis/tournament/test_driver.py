@@ -43,6 +43,26 @@ def test_a_worker_count_below_one_is_refused_before_the_store(
     assert not store.exists()
 
 
+def test_more_than_one_worker_for_the_serial_backend_is_refused(tmp_path, small_spec, capsys):
+    # `surveil tournament spec --backend serial --workers 4` played serially without a word
+    from analysis.cli import main
+    from envs.errors import InvalidConfigError
+
+    store = tmp_path / "s.sqlite"
+    spec = spec_from_dict(small_spec)
+    with pytest.raises(InvalidConfigError, match="workers = 4: the serial backend plays one"):
+        run_tournament(spec, store, backend="serial", workers=4, progress=False)
+    assert not store.exists()
+    toml = tmp_path / "mini.toml"
+    toml.write_text(
+        'maps = ["open_room"]\npursuers = ["pursuer/greedy"]\nevaders = ["evader/random"]\n'
+    )
+    argv = ["tournament", str(toml), "--store", str(store), "--backend", "serial", "--workers", "4"]
+    assert main(argv) != 0
+    assert "workers = 4: the serial backend" in capsys.readouterr().err
+    assert not store.exists()
+
+
 def test_sprt_stops_a_decided_run_and_a_rerun_keeps_the_decision(tmp_path):
     import analysis.tournament.statistics as st
 
@@ -100,8 +120,9 @@ def test_raising_and_hanging_policies_forfeit_and_the_run_goes_on(tmp_path, test
         "env": {"max_cycles": 40},
     }
     t0 = time.monotonic()
+    workers = None if backend == "serial" else 2  # the serial backend refuses more than one
     s = run_tournament(
-        spec_from_dict(d), tmp_path / "s.sqlite", backend=backend, workers=2, progress=False
+        spec_from_dict(d), tmp_path / "s.sqlite", backend=backend, workers=workers, progress=False
     )
     assert time.monotonic() - t0 < 15
     assert s.played == 6 and s.forfeits == 4 and s.errors == 0

@@ -62,12 +62,20 @@ def test_report_renders_with_heat_maps_ratings_and_replays(tmp_path, small_spec)
 def _mini_tournament(tmp_path):
     """(store, argv) of a 4-match tournament on the open room (greedy pursuer, two evaders,
     two seeds, 20 steps), played serially without progress bars."""
-    spec = tmp_path / "mini.toml"
-    spec.write_text(
+    return _tournament(
+        tmp_path,
+        "mini",
         'maps = ["open_room"]\npursuers = ["pursuer/greedy"]\n'
-        'evaders = ["evader/random", "evader/straight"]\nseeds = 2\n[env]\nmax_cycles = 20\n'
+        'evaders = ["evader/random", "evader/straight"]\nseeds = 2\n[env]\nmax_cycles = 20\n',
     )
-    store = tmp_path / "mini.sqlite"
+
+
+def _tournament(tmp_path, name, toml):
+    """(store, argv) of the tournament spec ``toml`` written to NAME.toml, stored in
+    NAME.sqlite, played serially without progress bars."""
+    spec = tmp_path / f"{name}.toml"
+    spec.write_text(toml)
+    store = tmp_path / f"{name}.sqlite"
     argv = ["tournament", str(spec), "--store", str(store), "--no-progress", "--backend", "serial"]
     return store, argv
 
@@ -304,13 +312,12 @@ def test_a_long_regret_solve_is_announced_with_its_estimate(tmp_path, capsys, mo
         raise KeyboardInterrupt  # the solve itself is not under test (Ctrl-C: code 130)
 
     monkeypatch.setenv("SURVEIL_CACHE_DIR", str(tmp_path / "cache"))
-    spec = tmp_path / "slow.toml"
-    spec.write_text(
+    store, argv = _tournament(
+        tmp_path,
+        "slow",
         'maps = ["corridor"]\npursuers = ["pursuer/greedy"]\nevaders = ["evader/straight"]\n'
-        'seeds = 1\nstart = "valid"\n[env]\nmax_cycles = 5\ndt = 10\nspawn_margin_steps = 0\n'
+        'seeds = 1\nstart = "valid"\n[env]\nmax_cycles = 5\ndt = 10\nspawn_margin_steps = 0\n',
     )
-    store = tmp_path / "slow.sqlite"
-    argv = ["tournament", str(spec), "--store", str(store), "--no-progress", "--backend", "serial"]
     assert main([*argv, "--no-report"]) == 0
     capsys.readouterr()
     monkeypatch.setattr(regrets, "solve", stop)

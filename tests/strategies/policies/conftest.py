@@ -1,8 +1,11 @@
-"""Shared fixtures: a small world, its config, and state observations along a path."""
+"""Shared fixtures: a small world, its config, state observations along a path, and the
+unseen-worlds benchmark module."""
 
 from __future__ import annotations
 
+import importlib
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -10,6 +13,8 @@ import pytest
 from envs.maps import Map
 from envs.surveillance.config import EnvConfig
 from envs.surveillance.observations import StateEncoder
+
+BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks"
 
 
 @pytest.fixture(scope="session")
@@ -41,3 +46,11 @@ def state_observations(config: EnvConfig, n: int = 12, seed: int = 0) -> list[np
         vp = tuple(rng.uniform(-1, 1, 2))
         out.append(enc.encode(p, vp, e, ve, True, k))
     return out
+
+
+@pytest.fixture
+def unseen(monkeypatch):
+    """The unseen-worlds benchmark module (benchmarks/unseen_worlds.py): its worlds,
+    parameter combos and opponents, for replaying a benchmark episode in a test."""
+    monkeypatch.syspath_prepend(str(BENCHMARKS))
+    return importlib.import_module("unseen_worlds")

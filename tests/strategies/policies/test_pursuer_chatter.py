@@ -11,22 +11,11 @@ pursuer into the corner.
 
 from __future__ import annotations
 
-import importlib
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 from strategies.policies import make_policy
 from strategies.runner import build_env, run_episode
-
-BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks"
-
-
-@pytest.fixture
-def unseen(monkeypatch):
-    monkeypatch.syspath_prepend(str(BENCHMARKS))
-    return importlib.import_module("unseen_worlds")
 
 
 def test_a_herder_at_a_corner_bisector_does_not_pin_the_pursuer(unseen):

@@ -10,9 +10,7 @@ turn away from the normal with a hard turn back through it.
 
 from __future__ import annotations
 
-import importlib
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -20,14 +18,6 @@ import pytest
 from strategies.policies import decomposition, make_policy
 from strategies.policies.base import Snapshot
 from strategies.runner import build_env, run_episode
-
-BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks"
-
-
-@pytest.fixture
-def unseen(monkeypatch):
-    monkeypatch.syspath_prepend(str(BENCHMARKS))
-    return importlib.import_module("unseen_worlds")
 
 
 def test_a_herded_pursuer_keeps_off_the_wall(unseen):

@@ -69,9 +69,9 @@ def _cmd_policies(args: argparse.Namespace) -> int:
     for name in policy_names(args.role):
         print(f"{name:<26} {describe_policy(name)}")
     print(
-        "learned policies: ROLE/sb3:PATH (a stable-baselines3 model zip); play and evaluate "
-        "also take zoo:NAME (python -m training.zoo list) or a model .zip, tournament specs "
-        "{ model = ... }"
+        "learned policies: ROLE/sb3:PATH (a stable-baselines3 model zip); play, evaluate, "
+        "tournament rosters and training opponents also take zoo:NAME (python -m "
+        "training.zoo list) or a model .zip, tournament specs { model = ... }"
     )
     return 0
 

@@ -42,6 +42,7 @@ from envs import validation
 from envs.errors import InvalidConfigError
 from envs.surveillance.config import EnvConfig, env_parameters
 from strategies.policies.base import check_role
+from strategies.policies.model_files import model_policy_name
 from training.single_agent import START_CHOICES
 
 __all__ = ["ALGORITHMS", "TrainConfig", "load_any_config", "load_config"]
@@ -76,8 +77,10 @@ class TrainConfig:
     role: str
     """The learner's role: ``"pursuer"`` or ``"evader"``."""
     opponent: str | tuple[str, ...]
-    """The other role's policy name (``"evader/straight"``, ``"pursuer/sb3:PATH"``...), or
-    several: a pool (:class:`training.pool.OpponentPool`), one drawn per episode."""
+    """The other role's policy name (``"evader/straight"``, ``"pursuer/sb3:PATH"``...), a
+    model as ``surveil play`` takes one (``"zoo:NAME"``, a ``.zip`` path relative to the
+    current directory), or several: a pool (:class:`training.pool.OpponentPool`), one
+    drawn per episode."""
     map: str | tuple[str, ...] = "open_room"
     """Built-in map name, map file path or ``random:SEED``; or several, one per episode."""
     env: dict[str, Any] = field(default_factory=dict)
@@ -127,11 +130,12 @@ class TrainConfig:
             raise InvalidConfigError("opponent: expected a policy name or a non-empty list")
         for name in pool:
             check.string("opponent", name)
-            if name.partition("/")[0] != other:
+            # a model as play, evaluate and tournaments take it: zoo:NAME or a .zip
+            if model_policy_name(name, other, f"opponent = {name!r}").partition("/")[0] != other:
                 article = "an" if self.role == "evader" else "a"
                 raise InvalidConfigError(
                     f"opponent: {article} {self.role} learner needs a '{other}/KIND' policy "
-                    f"(a model: '{other}/sb3:PATH'), got {name!r}"
+                    f"(a model: 'zoo:NAME' or a .zip path), got {name!r}"
                 )
         put("opponent", pool[0] if len(pool) == 1 and isinstance(self.opponent, str) else pool)
         put("opponent_weights", tuple(self.opponent_weights))
@@ -261,7 +265,8 @@ class TrainConfig:
         from training.pool import OpponentPool
 
         pool = (self.opponent,) if isinstance(self.opponent, str) else self.opponent
-        return OpponentPool(list(pool), list(self.opponent_weights) or None)
+        other = "evader" if self.role == "pursuer" else "pursuer"
+        return OpponentPool(list(pool), list(self.opponent_weights) or None, role=other)
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON/TOML-ready dict that :meth:`from_dict` turns back into this config."""

@@ -62,6 +62,7 @@ from envs.errors import InvalidConfigError
 from strategies.policies import make_policy
 from strategies.policies.base import check_role
 from strategies.policies.learner_inputs import LearnerInputs, check_features
+from strategies.policies.model_files import model_policy_name
 from strategies.runner import check_observation_options, run_episode
 
 __all__ = ["DaggerConfig", "DaggerResult", "dagger", "load_dagger_config"]
@@ -142,10 +143,10 @@ class DaggerConfig:
             )
         other = "evader" if self.role == "pursuer" else "pursuer"
         pool = (self.opponent,) if isinstance(self.opponent, str) else tuple(self.opponent)
-        if not pool or not all(isinstance(o, str) and o.startswith(other + "/") for o in pool):
+        if not pool or not all(_plays(o, other, f"{where}: opponent") for o in pool):
             raise InvalidConfigError(
                 f"{where}: opponent = {self.opponent!r}: expected one or more "
-                f"'{other}/KIND' policy names"
+                f"'{other}/KIND' policy names (or models: 'zoo:NAME', a .zip path)"
             )
         put("opponent", pool[0] if len(pool) == 1 else pool)
         put("opponent_weights", tuple(float(w) for w in self.opponent_weights))
@@ -164,9 +165,10 @@ class DaggerConfig:
             )
         vo = self.validation_opponent
         vpool = (vo,) if isinstance(vo, str) else tuple(vo)
-        if not all(isinstance(o, str) and o.startswith(other + "/") for o in vpool):
+        if not all(_plays(o, other, f"{where}: validation_opponent") for o in vpool):
             raise InvalidConfigError(
-                f"{where}: validation_opponent = {vo!r}: expected '{other}/KIND' policy names"
+                f"{where}: validation_opponent = {vo!r}: expected '{other}/KIND' policy names "
+                "(or models: 'zoo:NAME', a .zip path)"
             )
         put("validation_opponent", vpool[0] if len(vpool) == 1 else vpool)
         validation.mapping("env", self.env, where=where)
@@ -227,11 +229,12 @@ class DaggerConfig:
 
     def opponent_policy(self) -> Any:
         """The opponent to play: a name, or an :class:`~training.pool.OpponentPool`."""
+        other = "evader" if self.role == "pursuer" else "pursuer"
         if isinstance(self.opponent, str) and not self.opponent_weights:
-            return self.opponent
+            return model_policy_name(self.opponent, other, f"opponent = {self.opponent!r}")
         from training.pool import OpponentPool
 
-        return OpponentPool(list(self.pool), list(self.opponent_weights) or None)
+        return OpponentPool(list(self.pool), list(self.opponent_weights) or None, role=other)
 
     def to_dict(self) -> dict[str, Any]:
         """A JSON/TOML-ready dict (``method = "dagger"``) that :meth:`from_dict` reads back."""
@@ -568,6 +571,15 @@ def _settle(out: Path, committed: int) -> None:
             path.unlink()
 
 
+def _plays(name: Any, role: str, where: str) -> bool:
+    """Whether ``name`` is a policy name of ``role``: ``ROLE/KIND``, or a model as users
+    name one (``zoo:NAME``, a ``.zip``: the file is checked, and the role it was trained
+    for, raising InvalidConfigError)."""
+    if not isinstance(name, str):
+        return False
+    return model_policy_name(name, role, f"{where} = {name!r}").startswith(role + "/")
+
+
 def _validate(cfg: DaggerConfig, model, opponent) -> float:
     """The share of ``cfg.validation_episodes`` fixed-seed episodes the learner wins alone.
 
@@ -580,11 +592,11 @@ def _validate(cfg: DaggerConfig, model, opponent) -> float:
     if cfg.validation_opponent:
         vo = cfg.validation_opponent
         if isinstance(vo, str):
-            opponent = vo
+            opponent = model_policy_name(vo, other, f"validation_opponent = {vo!r}")
         else:
             from training.pool import OpponentPool
 
-            opponent = OpponentPool(list(vo))
+            opponent = OpponentPool(list(vo), role=other)
     for k in range(cfg.validation_episodes):
         seed = 10_000_019 + cfg.seed * 1_003 + k
         learner = _Rollout(make_policy(cfg.expert, **cfg.expert_params), model, 0.0, seed,

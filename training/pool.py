@@ -29,6 +29,12 @@ from typing import Any
 import numpy as np
 
 from envs.errors import InvalidConfigError
+from strategies.policies.model_files import (
+    is_model_reference,
+    model_path,
+    model_policy_name,
+    read_provenance,
+)
 
 __all__ = ["OpponentPool"]
 
@@ -37,8 +43,9 @@ class OpponentPool:
     """A weighted set of policies of one role; ``select(seed)`` draws one.
 
     Args:
-        members: policy names (``"evader/shooting"``, ``"evader/sb3:PATH"``) or Policy
-            objects, all of one role.
+        members: policy names (``"evader/shooting"``, ``"evader/sb3:PATH"``), models as
+            users name them (``"zoo:NAME"``, a ``.zip`` path) or Policy objects, all of
+            one role.
         weights: non-negative weights, one per member, not all zero (default: uniform).
             They are normalised into :attr:`probabilities`.
         role: the role every member must play (default: the first member's).
@@ -59,7 +66,7 @@ class OpponentPool:
                 f"opponent pool: expected a non-empty list of policies, got {members!r}"
             )
         self.members = list(members)
-        roles = [_role_of(m) for m in self.members]
+        roles = [_role_of(m, role) for m in self.members]
         self.role = role or roles[0]
         wrong = [str(m) for m, r in zip(self.members, roles, strict=True) if r != self.role]
         if wrong:
@@ -128,6 +135,7 @@ class OpponentPool:
                 from strategies.policies import make_policy
                 from training.single_agent import sb3_params
 
+                member = model_policy_name(member, self.role, f"opponent pool: {member!r}")
                 member = make_policy(member, **sb3_params(member))
             self._built[i] = member
         return self._built[i]
@@ -145,7 +153,16 @@ class OpponentPool:
         return f"OpponentPool({self.name})"
 
 
-def _role_of(member: Any) -> str:
+def _role_of(member: Any, role: str | None = None) -> str:
+    if isinstance(member, str) and is_model_reference(member):  # zoo:NAME, a .zip
+        what = f"opponent pool: {member!r}"
+        trained = (read_provenance(model_path(member, what)) or {}).get("role")
+        if trained is None and role is None:
+            raise InvalidConfigError(
+                f"{what}: cannot tell which role this model plays (no provenance.json "
+                "beside it); pass role= or name it 'ROLE/sb3:PATH'"
+            )
+        return trained or role
     if isinstance(member, str):
         role = member.partition("/")[0]
         if role not in ("pursuer", "evader"):

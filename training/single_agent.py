@@ -39,6 +39,7 @@ from envs.surveillance.env import EVADER, PURSUER
 from strategies.policies import Policy, make_policy
 from strategies.policies.base import check_role
 from strategies.policies.learner_inputs import LearnerInputs
+from strategies.policies.model_files import model_policy_name
 from strategies.policies.starts import START_KINDS, sample_start
 
 __all__ = ["AGENT_OF_ROLE", "START_CHOICES", "SingleAgentEnv", "make_opponent", "sb3_params"]
@@ -79,7 +80,8 @@ def make_opponent(opponent: str | Policy, role: str) -> Policy:
     """Build the opponent of a learner playing ``role``.
 
     Args:
-        opponent: a policy name (``"evader/straight"``, ``"evader/sb3:PATH"``) or a Policy.
+        opponent: a policy name (``"evader/straight"``, ``"evader/sb3:PATH"``), a model
+            as users name one (``"zoo:NAME"``, a ``.zip`` path) or a Policy.
         role: the learner's role; the opponent must play the other one.
 
     Raises:
@@ -89,12 +91,14 @@ def make_opponent(opponent: str | Policy, role: str) -> Policy:
     check_role(role)
     want = _other(role)
     if isinstance(opponent, str):
-        if opponent.partition("/")[0] != want:
+        # a model as play, evaluate and tournaments take it: zoo:NAME or a .zip
+        name = model_policy_name(opponent, want, f"opponent = {opponent!r}")
+        if name.partition("/")[0] != want:
             raise InvalidConfigError(
-                f"opponent: a {role} learner needs a {want!r} policy ('{want}/KIND'), "
-                f"got {opponent!r}"
+                f"opponent: a {role} learner needs a {want!r} policy ('{want}/KIND', "
+                f"'zoo:NAME' or a model .zip), got {opponent!r}"
             )
-        return make_policy(opponent, **sb3_params(opponent))
+        return make_policy(name, **sb3_params(name))
     if isinstance(opponent, Policy):
         roles = getattr(opponent, "roles", (want,))
         if want not in roles:

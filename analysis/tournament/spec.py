@@ -8,7 +8,7 @@ seeds::
     maps = ["corridor", "two_rooms", "worlds/office.json", "random:7"]  # built-ins, files, seeds
     seeds = 10                          # seeds 0..9, or a list [3, 5, 8]
     start = "safe"                      # "safe", "valid", or a list of both
-    time_limit = 120                    # wall-clock seconds per match (forfeit beyond)
+    time_limit = 120                    # seconds each role may spend deciding in a match
     salt = ""                           # mixed into every match identity (e.g. a code SHA)
 
     pursuers = ["pursuer/decomposition", "pursuer/greedy"]   # names, or tables:
@@ -33,6 +33,13 @@ seeds::
     alpha = 0.05                        # error rates of Wald's test
     beta = 0.05
 
+``time_limit`` is a chess clock per role and per match: the seconds a role's policy may
+spend in its ``reset`` and ``act`` calls (building the env, drawing the start and the
+env's steps are on no clock). A role whose clock runs out forfeits the match; with no
+policy deciding, a stretch of the env's or the harness's work longer than the limit (plus
+a grace) is a hang: the match is an error, charged to nobody. The limit is part of each
+match's identity (:mod:`analysis.tournament.identity`).
+
 Every pairing on a map plays the same seeded starts (common random numbers): the start
 depends only on the map, the env config and the seed. Relative paths are relative to
 the spec file. Roster entries with the same identity (name, parameters, model file
@@ -44,12 +51,10 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import importlib.util
 import itertools
 import json
 import os
 import warnings
-import zipfile
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -58,6 +63,7 @@ from typing import Any
 from analysis.arguments import why_not_a_file
 from envs.errors import InvalidConfigError
 from envs.validation import choice, integer, mapping, positive, string, unit_interval
+from strategies.policies.model_files import is_model_reference, model_path
 
 __all__ = [
     "ENV_FIELDS",
@@ -103,6 +109,10 @@ _SPRT_KEYS = {"role", "candidate", "baseline", "p1", "alpha", "beta"}
 _ENTRY_KEYS = {"policy", "params", "label", "model", "algo", "deterministic", "observation"}
 _START_KINDS = ("safe", "valid")
 DEFAULT_TIME_LIMIT = 300.0
+TIME_LIMIT_RULE = "decision time per role"
+"""What ``time_limit`` applies to, written into :meth:`Spec.to_dict` (so into the run's id):
+a store's runs without it were played by an older surveil, whose limit counted the whole
+match, the env's set-up included, and blamed the side that had spent more time deciding."""
 
 
 @dataclass(frozen=True)
@@ -227,6 +237,7 @@ class Spec:
             "env": self.env,
             "variants": [dataclasses.asdict(v) for v in self.variants],
             "time_limit": self.time_limit,
+            "time_limit_rule": TIME_LIMIT_RULE,
             "salt": self.salt,
             **({"sprt": self.sprt} if self.sprt is not None else {}),
         }
@@ -492,7 +503,7 @@ def _roster_item(item: str, role: str) -> str | dict[str, str]:
         return {"model": item.removeprefix(f"{role}/sb3:")}
     if item.startswith(("pursuer/sb3:", "evader/sb3:")):
         return item  # the other role's: refused as a name of the wrong role
-    if item.startswith("zoo:") or item.lower().endswith(".zip"):
+    if is_model_reference(item):
         return {"model": item}
     return item
 
@@ -547,8 +558,7 @@ def _entry(item: Any, role: str, where: str, base: Path) -> PolicyEntry:
         label = string("label", d.get("label", name), where=where)
         return PolicyEntry(role, label, name, _canonical(params), None, None, observation)
     text = string("model", d["model"], where=where)
-    path = _model_path(text, where, base)
-    _check_model_zip(path, text, where)
+    path = model_file(text, where, base)
     digest = hashlib.sha256(path.read_bytes()).hexdigest()
     provenance = _provenance(path)
     if provenance.get("role") not in (None, role):
@@ -591,14 +601,6 @@ def _canonical(params: Mapping[str, Any]) -> dict[str, Any]:
     return json.loads(json.dumps(dict(params), sort_keys=True))
 
 
-def zoo_dir() -> Path | None:
-    """The shipped model zoo's directory, found without importing ``training``."""
-    spec = importlib.util.find_spec("training")
-    if spec is None or not spec.submodule_search_locations:
-        return None
-    return Path(next(iter(spec.submodule_search_locations))) / "zoo" / "models"
-
-
 def model_file(text: str, where: str, base: Path | None = None) -> Path:
     """The model file ``text`` names: ``zoo:NAME`` (a shipped model) or a path (relative
     to ``base``, default the current directory), checked to be an SB3 model zip.
@@ -607,38 +609,7 @@ def model_file(text: str, where: str, base: Path | None = None) -> Path:
         InvalidConfigError: no such zoo model (listing them) or file, or not a model zip;
             the message starts with ``where``.
     """
-    path = _model_path(text, where, Path.cwd() if base is None else base)
-    _check_model_zip(path, text, where)
-    return path
-
-
-def _model_path(text: str, where: str, base: Path) -> Path:
-    if text.startswith("zoo:"):
-        name = text[len("zoo:") :]
-        root = zoo_dir()
-        path = None if root is None else root / name / "model.zip"
-        if path is None or not path.is_file():
-            known = sorted(p.name for p in root.iterdir()) if root and root.is_dir() else []
-            raise InvalidConfigError(
-                f"{where}: model = {text!r}: no zoo model {name!r}; known: {known}"
-            )
-        return path
-    path = (base / text).resolve()
-    if not path.is_file():
-        raise InvalidConfigError(f"{where}: model = {text!r}: no such file ({path})")
-    return path
-
-
-def _check_model_zip(path: Path, text: str, where: str) -> None:
-    """A model file is a zip with SB3's ``data`` entry (checked on load, not by every
-    match's worker: a wrong file was an error row per match)."""
-    try:
-        with zipfile.ZipFile(path) as zf:
-            zf.getinfo("data")
-    except (OSError, KeyError, zipfile.BadZipFile) as exc:
-        raise InvalidConfigError(
-            f"{where}: model = {text!r}: not a stable-baselines3 model zip ({exc})"
-        ) from None
+    return model_path(text, f"{where}: model = {text!r}", base)
 
 
 def _provenance(model: Path) -> dict[str, Any]:

@@ -32,6 +32,7 @@ import numpy as np
 from envs.errors import InvalidConfigError, InvalidObservationError
 from strategies.policies.base import BasePolicy
 from strategies.policies.learner_inputs import LearnerInputs, check_features
+from strategies.policies.model_files import read_provenance
 
 __all__ = [
     "SB3_ALGORITHMS",
@@ -108,7 +109,7 @@ class SB3Policy(BasePolicy):
         self.model: Any = None
         self._warned: set[str] = set()
         self._digests: set[str] | None = None
-        self.provenance = _provenance(self.path)
+        self.provenance = read_provenance(self.path)
         trained = None if self.provenance is None else self.provenance.get("role")
         if trained is not None and trained != role:
             raise InvalidConfigError(
@@ -267,21 +268,3 @@ def learner_inputs_spec(provenance: Mapping[str, Any] | None) -> dict[str, Any] 
         "expert": cfg.get("expert"),
         "expert_params": dict(cfg.get("expert_params") or {}),
     }
-
-
-def _provenance(path: Path) -> dict[str, Any] | None:
-    """The ``provenance.json`` beside a model zip, or None if there is none.
-
-    Raises:
-        InvalidConfigError: it exists but is not a JSON object (naming the file).
-    """
-    prov = path.parent / "provenance.json"
-    if not prov.is_file():
-        return None
-    try:
-        data = json.loads(prov.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise InvalidConfigError(f"{prov}: unreadable provenance ({exc})") from exc
-    if not isinstance(data, dict):
-        raise InvalidConfigError(f"{prov}: expected a JSON object, got {type(data).__name__}")
-    return data

@@ -211,7 +211,7 @@ def test_a_run_whose_every_match_errored_does_not_exit_0(tmp_path, capsys):
 def test_play_takes_a_shipped_model_or_a_model_file_as_evaluate_does(tmp_path, capsys):
     # `surveil evaluate --pursuers zoo:NAME` played; `surveil play --pursuer zoo:NAME` said
     # "expected a policy name of the form 'pursuer/KIND'"
-    from analysis.tournament.spec import zoo_dir
+    from strategies.policies.model_files import zoo_dir
 
     model = zoo_dir() / "ppo_evader_vs_greedy_open_room" / "model.zip"
     fast = ["--map", "open_room", "--max-cycles", "5", "--no-gif"]
@@ -234,7 +234,7 @@ def test_play_and_evaluate_take_the_registry_name_of_a_model_file(tmp_path, caps
     """README (Policies) and surveil policies: trained models are ROLE/sb3:PATH. play and
     evaluate read any name ending in .zip as a file path and looked for the file
     'pursuer/sb3:PATH' ("no such file (/cwd/pursuer/sb3:...)")."""
-    from analysis.tournament.spec import zoo_dir
+    from strategies.policies.model_files import zoo_dir
 
     model = zoo_dir() / "ppo_pursuer_vs_straight_open_room" / "model.zip"
     fast = ["--map", "open_room", "--max-cycles", "5", "--no-gif"]

@@ -41,11 +41,11 @@ def test_a_pool_of_opponents_round_trips_and_is_checked(tmp_path):
         TrainConfig(role="pursuer", opponent=("evader/straight", "pursuer/greedy"))
     with pytest.raises(InvalidConfigError, match="opponent pool"):
         TrainConfig(role="pursuer", opponent=("evader/straight",), opponent_weights=(1.0, 2.0))
-    # 'a evader learner needs an 'pursuer/KIND' policy', and a zoo model was not named
+    # 'a evader learner needs an 'pursuer/KIND' policy' was the message
     want = (r"^opponent: an evader learner needs a 'pursuer/KIND' policy "
-            r"\(a model: 'pursuer/sb3:PATH'\), got 'zoo:x'$")  # fmt: skip
+            r"\(a model: 'zoo:NAME' or a .zip path\), got 'evader/straight'$")  # fmt: skip
     with pytest.raises(InvalidConfigError, match=want):
-        TrainConfig(role="evader", opponent="zoo:x")
+        TrainConfig(role="evader", opponent="evader/straight")
 
 
 def test_overrides_and_defaults(tmp_path):

@@ -17,7 +17,7 @@ ray = pytest.importorskip(
 
 def test_ray_backend_matches_the_serial_backend_and_ships_models(tmp_path, small_spec):
     from analysis.tournament.executors import RayExecutor
-    from analysis.tournament.spec import zoo_dir
+    from strategies.policies.model_files import zoo_dir
 
     model = zoo_dir() / "ppo_evader_vs_greedy_open_room" / "model.zip"
     d = {

@@ -14,8 +14,8 @@ import pytest
 
 from analysis.tournament import Store, StoreBusyError, load_spec, run_tournament, spec_from_dict
 from analysis.tournament.identity import plan
-from analysis.tournament.spec import zoo_dir
 from envs.errors import InvalidConfigError
+from strategies.policies.model_files import zoo_dir
 
 from .conftest import comparable
 

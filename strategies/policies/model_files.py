@@ -1,0 +1,125 @@
+"""Model files as users name them: ``zoo:NAME`` (a shipped model) or a path to a ``.zip``.
+
+``surveil play``, ``evaluate``, tournament specs and training opponents all take these
+names; :func:`model_policy_name` turns one into the registry's ``ROLE/sb3:PATH``
+(:func:`strategies.policies.make_policy`) after checking the file, and the role its
+``provenance.json`` records. Light on purpose (no numpy, no policy imported): the CLI
+and the tournament spec check names before anything heavy loads.
+
+Examples:
+    >>> is_model_reference("zoo:ppo_evader_vs_greedy_open_room"), is_model_reference("m.zip")
+    (True, True)
+    >>> is_model_reference("evader/sb3:m.zip"), is_model_reference("evader/straight")
+    (False, False)
+    >>> model_policy_name("evader/straight", "evader", "opponent")
+    'evader/straight'
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import zipfile
+from pathlib import Path
+from typing import Any
+
+from envs.errors import InvalidConfigError
+
+__all__ = [
+    "is_model_reference",
+    "model_path",
+    "model_policy_name",
+    "read_provenance",
+    "zoo_dir",
+]
+
+_SB3 = "sb3:"
+"""The registry's prefix of a model file's kind (``ROLE/sb3:PATH``)."""
+
+
+def zoo_dir() -> Path | None:
+    """The shipped model zoo's directory (``training/zoo/models``), found without
+    importing ``training`` (the layers keep ``strategies`` below it)."""
+    spec = importlib.util.find_spec("training")
+    if spec is None or not spec.submodule_search_locations:
+        return None
+    return Path(next(iter(spec.submodule_search_locations))) / "zoo" / "models"
+
+
+def is_model_reference(text: str) -> bool:
+    """Whether ``text`` names a model file the way users do: ``zoo:NAME`` or a path
+    ending in ``.zip`` (not the registry's ``ROLE/sb3:PATH``)."""
+    if text.startswith((f"pursuer/{_SB3}", f"evader/{_SB3}")):
+        return False
+    return text.startswith("zoo:") or text.lower().endswith(".zip")
+
+
+def model_path(text: str, what: str, base: Path | None = None) -> Path:
+    """The model file ``text`` names: ``zoo:NAME`` (a shipped model) or a path (relative
+    to ``base``, default the current directory), checked to be an SB3 model zip.
+
+    Args:
+        text: ``zoo:NAME`` or a path.
+        what: how the caller names the value, the start of every message
+            (``"opponent = 'zoo:x'"``).
+        base: the directory a relative path is relative to.
+
+    Raises:
+        InvalidConfigError: no such zoo model (listing them) or file, or not a model zip.
+    """
+    if text.startswith("zoo:"):
+        name = text[len("zoo:") :]
+        root = zoo_dir()
+        path = None if root is None or not name else root / name / "model.zip"
+        if path is None or not path.is_file():
+            known = sorted(p.name for p in root.iterdir()) if root and root.is_dir() else []
+            raise InvalidConfigError(f"{what}: no zoo model {name!r}; known: {known}")
+    else:
+        path = ((Path.cwd() if base is None else base) / text).resolve()
+        if not path.is_file():
+            raise InvalidConfigError(f"{what}: no such file ({path})")
+    try:  # SB3's zip has a "data" entry (checked here, not at the first episode's reset)
+        with zipfile.ZipFile(path) as zf:
+            zf.getinfo("data")
+    except (OSError, KeyError, zipfile.BadZipFile) as exc:
+        raise InvalidConfigError(f"{what}: not a stable-baselines3 model zip ({exc})") from None
+    return path
+
+
+def model_policy_name(text: str, role: str, what: str) -> str:
+    """A policy name as users write it, as the registry's name: ``zoo:NAME`` or a model
+    ``.zip`` becomes ``ROLE/sb3:PATH`` (the file checked, and the role its
+    ``provenance.json`` records); any other name is returned unchanged.
+
+    Raises:
+        InvalidConfigError: no such model, not a model zip, or a model trained as the
+            other role (the message starts with ``what``).
+    """
+    if not is_model_reference(text):
+        return text
+    path = model_path(text, what)
+    trained = (read_provenance(path) or {}).get("role")
+    if trained is not None and trained != role:
+        raise InvalidConfigError(
+            f"{what}: this model was trained as the {trained} (its provenance.json says "
+            f"role = {trained!r}); it cannot play the {role}"
+        )
+    return f"{role}/{_SB3}{path}"
+
+
+def read_provenance(path: Path) -> dict[str, Any] | None:
+    """The ``provenance.json`` beside a model zip, or None if there is none.
+
+    Raises:
+        InvalidConfigError: it exists but is not a JSON object (naming the file).
+    """
+    prov = Path(path).parent / "provenance.json"
+    if not prov.is_file():
+        return None
+    try:
+        data = json.loads(prov.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise InvalidConfigError(f"{prov}: unreadable provenance ({exc})") from exc
+    if not isinstance(data, dict):
+        raise InvalidConfigError(f"{prov}: expected a JSON object, got {type(data).__name__}")
+    return data

@@ -1,0 +1,126 @@
+"""Training opponents take models as play, evaluate and tournaments do: ``zoo:NAME`` or a
+``.zip`` path (``ROLE/sb3:PATH`` as before), in TrainConfig, DaggerConfig, pools and the
+single-agent env."""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import pytest
+
+from envs.errors import InvalidConfigError
+from strategies.policies.model_files import zoo_dir
+from training.config import load_config
+from training.dagger import DaggerConfig
+from training.pool import OpponentPool
+from training.single_agent import SingleAgentEnv
+
+EVADER = "zoo:ppo_evader_vs_greedy_open_room"
+PURSUER = "zoo:ppo_pursuer_vs_straight_open_room"
+
+
+def _zip_copy(tmp_path, name: str, provenance: bool = True):
+    """A copy of a zoo model under tmp_path (with its provenance.json or without)."""
+    src = zoo_dir() / name
+    dst = tmp_path / name
+    dst.mkdir()
+    shutil.copy(src / "model.zip", dst / "model.zip")
+    if provenance:
+        shutil.copy(src / "provenance.json", dst / "provenance.json")
+    return dst / "model.zip"
+
+
+def test_a_train_config_takes_a_zoo_model_and_a_zip_and_keeps_the_name(tmp_path, tiny):
+    path = _zip_copy(tmp_path, "ppo_evader_vs_greedy_open_room")
+    cfg = tiny(opponent=(EVADER, str(path), "evader/straight"))
+    assert cfg.opponent == (EVADER, str(path), "evader/straight")  # as the user wrote it
+    out = tmp_path / "c.toml"
+    out.write_text(cfg.to_toml())
+    assert load_config(out) == cfg
+    pool = cfg.opponent_policy()
+    built = {pool.select(seed).name for seed in range(40)}
+    assert f"evader/sb3:{zoo_dir() / 'ppo_evader_vs_greedy_open_room' / 'model.zip'}" in built
+    assert f"evader/sb3:{path}" in built and "evader/straight" in built
+
+
+def test_a_single_zoo_opponent_trains_and_its_name_is_the_provenances(tiny) -> None:
+    from training.train import train
+
+    result = train(tiny(opponent=EVADER, total_timesteps=64, checkpoint_freq=64))
+    prov = json.loads((result.model_path.parent / "provenance.json").read_text())
+    assert prov["opponent"] == EVADER and prov["config"]["opponent"] == EVADER
+    assert result.evaluation.episodes == 2
+
+
+@pytest.mark.parametrize(
+    ("opponent", "match"),
+    [
+        ("zoo:nope", r"^opponent = 'zoo:nope': no zoo model 'nope'; known: \[.*'"),
+        (PURSUER, r"trained as the pursuer .* cannot play the evader"),
+        ("missing/model.zip", r"^opponent = 'missing/model.zip': no such file \("),
+    ],
+)
+def test_a_bad_model_opponent_is_refused_naming_it(tiny, opponent, match) -> None:
+    with pytest.raises(InvalidConfigError, match=match):
+        tiny(opponent=opponent)
+
+
+def test_a_zip_that_is_no_model_is_refused(tmp_path, tiny) -> None:
+    notes = tmp_path / "notes.zip"
+    notes.write_bytes(b"not a zip")
+    with pytest.raises(InvalidConfigError, match="not a stable-baselines3 model zip"):
+        tiny(opponent=str(notes))
+
+
+def test_the_single_agent_env_takes_a_zoo_opponent() -> None:
+    env = SingleAgentEnv("pursuer", EVADER, map="open_room", max_cycles=5)
+    env.reset(seed=0)
+    assert env.opponent.name.startswith("evader/sb3:") and env.opponent.roles == ("evader",)
+    env.step(env.action_space.sample())
+    with pytest.raises(InvalidConfigError, match="trained as the evader"):
+        SingleAgentEnv("evader", EVADER, map="open_room")
+
+
+def test_a_pool_learns_a_models_role_from_its_provenance_or_is_told(tmp_path) -> None:
+    assert OpponentPool([EVADER, "evader/straight"]).role == "evader"
+    with pytest.raises(InvalidConfigError, match="every member must play the evader"):
+        OpponentPool(["evader/straight", PURSUER])
+    bare = _zip_copy(tmp_path, "ppo_evader_vs_greedy_open_room", provenance=False)
+    with pytest.raises(InvalidConfigError, match="cannot tell which role this model plays"):
+        OpponentPool([str(bare)])
+    pool = OpponentPool([str(bare)], role="evader")
+    assert pool.select(0).name == f"evader/sb3:{bare}"
+
+
+def test_a_dagger_config_takes_model_opponents(tmp_path) -> None:
+    base = dict(role="pursuer", expert="pursuer/decomposition", output_dir=str(tmp_path))
+    cfg = DaggerConfig(**base, opponent=[EVADER, "evader/straight"], validation_opponent=EVADER)
+    assert cfg.pool == (EVADER, "evader/straight") and cfg.opponent_policy().role == "evader"
+    one = DaggerConfig(**base, opponent=EVADER).opponent_policy()  # what run_episode is given
+    assert one == f"evader/sb3:{zoo_dir() / 'ppo_evader_vs_greedy_open_room' / 'model.zip'}"
+    with pytest.raises(InvalidConfigError, match="trained as the pursuer"):
+        DaggerConfig(**base, opponent=PURSUER)
+    with pytest.raises(InvalidConfigError, match="validation_opponent = 'zoo:nope': no zoo"):
+        DaggerConfig(**base, opponent=EVADER, validation_opponent="zoo:nope")
+
+
+def test_a_dagger_run_plays_a_zoo_opponent_in_training_and_validation(tmp_path) -> None:
+    from training.dagger import dagger
+
+    cfg = DaggerConfig(
+        role="pursuer",
+        expert="pursuer/greedy",
+        opponent=EVADER,
+        validation_opponent=EVADER,
+        iterations=1,
+        episodes=1,
+        max_cycles=10,
+        epochs=2,
+        validation_episodes=1,
+        output_dir=str(tmp_path / "run"),
+    )
+    r = dagger(cfg)
+    assert r.samples[-1] > 0
+    prov = json.loads((r.model_path.parent / "provenance.json").read_text())
+    assert prov["opponent"] == EVADER

@@ -183,12 +183,26 @@ def string(name: str, value: Any, *, where: str | None = None, nonempty: bool = 
     return value
 
 
+def _same_kind(a: Any, b: Any) -> bool:
+    """Whether ``a`` and ``b`` may be compared as options: both strings (numpy's too), both
+    integers (numpy's too, :func:`is_integer`), both bools, or else of one type."""
+    if isinstance(a, str) or isinstance(b, str):
+        return isinstance(a, str) and isinstance(b, str)
+    if is_integer(a) or is_integer(b):
+        return is_integer(a) and is_integer(b)
+    if isinstance(a, (bool, np.bool_)) or isinstance(b, (bool, np.bool_)):
+        return isinstance(a, (bool, np.bool_)) and isinstance(b, (bool, np.bool_))
+    return type(a) is type(b)
+
+
 def choice(name: str, value: Any, options: Iterable[Any], *, where: str | None = None) -> Any:
-    """``value`` if it is one of ``options`` (compared with ``==``, bools never match ints)."""
+    """The option equal to ``value`` (compared with ``==``; bools never match ints, a
+    numpy string or integer matches the option it equals and the option is returned, so
+    no numpy type leaks into a config)."""
     opts = list(options)
     for o in opts:
-        if type(o) is type(value) and o == value:
-            return value
+        if _same_kind(o, value) and o == value:
+            return o
     raise InvalidConfigError(
         f"{_where(name, where)} = {value!r}: expected one of {', '.join(map(repr, opts))}"
     )

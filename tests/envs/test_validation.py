@@ -5,6 +5,7 @@ import math
 import numpy as np
 import pytest
 
+from envs import surveillance_v1
 from envs import validation as v
 from envs.errors import InvalidConfigError
 
@@ -68,6 +69,26 @@ def test_boolean_choice_string_mapping():
     assert v.mapping("params", {"a": 1}) == {"a": 1}
     with pytest.raises(InvalidConfigError, match="table"):
         v.mapping("params", [1, 2])
+
+
+def test_choice_takes_numpy_strings_and_integers_as_the_option_they_equal():
+    """Found by probing the env with numpy scalars: ``parallel_env(observation=np.str_(
+    "lidar"))`` (an option drawn with ``rng.choice`` or read from an array) was refused with
+    "observation = np.str_('lidar'): expected one of 'state', 'lidar', 'lidar_track'", as
+    was ``np.int64(1)`` for the option 1, although the number rule takes numpy integers
+    for integers (and ``map=np.str_("corridor")`` was accepted). Bools still match bools only."""
+    got = v.choice("observation", np.str_("lidar"), ("state", "lidar"))
+    assert got == "lidar" and type(got) is str  # the option itself: no numpy type leaks on
+    got = v.choice("direction", np.int64(-1), (1, -1))
+    assert got == -1 and type(got) is int
+    assert v.choice("flag", np.bool_(True), (True, False)) is True
+    for value, options in [(1, (True, False)), (True, (1, 0)), (np.int64(1), (True, False)),
+                           (1.0, (1, -1)), (np.str_("1"), (1, -1)), (1, ("1", "2"))]:  # fmt: skip
+        with pytest.raises(InvalidConfigError, match="expected one of"):
+            v.choice("x", value, options)
+    env = surveillance_v1.parallel_env(observation=np.str_("lidar"), reward=np.str_("sparse"))
+    assert (env.config.observation, env.config.reward) == ("lidar", "sparse")
+    assert type(env.config.observation) is str
 
 
 def test_arrays_and_points():

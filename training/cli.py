@@ -204,7 +204,8 @@ def summary(result: TrainResult) -> str:
     """One line: what was trained, for how long, where, and how it did."""
     c = result.config
     head = (
-        f"{c.algo.upper()} {c.role} vs {c.opponent} on {c.map}: {result.timesteps} timesteps"
+        f"{c.algo.upper()} {c.role} vs {_opponents(c)} on {', '.join(c.maps)}: "
+        f"{result.timesteps} timesteps"
         f" in {result.wall_time:.1f} s"
         + (f" (resumed from {result.resumed_from.name})" if result.resumed_from else "")
         + f" -> {result.model_path}"
@@ -217,3 +218,14 @@ def summary(result: TrainResult) -> str:
         f"; eval: success {ev.successes}/{ev.episodes} ({ev.success_rate:.0%}), "
         f"mean escape time {t}"
     )
+
+
+def _opponents(config: TrainConfig) -> str:
+    """The opponent(s) as the config names them, a pool as a list with each member's share
+    (was a Python tuple: ``('evader/straight', 'evader/shooting')``)."""
+    pool = (config.opponent,) if isinstance(config.opponent, str) else config.opponent
+    if not config.opponent_weights:
+        return ", ".join(pool)
+    total = sum(config.opponent_weights)
+    shares = (w / total for w in config.opponent_weights)
+    return ", ".join(f"{name} ({p:.0%})" for name, p in zip(pool, shares, strict=True))

@@ -166,3 +166,21 @@ def test_cli_train(tmp_path, capsys):
     line = capsys.readouterr().out
     assert "PPO evader vs pursuer/greedy on open_room: 64 timesteps" in line
     assert (tmp_path / "o" / "model.zip").is_file()
+
+
+def test_the_summary_names_maps_and_a_pool_as_a_user_writes_them(tiny):
+    from training.cli import summary
+    from training.train import TrainResult
+
+    cfg = tiny(opponent=("evader/straight", "evader/random"), opponent_weights=(3.0, 1.0),
+               map=("open_room", "corridor"))  # fmt: skip
+    result = TrainResult(cfg, Path("o"), Path("o/model.zip"), Path("o/provenance.json"),
+                         64, 1.0, None, None)  # fmt: skip
+    # was "vs ('evader/straight', 'evader/random') on ('open_room', 'corridor')"
+    assert summary(result) == (
+        "PPO pursuer vs evader/straight (75%), evader/random (25%) on open_room, corridor: "
+        "64 timesteps in 1.0 s -> o/model.zip"
+    )
+    result = TrainResult(tiny(opponent=("evader/straight", "evader/random")), Path("o"),
+                         Path("o/model.zip"), Path("o/p.json"), 64, 1.0, None, None)  # fmt: skip
+    assert summary(result).startswith("PPO pursuer vs evader/straight, evader/random on open_room:")

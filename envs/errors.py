@@ -24,6 +24,7 @@ __all__ = [
     "RhoAboveOneWarning",
     "SurveilValueError",
     "UnknownNameError",
+    "UnknownOptionWarning",
     "VacuousBoundWarning",
 ]
 
@@ -134,6 +135,12 @@ class LongRunWarning(UserWarning):
     """A computation estimated, before it starts, to run longer than its module's limit
     (the hindsight's grids: :data:`strategies.referee.hindsight.LONG_SECONDS`); the
     message gives the estimate and the knobs that shorten it."""
+
+
+class UnknownOptionWarning(UserWarning):
+    """A ``reset`` option the env does not read whose name is close to one it does
+    (``"pursuer_0"``, ``"evader "``): most likely a misspelt placement, which would
+    otherwise be lost without a word (:func:`envs.surveillance.placement.check_option_keys`)."""
 
 
 class VacuousBoundWarning(UserWarning):

@@ -69,11 +69,13 @@ Every step: `surveillance` (held throughout the step), `distance`, `theta`, `ste
 ### Starts
 
 `reset(options={"pursuer": (x, y), "evader": (x, y)})` places the agents exactly
-(`InvalidPlacementError` names the positions and the reason otherwise). Without it the
-start is drawn with the env's generator: evader uniform, theta uniform, L uniform in
-`[l_min + m, l_max - m]`, rejected until both discs fit in free space, the pursuer sees
-the evader and no convex obstacle corner is near the rod, so that a random start
-survives any actions for `spawn_margin_steps` steps.
+(`InvalidPlacementError` names the positions and the reason otherwise). Other keys are
+left to wrappers; one close to those two (`"pursuer_0"`, `"Evader"`) warns
+(`UnknownOptionWarning`: a misspelt placement would give a random start without a
+word). Without a placement the start is drawn with the env's generator: evader uniform,
+theta uniform, L uniform in `[l_min + m, l_max - m]`, rejected until both discs fit in
+free space, the pursuer sees the evader and no convex obstacle corner is near the rod, so
+that a random start survives any actions for `spawn_margin_steps` steps.
 
 ### Arguments
 

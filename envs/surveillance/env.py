@@ -46,7 +46,7 @@ from envs.surveillance.observations import (
     state_space,
 )
 from envs.surveillance.physics import World
-from envs.surveillance.placement import random_start, validate_placement
+from envs.surveillance.placement import check_option_keys, random_start, validate_placement
 from envs.tolerances import REL_LENGTH_TOL
 
 __all__ = [
@@ -204,8 +204,10 @@ class parallel_env(ParallelEnv, EzPickle):
             options: ``{"pursuer": (x, y), "evader": (x, y)}`` places the agents exactly
                 (validated: both in free space with body clearance, within range, with
                 line of sight); without them the start is drawn at random (see
-                :func:`envs.surveillance.placement.random_start`). Other keys are ignored,
-                as wrappers pass their own options through.
+                :func:`envs.surveillance.placement.random_start`). Other keys are left
+                to wrappers, which pass their own options through; one whose name is
+                close to a placement key (``"pursuer_0"``) warns
+                (:class:`~envs.errors.UnknownOptionWarning`).
 
         Returns:
             Observations and infos of both agents.
@@ -226,6 +228,8 @@ class parallel_env(ParallelEnv, EzPickle):
                 f"'evader': (x, y)}}, got {type(options).__name__} {options!r}"
             )
         cfg = self.config
+        if options:
+            check_option_keys(options, stacklevel=2)
         if options and ("pursuer" in options or "evader" in options):
             p, e = validate_placement(
                 cfg, self.kernel, options.get("pursuer"), options.get("evader")
@@ -261,6 +265,10 @@ class parallel_env(ParallelEnv, EzPickle):
                 a = np.asarray(action)
                 if a.dtype.kind not in "iuf":  # no strings, booleans, complex or objects
                     raise TypeError(f"dtype {a.dtype}")
+                if isinstance(action, (list, tuple)) and any(
+                    isinstance(v, (bool, np.bool_)) for v in action
+                ):  # numpy reads [True, 0.5] as [1.0, 0.5]: a bool is not a number
+                    raise TypeError("a bool")
                 a = a.astype(np.float64)
             except (TypeError, ValueError) as exc:
                 raise InvalidActionError(

@@ -2,13 +2,21 @@
 
 from __future__ import annotations
 
+import difflib
 import math
+import warnings
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
 from envs import validation
-from envs.errors import InfeasibleError, InvalidConfigError, InvalidPlacementError
+from envs.errors import (
+    InfeasibleError,
+    InvalidConfigError,
+    InvalidPlacementError,
+    UnknownOptionWarning,
+)
 from envs.surveillance import rules
 from envs.surveillance.config import EnvConfig
 from envs.tolerances import REL_LENGTH_TOL
@@ -16,6 +24,8 @@ from envs.tolerances import REL_LENGTH_TOL
 __all__ = [
     "BATCH",
     "MAX_BATCHES",
+    "PLACEMENT_KEYS",
+    "check_option_keys",
     "check_room",
     "random_start",
     "spawn_margins",
@@ -27,6 +37,38 @@ BATCH = 256
 
 MAX_BATCHES = 64
 """Batches tried before :func:`random_start` gives up (16384 candidates)."""
+
+
+PLACEMENT_KEYS = ("pursuer", "evader")
+"""The ``reset`` options the env reads: the agents' start positions."""
+
+
+def check_option_keys(options: Mapping[Any, Any], stacklevel: int = 2) -> None:
+    """Warn about ``reset`` options whose name is close to a placement key but is not one.
+
+    Other keys are left alone, as Gymnasium and PettingZoo envs do: wrappers pass their own
+    options through ``reset``, and PettingZoo's ``api_test`` and ``parallel_api_test``
+    reset with ``options={"options": 1}`` (refusing unknown keys would fail the official
+    suites, and a warning on every unknown key would make them warn). A near miss
+    (``"pursuer_0"``, the agent's name; ``"Evader"``; ``"persuer"``) is a placement lost
+    without a word, the start then drawn at random: that one warns.
+
+    Warns:
+        UnknownOptionWarning: for each near miss, naming it and the key it resembles.
+    """
+    placed = any(k in options for k in PLACEMENT_KEYS)
+    for key in options:
+        if key in PLACEMENT_KEYS or not isinstance(key, str):
+            continue
+        close = difflib.get_close_matches(key.strip().lower(), PLACEMENT_KEYS, n=1, cutoff=0.6)
+        if close:
+            warnings.warn(
+                f"reset: options key {key!r} is not read by the env (its keys are "
+                f"{list(PLACEMENT_KEYS)}; other keys are left to wrappers): did you mean "
+                f"{close[0]!r}?" + ("" if placed else " The start is drawn at random."),
+                UnknownOptionWarning,
+                stacklevel=stacklevel + 1,
+            )
 
 
 def _point(value: Any, who: str) -> np.ndarray:

@@ -12,6 +12,7 @@ from envs.errors import (
     InvalidConfigError,
     InvalidPlacementError,
     UnknownNameError,
+    UnknownOptionWarning,
 )
 from envs.surveillance_v1 import parallel_env
 
@@ -41,6 +42,41 @@ def test_reset_rejects_options_that_are_not_a_dict(env, options):
         env.reset(options=options)
 
 
+@pytest.mark.parametrize(
+    ("options", "meant"),
+    [
+        ({"pursuer_0": (1.0, 1.0), "evader_0": (2.0, 2.0)}, ["pursuer", "evader"]),
+        ({"persuer": (1.0, 1.0)}, ["pursuer"]),
+        ({"Evader": (1.0, 1.0)}, ["evader"]),
+    ],
+)
+def test_a_misspelt_placement_warns_naming_the_key_it_resembles(env, options, meant):
+    # it was ignored without a word, and the start drawn at random
+    want = [
+        f"reset: options key {key!r} is not read by the env (its keys are ['pursuer', "
+        f"'evader']; other keys are left to wrappers): did you mean {m!r}? The start is "
+        "drawn at random."
+        for key, m in zip(options, meant, strict=True)
+    ]
+    for reset in (env.reset, surveillance_v1.env().reset):  # the AEC conversion too
+        with pytest.warns(UnknownOptionWarning) as caught:
+            reset(seed=0, options=options)
+        assert [str(w.message) for w in caught] == want
+
+
+def test_options_the_env_does_not_read_are_left_to_wrappers_without_a_word(env):
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        # pettingzoo.test's api_test and parallel_api_test reset with these options
+        env.reset(seed=0, options={"options": 1})
+        env.reset(seed=0, options={"curriculum_level": 2, 3: "x", "start": "safe"})
+        p, e = env._pursuer, env._evader
+        env.reset(seed=0, options={"pursuer": p, "evader": e, "wrapper_flag": True})
+    assert (env._pursuer, env._evader) == (p, e)
+
+
 def test_reset_rejects_boolean_or_string_positions(env):
     p, e = env._pursuer, env._evader
     env.reset(options={"pursuer": np.array(p, dtype=np.float32).astype(float), "evader": list(e)})
@@ -55,7 +91,17 @@ def test_step_rejects_actions_that_are_not_a_dict(env, actions):
         env.step(actions)
 
 
-@pytest.mark.parametrize("action", [np.array([True, False]), ["0.1", "0.2"], [1 + 1j, 0.0]])
+@pytest.mark.parametrize(
+    "action",
+    [
+        np.array([True, False]),
+        ["0.1", "0.2"],
+        [1 + 1j, 0.0],
+        # a bool beside a number: numpy read it as 1.0 and the step went on (helper-123's probe)
+        (True, 0.0),
+        [0.5, np.bool_(False)],
+    ],
+)
 def test_step_rejects_non_real_actions(env, action):
     with pytest.raises(InvalidActionError, match="pursuer_0"):
         env.step({"pursuer_0": action, "evader_0": [0.0, 0.0]})

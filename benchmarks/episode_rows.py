@@ -72,8 +72,12 @@ def key(values: Iterable[Any]) -> str:
     return json.dumps(list(values))
 
 
-def read(path: str | os.PathLike, key_of: Callable[[dict], str]) -> dict[str, dict]:
+def read(
+    path: str | os.PathLike, key_of: Callable[[dict], str], *, note_other_code: bool = True
+) -> dict[str, dict]:
     """The rows already in ``path`` by ``key_of(row)``; empty when there is no file.
+    ``note_other_code=False`` leaves out the note on rows played by other code (a reader
+    that compares code versions itself, ``policy_sets.py``).
 
     Raises:
         InvalidConfigError: a line is not a JSON object (the file is not such a results
@@ -108,7 +112,7 @@ def read(path: str | os.PathLike, key_of: Callable[[dict], str]) -> dict[str, di
                 f"{os.fspath(path)}, line {i + 1}: the row has no field {exc}; {expected}"
             ) from None
     other = [r.get("code") for r in rows.values() if r.get("code") != code_version()]
-    if other and code_version() is not None:
+    if other and note_other_code and code_version() is not None:
         seen = sorted({str(c) for c in other if c}) + ["not recorded"] * (None in other)
         print(f"note: {len(other)} of the {len(rows)} rows in {os.fspath(path)} were played by "
               f"other code ({', '.join(seen[:3])}{', ...' if len(seen) > 3 else ''}; this is "

@@ -1,0 +1,362 @@
+"""Named policy benchmark sets: play them, total them, compare two runs episode by episode.
+
+A change to a policy is measured per episode on fixed sets: each set below is one
+benchmark command that README's "How well the analytic policies play" quotes, with the
+figure last measured. ``run`` plays sets into a directory (one results file a set,
+``DIR/SET.jsonl``, the scripts' own rows: ``benchmarks/episode_rows.py``; a rerun resumes),
+``totals`` counts them, and ``compare`` lists the episodes whose winner changed between two
+such directories::
+
+    python benchmarks/policy_sets.py run holds-bench unseen-p0 --out out/base --workers 1
+    # ... change the policy (in a worktree of its own), then from that checkout:
+    python benchmarks/policy_sets.py run holds-bench unseen-p0 --out out/cand --workers 1
+    python benchmarks/policy_sets.py compare out/base out/cand
+
+The scripts run from the checkout this file is in (its code plays), one after the other,
+each printing its own report; their rows record that code (``"code"``). ``compare`` lists
+per set the episodes the candidate lost that the base won and those it gained (world,
+opponent, seed, cause and time of the loss, and the command that replays it), counts the
+rows only one side has, says when a side's rows come from more than one code version, and
+exits with status 1 when the candidate lost an episode the base won (0 otherwise; 2 for a
+bad directory or file), so a session can gate on it.
+
+Which side won, per script (their rows differ): ``pursuer_holds.py`` keeps
+``out["pursuer/decomposition"] = [winner, cause, time, ...]``; ``unseen_worlds.py`` keeps
+``winner``, ``cause`` and ``t`` (an ``error`` row, a crash, is a loss); ``evader_escapes.py``
+keeps ``out["shooting"] = [winner, time, ...]`` and no cause.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import os
+import shlex
+import subprocess
+import sys
+from collections import Counter
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import episode_rows
+from bench_cli import integer, path_text, run
+
+from envs.errors import InvalidConfigError
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+"""The checkout whose code the sets play (the scripts run from here)."""
+
+SCRIPTS = ("pursuer_holds.py", "unseen_worlds.py", "evader_escapes.py")
+
+
+@dataclass(frozen=True)
+class PolicySet:
+    """One benchmark command and the figure it last gave."""
+
+    name: str
+    script: str
+    """One of :data:`SCRIPTS`, in ``benchmarks/``."""
+    args: tuple[str, ...]
+    """Its arguments, as README quotes them (``--results`` and ``--workers`` are added)."""
+    role: str
+    """The side whose wins are counted: ``"pursuer"`` or ``"evader"``."""
+    won: int
+    episodes: int
+    measured: str
+    """Where the figure comes from (a commit)."""
+    alias: str = ""
+    """The short name sessions used for it (b1, pu0, ...)."""
+
+    def command(self) -> list[str]:
+        return ["python", f"benchmarks/{self.script}", *self.args]
+
+
+FRESH_WORLDS = " ".join(
+    f"rand:{kind}:{seed}:3.0"
+    for kind in ("convex", "rectangles", "star", "polygons")
+    for seed in range(3001, 3009)
+)
+"""32 random maps nobody had used (README: "On 32 random maps nobody had used")."""
+_HOLDS = "--seeds 8 --rho 0.5 --no-greedy"
+_HELDOUT_P = "--worlds @benchmarks/heldout_worlds_pursuer.txt"
+_README = "README, before 94c5063"
+
+
+def _set(name: str, alias: str, role: str, figure: str, measured: str, command: str):
+    script, *args = shlex.split(command)
+    won, episodes = (int(n) for n in figure.split("/"))
+    return PolicySet(name, script, tuple(args), role, won, episodes, measured, alias)
+
+
+SETS: dict[str, PolicySet] = {
+    s.name: s
+    for s in (
+        _set("holds-bench", "b1", "pursuer", "379/384", "94c5063",
+             "pursuer_holds.py --worlds corridor l_hall open_room corner pillars maze "
+             f"--variants 'as is' {_HOLDS}"),
+        _set("holds-variants", "b2", "pursuer", "558/576", "94c5063",
+             "pursuer_holds.py --worlds corridor l_hall corner "
+             f"--variants 'rot 0.37' 'x10 rot 1.1' off-centre {_HOLDS}"),
+        _set("unseen-p0", "pu0", "pursuer", "426/450", "94c5063",
+             "unseen_worlds.py --role pursuer --combos 0"),
+        _set("unseen-p1", "pu1", "pursuer", "446/450", "94c5063",
+             "unseen_worlds.py --role pursuer --combos 1"),
+        _set("unseen-p2", "pu2", "pursuer", "486/486", "94c5063",
+             "unseen_worlds.py --role pursuer --combos 2"),
+        _set("heldout-p0", "ph0", "pursuer", "609/648", "94c5063",
+             f"unseen_worlds.py --role pursuer {_HELDOUT_P} --combos 0"),
+        _set("heldout-p1", "ph1", "pursuer", "633/648", "94c5063",
+             f"unseen_worlds.py --role pursuer {_HELDOUT_P} --combos 1"),
+        _set("heldout-p2", "ph2", "pursuer", "666/666", "94c5063",
+             f"unseen_worlds.py --role pursuer {_HELDOUT_P} --combos 2"),
+        _set("fresh-p0", "fresh_p0", "pursuer", "549/576", "94c5063",
+             f"unseen_worlds.py --role pursuer --combos 0 --worlds {FRESH_WORLDS}"),
+        _set("unseen-e", "eunseen", "evader", "1188/1189", _README,
+             "unseen_worlds.py --role evader"),
+        _set("heldout-e", "eheldout", "evader", "775/779", _README,
+             "unseen_worlds.py --role evader --worlds @benchmarks/heldout_worlds_evader.txt"),
+        _set("escapes-bench", "bench3", "evader", "512/512", _README,
+             "evader_escapes.py --seeds 4 --simple-seeds 0"),
+    )
+}  # fmt: skip
+
+
+# ------------------------------------------------------------------ reading the rows
+
+
+@dataclass(frozen=True)
+class Episode:
+    """What ``compare`` says of one row."""
+
+    key: str
+    won: bool
+    world: str
+    opponent: str
+    seed: int
+    cause: str | None
+    t: float | None
+    code: str | None
+    row: dict
+
+
+def _module(script: str):
+    return importlib.import_module(script.removesuffix(".py"))
+
+
+def _episode(script: str, row: dict, key: str) -> Episode:
+    """``row`` of ``script`` as an :class:`Episode` (``KeyError``, ``IndexError`` or
+    ``TypeError`` when it is not such a row)."""
+    code = row.get("code")
+    if script == "pursuer_holds.py":
+        winner, cause, t = row["out"]["pursuer/decomposition"][:3]
+        world = f"{row['world']} [{row['variant']}] rho={row['rho']}"
+        return Episode(key, winner == "pursuer", world, row["evader"], row["seed"], cause, t,
+                       code, row)  # fmt: skip
+    if script == "unseen_worlds.py":
+        world = f"{row['world']} {row['combo']}"
+        cause = row["error"] if "error" in row else row["cause"]
+        return Episode(key, row.get("winner") == row["role"], world, row["opponent"],
+                       row["seed"], cause, row.get("t"), code, row)  # fmt: skip
+    winner, t = row["out"]["shooting"][:2]
+    return Episode(key, winner == "evader", f"{row['world']} [{row['variant']}]",
+                   row["pursuer"], row["seed"], None, t, code, row)  # fmt: skip
+
+
+def read_set(path: str, policy_set: PolicySet) -> dict[str, Episode]:
+    """The episodes of ``policy_set`` in the results file ``path``, by the script's own
+    episode key; empty when there is no such file.
+
+    Raises:
+        InvalidConfigError: ``path`` is not a results file of the set's script (or holds
+            rows of the other role), naming the file and what was expected.
+    """
+    module = _module(policy_set.script)
+    key_of = module.row_key if policy_set.script == "unseen_worlds.py" else module._row_key
+    rows = episode_rows.read(path, key_of, note_other_code=False)
+    expected = f"expected rows of {policy_set.script} (set {policy_set.name})"
+    out = {}
+    for key, row in rows.items():
+        if policy_set.script == "unseen_worlds.py" and row["role"] != policy_set.role:
+            raise InvalidConfigError(
+                f"{path}: the row {key} is of the {row['role']} role; set {policy_set.name} "
+                f"measures the {policy_set.role} ({expected})"
+            )
+        try:
+            out[key] = _episode(policy_set.script, row, key)
+        except (KeyError, IndexError, TypeError) as exc:
+            raise InvalidConfigError(
+                f"{path}: the row {key} has no {exc!s} as {policy_set.script} writes; {expected}"
+            ) from None
+    return out
+
+
+def replay_command(policy_set: PolicySet, e: Episode) -> str:
+    """The command that plays episode ``e`` again, as the set's script prints it (for
+    ``evader_escapes.py``, which prints none: the script narrowed to the episode's world,
+    variant and pursuer, which plays seeds 0 to the episode's)."""
+    module = _module(policy_set.script)
+    r = e.row
+    if policy_set.script == "pursuer_holds.py":
+        return module.replay_command(r["world"], r["variant"], r["rho"], r["evader"], r["seed"],
+                                     r["max_cycles"], r["l_min"])  # fmt: skip
+    if policy_set.script == "unseen_worlds.py":
+        return module.replay_command(r)
+    words = ["python", "benchmarks/evader_escapes.py", "--worlds", r["world"], "--variants",
+             r["variant"], "--pursuers", r["pursuer"], "--seeds", str(r["seed"] + 1),
+             "--simple-seeds", "0", "--k", f"{r['k']:g}", "--start", r["start"]]  # fmt: skip
+    return shlex.join(words) + f"  # seeds 0-{r['seed']}"
+
+
+# ------------------------------------------------------------------ the commands
+
+
+def _sets_in(directory: str, sets: Mapping[str, PolicySet]) -> list[str]:
+    """The names of the sets with a results file in ``directory``."""
+    if not os.path.isdir(directory):
+        raise InvalidConfigError(
+            f"{directory!r}: no such directory; expected a directory of results files "
+            "written by 'policy_sets.py run --out DIR'"
+        )
+    names = [n for n in sets if os.path.isfile(os.path.join(directory, f"{n}.jsonl"))]
+    if not names:
+        raise InvalidConfigError(
+            f"{directory!r} holds no results file of any set; expected files named SET.jsonl, "
+            f"SET one of {', '.join(sets)}"
+        )
+    return names
+
+
+def _versions(episodes: Mapping[str, Episode]) -> str:
+    counts = Counter(str(e.code) if e.code else "not recorded" for e in episodes.values())
+    return ", ".join(f"{c} ({n})" for c, n in counts.most_common())
+
+
+def _wins(episodes: Mapping[str, Episode]) -> str:
+    return f"{sum(e.won for e in episodes.values())}/{len(episodes)}"
+
+
+def totals(directory: str, sets: Mapping[str, PolicySet] = SETS) -> int:
+    """Print, per set with results in ``directory``, the wins of the set's role over its
+    episodes beside the figure last measured, and the code versions of its rows."""
+    names = _sets_in(directory, sets)
+    read = {n: read_set(os.path.join(directory, f"{n}.jsonl"), sets[n]) for n in names}
+    print(f"{'set':<16}{'role':<9}{'won':>11}  {'last measured':<28}code (rows)")
+    for name, episodes in read.items():
+        s = sets[name]
+        note = ""
+        if len(episodes) != s.episodes:
+            note = f"  [{len(episodes)} of the set's {s.episodes} episodes]"
+        last = f"{s.won}/{s.episodes} at {s.measured}"
+        print(f"{name:<16}{s.role:<9}{_wins(episodes):>11}  {last:<28}{_versions(episodes)}{note}")
+    return 0
+
+
+def _describe(e: Episode) -> str:
+    words = ["won" if e.won else "lost"]
+    if e.cause is not None:
+        words.append(str(e.cause))
+    if e.t is not None:
+        words.append(f"at {e.t:.2f} s")
+    elif e.cause is None:
+        words.append("to the horizon")
+    return " ".join(words)
+
+
+def compare(base: str, cand: str, sets: Mapping[str, PolicySet] = SETS) -> int:
+    """Print, per set in either directory, the episodes whose winner changed from ``base``
+    to ``cand``; 1 when ``cand`` lost an episode ``base`` won, else 0."""
+    names = [n for n in sets if n in set(_sets_in(base, sets)) | set(_sets_in(cand, sets))]
+    lost_any = 0
+    for name in names:
+        s = sets[name]
+        b = read_set(os.path.join(base, f"{name}.jsonl"), s)
+        c = read_set(os.path.join(cand, f"{name}.jsonl"), s)
+        both = [k for k in b if k in c]
+        lost = [k for k in both if b[k].won and not c[k].won]
+        gained = [k for k in both if c[k].won and not b[k].won]
+        lost_any += len(lost)
+        print(f"{name} ({s.role} wins): base {_wins(b)}, cand {_wins(c)}; {len(both)} episodes "
+              f"in both: {len(lost)} lost, {len(gained)} gained")  # fmt: skip
+        for side, episodes in (("base", b), ("cand", c)):
+            if len({e.code for e in episodes.values()}) > 1:
+                print(f"  note: the {side} rows come from more than one code version: "
+                      f"{_versions(episodes)}")  # fmt: skip
+        only_b, only_c = len(b) - len(both), len(c) - len(both)
+        if only_b or only_c:
+            print(f"  rows only in base: {only_b}, only in cand: {only_c} (not compared)")
+        for label, keys in (("lost", lost), ("gained", gained)):
+            for k in keys:
+                e = c[k]
+                print(f"  {label}: {e.world} {e.opponent} seed={e.seed}: cand {_describe(e)}; "
+                      f"base {_describe(b[k])}")  # fmt: skip
+                print(f"    replay: {replay_command(s, e)}")
+    print(f"cand lost {lost_any} episode(s) that base won" if lost_any else "cand lost none")
+    return 1 if lost_any else 0
+
+
+def run_sets(names: Sequence[str], out: str, workers: int | None,
+             sets: Mapping[str, PolicySet] = SETS) -> int:  # fmt: skip
+    """Play each set through its script into ``out/SET.jsonl`` (resuming), then print the
+    totals; non-zero when a script failed."""
+    failed = []
+    os.makedirs(out, exist_ok=True)
+    for name in names:
+        s = sets[name]
+        results = os.path.abspath(os.path.join(out, f"{name}.jsonl"))
+        argv = [sys.executable, os.path.join("benchmarks", s.script), *s.args, "--results", results]
+        if workers is not None:
+            argv += ["--workers", str(workers)]
+        print(f"== {name}: {shlex.join([*s.command(), '--results', results])}", flush=True)
+        code = subprocess.run(argv, cwd=ROOT).returncode
+        if code:
+            print(f"== {name}: {s.script} exited with status {code}", flush=True)
+            failed.append(name)
+    totals(out, {n: sets[n] for n in names})
+    if failed:
+        print(f"failed: {', '.join(failed)}")
+    return 1 if failed else 0
+
+
+def _set_list() -> str:
+    lines = ["sets (name, short name, figure last measured, command):"]
+    for s in SETS.values():
+        command = shlex.join(s.command()).replace(
+            FRESH_WORLDS,
+            "rand:KIND:SEED:3.0 (KIND convex rectangles star polygons, SEED 3001-3008)",
+        )
+        lines.append(f"  {s.name} ({s.alias}): {s.won}/{s.episodes} {s.role} wins at "
+                     f"{s.measured}: {command}")  # fmt: skip
+    return "\n".join(lines)
+
+
+def _set_name(text: str) -> str:
+    if text not in SETS:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a set name, one of {', '.join(SETS)}")
+    return text
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0], epilog=_set_list(),
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)  # fmt: skip
+    sub = ap.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("run", help="play sets into DIR/SET.jsonl (resumes), then their totals")
+    p.add_argument("sets", nargs="+", type=_set_name, metavar="SET")
+    p.add_argument("--out", required=True, type=path_text("a directory"), metavar="DIR")
+    p.add_argument("--workers", type=integer(1), default=None,
+                   help="passed to each script (default: the script's own)")  # fmt: skip
+    p = sub.add_parser("totals", help="per set in DIR: wins / episodes, code versions")
+    p.add_argument("dir", type=path_text("a directory"), metavar="DIR")
+    p = sub.add_parser("compare", help="per episode: winner changed from BASE to CAND "
+                       "(exit 1 when CAND lost one BASE won)")  # fmt: skip
+    p.add_argument("base", type=path_text("a directory"), metavar="BASE")
+    p.add_argument("cand", type=path_text("a directory"), metavar="CAND")
+    args = ap.parse_args(argv)
+    if args.command == "run":
+        return run_sets(list(dict.fromkeys(args.sets)), args.out, args.workers)
+    if args.command == "totals":
+        return totals(args.dir)
+    return compare(args.base, args.cand)
+
+
+if __name__ == "__main__":
+    raise SystemExit(run(main))

@@ -311,7 +311,9 @@ def run_sets(names: Sequence[str], out: str, workers: int | None,
         if code:
             print(f"== {name}: {s.script} exited with status {code}", flush=True)
             failed.append(name)
-    totals(out, {n: sets[n] for n in names})
+    written = {n: sets[n] for n in names if os.path.isfile(os.path.join(out, f"{n}.jsonl"))}
+    if written:
+        totals(out, written)
     if failed:
         print(f"failed: {', '.join(failed)}")
     return 1 if failed else 0

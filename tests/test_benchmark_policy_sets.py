@@ -247,3 +247,11 @@ def test_each_set_is_the_command_readme_quotes(ps):
         quoted = " ".join(f'"{w}"' if " " in w else w for w in command)
         assert quoted in readme, quoted
     assert len(ps.FRESH_WORLDS.split()) == 32
+
+
+def test_run_says_which_script_failed_and_exits_non_zero(ps, tmp_path, capsys):
+    sets = {"bad": _tiny(ps, "bad", "pursuer_holds.py", ("--worlds", "nowhere"))}
+    assert ps.run_sets(["bad"], str(tmp_path), 1, sets) == 1
+    out = capsys.readouterr().out
+    assert "== bad: pursuer_holds.py exited with status 2" in out
+    assert "failed: bad" in out

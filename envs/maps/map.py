@@ -27,6 +27,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -78,6 +79,13 @@ def _as_ring(points: object, what: str) -> np.ndarray:
 
 _EPS = float(np.finfo(float).eps)
 """Relative rounding of a float64 coordinate."""
+
+SIZE_RANGE = (1e-30, 1e30)
+"""Sizes (the boundary's bounding-box diagonal) a map may have. The kernel's sweep squares
+squared lengths (its discriminants), which overflow or underflow float64 near sizes of
+1e+-77: a map scaled by 1e100 timed a rod passing a corner at the step's end instead of
+halfway, without a word. Measured exact at 1e+-60 (probes under similarities); the
+range keeps a wide margin for the theory's higher powers."""
 
 _PAIRS = 1 << 20
 """(point, edge) pairs per batch of ``Map.contains`` / ``Map.distance_to_walls``: about
@@ -172,9 +180,18 @@ class Map:
         except InvalidConfigError as exc:
             raise InvalidMapError(str(exc)) from None
         b = _as_ring(boundary, "boundary")
-        span = float(np.linalg.norm(b.max(axis=0) - b.min(axis=0)))
+        with np.errstate(over="ignore"):  # +-1e308 corners: an infinite extent, refused below
+            ext = b.max(axis=0) - b.min(axis=0)
+        span = math.hypot(float(ext[0]), float(ext[1]))  # no overflow nor underflow on the way
         if span <= 0:
             raise InvalidMapError("boundary: degenerate polygon (zero extent)")
+        lo, hi = SIZE_RANGE
+        if not lo <= span <= hi:
+            raise InvalidMapError(
+                f"boundary: the map's size (its bounding box's diagonal) is {span:.3g}; "
+                f"expected one in [{lo:g}, {hi:g}]: the geometry squares squared lengths, "
+                "which overflow or underflow float64 beyond (rescale it, e.g. NAME~xS)"
+            )
         far = float(np.abs(b).max())
         if far * _EPS > REL_LENGTH_TOL * span:
             # a coordinate rounds by more than the geometry's length tolerance: walls,

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import pickle
+import warnings
 
 import numpy as np
 import pytest
@@ -174,6 +175,35 @@ def test_a_map_too_far_from_the_origin_for_its_size_is_refused():
     assert load_map("corner~rot0.3off(1e7,1e7)").n_vertices == load_map("corner").n_vertices
     with pytest.raises(InvalidMapError, match="from the origin"):
         load_map("corner~rot0.3off(1e9,1e9)")
+
+
+@pytest.mark.parametrize("size", [1e100, 1e160, 1e-100, 1e-200])
+def test_a_map_of_a_size_float64_geometry_cannot_square_is_refused(size):
+    """Found by probing the kernel under similarities (helper-123): the sweep squares
+    squared lengths (its discriminants), which overflow or underflow float64 at sizes
+    near 1e+-77. The room below scaled by 1e100 (or 1e-100) was accepted, and its sweep
+    timed the rod passing the block's corners at the step's end (t = 1) instead of
+    t = 1/2, without a word; at 1e160 the triangle was refused as "fewer than 3
+    non-collinear vertices" and at 1e-200 as "zero extent", after numpy overflow
+    warnings. Now one message names the size."""
+    tri = size * np.array([(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no overflow warnings on the way
+        with pytest.raises(InvalidMapError, match=r"size .* expected one in \[1e-30, 1e\+30\]"):
+            Map(tri)
+
+
+def test_sizes_within_the_range_keep_the_kernel_s_answers():
+    from envs.geometry import kernel_for
+
+    base = Map(ROOM, [box(1, 1, 3, 3)])
+    # a level rod from x = 0.5 to 4 moves down past the block's top corners at t = 1/2
+    step = ((0.5, 5.0), (4.0, 5.0), (0.5, 1.0), (4.0, 1.0))
+    want = kernel_for(base).sweep(*step, 0.0, 10.0)
+    for s in (1e-31, 5e28):  # sizes 1.4e-30 and 7e29
+        m = base.transformed(s * np.eye(2))
+        got = kernel_for(m).sweep(*(s * np.array(x) for x in step), 0.0, 10.0 * s)
+        assert (got.cause, got.time) == pytest.approx((want.cause, want.time), abs=1e-9)
 
 
 def test_gap_just_above_tolerance_is_accepted():

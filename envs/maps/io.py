@@ -429,7 +429,9 @@ def map_from_wkt(
         with np.errstate(invalid="ignore"):  # NaN coordinates: refused below, in one line
             geom = shapely.from_wkt(text.strip())
     except (ShapelyError, TypeError, ValueError) as exc:
-        raise _fail(source, f"not valid WKT ({exc})") from exc
+        # one line: some GEOS messages end in a newline ("point array must contain 0 or
+        # >1 elements\n" for a one-point ring)
+        raise _fail(source, f"not valid WKT ({' '.join(str(exc).split())})") from exc
     if geom is None or geom.is_empty:
         raise _fail(source, "empty geometry (a map needs at least its boundary)")
     if geom.has_z:

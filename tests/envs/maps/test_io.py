@@ -374,6 +374,13 @@ MALFORMED = [
     ("wkt", "POLYGON Z ((0 0 1, 1 0 1, 1 1 1, 0 0 1))", r"3D"),
     ("wkt", "POLYGON ((0 0, 10 10, 10 0, 0 10, 0 0))", r"boundary: .*not simple"),
     ("wkt", "POLYGON ((0 0, 10 0, 10 10, 0 10))", r"not valid WKT"),
+    # a one-point ring: GEOS's message ended in a newline, which the refusal kept (found by
+    # helper-123's file probe)
+    (
+        "wkt",
+        "POLYGON ((0 0, 10 0, 10 10, 0 10, 0 0), (6 6))",
+        r"not valid WKT \(IllegalArgumentException: point array must contain 0 or >1 elements\)$",
+    ),
     (
         "wkt",
         "MULTIPOLYGON (((0 0, 10 0, 10 10, 0 10, 0 0)), "
@@ -397,6 +404,7 @@ def test_malformed_files_name_the_file_and_the_problem(tmp_path, fmt, text, patt
     with pytest.raises(InvalidMapError, match=pattern) as info:
         load_map(p)
     assert str(info.value).startswith(str(p) + ": ")
+    assert "\n" not in str(info.value)  # one line
 
 
 def test_non_utf8_file(tmp_path):

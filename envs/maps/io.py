@@ -272,6 +272,12 @@ def _geojson_polygons(
             raise _fail(source, f"{label}: expected a list of linear rings, got {rings!r:.60}")
         checked = [_ring(r, source, f"{label} ring {j}") for j, r in enumerate(rings)]
         for j, r in enumerate(checked):
+            if len(r) < 4:  # RFC 7946 3.1.6; shapely raised a bare ValueError on fewer
+                raise _fail(
+                    source,
+                    f"{label} ring {j}: {len(r)} positions; a linear ring needs at least 4 "
+                    "(3 vertices and the first repeated)",
+                )
             if r[0] != r[-1]:
                 raise _fail(
                     source, f"{label} ring {j}: not closed (first vertex {r[0]} != last {r[-1]})"

@@ -367,6 +367,18 @@ MALFORMED = [
         json.dumps(feature([closed(ROOM), *SQ], merge=1)),
         r'"merge" must be true or false',
     ),
+    # rings of fewer than 4 positions: shapely's bare ValueError 'A linearring requires at
+    # least 4 coordinates.' (found by helper-123's file probe)
+    (
+        "geojson",
+        json.dumps(feature([[[1, 2]], *SQ])),
+        r"feature 0 ring 0: 1 positions; a linear ring needs at least 4",
+    ),
+    (
+        "geojson",
+        json.dumps(feature([closed(ROOM), [[1, 1], [2, 2], [1, 1]]])),
+        r"feature 0 ring 1: 3 positions; a linear ring needs at least 4",
+    ),
     ("wkt", "POLYGN ((0 0, 1 0, 1 1, 0 0))", r"not valid WKT"),
     ("wkt", "", r"not valid WKT"),
     ("wkt", "POLYGON EMPTY", r"empty geometry"),

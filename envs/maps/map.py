@@ -211,10 +211,23 @@ class Map:
                 f"obstacles: expected a sequence of polygons, got {type(obstacles).__name__} "
                 f"{obstacles!r}"
             )
-        obs = [
-            _clean_ring(_as_ring(o, f"obstacle {i}"), span, f"obstacle {i}")
-            for i, o in enumerate(obstacles)
-        ]
+        lo_b, hi_b = b.min(axis=0), b.max(axis=0)
+        far_out = REL_LENGTH_TOL / _EPS * span  # the far-from-origin rule's reach
+        obs = []
+        for i, o in enumerate(obstacles):
+            ring = _as_ring(o, f"obstacle {i}")
+            # a vertex far beyond the boundary's box is refused before the ring is cleaned:
+            # cleaning one at +-1e308 overflowed and called the obstacle "degenerate
+            # (fewer than 3 non-collinear vertices)"; nearer ones get shapely's verdict
+            out = np.flatnonzero(((ring < lo_b - far_out) | (ring > hi_b + far_out)).any(axis=1))
+            if len(out):
+                k = int(out[0])
+                raise InvalidMapError(
+                    f"obstacle {i}: not inside the boundary (vertex {k} "
+                    f"({ring[k, 0]:.4g}, {ring[k, 1]:.4g}) is over {far_out:.3g} beyond the "
+                    f"boundary's bounds {tuple(float(v) for v in (*lo_b, *hi_b))})"
+                )
+            obs.append(_clean_ring(ring, span, f"obstacle {i}"))
         self.merged = bool(merge)
         self.boundary = b
         self.obstacles = tuple(obs)

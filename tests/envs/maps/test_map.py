@@ -193,6 +193,21 @@ def test_a_map_of_a_size_float64_geometry_cannot_square_is_refused(size):
             Map(tri)
 
 
+@pytest.mark.parametrize("far", [1e308, 1e8])
+def test_an_obstacle_vertex_far_beyond_the_boundary_is_named(far):
+    """helper-123's map-file probe: an obstacle with a vertex at -1e308 and one at 1e308
+    was refused as "degenerate polygon (fewer than 3 non-collinear vertices)" (cleaning
+    its ring overflowed, after numpy warnings); one at 1e308 and the rest inside got the
+    right reason, after warnings too."""
+    for ring in ([(-far, 1.0), (far, 1.0), (1.0, 2.0)], [(1.0, 1.0), (far, 1.0), (1.0, 2.0)]):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            with pytest.raises(
+                InvalidMapError, match=r"obstacle 0: not inside the boundary \(vertex \d \("
+            ):
+                Map(ROOM, [ring])
+
+
 def test_sizes_within_the_range_keep_the_kernel_s_answers():
     from envs.geometry import kernel_for
 

@@ -247,16 +247,27 @@ class Kernel:
             p, q, self._a[idx], self._b[idx], self._n[idx], self.eps
         )
         best = None
-        for mask, t, kind in (
-            (vhit, t_vertex, "vertex"),
-            (cross, t_cross, "edge"),
-            (along & ~vhit, t_vertex, "edge"),
-        ):
+        for mask, t, kind in ((vhit, t_vertex, "vertex"), (cross, t_cross, "edge")):
             if mask.any():
                 j = np.flatnonzero(mask)
                 k = j[np.argmin(t[j])]
                 if best is None or float(t[k]) < best[0]:
                     best = (float(t[k]), kind, int(idx[k]))
+        if along.any():
+            # an edge the segment runs along is first met where their overlap begins, also
+            # when the edge's start vertex lies on the segment further on (segment_contacts
+            # gives the vertex's time there): as scan_segment does, or a segment along a
+            # wall from a point on it was blamed on the vertex it reaches later
+            j = np.flatnonzero(along)
+            e = idx[j]
+            dx, dy = qx - px, qy - py
+            inv = 1.0 / (dx * dx + dy * dy)
+            ta = ((self._a[e, 0] - px) * dx + (self._a[e, 1] - py) * dy) * inv
+            tb = ((self._b[e, 0] - px) * dx + (self._b[e, 1] - py) * dy) * inv
+            lo = np.maximum(np.minimum(ta, tb), 0.0)
+            k = int(np.argmin(lo))
+            if best is None or float(lo[k]) < best[0]:
+                best = (float(lo[k]), "edge", int(e[k]))
         return best
 
     def _through_obstacle(self, px: float, py: float, qx: float, qy: float) -> bool:

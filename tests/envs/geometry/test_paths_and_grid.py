@@ -31,6 +31,29 @@ def _kernels(world):
     return scalar, vector
 
 
+@pytest.mark.parametrize("name", ["corridor", "maze", "random:star:1"])
+def test_a_segment_along_a_wall_from_a_point_on_it_blames_the_wall_on_both_paths(name):
+    """The blocking feature nearest to p of a segment that starts on a wall edge and runs
+    along it past the edge's start vertex (a convex corner) is the edge, met at p. The
+    numpy path named the corner vertex, met further on (helper-123's differential probe:
+    corridor p = (0, -0.989), q = (0, 1.41): 'convex vertex 1 (0, -0.5)' against the
+    plain-Python path's 'edge 1 (0, -0.5)-(0, -5)'); it serves maps where a segment meets
+    more than 48 candidate edges, so the env's reported feature hung on the map's size."""
+    from envs.maps import Feature, load_map
+
+    world = load_map(name)
+    scalar, vector = _kernels(world)
+    checked = 0
+    for e in np.flatnonzero(world.vertex_convex):  # edge e starts at convex vertex e
+        a, b = world.edge_start[e], world.edge_end[e]
+        p = a + 0.5 * (b - a)
+        for q in (a + 1e-3 * (a - b), b):  # past the start vertex; to the end vertex
+            assert scalar.blocking_feature(p, q) == Feature("edge", int(e))
+            assert vector.blocking_feature(p, q) == Feature("edge", int(e))
+            checked += 1
+    assert checked >= 4
+
+
 @pytest.mark.parametrize("seed", [0, 1])
 def test_scalar_and_numpy_paths_agree(seed):
     world = random_map(seed, nx=4, ny=4)

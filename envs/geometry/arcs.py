@@ -60,6 +60,10 @@ def free_arcs_at(kernel: Kernel, ex: float, ey: float, L: float) -> FreeArcs:
     """
     E = np.array([ex, ey])
     eps = kernel.eps
+    if L > kernel.map.diameter + eps:
+        # P = E + L u lies outside the map whatever u: nothing is free (what the clipping
+        # below finds too, up to L ~ 1e154, where squaring L overflowed)
+        return FreeArcs(E, float(L), ())
     r = L + eps
     cand = kernel.edges_near_box(ex - r, ey - r, ex + r, ey + r)
     if len(cand) > kernel.numpy_threshold:

@@ -49,3 +49,14 @@ def test_point_arrays_not_numeric(kernel, points):
         kernel.free_arcs_many(points, 1.0)
     with pytest.raises(InvalidConfigError, match="line_of_sight_many starts"):
         kernel.line_of_sight_many(points, [(1.0, 1.0)])
+
+
+@pytest.mark.parametrize("L", [1e155, 1e200, 1e308])
+def test_a_rod_longer_than_the_map_has_no_free_orientation_at_any_length(kernel, L):
+    """Its pursuer end leaves the map whatever the orientation, so no arc is free (as at
+    1.5 diameters). Beyond L = 1.3e154, free_arcs raised a bare OverflowError ((L + eps)
+    ** 2; found by helper-123's probe of the kernel's edge cases)."""
+    assert kernel.free_arcs((1.0, 1.0), 1.5 * kernel.map.diameter).is_empty
+    fa = kernel.free_arcs((1.0, 1.0), L)
+    assert fa.is_empty and fa.L == L
+    assert all(a.is_empty for a in kernel.free_arcs_many([(1.0, 1.0), (8.0, 2.0)], L))

@@ -132,7 +132,8 @@ def test_a_spec_takes_transformed_maps_as_load_map_does(tmp_path):
 def test_a_transform_that_leaves_no_valid_map_names_the_map_entry(name):
     """A well-formed transform whose result no map can be (scaled to nothing): one error
     naming the spec entry and the map, not a bare 'boundary: degenerate polygon'."""
-    with pytest.raises(InvalidConfigError, match=rf"\[maps #1\]: map = '{re.escape(name)}'.*zero"):
+    pattern = rf"\[maps #1\]: map = '{re.escape(name)}'.*size .* expected one in"
+    with pytest.raises(InvalidConfigError, match=pattern):
         spec_from_dict({"maps": [name], "pursuers": ["pursuer/greedy"],
                         "evaders": ["evader/random"], "seeds": 1})  # fmt: skip
 

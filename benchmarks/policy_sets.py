@@ -79,7 +79,8 @@ FRESH_WORLDS = " ".join(
 """32 random maps nobody had used (README: "On 32 random maps nobody had used")."""
 _HOLDS = "--seeds 8 --rho 0.5 --no-greedy"
 _HELDOUT_P = "--worlds @benchmarks/heldout_worlds_pursuer.txt"
-_README = "README, before 94c5063"
+_BASE = "94c5063"
+"""The commit every figure below was measured at (all twelve sets played there)."""
 
 
 def _set(name: str, alias: str, role: str, figure: str, measured: str, command: str):
@@ -91,31 +92,31 @@ def _set(name: str, alias: str, role: str, figure: str, measured: str, command: 
 SETS: dict[str, PolicySet] = {
     s.name: s
     for s in (
-        _set("holds-bench", "b1", "pursuer", "379/384", "94c5063",
+        _set("holds-bench", "b1", "pursuer", "379/384", _BASE,
              "pursuer_holds.py --worlds corridor l_hall open_room corner pillars maze "
              f"--variants 'as is' {_HOLDS}"),
-        _set("holds-variants", "b2", "pursuer", "558/576", "94c5063",
+        _set("holds-variants", "b2", "pursuer", "558/576", _BASE,
              "pursuer_holds.py --worlds corridor l_hall corner "
              f"--variants 'rot 0.37' 'x10 rot 1.1' off-centre {_HOLDS}"),
-        _set("unseen-p0", "pu0", "pursuer", "426/450", "94c5063",
+        _set("unseen-p0", "pu0", "pursuer", "426/450", _BASE,
              "unseen_worlds.py --role pursuer --combos 0"),
-        _set("unseen-p1", "pu1", "pursuer", "446/450", "94c5063",
+        _set("unseen-p1", "pu1", "pursuer", "446/450", _BASE,
              "unseen_worlds.py --role pursuer --combos 1"),
-        _set("unseen-p2", "pu2", "pursuer", "486/486", "94c5063",
+        _set("unseen-p2", "pu2", "pursuer", "486/486", _BASE,
              "unseen_worlds.py --role pursuer --combos 2"),
-        _set("heldout-p0", "ph0", "pursuer", "609/648", "94c5063",
+        _set("heldout-p0", "ph0", "pursuer", "609/648", _BASE,
              f"unseen_worlds.py --role pursuer {_HELDOUT_P} --combos 0"),
-        _set("heldout-p1", "ph1", "pursuer", "633/648", "94c5063",
+        _set("heldout-p1", "ph1", "pursuer", "633/648", _BASE,
              f"unseen_worlds.py --role pursuer {_HELDOUT_P} --combos 1"),
-        _set("heldout-p2", "ph2", "pursuer", "666/666", "94c5063",
+        _set("heldout-p2", "ph2", "pursuer", "666/666", _BASE,
              f"unseen_worlds.py --role pursuer {_HELDOUT_P} --combos 2"),
-        _set("fresh-p0", "fresh_p0", "pursuer", "549/576", "94c5063",
+        _set("fresh-p0", "fresh_p0", "pursuer", "549/576", _BASE,
              f"unseen_worlds.py --role pursuer --combos 0 --worlds {FRESH_WORLDS}"),
-        _set("unseen-e", "eunseen", "evader", "1188/1189", _README,
+        _set("unseen-e", "eunseen", "evader", "1188/1189", _BASE,
              "unseen_worlds.py --role evader"),
-        _set("heldout-e", "eheldout", "evader", "775/779", _README,
+        _set("heldout-e", "eheldout", "evader", "775/779", _BASE,
              "unseen_worlds.py --role evader --worlds @benchmarks/heldout_worlds_evader.txt"),
-        _set("escapes-bench", "bench3", "evader", "512/512", _README,
+        _set("escapes-bench", "bench3", "evader", "512/512", _BASE,
              "evader_escapes.py --seeds 4 --simple-seeds 0"),
     )
 }  # fmt: skip

@@ -38,6 +38,7 @@ __all__ = [
     "SB3_ALGORITHMS",
     "SB3Policy",
     "UnseenMapWarning",
+    "UnseenParametersWarning",
     "learner_inputs_spec",
     "trained_observation",
 ]
@@ -52,6 +53,27 @@ _PLAY_ONLY = {"lr_schedule": 0.0, "learning_rate": 0.0, "clip_range": 0.0}
 
 class UnseenMapWarning(UserWarning):
     """A model that sees map coordinates plays a map it was not trained on."""
+
+
+class UnseenParametersWarning(UserWarning):
+    """A model plays a game whose speeds or ranges differ, up to scale, from the ones it
+    was trained at (its ``provenance.json``'s ``env_config``)."""
+
+
+_GAME_RATIOS = (
+    ("rho = v_evader / v_pursuer", lambda c: c["v_evader"] / c["v_pursuer"],
+     lambda c: f"{c['v_evader']:g} / {c['v_pursuer']:g}"),
+    ("l_max / l_min", lambda c: c["l_max"] / c["l_min"],
+     lambda c: f"{c['l_max']:g} / {c['l_min']:g}"),
+    ("the pursuer's step in L_min, v_pursuer * dt / l_min",
+     lambda c: c["v_pursuer"] * c["dt"] / c["l_min"],
+     lambda c: f"{c['v_pursuer']:g} * {c['dt']:g} / {c['l_min']:g}"),
+)  # fmt: skip
+"""The numbers that fix a game up to scale (name, value, how it is made): a map scaled
+with its ranges and speeds (``NAME~xS``) is the same game, so only these are compared."""
+
+_RATIO_RTOL = 1e-6
+"""Relative difference below which two ratios are the same (rounding of the inputs)."""
 
 
 def _algo_from_zip(path: Path) -> str:
@@ -174,6 +196,35 @@ class SB3Policy(BasePolicy):
         if self._inputs is not None:
             self._inputs.reset(self.config, self.role)
         self._warn_unseen_map()
+        self._warn_unseen_parameters()
+
+    def _warn_unseen_parameters(self) -> None:
+        """Warn (once per game) when the game's speed ratio, range ratio or step differs
+        from the one the model was trained at: it never saw that game, whatever the map
+        (a lidar generalist too)."""
+        trained = (self.provenance or {}).get("env_config") or {}
+        keys = ("l_min", "l_max", "v_pursuer", "v_evader", "dt")
+        try:
+            was = {k: float(trained[k]) for k in keys}
+        except (KeyError, TypeError, ValueError):  # an older provenance: nothing to compare
+            return
+        now = {k: float(getattr(self.config, k)) for k in keys}
+        differ = [
+            f"{name}: {value(was):.4g} in training ({how(was)}), {value(now):.4g} here ({how(now)})"
+            for name, value, how in _GAME_RATIOS
+            if abs(value(now) - value(was)) > _RATIO_RTOL * abs(value(was))
+        ]
+        key = "; ".join(differ)
+        if not differ or key in self._warned:
+            return
+        self._warned.add(key)
+        warnings.warn(
+            f"{self.name}: this model plays a game it was not trained at: {key}. Up to "
+            "scale only these numbers matter (a map scaled with its ranges and speeds, "
+            "NAME~xS, is the same game); how it plays this one is unmeasured",
+            UnseenParametersWarning,
+            stacklevel=3,
+        )
 
     def _warn_unseen_map(self) -> None:
         """Warn (once per map) when a model that sees map coordinates plays a map it did

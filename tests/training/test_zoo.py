@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -140,6 +142,35 @@ def test_a_specialist_warns_on_a_map_it_has_not_seen():
     with warnings.catch_warnings():
         warnings.simplefilter("error", UnseenMapWarning)
         general.reset(role="pursuer", map=load_map("pillars"), config=env.config, seed=0)
+
+
+def test_a_model_warns_once_at_speeds_or_ranges_it_was_not_trained_at():
+    import warnings
+
+    from strategies.policies.learned import UnseenParametersWarning
+
+    policy = zoo.load("dagger_pursuer_generalist")  # trained at l_min 2, l_max 4, rho 0.5
+    cases = (
+        ("corridor", {}, None),
+        ("corridor~x2", {}, None),  # l_min 4, speeds 2: the same game up to scale
+        ("pillars", {"l_min": 4.0, "l_max": 8.0, "v_pursuer": 2.0, "v_evader": 1.0}, None),
+        ("corridor", {"v_evader": 0.8},
+         r"rho = v_evader / v_pursuer: 0\.5 in training \(0\.5 / 1\), 0\.8 here \(0\.8 / 1\)"),
+        ("corridor", {"l_min": 1.0},
+         r"l_max / l_min: 2 in training \(4 / 2\), 4 here \(4 / 1\); the pursuer's step "
+         r"in L_min, v_pursuer \* dt / l_min: 0\.05 in training \(1 \* 0\.1 / 2\), 0\.1 here"),
+        ("corridor", {"dt": 0.2}, r"v_pursuer \* dt / l_min: 0\.05 in training .* 0\.1 here"),
+    )  # fmt: skip
+    for world, overrides, want in cases:
+        env = surveillance_v1.parallel_env(map=world, **overrides, **policy.observation_options)
+        with warnings.catch_warnings(record=True) as got:
+            warnings.simplefilter("always")
+            for seed in (0, 1):  # was: no word at all
+                policy.reset(role="pursuer", map=env.config.map, config=env.config, seed=seed)
+        said = [str(w.message) for w in got if issubclass(w.category, UnseenParametersWarning)]
+        assert len(said) == (0 if want is None else 1), (world, overrides, said)  # once
+        if want is not None:
+            assert re.search(want, said[0]), said[0]
 
 
 def test_unknown_model():

@@ -10,6 +10,12 @@ never glued to the next row; any other line that is not a row of this script (no
 a row of another script, without the fields of its key) is refused before anything is
 played or appended.
 
+One run appends to a results file at a time: :func:`appending` holds an exclusive
+``flock`` on it for the whole run (the kernel releases it however the run ends), and a
+second run on the same file is refused at once, before it plays anything, naming the
+holder where the system says (:class:`ResultsBusyError`); two runs' rows interleaved, and
+each truncated the other's row in flight as a row cut short by a kill.
+
 Each row records the code that played it (``"code"``: the commit, and a digest of the
 uncommitted changes to the package's sources when there are any; :func:`code_version`).
 A rerun reuses rows whatever code played them, since an episode's key does not name the
@@ -20,6 +26,8 @@ plays them with this code).
 
 from __future__ import annotations
 
+import contextlib
+import fcntl
 import functools
 import hashlib
 import json
@@ -31,10 +39,47 @@ from typing import IO, Any
 
 from envs.errors import InvalidConfigError
 
-__all__ = ["appending", "code_version", "key", "read"]
+__all__ = ["ResultsBusyError", "appending", "code_version", "key", "read"]
 
 SOURCES = ("envs", "strategies", "analysis", "training", "benchmarks")
 """The folders whose code plays an episode (their uncommitted changes count too)."""
+
+
+class ResultsBusyError(InvalidConfigError):
+    """Another run is appending to the results file (it holds the file's lock)."""
+
+
+def _lock(f: IO, path: str | os.PathLike, exclusive: bool) -> None:
+    """``flock`` the open file ``f`` without waiting (shared to read, exclusive to append).
+
+    Raises:
+        ResultsBusyError: another run holds the exclusive lock (or, for an exclusive one,
+            any lock), naming the file and, where ``/proc/locks`` says, its holder.
+    """
+    try:
+        fcntl.flock(f.fileno(), (fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH) | fcntl.LOCK_NB)
+    except BlockingIOError:
+        holder = _holder(f.fileno())
+        raise ResultsBusyError(
+            f"{os.fspath(path)}: another run{f' ({holder})' if holder else ''} is appending "
+            "to this results file; wait for it to finish, or give this run another --results "
+            "file (two runs on one file interleave their rows)"
+        ) from None
+
+
+def _holder(fd: int) -> str | None:
+    """``pid N`` of the process holding a ``flock`` on ``fd``'s file, from ``/proc/locks``
+    (Linux), or None."""
+    st = os.fstat(fd)
+    device = f"{os.major(st.st_dev):02x}:{os.minor(st.st_dev):02x}:{st.st_ino}"
+    with contextlib.suppress(OSError):
+        with open("/proc/locks") as f:
+            for line in f:
+                fields = line.split()  # "1: FLOCK ADVISORY WRITE 4242 08:01:1234 0 EOF"
+                if len(fields) >= 6 and fields[1] == "FLOCK" and fields[5] == device:
+                    if fields[4] != str(os.getpid()):
+                        return f"pid {fields[4]}"
+    return None
 
 
 def _git(*args: str) -> str | None:
@@ -80,6 +125,8 @@ def read(
     that compares code versions itself, ``policy_sets.py``).
 
     Raises:
+        ResultsBusyError: another run is appending to ``path`` (refused before anything is
+            played, rather than by :func:`appending`).
         InvalidConfigError: a line is not a JSON object (the file is not such a results
             file), the last one included unless it was cut short (no newline after it), or
             a row lacks a field of ``key_of`` (a results file of another script); the
@@ -89,6 +136,7 @@ def read(
     if not os.path.exists(path):
         return rows
     with open(path) as f:
+        _lock(f, path, exclusive=False)
         text = f.read()
     lines = text.split("\n")  # a row cut short is the last item (text ends without "\n")
     expected = "expected a results file of JSON lines (one episode a line) of this script"
@@ -123,17 +171,22 @@ def read(
 
 @contextmanager
 def appending(path: str | os.PathLike) -> Iterator[Callable[[dict], None]]:
-    """``write(row)``: append one row to ``path`` and flush it. The directory is made,
-    and a last line cut short by a hard kill (no newline after it) is removed first: it
-    is no row (:func:`read` drops it), and the next row must start a line of its own."""
+    """``write(row)``: append one row to ``path`` and flush it, holding the file's
+    exclusive lock until the block ends. The directory is made, and a last line cut short
+    by a hard kill (no newline after it) is removed first: it is no row (:func:`read`
+    drops it), and the next row must start a line of its own.
+
+    Raises:
+        ResultsBusyError: another run is appending to ``path``; nothing is changed.
+    """
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-    if os.path.exists(path):
-        with open(path, "rb+") as f:
-            data = f.read()
+    with open(path, "a") as f:
+        _lock(f, path, exclusive=True)  # before the truncation: another run's row in flight
+        with open(path, "rb+") as g:
+            data = g.read()
             end = data.rfind(b"\n") + 1
             if end < len(data):
-                f.truncate(end)
-    with open(path, "a") as f:
+                g.truncate(end)
 
         def write(row: dict) -> None:
             _write(f, row if "code" in row else {**row, "code": code_version()})

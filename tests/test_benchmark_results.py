@@ -247,3 +247,64 @@ def test_pursuer_holds_prints_a_surveil_play_command_that_replays_a_variant_loss
     printed = capsys.readouterr().out
     assert f"evader escaped at t = {t:.3f} s ({cause})" in printed, printed
     assert gif.stat().st_size > 0
+
+
+@pytest.fixture
+def appending_elsewhere():
+    """Another process appends to a results file (holds its lock) until the block ends;
+    the block gets its pid. The file holds that run's row in flight (no newline yet)."""
+    import contextlib
+    import subprocess
+    import sys
+
+    @contextlib.contextmanager
+    def hold(path: Path):
+        code = (
+            f"import sys; sys.path[:0] = [{str(BENCHMARKS)!r}, {str(BENCHMARKS.parent)!r}]\n"
+            "import episode_rows, time\n"
+            f"with episode_rows.appending({str(path)!r}):\n"
+            f"    open({str(path)!r}, 'a').write('{{\"world\": \"open')\n"
+            "    print('holding', flush=True)\n"
+            "    time.sleep(60)\n"
+        )
+        holder = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+        try:
+            assert holder.stdout.readline().strip() == "holding"
+            yield holder.pid
+        finally:
+            holder.kill()
+            holder.wait()
+
+    return hold
+
+
+def test_a_second_run_on_a_results_file_in_use_is_refused_and_changes_nothing(
+    bench, tmp_path, capsys, appending_elsewhere
+):
+    """Two runs on one --results file interleaved their rows, and the second truncated the
+    first's row in flight as if a kill had cut it short; now the second is refused at once
+    (exit 2, one line naming the file and the holder), before it plays anything."""
+    holds = bench("pursuer_holds")
+    rows = bench("episode_rows")
+    bench_cli = bench("bench_cli")
+    out = tmp_path / "holds.jsonl"
+    argv = ["--worlds", "open_room", "--variants", "as is", "--rho", "0.3", "--seeds", "1",
+            "--no-greedy", "--workers", "1", "--max-cycles", "30",
+            "--results", str(out)]  # fmt: skip
+    with appending_elsewhere(out) as pid:
+        before = out.read_text()
+        old = signal.getsignal(signal.SIGTERM)
+        try:
+            assert bench_cli.run(lambda: holds.main(argv)) == 2
+        finally:
+            signal.signal(signal.SIGTERM, old)
+        err = capsys.readouterr().err
+        assert f"holds.jsonl: another run (pid {pid}) is appending to this results file" in err
+        assert "Traceback" not in err and len(err.strip().splitlines()) == 1
+        with pytest.raises(rows.ResultsBusyError, match="another --results file"):
+            with rows.appending(out):  # reached past read() too: the row in flight is kept
+                pass
+        assert out.read_text() == before == '{"world": "open'
+    with rows.appending(out) as write:  # the holder gone, the file is free again
+        write({"id": 2})
+    assert _lines(out) == ['{"id": 2, "code": ' + json.dumps(rows.code_version()) + "}"]

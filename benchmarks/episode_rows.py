@@ -12,9 +12,10 @@ played or appended.
 
 One run appends to a results file at a time: :func:`appending` holds an exclusive
 ``flock`` on it for the whole run (the kernel releases it however the run ends), and a
-second run on the same file is refused at once, before it plays anything, naming the
-holder where the system says (:class:`ResultsBusyError`); two runs' rows interleaved, and
-each truncated the other's row in flight as a row cut short by a kill.
+second run on the same file is refused as it starts to append, before it plays anything,
+naming the holder where the system says (:class:`ResultsBusyError`); two runs' rows
+interleaved, and each truncated the other's row in flight as a row cut short by a kill.
+Reading needs no lock (a report may read a file in use).
 
 Each row records the code that played it (``"code"``: the commit, and a digest of the
 uncommitted changes to the package's sources when there are any; :func:`code_version`).
@@ -49,15 +50,15 @@ class ResultsBusyError(InvalidConfigError):
     """Another run is appending to the results file (it holds the file's lock)."""
 
 
-def _lock(f: IO, path: str | os.PathLike, exclusive: bool) -> None:
-    """``flock`` the open file ``f`` without waiting (shared to read, exclusive to append).
+def _lock(f: IO, path: str | os.PathLike) -> None:
+    """``flock`` the open file ``f`` exclusively, without waiting.
 
     Raises:
-        ResultsBusyError: another run holds the exclusive lock (or, for an exclusive one,
-            any lock), naming the file and, where ``/proc/locks`` says, its holder.
+        ResultsBusyError: another run holds the lock, naming the file and, where
+            ``/proc/locks`` says, its holder.
     """
     try:
-        fcntl.flock(f.fileno(), (fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH) | fcntl.LOCK_NB)
+        fcntl.flock(f.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
     except BlockingIOError:
         holder = _holder(f.fileno())
         raise ResultsBusyError(
@@ -124,9 +125,10 @@ def read(
     ``note_other_code=False`` leaves out the note on rows played by other code (a reader
     that compares code versions itself, ``policy_sets.py``).
 
+    Reading takes no lock: a report may read a file another run is appending to (its
+    row in flight, cut short, is dropped as above).
+
     Raises:
-        ResultsBusyError: another run is appending to ``path`` (refused before anything is
-            played, rather than by :func:`appending`).
         InvalidConfigError: a line is not a JSON object (the file is not such a results
             file), the last one included unless it was cut short (no newline after it), or
             a row lacks a field of ``key_of`` (a results file of another script); the
@@ -136,7 +138,6 @@ def read(
     if not os.path.exists(path):
         return rows
     with open(path) as f:
-        _lock(f, path, exclusive=False)
         text = f.read()
     lines = text.split("\n")  # a row cut short is the last item (text ends without "\n")
     expected = "expected a results file of JSON lines (one episode a line) of this script"
@@ -181,7 +182,7 @@ def appending(path: str | os.PathLike) -> Iterator[Callable[[dict], None]]:
     """
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     with open(path, "a") as f:
-        _lock(f, path, exclusive=True)  # before the truncation: another run's row in flight
+        _lock(f, path)  # before the truncation: another run's row in flight
         with open(path, "rb+") as g:
             data = g.read()
             end = data.rfind(b"\n") + 1

@@ -302,8 +302,9 @@ def test_a_second_run_on_a_results_file_in_use_is_refused_and_changes_nothing(
         assert f"holds.jsonl: another run (pid {pid}) is appending to this results file" in err
         assert "Traceback" not in err and len(err.strip().splitlines()) == 1
         with pytest.raises(rows.ResultsBusyError, match="another --results file"):
-            with rows.appending(out):  # reached past read() too: the row in flight is kept
+            with rows.appending(out):  # the row in flight is kept
                 pass
+        assert rows.read(out, lambda r: r["world"]) == {}  # a report may read it meanwhile
         assert out.read_text() == before == '{"world": "open'
     with rows.appending(out) as write:  # the holder gone, the file is free again
         write({"id": 2})

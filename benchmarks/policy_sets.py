@@ -13,11 +13,12 @@ such directories::
     python benchmarks/policy_sets.py compare out/base out/cand
 
 The scripts run from the checkout this file is in (its code plays), one after the other,
-each printing its own report; their rows record that code (``"code"``). ``compare`` lists
-per set the episodes the candidate lost that the base won and those it gained (world,
-opponent, seed, cause and time of the loss, and the command that replays it), counts the
-rows only one side has, says when a side's rows come from more than one code version, and
-exits with status 1 when the candidate lost an episode the base won (0 otherwise; 2 for a
+each printing its own report; their rows record that code (``"code"``). ``compare`` lists,
+per set both directories hold (a set only one holds is named, not compared), the episodes
+the candidate lost that the base won and those it gained (world, opponent, seed, cause and
+time of the loss, and the command that replays it), counts the rows only one side has,
+says when a side's rows come from more than one code version, and exits with status 1
+when the candidate lost an episode the base won (0 otherwise; 2 for a
 bad directory or file), so a session can gate on it.
 
 Which side won, per script (their rows differ): ``pursuer_holds.py`` keeps
@@ -264,9 +265,24 @@ def _describe(e: Episode) -> str:
 
 
 def compare(base: str, cand: str, sets: Mapping[str, PolicySet] = SETS) -> int:
-    """Print, per set in either directory, the episodes whose winner changed from ``base``
-    to ``cand``; 1 when ``cand`` lost an episode ``base`` won, else 0."""
-    names = [n for n in sets if n in set(_sets_in(base, sets)) | set(_sets_in(cand, sets))]
+    """Print, per set in both directories, the episodes whose winner changed from ``base``
+    to ``cand``; 1 when ``cand`` lost an episode ``base`` won, else 0.
+
+    Raises:
+        InvalidConfigError: a directory is missing or holds no set, or the two hold no set
+            in common.
+    """
+    in_base, in_cand = _sets_in(base, sets), _sets_in(cand, sets)
+    names = [n for n in in_base if n in in_cand]
+    if not names:
+        raise InvalidConfigError(
+            f"{base!r} and {cand!r} have no set in common (base: {', '.join(in_base)}; "
+            f"cand: {', '.join(in_cand)}); expected results files of the same set in both"
+        )
+    for side, only in (("base", in_base), ("cand", in_cand)):
+        if set(only) - set(names):
+            print(f"sets only in {side} (not compared): "
+                  f"{', '.join(n for n in only if n not in names)}")  # fmt: skip
     lost_any = 0
     for name in names:
         s = sets[name]

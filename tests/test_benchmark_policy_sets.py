@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import importlib
 import json
+import shutil
 import signal
 from pathlib import Path
 
@@ -255,3 +256,21 @@ def test_run_says_which_script_failed_and_exits_non_zero(ps, tmp_path, capsys):
     out = capsys.readouterr().out
     assert "== bad: pursuer_holds.py exited with status 2" in out
     assert "failed: bad" in out
+
+
+def test_a_set_only_one_directory_holds_is_named_not_compared(ps, corner_runs, tmp_path, capsys):
+    root, tiny = corner_runs
+    other = _tiny(ps, "other", "unseen_worlds.py", CORNER)
+    sets = {"corner": tiny, "other": other}
+    shutil.copy(root / "long" / "corner.jsonl", tmp_path / "other.jsonl")
+    assert ps.compare(str(root / "long"), str(root / "short"), sets) == 0
+    assert "sets only in" not in capsys.readouterr().out
+    (tmp_path / "base").mkdir()
+    shutil.copy(root / "long" / "corner.jsonl", tmp_path / "base" / "corner.jsonl")
+    shutil.copy(root / "long" / "corner.jsonl", tmp_path / "base" / "other.jsonl")
+    assert ps.compare(str(tmp_path / "base"), str(root / "short"), sets) == 0
+    out = capsys.readouterr().out
+    assert "sets only in base (not compared): other" in out and "other (pursuer" not in out
+    with pytest.raises(InvalidConfigError, match=r"have no set in common \(base: corner; "
+                       r"cand: other\)"):  # fmt: skip
+        ps.compare(str(root / "long"), str(tmp_path), sets)

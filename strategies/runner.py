@@ -29,10 +29,18 @@ the concrete policy of the episode with its role's seed.
 **Failures.** An exception raised by a policy's ``act`` (or a non-``ValueError`` one from
 its ``reset``), or an action the env refuses (NaN, inf, a wrong shape, not numbers: the
 env's :class:`~envs.errors.InvalidActionError`), becomes a :class:`PolicyFailure` naming
-the role, the policy and the step (the original exception is its ``__cause__``); a
-``time_limit`` overrun is an :class:`EpisodeTimeout` blaming the role that spent more time
-deciding. Configuration errors (``ValueError`` subclasses, see :mod:`envs.errors`)
-propagate unchanged.
+the role, the policy and the step (the original exception is its ``__cause__``).
+Configuration errors (``ValueError`` subclasses, see :mod:`envs.errors`) propagate
+unchanged.
+
+**Time limits are chess clocks.** ``time_limit`` is what each role may spend deciding in
+the episode: its clock runs during its policy's ``reset`` and each of its ``act`` calls,
+and only then. Building the env, drawing the start, making observations and stepping the
+env are on no clock. The clock is read as each call returns, and a role whose clock has
+passed the limit loses at once (:class:`EpisodeTimeout`, which blames that role whichever
+side was slower overall). ``on_clock(role, seconds_left)`` is told when a policy starts
+deciding and ``on_clock(None, None)`` when it stops (a tournament worker arms its alarm
+and tells its driver from these).
 
 Examples:
     >>> r = run_episode("open_room", "pursuer/greedy", "evader/straight", seed=3, max_cycles=20)
@@ -42,6 +50,7 @@ Examples:
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import time
 from collections.abc import Callable, Mapping
@@ -102,7 +111,7 @@ class PolicyFailure(RuntimeError):
 
 
 class EpisodeTimeout(PolicyFailure):
-    """The episode exceeded its wall-clock ``time_limit``; ``role`` decided slower."""
+    """``role``'s decision clock (its reset and acts) passed the episode's ``time_limit``."""
 
 
 # --------------------------------------------------------------------------- records
@@ -387,6 +396,7 @@ def run_episode(
     on_frame: Callable[[np.ndarray], None] | None = None,
     record: bool = False,
     time_limit: float | None = None,
+    on_clock: Callable[[str | None, float | None], None] | None = None,
 ) -> EpisodeResult:
     """Play one episode between two policies.
 
@@ -408,7 +418,11 @@ def run_episode(
         on_frame: called with each rendered RGB frame (the env renders ``"rgb_array"``);
             frames are not kept, so a writer can stream them.
         record: also keep the frames in ``result.frames`` (memory grows with the episode).
-        time_limit: wall-clock seconds the episode may take (> 0); checked between steps.
+        time_limit: wall-clock seconds each role may spend deciding in the episode (> 0):
+            its ``reset`` and all its ``act`` calls (see the module docstring).
+        on_clock: called with ``(role, seconds left on its clock)`` (``None`` without a
+            limit) as a policy starts a ``reset`` or ``act``, and with ``(None, None)`` as
+            it returns.
 
     Returns:
         The :class:`EpisodeResult`.
@@ -416,13 +430,14 @@ def run_episode(
     Raises:
         PolicyFailure: a policy raised while playing, or returned an action the env
             refuses (its role forfeits).
-        EpisodeTimeout: ``time_limit`` was exceeded.
+        EpisodeTimeout: a role's decision clock passed ``time_limit`` (that role).
         InvalidConfigError: bad arguments (names, overrides, start, observations,
             time_limit).
     """
     from strategies.policies.starts import START_KINDS, sample_start
 
     t_start = time.perf_counter()
+    clocks = _Clocks(time_limit, on_clock)
     if time_limit is not None:  # a bad limit is the caller's error, not a policy's forfeit
         from envs.validation import positive
 
@@ -462,9 +477,10 @@ def run_episode(
             )
         for role, pol in policies.items():
             try:
-                pol.reset(
-                    role=role, map=config.map, config=observers[role].config, seed=seeds[role]
-                )
+                with clocks.deciding(role):
+                    pol.reset(
+                        role=role, map=config.map, config=observers[role].config, seed=seeds[role]
+                    )
             except MemoryBudgetError as exc:  # say whose parameter (the table's resolution)
                 knob = exc.args[1]
                 if not knob or _name(pol) in knob:
@@ -474,6 +490,7 @@ def run_episode(
                 raise
             except Exception as exc:
                 raise PolicyFailure(role, _name(pol), -1, _describe(exc)) from exc
+            clocks.check(role, _name(pol), -1)
         obs, infos = env.reset(seed=s_env, options=placement)
         frames: list[np.ndarray] | None = [] if record else None
         _emit_frame(env, on_frame, frames)
@@ -487,12 +504,13 @@ def run_episode(
             state = env.state() if on_step is not None else None
             actions = {}
             for role, pol in policies.items():
-                t0 = time.perf_counter()
                 try:
-                    actions[role] = pol.act(seen[role])
+                    with clocks.deciding(role) as took:
+                        actions[role] = pol.act(seen[role])
                 except Exception as exc:
                     raise PolicyFailure(role, _name(pol), steps, _describe(exc)) from exc
-                dt = time.perf_counter() - t0
+                clocks.check(role, _name(pol), steps)
+                dt = took[0]
                 try:  # an action the env refuses (NaN, wrong shape...) is the policy's fault
                     env._command(AGENT[role], actions[role])
                 except InvalidActionError as exc:
@@ -511,17 +529,6 @@ def run_episode(
             if on_step is not None:  # copies: a policy may reuse its action's buffer
                 taken = {r: np.array(a, dtype=float) for r, a in actions.items()}
                 on_step(Transition(steps - 1, seen, state, taken, info, not env.agents))
-            if time_limit is not None and env.agents:
-                if time.perf_counter() - t_start > time_limit:
-                    blame = max(spent, key=spent.get)
-                    raise EpisodeTimeout(
-                        blame,
-                        _name(policies[blame]),
-                        steps,
-                        f"episode exceeded its time limit of {time_limit:g} s "
-                        f"(decision time: pursuer {spent['pursuer']:.2f} s, "
-                        f"evader {spent['evader']:.2f} s)",
-                    )
     finally:
         env.close()
     return EpisodeResult(
@@ -548,6 +555,46 @@ def run_episode(
         config=config,
         frames=frames,
     )
+
+
+class _Clocks:
+    """The two roles' decision clocks of one episode (see the module docstring)."""
+
+    def __init__(
+        self, limit: float | None, watch: Callable[[str | None, float | None], None] | None
+    ) -> None:
+        self.limit = limit
+        self.watch = watch
+        self.spent = {"pursuer": 0.0, "evader": 0.0}
+
+    @contextlib.contextmanager
+    def deciding(self, role: str):
+        """Run ``role``'s clock for the body; yields a list that gets the seconds it took."""
+        took = [0.0]
+        if self.watch is not None:
+            self.watch(role, None if self.limit is None else self.limit - self.spent[role])
+        t0 = time.perf_counter()
+        try:
+            yield took
+        finally:
+            took[0] = time.perf_counter() - t0
+            self.spent[role] += took[0]
+            if self.watch is not None:
+                self.watch(None, None)
+
+    def check(self, role: str, policy: str, step: int) -> None:
+        """Raise :class:`EpisodeTimeout` if ``role``'s clock has passed the limit."""
+        if self.limit is None or self.spent[role] <= self.limit:
+            return
+        other = "evader" if role == "pursuer" else "pursuer"
+        raise EpisodeTimeout(
+            role,
+            policy,
+            step,
+            f"its clock ran out: {self.spent[role]:.2f} s of decision time (reset and acts) "
+            f"against the time limit of {self.limit:g} s per role (the {other}'s clock: "
+            f"{self.spent[other]:.2f} s)",
+        )
 
 
 def _requests(

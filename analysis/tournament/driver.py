@@ -7,6 +7,10 @@ or SIGTERM stops it within a second or two: workers are stopped, the matches in 
 are dropped (they are replayed on resume), and the summary says how to resume. A rerun
 of the same spec on the same store resumes; nothing stored is played again.
 
+A store may hold a run of the same spec played by an older surveil whose time limit meant
+something else (:data:`~analysis.tournament.spec.TIME_LIMIT_RULE`): its matches have
+other identities and are not reused, the run is a new one, and the summary says so.
+
 A spec with an ``[sprt]`` table stops as soon as Wald's sequential test on the
 candidate's and the baseline's paired starts is decided (run status ``decided``); the
 matches left are not played. Matches are planned seed-major, so pairs complete as the
@@ -145,6 +149,7 @@ def run_tournament(
             done = db.finished(spec.run_id, include_errors=False)
         todo = [m for m, _ in unique if m.match_id not in done]
         summary = RunSummary(spec.run_id, spec.name, path, len(unique), len(unique) - len(todo))
+        summary.messages += _older_runs(db, spec)
         test = Sequential(spec.sprt, db.rows(spec.run_id)) if spec.sprt else None
         if test is not None and test.decision is not None:
             todo = []
@@ -176,6 +181,22 @@ def run_tournament(
         db.close()
         if summary is not None:
             summary.seconds = time.monotonic() - t0
+
+
+def _older_runs(db: Store, spec: Spec) -> list[str]:
+    """A line for each run of ``spec`` in ``db`` an older surveil played (not reused)."""
+    from analysis.tournament.spec import TIME_LIMIT_RULE
+
+    bare = {k: v for k, v in spec.to_dict().items() if k != "time_limit_rule"}
+    return [
+        f"run {r['run_id']} in {db.path} is this spec played by an older surveil, whose time "
+        "limit counted the whole match (the env's set-up included) and blamed the side "
+        f"that had decided slower: none of its {r['done']} stored matches is reused, and "
+        f"this run ({spec.run_id}) plays them with a clock per role ({TIME_LIMIT_RULE}); "
+        f"the old run stays in the store (surveil report {db.path} --run {r['run_id']})"
+        for r in db.runs()
+        if r["run_id"] != spec.run_id and r["spec"] == bare
+    ]
 
 
 class Sequential:

@@ -10,7 +10,9 @@ leaves no process behind. A new backend is one class.
 * :class:`ProcessExecutor` -- N worker processes fed batches through pipes (default).
   Workers die with the driver even on SIGKILL (``PR_SET_PDEATHSIG`` on Linux, a
   parent-watching thread elsewhere), ignore Ctrl-C (the driver handles it), and a worker
-  whose match runs past the time limit plus :data:`KILL_GRACE` is killed and replaced.
+  still busy :data:`KILL_GRACE` seconds after the deciding role's clock ran out (or the
+  harness's stretch did: see :mod:`~analysis.tournament.worker`) is killed and replaced:
+  the role that was deciding forfeits; with none deciding the match is an error.
 * :class:`RayExecutor` -- Ray core tasks (``ray.init(address=...)`` for a cluster, a local
   instance otherwise), the context put in the object store once, batches of about
   :data:`TARGET_BATCH_SECONDS` each.
@@ -31,7 +33,7 @@ from multiprocessing.connection import Connection, wait
 from typing import Any
 
 from analysis.tournament.identity import Match
-from analysis.tournament.worker import Context, play, warm_up
+from analysis.tournament.worker import ALARM_GRACE, Board, Context, forfeit, play, warm_up
 
 __all__ = [
     "BACKENDS",
@@ -49,7 +51,8 @@ BACKENDS = ("serial", "process", "ray")
 TARGET_BATCH_SECONDS = 1.0
 """Aim for tasks of about this long (fewer messages; Ray's per-task cost is ~ms)."""
 KILL_GRACE = 5.0
-"""Seconds past a match's time limit before its worker process is killed."""
+"""Seconds past the end of the deciding role's clock (or of the harness's stretch) before
+a process worker is killed."""
 POLL = 0.1
 """Seconds between checks of the stop event and the deadlines."""
 
@@ -108,6 +111,7 @@ class SerialExecutor(Executor):
         self.in_match = False
 
     def run(self, matches: Sequence[Match], ctx: Context, stop: threading.Event) -> Iterator[dict]:
+        warm_up()  # as a process or Ray worker does: the imports are on no match's time
         for m in matches:
             if stop.is_set():
                 return
@@ -142,7 +146,7 @@ def _die_with_parent(parent: int) -> None:
     threading.Thread(target=watch, daemon=True).start()
 
 
-def _worker_main(conn: Connection, ctx: Context, parent: int) -> None:
+def _worker_main(conn: Connection, ctx: Context, parent: int, board: Board) -> None:
     _die_with_parent(parent)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the driver's business
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
@@ -156,16 +160,17 @@ def _worker_main(conn: Connection, ctx: Context, parent: int) -> None:
             break
         for m in batch:
             conn.send(("start", m.match_id, time.monotonic()))
-            conn.send(("done", play(m, ctx)))
+            conn.send(("done", play(m, ctx, board)))
     conn.close()
 
 
 class _Worker:
     def __init__(self, mpctx: Any, ctx: Context) -> None:
         self.conn, child = mpctx.Pipe()
+        self.board = Board(mpctx)
         self.proc = mpctx.Process(
             target=_worker_main,
-            args=(child, ctx, os.getpid()),
+            args=(child, ctx, os.getpid(), self.board),
             daemon=True,
             name="surveil-tournament-worker",
         )
@@ -173,7 +178,28 @@ class _Worker:
         child.close()
         self.batch: collections.deque[Match] = collections.deque()
         self.current: Match | None = None
-        self.since = 0.0
+
+    def overrun(self, now: float, grace: float) -> dict | None:
+        """The outcome to store if the match in play is ``grace`` past its board's deadline."""
+        seen = self.board.read() if self.current is not None else None
+        if seen is None or now <= seen[1] + grace:
+            return None
+        role, _ = seen
+        mid = self.current.match_id
+        if role is None:
+            return {
+                "match_id": mid,
+                "status": "error",
+                "error": f"killed: the env or the harness gave no answer for the time limit "
+                f"+ {grace:g} s while no policy was deciding (a hang the alarm could not "
+                "interrupt)",
+            }
+        return forfeit(
+            mid,
+            role,
+            f"{role} killed: no answer {grace:g} s after its clock ran out (a hang the "
+            "alarm could not interrupt)",
+        )
 
     def kill(self) -> None:
         if self.proc.is_alive():
@@ -235,7 +261,7 @@ class ProcessExecutor(Executor):
                     while w.conn.poll():
                         msg = w.conn.recv()
                         if msg[0] == "start":
-                            w.current, w.since = w.batch.popleft(), time.monotonic()
+                            w.current = w.batch.popleft()
                         else:
                             w.current = None
                             batcher.observe(msg[1])
@@ -245,27 +271,25 @@ class ProcessExecutor(Executor):
                 except (EOFError, OSError):
                     # the worker died (killed by the OOM killer, a segfault in a policy...)
                     lost = w.current
-                    yield from self._replace(w, ctx, todo, lost, "worker process died")
+                    why = {"status": "error", "error": "worker process died"}
+                    yield from self._replace(
+                        w, ctx, todo, None if lost is None else {"match_id": lost.match_id, **why}
+                    )
             now = time.monotonic()
             for w in list(self.pool):
-                if w.current is not None and now - w.since > ctx.time_limit + self.kill_grace:
-                    yield from self._replace(
-                        w,
-                        ctx,
-                        todo,
-                        w.current,
-                        f"killed: no answer {ctx.time_limit + self.kill_grace:g} s into the match "
-                        "(a hang the time limit could not interrupt)",
-                    )
+                outcome = w.overrun(now, self.kill_grace)
+                if outcome is not None:
+                    yield from self._replace(w, ctx, todo, outcome)
 
     def _replace(
-        self, w: _Worker, ctx: Context, todo: collections.deque, lost: Match | None, why: str
+        self, w: _Worker, ctx: Context, todo: collections.deque, lost: dict | None
     ) -> Iterator[dict]:
+        """Kill ``w``, queue its unplayed batch again, yield ``lost`` (its match's outcome)."""
         w.kill()
         todo.extendleft(reversed(w.batch))  # the unplayed rest goes back to the queue
         self.pool.remove(w)
         if lost is not None:
-            yield {"match_id": lost.match_id, "status": "error", "error": why}
+            yield lost
         if todo:
             self.pool.append(_Worker(self.mpctx, ctx))
 
@@ -333,6 +357,11 @@ def _register_missing(registrations: dict[str, tuple[Any, str]]) -> None:
             register_policy(name, factory, description)
 
 
+def _ray_allowance(time_limit: float) -> float:
+    """Seconds from a match's start before the Ray driver kills its task."""
+    return 3 * (time_limit + ALARM_GRACE) + KILL_GRACE
+
+
 class _RayTask:
     """The driver's view of one Ray task: its batch and what it has reported."""
 
@@ -344,10 +373,15 @@ class _RayTask:
         self.since: float | None = None  # the driver's clock at its last match report
 
     def deadline(self, time_limit: float) -> float | None:
-        """When to kill it: ``None`` until it starts a match (queued, or its worker starting)."""
+        """When to kill it: ``None`` until it starts a match (queued, or its worker starting).
+
+        The driver cannot see which role a Ray worker's match is deciding, so it allows
+        the match both clocks and as long again for the env and the harness, each with the
+        alarm's grace, and :data:`KILL_GRACE` more.
+        """
         if self.since is None:
             return None
-        return self.since + time_limit + 1.0 + KILL_GRACE
+        return self.since + _ray_allowance(time_limit)
 
 
 class RayExecutor(Executor):
@@ -360,10 +394,12 @@ class RayExecutor(Executor):
             is already initialised, the most CPUs this run's tasks occupy at once.
 
     Up to two tasks per CPU are in flight, so a task may wait in Ray's queue. A task
-    reports when it starts each match (it is a generator, see :func:`_ray_play`), and the
-    driver kills its worker when a match runs past the time limit plus one second (the
-    worker's own alarm) plus :data:`KILL_GRACE`, timed from that report, as the process
-    backend does. A wait in Ray's queue, a worker's start and its fetching of the context
+    reports when it starts each match (it is a generator, see :func:`_ray_play`). Within a
+    match the worker's own alarm blames the role whose clock ran out, as in the other
+    backends; a hang the alarm cannot interrupt is killed by the driver three times the
+    time limit plus the alarm's grace, plus :data:`KILL_GRACE`, after that report (the
+    driver cannot see who is deciding in a Ray worker: such a match is an error, charged
+    to nobody). A wait in Ray's queue, a worker's start and its fetching of the context
     are no match's time and are not timed: timed from the submission, with a guessed
     allowance (30 s), they outran it at load 14 on 2 cores (a worker's start 23 s, the
     context 14 s more) and matches that never overran were stored as overruns. A hang
@@ -448,8 +484,9 @@ class RayExecutor(Executor):
                     ray.cancel(gen, force=True)
                     del self.inflight[gen]
                     why = (
-                        f"killed: no answer {ctx.time_limit + 1.0 + KILL_GRACE:g} s into "
-                        "the match (the Ray task overran the time limit)"
+                        f"killed: no answer {_ray_allowance(ctx.time_limit):g} s into "
+                        "the match (a hang the alarm could not interrupt; on Ray the driver "
+                        "cannot tell which role was deciding)"
                     )
                     yield from self._lost(task, todo, solo, why)
 

@@ -1,13 +1,15 @@
 """Match identity: a content hash of everything that decides a match's outcome.
 
 A match is one episode: a map, an env configuration, a pursuer, an evader, a start kind
-and a seed. Its identity hashes the map's *geometry* digest (not its path or name), the
-resolved env parameters, each policy's name, parameters, observation and, for a learned
-model, the SHA-256 of its file (not its path), the start kind, the seed and the spec's
-``salt``. The same identity means the same record, bit for bit, so a store reuses it;
-anything changed (an edited map file, a retrained model at the same path, a parameter)
-is a new match. Policy *code* is not hashed: set the spec's ``salt`` (e.g. to a git SHA)
-to invalidate results after changing a policy's implementation.
+and a seed, played under a time limit. Its identity hashes the map's *geometry* digest
+(not its path or name), the resolved env parameters, each policy's name, parameters,
+observation and, for a learned model, the SHA-256 of its file (not its path), the start
+kind, the seed, the time limit (a slow policy forfeits under a short one, not under a
+long one) and the spec's ``salt``. The same identity means the same record, bit for bit,
+so a store reuses it; anything changed (an edited map file, a retrained model at the same
+path, a parameter, the time limit) is a new match. Policy *code* is not hashed: set the
+spec's ``salt`` (e.g. to a git SHA) to invalidate results after changing a policy's
+implementation.
 """
 
 from __future__ import annotations
@@ -22,8 +24,12 @@ from analysis.tournament.spec import Spec
 
 __all__ = ["IDENTITY_VERSION", "Match", "match_identity", "plan"]
 
-IDENTITY_VERSION = 1
-"""Bumped when the meaning of an identity field changes (all old matches become new)."""
+IDENTITY_VERSION = 2
+"""Bumped when the meaning of an identity field changes (all old matches become new).
+
+2: the time limit is each role's decision clock (it was the whole match's wall-clock
+time, the env's set-up included, blamed on the side that had decided slower), and it is
+part of the identity (a forfeit on time under one limit was reused under another)."""
 
 ENV_ID = "surveillance_v1"
 
@@ -58,6 +64,7 @@ def match_identity(
     evader: dict[str, Any],
     start: str,
     seed: int,
+    time_limit: float,
     salt: str = "",
 ) -> tuple[str, dict[str, Any]]:
     """The identity hash of a match and the canonical dict it hashes."""
@@ -70,6 +77,7 @@ def match_identity(
         "evader": evader,
         "start": start,
         "seed": int(seed),
+        "time_limit": float(time_limit),
         "salt": salt,
     }
     text = json.dumps(doc, sort_keys=True, separators=(",", ":"), allow_nan=False)
@@ -97,6 +105,7 @@ def plan(spec: Spec) -> Iterator[tuple[Match, dict[str, Any]]]:
                                 evader=e.identity(),
                                 start=start,
                                 seed=seed,
+                                time_limit=spec.time_limit,
                                 salt=spec.salt,
                             )
                             yield Match(mid, m.label, v.label, p.label, e.label, start, seed), doc

@@ -589,11 +589,25 @@ def _header(a: Analysis) -> list[str]:
         f"run `{run['run_id']}` ({run['status']}): {run['done']} of {run['planned']} matches "
         f"stored; {statuses['forfeit']} forfeits, {statuses['error']} errors",
         f"maps: {', '.join(m['label'] for m in spec['maps'])}; seeds: {len(spec['seeds'])}; "
-        f"starts: {', '.join(spec['starts'])}; time limit {spec['time_limit']:g} s per match",
+        f"starts: {', '.join(spec['starts'])}; {_time_limit(spec)}",
         f"env: {json.dumps(spec['env'])}; grid: "
         f"{', '.join(v['label'] for v in spec['variants'] if v['label']) or 'none'}",
         *sequential,
     ]
+
+
+def _time_limit(spec: dict[str, Any]) -> str:
+    """How a run's time limit was applied (a run an older surveil played says so)."""
+    limit = f"time limit {spec['time_limit']:g} s"
+    if spec.get("time_limit_rule"):
+        return (
+            f"{limit} of decision time per role per match (its policy's reset and actions; "
+            "a role whose clock runs out forfeits)"
+        )
+    return (
+        f"{limit} per match, as an older surveil applied it: the whole match's time, the "
+        "env's set-up included, charged to the side that had decided slower"
+    )
 
 
 _SECTIONS = [

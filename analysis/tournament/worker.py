@@ -6,28 +6,36 @@ model files as bytes) and ships it to each worker once; tasks are small
 match into an *outcome* dict for :meth:`Store.record`:
 
 * ``ok`` -- the episode was played out (the record of :func:`strategies.runner.run_episode`);
-* ``forfeit`` -- a policy raised, or overran the match's time limit: the other side wins,
-  ``blame`` names the role at fault, ``error`` says what happened;
-* ``error`` -- the match could not be played (no start exists, a bad env parameter):
-  nobody wins.
+* ``forfeit`` -- a policy raised, returned an action the env refuses, or ran out of time:
+  the other side wins, ``blame`` names the role at fault, ``error`` says what happened;
+* ``error`` -- the match could not be played (no start exists, a bad env parameter, the
+  env or the harness hung): nobody wins.
 
-A hang is cut short twice: the runner checks the time limit between steps, and a
-``SIGALRM`` one second later interrupts a policy stuck inside one call (where the
-platform allows it: the main thread of a POSIX process). The process backend also kills
-a worker whose match runs past the limit plus a grace period (a hang in C code).
+**The time limit is a chess clock per role** (:func:`strategies.runner.run_episode`):
+each role may spend ``time_limit`` seconds deciding in a match, its policy's ``reset``
+and ``act`` calls; building the env and the policy objects, drawing the start, the
+observations and the env's steps are on no clock. A role whose clock runs out forfeits,
+whichever side was slower overall.
+
+A hang is cut short twice. A ``SIGALRM`` interrupts a call :data:`ALARM_GRACE` seconds
+after the deciding role's clock ran out (where the platform allows it: the main thread of
+a POSIX process), and that role forfeits. The worker also writes on a :class:`Board` who
+is deciding and until when, so the process backend can kill a worker stuck where signals
+do not reach (C code, signals blocked) and still blame the role that was deciding. With
+no policy deciding, each stretch of the env's and the harness's work gets the time limit
+too (the same alarm, the same kill): past it the match is an ``error``, charged to nobody.
 """
 
 from __future__ import annotations
 
-import contextlib
 import json
 import os
 import signal
 import tempfile
 import threading
+import time
 import traceback
 import warnings
-from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -36,14 +44,64 @@ from analysis.tournament.identity import Match
 from analysis.tournament.spec import PolicyEntry, Spec
 from envs.errors import RhoAboveOneWarning
 
-__all__ = ["Context", "MatchTimeout", "context_for", "play", "warm_up"]
+__all__ = ["Board", "Context", "MatchTimeout", "context_for", "forfeit", "play", "warm_up"]
 
 ALARM_GRACE = 1.0
-"""Seconds past the time limit before ``SIGALRM`` interrupts a policy inside one call."""
+"""Seconds past the end of a clock before ``SIGALRM`` interrupts the call in progress."""
 
 
 class MatchTimeout(Exception):
-    """Raised inside a hung call by the ``SIGALRM`` handler (the runner blames its role)."""
+    """Raised by the ``SIGALRM`` handler inside a hung call.
+
+    Attributes:
+        role: the role that was deciding (it forfeits), or ``None``: the env or the
+            harness was working (the match is an error).
+    """
+
+    def __init__(self, message: str, role: str | None = None) -> None:
+        super().__init__(message)
+        self.role = role
+
+
+IDLE, HARNESS = -1.0, 0.0
+"""What a :class:`Board` says between matches, and while no policy is deciding."""
+ROLE_CODES = {"pursuer": 1.0, "evader": 2.0}
+
+
+class Board:
+    """Who is deciding in one worker and until when, readable by the driver's process.
+
+    Three shared doubles, ``[sequence, who, deadline]``, written by the worker only, as a
+    seqlock: the sequence is odd while a write is under way, so a reader that sees it odd
+    or changed across its read skips that read. ``who`` is :data:`IDLE`,
+    :data:`HARNESS` or a :data:`ROLE_CODES` value; ``deadline`` is the
+    ``time.monotonic()`` (one clock for every process of the machine) at which the
+    deciding role's clock runs out, or the harness's stretch does.
+
+    Args:
+        mpctx: the multiprocessing context that starts the worker.
+    """
+
+    def __init__(self, mpctx: Any) -> None:
+        self.values = mpctx.RawArray("d", 3)
+        self.values[1] = IDLE
+
+    def write(self, who: float, deadline: float) -> None:
+        """Say who is deciding and until when (the worker)."""
+        v = self.values
+        v[0] += 1.0
+        v[1] = who
+        v[2] = deadline
+        v[0] += 1.0
+
+    def read(self) -> tuple[str | None, float] | None:
+        """``(role or None for the harness, deadline)``; ``None`` when idle or mid-write."""
+        v = self.values
+        before, who, deadline, after = v[0], v[1], v[2], v[0]
+        if before != after or before % 2 or who == IDLE:
+            return None
+        role = next((r for r, c in ROLE_CODES.items() if c == who), None)
+        return role, deadline
 
 
 @dataclass
@@ -55,7 +113,8 @@ class Context:
         envs: ``{(map label, variant label): resolved env parameters}``.
         policies: ``{"ROLE:label": PolicyEntry}``.
         models: ``{sha256: model file bytes}`` (shipped once, materialised per worker).
-        time_limit: wall-clock seconds per match.
+        time_limit: wall-clock seconds each role may spend deciding in a match (its
+            reset and acts); also the longest stretch of the env's and the harness's work.
     """
 
     maps: dict[str, Any]
@@ -120,24 +179,67 @@ def build_policy(ctx: Context, entry: PolicyEntry) -> Any:
     return _LEARNED[key]
 
 
-@contextlib.contextmanager
-def _alarm(seconds: float) -> Iterator[None]:
-    """Raise :class:`MatchTimeout` in the main thread after ``seconds`` (where possible)."""
-    usable = hasattr(signal, "setitimer") and threading.current_thread() is threading.main_thread()
-    if not usable:
-        yield
-        return
+class _Watch:
+    """One match's clocks as the worker's alarm and its :class:`Board` see them.
 
-    def _ring(signum: int, frame: Any) -> None:
-        raise MatchTimeout(f"no answer within the time limit (+{ALARM_GRACE:g} s)")
+    Called by the runner (``on_clock``) as a policy starts deciding, with its role and the
+    seconds left on its clock, and as it stops, with ``(None, None)``: from then on the env
+    and the harness get a stretch of ``limit`` seconds.
+    """
 
-    previous = signal.signal(signal.SIGALRM, _ring)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0.0)
-        signal.signal(signal.SIGALRM, previous)
+    def __init__(self, limit: float, board: Board | None) -> None:
+        self.limit = limit
+        self.board = board
+        self.role: str | None = None
+        self.alarm = (
+            hasattr(signal, "setitimer") and threading.current_thread() is threading.main_thread()
+        )
+
+    def __call__(self, role: str | None, left: float | None) -> None:
+        span = self.limit if role is None else max(float(left), 0.0)
+        # the alarm is re-armed before the role changes: a ring in between is the
+        # previous stretch's, and its handler still names who was working then
+        if self.alarm:
+            signal.setitimer(signal.ITIMER_REAL, span + ALARM_GRACE)
+        self.role = role
+        if self.board is not None:
+            self.board.write(HARNESS if role is None else ROLE_CODES[role], time.monotonic() + span)
+
+    def _ring(self, signum: int, frame: Any) -> None:
+        if self.role is None:
+            raise MatchTimeout(
+                f"the env or the harness gave no answer for {self.limit + ALARM_GRACE:g} s "
+                f"(the time limit + {ALARM_GRACE:g} s) while no policy was deciding"
+            )
+        raise MatchTimeout(
+            f"no answer {ALARM_GRACE:g} s after its clock ran out (time limit "
+            f"{self.limit:g} s of decision time per role)",
+            self.role,
+        )
+
+    def __enter__(self) -> _Watch:
+        if self.alarm:
+            self.previous = signal.signal(signal.SIGALRM, self._ring)
+        self(None, None)
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        if self.alarm:
+            signal.setitimer(signal.ITIMER_REAL, 0.0)
+            signal.signal(signal.SIGALRM, self.previous)
+        if self.board is not None:
+            self.board.write(IDLE, 0.0)
+
+
+def forfeit(match_id: str, role: str, error: str) -> dict[str, Any]:
+    """The outcome of a match ``role`` forfeits (the other side wins)."""
+    return {
+        "match_id": match_id,
+        "status": "forfeit",
+        "winner": "evader" if role == "pursuer" else "pursuer",
+        "blame": role,
+        "error": error,
+    }
 
 
 def warm_up() -> None:
@@ -158,8 +260,14 @@ def warm_up() -> None:
     policy_names()  # the catalog of built-in policies
 
 
-def play(match: Match, ctx: Context) -> dict[str, Any]:
-    """Play one match; never raises for a failure of the match itself (see the module)."""
+def play(match: Match, ctx: Context, board: Board | None = None) -> dict[str, Any]:
+    """Play one match; never raises for a failure of the match itself (see the module).
+
+    Args:
+        match: the match.
+        ctx: the run's worker context.
+        board: where to say who is deciding (a process worker's; see :class:`Board`).
+    """
     from strategies.runner import PolicyFailure, run_episode
 
     out: dict[str, Any] = {"match_id": match.match_id}
@@ -168,7 +276,7 @@ def play(match: Match, ctx: Context) -> dict[str, Any]:
         e = ctx.policies[f"evader:{match.evader}"]
         env = ctx.envs[(match.map, match.variant)]
         observations = {"pursuer": p.observation, "evader": e.observation}
-        with _alarm(ctx.time_limit + ALARM_GRACE), warnings.catch_warnings():
+        with _Watch(ctx.time_limit, board) as watch, warnings.catch_warnings():
             warnings.simplefilter("ignore", RhoAboveOneWarning)  # said once, at spec load
             result = run_episode(
                 ctx.maps[match.map],
@@ -179,16 +287,13 @@ def play(match: Match, ctx: Context) -> dict[str, Any]:
                 start=match.start,
                 observations=observations,
                 time_limit=ctx.time_limit,
+                on_clock=watch,
             )
     except PolicyFailure as exc:
-        out.update(
-            status="forfeit",
-            winner="evader" if exc.role == "pursuer" else "pursuer",
-            blame=exc.role,
-            error=str(exc),
-        )
-        return out
-    except MatchTimeout as exc:  # the alarm rang outside policy code
+        return forfeit(match.match_id, exc.role, str(exc))
+    except MatchTimeout as exc:  # the alarm rang outside a policy's call
+        if exc.role is not None:  # as the call returned, past its clock and the grace
+            return forfeit(match.match_id, exc.role, f"{exc.role} MatchTimeout: {exc}")
         out.update(status="error", error=f"MatchTimeout: {exc}")
         return out
     except Exception as exc:

@@ -24,16 +24,21 @@ MAP = "open_room"
 class Probe(BasePolicy):
     """Records what it sees; moves on a fixed, observation-independent schedule."""
 
-    def __init__(self, options=None, *, name="probe", fail_at=None, sleep=0.0, fail_reset=None):
+    def __init__(
+        self, options=None, *, name="probe", fail_at=None, sleep=0.0, fail_reset=None,
+        reset_sleep=0.0,
+    ):  # fmt: skip
         super().__init__(name=name)
         self.uses_state = options is None or options.get("observation") == "state"
         self.observation_options = options
         self.fail_at, self.sleep, self.fail_reset = fail_at, sleep, fail_reset
+        self.reset_sleep = reset_sleep
         self.seen: list[np.ndarray] = []
 
     def _reset(self) -> None:
         if self.fail_reset is not None:
             raise self.fail_reset
+        time.sleep(self.reset_sleep)
         self.seen = []
 
     def act(self, observation):
@@ -192,6 +197,27 @@ def test_time_limit_blames_the_slow_side():
             MAP, Probe(sleep=0.02), "evader/random", seed=0, max_cycles=200, time_limit=0.15
         )
     assert info.value.role == "pursuer" and 0 < info.value.step < 200
+
+
+def test_the_time_limit_is_each_roles_own_decision_clock():
+    # The limit counted the whole episode, the env's work included, and an overrun was
+    # blamed on the side that had spent more time in act: the env's time alone (a
+    # 4096-ray lidar on a round room of 1000 walls) made the greedy pursuer forfeit, and a
+    # pursuer whose reset overran the limit was not blamed when the evader acted slower.
+    from envs.maps import Map
+
+    a = np.linspace(0, 2 * np.pi, 1000, endpoint=False)
+    disc = Map(np.c_[10 + 10 * np.cos(a), 10 + 10 * np.sin(a)], [], name="disc")
+    lidar = Probe({"observation": "lidar", "n_rays": 4096})
+    r = run_episode(
+        disc, "pursuer/greedy", lidar, seed=1, max_cycles=40, start="valid", time_limit=0.3
+    )
+    assert r.steps == 40 and r.wall_seconds > 0.3  # the env's time alone is past the limit
+    with pytest.raises(EpisodeTimeout) as info:
+        run_episode(MAP, Probe(reset_sleep=0.3), Probe(sleep=0.002), seed=0, max_cycles=40,
+                    time_limit=0.2)  # fmt: skip
+    assert info.value.role == "pursuer" and info.value.step == -1
+    assert "its clock ran out" in str(info.value) and "failed at reset" in str(info.value)
 
 
 def test_mixture_picks_one_component_per_episode_reproducibly():

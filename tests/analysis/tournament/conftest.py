@@ -1,4 +1,4 @@
-"""Shared fixtures: small specs and test-only policies (a raising, a hanging, a slow one).
+"""Shared fixtures: small specs and test-only policies (raising, hanging, slow ones).
 
 The ``test_policies`` fixture registers the test policies for one test only (other tests
 enumerate the registry); the process backend forks its workers, which inherit them.
@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import signal
 import time
+from typing import ClassVar
 
 import numpy as np
 import pytest
@@ -44,6 +45,43 @@ class DeafHangingEvader(RandomPolicy):
         return super()._decide(snap)
 
 
+class DeafPickEvader(RandomPolicy):
+    """A mixture whose pick of the episode's policy hangs with SIGALRM blocked.
+
+    The runner picks before any policy decides (the harness's work, on no clock).
+    """
+
+    def select(self, seed):
+        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGALRM})
+        time.sleep(3600)
+
+
+class LidarEvader(RandomPolicy):
+    """A random evader that asks for a 4096-ray lidar: the env's work, on no clock."""
+
+    uses_state = False
+    observation_options: ClassVar[dict] = {"observation": "lidar", "n_rays": 4096}
+
+    def act(self, observation):
+        self._steps += 1
+        return self.rng.uniform(-0.7, 0.7, 2)
+
+
+class SlowResetPursuer(RandomPolicy):
+    """A random pursuer whose reset takes 0.6 s."""
+
+    def _reset(self):
+        time.sleep(0.6)
+
+
+class SlowActEvader(RandomPolicy):
+    """A random evader that takes 5 ms per decision."""
+
+    def _decide(self, snap):
+        time.sleep(0.005)
+        return super()._decide(snap)
+
+
 class SlowPursuer(RandomPolicy):
     """A random pursuer that takes a few milliseconds per decision."""
 
@@ -65,6 +103,10 @@ TEST_POLICIES = {
     "evader/test_nan": NanEvader,
     "evader/test_hanging": HangingEvader,
     "evader/test_deaf": DeafHangingEvader,
+    "evader/test_deaf_pick": DeafPickEvader,
+    "evader/test_lidar": LidarEvader,
+    "evader/test_slow_act": SlowActEvader,
+    "pursuer/test_slow_reset": SlowResetPursuer,
     "pursuer/test_slow": SlowPursuer,
 }
 

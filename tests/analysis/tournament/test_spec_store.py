@@ -397,3 +397,64 @@ def test_a_map_file_s_recommendations_apply_and_editing_them_is_a_new_run(tmp_pa
     with pytest.raises(InvalidConfigError, match=r"\[maps #1\]: map = 'room.json': .*l_min"):
         save_map(load_map("open_room"), room, metadata={"l_min": "1"})
         spec_from_dict(d, base_dir=tmp_path)
+
+
+def test_another_time_limit_makes_new_matches(tmp_path, small_spec):
+    # The limit was not part of a match's identity: a forfeit on time under a limit of
+    # 1 s was reused by a spec whose limit is 300 s (and a match played out under 300 s
+    # by a spec whose slow policy would forfeit under 1 s).
+    d = {**small_spec, "maps": ["open_room"], "seeds": 1, "time_limit": 30}
+    store = tmp_path / "s.sqlite"
+    first = run_tournament(spec_from_dict(d), store, backend="serial", progress=False)
+    assert first.played == 4
+    longer = run_tournament(
+        spec_from_dict({**d, "time_limit": 60}), store, backend="serial", progress=False
+    )
+    assert longer.reused == 0 and longer.played == 4
+    with Store(store) as db:
+        assert not {r["match_id"] for r in db.rows(first.run_id)} & {
+            r["match_id"] for r in db.rows(longer.run_id)
+        }
+    (_, doc), *_ = plan(spec_from_dict(d))
+    assert doc["time_limit"] == 30.0 and doc["version"] == 2
+
+
+# The spec of data/store_identity_v1.sql: a store written by 94c5063 (match identity
+# version 1: the limit counted the whole match), dumped with sqlite3's iterdump after
+# run_tournament(spec_from_dict(_OLD_SPEC), "old.sqlite", backend="serial") run from a
+# checkout of that commit.
+_OLD_SPEC = {
+    "name": "old_clock",
+    "maps": ["open_room"],
+    "pursuers": ["pursuer/greedy"],
+    "evaders": ["evader/random"],
+    "seeds": 2,
+    "start": "valid",
+    "time_limit": 30,
+    "env": {"max_cycles": 10},
+}
+_OLD_RUN = "e9ddc92e6e602cb3"
+
+
+def test_a_run_an_older_surveil_stored_is_played_again_and_said_so(tmp_path):
+    # A store from before the per-role clocks: the same spec reused both of its matches
+    # (stored under the old meaning of the time limit) without a word.
+    from importlib import resources
+
+    from analysis.tournament.report import write_report
+
+    store = tmp_path / "old.sqlite"
+    dump = resources.files("tests.analysis.tournament").joinpath("data", "store_identity_v1.sql")
+    with contextlib.closing(sqlite3.connect(store)) as c:
+        c.executescript(dump.read_text())
+    s = run_tournament(spec_from_dict(_OLD_SPEC), store, backend="serial", progress=False)
+    assert s.run_id != _OLD_RUN and s.reused == 0 and s.played == 2
+    said = s.describe()
+    assert f"run {_OLD_RUN} in {store} is this spec played by an older surveil" in said
+    assert "none of its 2 stored matches is reused" in said and f"--run {_OLD_RUN}" in said
+    with Store(store) as db:
+        assert len(db.rows(s.run_id)) == 2 and len(db.rows(_OLD_RUN)) == 2  # never mixed
+    old = write_report(store, tmp_path / "old", run_id=_OLD_RUN, replays=False, regret=False)
+    new = write_report(store, tmp_path / "new", run_id=s.run_id, replays=False, regret=False)
+    assert "30 s per match, as an older surveil applied it" in old["markdown"].read_text()
+    assert "30 s of decision time per role per match" in new["markdown"].read_text()

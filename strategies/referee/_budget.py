@@ -55,7 +55,7 @@ from dataclasses import dataclass
 
 from envs.errors import MemoryBudgetError
 from strategies.cspace._budget import _physical_memory, memory_budget
-from strategies.referee.lattice import grid_shape, lattice_vectors, window_half_width
+from strategies.referee.lattice import count_lattice_vectors, grid_shape, window_half_width
 from strategies.referee.spec import GameSpec, Resolution
 
 __all__ = [
@@ -168,7 +168,7 @@ def bound_size(spec: GameSpec, res: Resolution, role: str) -> SolveSize:
     (``role="pursuer"``) or :func:`~strategies.referee.evader_bound.solve_evader_bound`."""
     points = _points(spec, res.spacing)
     W = 2 * window_half_width(spec.l_max, res.cell) + 1
-    moves = len(lattice_vectors(spec.speed(role) * res.tau, res.spacing))
+    moves = count_lattice_vectors(spec.speed(role) * res.tau, res.spacing)
     states = points * W * W
     seconds = SECONDS_PER_STATE[role] * states
     if role == "pursuer":
@@ -266,7 +266,11 @@ def check_budget(
     advice = []
     if resize is not None and cells_per_lmin is not None:
         lo, hi = 0.0, float(cells_per_lmin)
-        for _ in range(30):  # the largest resolution that fits, to 1e-9 relative
+        # the largest resolution that fits, to 1e-9 of it, or none >= 0.1 (named as 0 below):
+        # 30 halvings of [0, asked] stopped at asked / 1e9, so from 1e12 asked every one
+        # tried was over and the message said none fits ("even --cells-per-lmin = 0.1 needs
+        # about 125 MB", with 12.6 GB)
+        while hi >= 0.1 and hi - lo > 1e-9 * hi:
             mid = 0.5 * (lo + hi)
             if mid <= 0 or peak(resize(mid))[0] <= limit:
                 lo = mid

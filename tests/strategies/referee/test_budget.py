@@ -201,3 +201,37 @@ def test_a_long_step_s_many_moves_lengthen_the_pursuer_bound_s_estimate():
     assert short.seconds == pytest.approx(2e-5 * short.states)  # a default step: as before
     # an upper bound of the measured 42.5 s (CPU, 8 cells per L_min, 1257 moves)
     assert long.tau == 10.0 and long.seconds >= 42.5 and long.seconds > 5 * short.seconds
+
+
+def test_a_refusal_at_a_huge_resolution_is_fast_and_names_the_resolution_that_fits():
+    """`surveil referee corner --cells-per-lmin 100000` took 26-41 s to refuse, listing and
+    sorting millions of lattice vectors to count them (the step rounded up to the env's dt
+    is thousands of spacings long), 62 times in the search for one that fits; and from
+    1e12 that search stopped at 1e12 / 2^30 cells per L_min, every one tried over the
+    budget, so it said none fits."""
+    from strategies.referee.referee import check_solve_budget
+
+    s = GameSpec.from_config(EnvConfig(map="corner"))
+    fits = []
+    for cpl in (1e5, 1e12):
+        t0 = time.perf_counter()
+        with pytest.raises(MemoryBudgetError) as err:
+            check_solve_budget(s, cpl, dt=0.1, memory_budget="4GB")
+        assert time.perf_counter() - t0 < 5.0, cpl
+        fits.append(float(str(err.value).split("Use cells_per_lmin <= ")[1].split(" ")[0]))
+    assert fits[0] == fits[1] and 20 < fits[0] < 60
+    check_solve_budget(s, fits[0], dt=0.1, memory_budget="4GB")  # it fits
+
+
+@pytest.mark.parametrize("spacing", [1.0, 0.7, 1 / 3, 0.05])
+def test_lattice_vectors_are_counted_without_listing_them(spacing):
+    from strategies.referee.lattice import count_lattice_vectors, lattice_vectors
+
+    rng = np.random.default_rng(0)
+    lengths = [*rng.uniform(0, 40 * spacing, 200), 0.0, 0.999 * spacing]
+    # on the boundary: the length of a lattice vector itself, as lattice_vectors tests it
+    lengths += [spacing * math.hypot(a, b) for a, b in rng.integers(0, 30, (200, 2))]
+    for length in lengths:
+        assert count_lattice_vectors(length, spacing) == len(lattice_vectors(length, spacing))
+    r = 3e6  # beyond the exact count: the disc's area, within 1e-6
+    assert count_lattice_vectors(r * spacing, spacing) == pytest.approx(math.pi * r * r, rel=1e-6)

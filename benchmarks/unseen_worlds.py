@@ -401,15 +401,30 @@ def other_evader_jobs(worlds, l_mins, draws: int) -> list[tuple]:
     ]
 
 
+MAX_CYCLES, K = 600, 8.0
+"""The default horizons: the pursuer role's in steps, the evader role's in D / V_e."""
+
+job_max_cycles, job_k = MAX_CYCLES, K  # the horizons, set by main (and in each worker)
+
+
+def _horizon(role: str) -> float:
+    """This run's horizon of a role's episodes (``--max-cycles`` or ``--k``)."""
+    return job_max_cycles if role == "pursuer" else job_k
+
+
 def job_key(job) -> str:
-    return episode_rows.key(job)
+    """A job's identity in a results file: its values and this run's horizon, so a rerun
+    at another horizon plays its episodes again instead of reusing rows that ended
+    elsewhere."""
+    return episode_rows.key([*job, _horizon(job[0])])
 
 
 def row_key(row) -> str:
-    return job_key([row[k] for k in ("role", "world", "combo", "opponent", "seed")])
-
-
-job_max_cycles, job_k = 600, 8.0  # the horizons, set by main (and in each worker)
+    """A row's identity (:func:`job_key`). A row of an older surveil recorded no horizon:
+    it counts as played at the default one."""
+    horizon = row.get("horizon", MAX_CYCLES if row["role"] == "pursuer" else K)
+    return episode_rows.key([*(row[k] for k in ("role", "world", "combo", "opponent", "seed")),
+                             horizon])  # fmt: skip
 
 
 def _init(max_cycles: int, k: float) -> None:
@@ -420,7 +435,8 @@ def _init(max_cycles: int, k: float) -> None:
 def play(job) -> dict:
     """Play one job; its JSONL row."""
     role, w, combo, opponent, seed = job
-    row = {"role": role, "world": w, "combo": combo, "opponent": opponent, "seed": seed}
+    row = {"role": role, "world": w, "combo": combo, "opponent": opponent, "seed": seed,
+           "horizon": _horizon(role)}  # fmt: skip
     t0 = time.perf_counter()
     try:
         if role == "pursuer":
@@ -724,9 +740,9 @@ def main(argv=None) -> int:
                     "scaling) of worlds outside the default set (1 2), and a filter on the "
                     "default set's")  # fmt: skip
     ap.add_argument(
-        "--max-cycles", type=integer(1), default=600, help="pursuer role: horizon in steps"
+        "--max-cycles", type=integer(1), default=MAX_CYCLES, help="pursuer role: horizon in steps"
     )
-    ap.add_argument("--k", type=real(0), default=8.0, help="evader role: horizon in D / V_e")
+    ap.add_argument("--k", type=real(0), default=K, help="evader role: horizon in D / V_e")
     ap.add_argument(
         "--results",
         type=path_text("a file"),
@@ -765,10 +781,10 @@ def main(argv=None) -> int:
     results = args.results or f"out/unseen_worlds_{args.role}.jsonl"
     print(f"load average: {os.getloadavg()}")
     jobs = select(args)
+    _init(args.max_cycles, args.k)  # before the keys: they name the horizon
     done = episode_rows.read(results, row_key)
     todo = [j for j in jobs if job_key(j) not in done]
     print(f"{len(jobs)} episodes selected, {len(todo)} to play, results in {results}")
-    _init(args.max_cycles, args.k)
     t0 = time.perf_counter()
     with episode_rows.appending(results) as write, contextlib.ExitStack() as stack:
         if args.workers > 1:  # leaving the with block (a stop included) terminates the pool

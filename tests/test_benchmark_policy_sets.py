@@ -55,6 +55,11 @@ def corner_runs(tmp_path_factory):
             assert ps.run_sets(["corner"], str(root / out), 1, {"corner": tiny}) == 0
     finally:
         sys.path.remove(str(BENCHMARKS))
+    # The 6 s rows stand for a candidate policy that holds seed 1: an episode's key names
+    # its horizon (a rerun at another horizon plays it again), so they are keyed as the
+    # base's episodes, played to 120 steps.
+    short = root / "short" / "corner.jsonl"
+    _write(short, [{**r, "horizon": 120} for r in _rows(short)])
     return root, tiny
 
 

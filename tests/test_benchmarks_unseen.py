@@ -50,6 +50,24 @@ def test_a_pursuer_subset_is_written_and_resumed(unseen, tmp_path, capsys) -> No
     assert _rows(out) == rows
 
 
+def test_a_rerun_at_another_horizon_plays_its_episodes_again(unseen, tmp_path, capsys) -> None:
+    """An episode's key names the horizon: rows that ended at 40 steps are not reused as
+    the result of a 60-step run (a row of an older surveil, without one, counts as the
+    default horizon's)."""
+    out = tmp_path / "h.jsonl"
+    argv = ["--role", "pursuer", "--worlds", "corridor~rot2.3", "--combos", "0",
+            "--opponents", "herder", "--results", str(out)]  # fmt: skip
+    assert unseen.main([*argv, "--max-cycles", "40"]) == 0
+    assert unseen.main([*argv, "--max-cycles", "60"]) == 0
+    assert "1 episodes selected, 1 to play" in capsys.readouterr().out.split("load average")[-1]
+    rows = _rows(out)
+    assert [(r["horizon"], r["steps"]) for r in rows] == [(40, 40), (60, 60)]
+    assert unseen.main([*argv, "--max-cycles", "40"]) == 0  # both stay reusable
+    assert "1 episodes selected, 0 to play" in capsys.readouterr().out
+    old = {k: v for k, v in rows[0].items() if k != "horizon"}
+    assert unseen.row_key(old) == unseen.row_key({**rows[0], "horizon": unseen.MAX_CYCLES})
+
+
 def test_an_evader_subset_escapes_and_prints_no_loss(unseen, tmp_path, capsys) -> None:
     out = tmp_path / "e.jsonl"
     argv = ["--role", "evader", "--worlds", "plus_w1.0", "--opponents", "still", "--results",
@@ -322,7 +340,7 @@ def test_a_hindsight_over_the_memory_budget_is_not_solved(unseen, tmp_path, caps
     reason printed) instead of stopping the report."""
     row = {"role": "pursuer", "world": "L_10x4", "combo": [0.5, 2.0, 2.0],
            "opponent": "evader/straight", "seed": 101, "winner": "evader", "cause": "occluded",
-           "t": 3.0, "steps": 30}  # fmt: skip
+           "t": 3.0, "steps": 30, "horizon": 20}  # fmt: skip
     out = tmp_path / "p.jsonl"
     out.write_text(json.dumps(row) + "\n")
     argv = ["--role", "pursuer", "--worlds", "L_10x4", "--combos", "0", "--opponents",

@@ -24,8 +24,11 @@ MODULES = [
     "envs",
     *_modules(envs),
     *_modules(strategies.control),
+    "strategies.memory",
     "strategies.policies.base",
+    "strategies.policies.model_files",
     "strategies.policies.registry",
+    "strategies.referee.lattice",
     "analysis.arguments",
     "analysis.replay",
 ]

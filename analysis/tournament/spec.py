@@ -651,7 +651,7 @@ def _seeds(value: Any, source: str, per_seed: int = 1) -> tuple[int, ...]:
 
 def _check_plan(n: int, per_seed: int, source: str) -> None:
     from envs.errors import MemoryBudgetError
-    from strategies.cspace._budget import memory_budget
+    from strategies.memory import memory_budget
 
     limit = memory_budget()
     need = _BYTES_PER_MATCH * n * per_seed

@@ -14,27 +14,24 @@ with the estimate and the ways to change it.
 
 The budget is ``decompose(..., memory_budget=...)``, else ``$SURVEIL_MEMORY_BUDGET``
 (bytes, or a number with a unit: ``"1.5GB"``, ``"800MB"``), else half the machine's
-physical memory.
+physical memory (:func:`strategies.memory.memory_budget`).
 """
 
 from __future__ import annotations
 
 import math
-import os
-import re
 from dataclasses import dataclass
 
 from scipy.spatial import cKDTree
 
-from envs.errors import InvalidConfigError, MemoryBudgetError
+from envs.errors import MemoryBudgetError
 from envs.maps.map import Map
 
-__all__ = ["Estimate", "check_budget", "estimate", "memory_budget"]
+__all__ = ["Estimate", "check_budget", "estimate"]
 
 BYTES_PER_PAIR = 4_500
 SECONDS_PER_PAIR = 1e-4
 BASE_BYTES = 250e6
-_UNITS = {"": 1, "b": 1, "kb": 1e3, "mb": 1e6, "gb": 1e9, "kib": 2**10, "mib": 2**20, "gib": 2**30}
 
 
 @dataclass(frozen=True)
@@ -58,39 +55,6 @@ def estimate(world: Map, L: float) -> Estimate:
     near = int(tree.count_neighbors(tree, 2.0 * L))
     pairs = 3 * near + 25 * world.n_vertices
     return Estimate(pairs, BASE_BYTES + BYTES_PER_PAIR * pairs, SECONDS_PER_PAIR * pairs)
-
-
-def _physical_memory() -> float:
-    try:
-        return float(os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
-    except (ValueError, OSError, AttributeError):  # pragma: no cover - not POSIX
-        return 8e9
-
-
-def memory_budget(value: object = None) -> float:
-    """The memory budget in bytes: ``value``, ``$SURVEIL_MEMORY_BUDGET`` or half the RAM.
-
-    Raises:
-        InvalidConfigError: for a budget that is not a positive size.
-    """
-    where = "memory_budget"
-    if value is None:
-        value = os.environ.get("SURVEIL_MEMORY_BUDGET")
-        where = "$SURVEIL_MEMORY_BUDGET"
-        if value is None or value == "":
-            return 0.5 * _physical_memory()
-    if isinstance(value, bool):
-        raise InvalidConfigError(f"{where} = {value!r}: expected a size in bytes or '2GB'")
-    if isinstance(value, (int, float)):
-        size = float(value)
-    else:
-        m = re.fullmatch(r"\s*([0-9.]+(?:e[+-]?[0-9]+)?)\s*([kmg]i?b|b)?\s*", str(value), re.I)
-        if not m:
-            raise InvalidConfigError(f"{where} = {value!r}: expected a size in bytes or '2GB'")
-        size = float(m.group(1)) * _UNITS[(m.group(2) or "").lower()]
-    if not size > 0 or size != size or size == float("inf"):
-        raise InvalidConfigError(f"{where} = {value!r}: expected a finite size > 0")
-    return size
 
 
 def check_budget(world: Map, L: float, budget: float) -> Estimate:

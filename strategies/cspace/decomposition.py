@@ -612,7 +612,7 @@ def decompose(
         InfeasibleError: if the build would exceed the memory budget (the message gives
             the estimate and how to change it).
     """
-    from strategies.cspace._budget import memory_budget as _budget
+    from strategies.memory import memory_budget as _budget
 
     world = _check_map(map)
     L = check_length(L)

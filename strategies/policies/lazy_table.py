@@ -33,8 +33,8 @@ import shapely
 from envs.errors import MemoryBudgetError
 from envs.maps import Map
 from envs.tolerances import REL_LENGTH_TOL
-from strategies.cspace._budget import memory_budget
 from strategies.cspace.grids import check_grid_spacing, grid_axis, grid_size
+from strategies.memory import memory_budget
 from strategies.policies._batch_classify import classify_points
 from strategies.policies.safety import SafetyTable, _circular_distance
 

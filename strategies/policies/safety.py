@@ -34,10 +34,10 @@ import numpy as np
 from envs import validation
 from envs.errors import InvalidConfigError, MemoryBudgetError
 from envs.maps import Map
-from strategies.cspace import _budget
 from strategies.cspace.cache import CacheWarning, resolve_cache_dir, write_cache_file
 from strategies.cspace.grids import check_grid_spacing, grid_bytes, grid_points
 from strategies.cspace.grids import points_at as _points_at
+from strategies.memory import memory_budget as _memory_budget
 
 __all__ = [
     "NO_PATH",
@@ -406,7 +406,7 @@ def safety_table(
     resolution = validation.positive("resolution", resolution, where=where)
     check_grid_spacing(world, resolution, where)
     n_bins = validation.integer("n_bins", n_bins, minimum=8, maximum=NO_PATH - 1, where=where)
-    budget = _budget.memory_budget(memory_budget)
+    budget = _memory_budget(memory_budget)
     need = table_bytes(world, resolution, n_bins, distinct)
     if need > budget:
         fit = resolution * math.sqrt(need / budget) * 1.05

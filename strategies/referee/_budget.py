@@ -42,7 +42,7 @@ of (a solve's peak plus what the solves before it keep).
 
 The budget is the ``memory_budget`` argument, else ``$SURVEIL_MEMORY_BUDGET`` (bytes, or
 ``"1.5GB"``), else half the machine's physical memory: the decompositions' budget
-(:func:`strategies.cspace._budget.memory_budget`). Issue 13's probe, ``pursuer/referee``
+(:func:`strategies.memory.memory_budget`). Issue 13's probe, ``pursuer/referee``
 on a 16 x 10 room at L_min = 0.3 (133 M states per bound), is estimated at about 3 GB, up
 to 45 min; it ran over 5 min and 1.8-3.8 GB before it was killed.
 """
@@ -54,7 +54,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from envs.errors import MemoryBudgetError
-from strategies.cspace._budget import _physical_memory, memory_budget
+from strategies.memory import memory_budget, physical_memory
 from strategies.referee.lattice import count_lattice_vectors, grid_shape, window_half_width
 from strategies.referee.spec import GameSpec, Resolution
 
@@ -286,7 +286,7 @@ def check_budget(
             coarsest = peak(resize(0.1))[0]
             advice.append(f"No {K} fits (even {K} = 0.1 needs about {_size(coarsest)})")
     more = math.ceil(1.2 * need / 1e9)
-    ram = _physical_memory()
+    ram = physical_memory()
     if need <= ram:
         advice.append(
             f"{'raise' if advice else 'Raise'} the budget with {MemoryBudgetError.BUDGET}"

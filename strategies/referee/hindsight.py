@@ -69,7 +69,7 @@ from envs.errors import (
 )
 from envs.geometry import kernel_for
 from envs.geometry.segments import point_in_walls
-from strategies.cspace._budget import memory_budget as _memory_budget
+from strategies.memory import memory_budget as _memory_budget
 from strategies.referee._budget import BASE_BYTES, _duration, _size
 from strategies.referee.lattice import segment_wall_distance
 from strategies.referee.robust import convex_corners, sweep_hits_vertex, sweep_range_ok

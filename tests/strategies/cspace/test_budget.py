@@ -8,7 +8,8 @@ import pytest
 
 from envs.errors import InfeasibleError, InvalidConfigError
 from strategies.cspace import decompose
-from strategies.cspace._budget import estimate, memory_budget
+from strategies.cspace._budget import estimate
+from strategies.memory import memory_budget
 from tests.strategies.cspace._oracle import corridor, hexagons
 
 

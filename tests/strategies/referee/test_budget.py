@@ -135,7 +135,7 @@ def test_a_solve_larger_than_the_machine_names_no_budget(monkeypatch):
         solve(s, 40, cache=False, memory_budget="200MB")
     need = float(re.search(r"would need about ([\d.]+) GB", str(err.value)).group(1)) * 1e9
     assert need > 1e9  # a machine of 1 GB cannot give it
-    monkeypatch.setattr(budget, "_physical_memory", lambda: 1e9)
+    monkeypatch.setattr(budget, "physical_memory", lambda: 1e9)
     with pytest.raises(MemoryBudgetError) as err:
         solve(s, 40, cache=False, memory_budget="200MB")
     msg = str(err.value)

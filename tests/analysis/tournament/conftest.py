@@ -68,17 +68,17 @@ class LidarEvader(RandomPolicy):
 
 
 class SlowResetPursuer(RandomPolicy):
-    """A random pursuer whose reset takes 0.6 s."""
+    """A random pursuer whose reset takes 1.5 s."""
 
     def _reset(self):
-        time.sleep(0.6)
+        time.sleep(1.5)
 
 
 class SlowActEvader(RandomPolicy):
-    """A random evader that takes 5 ms per decision."""
+    """A random evader that takes 2 ms per decision (or the wait for a CPU under load)."""
 
     def _decide(self, snap):
-        time.sleep(0.005)
+        time.sleep(0.002)
         return super()._decide(snap)
 
 

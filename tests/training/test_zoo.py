@@ -188,6 +188,33 @@ def test_cli_list(capsys):
     assert "features safety_table" in lines["dagger_pursuer_table"]
     assert "features escape_plan, escape_memory" in lines["dagger_evader_memory"]
     assert "features" not in lines["dagger_pursuer_generalist"]
+    # a pool as a user writes it (was "vs ['evader/shooting', 'evader/straight', ...]")
+    assert (
+        "vs evader/shooting, evader/straight, evader/toward_away, evader/random on "
+        in (lines["dagger_pursuer_generalist"])
+    )
+    assert "[" not in out
+
+
+def test_python_m_training_zoo_evaluate_prints_no_python_reprs(capsys):
+    """Its causes were a dict ("causes {'too_close': 2}"); its help was reST
+    (":mod:`training.zoo`") and said nothing of NAME, --episodes or --seed."""
+    from training.zoo.__main__ import main as zoo_main
+
+    argv = ["evaluate", "ppo_pursuer_vs_straight_open_room", "--episodes", "2"]
+    assert zoo_main([*argv, "--opponent", "zoo:ppo_evader_vs_greedy_open_room"]) == 0
+    line = capsys.readouterr().out.strip()
+    assert re.fullmatch(
+        r"pursuer vs zoo:ppo_evader_vs_greedy_open_room: success \d/2 \(\d+%\), mean escape "
+        r"time (-|[\d.]+ s), causes (none|[a-z_]+ \d(, [a-z_]+ \d)*)",
+        line,
+    ), line
+    assert zoo_main(["evaluate", "--help"]) == 0
+    help_text = capsys.readouterr().out
+    assert "a shipped model (python -m training.zoo list)" in help_text
+    assert "zoo:NAME or a model .zip" in help_text and "default 50" in help_text
+    assert zoo_main(["--help"]) == 0
+    assert ":mod:" not in capsys.readouterr().out
 
 
 def _weights(path):

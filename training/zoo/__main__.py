@@ -11,6 +11,8 @@ from training import zoo
 from training.cli import run_cli
 from training.train import evaluate_model
 
+_NAME_HELP = "a shipped model (python -m training.zoo list)"
+
 
 def main(argv: list[str] | None = None) -> int:
     """Run the zoo command line; returns the exit code (2 and one line for a user error)."""
@@ -18,22 +20,36 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _main(argv: list[str] | None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m training.zoo", description=__doc__)
+    parser = argparse.ArgumentParser(
+        prog="python -m training.zoo",
+        description="The shipped models: list them, show one's provenance, retrain one "
+        "from its recipe, or play one against an opponent.",
+    )
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("list", help="names of the shipped models")
     p_info = sub.add_parser("info", help="provenance of one model")
-    p_info.add_argument("name")
+    p_info.add_argument("name", help=_NAME_HELP)
     p_rep = sub.add_parser("reproduce", help="retrain a model from its stored config")
-    p_rep.add_argument("name")
+    p_rep.add_argument("name", help=_NAME_HELP)
     p_rep.add_argument("--output-dir", default=None, help="default: out/zoo/NAME")
     p_rep.add_argument("--install", action="store_true", help="replace the shipped model")
     p_rep.add_argument("--progress", action="store_true", help="SB3 progress bar")
     p_ev = sub.add_parser("evaluate", help="play a model against an opponent")
-    p_ev.add_argument("name")
-    p_ev.add_argument("--opponent", required=True, help="e.g. evader/shooting")
-    p_ev.add_argument("--episodes", type=int, default=50)
-    p_ev.add_argument("--seed", type=int, default=0)
-    p_ev.add_argument("--start", default="safe", choices=["env", "valid", "safe"])
+    p_ev.add_argument("name", help=_NAME_HELP)
+    p_ev.add_argument(
+        "--opponent",
+        required=True,
+        help="the other role's policy: a name (evader/shooting; surveil policies), "
+        "zoo:NAME or a model .zip",
+    )
+    p_ev.add_argument("--episodes", type=int, default=50, help="episodes (default 50)")
+    p_ev.add_argument("--seed", type=int, default=0, help="seed of the first (default 0)")
+    p_ev.add_argument(
+        "--start",
+        default="safe",
+        choices=["env", "valid", "safe"],
+        help="starts: the env's random one, or sample_start's valid or safe (default)",
+    )
     args = parser.parse_args(argv)
     if args.command == "list":
         for name in zoo.list_models():
@@ -43,7 +59,10 @@ def _main(argv: list[str] | None) -> int:
             features = (prov.get("config") or {}).get("features")
             if features:  # a learned policy with analytic features: say which
                 how += f" + features {', '.join(features)}"
-            print(f"{name}\t{prov['role']} ({how}) vs {prov['opponent']} on {', '.join(maps)}")
+            opponents = prov["opponent"]  # one name, or a pool's list (was printed as one)
+            if not isinstance(opponents, str):
+                opponents = ", ".join(opponents)
+            print(f"{name}\t{prov['role']} ({how}) vs {opponents} on {', '.join(maps)}")
     elif args.command == "info":
         print(json.dumps(zoo.info(args.name), indent=2))
     elif args.command == "reproduce":
@@ -78,7 +97,8 @@ def _line(ev) -> str:
     t = "-" if math.isnan(ev.mean_escape_time) else f"{ev.mean_escape_time:.2f} s"
     return (
         f"{ev.role} vs {ev.opponent}: success {ev.successes}/{ev.episodes} "
-        f"({ev.success_rate:.0%}), mean escape time {t}, causes {ev.causes}"
+        f"({ev.success_rate:.0%}), mean escape time {t}, causes "
+        + (", ".join(f"{c} {n}" for c, n in sorted(ev.causes.items())) or "none")
     )
 
 

@@ -97,6 +97,7 @@ def _env_config(flag_map: str, map_: str, overrides: dict, where: str):
 def _policy(flag: str, name: str, params_flag: str, params_text: str | None):
     """The policy a flag names, with the parameters of its ``-params`` flag, checked."""
     from strategies.policies import make_policy
+    from strategies.policies.model_files import is_model_reference, model_policy_name
 
     params = json_object(params_flag, params_text, example=PARAMS_EXAMPLE)
     role = flag.lstrip("-")
@@ -107,10 +108,9 @@ def _policy(flag: str, name: str, params_flag: str, params_text: str | None):
             f"{flag} = {name!r}: expected a policy name of the form '{role}/KIND' "
             "(see surveil policies)"
         )
-    if name.startswith("zoo:") or name.endswith(".zip"):  # as surveil evaluate takes them
-        from analysis.tournament.spec import model_file
-
-        name = f"{role}/sb3:{model_file(name, flag)}"
+    if is_model_reference(name):  # zoo:NAME or a .zip, as surveil evaluate takes them
+        # a refusal names the model as the user did (was the zip's absolute path)
+        name = model_policy_name(name, role, f"{flag}: model = {name!r}")
     if not name.startswith(f"{role}/"):
         raise InvalidConfigError(
             f"{flag} = {name!r}: expected a policy name of the form '{role}/KIND' "

@@ -321,7 +321,12 @@ def test_play_refuses_a_model_that_is_not_there_or_of_the_other_role(capsys, tmp
         (["--pursuer", "zoo:nope"], "--pursuer: model = 'zoo:nope': no zoo model 'nope'; known: ["),
         (["--evader", str(tmp_path / "notes.zip")], "not a stable-baselines3 model zip"),
         (["--evader", str(tmp_path / "gone.zip")], "--evader: model = ", "no such file"),
-        (["--pursuer", "zoo:ppo_evader_vs_greedy_open_room"], "trained as the evader"),
+        # named as the user did, not by the zip's absolute path
+        (
+            ["--pursuer", "zoo:ppo_evader_vs_greedy_open_room"],
+            "--pursuer: model = 'zoo:ppo_evader_vs_greedy_open_room': this model was trained as "
+            "the evader (its provenance.json says role = 'evader'); it cannot play the pursuer",
+        ),
     ]
     for argv, *needles in cases:
         assert_fails(capsys, ["play", *FAST, *argv, "--no-gif"], *needles)

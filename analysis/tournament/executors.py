@@ -213,7 +213,8 @@ class ProcessExecutor(Executor):
 
     Args:
         workers: processes (default: the CPUs available to this process).
-        kill_grace: seconds past the time limit before a silent worker is killed.
+        kill_grace: seconds past the end of the deciding role's clock (or of the
+            harness's stretch) before a silent worker is killed.
         start_method: multiprocessing start method (default ``"fork"`` where available:
             workers start in milliseconds and see everything the driver registered).
     """

@@ -48,6 +48,8 @@ __all__ = ["Board", "Context", "MatchTimeout", "context_for", "forfeit", "play",
 
 ALARM_GRACE = 1.0
 """Seconds past the end of a clock before ``SIGALRM`` interrupts the call in progress."""
+ALARM_MAX = 1e8
+"""The longest alarm set (about three years): ``setitimer`` overflows near 1e12 s."""
 
 
 class MatchTimeout(Exception):
@@ -200,7 +202,7 @@ class _Watch:
         # the alarm is re-armed before the role changes: a ring in between is the
         # previous stretch's, and its handler still names who was working then
         if self.alarm:
-            signal.setitimer(signal.ITIMER_REAL, span + ALARM_GRACE)
+            signal.setitimer(signal.ITIMER_REAL, min(span + ALARM_GRACE, ALARM_MAX))
         self.role = role
         if self.board is not None:
             self.board.write(HARNESS if role is None else ROLE_CODES[role], time.monotonic() + span)

@@ -193,6 +193,24 @@ def test_a_hang_that_ignores_signals_is_killed_and_blamed_on_who_was_deciding(
     assert all(r["status"] == "ok" for r in rows if r["evader"] == "evader/random")
 
 
+def test_a_time_limit_longer_than_an_alarm_can_be_set_plays(tmp_path):
+    # setitimer overflows near 1e12 s: a spec's time_limit = 1e12 (valid: finite, > 0)
+    # stored every match as an error ('OverflowError: timestamp out of range ...')
+    d = {
+        "maps": ["open_room"],
+        "pursuers": ["pursuer/greedy"],
+        "evaders": ["evader/random"],
+        "seeds": 1,
+        "start": "valid",
+        "time_limit": 1e12,
+        "env": {"max_cycles": 5},
+    }
+    s = run_tournament(spec_from_dict(d), tmp_path / "s.sqlite", backend="serial", progress=False)
+    with Store(tmp_path / "s.sqlite") as db:
+        (row,) = db.rows(s.run_id)
+    assert row["status"] == "ok", row["error"]
+
+
 def _round_room(tmp_path: Path, walls: int = 1000) -> str:
     """A map file: a round room of ``walls`` walls (a lidar's work grows with them)."""
     import numpy as np

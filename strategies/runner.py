@@ -50,7 +50,6 @@ Examples:
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import time
 from collections.abc import Callable, Mapping
@@ -476,11 +475,11 @@ def run_episode(
                 f"{{'pursuer': (x, y), 'evader': (x, y)}}, got {start!r}"
             )
         for role, pol in policies.items():
+            t0 = clocks.start(role)
             try:
-                with clocks.deciding(role):
-                    pol.reset(
-                        role=role, map=config.map, config=observers[role].config, seed=seeds[role]
-                    )
+                pol.reset(
+                    role=role, map=config.map, config=observers[role].config, seed=seeds[role]
+                )
             except MemoryBudgetError as exc:  # say whose parameter (the table's resolution)
                 knob = exc.args[1]
                 if not knob or _name(pol) in knob:
@@ -490,6 +489,8 @@ def run_episode(
                 raise
             except Exception as exc:
                 raise PolicyFailure(role, _name(pol), -1, _describe(exc)) from exc
+            finally:
+                clocks.stop(role, t0)
             clocks.check(role, _name(pol), -1)
         obs, infos = env.reset(seed=s_env, options=placement)
         frames: list[np.ndarray] | None = [] if record else None
@@ -504,13 +505,14 @@ def run_episode(
             state = env.state() if on_step is not None else None
             actions = {}
             for role, pol in policies.items():
+                t0 = clocks.start(role)
                 try:
-                    with clocks.deciding(role) as took:
-                        actions[role] = pol.act(seen[role])
+                    actions[role] = pol.act(seen[role])
                 except Exception as exc:
                     raise PolicyFailure(role, _name(pol), steps, _describe(exc)) from exc
+                finally:
+                    dt = clocks.stop(role, t0)
                 clocks.check(role, _name(pol), steps)
-                dt = took[0]
                 try:  # an action the env refuses (NaN, wrong shape...) is the policy's fault
                     env._command(AGENT[role], actions[role])
                 except InvalidActionError as exc:
@@ -567,20 +569,19 @@ class _Clocks:
         self.watch = watch
         self.spent = {"pursuer": 0.0, "evader": 0.0}
 
-    @contextlib.contextmanager
-    def deciding(self, role: str):
-        """Run ``role``'s clock for the body; yields a list that gets the seconds it took."""
-        took = [0.0]
+    def start(self, role: str) -> float:
+        """Start ``role``'s clock (call :meth:`stop` with what it returns, however it ends)."""
         if self.watch is not None:
             self.watch(role, None if self.limit is None else self.limit - self.spent[role])
-        t0 = time.perf_counter()
-        try:
-            yield took
-        finally:
-            took[0] = time.perf_counter() - t0
-            self.spent[role] += took[0]
-            if self.watch is not None:
-                self.watch(None, None)
+        return time.perf_counter()
+
+    def stop(self, role: str, t0: float) -> float:
+        """Stop ``role``'s clock started at ``t0``; the seconds it ran."""
+        took = time.perf_counter() - t0
+        self.spent[role] += took
+        if self.watch is not None:
+            self.watch(None, None)
+        return took
 
     def check(self, role: str, policy: str, step: int) -> None:
         """Raise :class:`EpisodeTimeout` if ``role``'s clock has passed the limit."""

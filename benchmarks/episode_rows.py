@@ -34,6 +34,7 @@ import hashlib
 import json
 import os
 import subprocess
+import sys
 from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from typing import IO, Any
@@ -83,8 +84,21 @@ def _holder(fd: int) -> str | None:
     return None
 
 
-def _git(*args: str) -> str | None:
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCRIPTS_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+"""The checkout these scripts are in."""
+
+
+def playing_root() -> str:
+    """The checkout whose policies play: where Python imports the package from. Not the
+    scripts' own when another checkout is installed in editable mode and this one is not
+    on ``sys.path`` (``python benchmarks/X.py`` puts ``benchmarks/`` there, not the root;
+    ``PYTHONPATH=ROOT`` does)."""
+    import strategies
+
+    return os.path.dirname(os.path.dirname(os.path.abspath(strategies.__file__)))
+
+
+def _git(*args: str, root: str = SCRIPTS_ROOT) -> str | None:
     try:
         out = subprocess.run(["git", *args], cwd=root, capture_output=True, text=True, timeout=20)
     except (OSError, subprocess.SubprocessError):
@@ -92,25 +106,45 @@ def _git(*args: str) -> str | None:
     return out.stdout if out.returncode == 0 else None
 
 
-@functools.cache
-def code_version() -> str | None:
-    """``SHA`` of HEAD (12 digits), ``SHA+DIGEST`` when :data:`SOURCES` differ from it
-    (DIGEST: 8 hex digits of the diff and of the untracked files' names and contents),
-    ``None`` outside a git checkout."""
-    sha = _git("rev-parse", "HEAD")
+def _version(root: str) -> str | None:
+    sha = _git("rev-parse", "HEAD", root=root)
     if not sha:
         return None
-    diff = _git("diff", "HEAD", "--", *SOURCES) or ""
-    untracked = (_git("ls-files", "--others", "--exclude-standard", "--", *SOURCES) or "").split()
+    diff = _git("diff", "HEAD", "--", *SOURCES, root=root) or ""
+    untracked = (
+        _git("ls-files", "--others", "--exclude-standard", "--", *SOURCES, root=root) or ""
+    ).split()
     if not diff and not untracked:
         return sha.strip()[:12]
     h = hashlib.sha256(diff.encode())
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     for name in sorted(untracked):
         h.update(name.encode())
         with open(os.path.join(root, name), "rb") as f:
             h.update(f.read())
     return f"{sha.strip()[:12]}+{h.hexdigest()[:8]}"
+
+
+@functools.cache
+def code_version() -> str | None:
+    """``SHA`` of HEAD (12 digits), ``SHA+DIGEST`` when :data:`SOURCES` differ from it
+    (DIGEST: 8 hex digits of the diff and of the untracked files' names and contents),
+    ``None`` outside a git checkout: the version of the checkout whose policies play
+    (:func:`playing_root`). When that is not the scripts' own checkout, the rows say so,
+    ``VERSION (scripts: VERSION)``, and a note on stderr tells how to play the scripts'
+    own code: the rows would otherwise name a commit that did not play them."""
+    playing = os.path.realpath(playing_root())
+    version = _version(playing)
+    if playing == os.path.realpath(SCRIPTS_ROOT):
+        return version
+    scripts = _version(SCRIPTS_ROOT)
+    print(
+        f"note: these benchmark scripts are in {SCRIPTS_ROOT} but the policies that play are "
+        f"imported from {playing} (an editable install of that checkout); rows record "
+        f"{version} (scripts: {scripts}). To play this checkout's code: "
+        f"PYTHONPATH={SCRIPTS_ROOT} python ...",
+        file=sys.stderr,
+    )
+    return f"{version} (scripts: {scripts})"
 
 
 def key(values: Iterable[Any]) -> str:

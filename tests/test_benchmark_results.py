@@ -69,6 +69,27 @@ def test_the_code_version_is_the_commit_and_a_digest_of_changes(bench):
     assert version is None or re.fullmatch(r"[0-9a-f]{12}(\+[0-9a-f]{8})?", version), version
 
 
+def test_scripts_of_another_checkout_record_the_code_that_plays(bench, tmp_path, capsys):
+    """Scripts run from a second checkout play the policies Python imports (an editable
+    install's checkout): the rows name that code and the scripts' apart, and a note says
+    how to play the scripts' own (they named the scripts' commit, which did not play)."""
+    import importlib.util
+
+    here = bench("episode_rows")
+    (tmp_path / "benchmarks").mkdir()
+    copy = tmp_path / "benchmarks" / "episode_rows.py"
+    copy.write_text((BENCHMARKS / "episode_rows.py").read_text())
+    spec = importlib.util.spec_from_file_location("episode_rows_elsewhere", copy)
+    other = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(other)
+    assert other.playing_root() == here.SCRIPTS_ROOT != other.SCRIPTS_ROOT == str(tmp_path)
+    assert other.code_version() == f"{here.code_version()} (scripts: None)"  # not a checkout
+    err = capsys.readouterr().err
+    assert f"scripts are in {tmp_path} but the policies that play are imported from" in err
+    assert f"PYTHONPATH={tmp_path} python" in err
+    assert here.code_version() is None or " " not in here.code_version()  # one checkout
+
+
 def test_a_file_that_is_not_json_lines_is_refused_naming_the_line(bench, tmp_path):
     rows = bench("episode_rows")
     path = tmp_path / "notes.txt"

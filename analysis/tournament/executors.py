@@ -15,12 +15,15 @@ leaves no process behind. A new backend is one class.
   the role that was deciding forfeits; with none deciding the match is an error.
 * :class:`RayExecutor` -- Ray core tasks (``ray.init(address=...)`` for a cluster, a local
   instance otherwise), the context put in the object store once, batches of about
-  :data:`TARGET_BATCH_SECONDS` each.
+  :data:`TARGET_BATCH_SECONDS` each. A worker's watchdog thread ends a hang the alarm
+  cannot interrupt :data:`KILL_GRACE` past its deadline and posts the match's outcome
+  (the deciding role forfeits) to a mailbox actor the driver reads.
 """
 
 from __future__ import annotations
 
 import collections
+import contextlib
 import math
 import multiprocessing as mp
 import os
@@ -33,7 +36,15 @@ from multiprocessing.connection import Connection, wait
 from typing import Any
 
 from analysis.tournament.identity import Match
-from analysis.tournament.worker import ALARM_GRACE, Board, Context, forfeit, play, warm_up
+from analysis.tournament.worker import (
+    ALARM_GRACE,
+    Board,
+    Context,
+    LocalBoard,
+    forfeit,
+    play,
+    warm_up,
+)
 
 __all__ = [
     "BACKENDS",
@@ -184,28 +195,30 @@ class _Worker:
         seen = self.board.read() if self.current is not None else None
         if seen is None or now <= seen[1] + grace:
             return None
-        role, _ = seen
-        mid = self.current.match_id
-        if role is None:
-            return {
-                "match_id": mid,
-                "status": "error",
-                "error": f"killed: the env or the harness gave no answer for the time limit "
-                f"+ {grace:g} s while no policy was deciding (a hang the alarm could not "
-                "interrupt)",
-            }
-        return forfeit(
-            mid,
-            role,
-            f"{role} killed: no answer {grace:g} s after its clock ran out (a hang the "
-            "alarm could not interrupt)",
-        )
+        return _killed(self.current.match_id, seen[0], grace)
 
     def kill(self) -> None:
         if self.proc.is_alive():
             self.proc.kill()
         self.proc.join(timeout=2.0)
         self.conn.close()
+
+
+def _killed(match_id: str, role: str | None, grace: float) -> dict:
+    """The outcome of a match whose worker is killed ``grace`` past its deadline."""
+    if role is None:
+        return {
+            "match_id": match_id,
+            "status": "error",
+            "error": f"killed: the env or the harness gave no answer for the time limit + "
+            f"{grace:g} s while no policy was deciding (a hang the alarm could not interrupt)",
+        }
+    return forfeit(
+        match_id,
+        role,
+        f"{role} killed: no answer {grace:g} s after its clock ran out (a hang the alarm "
+        "could not interrupt)",
+    )
 
 
 class ProcessExecutor(Executor):
@@ -309,15 +322,66 @@ class ProcessExecutor(Executor):
 _RAY_CONTEXTS: dict[str, Context] = {}
 
 
-def _ray_play(batch: list[Match], ctx_box: list[Any]) -> Iterator[tuple[str, Any]]:
+class _Mailbox:
+    """A Ray actor of a run: the outcome a Ray worker posts before it ends itself."""
+
+    def __init__(self) -> None:
+        self.box: dict[str, dict] = {}
+
+    def post(self, match_id: str, outcome: dict) -> None:
+        self.box[match_id] = outcome
+
+    def take(self, match_id: str) -> dict | None:
+        return self.box.pop(match_id, None)
+
+
+class _RayWatch:
+    """A Ray worker process's watchdog: a thread reading the board of the match in play.
+
+    A hang the alarm cannot interrupt (C code, signals blocked) outlives its deadline by
+    :data:`KILL_GRACE`: the thread posts the match's outcome (a forfeit of the role that
+    was deciding, or an error) to the run's mailbox and ends the process, and the driver
+    stores what it finds there when it sees the task fail.
+    """
+
+    def __init__(self) -> None:
+        self.board = LocalBoard()
+        self.match: Match | None = None
+        self.mailbox: Any = None
+        threading.Thread(target=self._watch, daemon=True, name="surveil-ray-watch").start()
+
+    def _watch(self) -> None:
+        import ray
+
+        while True:
+            time.sleep(POLL)
+            match, seen = self.match, self.board.read()
+            if match is None or seen is None or time.monotonic() <= seen[1] + KILL_GRACE:
+                continue
+            try:
+                outcome = _killed(match.match_id, seen[0], KILL_GRACE)
+                ray.get(self.mailbox.post.remote(match.match_id, outcome), timeout=60)
+            finally:
+                os._exit(1)
+
+
+_RAY_WATCH: list[_RayWatch] = []
+
+
+def _ray_play(batch: list[Match], ctx_box: list[Any], mailbox: Any) -> Iterator[tuple[str, Any]]:
     """A Ray task (a generator): fetch the run's context once per worker process, play.
 
     Yields ``("start", match_id)`` and ``("done", outcome)`` for each match, so that the
     driver times each match from its own start, as the process backend does (not the wait
-    in Ray's queue, the worker's start or the context's fetching before it).
+    in Ray's queue, the worker's start or the context's fetching before it). The worker's
+    :class:`_RayWatch` posts to ``mailbox`` the outcome of a match it ends.
     """
     import ray
 
+    if not _RAY_WATCH:
+        _RAY_WATCH.append(_RayWatch())
+    watch = _RAY_WATCH[0]
+    watch.mailbox = mailbox
     ref = ctx_box[0]
     key = ref.hex()
     if key not in _RAY_CONTEXTS:
@@ -328,7 +392,12 @@ def _ray_play(batch: list[Match], ctx_box: list[Any]) -> Iterator[tuple[str, Any
         _RAY_CONTEXTS[key] = ctx
     for m in batch:
         yield ("start", m.match_id)
-        yield ("done", play(m, _RAY_CONTEXTS[key]))
+        watch.match = m
+        try:
+            out = play(m, _RAY_CONTEXTS[key], watch.board)
+        finally:
+            watch.match = None
+        yield ("done", out)
 
 
 def _roster_registrations(ctx: Context) -> dict[str, tuple[Any, str]]:
@@ -397,10 +466,13 @@ class RayExecutor(Executor):
     Up to two tasks per CPU are in flight, so a task may wait in Ray's queue. A task
     reports when it starts each match (it is a generator, see :func:`_ray_play`). Within a
     match the worker's own alarm blames the role whose clock ran out, as in the other
-    backends; a hang the alarm cannot interrupt is killed by the driver three times the
-    time limit plus the alarm's grace, plus :data:`KILL_GRACE`, after that report (the
-    driver cannot see who is deciding in a Ray worker: such a match is an error, charged
-    to nobody). A wait in Ray's queue, a worker's start and its fetching of the context
+    backends, and a hang the alarm cannot interrupt is ended by the worker's watchdog
+    thread :data:`KILL_GRACE` past its deadline, which posts the outcome (a forfeit of the
+    role that was deciding, or an error with none deciding) to the run's mailbox actor
+    (:class:`_Mailbox`, no CPU) before it ends the process. Where the watchdog cannot run
+    either (C code holding the GIL), the driver kills the task three times the time limit
+    plus the alarm's grace, plus :data:`KILL_GRACE`, after that report: an error, charged
+    to nobody. A wait in Ray's queue, a worker's start and its fetching of the context
     are no match's time and are not timed: timed from the submission, with a guessed
     allowance (30 s), they outran it at load 14 on 2 cores (a worker's start 23 s, the
     context 14 s more) and matches that never overran were stored as overruns. A hang
@@ -448,6 +520,7 @@ class RayExecutor(Executor):
         self.max_inflight = 2 * self.cpus if self.cpus == self.cluster_cpus else self.cpus
         self.task = ray.remote(num_cpus=1, max_retries=0)(_ray_play)
         self.inflight: dict[Any, _RayTask] = {}  # task (an ObjectRefGenerator): its state
+        self.mailbox: Any = None
 
     def describe(self) -> str:
         if self.cpus < self.cluster_cpus:
@@ -465,6 +538,8 @@ class RayExecutor(Executor):
                 f"the run's context (maps, policies, models) cannot be sent to Ray workers: "
                 f"{type(exc).__name__}: {exc}; use --backend process"
             ) from exc
+        if self.mailbox is None:
+            self.mailbox = ray.remote(num_cpus=0)(_Mailbox).remote()
         todo = collections.deque(matches)
         batcher = _Batcher(self.cpus)
         solo: set[str] = set()  # matches of a task that died before it started one
@@ -472,7 +547,7 @@ class RayExecutor(Executor):
             while todo and len(self.inflight) < self.max_inflight:
                 n = 1 if todo[0].match_id in solo else batcher.size(len(todo))
                 batch = [todo.popleft() for _ in range(min(n, len(todo)))]
-                self.inflight[self.task.remote(batch, box)] = _RayTask(batch)
+                self.inflight[self.task.remote(batch, box, self.mailbox)] = _RayTask(batch)
             ready, _ = ray.wait(list(self.inflight), num_returns=1, timeout=POLL)
             for gen in ready:
                 yield from self._drain(gen, todo, solo, batcher)
@@ -486,8 +561,8 @@ class RayExecutor(Executor):
                     del self.inflight[gen]
                     why = (
                         f"killed: no answer {_ray_allowance(ctx.time_limit):g} s into "
-                        "the match (a hang the alarm could not interrupt; on Ray the driver "
-                        "cannot tell which role was deciding)"
+                        "the match (a hang neither the alarm nor the worker's watchdog "
+                        "could end)"
                     )
                     yield from self._lost(task, todo, solo, why)
 
@@ -520,12 +595,19 @@ class RayExecutor(Executor):
             if not ray.wait([gen], num_returns=1, timeout=0)[0]:
                 return
 
-    @staticmethod
-    def _lost(task: _RayTask, todo: collections.deque, solo: set[str], why: str) -> Iterator[dict]:
-        """A task killed or dead: its match in play is an error, the rest is replayed."""
+    def _lost(
+        self, task: _RayTask, todo: collections.deque, solo: set[str], why: str
+    ) -> Iterator[dict]:
+        """A task killed or dead: its match in play is what its worker posted before it
+        ended itself (see :class:`_RayWatch`), or an error; the rest is replayed."""
         rest = list(task.pending)
         if task.current is not None:
-            yield {"match_id": task.current.match_id, "status": "error", "error": why}
+            mid = task.current.match_id
+            try:
+                posted = self.ray.get(self.mailbox.take.remote(mid), timeout=60)
+            except Exception:  # pragma: no cover - the mailbox died with the cluster
+                posted = None
+            yield posted or {"match_id": mid, "status": "error", "error": why}
         elif task.played == 0 and len(task.batch) == 1 and task.batch[0].match_id in solo:
             # a worker that never started this match, already alone in its task: give up
             yield {"match_id": rest[0].match_id, "status": "error", "error": why}
@@ -541,6 +623,10 @@ class RayExecutor(Executor):
             except Exception:  # pragma: no cover - already finished
                 pass
         self.inflight.clear()
+        if self.mailbox is not None:
+            with contextlib.suppress(Exception):
+                self.ray.kill(self.mailbox)
+            self.mailbox = None
         if self.started and self.ray.is_initialized():
             self.ray.shutdown()
             self.started = False

@@ -45,7 +45,16 @@ from analysis.tournament.identity import Match
 from analysis.tournament.spec import PolicyEntry, Spec
 from envs.errors import RhoAboveOneWarning
 
-__all__ = ["Board", "Context", "MatchTimeout", "context_for", "forfeit", "play", "warm_up"]
+__all__ = [
+    "Board",
+    "Context",
+    "LocalBoard",
+    "MatchTimeout",
+    "context_for",
+    "forfeit",
+    "play",
+    "warm_up",
+]
 
 ALARM_GRACE = 1.0
 """Seconds past the end of a clock before ``SIGALRM`` interrupts the call in progress."""
@@ -105,6 +114,24 @@ class Board:
             return None
         role = next((r for r, c in ROLE_CODES.items() if c == who), None)
         return role, deadline
+
+
+class LocalBoard:
+    """A :class:`Board` read by a thread of the same process (a Ray worker's watchdog)."""
+
+    def __init__(self) -> None:
+        self.seen: tuple[float, float] = (IDLE, 0.0)  # one object: read whole or not at all
+
+    def write(self, who: float, deadline: float) -> None:
+        """Say who is deciding and until when."""
+        self.seen = (who, deadline)
+
+    def read(self) -> tuple[str | None, float] | None:
+        """``(role or None for the harness, deadline)``; ``None`` when idle."""
+        who, deadline = self.seen
+        if who == IDLE:
+            return None
+        return next((r for r, c in ROLE_CODES.items() if c == who), None), deadline
 
 
 @dataclass

@@ -139,13 +139,15 @@ def test_a_match_queued_behind_a_hang_is_not_killed_as_an_overrun(
 
 
 def test_a_deaf_hang_is_killed_and_the_match_queued_behind_it_plays(tmp_path, test_policies):
-    # A hang with SIGALRM blocked is killed by the driver (ray.cancel(force=True)); the
-    # task queued for that CPU starts only then, in a new worker, and was killed with it
-    # as an overrun (its clock had run since its submission).
+    # A hang with SIGALRM blocked is ended by the worker's watchdog, which posts a forfeit
+    # of the role that was deciding (it was an error, charged to nobody: the driver killed
+    # the task without knowing who decided); one with no policy deciding (a mixture's
+    # pick) stays an error. The task queued for that CPU starts only then, in a new
+    # worker, and was killed with it as an overrun (its clock had run since its submission).
     d = {
         "maps": ["open_room"],
         "pursuers": ["pursuer/greedy"],
-        "evaders": ["evader/test_deaf", "evader/random"],
+        "evaders": ["evader/test_deaf", "evader/test_deaf_pick", "evader/random"],
         "seeds": 2,
         "start": "valid",
         "time_limit": 2,
@@ -161,7 +163,11 @@ def test_a_deaf_hang_is_killed_and_the_match_queued_behind_it_plays(tmp_path, te
     with Store(tmp_path / "r.sqlite") as db:
         rows = db.rows(s.run_id)
     deaf = [r for r in rows if r["evader"] == "evader/test_deaf"]
-    assert len(deaf) == 2 and all(r["status"] == "error" and "killed" in r["error"] for r in deaf)
+    assert len(deaf) == 2 and all(r["status"] == "forfeit" for r in deaf), deaf
+    assert all(r["blame"] == "evader" and "evader killed" in r["error"] for r in deaf)
+    picked = [r for r in rows if r["evader"] == "evader/test_deaf_pick"]
+    assert len(picked) == 2 and all(r["status"] == "error" for r in picked), picked
+    assert all("no policy was deciding" in r["error"] for r in picked)
     played = [r for r in rows if r["evader"] == "evader/random"]
     assert len(played) == 2 and all(r["status"] == "ok" for r in played), played
 

@@ -20,8 +20,9 @@ whichever side was slower overall.
 A hang is cut short twice. A ``SIGALRM`` interrupts a call :data:`ALARM_GRACE` seconds
 after the deciding role's clock ran out (where the platform allows it: the main thread of
 a POSIX process), and that role forfeits. The worker also writes on a :class:`Board` who
-is deciding and until when, so the process backend can kill a worker stuck where signals
-do not reach (C code, signals blocked) and still blame the role that was deciding. With
+is deciding and until when (a :class:`LocalBoard` in a Ray worker, read by its watchdog
+thread), so a worker stuck where signals do not reach (C code, signals blocked) can be
+killed and the role that was deciding still blamed. With
 no policy deciding, each stretch of the env's and the harness's work gets the time limit
 too (the same alarm, the same kill): past it the match is an ``error``, charged to nobody.
 """

@@ -111,9 +111,10 @@ def run(args: argparse.Namespace) -> int:
     from strategies.referee import referee_for
     from strategies.referee.estimates import check_cpls, check_estimate
     from strategies.referee.referee import check_solve_budget, check_start
-    from strategies.referee.spec import GameSpec
+    from strategies.referee.spec import GameSpec, check_cells_per_lmin
     from strategies.runner import map_parameters
 
+    check_cells_per_lmin(args.cells_per_lmin, "--cells-per-lmin")  # 1e100 was a traceback
     overrides = json_object("--config", args.config, example=CONFIG_EXAMPLE)
     out = None
     if args.out:

@@ -32,7 +32,7 @@ from strategies.referee.estimates import (
     heading_moves,
 )
 from strategies.referee.robust import convex_corners
-from strategies.referee.spec import GameSpec
+from strategies.referee.spec import GameSpec, check_cells_per_lmin
 
 __all__ = ["EstimateEvader"]
 
@@ -80,7 +80,7 @@ class EstimateEvader(BasePolicy):
             )
         if solution is not None and solution.evader_first_rank is None:
             raise InvalidConfigError("EstimateEvader: the solution has no evader_first_rank")
-        self.cells_per_lmin = V.positive("cells_per_lmin", cells_per_lmin)
+        self.cells_per_lmin = check_cells_per_lmin(cells_per_lmin)
         self.steps = V.positive("steps", steps)
         self.headings = V.integer("headings", headings, minimum=4)
         self.solution = solution

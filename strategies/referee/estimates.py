@@ -98,7 +98,7 @@ from strategies.referee._fixpoint import shifted
 from strategies.referee.cache import load_arrays, save_arrays
 from strategies.referee.lattice import Lattice, _cross, segment_wall_distance
 from strategies.referee.robust import convex_corners
-from strategies.referee.spec import GameSpec, Resolution
+from strategies.referee.spec import GameSpec, Resolution, check_cells_per_lmin
 
 __all__ = [
     "ESTIMATE_LABELS",
@@ -379,7 +379,7 @@ def solve_estimate(
     """
     if not isinstance(spec, GameSpec):
         raise InvalidConfigError(f"solve_estimate: expected a GameSpec, got {type(spec).__name__}")
-    cpl = V.positive("cells_per_lmin", cells_per_lmin)
+    cpl = check_cells_per_lmin(cells_per_lmin)
     steps = V.positive("steps", steps)
     headings = V.integer("headings", headings, minimum=4)
     check_budget(
@@ -661,7 +661,7 @@ def check_cpls(cpls: Sequence[float]) -> list[float]:
     Raises:
         InvalidConfigError: otherwise (the resolution error is their disagreement).
     """
-    values = [V.positive("cpls", c) for c in cpls]
+    values = [check_cells_per_lmin(c, "cpls") for c in cpls]
     if len(set(values)) < 2 or len(set(values)) < len(values):
         raise InvalidConfigError(
             f"cpls = {tuple(cpls)!r}: expected at least two different resolutions (the "

@@ -24,11 +24,11 @@ import math
 
 import numpy as np
 
-from envs import validation as V
 from envs.errors import InvalidConfigError, MemoryBudgetError
 from strategies.policies.base import BasePolicy, Snapshot, unit
 from strategies.referee.evader_bound import EvaderBound
 from strategies.referee.pursuer_bound import PursuerBound
+from strategies.referee.spec import check_cells_per_lmin
 
 __all__ = ["RefereeEvader", "RefereePursuer", "env_steps_per_referee_step"]
 
@@ -86,7 +86,7 @@ class _RefereePolicy(BasePolicy):
         self.roles = (self.role_name,)
         self.bound = bound
         self._solve = bound is None
-        self.cells_per_lmin = V.positive("cells_per_lmin", cells_per_lmin)
+        self.cells_per_lmin = check_cells_per_lmin(cells_per_lmin)
         self._k = 1
         self._target: np.ndarray | None = None
         self.uncertified_steps = 0

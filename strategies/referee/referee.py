@@ -35,7 +35,7 @@ from strategies.referee._budget import SolveSize, bound_size, check_budget
 from strategies.referee.cache import cache_path, load_arrays, save_arrays
 from strategies.referee.evader_bound import EvaderBound, solve_evader_bound
 from strategies.referee.pursuer_bound import VACUOUS_RHO, PursuerBound, solve_pursuer_bound
-from strategies.referee.spec import GameSpec, Resolution
+from strategies.referee.spec import GameSpec, Resolution, check_cells_per_lmin
 
 __all__ = [
     "LABELS",
@@ -438,7 +438,7 @@ def solve(
     """
     if not isinstance(spec, GameSpec):
         raise InvalidConfigError(f"solve: expected a GameSpec, got {type(spec).__name__}")
-    cells_per_lmin = V.positive("cells_per_lmin", cells_per_lmin)
+    cells_per_lmin = check_cells_per_lmin(cells_per_lmin)
     pursuer_fallback = V.boolean("pursuer_fallback", pursuer_fallback)
     knobs = dict(pursuer_coarse=pursuer_coarse, evader_coarse=evader_coarse,
                  pursuer_steps=pursuer_steps, evader_steps=evader_steps,
@@ -472,7 +472,7 @@ def check_solve_budget(
     Raises:
         MemoryBudgetError: as :func:`solve`.
     """
-    cells_per_lmin = V.positive("cells_per_lmin", cells_per_lmin)
+    cells_per_lmin = check_cells_per_lmin(cells_per_lmin)
 
     def sizes(cpl: float) -> list[SolveSize]:
         return [
@@ -617,7 +617,7 @@ def unsolved_sizes(
         **knobs: :func:`solve`'s ``pursuer_coarse, evader_coarse, pursuer_steps,
             evader_steps, sweep_pieces, dt``.
     """
-    cells_per_lmin = V.positive("cells_per_lmin", cells_per_lmin)
+    cells_per_lmin = check_cells_per_lmin(cells_per_lmin)
     out = []
     for role in ("pursuer", "evader"):
         res = _resolution(spec, role, cells_per_lmin, **knobs)
@@ -646,7 +646,7 @@ def fallback_size(
     Args:
         spec, cells_per_lmin, cache, cache_dir, knobs: as :func:`unsolved_sizes`.
     """
-    cells_per_lmin = V.positive("cells_per_lmin", cells_per_lmin)
+    cells_per_lmin = check_cells_per_lmin(cells_per_lmin)
     res = _resolution(spec, "pursuer", cells_per_lmin, **knobs)
     alt = _fallback_resolution(spec, res, cells_per_lmin, knobs)
     if alt is None or (cache and cache_path("pursuer", spec, alt, cache_dir).is_file()):
@@ -731,7 +731,7 @@ def solve_role(
         raise InvalidConfigError(f"solve_role: expected a GameSpec, got {type(spec).__name__}")
     if role not in ("pursuer", "evader"):
         raise InvalidConfigError(f"role = {role!r}: expected 'pursuer' or 'evader'")
-    cells_per_lmin = V.positive("cells_per_lmin", cells_per_lmin)
+    cells_per_lmin = check_cells_per_lmin(cells_per_lmin)
     pursuer_fallback = V.boolean("pursuer_fallback", pursuer_fallback)
 
     def sizes(cpl: float) -> list[SolveSize]:

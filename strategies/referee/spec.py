@@ -15,7 +15,7 @@ from envs import validation as V
 from envs.errors import InvalidConfigError
 from envs.maps import Map
 
-__all__ = ["MARGIN_REL", "GameSpec", "Resolution"]
+__all__ = ["MARGIN_REL", "MAX_CELLS_PER_LMIN", "GameSpec", "Resolution", "check_cells_per_lmin"]
 
 MARGIN_REL = 1e-6
 """Safety margin of every robust test, relative to the map's scale.
@@ -24,6 +24,29 @@ It absorbs the kernel's contact tolerance (``REL_LENGTH_TOL``, 1000 times smalle
 the float32 rounding of positions in the env's ``"state"`` observation, which is what a
 referee policy reads its position from.
 """
+
+
+MAX_CELLS_PER_LMIN = 1e12
+"""The finest resolution a solve or an estimate takes. A solve's states grow as the
+fourth power of it (about 1e43 million on the corner world at 1e12, refused by the memory
+budget in a second); from about 1e70 its size estimate overflowed a float (1e100: an
+OverflowError, 1e300: a ZeroDivisionError, tracebacks)."""
+
+
+def check_cells_per_lmin(value: Any, name: str = "cells_per_lmin") -> float:
+    """``value`` as a float in ``(0, MAX_CELLS_PER_LMIN]``.
+
+    Raises:
+        InvalidConfigError: it is not a finite number > 0, or it is above
+            :data:`MAX_CELLS_PER_LMIN`, naming it.
+    """
+    cpl = V.positive(name, value)
+    if cpl > MAX_CELLS_PER_LMIN:
+        raise InvalidConfigError(
+            f"{name} = {value!r}: expected at most {MAX_CELLS_PER_LMIN:g} (a solve's states "
+            "grow as its fourth power: far beyond any memory there already)"
+        )
+    return cpl
 
 
 def _check_map(value: Any, where: str | None) -> Map:
@@ -218,7 +241,7 @@ class Resolution:
             (0.1, 0.4, 0.8)
         """
         V.choice("role", role, ("pursuer", "evader"))
-        cpl = V.positive("cells_per_lmin", cells_per_lmin)
+        cpl = check_cells_per_lmin(cells_per_lmin)
         st = V.real("steps", steps, minimum=1.0)
         co = V.integer("coarse", coarse, minimum=1)
         h = spec.l_min / cpl

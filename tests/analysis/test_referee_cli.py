@@ -254,3 +254,13 @@ def test_a_long_solve_s_announcement_counts_the_pursuer_bound_s_fallback(capsys,
     assert retry.kind == "pursuer" and retry.tau < default.tau and retry.points > default.points
     assert fallback_size(spec, 16, cache=False, pursuer_coarse=4) is None  # asked for: kept
     assert fallback_size(GameSpec.from_config(EnvConfig(map="corridor")), 16) is None
+
+
+@pytest.mark.parametrize("flag", [["--cells-per-lmin", "1e100"], ["--estimate", "1e300", "2e300"]])
+def test_an_absurd_resolution_is_one_line_naming_the_flag(flag, capsys):
+    """--cells-per-lmin 1e100 was an OverflowError traceback from the memory estimate (1e300
+    a ZeroDivisionError); --estimate 1e300 2e300 too."""
+    assert main(["referee", "corner", *flag]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"surveil: error: {flag[0]}") and "Traceback" not in err, err
+    assert "expected at most 1e+12" in err and len(err.strip().splitlines()) == 1

@@ -235,3 +235,25 @@ def test_lattice_vectors_are_counted_without_listing_them(spacing):
         assert count_lattice_vectors(length, spacing) == len(lattice_vectors(length, spacing))
     r = 3e6  # beyond the exact count: the disc's area, within 1e-6
     assert count_lattice_vectors(r * spacing, spacing) == pytest.approx(math.pi * r * r, rel=1e-6)
+
+
+def test_a_resolution_beyond_any_memory_is_refused_naming_it():
+    """From about 1e70 cells per L_min the size estimate overflowed: solve(spec, 1e100) was
+    an OverflowError, 1e300 a ZeroDivisionError; every entry point now refuses it."""
+    from strategies.referee import RefereePursuer
+    from strategies.referee.referee import check_solve_budget
+    from strategies.referee.spec import MAX_CELLS_PER_LMIN
+
+    s = GameSpec.from_config(EnvConfig(map="corner"))
+    want = r"cells_per_lmin = 1e\+(100|300): expected at most 1e\+12"
+    for cpl in (1e100, 1e300):
+        with pytest.raises(InvalidConfigError, match=want):
+            check_solve_budget(s, cpl, dt=0.1)
+        with pytest.raises(InvalidConfigError, match=want):
+            solve(s, cpl, cache=False)
+        with pytest.raises(InvalidConfigError, match=want):
+            RefereePursuer(cells_per_lmin=cpl)
+        with pytest.raises(InvalidConfigError, match=r"cpls = 1e\+300: expected at most"):
+            estimate(s, (4, 1e300), cache=False)
+    with pytest.raises(MemoryBudgetError):  # the largest taken: the budget refuses it
+        check_solve_budget(s, MAX_CELLS_PER_LMIN, dt=0.1)

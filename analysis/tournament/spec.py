@@ -563,7 +563,7 @@ def _entry(item: Any, role: str, where: str, base: Path) -> PolicyEntry:
     provenance = _provenance(path)
     if provenance.get("role") not in (None, role):
         raise InvalidConfigError(
-            f"{where}: model {text!r} was trained as a {provenance['role']}, not a {role}"
+            f"{where}: model {text!r} was trained as the {provenance['role']}, not the {role}"
         )
     params: dict[str, Any] = {}
     algo = d.get("algo", provenance.get("algo"))

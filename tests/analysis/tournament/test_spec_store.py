@@ -240,6 +240,10 @@ def test_a_model_named_as_a_string_is_a_model_entry(tmp_path):
         entry({"policy": "pursuer/sb3:m/model.zip", "label": "ppo"})
     with pytest.raises(InvalidConfigError, match=r"'params' applies to 'policy' entries"):
         entry({"model": "m/model.zip", "params": {"deterministic": False}})
+    # was "was trained as a evader, not a pursuer"
+    with pytest.raises(InvalidConfigError, match=r"model 'zoo:ppo_evader_vs_greedy_open_room' "
+                       r"was trained as the evader, not the pursuer$"):  # fmt: skip
+        entry("zoo:ppo_evader_vs_greedy_open_room")
 
 
 def test_store_lock_refuses_a_second_writer(tmp_path, small_spec):

@@ -91,7 +91,7 @@ SCRIPTS_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 def playing_root() -> str:
     """The checkout whose policies play: where Python imports the package from. Not the
     scripts' own when another checkout is installed in editable mode and this one is not
-    on ``sys.path`` (``python benchmarks/X.py`` puts ``benchmarks/`` there, not the root;
+    on the import path (``python benchmarks/X.py`` puts ``benchmarks/`` there, not the root;
     ``PYTHONPATH=ROOT`` does)."""
     import strategies
 

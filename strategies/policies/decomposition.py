@@ -10,7 +10,9 @@ steps the table reads the rod's own orientation as blocked, :func:`crossable_ste
    way round), and a ray stops at the first wall it meets. An evader hugging a wall
    toward a convex corner is probed round that corner too, on rays from where it rounds
    it, and round the next corner if the wall it rounds onto ends in one
-   (:meth:`DecompositionPursuer._corners_in_reach`).
+   (:meth:`DecompositionPursuer._corners_in_reach`); an evader walking round an
+   obstacle small enough to circle is probed round every corner of the walk within
+   reach (:meth:`DecompositionPursuer._walk_corners`).
 2. The value of each orientation (eqs. 2-3 with a straight-line evader and the pursuer
    turning at ``omega = (V_p / L_min) sqrt(1 - rho^2)``, the least rate the evader can
    impose, Sec. 6.1)::
@@ -53,6 +55,7 @@ from __future__ import annotations
 import functools
 import math
 from collections import deque
+from typing import NamedTuple
 
 import numpy as np
 
@@ -257,6 +260,9 @@ class DecompositionPursuer(BasePolicy):
         corners = _rounding_corners(c.map)
         self._corners, self._corner_vertex = _corner_starts(c.map, corners, c.body_radius)
         self._corner_next, self._corner_in = _corner_neighbours(c.map, corners)
+        # obstacles small enough to circle, and their corners along the walk round them
+        # (:meth:`_walk_corners`): within the evader's circle at the rod's least rate
+        self._small = _small_obstacles(c.map, corners, 2.0 * math.pi * c.v_evader / self.omega)
 
     # ------------------------------------------------------------------ decision
     def orientation_values(self, evader: np.ndarray) -> np.ndarray:
@@ -345,20 +351,95 @@ class DecompositionPursuer(BasePolicy):
             j = self._corner_after(k, vx, vy)
             nxt = self._corner_probe(j, evader, 0.0, reach) if j >= 0 else None
             if nxt is not None:
-                return [nxt]
+                return [nxt, *self._walk_corners(evader, vx, vy, speed, reach, [j])]
             break
+        out: list[tuple[np.ndarray, float, np.ndarray, int]] = []
+        done: list[int] = []  # the corners probed so far
         ahead = (d < reach) & (dx * vx + dy * vy >= self.CORNER_HEADING * speed * d)
         for k in np.flatnonzero(ahead)[np.argsort(d[ahead], kind="stable")]:
             first = self._corner_probe(k, evader, 0.0, reach)
             if first is None:  # no straight free walk
                 continue
-            out = [(*first[:3], 0)]
+            out.append((*first[:3], 0))
+            done.append(int(k))
             j = self._corner_after(k, float(dx[k]), float(dy[k]))
             nxt = self._corner_probe(j, starts[k], float(d[k]), reach) if j >= 0 else None
             if nxt is not None:
                 out.append(nxt)
-            return out
-        return []
+                done.append(j)
+            break
+        return out + self._walk_corners(evader, vx, vy, speed, reach, done)
+
+    def _walk_corners(
+        self, evader: np.ndarray, vx: float, vy: float, speed: float, reach: float, done: list
+    ) -> list[tuple[np.ndarray, float, np.ndarray, int]]:
+        """Probes round every corner of a small obstacle the evader walks round (issue 13).
+
+        Small: the obstacle's convex hull is no longer than the circle the evader runs on
+        while the rod turns at its least rate ``omega`` (radius ``V_e / omega``, Sec. 6.1;
+        a convex obstacle inside that circle is no longer than it), so a lap round it
+        takes about as long as the rod's full turn, or less. Circling one, the evader
+        keeps turning its heading, and the corners it rounds next threaten orientations a
+        straight-line evader never reaches (eqs. 2-3): the rod idled at a near target for
+        5-7 s while only the next corner was probed (:meth:`_corners_in_reach`), then the
+        best orientation jumped about 120 degrees ahead and the rod, turning at its
+        limit, fell behind (the orbit at 0.25 on rand:star:3007 and rand:polygons:3005,
+        rho 0.5, occluded at 14.0 s and 17.0 s; both hulls 7.0 and 6.1 against 7.26).
+        A larger obstacle (the maze's walls, the pillars of the built-in worlds) is left
+        alone: a lap round it takes longer than the rod's full turn.
+
+        Where the evader hugs such an obstacle (within ``CORNER_HUG`` grid steps of its
+        body from a wall) and walks round it (its heading within ``CORNER_HEADING`` of
+        the hull's tangent), each hull corner along the walk within ``reach`` (the walk's
+        length along the hull) is probed from where its centre rounds it, with
+        ``t_e = walk / V_e``, on the rays turning round it, and the rotation counted the
+        way the walk turns (as the second corner of :meth:`_corners_in_reach`), except the
+        ``done`` corners that method probes already.
+        """
+        small = self._small
+        if small is None:
+            return []
+        c = self.config
+        e, dist, _, _ = _nearest_edge(evader, small.wall)
+        if dist > c.body_radius + self.CORNER_HUG * self.table.resolution:
+            return []
+        ring = int(small.wall.ring[e])
+        hull = small.hull[ring]
+        e, _, t, g = _nearest_edge(evader, hull)
+        # the walk's tangent, forward along the hull (oriented as the map's rings, free
+        # space on its left): away from the hull turned by -90 degrees outside it, the
+        # hull edge's direction on it or inside it (in a pocket of the obstacle)
+        gn = math.hypot(*g)
+        hdir = hull.dir[e]
+        if gn > 1e-9 and g[1] * hdir[0] - g[0] * hdir[1] >= 0.0:
+            tx, ty = g[1] / gn, -g[0] / gn
+        else:
+            tx, ty = float(hdir[0]), float(hdir[1])
+        along = vx * tx + vy * ty
+        if abs(along) < self.CORNER_HEADING * speed:
+            return []
+        s = float(hull.pos[e]) + t
+        forward = along > 0.0
+        lap = small.perimeter[ring]
+        pos = small.corner_pos[ring]
+        walk = (pos - s) % lap if forward else (s - pos) % lap
+        out = []
+        for i in np.argsort(walk, kind="stable"):
+            w = float(walk[i])
+            if w >= reach:
+                break
+            k = int(small.corners[ring][i])
+            if k in done:
+                continue
+            start = self._corners[k]
+            fx, fy = (float(v) for v in small.arrive[ring][i, 0 if forward else 1])
+            wx = float(self._corner_vertex[k, 0] - start[0])
+            wy = float(self._corner_vertex[k, 1] - start[1])
+            side = fx * wy - fy * wx  # > 0: the obstacle left of the walk
+            cross = fx * self._dirs[:, 1] - fy * self._dirs[:, 0]
+            sense = 1 if side > 0 else -1
+            out.append((start, w / c.v_evader, cross * side > 0.0, sense))
+        return out
 
     def _corner_after(self, k: int, vx: float, vy: float) -> int:
         """The corner at the far end of the wall an evader walking ``(vx, vy)`` along a
@@ -402,21 +483,28 @@ class DecompositionPursuer(BasePolicy):
         rotation is counted ccw (``sense`` > 0) or cw (< 0) only if given (a probe with
         no safe orientation then counts as a full turn, more than any turn that way)."""
         tab = self.table
-        offsets, n_rays = self._offsets, self.rays
-        if rays is not None:  # only those rays' samples (the others would count as safe)
-            n_rays = int(rays.sum())
-            offsets = offsets.reshape(self.rays, self._n_r, 2)[rays].reshape(-1, 2)
+        offsets, n_rays, n_r = self._offsets, self.rays, self._n_r
+        cols, t_e = self._probe_cols, self._t_e
+        if delay:  # probes beyond the horizon drop out: only the samples up to the last
+            # probe within it are looked up (a ray's reach there depends on those alone)
+            t_e = t_e + np.float32(delay)
+            n_in = int(np.count_nonzero(t_e <= self.horizon))  # t_e rises along a ray
+            if not n_in:
+                return np.full(tab.n_bins, self.horizon)
+            cols, t_e = cols[:n_in], t_e[:n_in]
+            n_r = int(cols[-1]) + 1
+        if rays is not None or n_r < self._n_r:  # only those rays' samples (the others
+            # would count as safe), up to n_r along each
+            keep = slice(None) if rays is None else rays
+            offsets = offsets.reshape(self.rays, self._n_r, 2)[keep, :n_r].reshape(-1, 2)
+            n_rays = self.rays if rays is None else int(rays.sum())
         points = origin + offsets
-        t_e = self._t_e + np.float32(delay) if delay else self._t_e
-        late = t_e > self.horizon if delay else None
         if self._fast:
             # eager table: one lookup of every ray sample serves as the wall test and
             # as the probes' rows
-            rows = tab.rows(points).reshape(n_rays, self._n_r)
+            rows = tab.rows(points).reshape(n_rays, n_r)
             reach = np.logical_and.accumulate(rows >= 0, axis=1)  # stop at the first wall
-            sub_ok = reach[:, self._probe_cols]
-            if late is not None:
-                sub_ok[:, late] = False
+            sub_ok = reach[:, cols]
             if not sub_ok.any():
                 return np.full(tab.n_bins, self.horizon)
             # the probes of one radius share t_e, and t_e - lut[k] falls as k grows (the
@@ -424,19 +512,17 @@ class DecompositionPursuer(BasePolicy):
             # largest need over its reached probes counts; an unreached probe counts as
             # safe (need 0: t_e + 1e9, never below the first radius's value)
             needs = tab.need if not sense else (tab.ccw if sense > 0 else tab.cw)
-            need = needs[rows[:, self._probe_cols]]  # (rays, radii, bins)
+            need = needs[rows[:, cols]]  # (rays, radii, bins)
             need[~sub_ok] = 0
             need = need.max(axis=0)
             v = t_e[:, None] - (self._way_lut if sense else self._turn_lut)[need]
             return v.min(axis=0)
-        inside = tab.inside(points).reshape(n_rays, self._n_r)
+        inside = tab.inside(points).reshape(n_rays, n_r)
         reach = np.cumsum(~inside, axis=1) == 0  # a ray stops at the first wall
-        sub_ok = reach[:, self._probe_cols]
-        if late is not None:
-            sub_ok[:, late] = False
+        sub_ok = reach[:, cols]
         if not sub_ok.any():
             return np.full(tab.n_bins, self.horizon)
-        probes = points.reshape(n_rays, self._n_r, 2)[:, self._probe_cols][sub_ok]
+        probes = points.reshape(n_rays, n_r, 2)[:, cols][sub_ok]
         r = tab.rows(probes)  # only the probes' orientations are looked up
         t_e = np.broadcast_to(t_e, sub_ok.shape)[sub_ok]
         # lut: seconds to turn by a number of bins; a safe bin (0) never threatens
@@ -969,6 +1055,109 @@ def _rounding_corners(world) -> list[int]:
         if float(np.hypot(b[0], b[1])) >= 1e-9:
             keep.append(int(i))
     return keep
+
+
+class _Edges(NamedTuple):
+    """Segments in order along rings: starts, unit directions, lengths, each one's
+    ring, and its start's distance along its ring."""
+
+    start: np.ndarray
+    dir: np.ndarray
+    length: np.ndarray
+    ring: np.ndarray
+    pos: np.ndarray
+
+
+def _nearest_edge(
+    point: np.ndarray, edges: _Edges
+) -> tuple[int, float, float, tuple[float, float]]:
+    """The nearest of ``edges`` to ``point``: (its index, the distance, the nearest
+    point's distance along the edge, and the offset (x, y) of ``point`` from it)."""
+    rel = point[None, :] - edges.start
+    t = np.clip(np.einsum("ej,ej->e", rel, edges.dir), 0.0, edges.length)
+    g = rel - t[:, None] * edges.dir
+    d2 = np.einsum("ej,ej->e", g, g)
+    e = int(np.argmin(d2))
+    gx, gy = float(g[e, 0]), float(g[e, 1])
+    return e, math.sqrt(float(d2[e])), float(t[e]), (gx, gy)
+
+
+def _edges(points: list[np.ndarray], rings: list[int]) -> _Edges:
+    """:class:`_Edges` of closed polylines ``points`` (each (n, 2), in order)."""
+    start, end, ring, pos = [], [], [], []
+    for pts, k in zip(points, rings, strict=True):
+        nxt = np.roll(pts, -1, axis=0)
+        length = np.hypot(*(nxt - pts).T)
+        start.append(pts)
+        end.append(nxt)
+        ring.append(np.full(len(pts), k))
+        pos.append(np.concatenate(([0.0], np.cumsum(length)[:-1])))
+    st, en = np.concatenate(start), np.concatenate(end)
+    length = np.hypot(*(en - st).T)
+    unit = (en - st) / length[:, None]
+    return _Edges(st, unit, length, np.concatenate(ring), np.concatenate(pos))
+
+
+class _SmallObstacles(NamedTuple):
+    """The obstacles small enough to circle (:func:`_small_obstacles`)."""
+
+    wall: _Edges  # their walls
+    hull: dict[int, _Edges]  # ring -> its convex hull, oriented as the ring
+    perimeter: dict[int, float]  # ring -> the hull's perimeter
+    corners: dict[int, np.ndarray]  # ring -> indices into the corners on the hull
+    corner_pos: dict[int, np.ndarray]  # ring -> their distances along the hull
+    arrive: dict[int, np.ndarray]  # ring -> (m, 2, 2) directions a walk along the hull
+    # arrives at each of those corners in (forward, then backward)
+
+
+def _small_obstacles(world, corners: list[int], budget: float) -> _SmallObstacles | None:
+    """The obstacles of ``world`` whose convex hull's perimeter is at most ``budget``,
+    with the ``corners`` (indices into them) on their hulls; None if there are none."""
+    index = {v: k for k, v in enumerate(corners)}
+    walls, hulls, per, on, at, arrive, rings = [], {}, {}, {}, {}, {}, []
+    for ring in range(1, len(world.rings)):
+        ids = np.flatnonzero(world.vertex_ring == ring)  # in ring order
+        pts = world.vertices[ids]
+        hull_at = _hull(pts)
+        hp = pts[hull_at]
+        hl = float(np.hypot(*(np.roll(hp, -1, axis=0) - hp).T).sum())
+        if hl > budget:
+            continue
+        rings.append(ring)
+        walls.append(pts)
+        h = _edges([hp], [ring])
+        hulls[ring], per[ring] = h, hl
+        keep = [i for i, v in enumerate(ids[hull_at]) if int(v) in index]
+        on[ring] = np.array([index[int(ids[hull_at][i])] for i in keep], dtype=np.int64)
+        at[ring] = h.pos[keep]
+        fwd = h.dir[np.array(keep, dtype=np.int64) - 1]  # the hull edge ending there
+        back = -h.dir[keep]  # the one starting there, walked backward
+        arrive[ring] = np.stack([fwd, back], axis=1).reshape(-1, 2, 2)
+    if not rings:
+        return None
+    return _SmallObstacles(_edges(walls, rings), hulls, per, on, at, arrive)
+
+
+def _hull(pts: np.ndarray) -> np.ndarray:
+    """Indices of the convex hull's vertices of a closed ring ``pts``, in the ring's own
+    order (a subsequence of it: the hull of a simple polygon visits its vertices in the
+    polygon's order), collinear points left out (monotone chain)."""
+    order = np.lexsort((pts[:, 1], pts[:, 0]))
+
+    def half(seq):
+        out: list[int] = []
+        for i in seq:
+            while len(out) >= 2:
+                a, b = pts[out[-2]], pts[out[-1]]
+                c = pts[i]
+                if (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]) > 0:
+                    break
+                out.pop()
+            out.append(int(i))
+        return out
+
+    keep = set(half(order)[:-1] + half(order[::-1])[:-1])
+    return np.array(sorted(keep), dtype=np.int64)
 
 
 def _corner_starts(world, corners: list[int], pad: float) -> tuple[np.ndarray, np.ndarray]:

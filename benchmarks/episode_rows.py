@@ -194,8 +194,10 @@ def read(
             raise InvalidConfigError(
                 f"{os.fspath(path)}, line {i + 1}: the row has no field {exc}; {expected}"
             ) from None
+    if not note_other_code:  # nor code_version(): its note on whose code plays is for players
+        return rows
     other = [r.get("code") for r in rows.values() if r.get("code") != code_version()]
-    if other and note_other_code and code_version() is not None:
+    if other and code_version() is not None:
         seen = sorted({str(c) for c in other if c}) + ["not recorded"] * (None in other)
         print(f"note: {len(other)} of the {len(rows)} rows in {os.fspath(path)} were played by "
               f"other code ({', '.join(seen[:3])}{', ...' if len(seen) > 3 else ''}; this is "

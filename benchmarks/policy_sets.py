@@ -12,7 +12,8 @@ such directories::
     python benchmarks/policy_sets.py run holds-bench unseen-p0 --out out/cand --workers 1
     python benchmarks/policy_sets.py compare out/base out/cand
 
-The scripts run from the checkout this file is in (its code plays), one after the other,
+The scripts run from the checkout this file is in (its code plays: it leads their
+``PYTHONPATH``, whichever checkout is installed), one after the other,
 each printing its own report; their rows record that code (``"code"``). ``compare`` lists,
 per set both directories hold (a set only one holds is named, not compared), the episodes
 the candidate lost that the base won and those it gained (world, opponent, seed, cause and
@@ -218,8 +219,9 @@ def replay_command(policy_set: PolicySet, e: Episode) -> str:
 def _sets_in(directory: str, sets: Mapping[str, PolicySet]) -> list[str]:
     """The names of the sets with a results file in ``directory``."""
     if not os.path.isdir(directory):
+        what = "not a directory" if os.path.exists(directory) else "no such directory"
         raise InvalidConfigError(
-            f"{directory!r}: no such directory; expected a directory of results files "
+            f"{directory!r}: {what}; expected a directory of results files "
             "written by 'policy_sets.py run --out DIR'"
         )
     names = [n for n in sets if os.path.isfile(os.path.join(directory, f"{n}.jsonl"))]
@@ -314,6 +316,16 @@ def compare(base: str, cand: str, sets: Mapping[str, PolicySet] = SETS) -> int:
     return 1 if lost_any else 0
 
 
+def _playing_here() -> dict[str, str]:
+    """The environment of a script that plays this checkout's code: :data:`ROOT` first on
+    ``PYTHONPATH``. ``python benchmarks/X.py`` puts ``benchmarks/`` on the import path, not
+    the checkout, so without it a script in a second checkout (a git worktree) imported
+    the package from the checkout installed in editable mode, and its rows were that
+    checkout's play."""
+    paths = [ROOT, *[p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]]
+    return {**os.environ, "PYTHONPATH": os.pathsep.join(paths)}
+
+
 def run_sets(names: Sequence[str], out: str, workers: int | None,
              sets: Mapping[str, PolicySet] = SETS) -> int:  # fmt: skip
     """Play each set through its script into ``out/SET.jsonl`` (resuming), then print the
@@ -327,7 +339,7 @@ def run_sets(names: Sequence[str], out: str, workers: int | None,
         if workers is not None:
             argv += ["--workers", str(workers)]
         print(f"== {name}: {shlex.join([*s.command(), '--results', results])}", flush=True)
-        code = subprocess.run(argv, cwd=ROOT).returncode
+        code = subprocess.run(argv, cwd=ROOT, env=_playing_here()).returncode
         if code:
             print(f"== {name}: {s.script} exited with status {code}", flush=True)
             failed.append(name)
@@ -352,9 +364,16 @@ def _set_list() -> str:
 
 
 def _set_name(text: str) -> str:
-    if text not in SETS:
-        raise argparse.ArgumentTypeError(f"{text!r}: expected a set name, one of {', '.join(SETS)}")
-    return text
+    """A set's name, given as it or as its short name (``b1``, ``pu0``...)."""
+    if text in SETS:
+        return text
+    for s in SETS.values():
+        if text == s.alias:
+            return s.name
+    raise argparse.ArgumentTypeError(
+        f"{text!r}: expected a set name, one of {', '.join(SETS)} (or its short name, "
+        f"{', '.join(s.alias for s in SETS.values())})"
+    )
 
 
 def main(argv=None) -> int:
@@ -362,16 +381,21 @@ def main(argv=None) -> int:
                                  formatter_class=argparse.RawDescriptionHelpFormatter)  # fmt: skip
     sub = ap.add_subparsers(dest="command", required=True)
     p = sub.add_parser("run", help="play sets into DIR/SET.jsonl (resumes), then their totals")
-    p.add_argument("sets", nargs="+", type=_set_name, metavar="SET")
-    p.add_argument("--out", required=True, type=path_text("a directory"), metavar="DIR")
+    p.add_argument("sets", nargs="+", type=_set_name, metavar="SET",
+                   help="a set's name or short name (listed by --help)")  # fmt: skip
+    p.add_argument("--out", required=True, type=path_text("a directory"), metavar="DIR",
+                   help="the results files go to DIR/SET.jsonl (a rerun resumes them)")  # fmt: skip
     p.add_argument("--workers", type=integer(1), default=None,
                    help="passed to each script (default: the script's own)")  # fmt: skip
     p = sub.add_parser("totals", help="per set in DIR: wins / episodes, code versions")
-    p.add_argument("dir", type=path_text("a directory"), metavar="DIR")
+    p.add_argument("dir", type=path_text("a directory"), metavar="DIR",
+                   help="a directory 'run --out DIR' wrote")  # fmt: skip
     p = sub.add_parser("compare", help="per episode: winner changed from BASE to CAND "
                        "(exit 1 when CAND lost one BASE won)")  # fmt: skip
-    p.add_argument("base", type=path_text("a directory"), metavar="BASE")
-    p.add_argument("cand", type=path_text("a directory"), metavar="CAND")
+    p.add_argument("base", type=path_text("a directory"), metavar="BASE",
+                   help="the run of the code before the change ('run --out BASE')")  # fmt: skip
+    p.add_argument("cand", type=path_text("a directory"), metavar="CAND",
+                   help="the run of the changed code, from its own checkout")  # fmt: skip
     args = ap.parse_args(argv)
     if args.command == "run":
         return run_sets(list(dict.fromkeys(args.sets)), args.out, args.workers)

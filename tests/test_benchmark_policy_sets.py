@@ -239,6 +239,13 @@ def test_the_command_line_lists_the_sets_and_a_bad_directory_is_one_line_exit_2(
         signal.signal(signal.SIGTERM, old)  # run() answers SIGTERM: not in pytest's process
     err = capsys.readouterr().err
     assert "nowhere': no such directory" in err and "Traceback" not in err
+    (tmp_path / "a.jsonl").write_text("")
+    with pytest.raises(InvalidConfigError, match=r"a.jsonl': not a directory; expected a dir"):
+        ps.totals(str(tmp_path / "a.jsonl"))  # it said 'no such directory'
+    with pytest.raises(SystemExit):
+        ps.main(["run", "--help"])
+    text = capsys.readouterr().out
+    assert "a set's name or short name" in text and "DIR/SET.jsonl" in text
     with pytest.raises(SystemExit):
         ps.main(["run", "nope", "--out", str(tmp_path)])
     assert "'nope': expected a set name, one of holds-bench" in capsys.readouterr().err
@@ -279,3 +286,39 @@ def test_a_set_only_one_directory_holds_is_named_not_compared(ps, corner_runs, t
     with pytest.raises(InvalidConfigError, match=r"have no set in common \(base: corner; "
                        r"cand: other\)"):  # fmt: skip
         ps.compare(str(root / "long"), str(tmp_path), sets)
+
+
+def test_a_set_s_short_name_is_taken_as_help_shows_it(ps):
+    # --help lists "holds-bench (b1)", and 'run b1' was refused as no set name
+    for s in ps.SETS.values():
+        assert ps._set_name(s.alias) == ps._set_name(s.name) == s.name
+
+
+def test_run_plays_the_code_of_the_checkout_it_is_in(tmp_path, capfd, monkeypatch):
+    # 'python benchmarks/X.py' imports the package from the checkout installed in editable
+    # mode, not from the one the script is in: 'policy_sets.py run' in a second checkout
+    # (a git worktree with the candidate policy) played the installed checkout's code, and
+    # its rows said so ('VERSION (scripts: VERSION)'). The second checkout here: a copy of
+    # benchmarks/ beside links to this one's packages.
+    import importlib.util
+    import sys
+
+    other = tmp_path / "checkout"
+    other.mkdir()
+    for package in ("envs", "strategies", "analysis", "training"):
+        (other / package).symlink_to(BENCHMARKS.parent / package, target_is_directory=True)
+    shutil.copytree(BENCHMARKS, other / "benchmarks", ignore=shutil.ignore_patterns("__pycache__"))
+    monkeypatch.syspath_prepend(str(other / "benchmarks"))
+    spec = importlib.util.spec_from_file_location(
+        "policy_sets_elsewhere", other / "benchmarks" / "policy_sets.py"
+    )
+    module = importlib.util.module_from_spec(spec)
+    monkeypatch.setitem(sys.modules, spec.name, module)  # its dataclasses look it up
+    spec.loader.exec_module(module)
+    assert module.ROOT == str(other)
+    args = (*CORNER[:-2], "0", "--max-cycles", "10")
+    tiny = _tiny(module, "corner", "unseen_worlds.py", args)
+    assert module.run_sets(["corner"], str(tmp_path / "out"), 1, {"corner": tiny}) == 0
+    (row,) = _rows(tmp_path / "out" / "corner.jsonl")
+    err = capfd.readouterr().err
+    assert "(scripts:" not in str(row["code"]) and "policies that play are imported" not in err

@@ -38,9 +38,12 @@ the episode: its clock runs during its policy's ``reset`` and each of its ``act`
 and only then. Building the env, drawing the start, making observations and stepping the
 env are on no clock. The clock is read as each call returns, and a role whose clock has
 passed the limit loses at once (:class:`EpisodeTimeout`, which blames that role whichever
-side was slower overall). ``on_clock(role, seconds_left)`` is told when a policy starts
-deciding and ``on_clock(None, None)`` when it stops (a tournament worker arms its alarm
-and tells its driver from these).
+side was slower overall). A call that raises past its clock is that timeout too, whatever
+it raised, a configuration error included: a tournament worker's alarm interrupts a call
+past its clock, and a policy may turn the interruption into an error of its own.
+``on_clock(role, seconds_left)`` is told when a policy starts deciding and
+``on_clock(None, None)`` when it stops (a tournament worker arms its alarm and tells its
+driver from these).
 
 Examples:
     >>> r = run_episode("open_room", "pursuer/greedy", "evader/straight", seed=3, max_cycles=20)
@@ -485,9 +488,11 @@ def run_episode(
                 if not knob or _name(pol) in knob:
                     raise
                 raise exc.named(f"{_name(pol)!r} with {knob}") from None
-            except ValueError:
+            except ValueError as exc:
+                clocks.check(role, _name(pol), -1, t0, exc)
                 raise
             except Exception as exc:
+                clocks.check(role, _name(pol), -1, t0, exc)
                 raise PolicyFailure(role, _name(pol), -1, _describe(exc)) from exc
             finally:
                 clocks.stop(role, t0)
@@ -509,6 +514,7 @@ def run_episode(
                 try:
                     actions[role] = pol.act(seen[role])
                 except Exception as exc:
+                    clocks.check(role, _name(pol), steps, t0, exc)
                     raise PolicyFailure(role, _name(pol), steps, _describe(exc)) from exc
                 finally:
                     dt = clocks.stop(role, t0)
@@ -583,19 +589,37 @@ class _Clocks:
             self.watch(None, None)
         return took
 
-    def check(self, role: str, policy: str, step: int) -> None:
-        """Raise :class:`EpisodeTimeout` if ``role``'s clock has passed the limit."""
-        if self.limit is None or self.spent[role] <= self.limit:
+    def check(
+        self,
+        role: str,
+        policy: str,
+        step: int,
+        t0: float | None = None,
+        raised: BaseException | None = None,
+    ) -> None:
+        """Raise :class:`EpisodeTimeout` if ``role``'s clock has passed the limit.
+
+        ``t0`` and ``raised``: the call started at ``t0`` (its clock still running) raised
+        ``raised``. Past the clock, that is the role's timeout whatever the call raised:
+        a tournament worker's alarm interrupts a call past its clock, and a policy may
+        turn that interruption into an error of its own (a model loader reports any
+        failure of its load as a bad model file, an ``InvalidConfigError``)."""
+        spent = self.spent[role] + (0.0 if t0 is None else time.perf_counter() - t0)
+        if self.limit is None or spent <= self.limit:
             return
         other = "evader" if role == "pursuer" else "pursuer"
-        raise EpisodeTimeout(
+        then = "" if raised is None else f"; the call then raised {_describe(raised)}"
+        timeout = EpisodeTimeout(
             role,
             policy,
             step,
-            f"its clock ran out: {self.spent[role]:.2f} s of decision time (reset and acts) "
-            f"against the time limit of {self.limit:g} s per role (the {other}'s clock: "
-            f"{self.spent[other]:.2f} s)",
+            f"its clock ran out: {spent:.2f} s of decision time (reset and acts) against "
+            f"the time limit of {self.limit:g} s per role (the {other}'s clock: "
+            f"{self.spent[other]:.2f} s){then}",
         )
+        if raised is not None:
+            raise timeout from raised
+        raise timeout
 
 
 def _requests(

@@ -122,7 +122,7 @@ class SerialExecutor(Executor):
         self.in_match = False
 
     def run(self, matches: Sequence[Match], ctx: Context, stop: threading.Event) -> Iterator[dict]:
-        warm_up()  # as a process or Ray worker does: the imports are on no match's time
+        warm_up(ctx)  # as a process or Ray worker does: the imports are on no match's time
         for m in matches:
             if stop.is_set():
                 return
@@ -161,7 +161,7 @@ def _worker_main(conn: Connection, ctx: Context, parent: int, board: Board) -> N
     _die_with_parent(parent)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the driver's business
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    warm_up()  # before the first match's clock starts, as a Ray worker does
+    warm_up(ctx)  # before the first match's clock starts, as a Ray worker does
     while True:
         try:
             batch = conn.recv()
@@ -388,7 +388,7 @@ def _ray_play(batch: list[Match], ctx_box: list[Any], mailbox: Any) -> Iterator[
         _RAY_CONTEXTS.clear()
         ctx, registrations = ray.get(ref)
         _register_missing(registrations)
-        warm_up()
+        warm_up(ctx)
         _RAY_CONTEXTS[key] = ctx
     for m in batch:
         yield ("start", m.match_id)

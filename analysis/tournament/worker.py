@@ -29,6 +29,7 @@ too (the same alarm, the same kill): past it the match is an ``error``, charged 
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -297,7 +298,7 @@ def forfeit(match_id: str, role: str, error: str) -> dict[str, Any]:
     }
 
 
-def warm_up() -> None:
+def warm_up(ctx: Context | None = None) -> None:
     """Import what a match imports on first use, before a fresh worker's first match.
 
     Without it the first match of a worker process imported the env (PettingZoo), the
@@ -305,6 +306,13 @@ def warm_up() -> None:
     load 6 on 2 cores (compiled from source where no bytecode is cached), against a time
     limit that a short tournament sets to 1 s, so a quick match could forfeit or be stored
     as a ``MatchTimeout`` error for time it never used.
+
+    With ``ctx``, its models are loaded too (stable-baselines3, torch and the model file:
+    2-3 s for the first at load 8), as building a policy is on no clock: a model loaded in
+    its first reset, on its clock, and an alarm that interrupted the load past a short
+    clock left torch half imported, so every later match of a model in that process
+    failed to load it ('module 'sympy' has no attribute 'core''), an error charged to
+    nobody. A model that fails to load here is left to its matches, which say why.
     """
     import envs.surveillance_v1  # noqa: F401
     import strategies.policies.observe
@@ -313,6 +321,10 @@ def warm_up() -> None:
     from strategies.policies.registry import policy_names
 
     policy_names()  # the catalog of built-in policies
+    for entry in () if ctx is None else ctx.policies.values():
+        if entry.model is not None:
+            with contextlib.suppress(Exception):  # its matches report it
+                build_policy(ctx, entry).load()
 
 
 def play(match: Match, ctx: Context, board: Board | None = None) -> dict[str, Any]:

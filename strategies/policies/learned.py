@@ -173,7 +173,14 @@ class SB3Policy(BasePolicy):
             return {"observation": "state"}
         return trained_observation(self.provenance)
 
-    def _reset(self) -> None:
+    def load(self) -> None:
+        """Load the model file, once (the first :meth:`reset` does it otherwise, on the
+        episode's clock: a tournament worker loads its models before its first match).
+
+        Raises:
+            InvalidConfigError: no model file, or one stable-baselines3 cannot load,
+                naming the file.
+        """
         if self.model is None:
             if not self.path.is_file():
                 raise InvalidConfigError(f"{self.name}: no model file at {self.path}")
@@ -191,6 +198,9 @@ class SB3Policy(BasePolicy):
                     f"{self.name}: cannot load the model file {self.path} "
                     f"({type(exc).__name__}: {exc})"
                 ) from exc
+
+    def _reset(self) -> None:
+        self.load()
         seed = int(self.rng.integers(2**31 - 1))
         self.model.set_random_seed(seed)
         if self._inputs is not None:

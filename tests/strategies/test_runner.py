@@ -220,6 +220,55 @@ def test_the_time_limit_is_each_roles_own_decision_clock():
     assert "its clock ran out" in str(info.value) and "failed at reset" in str(info.value)
 
 
+class _SlowThenRaises(Probe):
+    """Its reset (or its act at step 2) runs past the clock, then raises ``error``: a
+    policy that turns whatever interrupted it into an error of its own (a model loader
+    reports any failure of its load as an ``InvalidConfigError``)."""
+
+    def __init__(self, error, *, at_reset=True):
+        super().__init__(name="wraps")
+        self.error, self.at_reset = error, at_reset
+
+    def _reset(self):
+        super()._reset()
+        if self.at_reset:
+            time.sleep(0.3)
+            raise self.error
+
+    def act(self, observation):
+        if not self.at_reset and self._steps == 2:
+            time.sleep(0.3)
+            raise self.error
+        return super().act(observation)
+
+
+@pytest.mark.parametrize(
+    ("error", "at_reset"),
+    [(InvalidConfigError("cannot load the model file"), True),
+     (RuntimeError("Error calling __set_name__"), True),
+     (RuntimeError("Error calling __set_name__"), False)],
+)  # fmt: skip
+def test_a_call_that_raises_past_its_clock_is_a_timeout_of_its_role(error, at_reset):
+    # A tournament's alarm interrupted a learned model's first reset (its import of torch,
+    # past a 1 s clock) and the model's loader wrapped the interruption in an
+    # InvalidConfigError: the runner let it through as a configuration error, and the
+    # match was stored as an error charged to nobody. Other errors raised past the clock
+    # were forfeits for what they said, not for the clock.
+    with pytest.raises(EpisodeTimeout) as info:
+        run_episode(MAP, _SlowThenRaises(error, at_reset=at_reset), "evader/random", seed=0,
+                    max_cycles=10, time_limit=0.1)  # fmt: skip
+    assert info.value.role == "pursuer" and info.value.step == (-1 if at_reset else 2)
+    text = str(info.value)
+    assert "its clock ran out" in text and f"then raised {type(error).__name__}" in text
+    assert info.value.__cause__ is error
+    # within its clock, the call's own error stands
+    with pytest.raises(type(error) if at_reset and isinstance(error, ValueError)
+                       else PolicyFailure) as info:  # fmt: skip
+        run_episode(MAP, _SlowThenRaises(error, at_reset=at_reset), "evader/random", seed=0,
+                    max_cycles=10, time_limit=5)  # fmt: skip
+    assert not isinstance(info.value, EpisodeTimeout)
+
+
 def test_mixture_picks_one_component_per_episode_reproducibly():
     mix = MixedPolicy(["evader/straight", "evader/random"], [0.5, 0.5])
     picks = {

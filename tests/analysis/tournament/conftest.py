@@ -13,6 +13,7 @@ from typing import ClassVar
 import numpy as np
 import pytest
 
+from envs.errors import InvalidConfigError
 from strategies.policies import registry
 from strategies.policies.baselines import RandomPolicy
 
@@ -74,6 +75,17 @@ class SlowResetPursuer(RandomPolicy):
         time.sleep(1.5)
 
 
+class WrappingHangPursuer(RandomPolicy):
+    """Its reset hangs, and it reports whatever interrupts it as a configuration error of
+    its own, as a model loader reports any failure of its load as a bad model file."""
+
+    def _reset(self):
+        try:
+            time.sleep(3600)
+        except Exception as exc:
+            raise InvalidConfigError(f"cannot load the model file ({exc})") from exc
+
+
 class SlowActEvader(RandomPolicy):
     """A random evader that takes 2 ms per decision (or the wait for a CPU under load)."""
 
@@ -107,6 +119,7 @@ TEST_POLICIES = {
     "evader/test_lidar": LidarEvader,
     "evader/test_slow_act": SlowActEvader,
     "pursuer/test_slow_reset": SlowResetPursuer,
+    "pursuer/test_wrapping_hang": WrappingHangPursuer,
     "pursuer/test_slow": SlowPursuer,
 }
 

@@ -279,6 +279,65 @@ def test_a_policy_past_its_own_clock_forfeits_though_the_other_decided_slower(
     assert rows["pursuer/greedy"]["status"] == "ok", rows["pursuer/greedy"]["error"]
 
 
+@pytest.mark.parametrize("backend", ["serial", "process"])
+def test_a_hang_a_policy_reports_as_its_own_error_forfeits_on_its_clock(
+    tmp_path, test_policies, backend
+):
+    # A learned model on the roster, time limit 1 s: the alarm interrupted its first reset
+    # (importing torch, 2.5 s at load 8) and its loader reported the interruption as
+    # 'InvalidConfigError: ...: cannot load the model file ... (MatchTimeout: no answer 1 s
+    # after its clock ran out ...)': the match was stored as an error charged to nobody.
+    d = {
+        "maps": ["open_room"],
+        "pursuers": ["pursuer/test_wrapping_hang", "pursuer/greedy"],
+        "evaders": ["evader/random"],
+        "seeds": 1,
+        "start": "valid",
+        "time_limit": 0.5,
+        "env": {"max_cycles": 10},
+    }
+    workers = None if backend == "serial" else 2
+    s = run_tournament(
+        spec_from_dict(d), tmp_path / "s.sqlite", backend=backend, workers=workers, progress=False
+    )
+    assert s.errors == 0 and s.forfeits == 1
+    with Store(tmp_path / "s.sqlite") as db:
+        rows = {r["pursuer"]: r for r in db.rows(s.run_id)}
+    hung = rows["pursuer/test_wrapping_hang"]
+    assert hung["status"] == "forfeit" and hung["blame"] == "pursuer", hung["error"]
+    assert "failed at reset: its clock ran out" in hung["error"]
+    assert "then raised InvalidConfigError: cannot load the model file" in hung["error"]
+    assert rows["pursuer/greedy"]["status"] == "ok", rows["pursuer/greedy"]["error"]
+
+
+def test_a_worker_loads_its_models_before_its_first_match():
+    # A model was loaded in its first reset (stable-baselines3, torch, the file: 2-3 s at
+    # load 8), on its clock; an alarm interrupting the load left torch half imported and
+    # every later match of a model in that process failed to load it ("module 'sympy' has
+    # no attribute 'core'"), stored as errors.
+    script = textwrap.dedent(
+        """
+        import sys
+        from analysis.tournament import worker
+        from analysis.tournament.spec import spec_from_dict
+        roster = {"maps": ["open_room"], "evaders": ["evader/random"], "seeds": 1}
+        plain = spec_from_dict({**roster, "pursuers": ["pursuer/greedy"]})
+        worker.warm_up(worker.context_for(plain))
+        before = "stable_baselines3" in sys.modules
+        model = {"model": "zoo:ppo_pursuer_vs_straight_open_room", "label": "ppo"}
+        ctx = worker.context_for(spec_from_dict({**roster, "pursuers": [model]}))
+        worker.warm_up(ctx)
+        loaded = [p.model is not None for p in worker._LEARNED.values()]
+        print(before, loaded, worker.build_policy(ctx, ctx.policies["pursuer:ppo"]).model
+              is not None)
+        """
+    )
+    root = Path(__file__).resolve().parents[3]  # "-c" imports this checkout from its cwd
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                         cwd=root, timeout=120)  # fmt: skip
+    assert out.stdout.split() == ["False", "[True]", "True"], out.stderr
+
+
 _SCRIPT = textwrap.dedent(
     """
     import sys, time

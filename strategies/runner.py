@@ -68,6 +68,7 @@ __all__ = [
     "VALID_START",
     "EpisodeResult",
     "EpisodeTimeout",
+    "Observer",
     "PolicyFailure",
     "Transition",
     "build_env",
@@ -326,8 +327,18 @@ def _settings(config: Any, opts: Mapping[str, Any]) -> tuple:
     return (kind, int(rays), None if rng is None else float(rng))
 
 
-class _Observer:
-    """Serves one role the observation it asked for from the env of the episode."""
+class Observer:
+    """Serves one role the observation it asked for from the env of the episode.
+
+    Args:
+        env: the episode's parallel env (built, not yet reset).
+        role: ``"pursuer"`` or ``"evader"``.
+        opts: the role's :data:`OBSERVATION_OPTIONS` (``{}``: the env's own).
+
+    ``config`` is the env config to reset the role's policy with; calling it with the
+    env's observations, whether the evader is in sight and the step gives the role's. A
+    new one for each episode (a lidar track differentiates positions across steps).
+    """
 
     def __init__(self, env: Any, role: str, opts: Mapping[str, Any]) -> None:
         cfg = env.config
@@ -464,7 +475,7 @@ def run_episode(
     env = build_env(map, {**overrides, **env_obs}, render_mode=render)
     try:
         config = env.config
-        observers = {r: _Observer(env, r, requests[r]) for r in policies}
+        observers = {r: Observer(env, r, requests[r]) for r in policies}
         if isinstance(start, Mapping):
             placement, start_kind = dict(start), "given"
         elif start in START_KINDS:

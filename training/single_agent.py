@@ -11,10 +11,13 @@ Seeding: ``reset(seed=s)`` reseeds ``self.np_random`` (Gymnasium's generator, bu
 env, one for the start sampler and one for the opponent. The same seed therefore gives
 the same episodes, and later resets without a seed continue the same stream.
 
-Opponents that read the ``"state"`` observation (every analytic policy) still play when
-the learner sees ``"lidar"``: they receive ``env.state()`` (the ``"state"`` vector) and a
-copy of the config with ``observation="state"``, so they are as strong as in a
-``"state"`` env. Learned opponents (``uses_state = False``) get their own observation.
+The opponent is given the observation it asks for, as :func:`strategies.runner.run_episode`
+gives it (the same :class:`~strategies.runner.Observer`): opponents that read the
+``"state"`` observation (every analytic policy) still play when the learner sees
+``"lidar"``: they receive ``env.state()`` (the ``"state"`` vector) and a copy of the
+config with ``observation="state"``, so they are as strong as in a ``"state"`` env; a
+learned model gets the observation it was trained on (its provenance's), whatever the
+learner sees.
 
 A learner trained with analytic features (``DaggerConfig.features``) reads more than any
 env observation: pass its :class:`~strategies.policies.learner_inputs.LearnerInputs` as
@@ -41,6 +44,7 @@ from strategies.policies.base import check_role
 from strategies.policies.learner_inputs import LearnerInputs
 from strategies.policies.model_files import model_policy_name
 from strategies.policies.starts import START_KINDS, sample_start
+from strategies.runner import Observer, observation_options
 
 __all__ = ["AGENT_OF_ROLE", "START_CHOICES", "SingleAgentEnv", "make_opponent", "sb3_params"]
 
@@ -223,11 +227,11 @@ class SingleAgentEnv(gym.Env):
         self._bind_opponent()
 
     def _bind_opponent(self) -> None:
-        # analytic opponents read the "state" vector even when the learner sees lidar
-        self._opponent_reads_state = bool(getattr(self.opponent, "uses_state", True))
-        self._opponent_config = self.config
-        if self._opponent_reads_state and self.config.observation != "state":
-            self._opponent_config = dataclasses.replace(self.config, observation="state")
+        # the observation the opponent asks for, as run_episode gives it: the "state"
+        # vector for an analytic one even when the learner sees lidar, the observation a
+        # model was trained on (lidar_track with 32 rays for the zoo's generalists)
+        self._opponent_options = observation_options(self.opponent) or {}
+        self._observer = Observer(self.env, self.opponent_role, self._opponent_options)
 
     # ------------------------------------------------------------------ episode
     def reset(
@@ -262,14 +266,17 @@ class SingleAgentEnv(gym.Env):
             if judge.observation != "state":
                 judge = dataclasses.replace(judge, observation="state")
             placement = sample_start(judge, np.random.default_rng(start_seed), kind=self.start)
+        # a new observer each episode (a lidar track differentiates positions over steps)
+        self._observer = Observer(self.env, self.opponent_role, self._opponent_options)
         self.opponent.reset(
             role=self.opponent_role,
             map=self.config.map,
-            config=self._opponent_config,
+            config=self._observer.config,
             seed=opp_seed,
         )
         obs, infos = self.env.reset(seed=env_seed, options=placement)
-        self._opponent_obs = self._opponent_view(obs)
+        self._steps = 0
+        self._opponent_obs = self._opponent_view(obs, infos)
         if self._inputs:
             self._inputs[self._map_index].reset(self.config, self.role)
         return self._learner_view(obs), dict(infos[self.agent])
@@ -279,10 +286,9 @@ class SingleAgentEnv(gym.Env):
             return self._inputs[self._map_index](self.env.state())
         return obs[self.agent]
 
-    def _opponent_view(self, obs: dict[str, np.ndarray]) -> np.ndarray:
-        if self._opponent_config is not self.config:
-            return self.env.state()
-        return obs[self.opponent_agent]
+    def _opponent_view(self, obs: dict[str, np.ndarray], infos: dict[str, Any]) -> np.ndarray:
+        visible = bool(infos[PURSUER].get("surveillance", True))
+        return self._observer(obs, visible, self._steps)
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         """Play the learner's ``action`` and the opponent's reply for one step.
@@ -305,7 +311,9 @@ class SingleAgentEnv(gym.Env):
         )
         terminated = bool(terms[self.agent])
         truncated = bool(truncs[self.agent])
-        self._opponent_obs = None if terminated or truncated else self._opponent_view(obs)
+        self._steps += 1
+        done = terminated or truncated
+        self._opponent_obs = None if done else self._opponent_view(obs, infos)
         return (
             self._learner_view(obs),
             float(rewards[self.agent]),

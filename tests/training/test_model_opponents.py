@@ -124,3 +124,22 @@ def test_a_dagger_run_plays_a_zoo_opponent_in_training_and_validation(tmp_path) 
     assert r.samples[-1] > 0
     prov = json.loads((r.model_path.parent / "provenance.json").read_text())
     assert prov["opponent"] == EVADER
+
+
+@pytest.mark.parametrize("learner_observation", ["state", "lidar"])
+def test_a_model_opponent_sees_the_observation_it_was_trained_on(learner_observation) -> None:
+    # The lidar-track generalists (most of the zoo) were given the learner's observation:
+    # 'surveil train' of an evader on the state against zoo:dagger_pursuer_generalist failed
+    # at its first step, "observation of shape (13,), but the model was trained on shape
+    # (40,) (observation options {'observation': 'lidar_track', 'n_rays': 32})".
+    env = SingleAgentEnv("evader", "zoo:dagger_pursuer_generalist", map="open_room",
+                         max_cycles=30, observation=learner_observation)  # fmt: skip
+    obs, _ = env.reset(seed=0)
+    assert obs.shape == env.observation_space.shape
+    assert env._opponent_obs.shape == (40,)  # lidar_track, 32 rays
+    done, steps = False, 0
+    while not done:
+        obs, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        done, steps = terminated or truncated, steps + 1
+        assert obs.shape == env.observation_space.shape
+    assert steps > 1

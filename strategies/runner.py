@@ -624,9 +624,9 @@ class _Clocks:
             role,
             policy,
             step,
-            f"its clock ran out: {spent:.2f} s of decision time (reset and acts) against "
-            f"the time limit of {self.limit:g} s per role (the {other}'s clock: "
-            f"{self.spent[other]:.2f} s){then}",
+            f"its clock ran out: {_seconds(spent)} s of decision time (reset and acts) "
+            f"against the time limit of {self.limit:g} s per role (the {other}'s clock: "
+            f"{_seconds(self.spent[other])} s){then}",
         )
         if raised is not None:
             raise timeout from raised
@@ -681,6 +681,12 @@ def _emit_frame(env: Any, sink: Callable | None, frames: list | None) -> None:
 
 def _name(policy: Any) -> str:
     return str(getattr(policy, "name", type(policy).__name__))
+
+
+def _seconds(x: float) -> str:
+    """``x`` seconds to two decimals, or two significant digits below 5 ms (a clock of a
+    tiny time limit read '0.00 s ... against the time limit of 0.0001 s')."""
+    return f"{x:.2f}" if x >= 0.005 else f"{x:.2g}"
 
 
 def _describe(exc: BaseException) -> str:

@@ -207,7 +207,11 @@ def build_policy(ctx: Context, entry: PolicyEntry) -> Any:
     key = f"{entry.role}:{entry.model_sha256}:{json.dumps(entry.params, sort_keys=True)}"
     if key not in _LEARNED:
         path = _model_file(ctx, entry.model_sha256)
-        _LEARNED[key] = make_policy(f"{entry.role}/sb3:{path}", **entry.params)
+        policy = make_policy(f"{entry.role}/sb3:{path}", **entry.params)
+        # named as the spec names it (its label: the model as written, by default), not by
+        # this process's copy of the file ('pursuer/sb3:/tmp/surveil-models-.../SHA.zip')
+        policy.name = entry.label
+        _LEARNED[key] = policy
     return _LEARNED[key]
 
 

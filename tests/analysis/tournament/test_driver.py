@@ -228,9 +228,11 @@ def _round_room(tmp_path: Path, walls: int = 1000) -> str:
 def test_the_envs_time_is_on_no_policys_clock(tmp_path, test_policies, backend):
     # The limit counted the whole match, and an overrun forfeited the side that had spent
     # more time deciding: here the env's work (a 4096-ray lidar on 1000 walls: 6.3 and
-    # 5.7 s for these two 60-step matches at load 13, 1 s or more idle) ran out a limit of
-    # 0.5 s that neither side came near (0.03 s of decisions at most at load 13; with 300
-    # walls and 150 steps the greedy pursuer's clock reached 0.31 s at load 14).
+    # 5.7 s for two 60-step matches at load 13, 0.9-1.2 s at load 2, so 120 steps: 2.0 s
+    # at load 2, the precondition below with a margin on an idle machine) ran out a limit
+    # of 0.5 s that neither side came near (0.03 s of decisions at most in 60 steps at
+    # load 13; with 300 walls and 150 steps the greedy pursuer's clock reached 0.31 s at
+    # load 14).
     d = {
         "maps": [_round_room(tmp_path)],
         "pursuers": ["pursuer/greedy"],
@@ -238,7 +240,7 @@ def test_the_envs_time_is_on_no_policys_clock(tmp_path, test_policies, backend):
         "seeds": [1, 2],
         "start": "valid",
         "time_limit": 0.5,
-        "env": {"max_cycles": 60},
+        "env": {"max_cycles": 120},
     }
     workers = None if backend == "serial" else 2
     s = run_tournament(

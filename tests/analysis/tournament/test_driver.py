@@ -224,6 +224,17 @@ def _round_room(tmp_path: Path, walls: int = 1000) -> str:
     return str(path)
 
 
+def _play(tmp_path: Path, d: dict, backend: str):
+    """The spec ``d`` played on ``backend`` (two workers for the process backend): the
+    run's summary and its stored rows."""
+    workers = None if backend == "serial" else 2
+    s = run_tournament(
+        spec_from_dict(d), tmp_path / "s.sqlite", backend=backend, workers=workers, progress=False
+    )
+    with Store(tmp_path / "s.sqlite") as db:
+        return s, db.rows(s.run_id)
+
+
 @pytest.mark.parametrize("backend", ["serial", "process"])
 def test_the_envs_time_is_on_no_policys_clock(tmp_path, test_policies, backend):
     # The limit counted the whole match, and an overrun forfeited the side that had spent
@@ -242,12 +253,7 @@ def test_the_envs_time_is_on_no_policys_clock(tmp_path, test_policies, backend):
         "time_limit": 0.5,
         "env": {"max_cycles": 120},
     }
-    workers = None if backend == "serial" else 2
-    s = run_tournament(
-        spec_from_dict(d), tmp_path / "s.sqlite", backend=backend, workers=workers, progress=False
-    )
-    with Store(tmp_path / "s.sqlite") as db:
-        rows = db.rows(s.run_id)
+    _, rows = _play(tmp_path, d, backend)
     assert len(rows) == 2 and all(r["status"] == "ok" for r in rows), [r["error"] for r in rows]
     assert all(r["wall_seconds"] > 0.5 for r in rows), rows  # the env alone is past the limit
 
@@ -267,12 +273,7 @@ def test_a_policy_past_its_own_clock_forfeits_though_the_other_decided_slower(
         "time_limit": 1.0,
         "env": {"max_cycles": 10},
     }
-    workers = None if backend == "serial" else 2
-    s = run_tournament(
-        spec_from_dict(d), tmp_path / "s.sqlite", backend=backend, workers=workers, progress=False
-    )
-    with Store(tmp_path / "s.sqlite") as db:
-        rows = {r["pursuer"]: r for r in db.rows(s.run_id)}
+    rows = {r["pursuer"]: r for r in _play(tmp_path, d, backend)[1]}
     slow = rows["pursuer/test_slow_reset"]
     assert slow["status"] == "forfeit" and slow["blame"] == "pursuer", slow["error"]
     assert slow["winner"] == "evader" and "failed at reset: its clock ran out" in slow["error"]
@@ -298,13 +299,9 @@ def test_a_hang_a_policy_reports_as_its_own_error_forfeits_on_its_clock(
         "time_limit": 0.5,
         "env": {"max_cycles": 10},
     }
-    workers = None if backend == "serial" else 2
-    s = run_tournament(
-        spec_from_dict(d), tmp_path / "s.sqlite", backend=backend, workers=workers, progress=False
-    )
+    s, stored = _play(tmp_path, d, backend)
     assert s.errors == 0 and s.forfeits == 1
-    with Store(tmp_path / "s.sqlite") as db:
-        rows = {r["pursuer"]: r for r in db.rows(s.run_id)}
+    rows = {r["pursuer"]: r for r in stored}
     hung = rows["pursuer/test_wrapping_hang"]
     assert hung["status"] == "forfeit" and hung["blame"] == "pursuer", hung["error"]
     assert "failed at reset: its clock ran out" in hung["error"]

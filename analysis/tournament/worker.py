@@ -204,7 +204,10 @@ def build_policy(ctx: Context, entry: PolicyEntry) -> Any:
 
     if entry.model is None:
         return make_policy(entry.name, **entry.params)
-    key = f"{entry.role}:{entry.model_sha256}:{json.dumps(entry.params, sort_keys=True)}"
+    # the label is part of the key: a process keeps its models across runs (the serial
+    # backend's is the caller's), and the same file under another label is another name
+    params = json.dumps(entry.params, sort_keys=True)
+    key = f"{entry.role}:{entry.model_sha256}:{params}:{entry.label}"
     if key not in _LEARNED:
         path = _model_file(ctx, entry.model_sha256)
         policy = make_policy(f"{entry.role}/sb3:{path}", **entry.params)

@@ -339,22 +339,26 @@ def test_a_worker_loads_its_models_before_its_first_match():
 
 def test_a_model_is_named_in_its_matches_as_the_spec_names_it(tmp_path):
     # A forfeit of a model read "pursuer 'pursuer/sb3:/tmp/surveil-models-x9p3cwoz/50fd76c7
-    # ...b5b.zip' failed at reset: ...": the worker's copy of the file, not the model.
-    d = {
-        "maps": ["open_room"],
-        "pursuers": [{"model": "zoo:ppo_pursuer_vs_straight_open_room", "label": "ppo"}],
-        "evaders": ["evader/random"],
-        "seeds": 1,
-        "start": "valid",
-        "time_limit": 1e-9,  # the clock runs out in the first reset
-        "env": {"max_cycles": 5},
-    }  # fmt: skip
-    s = run_tournament(spec_from_dict(d), tmp_path / "s.sqlite", backend="serial", progress=False)
-    with Store(tmp_path / "s.sqlite") as db:
-        (row,) = db.rows(s.run_id)
-    assert row["status"] == "forfeit" and row["blame"] == "pursuer"
-    assert row["error"].startswith("pursuer 'ppo' failed at reset: its clock ran out")
-    assert "out: 0.00 s" not in row["error"]  # against the time limit of 1e-09 s
+    # ...b5b.zip' failed at reset: ...": the worker's copy of the file, not the model. The
+    # same file under another label in a later run of the same process (the serial
+    # backend's is the caller's: a suite, a notebook) kept the first run's name.
+    for label in ("ppo", "ppo_again"):
+        d = {
+            "maps": ["open_room"],
+            "pursuers": [{"model": "zoo:ppo_pursuer_vs_straight_open_room", "label": label}],
+            "evaders": ["evader/random"],
+            "seeds": 1,
+            "start": "valid",
+            "time_limit": 1e-9,  # the clock runs out in the first reset
+            "env": {"max_cycles": 5},
+        }  # fmt: skip
+        store = tmp_path / f"{label}.sqlite"
+        s = run_tournament(spec_from_dict(d), store, backend="serial", progress=False)
+        with Store(store) as db:
+            (row,) = db.rows(s.run_id)
+        assert row["status"] == "forfeit" and row["blame"] == "pursuer"
+        assert row["error"].startswith(f"pursuer '{label}' failed at reset: its clock ran out")
+        assert "out: 0.00 s" not in row["error"]  # against the time limit of 1e-09 s
 
 
 _SCRIPT = textwrap.dedent(

@@ -65,7 +65,7 @@ def free_arcs_at(kernel: Kernel, ex: float, ey: float, L: float) -> FreeArcs:
         # below finds too, up to L ~ 1e154, where squaring L overflowed)
         return FreeArcs(E, float(L), ())
     r = L + eps
-    cand = kernel.edges_near_box(ex - r, ey - r, ex + r, ey + r)
+    cand = kernel._edges_near_box(ex - r, ey - r, ex + r, ey + r)
     if len(cand) > kernel.numpy_threshold:
         if not isinstance(cand, np.ndarray):
             cand = np.fromiter(cand, dtype=np.intp, count=len(cand))
@@ -158,7 +158,7 @@ def _blocked_scalar(kernel: Kernel, cand, ex: float, ey: float, L: float) -> Blo
     if on_edges:
         (lo, wid, lab_lo, lab_hi), skip = _on_wall_blocks(kernel, ex, ey, on_edges)
     else:
-        if not kernel.contains_point(ex, ey):
+        if not kernel._contains(ex, ey):
             return None
         lo, wid, lab_lo, lab_hi, skip = [], [], [], [], set()
     ev = kernel.map.edge_vertices
@@ -229,7 +229,7 @@ def _blocked_numpy(
         (lo, wid, lab_lo, lab_hi), skip = _on_wall_blocks(kernel, ex, ey, idx[on].tolist())
         keep &= ~on & ~np.isin(idx, list(skip))
     else:
-        if not kernel.contains_point(ex, ey):
+        if not kernel._contains(ex, ey):
             return None
         lo, wid, lab_lo, lab_hi = [], [], [], []
     idx, wx, wy, u, length, s = idx[keep], wx[keep], wy[keep], u[keep], length[keep], s[keep]

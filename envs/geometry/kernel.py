@@ -47,6 +47,20 @@ def _xy(p: ArrayLike, what: str) -> tuple[float, float]:
     return x, y
 
 
+def _finite(x: float, y: float, what: str) -> tuple[float, float]:
+    """``(x, y)`` as two finite floats (fast path for the per-step predicates that take
+    coordinates, not a point: NaN fell through their grid lookup as a bare ``ValueError``
+    and ``contains_point(nan, y)`` read False)."""
+    if type(x) is float and type(y) is float and math.isfinite(x) and math.isfinite(y):
+        return x, y
+    if isinstance(x, (list, tuple, np.ndarray)) or isinstance(y, (list, tuple, np.ndarray)):
+        raise InvalidConfigError(
+            f"{what}: expected two numbers x, y, got {validation.shown(x)} and "
+            f"{validation.shown(y)}"
+        )
+    return _xy((x, y), what)
+
+
 def _point(x: ArrayLike, what: str) -> np.ndarray:
     return validation.point(what, x)
 
@@ -165,7 +179,16 @@ class Kernel:
         A small box reads the grid cells it overlaps (a tuple or set of indices); a box
         spanning many cells filters precomputed edge bounding boxes with numpy (an index
         array), which is cheaper than merging many cells.
+
+        Raises:
+            InvalidConfigError: a corner that is not two finite numbers (naming it).
         """
+        xmin, ymin = _finite(xmin, ymin, "edges_near_box (xmin, ymin)")
+        xmax, ymax = _finite(xmax, ymax, "edges_near_box (xmax, ymax)")
+        return self._edges_near_box(xmin, ymin, xmax, ymax)
+
+    def _edges_near_box(self, xmin: float, ymin: float, xmax: float, ymax: float):
+        """:meth:`edges_near_box` on finite floats."""
         g = self.grid
         ncells = (g.ix(xmax) - g.ix(xmin) + 1) * (g.iy(ymax) - g.iy(ymin) + 1)
         if ncells <= 16:
@@ -197,7 +220,16 @@ class Kernel:
         return None
 
     def on_wall(self, x: float, y: float) -> int | None:
-        """An edge within ``eps`` of (x, y), or None."""
+        """An edge within ``eps`` of (x, y), or None.
+
+        Raises:
+            InvalidConfigError: (x, y) is not two finite numbers (naming them).
+        """
+        x, y = _finite(x, y, "on_wall (x, y)")
+        return self._on_wall(x, y)
+
+    def _on_wall(self, x: float, y: float) -> int | None:
+        """:meth:`on_wall` on finite floats (the kernel's own calls)."""
         return self._near_wall(x, y, self.grid.cells[self.grid.cell_of(x, y)], self.eps)
 
     def contains_point(self, x: float, y: float) -> bool:
@@ -205,7 +237,16 @@ class Kernel:
 
         The parity of wall crossings on the segment from the cell's reference point,
         whose status was computed at construction, decides; only the cell's walls count.
+
+        Raises:
+            InvalidConfigError: (x, y) is not two finite numbers (naming them; NaN read
+                as a point outside the map).
         """
+        x, y = _finite(x, y, "contains_point (x, y)")
+        return self._contains(x, y)
+
+    def _contains(self, x: float, y: float) -> bool:
+        """:meth:`contains_point` on finite floats (the kernel's own calls)."""
         x0, y0, x1, y1 = self._bounds
         if not (x0 <= x <= x1 and y0 <= y <= y1):
             return False
@@ -275,9 +316,9 @@ class Kernel:
 
         Only possible when both ends rest on walls; decided by the midpoint.
         """
-        if self.on_wall(px, py) is None or self.on_wall(qx, qy) is None:
+        if self._on_wall(px, py) is None or self._on_wall(qx, qy) is None:
             return False
-        return not self.contains_point(0.5 * (px + qx), 0.5 * (py + qy))
+        return not self._contains(0.5 * (px + qx), 0.5 * (py + qy))
 
     def line_of_sight(self, p: ArrayLike, q: ArrayLike) -> bool:
         """Whether the segment p-q touches no wall.
@@ -361,7 +402,7 @@ class Kernel:
         if hit is not None:
             return Feature(hit[1], hit[2])
         if self._through_obstacle(px, py, qx, qy):
-            return Feature("edge", self.on_wall(px, py))
+            return Feature("edge", self._on_wall(px, py))
         return None
 
     # ------------------------------------------------------------------ sweep
@@ -443,7 +484,7 @@ class Kernel:
         rmax = _length(max_range, "ray_distances max_range")
         eps = self.eps
         r = rmax + eps
-        idx = self.edges_near_box(o[0] - r, o[1] - r, o[0] + r, o[1] + r)
+        idx = self._edges_near_box(o[0] - r, o[1] - r, o[0] + r, o[1] + r)
         if not isinstance(idx, np.ndarray):
             idx = np.fromiter(idx, dtype=np.intp, count=len(idx))
         out = np.full(len(ang), rmax)

@@ -60,3 +60,24 @@ def test_a_rod_longer_than_the_map_has_no_free_orientation_at_any_length(kernel,
     fa = kernel.free_arcs((1.0, 1.0), L)
     assert fa.is_empty and fa.L == L
     assert all(a.is_empty for a in kernel.free_arcs_many([(1.0, 1.0), (8.0, 2.0)], L))
+
+
+@pytest.mark.parametrize("x", [np.nan, np.inf, -np.inf, "1", None, True])
+def test_coordinate_queries_refuse_what_is_not_a_finite_number(kernel, x):
+    """``on_wall``, ``contains_point`` and ``edges_near_box`` take coordinates, not a
+    point, and skipped the kernel's check: NaN was a bare ``ValueError`` ("cannot convert
+    float NaN to integer", from the grid lookup), inf an ``OverflowError``, and
+    ``contains_point(nan, y)`` answered False (a point outside the map)."""
+    with pytest.raises(InvalidConfigError, match=r"on_wall \(x, y\) = .*: expected"):
+        kernel.on_wall(x, 1.0)
+    with pytest.raises(InvalidConfigError, match=r"contains_point \(x, y\) = .*: expected"):
+        kernel.contains_point(1.0, x)
+    with pytest.raises(InvalidConfigError, match=r"edges_near_box \(xmax, ymax\)"):
+        kernel.edges_near_box(1.0, 1.0, x, 2.0)
+
+
+def test_coordinate_queries_take_any_real_numbers(kernel):
+    assert kernel.on_wall(np.float32(0.0), 5) is not None
+    assert kernel.on_wall(1.0, 1.0) is None
+    assert kernel.contains_point(np.int64(1), 1.0) and not kernel.contains_point(5.0, 4.5)
+    assert len(kernel.edges_near_box(3, 3, 7, 7)) == 3

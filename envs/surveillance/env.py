@@ -26,6 +26,7 @@ from pettingzoo.utils.wrappers import OrderEnforcingWrapper
 from envs import validation
 from envs.errors import (
     EpisodeStateError,
+    InfeasibleError,
     InvalidActionError,
     InvalidPlacementError,
     UnknownNameError,
@@ -199,6 +200,9 @@ class parallel_env(ParallelEnv, EzPickle):
     ) -> tuple[dict[str, np.ndarray], dict[str, dict[str, Any]]]:
         """Start an episode.
 
+        A refused reset (any error below) changes nothing: not the generator, not the
+        episode under way.
+
         Args:
             seed: reseeds ``self.np_random`` when not ``None``.
             options: ``{"pursuer": (x, y), "evader": (x, y)}`` places the agents exactly
@@ -221,7 +225,6 @@ class parallel_env(ParallelEnv, EzPickle):
         """
         if seed is not None:
             seed = validation.integer("seed", seed, minimum=0, where="reset")
-            self.np_random, self._np_random_seed = seeding.np_random(int(seed))
         if options is not None and not isinstance(options, Mapping):
             raise InvalidPlacementError(
                 "reset: options must be None or a dict such as {'pursuer': (x, y), "
@@ -230,12 +233,24 @@ class parallel_env(ParallelEnv, EzPickle):
         cfg = self.config
         if options:
             check_option_keys(options, stacklevel=2)
+        # the generator is replaced only once the start stands: a refused reset (a
+        # placement that is not valid, no random start) leaves the env as it was, so
+        # the next reset() plays the episode it would have played without the refused one
+        rng, rng_seed = (
+            (self.np_random, self._np_random_seed) if seed is None else seeding.np_random(int(seed))
+        )
         if options and ("pursuer" in options or "evader" in options):
             p, e = validate_placement(
                 cfg, self.kernel, options.get("pursuer"), options.get("evader")
             )
         else:
-            p, e = random_start(cfg, self.kernel, self.np_random)
+            state = rng.bit_generator.state
+            try:
+                p, e = random_start(cfg, self.kernel, rng)
+            except InfeasibleError:
+                rng.bit_generator.state = state  # the draws of a refused reset never happened
+                raise
+        self.np_random, self._np_random_seed = rng, rng_seed
         self.world.reset(p, e)
         self._pursuer = (float(p[0]), float(p[1]))
         self._evader = (float(e[0]), float(e[1]))

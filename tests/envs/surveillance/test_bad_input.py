@@ -8,6 +8,7 @@ import pytest
 from envs import surveillance_v1
 from envs.errors import (
     EpisodeStateError,
+    InfeasibleError,
     InvalidActionError,
     InvalidConfigError,
     InvalidPlacementError,
@@ -207,3 +208,37 @@ def test_small_steps_and_speeds_that_move_a_body_still_play():
             "corridor", "pursuer/greedy", "evader/shooting", 0, max_cycles=5, overrides=over
         )
         assert result.steps == 5, over
+
+
+def _next_episode(env) -> dict:
+    obs, _ = env.reset()
+    return obs
+
+
+@pytest.mark.parametrize(
+    "options",
+    [
+        {"pursuer": (1e9, 0.0), "evader": (1.0, 1.0)},  # outside the map
+        {"pursuer": (True, 1.0), "evader": (1.0, 1.0)},
+        [("pursuer", (1.0, 1.0))],  # not a dict
+    ],
+)
+def test_a_refused_reset_leaves_the_env_as_it_was(env, options):
+    """reset(seed=7, options=bad) reseeded the generator before refusing the options, so
+    the next reset() played seed 7's stream instead of the one under way."""
+    untouched = parallel_env()
+    untouched.reset(seed=0)
+    with pytest.raises(InvalidPlacementError):
+        env.reset(seed=7, options=options)
+    a, b = _next_episode(env), _next_episode(untouched)
+    assert all(np.array_equal(a[k], b[k]) for k in a)
+
+
+def test_a_random_start_that_finds_nothing_draws_nothing():
+    """The maze at dt = 2 rules every proposal out (rod clearance 6): the refused reset
+    used to leave the generator advanced by its 25,600 proposals."""
+    env = parallel_env(map="maze", dt=2.0)
+    before = env.np_random.bit_generator.state
+    with pytest.raises(InfeasibleError, match="no valid surveillance configuration"):
+        env.reset()
+    assert env.np_random.bit_generator.state == before

@@ -3,6 +3,9 @@
 * :func:`integer` and :func:`real` (from :mod:`analysis.arguments`) are argparse
   ``type=`` functions with ranges: ``--seeds 0`` or ``--rho nan`` is a usage error naming
   the value and what was expected (exit code 2) before any long work.
+* :class:`ArgumentParser` reads ``@FILE`` arguments (one argument a line) and refuses
+  one whose file cannot be read by naming it: ``--worlds @nosuch.txt`` was argparse's
+  bare ``error: [Errno 2] No such file or directory: 'nosuch.txt'``.
 * :func:`run` calls a script's ``main`` and turns SIGINT (Ctrl-C) and SIGTERM (``timeout``,
   ``kill``) into one line on stderr and exit code 130 / 143, no traceback. What a script
   wrote before the signal is kept (results files are appended and flushed row by row; rerun
@@ -18,20 +21,64 @@
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import multiprocessing as mp
 import os
 import signal
 import sys
 import threading
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from multiprocessing.pool import Pool
+from typing import Any
 
-from analysis.arguments import integer, path_text, real, user_error
+from analysis.arguments import integer, path_text, real, user_error, why_not_a_file
 
-__all__ = ["integer", "path_text", "real", "run", "worker_pool"]
+__all__ = ["ArgumentParser", "integer", "path_text", "real", "run", "worker_pool"]
 
 EXIT_CODE = {"SIGINT": 130, "SIGTERM": 143}
+
+
+class ArgumentParser(argparse.ArgumentParser):
+    """``argparse.ArgumentParser`` that takes ``@FILE`` for the arguments in FILE, one a
+    line, and refuses an ``@FILE`` it cannot read as a usage error
+    naming it, also one named inside another such file."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs.setdefault("fromfile_prefix_chars", "@")
+        super().__init__(*args, **kwargs)
+
+    def parse_known_args(
+        self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
+    ) -> tuple[argparse.Namespace, list[str]]:
+        """argparse's, once every ``@FILE`` named (directly or in such a file) is readable."""
+        self._check_argument_files(sys.argv[1:] if args is None else args, "", set())
+        return super().parse_known_args(args, namespace)
+
+    def _check_argument_files(self, args: Sequence[str], named_in: str, seen: set[str]) -> None:
+        prefix = self.fromfile_prefix_chars or ""
+        for arg in args:
+            if not (isinstance(arg, str) and arg[:1] and arg[0] in prefix):
+                continue
+            name = arg[1:]
+            why = why_not_a_file(name) if name else "names no file"
+            if why is not None and (not name or not os.path.exists(name) or os.path.isdir(name)):
+                where = "" if os.path.isabs(name) else f" (in {os.getcwd()})"
+                self.error(
+                    f"{arg}{named_in}: {why}{where}; {arg[0]}FILE reads arguments from FILE, "
+                    "one a line"
+                )
+            key = os.path.realpath(name)
+            if why is not None or key in seen:
+                continue  # a device or a pipe (@/dev/stdin, @<(...)): argparse reads it once
+            seen.add(key)
+            try:
+                with open(name, encoding="utf-8") as f:
+                    lines = f.read().splitlines()
+            except (OSError, UnicodeDecodeError) as exc:
+                self.error(f"{arg}{named_in}: cannot be read ({exc})")
+            inner = [a for line in lines for a in self.convert_arg_line_to_args(line)]
+            self._check_argument_files(inner, f" (named in {arg})", seen)
 
 
 def _raise_interrupt(signum: int, frame: object) -> None:

@@ -93,7 +93,6 @@ busy core (load ~4.5 on 2): ``--role pursuer --combos 0`` 10 min, ``--role evade
 
 from __future__ import annotations
 
-import argparse
 import contextlib
 import json
 import math
@@ -106,7 +105,7 @@ import zlib
 import episode_rows
 import numpy as np
 import referee_labels
-from bench_cli import integer, path_text, real, run, worker_pool
+from bench_cli import ArgumentParser, integer, path_text, real, run, worker_pool
 from referee_labels import similarity_back
 from unseen_opponents import make_opponent
 
@@ -719,9 +718,8 @@ def report(
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(
+    ap = ArgumentParser(  # reads @FILE: --worlds @benchmarks/heldout_worlds_pursuer.txt
         description=__doc__.splitlines()[0],
-        fromfile_prefix_chars="@",  # --worlds @benchmarks/heldout_worlds_pursuer.txt
         epilog=f"combos: pursuer role (rho, L_max/L_min, L_min) {PURSUER_COMBOS}; "
         f"evader role (rho, L_max/L_min) {EVADER_COMBOS}",
     )

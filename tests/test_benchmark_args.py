@@ -48,6 +48,14 @@ def _run(script: str, *args: str, **kwargs) -> subprocess.CompletedProcess:
         ("unseen_worlds.py", ["--results", ""], "--results: '': expected a file"),
         ("analytic_matchups.py", ["--results", ""], "'': expected a results database file"),
         ("finetune_curve.py", ["--save", ""], "--save: '': expected a directory"),
+        # an @FILE that cannot be read was argparse's bare "[Errno 2] No such file or
+        # directory: 'nosuch.txt'", naming neither the @ argument nor where it was looked for
+        (
+            "unseen_worlds.py",
+            ["--role", "pursuer", "--worlds", "@nosuch.txt"],
+            f"error: @nosuch.txt: no such file (in {BENCHMARKS}); @FILE reads arguments",
+        ),
+        ("unseen_worlds.py", ["--role", "evader", "--worlds", "@."], "@.: is a directory"),
     ],
 )
 def test_a_bad_argument_is_a_usage_error(script, args, message) -> None:
@@ -57,6 +65,19 @@ def test_a_bad_argument_is_a_usage_error(script, args, message) -> None:
     assert message in out.stderr
     assert "Traceback" not in out.stderr
     assert out.stdout == ""  # no work started (the scripts print the load average first)
+
+
+def test_an_argument_file_names_the_one_it_cannot_read(tmp_path) -> None:
+    """An @FILE named inside another is checked too, and said to be named there; a file
+    that reads is expanded as argparse does (one argument a line)."""
+    outer = tmp_path / "worlds.txt"
+    outer.write_text("corridor~rot2.3\n@inner.txt\n")
+    out = _run("unseen_worlds.py", "--role", "pursuer", "--worlds", f"@{outer}")
+    assert out.returncode == 2 and out.stdout == ""
+    assert f"@inner.txt (named in @{outer}): no such file (in {BENCHMARKS})" in out.stderr
+    outer.write_text("corridor~rot2.3\nnowhere\n")
+    out = _run("unseen_worlds.py", "--role", "pursuer", "--worlds", f"@{outer}")
+    assert out.returncode == 2 and "unknown pursuer-role world 'nowhere'" in out.stderr
 
 
 def test_a_name_found_unknown_after_parsing_is_one_line() -> None:

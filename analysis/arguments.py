@@ -62,6 +62,34 @@ class Parser(argparse.ArgumentParser):
             message = re.sub(r"^argument (\S+?)(?:/\S+)?: ", r"\1: ", message)
         self.exit(2, f"{PROG}: error: {message} (see '{self.prog} --help')\n")
 
+    def parse_args(  # type: ignore[override]
+        self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
+    ) -> argparse.Namespace:
+        """argparse's, but arguments no parser took are refused by the subcommand they
+        were given to: ``surveil policies extra`` points at ``surveil policies --help``
+        (it pointed at ``surveil --help``, whose usage does not show them)."""
+        parsed, extras = self.parse_known_args(args, namespace)
+        if extras:
+            self._chosen(parsed).error(f"unrecognized arguments: {' '.join(extras)}")
+        return parsed
+
+    def _chosen(self, parsed: argparse.Namespace) -> argparse.ArgumentParser:
+        """The (sub)command parser ``parsed`` was read by: the deepest chosen subparser."""
+        parser: argparse.ArgumentParser = self
+        while True:
+            sub = next(
+                (
+                    a
+                    for a in parser._actions  # argparse keeps its subparsers only here
+                    if isinstance(a, argparse._SubParsersAction)
+                ),
+                None,
+            )
+            name = None if sub is None else getattr(parsed, sub.dest or "", None)
+            if sub is None or name not in sub.choices:
+                return parser
+            parser = sub.choices[name]
+
 
 MAP_HELP = (
     "a built-in name (surveil maps), a map file (.json, .geojson or .wkt: see "

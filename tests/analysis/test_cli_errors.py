@@ -228,6 +228,21 @@ def test_bad_numbers_and_flags_name_the_flag(capsys, argv, needles):
     assert_fails(capsys, argv, *needles)
 
 
+@pytest.mark.parametrize(
+    ("argv", "command"),
+    [
+        (["policies", "--role", "evader", "extra"], "policies"),
+        (["maps", "x", "y"], "maps"),
+        (["play", "--no-gif", "--no-such-flag"], "play"),
+        (["report", "x.db", "--nope"], "report"),
+    ],
+)
+def test_an_argument_no_command_takes_points_at_its_commands_help(capsys, argv, command):
+    """It pointed at 'surveil --help', whose usage lists the commands, not their flags."""
+    line = assert_fails(capsys, argv, "unrecognized arguments: ")
+    assert line.endswith(f"(see 'surveil {command} --help')"), line
+
+
 def test_analyze_needs_a_length_for_a_map_file(capsys, map_file):
     assert_fails(capsys, ["analyze", str(map_file)], "--length is required", str(map_file))
 

@@ -53,9 +53,11 @@ develop the policies (seeds 2001-2026, floor plans 6-8, other transforms and roo
 ``@benchmarks/heldout_worlds_evader.txt`` (32).
 
 Body radius 0.1 (times the scale). Episodes are appended to ``--results`` (JSON lines)
-as they finish; a rerun plays only what the file lacks, then prints the table of every
+as they finish; a rerun plays only what the file lacks (``--play-again``: every selected
+episode, its new row counting in place of the old), then prints the table of every
 selected episode: per world and combo, per opponent, the total, and every loss with the
-command that replays it.
+command that replays it (with ``--play-again``: it plays the episode whatever the file
+holds).
 
 ``--referee CPL`` (pursuer role) asks the referee, the bounded-speed ground truth, about
 every start of the selected episodes (one per world, combo and seed; the opponents share
@@ -527,14 +529,20 @@ def _shell_word(label: str) -> str:
 
 
 def replay_command(row, results: str = "replay.jsonl") -> str:
-    """The command that plays this episode again (alone)."""
-    other = row["role"] == "evader" and row["world"] not in EVADER_NAMES
+    """The command that plays this episode again (alone), at its horizon, whatever
+    ``results`` already holds (``--play-again``: a second replay of the episode, after a
+    change of the code, read the first one's row and played nothing)."""
+    pursuer = row["role"] == "pursuer"
+    other = not pursuer and row["world"] not in EVADER_NAMES
     l_min = f" --l-mins {row['combo'][2]:g}" if other else ""
+    horizon = row.get("horizon", MAX_CYCLES if pursuer else K)
+    if horizon != (MAX_CYCLES if pursuer else K):
+        l_min += f" --max-cycles {horizon}" if pursuer else f" --k {horizon:g}"
     return (
         f"python benchmarks/unseen_worlds.py --role {row['role']} "
         f"--worlds {_shell_word(row['world'])} "
         f"--combos {_combo_index(row['role'], row['combo'])} --opponents '{row['opponent']}' "
-        f"--seeds {row['seed']}{l_min} --results {results}"
+        f"--seeds {row['seed']}{l_min} --results {results} --play-again"
     )
 
 
@@ -746,6 +754,8 @@ def main(argv=None) -> int:
         type=path_text("a file"),
         help="JSON-lines file (default out/unseen_worlds_ROLE.jsonl)",
     )
+    ap.add_argument("--play-again", action="store_true", help="play every selected episode, "
+                    "also those the results file holds (the new row counts)")  # fmt: skip
     ap.add_argument("--workers", type=integer(1), default=1)
     ap.add_argument("--referee", type=real(0), metavar="CPL", help="pursuer role: label every "
                     "start with the referee at CPL cells per L_min (module docstring)")  # fmt: skip
@@ -781,7 +791,7 @@ def main(argv=None) -> int:
     jobs = select(args)
     _init(args.max_cycles, args.k)  # before the keys: they name the horizon
     done = episode_rows.read(results, row_key)
-    todo = [j for j in jobs if job_key(j) not in done]
+    todo = jobs if args.play_again else [j for j in jobs if job_key(j) not in done]
     print(f"{len(jobs)} episodes selected, {len(todo)} to play, results in {results}")
     t0 = time.perf_counter()
     with episode_rows.appending(results) as write, contextlib.ExitStack() as stack:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib
 import json
+import shlex
 from pathlib import Path
 
 import pytest
@@ -179,12 +180,32 @@ def test_a_fresh_evader_world_draws_its_own_episodes(unseen, tmp_path, capsys) -
     assert row["world"] == "tee_w1.4" and row["combo"][2] == 2.0 and row["winner"] == "evader"
     assert "shooting evader escaped 1/1" in capsys.readouterr().out
     assert unseen.replay_command({**row, "winner": "pursuer"}).endswith(
-        f"--seeds {row['seed']} --l-mins 2 --results replay.jsonl"
+        f"--seeds {row['seed']} --l-mins 2 --results replay.jsonl --play-again"
     )
     label = "office~x0.6rot1.7off(1,2)"
     assert f"--worlds '{label}' " in unseen.replay_command(
         {"role": "pursuer", "world": label, "combo": [0.5, 2.0, 2.0], "opponent": "herder",
          "seed": 101})  # fmt: skip
+
+
+def test_a_replay_command_plays_its_episode_each_time(unseen, tmp_path, capsys, monkeypatch):
+    """A loss's replay command, run as printed, plays the episode at its horizon every
+    time: a second run (after a change of the code) read the first one's row from
+    replay.jsonl and played nothing, and a row of a --max-cycles 40 run replayed at 600."""
+    argv = ["--role", "pursuer", "--worlds", "corridor~rot2.3", "--combos", "0",
+            "--opponents", "herder", "--max-cycles", "40", "--results",
+            str(tmp_path / "run.jsonl")]  # fmt: skip
+    assert unseen.main(argv) == 0
+    (row,) = _rows(tmp_path / "run.jsonl")
+    words = shlex.split(unseen.replay_command(row))
+    assert words[:2] == ["python", "benchmarks/unseen_worlds.py"]
+    monkeypatch.chdir(tmp_path)
+    capsys.readouterr()
+    for _ in range(2):
+        assert unseen.main(words[2:]) == 0
+        assert "1 episodes selected, 1 to play" in capsys.readouterr().out
+    replays = _rows(tmp_path / "replay.jsonl")
+    assert [(r["horizon"], r["steps"], r["winner"]) for r in replays] == [(40, 40, "pursuer")] * 2
 
 
 @pytest.mark.parametrize("role", ["pursuer", "evader"])

@@ -144,12 +144,13 @@ def run_tournament(
         from envs.maps.io import map_to_dict
 
         geometry = {m.digest: (m.map.name, map_to_dict(m.map)) for m in spec.maps}
+        older = _older_runs(db, spec)  # before this run is in the store
         done = db.begin_run(spec.run_id, spec.name, spec.to_dict(), unique, geometry)
         if retry_errors:
             done = db.finished(spec.run_id, include_errors=False)
         todo = [m for m, _ in unique if m.match_id not in done]
         summary = RunSummary(spec.run_id, spec.name, path, len(unique), len(unique) - len(todo))
-        summary.messages += _older_runs(db, spec)
+        summary.messages += older
         test = Sequential(spec.sprt, db.rows(spec.run_id)) if spec.sprt else None
         if test is not None and test.decision is not None:
             todo = []
@@ -184,19 +185,38 @@ def run_tournament(
 
 
 def _older_runs(db: Store, spec: Spec) -> list[str]:
-    """A line for each run of ``spec`` in ``db`` an older surveil played (not reused)."""
+    """A line for each run of ``spec`` in ``db`` an older surveil played (not reused),
+    said when this run begins: none when ``db`` holds it already (a resume; the lines
+    were repeated on every one)."""
     from analysis.tournament.spec import TIME_LIMIT_RULE
 
-    bare = {k: v for k, v in spec.to_dict().items() if k != "time_limit_rule"}
+    runs = db.runs()
+    if any(r["run_id"] == spec.run_id for r in runs):
+        return []
+    bare = _placeless({k: v for k, v in spec.to_dict().items() if k != "time_limit_rule"})
     return [
         f"run {r['run_id']} in {db.path} is this spec played by an older surveil, whose time "
         "limit counted the whole match (the env's set-up included) and blamed the side "
         f"that had decided slower: none of its {r['done']} stored matches is reused, and "
         f"this run ({spec.run_id}) plays them with a clock per role ({TIME_LIMIT_RULE}); "
         f"the old run stays in the store (surveil report {db.path} --run {r['run_id']})"
-        for r in db.runs()
-        if r["run_id"] != spec.run_id and r["spec"] == bare
+        for r in runs
+        if _placeless(r["spec"]) == bare
     ]
+
+
+def _placeless(spec: dict[str, Any]) -> dict[str, Any]:
+    """A normalised spec without where its files lie (a model's path, a map file's),
+    whose contents it identifies by hash: the same spec run from another checkout (a
+    zoo model under another root) is the same game. The run id keeps the paths."""
+    out = dict(spec)
+    for key, place in (("pursuers", "model_path"), ("evaders", "model_path"), ("maps", "source")):
+        if isinstance(spec.get(key), list):  # any spec a store holds, whatever wrote it
+            out[key] = [
+                {k: v for k, v in e.items() if k != place} if isinstance(e, dict) else e
+                for e in spec[key]
+            ]
+    return out
 
 
 class Sequential:

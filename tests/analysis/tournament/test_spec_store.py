@@ -462,3 +462,26 @@ def test_a_run_an_older_surveil_stored_is_played_again_and_said_so(tmp_path):
     new = write_report(store, tmp_path / "new", run_id=s.run_id, replays=False, regret=False)
     assert "30 s per match, as an older surveil applied it" in old["markdown"].read_text()
     assert "30 s of decision time per role per match" in new["markdown"].read_text()
+    # a resume of the new run says it no more (it was repeated on every resume)
+    again = run_tournament(spec_from_dict(_OLD_SPEC), store, backend="serial", progress=False)
+    assert again.run_id == s.run_id and (again.reused, again.played) == (2, 0)
+    assert "older surveil" not in again.describe()
+
+
+def test_an_older_run_from_another_checkout_is_said_so(tmp_path):
+    """data/store_identity_v1_zoo.sql: 94c5063 played _OLD_SPEC's open_room with the zoo
+    evader from a checkout in /tmp/h132-old (dumped as store_identity_v1.sql was): its
+    spec names the model under that root, so the same spec from this checkout (the same
+    model's bytes under another path) was not recognised and the message was missing."""
+    from importlib import resources
+
+    store = tmp_path / "old.sqlite"
+    data = resources.files("tests.analysis.tournament").joinpath("data")
+    dump = data.joinpath("store_identity_v1_zoo.sql").read_text()
+    assert "/tmp/h132-old/training/zoo/models/" in dump  # another checkout's path
+    with contextlib.closing(sqlite3.connect(store)) as c:
+        c.executescript(dump)
+    zoo = {**_OLD_SPEC, "name": "old_clock_zoo", "evaders": ["zoo:ppo_evader_vs_greedy_open_room"]}
+    s = run_tournament(spec_from_dict(zoo), store, backend="serial", progress=False)
+    assert (s.reused, s.played) == (0, 2)
+    assert "run 40ffb68c9c0885cf in " in s.describe() and "older surveil" in s.describe()

@@ -25,13 +25,14 @@ import signal
 import sys
 import threading
 import time
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from analysis.tournament.executors import Executor, SerialExecutor, check_backend, make_executor
 from analysis.tournament.identity import plan
-from analysis.tournament.spec import Spec, load_spec
+from analysis.tournament.spec import Spec, load_spec, unseen_games
 from analysis.tournament.store import Store
 from analysis.tournament.worker import context_for
 
@@ -156,6 +157,9 @@ def run_tournament(
             todo = []
             summary.decided = test.decision
             summary.messages.append(test.describe())
+        if todo:  # once per run, here: a worker's copy of a model says nothing
+            for category, message in unseen_games(spec):
+                warnings.warn(message, category, stacklevel=2)
         if not todo:
             summary.backend = "nothing to play"
             db.end_run(spec.run_id, "decided" if summary.decided else "finished")

@@ -73,6 +73,7 @@ __all__ = [
     "Variant",
     "load_spec",
     "spec_from_dict",
+    "unseen_games",
 ]
 
 ENV_FIELDS = (
@@ -619,6 +620,60 @@ def _provenance(model: Path) -> dict[str, Any]:
     except (OSError, ValueError):
         return {}
     return data if isinstance(data, dict) else {}
+
+
+def unseen_games(spec: Spec) -> list[tuple[type[Warning], str]]:
+    """The warnings a learned model of ``spec`` earns, one of each kind per model: it
+    plays games its provenance says it was not trained at
+    (:class:`~strategies.policies.learned.UnseenParametersWarning`, each difference with
+    the maps and variants where it holds unless it holds on all), or, seeing map
+    coordinates, maps it has not seen (:class:`~strategies.policies.learned.UnseenMapWarning`).
+
+    The driver says them once per run in the main process: the copy of a model's file a
+    worker plays has no provenance beside it (it said nothing), and a worker would say
+    them once per process and game.
+    """
+    from strategies.policies.learned import (
+        UnseenMapWarning,
+        UnseenParametersWarning,
+        maps_trained_on,
+        trained_map_digests,
+        unseen_map_message,
+        unseen_parameters,
+        unseen_parameters_message,
+    )
+
+    games = [
+        (m.label + (f" [{v.label}]" if v.label else ""), spec.env_config(m, v))
+        for m in spec.maps
+        for v in spec.variants
+    ]
+    out: list[tuple[type[Warning], str]] = []
+    for entry in (*spec.pursuers, *spec.evaders):
+        if entry.model is None:
+            continue
+        provenance = _provenance(Path(entry.model))
+        differ: dict[str, list[str]] = {}
+        for where, game in games:
+            key = unseen_parameters(provenance, game)
+            if key is not None:
+                differ.setdefault(key, []).append(where)
+        if differ:
+            everywhere = len(differ) == 1 and len(next(iter(differ.values()))) == len(games)
+            text = " | ".join(
+                key if everywhere else f"{key} (on {', '.join(where)})"
+                for key, where in differ.items()
+            )
+            message = unseen_parameters_message(entry.label, text, games=len(differ))
+            out.append((UnseenParametersWarning, message))
+        trained = maps_trained_on(provenance)
+        if trained:
+            known = trained_map_digests(provenance)
+            unseen = [m.label for m in spec.maps if m.map.digest not in known]
+            if unseen:
+                message = unseen_map_message(entry.label, trained, unseen)
+                out.append((UnseenMapWarning, message))
+    return out
 
 
 _BYTES_PER_MATCH = 2100.0

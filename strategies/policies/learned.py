@@ -40,7 +40,12 @@ __all__ = [
     "UnseenMapWarning",
     "UnseenParametersWarning",
     "learner_inputs_spec",
+    "maps_trained_on",
+    "trained_map_digests",
     "trained_observation",
+    "unseen_map_message",
+    "unseen_parameters",
+    "unseen_parameters_message",
 ]
 
 SB3_ALGORITHMS = ("A2C", "DDPG", "PPO", "SAC", "TD3")
@@ -74,6 +79,78 @@ with its ranges and speeds (``NAME~xS``) is the same game, so only these are com
 
 _RATIO_RTOL = 1e-6
 """Relative difference below which two ratios are the same (rounding of the inputs)."""
+
+_GAME_KEYS = ("l_min", "l_max", "v_pursuer", "v_evader", "dt")
+
+
+def unseen_parameters(provenance: Mapping[str, Any] | None, game: Any) -> str | None:
+    """What differs, up to scale, between the game a model was trained at (its
+    provenance's ``env_config``) and ``game`` (an ``EnvConfig``, or a mapping of its
+    parameters): ``"rho = v_evader / v_pursuer: 0.5 in training (0.5 / 1), 0.8 here (0.8
+    / 1)"``, the differing ratios joined by ``"; "``; ``None`` when none differs or the
+    provenance records no game (an older one)."""
+    trained = (provenance or {}).get("env_config") or {}
+    try:
+        was = {k: float(trained[k]) for k in _GAME_KEYS}
+    except (KeyError, TypeError, ValueError):  # an older provenance: nothing to compare
+        return None
+    read = game.get if isinstance(game, Mapping) else lambda k: getattr(game, k)
+    now = {k: float(read(k)) for k in _GAME_KEYS}
+    differ = [
+        f"{name}: {value(was):.4g} in training ({how(was)}), {value(now):.4g} here ({how(now)})"
+        for name, value, how in _GAME_RATIOS
+        if abs(value(now) - value(was)) > _RATIO_RTOL * abs(value(was))
+    ]
+    return "; ".join(differ) or None
+
+
+def unseen_parameters_message(label: str, differ: str, *, games: int = 1) -> str:
+    """The :class:`UnseenParametersWarning` of model ``label`` at ``games`` games where
+    ``differ`` (:func:`unseen_parameters`, or several joined)."""
+    what, how = ("a game", "this one") if games == 1 else (f"{games} games", "these")
+    return (
+        f"{label}: this model plays {what} it was not trained at: {differ}. Up to scale "
+        "only these numbers matter (a map scaled with its ranges and speeds, NAME~xS, is "
+        f"the same game); how it plays {how} is unmeasured"
+    )
+
+
+def maps_trained_on(provenance: Mapping[str, Any] | None) -> list[Any]:
+    """The maps a model that sees map coordinates (observation ``"state"``) was trained
+    on, as its config names them; empty for any other model (a lidar one sees no
+    coordinates) or a provenance that names none."""
+    prov = provenance or {}
+    if (prov.get("env_config") or {}).get("observation") != "state":
+        return []
+    cfg = prov.get("config") or {}
+    return list(cfg.get("maps") or ([cfg["map"]] if cfg.get("map") else []))
+
+
+def trained_map_digests(provenance: Mapping[str, Any] | None) -> set[str]:
+    """Geometry digests of the maps of :func:`maps_trained_on`, as they load now (those
+    that do not load, e.g. a file moved since, are left out), and the one the provenance
+    recorded. By geometry, not by name: a map file is named by its path in the config and
+    by its own name on the map, and a user's map called "l_hall" is not the l_hall
+    trained on."""
+    from envs.maps import load_map
+
+    found = {((provenance or {}).get("env_config") or {}).get("map_digest")}
+    for name in maps_trained_on(provenance):
+        try:
+            found.add(load_map(str(name)).digest)
+        except (ValueError, OSError):
+            pass
+    return {d for d in found if d}
+
+
+def unseen_map_message(label: str, trained: list[Any], here: list[str]) -> str:
+    """The :class:`UnseenMapWarning` of model ``label``, trained on ``trained``, playing
+    the maps named ``here``, which it has not seen."""
+    plays = f"{here[0]!r}, a map" if len(here) == 1 else f"{', '.join(map(repr, here))}, maps"
+    return (
+        f"{label}: this model sees map coordinates (observation 'state') and was trained "
+        f"on {', '.join(map(str, trained))}; it plays {plays} it has not seen"
+    )
 
 
 def _algo_from_zip(path: Path) -> str:
@@ -212,71 +289,34 @@ class SB3Policy(BasePolicy):
         """Warn (once per game) when the game's speed ratio, range ratio or step differs
         from the one the model was trained at: it never saw that game, whatever the map
         (a lidar generalist too)."""
-        trained = (self.provenance or {}).get("env_config") or {}
-        keys = ("l_min", "l_max", "v_pursuer", "v_evader", "dt")
-        try:
-            was = {k: float(trained[k]) for k in keys}
-        except (KeyError, TypeError, ValueError):  # an older provenance: nothing to compare
-            return
-        now = {k: float(getattr(self.config, k)) for k in keys}
-        differ = [
-            f"{name}: {value(was):.4g} in training ({how(was)}), {value(now):.4g} here ({how(now)})"
-            for name, value, how in _GAME_RATIOS
-            if abs(value(now) - value(was)) > _RATIO_RTOL * abs(value(was))
-        ]
-        key = "; ".join(differ)
-        if not differ or key in self._warned:
+        key = unseen_parameters(self.provenance, self.config)
+        if key is None or key in self._warned:
             return
         self._warned.add(key)
         warnings.warn(
-            f"{self.name}: this model plays a game it was not trained at: {key}. Up to "
-            "scale only these numbers matter (a map scaled with its ranges and speeds, "
-            "NAME~xS, is the same game); how it plays this one is unmeasured",
-            UnseenParametersWarning,
-            stacklevel=3,
+            unseen_parameters_message(self.name, key), UnseenParametersWarning, stacklevel=3
         )
 
     def _warn_unseen_map(self) -> None:
         """Warn (once per map) when a model that sees map coordinates plays a map it did
         not train on: a ``"state"`` observation places both agents in the map's bounds,
         so what it learned belongs to its training maps (a map specialist)."""
-        prov = self.provenance or {}
-        if (prov.get("env_config") or {}).get("observation") != "state":
-            return
-        cfg = prov.get("config") or {}
-        trained = cfg.get("maps") or ([cfg["map"]] if cfg.get("map") else [])
+        trained = maps_trained_on(self.provenance)
         here = getattr(self.map, "name", None)
         if not trained or here is None or here in self._warned:
             return
-        # by geometry, not by name: a map file is named by its path in the config and by
-        # its own name (the file's "name" or stem) on the map, so the very file trained on
-        # was "not seen"; and a user's map called "l_hall" is not the l_hall trained on
         digest = getattr(self.map, "digest", None)
-        if (here in trained) if digest is None else (digest in self._trained_digests(trained)):
+        if (here in trained) if digest is None else (digest in self._trained_digests()):
             return
         self._warned.add(here)
         warnings.warn(
-            f"{self.name}: this model sees map coordinates (observation 'state') and was "
-            f"trained on {', '.join(map(str, trained))}; it plays {here!r}, a map it has "
-            "not seen",
-            UnseenMapWarning,
-            stacklevel=3,
+            unseen_map_message(self.name, trained, [here]), UnseenMapWarning, stacklevel=3
         )
 
-    def _trained_digests(self, trained: list[Any]) -> set[str]:
-        """Geometry digests of the maps the model trained on, as they load now (those that
-        do not load, e.g. a file moved since, are left out), and the one its provenance
-        recorded; computed once."""
+    def _trained_digests(self) -> set[str]:
+        """:func:`trained_map_digests`, computed once."""
         if self._digests is None:
-            from envs.maps import load_map
-
-            found = {(self.provenance.get("env_config") or {}).get("map_digest")}
-            for name in trained:
-                try:
-                    found.add(load_map(str(name)).digest)
-                except (ValueError, OSError):
-                    pass
-            self._digests = {d for d in found if d}
+            self._digests = trained_map_digests(self.provenance)
         return self._digests
 
     def act(self, observation: np.ndarray) -> np.ndarray:

@@ -7,6 +7,7 @@ import io
 import re
 from html.parser import HTMLParser
 
+import pytest
 from PIL import Image
 
 from analysis.cli import main
@@ -159,6 +160,30 @@ def test_evaluate_takes_zoo_models_by_name(tmp_path, capsys):
     assert main(argv) == 0
     out = capsys.readouterr().out
     assert "1 of 1 matches stored" in out and "zoo:ppo_pursuer_vs_straight_open_room" in out
+
+
+@pytest.mark.parametrize("workers", ["1", "2"])
+def test_evaluate_warns_once_per_model_at_a_game_it_was_not_trained_at(tmp_path, capsys, workers):
+    """A model at another rho than its training's, on two maps, four matches: one warning
+    per model and kind, said by the main process. It said nothing: the workers play a copy
+    of the model file without the provenance.json the check reads (``surveil play`` said
+    it)."""
+    argv = ["evaluate", "--maps", "corridor", "l_hall", "--pursuers",
+            "zoo:dagger_pursuer_generalist", "zoo:dagger_pursuer_l_hall", "--evaders",
+            "evader/straight", "--seeds", "2", "--max-cycles", "3", "--config",
+            '{"v_evader": 0.8}', "--workers", workers, "--results",
+            str(tmp_path / "z.sqlite"), "--no-progress"]  # fmt: skip
+    assert main(argv) == 0
+    said = [x for x in capsys.readouterr().err.splitlines() if x.startswith("surveil: warning:")]
+    rho = "rho = v_evader / v_pursuer: 0.5 in training (0.5 / 1), 0.8 here (0.8 / 1). Up to"
+    assert [x.split(": this model")[0] for x in said] == [
+        "surveil: warning: zoo:dagger_pursuer_generalist",
+        "surveil: warning: zoo:dagger_pursuer_l_hall",
+        "surveil: warning: zoo:dagger_pursuer_l_hall",
+    ], said
+    assert rho in said[0] and " plays a game it was not trained at" in said[0]
+    assert rho in said[1]
+    assert "trained on l_hall; it plays 'corridor', a map it has not seen" in said[2]
 
 
 def test_a_regret_table_over_the_memory_budget_leaves_the_rest_of_the_report(

@@ -45,7 +45,14 @@ from strategies.policies.base import check_role
 from strategies.policies.model_files import model_policy_name
 from training.single_agent import START_CHOICES
 
-__all__ = ["ALGORITHMS", "TrainConfig", "load_any_config", "load_config"]
+__all__ = [
+    "ALGORITHMS",
+    "TrainConfig",
+    "check_same_maps",
+    "load_any_config",
+    "load_config",
+    "map_fingerprints",
+]
 
 ALGORITHMS = ("ppo", "sac")
 """The SB3 algorithms :func:`training.train` runs (continuous actions)."""
@@ -303,6 +310,56 @@ class TrainConfig:
     def replace(self, **changes: Any) -> TrainConfig:
         """A copy with some fields changed (validated again)."""
         return dataclasses.replace(self, **changes)
+
+
+def map_fingerprints(names: Any) -> dict[str, dict[str, Any]]:
+    """The maps a run plays, by the names its config gives them: each one's geometry
+    digest and recommended parameters (:func:`~envs.surveillance.config.map_recommendations`)
+    as they resolve now. A config names a map file by its path, so the file edited
+    between an interruption and the rerun is seen only here (the config's own values,
+    ``[env]`` included, are compared as the config). Recorded when a run starts and
+    checked by :func:`check_same_maps` when it resumes: the one home of this check for
+    ``surveil train`` (``env.json``) and DAgger (``progress.json``).
+
+    Args:
+        names: one map name or an iterable of them.
+    """
+    from envs.maps import load_map
+    from envs.surveillance.config import map_recommendations
+
+    names = [names] if isinstance(names, str) else sorted({str(n) for n in names})
+    return {n: {"digest": load_map(n).digest, **map_recommendations(n)} for n in names}
+
+
+def check_same_maps(recorded: Any, now: dict[str, dict[str, Any]], *, where: str) -> None:
+    """Refuse to resume a run whose maps resolve otherwise than when it started.
+
+    Args:
+        recorded: the :func:`map_fingerprints` recorded at the start (a map missing from
+            it, or a value that is not such a record, is not compared).
+        now: the fingerprints as they resolve now.
+        where: the message's start: ``"output_dir 'out/x' holds a DAgger run"``.
+
+    Raises:
+        InvalidConfigError: naming the first map that changed and what changed in it.
+    """
+    if not isinstance(recorded, dict):
+        return
+    for name, fp in now.items():
+        was = recorded.get(name)
+        if not isinstance(was, dict):
+            continue
+        diff = sorted(k for k in set(was) | set(fp) if was.get(k) != fp.get(k))
+        if diff:
+            raise InvalidConfigError(
+                f"{where} on another game: map {name!r} resolves to {_shown(fp, diff)} now, "
+                f"{_shown(was, diff)} when the run started (its map file or the file's "
+                "metadata changed); use another output_dir or delete that one"
+            )
+
+
+def _shown(record: dict[str, Any], keys: list[str]) -> str:
+    return ", ".join(f"{k} = {record.get(k)!r}" for k in keys)
 
 
 def read_toml(path: str | os.PathLike[str]) -> dict[str, Any]:

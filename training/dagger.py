@@ -64,6 +64,7 @@ from strategies.policies.base import check_role
 from strategies.policies.learner_inputs import LearnerInputs, check_features
 from strategies.policies.model_files import model_policy_name
 from strategies.runner import check_observation_options, run_episode
+from training.config import check_same_maps, map_fingerprints
 
 __all__ = ["DaggerConfig", "DaggerResult", "dagger", "load_dagger_config"]
 
@@ -491,16 +492,8 @@ def _resume(cfg: DaggerConfig, out: Path, env) -> tuple[Any, dict[str, Any], lis
             f"{diff}: {[before[k] for k in diff]} there, {[now[k] for k in diff]} now); "
             "use another output_dir or delete that one"
         )
-    if "maps" in progress:  # (a run of an older surveil has none)
-        now_maps = _map_fingerprints(cfg)
-        changed = sorted(m for m in now_maps if progress["maps"].get(m, now_maps[m]) != now_maps[m])
-        if changed:
-            m = changed[0]
-            raise InvalidConfigError(
-                f"output_dir {str(out)!r} holds a DAgger run on other maps: {m!r} resolves to "
-                f"{now_maps[m]} now, {progress['maps'][m]} when the run started (its map file "
-                "or the file's metadata changed); use another output_dir or delete that one"
-            )
+    where = f"output_dir {str(out)!r} holds a DAgger run"
+    check_same_maps(progress.get("maps"), _map_fingerprints(cfg), where=where)  # none: older
     _settle(out, len(progress["samples"]) - 1)
     try:
         last = out / "model_last.zip"
@@ -521,16 +514,9 @@ def _resume(cfg: DaggerConfig, out: Path, env) -> tuple[Any, dict[str, Any], lis
 
 
 def _map_fingerprints(cfg: DaggerConfig) -> dict[str, dict[str, Any]]:
-    """Every map the run plays (curriculum stages included), by name: its geometry digest
-    and recommended parameters as they resolve now. A config names a map file by its path,
-    so an edit between an interruption and the rerun is seen only here."""
-    from envs.maps import load_map
-    from envs.surveillance.config import map_recommendations
-
-    names: set[str] = set()
-    for it in range(cfg.iterations):
-        names.update(str(m) for m in cfg.stage(it)[0])
-    return {n: {"digest": load_map(n).digest, **map_recommendations(n)} for n in sorted(names)}
+    """:func:`~training.config.map_fingerprints` of every map the run plays (curriculum
+    stages included)."""
+    return map_fingerprints({str(m) for it in range(cfg.iterations) for m in cfg.stage(it)[0]})
 
 
 def _write_iteration(out: Path, model, obs, act, progress: dict[str, Any], best: bool) -> None:

@@ -5,9 +5,10 @@ trains on the CPU with one torch thread, and writes into ``config.output_dir``:
 
 * ``config.toml`` -- the config of the run (a resumed run must match it);
 * ``train.lock`` -- held while a process trains there (a second one is refused);
-* ``env.json`` -- the env configs the run plays, one per map, resolved (the map's
-  geometry digest and its recommended parameters included): a resumed run must play the
-  same (a map file edited in between is refused, not trained on without a word);
+* ``env.json`` -- the maps the run plays, by name: each one's geometry digest and
+  recommended parameters (:func:`~training.config.map_fingerprints`, as DAgger's
+  ``progress.json`` records them): a resumed run must play the same (a map file edited
+  in between is refused, not trained on without a word);
 * ``checkpoints/ckpt_<timesteps>.zip`` -- written as it goes (atomically, the last two
   kept); a rerun of an interrupted run continues from the newest one with the
   remaining timesteps;
@@ -42,7 +43,7 @@ from envs import pidlock
 from envs.errors import InvalidConfigError
 from envs.surveillance_v1 import ENV_ID
 from strategies.policies import Policy, make_policy
-from training.config import TrainConfig, load_config
+from training.config import TrainConfig, check_same_maps, load_config, map_fingerprints
 from training.single_agent import SingleAgentEnv, sb3_params
 
 __all__ = [
@@ -264,39 +265,29 @@ def _check_resumable(config: TrainConfig, out: Path) -> None:
         )
 
 
-def _env_records(vec_env) -> list[dict[str, Any]]:
-    """The resolved env config of every map of the run (JSON-ready)."""
-    single = vec_env.envs[0].unwrapped
-    out = []
-    for env in single.envs:
-        d = env.config.to_dict()
-        d.pop("render_mode", None)
-        out.append(json.loads(json.dumps(d)))
-    return out
-
-
-def _check_same_envs(vec_env, out: Path) -> None:
+def _check_same_envs(config: TrainConfig, out: Path) -> None:
     """Refuse to resume a run whose maps now resolve to other games (``config.toml`` names a
-    map file by its path: its geometry or recommended parameters may have changed since);
-    record them for the first segment (and for a run of a surveil without ``env.json``)."""
-    now = _env_records(vec_env)
+    map file by its path: its geometry or recommended parameters may have changed since),
+    by :func:`~training.config.check_same_maps`; record them in ``env.json`` for the first
+    segment (and for a run of a surveil without ``env.json``)."""
+    names = [config.map] if isinstance(config.map, str) else [str(m) for m in config.map]
+    now = map_fingerprints(names)
     stored = out / "env.json"
     if stored.is_file() and _latest_checkpoint_exists(out):
         try:
             before = json.loads(stored.read_text())
         except ValueError:  # a torn write: nothing to compare with
-            before = now
-        if isinstance(before, list) and len(before) == len(now):
-            for a, b in zip(before, now, strict=True):
-                diff = sorted(k for k in set(a) | set(b) if a.get(k) != b.get(k))
-                if diff:
-                    raise InvalidConfigError(
-                        f"output_dir {str(out)!r} holds a run on another game: map "
-                        f"{b.get('map')!r} resolves to {[b.get(k) for k in diff]} for {diff} "
-                        f"now, {[a.get(k) for k in diff]} when the run started (its map file "
-                        "or the file's metadata changed); use another output_dir or delete "
-                        "that one"
-                    )
+            before = None
+        if isinstance(before, list) and len(before) == len(names):
+            # an older surveil's env.json: the resolved env config of each map in the
+            # config's order, whose values include [env]'s (compared as the config): its
+            # geometry digest is what it says of the map alone
+            before = {
+                n: {**now[n], "digest": e.get("map_digest") if isinstance(e, dict) else None}
+                for n, e in zip(names, before, strict=True)
+            }
+        where = f"output_dir {str(out)!r} holds a run"
+        check_same_maps(before, now, where=where)
     _atomic_write(stored, json.dumps(now, indent=1, sort_keys=True))
 
 
@@ -486,7 +477,7 @@ def _train(config, out, t0, init_model, callbacks, progress_bar) -> TrainResult:
     # the envs first: an opponent that does not resolve (a misspelt name) must not leave a
     # config.toml behind, which would refuse the corrected rerun as "a different config"
     vec_env = _make_vec_env(config)
-    _check_same_envs(vec_env, out)
+    _check_same_envs(config, out)
     _atomic_write(out / "config.toml", config.to_toml())
     cls = _algo_class(config.algo)
     ckpt = _load_checkpoint(out, cls, vec_env)

@@ -10,6 +10,7 @@ every user error into one line and exit code 2.
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 import tempfile
@@ -344,16 +345,40 @@ def test_a_resumed_run_whose_map_file_changed_is_refused(tiny, tmp_path):
         train(config, callbacks=[Interrupt(at=150)])
     out = Path(config.output_dir)
     recorded = json.loads((out / "env.json").read_text())
-    assert [(r["l_min"], r["l_max"]) for r in recorded] == [(1.5, 3.0)]
+    assert (recorded[str(world)]["l_min"], recorded[str(world)]["l_max"]) == (1.5, 3.0)
     save_map(load_map("open_room"), world, metadata={"l_min": 1.0, "l_max": 3.0})
-    with pytest.raises(InvalidConfigError, match=r"another game: map 'open_room' resolves to "
-                       r"\[1\.0\] for \['l_min'\] now, \[1\.5\] when the run started"):  # fmt: skip
+    # the map as the config names it (it read 'open_room', the map's own name), and only
+    # what changed, as DAgger says it (one check for both: training.config.check_same_maps)
+    with pytest.raises(InvalidConfigError, match=re.escape(
+            f"holds a run on another game: map {str(world)!r} resolves to l_min = 1.0 now, "
+            "l_min = 1.5 when the run started")):  # fmt: skip
         train(config)
     save_map(load_map("corner"), world, metadata={"l_min": 1.5, "l_max": 3.0})
-    with pytest.raises(InvalidConfigError, match=r"\['map', 'map_digest'\]"):
+    with pytest.raises(InvalidConfigError, match=r"resolves to digest = '"):
         train(config)
     save_map(load_map("open_room"), world, metadata={"l_min": 1.5, "l_max": 3.0})
     assert train(config).timesteps == 256  # the same game again: resumed
+
+
+def test_a_run_of_an_older_surveil_is_still_checked_by_its_maps_geometry(tiny, tmp_path):
+    """An env.json written before the one check (a list of resolved env configs) is read
+    for its maps' geometry: the same walls resume, other walls are refused."""
+    from envs.maps import load_map, save_map
+
+    world = tmp_path / "room.json"
+    save_map(load_map("open_room"), world, metadata={"l_min": 1.5, "l_max": 3.0})
+    config = tiny(map=str(world))
+    with pytest.raises(KeyboardInterrupt):
+        train(config, callbacks=[Interrupt(at=150)])
+    out = Path(config.output_dir)
+    old = [{"map": "open_room", "map_digest": load_map("open_room").digest, "l_min": 1.5}]
+    (out / "env.json").write_text(json.dumps(old))
+    save_map(load_map("corner"), world, metadata={"l_min": 1.5, "l_max": 3.0})
+    with pytest.raises(InvalidConfigError, match=r"map '.*room\.json' resolves to digest = "):
+        train(config)
+    save_map(load_map("open_room"), world, metadata={"l_min": 1.5, "l_max": 3.0})
+    (out / "env.json").write_text(json.dumps(old))
+    assert train(config).timesteps == 256
 
 
 def test_a_second_run_in_a_busy_output_dir_is_refused_naming_the_first(tiny):

@@ -4,7 +4,8 @@ Every user error becomes one line, ``surveil: error: WHAT = VALUE: expected ...`
 code 2, no traceback, and is found before any long work starts:
 
 * :class:`Parser` is an ``argparse.ArgumentParser`` whose errors are that one line (no
-  usage dump); subparsers inherit it.
+  usage dump); subparsers inherit it. An argument no command takes is refused by the
+  command it was given to (:class:`CommandParser`, also for the benchmark scripts).
 * :func:`integer` and :func:`real` are argparse ``type=`` functions with ranges.
 * :func:`json_object` parses a JSON option (``--config``, ``--params``) and says which
   flag failed and where its JSON breaks.
@@ -35,6 +36,7 @@ from typing import Any, NoReturn
 from envs.errors import InvalidConfigError, MemoryBudgetError, SurveilValueError
 
 __all__ = [
+    "CommandParser",
     "Parser",
     "integer",
     "json_object",
@@ -50,17 +52,9 @@ __all__ = [
 PROG = "surveil"
 
 
-class Parser(argparse.ArgumentParser):
-    """``argparse.ArgumentParser`` whose errors are one line: ``surveil: error: ...``."""
-
-    def error(self, message: str) -> NoReturn:
-        """Print ``surveil: error: MESSAGE`` (flag and value first) and exit with code 2."""
-        m = re.fullmatch(r"argument (\S+?)(?:/\S+)?: ('.*?'): (.*)", message, flags=re.S)
-        if m:  # a type= check: "--seed = '-1': expected an integer >= 0"
-            message = f"{m[1]} = {m[2]}: {m[3]}"
-        else:
-            message = re.sub(r"^argument (\S+?)(?:/\S+)?: ", r"\1: ", message)
-        self.exit(2, f"{PROG}: error: {message} (see '{self.prog} --help')\n")
+class CommandParser(argparse.ArgumentParser):
+    """``argparse.ArgumentParser`` whose arguments that no parser took are refused by the
+    subcommand they were given to (its usage and help), not by the top-level parser."""
 
     def parse_args(  # type: ignore[override]
         self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
@@ -89,6 +83,19 @@ class Parser(argparse.ArgumentParser):
             if sub is None or name not in sub.choices:
                 return parser
             parser = sub.choices[name]
+
+
+class Parser(CommandParser):
+    """``argparse.ArgumentParser`` whose errors are one line: ``surveil: error: ...``."""
+
+    def error(self, message: str) -> NoReturn:
+        """Print ``surveil: error: MESSAGE`` (flag and value first) and exit with code 2."""
+        m = re.fullmatch(r"argument (\S+?)(?:/\S+)?: ('.*?'): (.*)", message, flags=re.S)
+        if m:  # a type= check: "--seed = '-1': expected an integer >= 0"
+            message = f"{m[1]} = {m[2]}: {m[3]}"
+        else:
+            message = re.sub(r"^argument (\S+?)(?:/\S+)?: ", r"\1: ", message)
+        self.exit(2, f"{PROG}: error: {message} (see '{self.prog} --help')\n")
 
 
 MAP_HELP = (

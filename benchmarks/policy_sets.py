@@ -43,6 +43,7 @@ from dataclasses import dataclass
 import episode_rows
 from bench_cli import integer, path_text, run
 
+from analysis.arguments import CommandParser, output_dir
 from envs.errors import InvalidConfigError
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -377,8 +378,8 @@ def _set_name(text: str) -> str:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0], epilog=_set_list(),
-                                 formatter_class=argparse.RawDescriptionHelpFormatter)  # fmt: skip
+    ap = CommandParser(description=__doc__.splitlines()[0], epilog=_set_list(),
+                       formatter_class=argparse.RawDescriptionHelpFormatter)  # fmt: skip
     sub = ap.add_subparsers(dest="command", required=True)
     p = sub.add_parser("run", help="play sets into DIR/SET.jsonl (resumes), then their totals")
     p.add_argument("sets", nargs="+", type=_set_name, metavar="SET",
@@ -398,6 +399,7 @@ def main(argv=None) -> int:
                    help="the run of the changed code, from its own checkout")  # fmt: skip
     args = ap.parse_args(argv)
     if args.command == "run":
+        output_dir("--out", args.out)  # a file there was "error: /etc/passwd: File exists"
         return run_sets(list(dict.fromkeys(args.sets)), args.out, args.workers)
     if args.command == "totals":
         return totals(args.dir)

@@ -56,6 +56,18 @@ def _run(script: str, *args: str, **kwargs) -> subprocess.CompletedProcess:
             f"error: @nosuch.txt: no such file (in {BENCHMARKS}); @FILE reads arguments",
         ),
         ("unseen_worlds.py", ["--role", "evader", "--worlds", "@."], "@.: is a directory"),
+        # a file as the output directory: "error: policy_sets.py: File exists"
+        (
+            "policy_sets.py",
+            ["run", "b1", "--out", "policy_sets.py"],
+            "error: --out = 'policy_sets.py': is a file, expected a directory",
+        ),
+        # a subcommand's extra argument: refused with the top-level usage, not the command's
+        (
+            "policy_sets.py",
+            ["totals", ".", "extra"],
+            "usage: policy_sets.py totals [-h] DIR\npolicy_sets.py totals: error: unrecognized",
+        ),
     ],
 )
 def test_a_bad_argument_is_a_usage_error(script, args, message) -> None:

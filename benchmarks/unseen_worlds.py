@@ -659,14 +659,17 @@ def report(
             v = labels[_start_key(r)]
             c[v] = c.get(v, 0) + 1
     head = "   referee (episodes per start's label)" if labels else ""
-    print(f"{'world':<26}{'rho, L_max/L_min, L_min':<26}{won:>8}{head}")
+    # columns as wide as the longest label (a held-out world's runs to 30 characters)
+    ww = max([26, *(len(w) + 2 for w, _ in per_world)])
+    wo = max([30, *(len(o) + 2 for o in per_opp)])
+    print(f"{'world':<{ww}}{'rho, L_max/L_min, L_min':<26}{won:>8}{head}")
     for (w, combo), (k, n) in sorted(per_world.items()):
         c = per_label.get((w, combo), {})
         ref = "   " + ", ".join(f"{m} {v}" for v, m in sorted(c.items())) if labels else ""
-        print(f"{w:<26}{list(combo)!s:<26}{f'{k}/{n}':>8}{ref}")
-    print(f"{'opponent':<30}{won:>8}")
+        print(f"{w:<{ww}}{list(combo)!s:<26}{f'{k}/{n}':>8}{ref}")
+    print(f"{'opponent':<{wo}}{won:>8}")
     for o, (k, n) in sorted(per_opp.items()):
-        print(f"{o:<30}{f'{k}/{n}':>8}")
+        print(f"{o:<{wo}}{f'{k}/{n}':>8}")
     by_combo: dict[tuple, list[int]] = {}
     for (_, combo), (k, n) in per_world.items():
         key = tuple(combo) if role == "pursuer" else ()

@@ -94,6 +94,23 @@ def test_a_loss_is_printed_with_its_replay_command(unseen, capsys) -> None:
     )
 
 
+def test_a_long_world_label_keeps_its_columns_apart(unseen, capsys) -> None:
+    """A held-out world's label runs to 30 characters: its table row keeps a space before
+    the combo (it was printed glued: 'two_rooms~x0.8rot1.3off(12,-3)[0.5, 2.0, 1.0]'), and
+    the rows line up with the header."""
+    world, opponent = "two_rooms~x0.8rot1.3off(12,-3)", "evader/toward_away:alternate-long"
+    row = {"role": "pursuer", "world": world, "combo": [0.5, 2.0, 1.0], "opponent": opponent,
+           "seed": 101, "winner": "pursuer", "cause": None, "t": None, "steps": 600}  # fmt: skip
+    unseen.report([row])
+    lines = capsys.readouterr().out.splitlines()
+    head = next(line for line in lines if line.startswith("world"))
+    line = next(line for line in lines if line.startswith(world))
+    assert line.split()[:2] == [world, "[0.5,"]
+    assert head.index("rho, L_max") == line.index("[0.5,")
+    opp = next(line for line in lines if line.startswith(opponent))
+    assert opp.split() == [opponent, "1/1"]
+
+
 def test_an_evader_loss_says_whether_the_escape_is_open_to_the_body(unseen, capsys) -> None:
     """two_rooms at L_min 1: Prop. 2 holds only for a point evader (every escape crosses a
     piece nearer a wall than the 0.1 body); at L_min 2 the body has its escape."""

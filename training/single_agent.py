@@ -248,6 +248,38 @@ class SingleAgentEnv(gym.Env):
         Returns:
             The learner's observation and info.
         """
+        # a refused reset (a placement the env refuses) leaves this env as it was: its
+        # generator, map and opponent are put back, and the opponent, reset only once the
+        # env has accepted the start, keeps the episode under way
+        rng = self._np_random
+        kept = (
+            rng,
+            self._np_random_seed,
+            None if rng is None else rng.bit_generator.state,
+            {k: self.__dict__[k] for k in self._EPISODE_CHOICES},
+        )
+        try:
+            return self._reset(seed, options)
+        except Exception:
+            self._np_random, self._np_random_seed = kept[0], kept[1]
+            if rng is not None:
+                rng.bit_generator.state = kept[2]
+            self.__dict__.update(kept[3])
+            raise
+
+    _EPISODE_CHOICES = (
+        "_map_index",
+        "env",
+        "config",
+        "opponent",
+        "_opponent_options",
+        "_observer",
+    )
+    """What :meth:`reset` chooses before the env accepts the start (put back if it refuses)."""
+
+    def _reset(
+        self, seed: int | None, options: dict[str, Any] | None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
         super().reset(seed=seed)
         env_seed, start_seed, opp_seed = (
             int(s) for s in self.np_random.integers(_SEED_BOUND, size=3)
@@ -268,13 +300,13 @@ class SingleAgentEnv(gym.Env):
             placement = sample_start(judge, np.random.default_rng(start_seed), kind=self.start)
         # a new observer each episode (a lidar track differentiates positions over steps)
         self._observer = Observer(self.env, self.opponent_role, self._opponent_options)
+        obs, infos = self.env.reset(seed=env_seed, options=placement)
         self.opponent.reset(
             role=self.opponent_role,
             map=self.config.map,
             config=self._observer.config,
             seed=opp_seed,
         )
-        obs, infos = self.env.reset(seed=env_seed, options=placement)
         self._steps = 0
         self._opponent_obs = self._opponent_view(obs, infos)
         if self._inputs:

@@ -10,7 +10,7 @@ from gymnasium.utils.env_checker import check_env
 from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
 from envs import surveillance_v1
-from envs.errors import InvalidConfigError
+from envs.errors import InvalidConfigError, InvalidPlacementError
 from strategies.policies import make_policy
 from training.single_agent import SingleAgentEnv
 
@@ -116,6 +116,27 @@ def test_explicit_placement_and_policy_object():
     _, info = env.reset(seed=0, options={"pursuer": (5.0, 5.0), "evader": (2.0, 5.0)})
     assert info["distance"] == pytest.approx(3.0)
     assert env.opponent is opp and opp.role == "evader"
+
+
+@pytest.mark.parametrize("maps", ["corridor", ["corridor", "open_room"]])
+def test_a_refused_reset_leaves_the_env_as_it_was(maps):
+    """reset(seed=7, options=bad) reseeded the generator (and drew the map, the start and
+    the opponent's seed from it) before the env refused the placement: the next reset()
+    played seed 7's stream. Now it plays the one under way, and the episode under way
+    keeps its opponent (reset only once the env accepts a start)."""
+
+    def made():
+        env = SingleAgentEnv("pursuer", make_policy("evader/straight"), map=maps)
+        env.reset(seed=0)
+        return env
+
+    env, untouched = made(), made()
+    opponent = env.opponent
+    with pytest.raises(InvalidPlacementError, match="outside the free space"):
+        env.reset(seed=7, options={"pursuer": (1e9, 0.0), "evader": (1.0, 1.0)})
+    assert env.opponent is opponent and env.config.map.name == untouched.config.map.name
+    for _ in range(3):
+        assert np.array_equal(env.reset()[0], untouched.reset()[0])
 
 
 @pytest.mark.parametrize(

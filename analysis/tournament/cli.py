@@ -114,6 +114,11 @@ def _cmd_tournament(args: argparse.Namespace) -> int:
     from analysis.tournament.spec import load_spec
 
     if args.list:
+        if args.spec is not None:  # it was listed past without a word
+            raise InvalidConfigError(
+                f"surveil tournament: --list takes no SPEC, got {args.spec!r}; give one or "
+                "the other"
+            )
         import warnings
 
         for name, path in sorted(shipped_specs().items()):

@@ -113,6 +113,8 @@ def test_cli_tournament_report_export_and_errors(tmp_path, capsys):
         (["export", "/dev/null", str(tmp_path / "y.csv")], "is a character device"),
         (["tournament", "quick", "--store", "/dev/null"], "is a character device"),
         (["tournament", str(tmp_path)], "is a directory, not a file"),
+        # a SPEC beside --list was ignored: the list printed, exit 0
+        (["tournament", "--list", "quick"], "--list takes no SPEC, got 'quick'"),
     ]:
         capsys.readouterr()
         assert main(bad) == 2

@@ -374,6 +374,10 @@ def read_toml(path: str | os.PathLike[str]) -> dict[str, Any]:
             return tomllib.load(fh)
     except FileNotFoundError:
         raise InvalidConfigError(f"config: no such file {str(p)!r}") from None
+    except IsADirectoryError:  # was the bare "/etc: Is a directory"
+        raise InvalidConfigError(
+            f"config: {str(p)!r} is a directory, expected a TOML file"
+        ) from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise InvalidConfigError(f"config: {str(p)!r} is not valid TOML ({exc})") from exc
     except RecursionError:  # the parser recurses once per nested array or table

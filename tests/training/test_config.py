@@ -95,6 +95,9 @@ def test_bad_values_name_the_field(changes, field):
 def test_bad_files(tmp_path):
     with pytest.raises(InvalidConfigError, match="no such file"):
         load_config(tmp_path / "missing.toml")
+    # a directory was a bare IsADirectoryError ('surveil: error: /etc: Is a directory')
+    with pytest.raises(InvalidConfigError, match=r"config: '.*' is a directory, expected a TOML"):
+        load_config(tmp_path)
     bad = tmp_path / "bad.toml"
     bad.write_text("role = \n")
     with pytest.raises(InvalidConfigError, match="not valid TOML"):

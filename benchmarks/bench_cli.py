@@ -34,7 +34,7 @@ from typing import Any
 
 from analysis.arguments import integer, path_text, real, user_error, why_not_a_file
 
-__all__ = ["ArgumentParser", "integer", "path_text", "real", "run", "worker_pool"]
+__all__ = ["ArgumentParser", "integer", "path_text", "real", "results_file", "run", "worker_pool"]
 
 EXIT_CODE = {"SIGINT": 130, "SIGTERM": 143}
 
@@ -79,6 +79,24 @@ class ArgumentParser(argparse.ArgumentParser):
                 self.error(f"{arg}{named_in}: cannot be read ({exc})")
             inner = [a for line in lines for a in self.convert_arg_line_to_args(line)]
             self._check_argument_files(inner, f" (named in {arg})", seen)
+
+
+def results_file(text: str) -> str:
+    """An argparse ``type=`` for ``--results FILE`` (JSON lines, :mod:`episode_rows`): a
+    file name, not a directory and not under a file, refused before any work (a directory
+    was the bare "error: /tmp: Is a directory" once the run had started, and a file where
+    a folder should be "error: /etc/passwd: File exists")."""
+    text = path_text("a file")(text)
+    if os.path.isdir(text):
+        raise argparse.ArgumentTypeError(f"{text!r}: is a directory, expected a file")
+    parent = os.path.dirname(os.path.abspath(text))
+    while not os.path.exists(parent):
+        parent = os.path.dirname(parent)
+    if not os.path.isdir(parent):
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: cannot be created: {parent!r} is a file, not a directory"
+        )
+    return text
 
 
 def _raise_interrupt(signum: int, frame: object) -> None:

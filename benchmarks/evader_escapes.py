@@ -55,7 +55,7 @@ import time
 
 import episode_rows
 import numpy as np
-from bench_cli import integer, path_text, real, run, worker_pool
+from bench_cli import integer, real, results_file, run, worker_pool
 
 from envs.maps import Map, builtin_info, load_map
 from envs.maps.junctions import crossroads, t_junction
@@ -182,7 +182,7 @@ def main(argv=None) -> int:
     )
     ap.add_argument("--progress", action="store_true",
                     help="a line per job (default: every 20 jobs, and each failure)")  # fmt: skip
-    ap.add_argument("--results", metavar="FILE", default=None, type=path_text("a file"),
+    ap.add_argument("--results", metavar="FILE", default=None, type=results_file,
                     help="append each episode to FILE (JSON lines) as it completes; a rerun "
                     "with the same FILE plays only the episodes missing from it")  # fmt: skip
     args = ap.parse_args(argv)

@@ -65,7 +65,7 @@ import warnings
 import episode_rows
 import numpy as np
 import referee_labels
-from bench_cli import integer, path_text, real, run, worker_pool
+from bench_cli import integer, real, results_file, run, worker_pool
 from referee_labels import similarity_back
 
 from envs.errors import InfeasibleError, LongRunWarning, MemoryBudgetError
@@ -252,7 +252,7 @@ def main(argv=None) -> int:
     ap.add_argument("--hindsight", type=real(0), metavar="CELL", default=None,
                     help="label every loss to an open-loop evader by hindsight at cell "
                     "side CELL (see above)")  # fmt: skip
-    ap.add_argument("--results", metavar="FILE", default=None, type=path_text("a file"),
+    ap.add_argument("--results", metavar="FILE", default=None, type=results_file,
                     help="append each episode to FILE (JSON lines) as it completes; a rerun "
                     "with the same FILE plays only the episodes missing from it")  # fmt: skip
     args = ap.parse_args(argv)

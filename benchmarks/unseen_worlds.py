@@ -107,7 +107,7 @@ import zlib
 import episode_rows
 import numpy as np
 import referee_labels
-from bench_cli import ArgumentParser, integer, path_text, real, run, worker_pool
+from bench_cli import ArgumentParser, integer, real, results_file, run, worker_pool
 from referee_labels import similarity_back
 from unseen_opponents import make_opponent
 
@@ -754,7 +754,7 @@ def main(argv=None) -> int:
     ap.add_argument("--k", type=real(0), default=K, help="evader role: horizon in D / V_e")
     ap.add_argument(
         "--results",
-        type=path_text("a file"),
+        type=results_file,
         help="JSON-lines file (default out/unseen_worlds_ROLE.jsonl)",
     )
     ap.add_argument("--play-again", action="store_true", help="play every selected episode, "

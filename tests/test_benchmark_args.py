@@ -56,6 +56,19 @@ def _run(script: str, *args: str, **kwargs) -> subprocess.CompletedProcess:
             f"error: @nosuch.txt: no such file (in {BENCHMARKS}); @FILE reads arguments",
         ),
         ("unseen_worlds.py", ["--role", "evader", "--worlds", "@."], "@.: is a directory"),
+        # a directory, or a path under a file, as the results file: "error: /tmp: Is a
+        # directory" and "error: /etc/passwd: File exists" once the run had started
+        (
+            "unseen_worlds.py",
+            ["--role", "pursuer", "--results", "."],
+            "--results: '.': is a directory, expected a file",
+        ),
+        ("pursuer_holds.py", ["--results", "."], "--results: '.': is a directory"),
+        (
+            "evader_escapes.py",
+            ["--results", "bench_cli.py/x.jsonl"],
+            "cannot be created: '" + str(BENCHMARKS / "bench_cli.py") + "' is a file",
+        ),
         # a file as the output directory: "error: policy_sets.py: File exists"
         (
             "policy_sets.py",

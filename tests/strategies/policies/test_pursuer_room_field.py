@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from envs.maps import Map
+from envs.maps import Map, load_map
 from envs.surveillance.config import EnvConfig
 from strategies.policies import make_policy
 from strategies.policies.decomposition import _clearance_grid, _room_field
@@ -92,4 +92,29 @@ def test_a_ride_that_reaches_room_is_not_stalled(unseen, world, cycles):
     m, ov = unseen.pursuer_world(world, list(unseen.PURSUER_COMBOS[0]))
     r = run_episode(m, "pursuer/decomposition", unseen.make_opponent("evader/shooting"), 101,
                     max_cycles=cycles, overrides=ov, start="safe")  # fmt: skip
+    assert r.winner == "pursuer", r.summary()
+
+
+_CORNER = {"l_min": 2.0, "l_max": 4.0, "v_pursuer": 1.0, "v_evader": 0.5, "body_radius": 0.2}
+_CORNER_X10 = {"l_min": 20.0, "l_max": 40.0, "v_pursuer": 10.0, "v_evader": 5.0, "body_radius": 2.0}
+
+
+@pytest.mark.parametrize(
+    ("world", "overrides", "seed", "cycles"),
+    [
+        # the ridden circle stood still while the other came nearer to room, 0.08 m a
+        # step (a stall judged on the nearer circle's way lost it at 14.4 s)
+        ("corner~rot0.37", _CORNER, 0, 180),
+        # the ridden circle short by 0.26, within its pad, for seconds (lost at 8.8 s)
+        ("corner~rot0.37", _CORNER, 1, 120),
+        # short by 2.87 (body 2, pad 3) but one step's 3.43 (lost at 48.3 s when the
+        # last step's shortfall alone was read)
+        ("corner~x10.0rot1.1", _CORNER_X10, 2, 500),
+    ],
+)
+def test_a_ride_round_a_nearly_free_circle_is_not_stalled(world, overrides, seed, cycles):
+    # the corner world's variants of the pursuer-holds benchmark: the rides there reach
+    # room, or hold, where a stall lost 14 episodes to straight chargers (candidate 4)
+    r = run_episode(load_map(world), "pursuer/decomposition", "evader/shooting", seed,
+                    max_cycles=cycles, overrides=overrides, start="safe")  # fmt: skip
     assert r.winner == "pursuer", r.summary()

@@ -101,6 +101,7 @@ def _policy(flag: str, name: str, params_flag: str, params_text: str | None):
 
     params = json_object(params_flag, params_text, example=PARAMS_EXAMPLE)
     role = flag.lstrip("-")
+    given = name
     if name.startswith(f"{role}/sb3:"):  # the registry's name of a model file (surveil policies)
         name = name.removeprefix(f"{role}/sb3:")
     elif name.startswith(("pursuer/sb3:", "evader/sb3:")):
@@ -117,11 +118,14 @@ def _policy(flag: str, name: str, params_flag: str, params_text: str | None):
             "(see surveil policies)"
         )
     try:
-        return make_policy(name, **params)
+        policy = make_policy(name, **params)
     except UnknownNameError as exc:
         raise UnknownNameError(f"{flag}: {exc}") from None
     except SurveilValueError as exc:  # say which flag brought the value
         raise type(exc)(f"{params_flag if params else flag}: {exc}") from None
+    if name != given:  # a model: its warnings and errors name it as the user did
+        policy.name = given  # (was 'pursuer/sb3:/abs/path/training/zoo/models/.../model.zip')
+    return policy
 
 
 def _cmd_play(args: argparse.Namespace) -> int:

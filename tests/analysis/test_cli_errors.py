@@ -265,6 +265,20 @@ def test_rho_above_one_is_played_with_one_warning_line(capsys):
     ]
 
 
+def test_a_models_warning_names_it_as_the_user_did(capsys):
+    """It named the zip's absolute path: 'pursuer/sb3:/.../training/zoo/models/.../model.zip:
+    this model plays a game it was not trained at'."""
+    argv = ["play", "--map", "corridor", "--pursuer", "zoo:dagger_pursuer_generalist",
+            "--evader", "evader/straight", "--max-cycles", "2", "--no-gif",
+            "--config", json.dumps({"v_evader": 0.8})]  # fmt: skip
+    assert main(argv) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(
+        "surveil: warning: zoo:dagger_pursuer_generalist: this model plays a game it was not "
+        "trained at: rho = v_evader / v_pursuer: 0.5 in training"
+    ), err
+
+
 def test_only_user_errors_lose_their_traceback():
     from analysis.arguments import user_error
     from envs.errors import InvalidObservationError

@@ -36,7 +36,8 @@ For rho > 1 it runs straight at the pursuer (footnote 4; see :meth:`ShootingEvad
    (D the map's diameter), from the first step the pursuer comes within L_max of a
    concave corner, herd instead: get to the far side of the pursuer from the nearest
    concave corner for which that point is in sight (sliding along a wall it grazes),
-   then charge, pinning it there; with no such corner, charge.
+   then charge, pinning it there; with no such corner, charge. Only corners whose walls
+   turn by at least ``HERD_MIN_TURN`` count (a shallow notch is a wall to the pursuer).
 """
 
 from __future__ import annotations
@@ -140,6 +141,13 @@ class ShootingEvader(BasePolicy):
     # times in the benchmarks' D / V_e: 2.92 -> 7.09 or 3.30, 5.98 -> 6.64 or 6.50), from
     # the first step it lost two (two_rooms at L_min 1, after 8 and 13 steps of charging)
     HERD_AFTER = 3.0
+    # the least turn (degrees) between the walls of a concave corner the herd heads for
+    # (an interior angle of at most 135 degrees). A random star's inner vertices turn by
+    # 1.4-8 degrees: charged into one, the pursuer slid along the wall and the herd
+    # picked the next such notch for the rest of the horizon (issue 13: held-out
+    # random:star:2017, rho 0.3, seed 849: herding into those, held for 8 D / V_e; into
+    # the map's corners and notches of 20-72 degrees, occluded at 5.08 D / V_e)
+    HERD_MIN_TURN = 45.0
 
     def _reset(self) -> None:
         c = self.config
@@ -195,7 +203,9 @@ class ShootingEvader(BasePolicy):
         bis = bis / np.maximum(np.linalg.norm(bis, axis=1, keepdims=True), 1e-12)
         self._corner_points = m.vertices[idx] + (c.body_radius + 2.0 * h) * bis
         self._corner_rows = self.table.rows(self._corner_points)
-        self._concave = m.vertices[~m.vertex_convex]  # the corners pressure herds into
+        # the corners pressure herds into: concave ones whose walls turn by at least
+        # HERD_MIN_TURN (a notch a few degrees deep is a wall to a pursuer pinned there)
+        self._concave = m.vertices[herd_corners(m, self.HERD_MIN_TURN)]
         # the pressure steps after which it herds (HERD_AFTER D / V_e of them)
         self._herd_after = self.HERD_AFTER * diameter(m) / (c.v_evader * c.dt)
         self.restart()
@@ -744,6 +754,17 @@ class ShootingEvader(BasePolicy):
             self._arc = None
             return unit(path[-1] - e)
         return unit(path[j] - e)
+
+
+def herd_corners(m, min_turn: float) -> np.ndarray:
+    """Indices of ``m``'s concave vertices (``Map.vertex_convex`` false) whose two walls'
+    normals turn by at least ``min_turn`` degrees: 90 at a rectangle's corner, 180 minus
+    the interior angle in general."""
+    idx = np.flatnonzero(~m.vertex_convex)
+    a = m.edge_normal[m.vertex_prev_edge[idx]]
+    b = m.edge_normal[m.vertex_next_edge[idx]]
+    cos = np.clip(np.einsum("ij,ij->i", a, b), -1.0, 1.0)
+    return idx[cos <= math.cos(math.radians(min_turn)) + 1e-12]
 
 
 def _row_norms(d: np.ndarray) -> np.ndarray:

@@ -80,3 +80,18 @@ def test_herds_after_a_charge_of_three_crossings_in_game_time():
     x0, y0, x1, y1 = m.bounds  # this map's diameter is its bounding-box diagonal
     assert ev._herd_after == pytest.approx(3.0 * math.hypot(x1 - x0, y1 - y0) / 0.3 / 0.2)
     assert ev._pressed > ev._herd_after  # it escaped herding
+
+
+def test_herds_into_a_corner_not_a_star_s_shallow_notch():
+    # held-out random:star:2017, rho 0.3, L_max 2 L_min, seed 849: herding into the star
+    # obstacles' inner vertices (walls turning by 1.4-8 degrees) the pursuer held for the
+    # whole 8 D / V_e; into corners whose walls turn by 45 degrees or more, too close at
+    # 5.08 D / V_e (test_evader_herd.py)
+    m = load_map("random:star:2017")
+    params = {"l_min": 2.0, "l_max": 4.0, "v_pursuer": 1.0, "v_evader": 0.3,
+              "body_radius": 0.1}  # fmt: skip
+    ev = ShootingEvader()
+    r = run_episode(m, "pursuer/decomposition", ev, 849, start="safe", overrides=params,
+                    max_cycles=_horizon(m, 0.3, 6.0))  # fmt: skip
+    assert r.winner == "evader", r.summary()
+    assert ev._herding and ev._pressed > ev._herd_after  # it escaped herding

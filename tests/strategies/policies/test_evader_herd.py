@@ -167,3 +167,62 @@ def test_the_herd_keeps_its_corner_across_the_bisector():
     ev._decide(_snap(e1, p1))
     ev._steps += 2
     assert np.allclose(ev._decide(_snap(e2, p2)), toward(e2, p2, high))
+
+
+def _turn_degrees(m, corner) -> float:
+    """How far the walls turn at ``corner``, a concave corner of ``m``'s free space (180
+    degrees less the free space's angle there), from the outline it lies on."""
+    for ring in [m.boundary, *m.obstacles]:
+        ring = np.asarray(ring, float)
+        for i, v in enumerate(ring):
+            if np.allclose(v, corner):
+                a, b = ring[i - 1] - v, ring[(i + 1) % len(ring)] - v
+                cos = a @ b / np.linalg.norm(a) / np.linalg.norm(b)
+                return 180.0 - math.degrees(math.acos(cos))
+    raise AssertionError(f"{corner} is no vertex of the map")
+
+
+def test_the_herd_heads_for_a_corner_not_a_shallow_notch():
+    # held-out random:star:2017, rho 0.3, L_max 2 L_min, seed 849 against the
+    # decomposition pursuer: the herd headed for the star obstacles' inner vertices,
+    # notches whose walls turn by 1.4-8 degrees; pressed into one, the pursuer slid along
+    # the wall, the herd took the next notch, and the pursuer held for the whole
+    # 8 D / V_e. The herd now heads only for corners whose walls turn by at least
+    # HERD_MIN_TURN (45) degrees: too close at 5.08 D / V_e
+    m = load_map("random:star:2017")
+    params = {"l_min": 2.0, "l_max": 4.0, "v_pursuer": 1.0, "v_evader": 0.3,
+              "body_radius": 0.1}  # fmt: skip
+    notch = np.array([7.4631101, 4.66755395])
+    assert _turn_degrees(m, notch) < 8.0
+    p = notch + 0.6 * np.array([0.437, 0.8995])  # 0.6 out of the notch
+    e = p + np.array([-2.165, 1.25])  # 2.5 away, up and to the left
+    L = float(np.linalg.norm(p - e))
+    assert float(m.distance_to_walls(np.stack([e, p])).min()) > 0.5
+    concave = m.vertices[~m.vertex_convex]
+    assert np.allclose(concave[np.argmin(np.linalg.norm(concave - p, axis=1))], notch)
+
+    def toward(corner):
+        q = p - L * (corner - p) / np.linalg.norm(corner - p)
+        return q, 0.3 * (q - e) / np.linalg.norm(q - e)
+
+    q, to_notch = toward(notch)
+    assert ev_sight(m, e, q)  # the notch's point is in sight: before, the herd's target
+    ev = _pressing(m, params)
+    ev._herding = True
+    v = ev._decide(_snap(e, p))
+    assert not np.allclose(v, to_notch)
+    # toward the far side of the pursuer from the nearest corner whose walls turn by 45
+    # degrees or more and whose point is in sight
+    sharp = sorted(
+        (c for c in concave if _turn_degrees(m, c) >= 45.0),
+        key=lambda c: float(np.linalg.norm(c - p)),
+    )
+    first = next(c for c in sharp if ev_sight(m, e, toward(c)[0]))
+    assert np.allclose(v, toward(first)[1])
+
+
+def ev_sight(m, a, b) -> bool:
+    """Line of sight between two points of ``m`` (the geometry kernel's)."""
+    from envs.geometry import kernel_for
+
+    return kernel_for(m).line_of_sight(tuple(map(float, a)), tuple(map(float, b)))

@@ -146,7 +146,9 @@ class ShootingEvader(BasePolicy):
     # 1.4-8 degrees: charged into one, the pursuer slid along the wall and the herd
     # picked the next such notch for the rest of the horizon (issue 13: held-out
     # random:star:2017, rho 0.3, seed 849: herding into those, held for 8 D / V_e; into
-    # the map's corners and notches of 20-72 degrees, occluded at 5.08 D / V_e)
+    # the room's four corners and two notches of 45.5 and 71.5 degrees, too close at
+    # 5.08 D / V_e; 30 degrees escapes it too, 60 does not, and 85 loses unseen
+    # random:star:11 seed 507: where a herd ends is path-dependent)
     HERD_MIN_TURN = 45.0
 
     def _reset(self) -> None:

@@ -142,10 +142,11 @@ class ShootingEvader(BasePolicy):
     # the first step it lost two (two_rooms at L_min 1, after 8 and 13 steps of charging)
     HERD_AFTER = 3.0
     # the least turn (degrees) between the walls of a concave corner the herd heads for
-    # (an interior angle of at most 135 degrees). A random star's inner vertices turn by
-    # 1.4-8 degrees: charged into one, the pursuer slid along the wall and the herd
+    # (an interior angle of at most 135 degrees). A random star's inner vertices can turn
+    # by a few degrees: charged into one, the pursuer slid along the wall and the herd
     # picked the next such notch for the rest of the horizon (issue 13: held-out
-    # random:star:2017, rho 0.3, seed 849: herding into those, held for 8 D / V_e; into
+    # random:star:2017, rho 0.3, seed 849, where they turn by 1.4-72 degrees: herding into
+    # notches of 4.2, 7.8 and 20.3 degrees among others, held for 8 D / V_e; into
     # the room's four corners and two notches of 45.5 and 71.5 degrees, too close at
     # 5.08 D / V_e; 30 degrees escapes it too, 60 does not, and 85 loses unseen
     # random:star:11 seed 507: where a herd ends is path-dependent)

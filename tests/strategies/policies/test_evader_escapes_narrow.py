@@ -84,9 +84,9 @@ def test_herds_after_a_charge_of_three_crossings_in_game_time():
 
 def test_herds_into_a_corner_not_a_star_s_shallow_notch():
     # held-out random:star:2017, rho 0.3, L_max 2 L_min, seed 849: herding into the star
-    # obstacles' inner vertices (walls turning by 1.4-8 degrees) the pursuer held for the
-    # whole 8 D / V_e; into corners whose walls turn by 45 degrees or more, too close at
-    # 5.08 D / V_e (test_evader_herd.py)
+    # obstacles' inner vertices (walls turning by as little as 4.2 degrees) the pursuer
+    # held for the whole 8 D / V_e; into corners whose walls turn by 45 degrees or more,
+    # too close at 5.08 D / V_e (test_evader_herd.py)
     m = load_map("random:star:2017")
     params = {"l_min": 2.0, "l_max": 4.0, "v_pursuer": 1.0, "v_evader": 0.3,
               "body_radius": 0.1}  # fmt: skip

@@ -185,10 +185,10 @@ def _turn_degrees(m, corner) -> float:
 def test_the_herd_heads_for_a_corner_not_a_shallow_notch():
     # held-out random:star:2017, rho 0.3, L_max 2 L_min, seed 849 against the
     # decomposition pursuer: the herd headed for the star obstacles' inner vertices,
-    # notches whose walls turn by 1.4-8 degrees; pressed into one, the pursuer slid along
-    # the wall, the herd took the next notch, and the pursuer held for the whole
-    # 8 D / V_e. The herd now heads only for corners whose walls turn by at least
-    # HERD_MIN_TURN (45) degrees: too close at 5.08 D / V_e
+    # notches whose walls turn by as little as 4.2 and 7.8 degrees; pressed into one,
+    # the pursuer slid along the wall, the herd took the next notch, and the pursuer
+    # held for the whole 8 D / V_e. The herd now heads only for corners whose walls turn
+    # by at least HERD_MIN_TURN (45) degrees: too close at 5.08 D / V_e
     m = load_map("random:star:2017")
     params = {"l_min": 2.0, "l_max": 4.0, "v_pursuer": 1.0, "v_evader": 0.3,
               "body_radius": 0.1}  # fmt: skip

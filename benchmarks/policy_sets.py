@@ -82,11 +82,15 @@ FRESH_WORLDS = " ".join(
 """32 random maps nobody had used (README: "On 32 random maps nobody had used")."""
 _HOLDS = "--seeds 8 --rho 0.5 --no-greedy"
 _HELDOUT_P = "--worlds @benchmarks/heldout_worlds_pursuer.txt"
-_BASE = "5b239ab"
-"""The commit every figure below holds at: all twelve sets were played at 94c5063; 5b239ab's
-pursuer change (probes round a small obstacle an evader circles) was played on every
-pursuer set and on the evader sets' episodes against the decomposition pursuer, and
-changed only fresh-p0 (549 -> 552)."""
+_BASE = "bd36034"
+"""The commit every figure below holds at: all twelve sets were played at 94c5063;
+5b239ab's pursuer change (probes round a small obstacle an evader circles) changed only
+fresh-p0 (549 -> 552); 4d0ccce's (the way to room once a ride against a charge stalls)
+was played on every pursuer set and on the evader sets' episodes against the
+decomposition pursuer (holds-variants 558 -> 560, unseen-p0 426 -> 429, heldout-p0
+609 -> 614, heldout-p1 633 -> 636, fresh-p0 552 -> 555); bd36034's evader change (the
+herd heads only for corners turning by 45 degrees or more) on the three evader sets
+(heldout-e 775 -> 776) and, with 4d0ccce's pursuer, on their episodes against it."""
 
 
 def _set(name: str, alias: str, role: str, figure: str, measured: str, command: str):
@@ -101,26 +105,26 @@ SETS: dict[str, PolicySet] = {
         _set("holds-bench", "b1", "pursuer", "379/384", _BASE,
              "pursuer_holds.py --worlds corridor l_hall open_room corner pillars maze "
              f"--variants 'as is' {_HOLDS}"),
-        _set("holds-variants", "b2", "pursuer", "558/576", _BASE,
+        _set("holds-variants", "b2", "pursuer", "560/576", _BASE,
              "pursuer_holds.py --worlds corridor l_hall corner "
              f"--variants 'rot 0.37' 'x10 rot 1.1' off-centre {_HOLDS}"),
-        _set("unseen-p0", "pu0", "pursuer", "426/450", _BASE,
+        _set("unseen-p0", "pu0", "pursuer", "429/450", _BASE,
              "unseen_worlds.py --role pursuer --combos 0"),
         _set("unseen-p1", "pu1", "pursuer", "446/450", _BASE,
              "unseen_worlds.py --role pursuer --combos 1"),
         _set("unseen-p2", "pu2", "pursuer", "486/486", _BASE,
              "unseen_worlds.py --role pursuer --combos 2"),
-        _set("heldout-p0", "ph0", "pursuer", "609/648", _BASE,
+        _set("heldout-p0", "ph0", "pursuer", "614/648", _BASE,
              f"unseen_worlds.py --role pursuer {_HELDOUT_P} --combos 0"),
-        _set("heldout-p1", "ph1", "pursuer", "633/648", _BASE,
+        _set("heldout-p1", "ph1", "pursuer", "636/648", _BASE,
              f"unseen_worlds.py --role pursuer {_HELDOUT_P} --combos 1"),
         _set("heldout-p2", "ph2", "pursuer", "666/666", _BASE,
              f"unseen_worlds.py --role pursuer {_HELDOUT_P} --combos 2"),
-        _set("fresh-p0", "fresh_p0", "pursuer", "552/576", _BASE,
+        _set("fresh-p0", "fresh_p0", "pursuer", "555/576", _BASE,
              f"unseen_worlds.py --role pursuer --combos 0 --worlds {FRESH_WORLDS}"),
         _set("unseen-e", "eunseen", "evader", "1188/1189", _BASE,
              "unseen_worlds.py --role evader"),
-        _set("heldout-e", "eheldout", "evader", "775/779", _BASE,
+        _set("heldout-e", "eheldout", "evader", "776/779", _BASE,
              "unseen_worlds.py --role evader --worlds @benchmarks/heldout_worlds_evader.txt"),
         _set("escapes-bench", "bench3", "evader", "512/512", _BASE,
              "evader_escapes.py --seeds 4 --simple-seeds 0"),

@@ -1,0 +1,117 @@
+"""The rotation bound (strategies/referee/rotation_bound.py): the rod's turn alone, against a
+known open-loop evader path, certifies where no pursuer keeps the rod clear (issue 13)."""
+
+from __future__ import annotations
+
+import importlib
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from envs.errors import InvalidConfigError
+from envs.maps import Map
+from envs.surveillance.config import EnvConfig
+from strategies.referee.hindsight import record_evader_path
+from strategies.referee.rotation_bound import blocked_bins, rotation_bound
+
+BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks"
+
+
+@pytest.fixture
+def unseen(monkeypatch):
+    """The unseen-worlds benchmark module: its worlds, combos and opponents."""
+    monkeypatch.syspath_prepend(str(BENCHMARKS))
+    return importlib.import_module("unseen_worlds")
+
+
+def _pillar_room(half: float) -> Map:
+    """A 16 x 16 room with a square pillar of side ``2 half`` centred at (8, 8)."""
+    lo, hi = 8.0 - half, 8.0 + half
+    return Map(
+        [(0, 0), (16, 0), (16, 16), (0, 16)],
+        [[(lo, lo), (hi, lo), (hi, hi), (lo, hi)]],
+        name=f"pillar{half:g}",
+    )
+
+
+def _config(world: Map) -> EnvConfig:
+    return EnvConfig(map=world, l_min=2.0, l_max=4.0, v_pursuer=1.0, v_evader=0.5, body_radius=0.1)
+
+
+def _circle(radius: float, seconds: float) -> tuple[np.ndarray, np.ndarray]:
+    """The evader's path round (8, 8) at V_e = 0.5, counter-clockwise, one frame a 0.1 s,
+    and a pursuer start 2.1 from it straight out from the centre."""
+    t = np.arange(round(seconds / 0.1) + 1) * 0.1
+    a = 0.5 * t / radius
+    path = np.stack([8.0 + radius * np.cos(a), 8.0 + radius * np.sin(a)], axis=1)
+    return path, path[0] + np.array([2.1, 0.0])
+
+
+def test_the_arcs_a_wall_blocks_are_exact():
+    # a wall segment x = 9, y in [7, 9] seen from (8, 8) with a rod of 2: the arc
+    # [-45, 45] degrees; only bins wholly inside it count as blocked
+    world = Map([(0, 0), (16, 0), (16, 16), (0, 16)], [[(9, 7), (10, 7), (10, 9), (9, 9)]])
+    blocked = blocked_bins(world, np.array([8.0, 8.0]), 2.0, 360)
+    on = np.flatnonzero(blocked)
+    assert set(on) == set(range(0, 45)) | set(range(315, 360))
+    # a rod of 0.9 falls short of the wall: nothing is blocked by it
+    assert not blocked_bins(world, np.array([8.0, 8.0]), 0.9, 360)[:90].any()
+
+
+def test_an_evader_circling_a_tiny_pillar_beats_every_pursuer():
+    # round a 0.2 x 0.2 pillar at radius 0.4 the pillar's shadow turns at 1.25 rad/s,
+    # the rod at most (V_p + V_e) / L_min = 0.75: it is caught from behind (by 4.0 s)
+    path, start = _circle(0.4, 30.0)
+    t = rotation_bound(_config(_pillar_room(0.1)), path, start)
+    assert t is not None and 2.0 < t < 10.0
+    # at radius 3 round a pillar of 2 x 2 the shadow turns at 0.17 rad/s: nothing proven
+    path, start = _circle(3.0, 30.0)
+    assert rotation_bound(_config(_pillar_room(1.0)), path, start) is None
+
+
+def test_a_standing_evader_in_an_open_room_proves_nothing():
+    world = Map([(0, 0), (16, 0), (16, 16), (0, 16)])
+    path = np.repeat([[8.0, 8.0]], 50, axis=0)
+    assert rotation_bound(_config(world), path, (10.1, 8.0)) is None
+
+
+@pytest.mark.parametrize(
+    ("world", "certain", "lost_at"),
+    [("rand:polygons:3007:3.0", 20.5, 8.4), ("rand:star:3007:3.0", None, None)],
+)
+def test_the_bound_agrees_with_the_played_orbits(unseen, world, certain, lost_at):
+    # the orbit (offset 0.25, ccw) at rho 0.5, L_min 2 round a small obstacle: on
+    # rand:polygons:3007 (hull 3.0) no pursuer holds past 20.5 s, where the hindsight's
+    # optimistic grid at cell 0.02 proves nothing (the decomposition pursuer lost at 8.4
+    # s); on rand:star:3007 (hull 7.0) the decomposition pursuer holds all 60 s, so the
+    # bound must prove nothing there
+    m, ov = unseen.pursuer_world(world, unseen.PURSUER_COMBOS[0])
+    path = record_evader_path(
+        m,
+        unseen.make_opponent("evader/orbit:1:0.25"),
+        101,
+        pursuers=("pursuer/decomposition",),
+        overrides=ov,
+        max_cycles=600,
+        extend_to=600,
+    )
+    t = rotation_bound(EnvConfig(map=m, **ov), path.positions, path.pursuer_start)
+    if certain is None:
+        assert t is None
+    else:
+        assert t == pytest.approx(certain, abs=0.15) and t > lost_at
+
+
+def test_bad_input_is_named():
+    config = _config(_pillar_room(0.1))
+    path, start = _circle(0.4, 1.0)
+    with pytest.raises(InvalidConfigError, match="bins"):
+        rotation_bound(config, path, start, bins=4)
+    with pytest.raises(InvalidConfigError, match="path"):
+        rotation_bound(config, path[:1], start)
+    with pytest.raises(InvalidConfigError, match="path"):
+        rotation_bound(config, path[:, :1], start)
+    with pytest.raises(InvalidConfigError, match="pursuer_start"):
+        rotation_bound(config, path, (math.nan, 0.0))

@@ -123,3 +123,17 @@ def hindsight_summary(cell: float, verdicts: Iterable[str]) -> str:
     recorded path to the episode's horizon)."""
     n, parts = tally(verdicts, "the hindsight's resolution gap")
     return f"hindsight (cell {cell:g}) on the {n} losses to open-loop evaders: " + parts
+
+
+def rotation_bound_summary(verdicts: Iterable[str]) -> str:
+    """``rotation bound on the N losses to open-loop evaders: a certain (unavoidable: no
+    pursuer holds past the time given), b not proven``: one verdict (``certain by T s`` or
+    ``not proven``) per lost episode (:mod:`strategies.referee.rotation_bound`, against the
+    evader's recorded path to the episode's horizon)."""
+    verdicts = list(verdicts)
+    certain = sum(v.startswith("certain") for v in verdicts)
+    return (
+        f"rotation bound on the {len(verdicts)} losses to open-loop evaders: {certain} certain "
+        f"(unavoidable: no pursuer holds past the time given), {len(verdicts) - certain} not "
+        "proven"
+    )

@@ -81,12 +81,19 @@ with the times the two grids give (optimistic set empty at, pessimistic set unti
 over them. The other losses are not labelled. Cell 0.02: 45-50 s a loss on the held-out
 random maps (18 x 18; held-out combo 0 has four such losses).
 
+``--rotation-bound`` (pursuer role) labels the same losses with
+:func:`strategies.referee.rotation_bound.rotation_bound` against the same recorded path:
+``certain by T s`` (the orientations a rod of any pursuer could have, turned no faster than
+V_p allows at L_min, are all blocked at T: no pursuer holds past T, the loss is unavoidable)
+or ``not proven`` (some orientation is left to the horizon: nothing is said); beside each
+such loss and over them. About 0.1 s a loss beside the path's recording (a replay).
+
 Usage::
 
     python benchmarks/unseen_worlds.py --role pursuer|evader [--worlds W ...]
         [--combos I ...] [--opponents O ...] [--seeds S ...] [--results F.jsonl]
         [--workers 1] [--max-cycles 600] [--k 8] [--draws 2] [--l-mins L ...]
-        [--referee CPL] [--hindsight CELL]
+        [--referee CPL] [--hindsight CELL] [--rotation-bound]
 
 ``--combos`` indexes the role's combos (``--help`` lists them). ``--seeds`` is the
 seed list in the pursuer role and a filter on the drawn seeds in the evader role. On one
@@ -118,6 +125,7 @@ from envs.maps.io import split_transform
 from envs.maps.junctions import crossroads, t_junction
 from envs.maps.random_maps import random_map
 from strategies.referee.hindsight import hindsight, record_evader_path
+from strategies.referee.rotation_bound import rotation_bound
 from strategies.runner import run_episode
 
 BODY = 0.1
@@ -565,17 +573,50 @@ def open_loop(opponent: str) -> bool:
     return any(opponent == o or opponent.startswith(o + ":") for o in OPEN_LOOP)
 
 
-def hindsight_verdict(row, cell: float, max_cycles: int):
-    """The hindsight (:func:`strategies.referee.hindsight.hindsight`, cell side ``cell``)
-    against the evader's path of a pursuer-role row, recorded from its episode and
-    extended alone to ``max_cycles`` steps (the episode's horizon)."""
+def _evader_path(row, max_cycles: int):
+    """(config, path): the env's config of a pursuer-role row and the evader's path,
+    recorded from its episode and extended alone to ``max_cycles`` steps (the episode's
+    horizon)."""
     from envs.surveillance.config import EnvConfig
 
     m, ov = pursuer_world(row["world"], row["combo"])
     path = record_evader_path(m, make_opponent(row["opponent"]), row["seed"],
                               pursuers=("pursuer/decomposition",), overrides=ov,
                               max_cycles=max_cycles, extend_to=max_cycles)  # fmt: skip
-    return hindsight(EnvConfig(map=m, **ov), path, path.pursuer_start, cell)
+    return EnvConfig(map=m, **ov), path
+
+
+def hindsight_verdict(row, cell: float, max_cycles: int):
+    """The hindsight (:func:`strategies.referee.hindsight.hindsight`, cell side ``cell``)
+    against the evader's path of a pursuer-role row, recorded from its episode and
+    extended alone to ``max_cycles`` steps (the episode's horizon)."""
+    config, path = _evader_path(row, max_cycles)
+    return hindsight(config, path, path.pursuer_start, cell)
+
+
+def rotation_bound_verdict(row, max_cycles: int) -> float | None:
+    """The rotation bound (:func:`strategies.referee.rotation_bound.rotation_bound`)
+    against the evader's path of a pursuer-role row (:func:`hindsight_verdict`'s path):
+    the time by which no pursuer holds, or ``None`` (nothing proven)."""
+    config, path = _evader_path(row, max_cycles)
+    return rotation_bound(config, path.positions, path.pursuer_start)
+
+
+def rotation_bound_verdicts(rows: list[dict], max_cycles: int) -> dict[str, str]:
+    """The rotation bound's label of every loss to an open-loop evader among ``rows``
+    (``certain by T s`` or ``not proven``), keyed by :func:`row_key`; each is printed with
+    the episode's time and the label's cost."""
+    labels: dict[str, str] = {}
+    for r in rows:
+        if not _won(r) and "error" not in r and open_loop(r["opponent"]):
+            t0 = time.perf_counter()
+            t = rotation_bound_verdict(r, max_cycles)
+            labels[row_key(r)] = "not proven" if t is None else f"certain by {t:.1f} s"
+            lost = f"lost at {r['t']:.1f} s" if r["cause"] is not None else "held"
+            print(f"  rotation bound {r['world']} {r['combo']} {r['opponent']} seed={r['seed']}: "
+                  f"{labels[row_key(r)]} ({lost}; {time.perf_counter() - t0:.1f} s)",
+                  flush=True)  # fmt: skip
+    return labels
 
 
 def hindsight_verdicts(rows: list[dict], cell: float, max_cycles: int) -> dict[str, str]:
@@ -631,12 +672,14 @@ def report(
     referee: float | None = None,
     hindsight_cell: float | None = None,
     max_cycles: int = 600,
+    rotation: bool = False,
 ) -> None:
     """The tables: per world and combo, per opponent, total; every loss. With ``referee``
     (pursuer role), every start's label at that many cells per L_min: the counts per world
     and combo, beside each loss, and over the lost starts. With ``hindsight_cell`` (pursuer
     role), every loss to an open-loop evader labelled by the hindsight at that cell side
-    (its path extended to ``max_cycles`` steps), beside the loss and over them."""
+    (its path extended to ``max_cycles`` steps), beside the loss and over them; with
+    ``rotation`` (pursuer role) the same by the rotation bound."""
     role = rows[0]["role"]
     labels = referee_verdicts(rows, referee) if referee and role == "pursuer" else {}
     hind = (
@@ -644,6 +687,7 @@ def report(
         if hindsight_cell and role == "pursuer"
         else {}
     )
+    rot = rotation_bound_verdicts(rows, max_cycles) if rotation and role == "pursuer" else {}
     won, verb = ("held", "held") if role == "pursuer" else ("escaped", "escaped")
     per_world: dict[tuple, list[int]] = {}
     per_opp: dict[str, list[int]] = {}
@@ -717,6 +761,8 @@ def report(
                 what += f"; referee: {lost_labels[-1]}"
             if row_key(r) in hind:
                 what += f"; hindsight: {hind[row_key(r)]}"
+            if row_key(r) in rot:
+                what += f"; rotation bound: {rot[row_key(r)]}"
             if role == "evader" and not body[(r["world"], r["combo"][2])]:
                 what += "; Prop. 2's escape is open only to a point evader"
             print(f"  lost: {r['world']} {r['combo']} {r['opponent']} seed={r['seed']}: {what}")
@@ -726,6 +772,8 @@ def report(
         print(referee_labels.summary(referee, lost_labels, len(distinct)))
     if hindsight_cell and role == "pursuer":
         print(referee_labels.hindsight_summary(hindsight_cell, hind.values()))
+    if rotation and role == "pursuer":
+        print(referee_labels.rotation_bound_summary(rot.values()))
 
 
 def main(argv=None) -> int:
@@ -765,11 +813,16 @@ def main(argv=None) -> int:
     ap.add_argument("--hindsight", type=real(0), metavar="CELL", help="pursuer role: label "
                     "every loss to an open-loop evader by hindsight at cell side CELL (module "
                     "docstring)")  # fmt: skip
+    ap.add_argument("--rotation-bound", action="store_true", help="pursuer role: label every "
+                    "loss to an open-loop evader by the rotation bound (certain by T s, or not "
+                    "proven; module docstring)")  # fmt: skip
     args = ap.parse_args(argv)
     if args.referee and args.role != "pursuer":
         ap.error("--referee: the pursuer role only (it labels the pursuer's starts)")
     if args.hindsight and args.role != "pursuer":
         ap.error("--hindsight: the pursuer role only (it labels the pursuer's losses)")
+    if args.rotation_bound and args.role != "pursuer":
+        ap.error("--rotation-bound: the pursuer role only (it labels the pursuer's losses)")
     for name in args.worlds or []:
         known = PURSUER_WORLDS if args.role == "pursuer" else EVADER_NAMES
         if name not in known:
@@ -816,7 +869,7 @@ def main(argv=None) -> int:
             pool.join()
     played = [done[job_key(j)] for j in jobs]
     if played:
-        report(played, args.referee, args.hindsight, args.max_cycles)
+        report(played, args.referee, args.hindsight, args.max_cycles, args.rotation_bound)
     return 0
 
 

@@ -392,6 +392,35 @@ def test_a_hindsight_over_the_memory_budget_is_not_solved(unseen, tmp_path, caps
     assert "on the 1 losses to open-loop evaders: 0 evader" in text and "1 not solved" in text
 
 
+def test_the_rotation_bound_labels_the_losses_to_open_loop_evaders(unseen, tmp_path, capsys):
+    """``--rotation-bound``: a loss to an open-loop evader is labelled ``certain by T s`` or
+    ``not proven`` against its recorded path (to the horizon); a closed-loop evader's loss
+    is not labelled. The orbit (offset 0.25) at rho 0.5 round rand:polygons:3007's 3.0-long
+    hull: no pursuer holds past 20.5 s (the decomposition pursuer was occluded at 8.4 s);
+    round rand:star:3007's 7.0-long one nothing is proven (the decomposition pursuer holds
+    it; its row is written as a loss here, to be labelled)."""
+    orbit, combo = "evader/orbit:1:0.25", [0.5, 2.0, 2.0]
+    worlds = ["rand:polygons:3007:3.0", "rand:star:3007:3.0"]
+    base = {"role": "pursuer", "combo": combo, "seed": 101, "horizon": 600, "winner": "evader",
+            "cause": "occluded", "t": 8.4, "steps": 84}  # fmt: skip
+    rows = [base | {"world": w, "opponent": o} for w in worlds for o in (orbit, "herder")]
+    out = tmp_path / "p.jsonl"
+    out.write_text("".join(json.dumps(r) + "\n" for r in rows))
+    argv = ["--role", "pursuer", "--worlds", *worlds, "--combos", "0", "--opponents", orbit,
+            "herder", "--results", str(out), "--rotation-bound"]  # fmt: skip
+    assert unseen.main(argv) == 0
+    text = capsys.readouterr().out
+    assert f"rotation bound {worlds[0]} {combo} {orbit} seed=101: certain by 20.5 s (lost " in text
+    assert f"rotation bound {worlds[1]} {combo} {orbit} seed=101: not proven (lost " in text
+    assert f"{orbit} seed=101: occluded at 8.4 s; rotation bound: certain by 20.5 s\n" in text
+    assert f"{orbit} seed=101: occluded at 8.4 s; rotation bound: not proven\n" in text
+    assert "herder seed=101: occluded at 8.4 s\n" in text  # closed loop: not labelled
+    assert (
+        "rotation bound on the 2 losses to open-loop evaders: 1 certain (unavoidable: no "
+        "pursuer holds past the time given), 1 not proven" in text
+    )
+
+
 def test_open_loop_names_the_evaders_whose_path_ignores_the_pursuer(unseen) -> None:
     assert all(map(unseen.open_loop, ["evader/straight", "evader/wall_hugging",
                                       "evader/random", "evader/orbit:-1:1.0"]))  # fmt: skip
@@ -405,7 +434,8 @@ def test_open_loop_names_the_evaders_whose_path_ignores_the_pursuer(unseen) -> N
      (["--role", "pursuer", "--referee", "nan"], "argument --referee: 'nan': expected a finite"),
      (["--role", "evader", "--referee", "8"], "--referee: the pursuer role only"),
      (["--role", "pursuer", "--hindsight", "0"], "argument --hindsight: '0': expected a finite"),
-     (["--role", "evader", "--hindsight", "0.1"], "--hindsight: the pursuer role only")],
+     (["--role", "evader", "--hindsight", "0.1"], "--hindsight: the pursuer role only"),
+     (["--role", "evader", "--rotation-bound"], "--rotation-bound: the pursuer role only")],
 )  # fmt: skip
 def test_a_bad_referee_cpl_is_a_usage_error_naming_it(unseen, tmp_path, capsys, argv,
                                                        message) -> None:  # fmt: skip

@@ -27,6 +27,14 @@ approximation favours the pursuer (an over-approximation, like the optimistic gr
   are exact: each wall edge clipped to the disc of radius ``L_min`` round ``E`` blocks the
   arc between the clipped ends.
 
+The env checks ``L >= L_min`` continuously over a step (its sweep), so the rate bound holds
+at every instant of it; where the evader's motion within a step is not the chord of the
+path (a wall deflected it), the rod's net turn still differs from the chord's by no more
+than the Lipschitz slack, for the evader's displacement is the chord's and, with
+``V_p > V_e``, ``V_p - c > 0`` throughout (at ``rho >= 1`` the cap at 0 is a chord-only
+approximation). The sign of ``c`` and the slack are checked against the closed form of an
+orbit round a disc (``tests/strategies/referee/test_rotation_bound.py``).
+
 Where the evader circles an obstacle small enough, the obstacle's shadow (its blocked arc)
 turns with it faster than any rod can turn on the average, and the set empties
 (issue 13: the orbit of a 3.0-long hull on ``rand:polygons:3007`` at rho 0.5 by 20.5 s,

@@ -151,6 +151,10 @@ class ShootingEvader(BasePolicy):
     # 5.08 D / V_e; 30 degrees escapes it too, 60 does not, and 85 loses unseen
     # random:star:11 seed 507: where a herd ends is path-dependent)
     HERD_MIN_TURN = 45.0
+    # a fallback stall: within STALL_RADIUS L_min of its mean position for STALL_WINDOW
+    # L_min / V_e of game time (2 L_min of travel); see _fallback_stalled
+    STALL_WINDOW = 2.0
+    STALL_RADIUS = 0.125
 
     def _reset(self) -> None:
         c = self.config
@@ -211,6 +215,7 @@ class ShootingEvader(BasePolicy):
         self._concave = m.vertices[herd_corners(m, self.HERD_MIN_TURN)]
         # the pressure steps after which it herds (HERD_AFTER D / V_e of them)
         self._herd_after = self.HERD_AFTER * diameter(m) / (c.v_evader * c.dt)
+        self._ban_radius = self.STALL_RADIUS * c.l_min
         self.restart()
 
     def restart(self) -> None:
@@ -247,6 +252,12 @@ class ShootingEvader(BasePolicy):
         # shots before the plan in cells whose rank guarantees nothing (from a dead end of
         # the plan until a shot has no candidate or the rank is a guarantee again)
         self._shoot_first = False
+        # progress of the fallback (shots, pressure): the evader's positions since the
+        # plan last steered, the shots' targets among them, and the targets given up
+        # after a stall (a shot at a point near one of them is never made again)
+        self._track: list[tuple[float, float]] = []
+        self._track_targets: list[np.ndarray] = []
+        self._banned = np.empty((0, 2))
 
     # ------------------------------------------------------------------ candidates
     def _candidates(self, e: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -296,6 +307,11 @@ class ShootingEvader(BasePolicy):
         n = len(rays)
         rows = np.concatenate([ray_rows, corner_rows])
         margin, branch = self._margins(e, theta, np.concatenate([rays, corners]), rows)
+        if len(self._banned):
+            # targets given up after a stall (_fallback_stalled), and points near them
+            near = np.concatenate([rays, corners])[:, None, :] - self._banned[None, :, :]
+            gone = np.einsum("ijk,ijk->ij", near, near).min(axis=1) <= self._ban_radius**2
+            margin[gone] = -np.inf
         ex, ey = float(e[0]), float(e[1])
         ray, top = -1, 0.0  # the best probe (in sight if asked) and its margin
         if in_sight:
@@ -402,7 +418,11 @@ class ShootingEvader(BasePolicy):
         if heading is not None and not self._shoot_first:
             self.mode = "plan"
             self._arc, self._in_sight = None, False
+            self._track.clear()
+            self._track_targets.clear()
             return c.v_evader * heading
+        if self._fallback_stalled(e):
+            self._arc = None  # (its target is given up)
         if self._arc is not None and self._arc_age < self.replan:
             self._arc_age += 1
             return c.v_evader * self._arc_heading(e)
@@ -420,6 +440,7 @@ class ShootingEvader(BasePolicy):
         if best is not None:
             self.mode = "shoot"
             self._shot = (float(e[0]), float(e[1]), self._steps)
+            self._track_targets.append(best[0])
             return c.v_evader * self._start_arc(e, theta, *best)
         if heading is not None:
             # no shot: back to the plan (and to the plan first, until the next dead end)
@@ -482,6 +503,36 @@ class ShootingEvader(BasePolicy):
             d = self.map.distance_to_walls(np.stack([e + h * s, e - h * s]))
             return c.v_evader * (-s if d[1] - d[0] > _PRESSING * h else s)
         return c.v_evader * u
+
+    def _fallback_stalled(self, e: np.ndarray) -> bool:
+        """Record ``e`` as a fallback position and tell whether the fallback stalled: over
+        the last ``STALL_WINDOW`` L_min / V_e of game time it kept within ``STALL_RADIUS``
+        L_min of the window's mean position. On a stall, the targets the window shot at
+        are given up (no shot lands within ``STALL_RADIUS`` L_min of them again: see
+        :meth:`_best_candidate`) and a new window starts.
+
+        Shots and pressure each undo the other: a shot at a point its disc cannot reach
+        (the point past a wall's end in sight, the disc against the end) and a slide
+        along the wall back, the pursuer's turns keeping the margin of that one shot
+        alternately positive and not (issue 13: office~x0.8rot-1.4off(6,2), rho 0.2,
+        L_max 3 L_min, seed 8, the decomposition pursuer: in a 0.09 x 0.05 m box from
+        30 s to the 1,320 s horizon, at the tip of a wall).
+        """
+        c = self.config
+        self._track.append((float(e[0]), float(e[1])))
+        n = max(2, math.ceil(self.STALL_WINDOW * c.l_min / (c.v_evader * c.dt)))
+        if len(self._track) < n:
+            return False
+        del self._track[:-n]
+        pts = np.array(self._track)
+        r = self.STALL_RADIUS * c.l_min
+        if float(_row_norms(pts - pts.mean(axis=0)).max()) > r:
+            return False
+        if self._track_targets:
+            self._banned = np.concatenate([self._banned, np.array(self._track_targets)])
+        self._track.clear()
+        self._track_targets.clear()
+        return True
 
     def _region_walk(self, e: np.ndarray) -> np.ndarray | None:
         """Heading of the grid walk from ``e`` to a witness region (Prop. 2), or ``None``

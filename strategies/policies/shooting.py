@@ -528,8 +528,16 @@ class ShootingEvader(BasePolicy):
         r = self.STALL_RADIUS * c.l_min
         if float(_row_norms(pts - pts.mean(axis=0)).max()) > r:
             return False
-        if self._track_targets:
-            self._banned = np.concatenate([self._banned, np.array(self._track_targets)])
+        if len(self._track_targets) > 1:
+            # the targets shot at more than once in the window (near one another): a shot
+            # made once and left for pressure is pressure's stall, which herding handles
+            # (random:star:2017, rho 0.3, seed 849: banning a single shot's target there
+            # changed where the herd began, held for 8 D / V_e instead of escaping)
+            t = np.array(self._track_targets)
+            d = t[:, None, :] - t[None, :, :]
+            again = (np.einsum("ijk,ijk->ij", d, d) <= self._ban_radius**2).sum(axis=1) > 1
+            if again.any():
+                self._banned = np.concatenate([self._banned, t[again]])
         self._track.clear()
         self._track_targets.clear()
         return True

@@ -508,7 +508,8 @@ class ShootingEvader(BasePolicy):
         """Record ``e`` as a fallback position and tell whether the fallback stalled: over
         the last ``STALL_WINDOW`` L_min / V_e of game time it kept within ``STALL_RADIUS``
         L_min of the window's mean position. On a stall, the targets the window shot at
-        are given up (no shot lands within ``STALL_RADIUS`` L_min of them again: see
+        more than once (within ``STALL_RADIUS`` L_min of another of its targets) are given
+        up (no shot lands within ``STALL_RADIUS`` L_min of them again: see
         :meth:`_best_candidate`) and a new window starts.
 
         Shots and pressure each undo the other: a shot at a point its disc cannot reach

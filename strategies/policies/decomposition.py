@@ -787,7 +787,15 @@ class DecompositionPursuer(BasePolicy):
         room by 0.08 m a step (the nearer-circle test took the still one's way, 3.10 <
         3.35), or the ridden circle was short by 0.26 (2.87 at x10, body 2), within its
         pad, and rode on for seconds; at x10 one step's 3.43 crossed the pad, hence
-        every step. On maps without room reachable the margin stands.
+        every step. "Beyond its pad" means by more than ``h / sqrt(2)``, the most the
+        wall distance of the nearest grid node can differ from the centre's (helper-135,
+        session 22): on the paper's corner world from the runner's default start
+        (corner_charge, seed 9) a ride along the corridor's wall was short by 0.2046
+        against a pad of 0.2 (the pursuer's own circle touching the wall), the way stood
+        at 4.74 for a second, and the stall fired where riding on for 6 s swung the rod
+        down the corridor to room (a52b3bf held; the stall lost at 23.5 s, and 10 of the
+        80 corner episodes of seeds 0-39 against toward_away:toward and shooting).
+        On maps without room reachable the margin stands.
         """
         if self._field is None:
             return self._orbit_choice(snap, rate, hi, lo, L)
@@ -816,7 +824,7 @@ class DecompositionPursuer(BasePolicy):
             and not outer0 - outer >= h  # and the other comes no nearer to room
             and inner - self._ridden[-1][3] > self.ORBIT_REACH * L
             # short beyond its pad on every step: no room at all
-            and min(e[3] for e in self._ridden) > self._orbit_pad
+            and min(e[3] for e in self._ridden) > self._orbit_pad + h / math.sqrt(2.0)
         ):
             self._stalled = True
             self._ridden.clear()
@@ -919,6 +927,14 @@ class DecompositionPursuer(BasePolicy):
         evader; in a room with a triangular pillar at rho 0.3 the same swing lost to a
         charger in 7.6 s (issue 13). Giving way as soon as any wall lay ahead, in either
         mode, lost other episodes (the corner world's variants, 422 -> 415/432).
+
+        With ``field`` (a stalled ride) a hard turn whose path stays clear replaces the pick
+        only if it scores no worse by the way to room: a clear path away from every circle
+        nearer room is the wall check's escape, not the field's. On the corner world
+        (default start, seed 9, toward_away:toward) that branch swung a stalled ride the
+        other way, to circles 5.6 and 7.4 m from room against the ridden one's 4.8; and
+        without this condition the stalls of seeds 27 and 39 (ridden circle 0.1 beyond
+        its pad, toward_away:toward and shooting) lost at 39-45 s, where a52b3bf held.
         """
         T = self.ORBIT_LOOKAHEAD
 
@@ -931,8 +947,9 @@ class DecompositionPursuer(BasePolicy):
         reach = -self.ORBIT_REACH * L
         best, pick = max(reach, base), rate
         near = base >= reach  # some circle is within reach
+        score = {rate: base}
         for r in (hi, lo):
-            m = after(r)
+            m = score[r] = after(r)
             near = near or m >= reach
             if m > best + 0.01 * L:
                 best, pick = m, r
@@ -948,8 +965,10 @@ class DecompositionPursuer(BasePolicy):
         turn = pick
         if all(self._time_to_wall(snap, pick, L, f) < math.inf for f in (True, False)):
             for r in (hi, lo):
-                if r != pick and all(
-                    self._time_to_wall(snap, r, L, f) == math.inf for f in (True, False)
+                if (
+                    r != pick
+                    and not (field and score[r] < score[pick])
+                    and all(self._time_to_wall(snap, r, L, f) == math.inf for f in (True, False))
                 ):
                     turn = r
                     break

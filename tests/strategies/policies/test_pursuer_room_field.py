@@ -118,3 +118,29 @@ def test_a_ride_round_a_nearly_free_circle_is_not_stalled(world, overrides, seed
     r = run_episode(load_map(world), "pursuer/decomposition", "evader/shooting", seed,
                     max_cycles=cycles, overrides=overrides, start="safe")  # fmt: skip
     assert r.winner == "pursuer", r.summary()
+
+
+@pytest.mark.parametrize(
+    ("evader", "seed", "cycles"),
+    [
+        # the ridden circle short by 0.2046 against a pad of 0.2 (its own circle touching
+        # the corridor's wall): the stall lost it at 23.5 s (report row 5.1's tally)
+        ("toward", 9, 300),
+        # a stall 0.1 beyond the pad, then the wall check's clear hard turn took the
+        # circles farther from room: lost at 44.6 s
+        ("toward", 27, 500),
+        # a stall 0.004 beyond the pad: lost at 17.9 s, and at 27.9 s with the field
+        # condition on the wall check alone
+        ("shooting", 20, 340),
+    ],
+)
+def test_a_ride_along_a_wall_the_circle_just_touches_is_not_stalled(evader, seed, cycles):
+    # the paper's corner world from the runner's default start (not the safe start of
+    # the benchmark sets), rho = 0.5; a52b3bf held all three to the horizon
+    opponent = (
+        make_policy("evader/toward_away", mode=evader)
+        if evader == "toward"
+        else make_policy("evader/shooting")
+    )
+    r = run_episode("corner", "pursuer/decomposition", opponent, seed, max_cycles=cycles)
+    assert r.winner == "pursuer", r.summary()

@@ -136,8 +136,9 @@ def test_rows_on_one_side_and_mixed_code_versions_are_said(ps, corner_runs, tmp_
 def test_pursuer_holds_rows_are_read_by_their_own_winner_field(ps, tmp_path, capsys):
     """pursuer_holds.py keeps the winner in out["pursuer/decomposition"]: on the rotated
     corner the toward-away evader wins from seed 2 at 14.70 s (3.18 s before 4d0ccce, 13.55 s
-    before ddb7e92) and not from seeds 0-1 within 20 s. A cand whose two rows swapped winners loses seed 0 and gains seed 2; a cand played
-    at another horizon shares no episode (the horizon is in this script's key)."""
+    before ddb7e92) and not from seeds 0-1 within 20 s. A cand whose two rows swapped
+    winners loses seed 0 and gains seed 2; a cand played at another horizon shares no
+    episode (the horizon is in this script's key)."""
     args = ("--worlds", "corner", "--variants", "rot 0.37", "--rho", "0.5", "--evaders",
             "evader/toward_away", "--seeds", "3", "--no-greedy")  # fmt: skip
     sets = {"holds": _tiny(ps, "holds", "pursuer_holds.py", (*args, "--max-cycles", "200"))}

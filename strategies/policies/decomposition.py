@@ -1108,15 +1108,9 @@ class DecompositionPursuer(BasePolicy):
         if herding:
             # the slide's charge is pure pursuit: the evader's velocity (one step old)
             # lies along the rod, up to the rod's turn in that step (at most V_p dt / L)
-            c = self.config
-            ve = snap.evader_velocity
-            speed = math.hypot(float(ve[0]), float(ve[1]))
-            u = (math.cos(snap.theta), math.sin(snap.theta))
-            along = float(ve[0]) * u[0] + float(ve[1]) * u[1]
-            across = float(ve[1]) * u[0] - float(ve[0]) * u[1]
-            lag = math.sin(min(c.v_pursuer * c.dt / L, 0.5 * math.pi))
-            if not (along > 0.0 and abs(across) <= speed * lag):
+            if not self._pure_charge(snap, L):
                 return pick
+            c = self.config
             # the cone is a straight wall's: a pursuer whose nearest wall point is a
             # corner of the walls is not sliding along one
             a = m.edge_start[k]

@@ -332,10 +332,9 @@ def test_an_extension_interrupted_in_its_evaluation_leaves_model_and_provenance_
     assert not (first.model_path.parent / "model.next.zip").exists()
 
 
-def test_a_resumed_run_whose_map_file_changed_is_refused(tiny, tmp_path):
-    """config.toml names a map file by its path: a run interrupted, its file's geometry or
-    recommended parameters (metadata) edited, then rerun trained on on the other game
-    without a word. The resolved env configs are kept in env.json and compared."""
+def _interrupted_on_a_map_file(tiny, tmp_path):
+    """A run on the map file room.json (open_room, l_min 1.5, l_max 3.0) interrupted after
+    150 steps: (the file, the config, its output dir)."""
     from envs.maps import load_map, save_map
 
     world = tmp_path / "room.json"
@@ -343,7 +342,16 @@ def test_a_resumed_run_whose_map_file_changed_is_refused(tiny, tmp_path):
     config = tiny(map=str(world))
     with pytest.raises(KeyboardInterrupt):
         train(config, callbacks=[Interrupt(at=150)])
-    out = Path(config.output_dir)
+    return world, config, Path(config.output_dir)
+
+
+def test_a_resumed_run_whose_map_file_changed_is_refused(tiny, tmp_path):
+    """config.toml names a map file by its path: a run interrupted, its file's geometry or
+    recommended parameters (metadata) edited, then rerun trained on on the other game
+    without a word. The resolved env configs are kept in env.json and compared."""
+    from envs.maps import load_map, save_map
+
+    world, config, out = _interrupted_on_a_map_file(tiny, tmp_path)
     recorded = json.loads((out / "env.json").read_text())
     assert (recorded[str(world)]["l_min"], recorded[str(world)]["l_max"]) == (1.5, 3.0)
     save_map(load_map("open_room"), world, metadata={"l_min": 1.0, "l_max": 3.0})
@@ -365,12 +373,7 @@ def test_a_run_of_an_older_surveil_is_still_checked_by_its_maps_geometry(tiny, t
     for its maps' geometry: the same walls resume, other walls are refused."""
     from envs.maps import load_map, save_map
 
-    world = tmp_path / "room.json"
-    save_map(load_map("open_room"), world, metadata={"l_min": 1.5, "l_max": 3.0})
-    config = tiny(map=str(world))
-    with pytest.raises(KeyboardInterrupt):
-        train(config, callbacks=[Interrupt(at=150)])
-    out = Path(config.output_dir)
+    world, config, out = _interrupted_on_a_map_file(tiny, tmp_path)
     old = [{"map": "open_room", "map_digest": load_map("open_room").digest, "l_min": 1.5}]
     (out / "env.json").write_text(json.dumps(old))
     save_map(load_map("corner"), world, metadata={"l_min": 1.5, "l_max": 3.0})

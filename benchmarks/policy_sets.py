@@ -82,7 +82,7 @@ FRESH_WORLDS = " ".join(
 """32 random maps nobody had used (README: "On 32 random maps nobody had used")."""
 _HOLDS = "--seeds 8 --rho 0.5 --no-greedy"
 _HELDOUT_P = "--worlds @benchmarks/heldout_worlds_pursuer.txt"
-_BASE = "bd36034"
+_BASE = "ddb7e92"
 """The commit every figure below holds at: all twelve sets were played at 94c5063;
 5b239ab's pursuer change (probes round a small obstacle an evader circles) changed only
 fresh-p0 (549 -> 552); 4d0ccce's (the way to room once a ride against a charge stalls)
@@ -90,7 +90,11 @@ was played on every pursuer set and on the evader sets' episodes against the
 decomposition pursuer (holds-variants 558 -> 560, unseen-p0 426 -> 429, heldout-p0
 609 -> 614, heldout-p1 633 -> 636, fresh-p0 552 -> 555); bd36034's evader change (the
 herd heads only for corners turning by 45 degrees or more) on the three evader sets
-(heldout-e 775 -> 776) and, with 4d0ccce's pursuer, on their episodes against it."""
+(heldout-e 775 -> 776) and, with 4d0ccce's pursuer, on their episodes against it;
+cdb9eac's (a stalled fallback gives up its targets) and ddb7e92's (two guards on the
+stall) were each played on all twelve (the evader's on the pursuer sets' shooting
+episodes) and, together, on the evader sets' episodes against the decomposition pursuer
+and the pursuer sets' against the shooting evader: no figure changed."""
 
 
 def _set(name: str, alias: str, role: str, figure: str, measured: str, command: str):

@@ -56,21 +56,22 @@ def test_no_walk_to_a_witness_region_from_inside_one():
     assert "region" not in modes, modes  # every region of this map is a witness region
 
 
-def _herd_escapes(name: str, seed: int, l_max: float, crossings: float) -> None:
-    """The shooting evader escapes the decomposition pursuer on ``name`` (rho 0.3, L_min
-    2) within ``crossings`` D / V_e, from ``seed``'s safe start, after herding."""
+def _herd(name: str, seed: int, l_max: float, crossings: float):
+    """The shooting evader against the decomposition pursuer on ``name`` (rho 0.3, L_min
+    2) for ``crossings`` D / V_e from ``seed``'s safe start: (the result, the evader)."""
     m = load_map(name)
     params = {"l_min": 2.0, "l_max": l_max, "v_pursuer": 1.0, "v_evader": 0.3,
               "body_radius": 0.1}  # fmt: skip
     ev = ShootingEvader()
     r = run_episode(m, "pursuer/decomposition", ev, seed, start="safe", overrides=params,
                     max_cycles=_horizon(m, 0.3, crossings))  # fmt: skip
-    assert r.winner == "evader", r.summary()
-    assert ev._herding and ev._pressed > ev._herd_after  # it escaped herding
+    return r, ev
 
 
 def test_herds_the_pursuer_into_a_corner_after_a_long_charge():
-    _herd_escapes("random:star:11", 507, 3.0, 7.0)
+    r, ev = _herd("random:star:11", 507, 3.0, 7.0)
+    assert r.winner == "evader", r.summary()
+    assert ev._herding and ev._pressed > ev._herd_after  # it escaped herding
 
 
 def test_herds_after_a_charge_of_three_crossings_in_game_time():
@@ -93,4 +94,6 @@ def test_herds_into_a_corner_not_a_star_s_shallow_notch():
     # obstacles' inner vertices (walls turning by as little as 4.2 degrees) the pursuer
     # held for the whole 8 D / V_e; into corners whose walls turn by 45 degrees or more,
     # too close at 5.08 D / V_e (test_evader_herd.py)
-    _herd_escapes("random:star:2017", 849, 4.0, 6.0)
+    r, ev = _herd("random:star:2017", 849, 4.0, 6.0)
+    assert r.winner == "evader", r.summary()
+    assert ev._herding and ev._pressed > ev._herd_after  # it escaped herding

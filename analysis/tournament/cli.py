@@ -116,8 +116,7 @@ def _cmd_tournament(args: argparse.Namespace) -> int:
     if args.list:
         if args.spec is not None:  # it was listed past without a word
             raise InvalidConfigError(
-                f"surveil tournament: --list takes no SPEC, got {args.spec!r}; give one or "
-                "the other"
+                f"tournament --list takes no SPEC, got {args.spec!r}; give one or the other"
             )
         import warnings
 
@@ -128,7 +127,10 @@ def _cmd_tournament(args: argparse.Namespace) -> int:
             print(f"{name:<14} {spec.description}")
         return 0
     if args.spec is None:
-        raise InvalidConfigError("surveil tournament: give a SPEC (a .toml file or --list)")
+        raise InvalidConfigError(
+            "tournament SPEC: missing; expected a .toml file or a shipped spec's name "
+            "(`surveil tournament --list` lists them)"
+        )
     path = _spec_path(args.spec)
     spec = load_spec(path)
     store = Path(args.store) if args.store else default_store(spec)

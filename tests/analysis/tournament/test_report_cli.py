@@ -115,6 +115,8 @@ def test_cli_tournament_report_export_and_errors(tmp_path, capsys):
         (["tournament", str(tmp_path)], "is a directory, not a file"),
         # a SPEC beside --list was ignored: the list printed, exit 0
         (["tournament", "--list", "quick"], "--list takes no SPEC, got 'quick'"),
+        # no SPEC at all: the message named the program twice ("surveil: error: surveil ...")
+        (["tournament"], "error: tournament SPEC: missing; expected a .toml file"),
     ]:
         capsys.readouterr()
         assert main(bad) == 2

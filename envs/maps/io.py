@@ -525,8 +525,8 @@ def read_map(path: str | os.PathLike[str], *, merge: bool | None = None) -> MapD
     p = Path(path)
     fmt = _format_of(p, for_writing=False)
     source = str(p)
-    try:
-        text = p.read_text(encoding="utf-8")
+    try:  # "utf-8-sig": past a byte order mark (Windows editors write one)
+        text = p.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError as exc:
         raise _fail(source, f"not UTF-8 text ({exc})") from exc
     except FileNotFoundError:

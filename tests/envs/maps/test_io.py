@@ -426,6 +426,17 @@ def test_non_utf8_file(tmp_path):
         load_map(p)
 
 
+@pytest.mark.parametrize("suffix", ["json", "geojson", "wkt"])
+def test_a_byte_order_mark_is_read_past(tmp_path, suffix):
+    """Windows editors (Notepad's "UTF-8 with BOM", PowerShell 5's ``Out-File``) start a
+    UTF-8 file with U+FEFF: the JSON reader refused it ("Unexpected UTF-8 BOM") and the
+    WKT reader called '\ufeffPOLYGON' an unknown type."""
+    m = MAPS["plain"]
+    p = save_map(m, tmp_path / f"bom.{suffix}")
+    p.write_bytes(b"\xef\xbb\xbf" + p.read_bytes())
+    assert load_map(p) == m
+
+
 def test_shapely_reads_our_wkt_and_geojson_files_identically(tmp_path):
     """Cross-check with an independent reader: both files describe one polygon."""
     m = MAPS["awkward_floats"]

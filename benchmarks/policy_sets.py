@@ -25,7 +25,9 @@ bad directory or file), so a session can gate on it.
 Which side won, per script (their rows differ): ``pursuer_holds.py`` keeps
 ``out["pursuer/decomposition"] = [winner, cause, time, ...]``; ``unseen_worlds.py`` keeps
 ``winner``, ``cause`` and ``t`` (an ``error`` row, a crash, is a loss); ``evader_escapes.py``
-keeps ``out["shooting"] = [winner, time, ...]`` and no cause.
+keeps ``out["shooting"] = [winner, time, ...]`` and no cause; ``fixed_starts.py`` keeps
+``winner``, ``cause`` and ``t`` (an ``error`` row is a loss) and, from a start the
+referee certified, ``regret``: ``compare`` says "a regret" beside such a loss.
 """
 
 from __future__ import annotations
@@ -49,7 +51,7 @@ from envs.errors import InvalidConfigError
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 """The checkout whose code the sets play (the scripts run from here)."""
 
-SCRIPTS = ("pursuer_holds.py", "unseen_worlds.py", "evader_escapes.py")
+SCRIPTS = ("pursuer_holds.py", "unseen_worlds.py", "evader_escapes.py", "fixed_starts.py")
 
 
 @dataclass(frozen=True)
@@ -95,6 +97,10 @@ cdb9eac's (a stalled fallback gives up its targets) and ddb7e92's (two guards on
 stall) were each played on all twelve (the evader's on the pursuer sets' shooting
 episodes) and, together, on the evader sets' episodes against the decomposition pursuer
 and the pursuer sets' against the shooting evader: no figure changed."""
+_FIXED = "1283649"
+"""Where the three sets of ``fixed_starts.py`` were first played: the corner world's
+default starts (the reproduction report's episodes) and the referee's certified starts
+(``benchmarks/certified_starts.json``)."""
 
 
 def _set(name: str, alias: str, role: str, figure: str, measured: str, command: str):
@@ -132,6 +138,12 @@ SETS: dict[str, PolicySet] = {
              "unseen_worlds.py --role evader --worlds @benchmarks/heldout_worlds_evader.txt"),
         _set("escapes-bench", "bench3", "evader", "512/512", _BASE,
              "evader_escapes.py --seeds 4 --simple-seeds 0"),
+        _set("corner-default", "cdef", "pursuer", "145/160", _FIXED,
+             "fixed_starts.py --starts default --world corner --seeds 0-39"),
+        _set("certified-p", "certp", "pursuer", "272/272", _FIXED,
+             "fixed_starts.py --starts certified --role pursuer"),
+        _set("certified-e", "certe", "evader", "286/288", _FIXED,
+             "fixed_starts.py --starts certified --role evader"),
     )
 }  # fmt: skip
 
@@ -152,6 +164,9 @@ class Episode:
     t: float | None
     code: str | None
     row: dict
+    note: str = ""
+    """Said after the result (``fixed_starts.py``: a loss from a certified start is a
+    regret)."""
 
 
 def _module(script: str):
@@ -172,6 +187,14 @@ def _episode(script: str, row: dict, key: str) -> Episode:
         cause = row["error"] if "error" in row else row["cause"]
         return Episode(key, row.get("winner") == row["role"], world, row["opponent"],
                        row["seed"], cause, row.get("t"), code, row)  # fmt: skip
+    if script == "fixed_starts.py":
+        world = row["world"] if row["combo"] is None else f"{row['world']} {row['combo']}"
+        cause = row["error"] if "error" in row else row["cause"]
+        # a loss from a certified start: the referee says the policy's side could win it
+        note = f"a regret (certified {row['certified']}-win start)" if row.get("regret") else ""
+        return Episode(key, row.get("winner") == row["role"] and "error" not in row, world,
+                       row["opponent"], row["seed"], cause, row.get("t"), code, row,
+                       note)  # fmt: skip
     winner, t = row["out"]["shooting"][:2]
     return Episode(key, winner == "evader", f"{row['world']} [{row['variant']}]",
                    row["pursuer"], row["seed"], None, t, code, row)  # fmt: skip
@@ -186,12 +209,13 @@ def read_set(path: str, policy_set: PolicySet) -> dict[str, Episode]:
             rows of the other role), naming the file and what was expected.
     """
     module = _module(policy_set.script)
-    key_of = module.row_key if policy_set.script == "unseen_worlds.py" else module._row_key
+    own = policy_set.script in ("unseen_worlds.py", "fixed_starts.py")
+    key_of = module.row_key if own else module._row_key
     rows = episode_rows.read(path, key_of, note_other_code=False)
     expected = f"expected rows of {policy_set.script} (set {policy_set.name})"
     out = {}
     for key, row in rows.items():
-        if policy_set.script == "unseen_worlds.py" and row["role"] != policy_set.role:
+        if own and row["role"] != policy_set.role:
             raise InvalidConfigError(
                 f"{path}: the row {key} is of the {row['role']} role; set {policy_set.name} "
                 f"measures the {policy_set.role} ({expected})"
@@ -214,7 +238,7 @@ def replay_command(policy_set: PolicySet, e: Episode) -> str:
     if policy_set.script == "pursuer_holds.py":
         return module.replay_command(r["world"], r["variant"], r["rho"], r["evader"], r["seed"],
                                      r["max_cycles"], r["l_min"])  # fmt: skip
-    if policy_set.script == "unseen_worlds.py":
+    if policy_set.script in ("unseen_worlds.py", "fixed_starts.py"):
         return module.replay_command(r)
     words = ["python", "benchmarks/evader_escapes.py", "--worlds", r["world"], "--variants",
              r["variant"], "--pursuers", r["pursuer"], "--seeds", str(r["seed"] + 1),
@@ -275,7 +299,7 @@ def _describe(e: Episode) -> str:
         words.append(f"at {e.t:.2f} s")
     elif e.cause is None:
         words.append("to the horizon")
-    return " ".join(words)
+    return " ".join(words) + (f", {e.note}" if e.note else "")
 
 
 def compare(base: str, cand: str, sets: Mapping[str, PolicySet] = SETS) -> int:

@@ -256,7 +256,7 @@ def test_each_set_is_the_command_readme_quotes(ps):
     """The sets are the README's commands (its table and the unseen-worlds paragraphs), so
     a figure there and a set here mean the same episodes."""
     readme = (BENCHMARKS.parent / "README.md").read_text()
-    for name in ("holds-bench", "unseen-p0", "escapes-bench"):
+    for name in ("holds-bench", "unseen-p0", "escapes-bench", "corner-default"):
         command = ps.SETS[name].command()
         quoted = " ".join(f'"{w}"' if " " in w else w for w in command)
         assert quoted in readme, quoted
@@ -323,3 +323,70 @@ def test_run_plays_the_code_of_the_checkout_it_is_in(tmp_path, capfd, monkeypatc
     (row,) = _rows(tmp_path / "out" / "corner.jsonl")
     err = capfd.readouterr().err
     assert "(scripts:" not in str(row["code"]) and "policies that play are imported" not in err
+
+
+def test_corner_default_rows_are_read_by_their_winner_and_replayed_by_fixed_starts(
+    ps, tmp_path, capsys
+):
+    """fixed_starts.py --starts default: the corner world as the report plays it. The
+    herder pins the pursuer from seed 1 (too_close at 19.7 s) and not from seed 0 in the
+    500 steps: 1/2; a cand that loses seed 0 too is one lost, with the replay command."""
+    args = ("--starts", "default", "--world", "corner", "--opponents", "herder", "--seeds",
+            "0-1")  # fmt: skip
+    sets = {"cdef": _tiny(ps, "cdef", "fixed_starts.py", args)}
+    assert ps.run_sets(["cdef"], str(tmp_path / "base"), 1, sets) == 0
+    out = capsys.readouterr().out
+    assert next(x for x in out.splitlines() if x.startswith("cdef")).split()[:3] == [
+        "cdef", "pursuer", "1/2"]  # fmt: skip
+    rows = {r["seed"]: r for r in _rows(tmp_path / "base" / "cdef.jsonl")}
+    assert (rows[0]["winner"], rows[0]["steps"]) == ("pursuer", 500)
+    assert (rows[1]["winner"], rows[1]["cause"]) == ("evader", "too_close")
+    assert rows[0]["start"] is None and set(rows[0]["start_drawn"]) == {"pursuer", "evader"}
+    lost = {**rows[0], "winner": "evader", "cause": "too_close", "t": 5.0}
+    _write(tmp_path / "cand" / "cdef.jsonl", [lost, rows[1]])
+    assert ps.compare(str(tmp_path / "base"), str(tmp_path / "cand"), sets) == 1
+    out = capsys.readouterr().out
+    assert "cdef (pursuer wins): base 1/2, cand 0/2; 2 episodes in both: 1 lost, 0 gained" in out
+    assert (
+        "  lost: corner herder seed=0: cand lost too_close at 5.00 s; base won to the horizon\n"
+        in out
+    )
+    assert (
+        "    replay: python benchmarks/fixed_starts.py --starts default --world corner "
+        "--opponents herder --seeds 0 --results replay.jsonl --play-again" in out
+    )
+
+
+def test_a_loss_from_a_certified_start_is_compared_as_a_regret(ps, tmp_path, capsys):
+    """fixed_starts.py --starts certified: the shooting evader escapes the decomposition
+    pursuer from the first two certified evader-win starts on plus_w1.6a4.5 (at 25.0 s and
+    9.8 s); played to 0.01 D / V_e (0.8 s) it escapes from neither, and its rows say each
+    loss is a regret. Those rows, keyed at the base's horizon, stand for a cand that lost
+    both: compare names them as regrets."""
+    args = ("--starts", "certified", "--role", "evader", "--worlds", "plus_w1.6a4.5",
+            "--opponents", "pursuer/decomposition", "--seeds", "0", "1")  # fmt: skip
+    base = {"certe": _tiny(ps, "certe", "fixed_starts.py", args, role="evader")}
+    short = {"certe": _tiny(ps, "certe", "fixed_starts.py", (*args, "--k", "0.01"), "evader")}
+    assert ps.run_sets(["certe"], str(tmp_path / "base"), 1, base) == 0
+    assert ps.run_sets(["certe"], str(tmp_path / "short"), 1, short) == 0
+    capsys.readouterr()
+    won = _rows(tmp_path / "base" / "certe.jsonl")
+    expected = [("evader", False, "evader")] * 2
+    assert [(r["winner"], r["regret"], r["certified"]) for r in won] == expected
+    held = _rows(tmp_path / "short" / "certe.jsonl")
+    assert [(r["winner"], r["regret"]) for r in held] == [("pursuer", True)] * 2
+    _write(tmp_path / "cand" / "certe.jsonl", [{**r, "horizon": 8.0} for r in held])
+    assert ps.compare(str(tmp_path / "base"), str(tmp_path / "cand"), base) == 1
+    out = capsys.readouterr().out
+    assert "certe (evader wins): base 2/2, cand 0/2; 2 episodes in both: 2 lost" in out
+    assert (
+        "  lost: plus_w1.6a4.5 [0.2, 3.0, 2.0] pursuer/decomposition seed=0: cand lost to the "
+        "horizon, a regret (certified evader-win start); base won occluded at 25.02 s" in out
+    )
+    assert (
+        "replay: python benchmarks/fixed_starts.py --starts certified --role evader --worlds "
+        "plus_w1.6a4.5 --opponents pursuer/decomposition --seeds 1 --results replay.jsonl "
+        "--play-again" in out
+    )
+    assert ps.totals(str(tmp_path / "short"), short) == 0
+    assert "0/2" in next(x for x in capsys.readouterr().out.splitlines() if x.startswith("certe"))

@@ -13,12 +13,12 @@ judges look:
 * ``--starts certified --role pursuer``: starts the referee certifies for the pursuer
   (:mod:`strategies.referee`: some bounded-speed pursuer holds from them forever), the
   decomposition pursuer against every evader of ``unseen_worlds.py`` (the registered
-  ones and the unseen opponents, but the referee's evader, which solves its world at
-  reset). A loss from such a start is the policy's regret, and its row says so
-  (``"regret": true``).
+  ones, the referee's included, and the unseen opponents). A loss from such a start is
+  the policy's regret, and its row says so (``"regret": true``).
 * ``--starts certified --role evader``: starts the referee certifies for the evader (no
   bounded-speed pursuer holds; ``"escape_bound"``: the certified time the evader needs),
-  the shooting evader against every pursuer of ``unseen_worlds.py`` but the referee's.
+  the shooting evader against every pursuer of ``unseen_worlds.py`` (the referee's
+  included: the first run solves its game, about 2 minutes a world).
   A loss (the pursuer held to the horizon) is the evader's regret.
 
 The certified starts ship in ``benchmarks/certified_starts.json`` (a solve takes 10-40 s
@@ -96,12 +96,11 @@ L_min)). The pursuer's: rooms where the referee's pursuer bound certifies starts
 point evader (no escape region a body can cross into; the shooting evader missed
 certified escapes there in session 22) and two open to a body."""
 
-OPPONENTS = {
-    "pursuer": [e for e in EVADERS if e != "evader/referee"],
-    "evader": [p for p in PURSUERS if p != "pursuer/referee"],
-}
-"""Who plays against the certified player's policy (the referee's own policies are left
-out: each solves its world at reset, minutes a world)."""
+OPPONENTS = {"pursuer": EVADERS, "evader": PURSUERS}
+"""Who plays against the certified player's policy: every opponent of ``unseen_worlds.py``
+(the referee's own policies solve their world at reset and cache it on disk: the first
+run of the evader-win starts spends about 2 minutes a world in the referee pursuer's
+solve, later runs seconds)."""
 POLICY = {"pursuer": "pursuer/decomposition", "evader": "evader/shooting"}
 DEFAULT_OPPONENTS = ["evader/toward_away:toward", "evader/shooting", "evader/wall_hugging",
                      "herder"]  # fmt: skip

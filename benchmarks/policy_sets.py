@@ -97,10 +97,10 @@ cdb9eac's (a stalled fallback gives up its targets) and ddb7e92's (two guards on
 stall) were each played on all twelve (the evader's on the pursuer sets' shooting
 episodes) and, together, on the evader sets' episodes against the decomposition pursuer
 and the pursuer sets' against the shooting evader: no figure changed."""
-_FIXED = "1283649"
-"""Where the three sets of ``fixed_starts.py`` were first played: the corner world's
-default starts (the reproduction report's episodes) and the referee's certified starts
-(``benchmarks/certified_starts.json``)."""
+_FIXED = "c427419"
+"""Where the three sets of ``fixed_starts.py`` were first played (1283649's policies): the
+corner world's default starts (the reproduction report's episodes) and the referee's
+certified starts (``benchmarks/certified_starts.json``)."""
 
 
 def _set(name: str, alias: str, role: str, figure: str, measured: str, command: str):
@@ -140,9 +140,9 @@ SETS: dict[str, PolicySet] = {
              "evader_escapes.py --seeds 4 --simple-seeds 0"),
         _set("corner-default", "cdef", "pursuer", "145/160", _FIXED,
              "fixed_starts.py --starts default --world corner --seeds 0-39"),
-        _set("certified-p", "certp", "pursuer", "272/272", _FIXED,
+        _set("certified-p", "certp", "pursuer", "288/288", _FIXED,
              "fixed_starts.py --starts certified --role pursuer"),
-        _set("certified-e", "certe", "evader", "286/288", _FIXED,
+        _set("certified-e", "certe", "evader", "310/312", _FIXED,
              "fixed_starts.py --starts certified --role evader"),
     )
 }  # fmt: skip

@@ -32,7 +32,7 @@ from strategies.cspace._progress import Progress
 from strategies.cspace.arrangement import Arrangement, arrange
 from strategies.cspace.curves import _curves, _walls
 from strategies.cspace.decomposition import Boundary, Cell, Decomposition, Region
-from strategies.cspace.tolerances import Tolerances, diameter
+from strategies.cspace.tolerances import RESOLVED_PASSAGE, Tolerances, diameter
 
 __all__ = ["build_decomposition"]
 
@@ -264,9 +264,10 @@ def build_decomposition(
     stats["merged_faces"] = merged
     stats["noncritical_violations"] = len(violations)
     stats["slivers_unresolved"] = len(lost)
+    stats["unresolved_passages"] = int(tol.unresolved)
     dec = Decomposition(world, L, curves, regions, cells, boundaries, tol.chord, stats)
     dec.timings = progress.close()
-    _warn(dec, violations, lost)
+    _warn(dec, violations, lost, tol)
     return dec
 
 
@@ -305,7 +306,7 @@ def _tip_ties(dec: Decomposition, points: list[np.ndarray]) -> tuple[np.ndarray,
     return None
 
 
-def _warn(dec: Decomposition, violations, lost: np.ndarray) -> None:
+def _warn(dec: Decomposition, violations, lost: np.ndarray, tol: Tolerances) -> None:
     """One warning naming what went wrong, if anything did (never silent), and, where
     the cause is a tie the kernel cannot break at floating point, which one."""
     problems = []
@@ -323,13 +324,21 @@ def _warn(dec: Decomposition, violations, lost: np.ndarray) -> None:
         problems.append(f"{dec.stats['slivers_unresolved']} pieces along slivers unresolved")
     if dec.stats.get("orphan_holes"):
         problems.append(f"{dec.stats['orphan_holes']} curve components outside every face")
+    if tol.unresolved:
+        wide = RESOLVED_PASSAGE * max(tol.probe, tol.collapse)
+        problems.append(
+            f"the map has a passage {tol.blocked:.2g} wide between its walls, narrower than "
+            f"it resolves ({wide:.2g}: {RESOLVED_PASSAGE:g} times its probe offset, floored "
+            "by the geometry kernel's length tolerance); a region there may be lost and the "
+            f"verdict wrong. Widening that passage to over {wide:.2g} removes it"
+        )
     if not problems:
         return
     where = [b.point for b in dec.boundaries if not b.resolved]
     where += [np.asarray(p) for _, p in violations] + list(lost)
     tie = _tip_ties(dec, where)
     if tie is None:
-        advice = ". Please report this map and L."
+        advice = "." if tol.unresolved and len(problems) == 1 else ". Please report this map and L."
     else:
         (x, y), tied = tie
         names = "vertices " + ", ".join(map(str, tied[:-1])) + f" and {tied[-1]}"

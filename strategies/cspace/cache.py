@@ -23,6 +23,7 @@ from __future__ import annotations
 import hashlib
 import io
 import json
+import math
 import os
 import tempfile
 import warnings
@@ -71,7 +72,7 @@ def _key(world: Map, L: float, chord_tol: float | None) -> dict:
 
 
 def _raw_key(world: Map, L: float, chord_tol: float | None) -> dict:
-    return {
+    key = {
         "format": FORMAT_VERSION,
         "tolerances": [
             _tol.CHORD_TOL_REL,
@@ -85,6 +86,12 @@ def _raw_key(world: Map, L: float, chord_tol: float | None) -> dict:
         "L": float(L).hex(),
         "chord_tol": None if chord_tol is None else float(chord_tol).hex(),
     }
+    # a map narrower than PASSAGE_REL * L is decomposed with smaller tolerances
+    # (Tolerances.of): its files from before that rule are not read back
+    passage = _tol.narrowest_passage(world, _tol.PASSAGE_REL * float(L))
+    if math.isfinite(passage):
+        key["passage"] = passage.hex()
+    return key
 
 
 def cache_path(

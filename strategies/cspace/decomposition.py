@@ -174,7 +174,9 @@ class Decomposition:
             ``slivers`` (faces too thin to probe), and the exactness checks, all 0 on
             a sound build: ``dangling`` (curve pieces with one face on both sides),
             ``orphan_holes``, ``noncritical_violations`` (check points whose stops are
-            not their region's), ``slivers_unresolved``.
+            not their region's), ``slivers_unresolved``, ``unresolved_passages`` (1 if
+            the map has a passage narrower than the tolerances resolve,
+            :attr:`.tolerances.Tolerances.unresolved`).
         timings: seconds spent in each phase of the build (empty when loaded).
     """
 
@@ -554,7 +556,13 @@ class _RegionGrid:
         return int(c[got[0]]) if len(got) == 1 else -1
 
 
-_CHECKS = ("dangling", "orphan_holes", "noncritical_violations", "slivers_unresolved")
+_CHECKS = (
+    "dangling",
+    "orphan_holes",
+    "noncritical_violations",
+    "slivers_unresolved",
+    "unresolved_passages",
+)
 
 
 def _point(point: object, what: str = "point") -> np.ndarray:

@@ -181,6 +181,8 @@ def probe_pieces(
     speck = arr.speck[fa] | arr.speck[fb]
     job = np.flatnonzero(~((ra < 0) & (rb < 0)) & (ra != rb) & ~speck)
     n_jobs = len(job)
+    if not n_jobs:  # no piece separates two regions (the rod fits only in specks)
+        return [], np.zeros((0, 2))
     # each job's edges, longest first (at most PROBE_EDGES)
     n_e = np.array([len(arr.pieces[i].edges) for i in job.tolist()], dtype=np.intp)
     e_all = np.concatenate([arr.pieces[i].edges for i in job.tolist()]) if n_jobs else n_e

@@ -10,6 +10,7 @@ monotone in L).
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -182,6 +183,22 @@ def test_a_rod_longer_than_the_map_is_said_not_to_fit():
     assert not dec.rod_fits and dec.evader_wins
     assert "no rod of length L = 1e+09 fits anywhere" in dec.summary()
     assert "no rod" not in decompose(tilted_block(), 2.0).summary()
+
+
+@pytest.mark.parametrize("short", [1e-6, 1e-9])
+def test_a_rod_a_hair_shorter_than_the_map_fits_only_in_specks(short):
+    """A 3 x 1 room at L = (1 - short) x its diagonal: the rod fits only within about
+    short x L of the corners, faces smaller than the speck size (1e-5 L), so no piece
+    separates two regions. The probing reshaped its empty job list and raised numpy's
+    'cannot reshape array of size 0 into shape (0,4,newaxis)' (E.md probe, s23)."""
+    room = Map([(0, 0), (3, 0), (3, 1), (0, 1)])
+    L = math.hypot(3.0, 1.0) * (1.0 - short)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        dec = decompose(room, L)
+    assert dec.exact and not dec.rod_fits and dec.evader_wins
+    assert "no rod of length" in dec.summary()
+    assert decompose(room, math.hypot(3.0, 1.0) * (1.0 - 1e-4)).rod_fits  # 4 corner cells
 
 
 @pytest.mark.parametrize(

@@ -176,8 +176,10 @@ def main(argv=None) -> int:
         + ("" if overrides is None else f"; L in [{args.l_min:g}, {2 * args.l_min:g}]")
         + ("" if args.rho is None else f"; rho {args.rho:g}")
     )
+    # the map column fits the longest label (floor_plan:0:200 ran into the policy's name)
+    w = max(16, *(len(m) + 1 for m in args.maps))
     print(
-        f"{'map':<16}{'policy':<24}{'steps':>6}{'mean ms':>9}{'p99 ms':>8}{'max ms':>8}"
+        f"{'map':<{w}}{'policy':<24}{'steps':>6}{'mean ms':>9}{'p99 ms':>8}{'max ms':>8}"
         f"{'first ms':>9}{'mean/ref':>10}{'p99/ref':>9}"
     )
     worst = {name: 0.0 for name, _ in POLICIES}
@@ -199,7 +201,7 @@ def main(argv=None) -> int:
             if name in worst:
                 worst[name] = max(worst[name], mean)
             print(
-                f"{map_name:<16}{name:<24}{len(t):>6}{mean:>9.3f}{p99:>8.3f}{t.max():>8.3f}"
+                f"{map_name:<{w}}{name:<24}{len(t):>6}{mean:>9.3f}{p99:>8.3f}{t.max():>8.3f}"
                 f"{1e3 * first[name]:>9.3f}{mean / (1e3 * ref):>10.1f}{p99 / (1e3 * ref):>9.1f}"
             )
     for name, mean in worst.items():

@@ -1,0 +1,36 @@
+"""benchmarks/decision_time.py's table: one column per field, whatever the map's label."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+BENCHMARKS = Path(__file__).resolve().parents[1] / "benchmarks"
+
+
+def test_a_long_map_label_keeps_its_own_column():
+    # README quotes `--maps floor_plan:0:200`: a 16-character label ran into the policy's
+    # name ("floor_plan:0:200pursuer/decomposition"), so the row had a field too few
+    label = "floor_plan:1234:40"  # a 40 m plan: seconds; 18 characters, past the old 16
+    out = subprocess.run(
+        [
+            *(sys.executable, "decision_time.py", "--maps", label, "--seeds", "1"),
+            *("--max-cycles", "3", "--reps", "1", "--clock", "cpu"),
+        ],
+        cwd=BENCHMARKS,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=True,
+    ).stdout.splitlines()
+    header = next(line for line in out if line.startswith("map"))
+    rows = [line for line in out if line.startswith(label)]
+    assert [r.split()[:2] for r in rows] == [
+        [label, "pursuer/decomposition"],
+        [label, "evader/shooting"],
+        [label, "pursuer/greedy"],
+    ]
+    assert all(len(r.split()) == 9 for r in rows)  # map, policy and seven figures
+    # the header's columns line up with the rows': "policy" starts where the names do
+    assert {r.index("/") - r.split()[1].index("/") for r in rows} == {header.index("policy")}

@@ -346,15 +346,19 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "evaluate", help="quick matchup table from flags (a one-off tournament spec)"
     )
-    p.add_argument("--maps", nargs="+", default=["corridor", "two_rooms"],
-                   help=f"each {MAP_HELP}")  # fmt: skip
+    # the help names each default: `surveil evaluate --maps corridor` plays a roster the
+    # user never typed
+    maps, pursuers = ["corridor", "two_rooms"], ["pursuer/decomposition", "pursuer/greedy"]
+    evaders = ["evader/shooting", "evader/straight"]
+    p.add_argument("--maps", nargs="+", default=maps,
+                   help=f"each {MAP_HELP} (default: {' '.join(maps)})")  # fmt: skip
     roster = "policy names, zoo:NAME (a shipped model) or a model .zip"
-    p.add_argument("--pursuers", nargs="+", default=["pursuer/decomposition", "pursuer/greedy"],
-                   help=roster)  # fmt: skip
-    p.add_argument("--evaders", nargs="+", default=["evader/shooting", "evader/straight"],
-                   help=roster)  # fmt: skip
+    p.add_argument("--pursuers", nargs="+", default=pursuers,
+                   help=f"{roster} (default: {' '.join(pursuers)})")  # fmt: skip
+    p.add_argument("--evaders", nargs="+", default=evaders,
+                   help=f"{roster} (default: {' '.join(evaders)})")  # fmt: skip
     p.add_argument("--seeds", type=integer(1), default=10,
-                   help="number of seeded starts per match (>= 1)")  # fmt: skip
+                   help="number of seeded starts per match (>= 1; default: 10)")  # fmt: skip
     p.add_argument("--max-cycles", type=integer(1), default=None,
                    help="episode horizon in steps (>= 1)")  # fmt: skip
     p.add_argument("--config", help=f"env overrides as JSON, e.g. {CONFIG_EXAMPLE}")

@@ -269,6 +269,21 @@ def test_every_map_argument_says_what_it_takes(command, flag, capsys):
     assert "a map file (.json, .geojson or .wkt" in text and "random:KIND:SEED" in text
 
 
+def test_evaluate_help_names_the_defaults_it_plays(capsys):
+    """README: `surveil evaluate --maps corridor two_rooms --seeds 20`. Which pursuers and
+    evaders that plays, and how many seeds without --seeds, the help did not say."""
+    assert main(["evaluate", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    for flag, default in [
+        ("--maps", "corridor two_rooms"),
+        ("--pursuers", "pursuer/decomposition pursuer/greedy"),
+        ("--evaders", "evader/shooting evader/straight"),
+        ("--seeds", "10"),
+    ]:
+        at = text.index(f" {flag} ", text.index("options:"))
+        assert f"default: {default})" in text[at : text.index(" --", at + len(flag) + 2)]
+
+
 def test_sigterm_stops_a_command_as_ctrl_c_does(tmp_path, capsys, monkeypatch):
     """``kill`` / ``timeout`` sent SIGTERM's default action: surveil play died at once and
     left its hidden temporary replay (.play.gif.PID.tmp) beside the output, and surveil

@@ -258,6 +258,14 @@ def _cmd_evaluate(args: argparse.Namespace) -> int:
             "env": env,
         },
         source="surveil evaluate",
+        # its fields came from flags: '--maps #1: ...', not 'surveil evaluate [maps #1]: ...'
+        # (after 'surveil: error:', the program named twice)
+        flags={
+            "maps": "--maps",
+            "pursuers": "--pursuers",
+            "evaders": "--evaders",
+            "env": "--config",
+        },
     )
     summary = run_tournament(
         spec,

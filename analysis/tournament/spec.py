@@ -300,8 +300,15 @@ def spec_from_dict(
     source: str = "<spec>",
     base_dir: str | os.PathLike[str] | None = None,
     default_name: str = "tournament",
+    flags: Mapping[str, str] | None = None,
 ) -> Spec:
-    """Validate a spec given as a dict (the parsed TOML); see :func:`load_spec`."""
+    """Validate a spec given as a dict (the parsed TOML); see :func:`load_spec`.
+
+    ``flags`` names the command-line flag that gave a field (``{"maps": "--maps", "env":
+    "--config"}``, as ``surveil evaluate`` builds its spec): a problem there is reported as
+    ``--maps #2: ...`` instead of ``SOURCE [maps #2]: ...``.
+    """
+    flags = dict(flags or {})
     d = mapping("spec", data, where=source)
     unknown = sorted(set(d) - _TOP)
     if unknown:
@@ -317,11 +324,11 @@ def spec_from_dict(
     for required in ("maps", "pursuers", "evaders"):
         if required not in d:
             raise InvalidConfigError(f"{source}: missing field {required!r}")
-    maps = _maps(d["maps"], source, base)
-    pursuers = _roster(d["pursuers"], "pursuer", source, base)
-    evaders = _roster(d["evaders"], "evader", source, base)
+    maps = _maps(d["maps"], source, base, flags.get("maps"))
+    pursuers = _roster(d["pursuers"], "pursuer", source, base, flags.get("pursuers"))
+    evaders = _roster(d["evaders"], "evader", source, base, flags.get("evaders"))
     starts = _starts(d.get("start", "safe"), source)
-    env = _env_table(d.get("env", {}), f"{source} [env]")
+    env = _env_table(d.get("env", {}), flags.get("env", f"{source} [env]"))
     variants = _grid(d.get("grid", {}), f"{source} [grid]")
     per_seed = len(maps) * len(variants) * len(starts) * len(pursuers) * len(evaders)
     seeds = _seeds(d.get("seeds", 10), source, per_seed)
@@ -455,10 +462,10 @@ def _map_entry(text: str, where: str, base: Path) -> MapEntry:
     return MapEntry(text, str(path), world, params)
 
 
-def _maps(value: Any, source: str, base: Path) -> tuple[MapEntry, ...]:
+def _maps(value: Any, source: str, base: Path, flag: str | None = None) -> tuple[MapEntry, ...]:
     out: dict[str, MapEntry] = {}
     for i, item in enumerate(_list("maps", value, source)):
-        where = f"{source} [maps #{i + 1}]"
+        where = f"{flag} #{i + 1}" if flag else f"{source} [maps #{i + 1}]"
         text = string("map", item, where=where)
         entry = _map_entry(text, where, base)
         if entry.label in out:
@@ -468,11 +475,13 @@ def _maps(value: Any, source: str, base: Path) -> tuple[MapEntry, ...]:
     return tuple(out.values())
 
 
-def _roster(value: Any, role: str, source: str, base: Path) -> tuple[PolicyEntry, ...]:
+def _roster(
+    value: Any, role: str, source: str, base: Path, flag: str | None = None
+) -> tuple[PolicyEntry, ...]:
     section = f"{role}s"
     entries: list[PolicyEntry] = []
     for i, item in enumerate(_list(section, value, source)):
-        where = f"{source} [{section} #{i + 1}]"
+        where = f"{flag} #{i + 1}" if flag else f"{source} [{section} #{i + 1}]"
         entries.append(_entry(item, role, where, base))
     merged: dict[str, PolicyEntry] = {}
     by_identity: dict[str, str] = {}
@@ -480,7 +489,8 @@ def _roster(value: Any, role: str, source: str, base: Path) -> tuple[PolicyEntry
         ident = json.dumps(e.identity(), sort_keys=True)
         if ident in by_identity:
             warnings.warn(
-                f"{source} [{section}]: {e.label!r} repeats {by_identity[ident]!r} (same "
+                f"{flag or f'{source} [{section}]'}: {e.label!r} repeats "
+                f"{by_identity[ident]!r} (same "
                 "policy, parameters and model); merged into one entry",
                 stacklevel=3,
             )
@@ -546,7 +556,8 @@ def _entry(item: Any, role: str, where: str, base: Path) -> PolicyEntry:
         name = string("policy", d["policy"], where=where)
         if name.partition("/")[0] != role:
             raise InvalidConfigError(
-                f"{where}: policy = {name!r}: a {role} entry needs a '{role}/KIND' name"
+                f"{where}: policy = {name!r}: {'an' if role == 'evader' else 'a'} {role} entry "
+                f"needs a name '{role}/KIND'"
             )
         for k in ("algo", "deterministic"):
             if k in d:

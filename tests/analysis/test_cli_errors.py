@@ -422,6 +422,24 @@ def test_evaluate_counts_are_checked_as_its_flags(capsys, argv, needle):
     assert_fails(capsys, argv, needle)
 
 
+@pytest.mark.parametrize(
+    ("argv", "prefix"),
+    [
+        (["--maps", "corridor", "nope"], "--maps #2: map = 'nope': neither a built-in map"),
+        (["--pursuers", "nope"], "--pursuers #1: policy = 'nope': a pursuer entry"),
+        (["--evaders", "pursuer/greedy"], "--evaders #1: policy = 'pursuer/greedy': an evader"),
+        (["--config", '{"l_min": -1}'], "--config: l_min = -1: expected a finite number > 0"),
+        (["--config", '{"rho": 2}'], "--config: unknown env parameter(s) ['rho']"),
+    ],
+)
+def test_evaluate_names_the_flag_a_bad_value_came_from(capsys, argv, prefix):
+    """``surveil evaluate --maps nope`` said "surveil: error: surveil evaluate [maps #1]:
+    ..." (the program twice, then the spec's field, not the flag), and ``--config`` was
+    "[env]"; ``surveil play --config`` says "--config: l_min = -1" as README quotes."""
+    line = assert_fails(capsys, ["evaluate", "--seeds", "1", *argv])
+    assert line.startswith(f"surveil: error: {prefix}"), line
+
+
 def test_play_on_a_huge_map_names_its_own_flags(tmp_path, capsys, monkeypatch):
     """``surveil play`` on a 1.4e9 m map said "use resolution >= 2.81e+04": the safe
     start's judge has no such flag here. Now the judge's refusal names ``--start valid``,

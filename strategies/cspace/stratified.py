@@ -35,6 +35,7 @@ from strategies.cspace._arcs import OVERLAP_TOL, overlap
 from strategies.cspace._paths import shortest_path
 from strategies.cspace.curves import _check_map, check_length
 from strategies.cspace.decomposition import Decomposition, Region, decompose
+from strategies.cspace.tolerances import diameter
 
 __all__ = [
     "StratifiedGraph",
@@ -47,7 +48,7 @@ __all__ = [
     "surveillance_verdict",
 ]
 
-_REL_MERGE = 1e-9  # candidates closer than this (relative to the map scale) coincide
+_REL_MERGE = 1e-9  # candidates closer than this (relative to the map's diameter) coincide
 
 
 def _check_range(world: Map, l_min: float, l_max: float) -> tuple[float, float]:
@@ -74,10 +75,15 @@ def candidate_lengths(map: Map, l_min: float, l_max: float) -> tuple[float, ...]
     foot = world.edge_start[None] + t[..., None] * world.edge_dir[None]
     dve = np.hypot(*(v[:, None, :] - foot).transpose(2, 0, 1)).ravel()
     d = np.concatenate([dvv, dve])
-    d = d[d > _REL_MERGE * world.scale]
+    # a length of the map's size: its diameter, the same in every frame (Map.scale, the
+    # bounding box's diagonal, grows by up to sqrt(2) under a rotation)
+    tol = _REL_MERGE * diameter(world)
+    d = d[d > tol]
     cand = np.unique(np.concatenate([d, 0.5 * d]))
-    cand = cand[(cand > lo) & (cand < hi)]
-    tol = _REL_MERGE * world.scale
+    # a candidate within tol of an end is that end, outside the open range: a rotated or
+    # shifted copy rounds a distance equal to l_max (two pillars' corners 6 apart) to
+    # either side of it, and (l_min, l_max) gained a candidate in one frame only
+    cand = cand[(cand > lo + tol) & (cand < hi - tol)]
     keep = np.concatenate([[True], np.diff(cand) > tol]) if len(cand) else cand.astype(bool)
     return tuple(float(x) for x in cand[keep])
 

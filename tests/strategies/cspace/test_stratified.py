@@ -41,6 +41,21 @@ def test_candidates_are_distances_and_their_halves():
         assert any(abs(c - want) < 1e-9 for c in cands), want
 
 
+@pytest.mark.parametrize("angle", [0.05, 0.37, 0.7, 2.5])
+@pytest.mark.parametrize("offset", [(0.0, 0.0), (1e4, -3e4)])
+def test_candidates_are_the_same_in_every_frame(angle, offset):
+    """Two pillars' corners 6 apart, with l_max = 6: a rotated or shifted copy computed
+    that distance as 5.999999999999 and counted it inside (0.5, 6), where the original
+    has it at l_max, outside (24 candidates against 23; critical_lengths likewise found
+    one more critical length, at l_max, in the rotated frame; E.md probe, s23)."""
+    world = two_pillars(2.0)
+    c, s = math.cos(angle), math.sin(angle)
+    moved = world.transformed([[c, -s], [s, c]], offset)
+    here, there = candidate_lengths(world, 0.5, 6.0), candidate_lengths(moved, 0.5, 6.0)
+    assert len(here) == len(there) == 23
+    np.testing.assert_allclose(there, here, rtol=0, atol=1e-9)
+
+
 def test_signature_ignores_geometry_but_sees_structure():
     world = two_pillars(2.0)
     a = graph_signature(decompose(world, 1.62))

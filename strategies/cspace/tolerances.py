@@ -158,8 +158,8 @@ class Tolerances:
         kernel: the geometry kernel's length tolerance (``REL_LENGTH_TOL * scale``).
         passage: the map's narrowest passage when below ``PASSAGE_REL * L`` (the
             tolerances were shrunk for it), else ``inf``.
-        blocked: the narrowest passage (thin dead ends aside) too narrow to resolve
-            (:attr:`unresolved`), else ``inf``.
+        blocked: the narrowest passage (thin dead ends and strips no longer than L
+            aside) too narrow to resolve (:attr:`unresolved`), else ``inf``.
     """
 
     L: float
@@ -191,14 +191,17 @@ class Tolerances:
             passage=passage,
         )
         resolved = RESOLVED_PASSAGE * max(tol.probe, tol.collapse)
-        blocked = narrowest_passage(world, resolved, dead_ends=False)
+        # a strip holds pieces of its own (the type-1 lines L from its ends) once longer
+        # than L; a shorter thin dead end (a notch) was seen to lose nothing
+        blocked = narrowest_passage(world, resolved, dead_ends=False, strips_over=L)
         return dataclasses.replace(tol, blocked=blocked)
 
     @property
     def unresolved(self) -> bool:
-        """Whether the map has a passage (thin dead ends aside) narrower than
-        :data:`RESOLVED_PASSAGE` times the probe offset or the collapse tolerance: the
-        decomposition may be wrong there (``blocked`` is its width)."""
+        """Whether the map has a passage (thin dead ends and strips no longer than L
+        aside) narrower than :data:`RESOLVED_PASSAGE` times the probe offset or the
+        collapse tolerance: the decomposition may be wrong there (``blocked`` is its
+        width)."""
         return math.isfinite(self.blocked)
 
 
@@ -218,7 +221,9 @@ def diameter(world: Map) -> float:
     return float(np.sqrt((d * d).sum(axis=2).max()))
 
 
-def narrowest_passage(world: Map, below: float, *, dead_ends: bool = True) -> float:
+def narrowest_passage(
+    world: Map, below: float, *, dead_ends: bool = True, strips_over: float = 0.0
+) -> float:
     """The width of the map's narrowest passage, if below ``below``, else ``inf``.
 
     A passage is where a wall vertex faces a wall edge across free space ``d`` wide (on
@@ -230,6 +235,9 @@ def narrowest_passage(world: Map, below: float, *, dead_ends: bool = True) -> fl
     no passage: the faces it makes are near-degeneracies of its corners, which the sliver
     and speck rules handle. Walls that touch (``d`` within the kernel's length
     tolerance: ``Map(merge=True)`` blocks meeting at a corner) bound no passage either.
+    A *strip* is one too: a wall edge at v running along e, its far end within ``2 d`` of
+    e, for more than :data:`PASSAGE_DETOUR` times ``d`` (a room 10 long and 1e-5 wide,
+    whose walls join at its short ends).
 
     Args:
         world: the map.
@@ -237,6 +245,7 @@ def narrowest_passage(world: Map, below: float, *, dead_ends: bool = True) -> fl
         dead_ends: count thin dead ends too: a passage on one ring whose shorter way
             round encloses, with the passage, less than twice its width times that way in
             area (a notch thin all along, with no room behind it).
+        strips_over: without ``dead_ends``, count only the strips longer than this.
 
     Examples:
         >>> from envs.maps import Map
@@ -274,10 +283,22 @@ def narrowest_passage(world: Map, below: float, *, dead_ends: bool = True) -> fl
     gap = along[e] + t - along[v]  # forward along the ring from v (mod its perimeter)
     gap = np.where(gap < 0.0, gap + perimeter[ring[v]], gap)
     way = np.where(same, np.minimum(gap, perimeter[ring[v]] - gap), np.inf)
-    ok = front & (d > REL_LENGTH_TOL * world.scale) & (d < below) & (way > PASSAGE_DETOUR * d)
+    # strips: an edge at v whose far end is within 2 d of e, running along it
+    strip = np.zeros(len(v))
+    prev, nxt = world.vertex_prev_edge[v], world.vertex_next_edge[v]
+    for far in (a[prev], b[nxt]):  # the other end of each edge at v
+        q = far - a[e]
+        tq = np.clip(np.einsum("kj,kj->k", q, u), 0.0, world.edge_length[e])
+        near = np.hypot(*(q - tq[:, None] * u).T) <= 2.0 * d
+        strip = np.maximum(strip, np.where(near, np.abs(tq - t), 0.0))
+    strip = np.where(strip > PASSAGE_DETOUR * d, strip, 0.0)
+    real = front & (d > REL_LENGTH_TOL * world.scale) & (d < below)
+    ok = real & ((way > PASSAGE_DETOUR * d) | (strip > 0.0))
     for k in np.flatnonzero(ok)[np.argsort(d[ok])].tolist():
-        if dead_ends or not same[k]:
+        if dead_ends or not same[k] or strip[k] > strips_over:
             return float(d[k])
+        if way[k] <= PASSAGE_DETOUR * d[k]:
+            continue  # a strip no longer than strips_over, not a passage round the walls
         # the shorter way round from v to its foot on e, closed by the passage
         r, i, j = int(ring[v[k]]), int(v[k]), int(e[k])
         n, s0 = len(world.rings[r]), int(start[r])

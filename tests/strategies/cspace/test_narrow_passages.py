@@ -81,6 +81,28 @@ def test_a_slit_too_narrow_to_resolve_is_reported_not_decided_silently():
     assert "UNRELIABLE" in dec.summary()
 
 
+@pytest.mark.parametrize(("width", "L"), [(1e-5, 2.0), (5e-6, 0.5)])
+def test_a_room_thinner_than_the_probes_keeps_its_escapes(width, L):
+    """A room 10 long and ``width`` wide, no vertex between its ends: the rod lies along
+    it, and with the rod pointing one way the evader walks the other way until the rod's
+    far end meets the end wall: both cells of the middle are escapable, the evader wins.
+    The probe offset (1e-5 L, floored at 2.8e-6 here) exceeded the width, probes fell
+    outside the room and the verdict was "the pursuer holds" (1e-5 wide at L = 2, 5e-6
+    at L = 0.5), exact. Its walls join only at its short ends: a strip, not a passage
+    round the walls; the tolerances now shrink for it too (5e-6 is below twice the
+    kernel's probe floor: reported as well)."""
+    room = Map([(0, 0), (10, 0), (10, width), (0, width)])
+    assert narrowest_passage(room, 1e-3) == pytest.approx(width, rel=1e-9)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        dec = decompose(room, L)
+    middle = dec.regions[dec.locate((5.0, 0.5 * width))]
+    assert len(middle.cells) == 2
+    assert all(dec.cells[c].escapable for c in middle.cells)
+    assert dec.evader_wins
+    assert dec.exact == (not caught) == (width > 2 * 2.8e-6)
+
+
 def test_a_neck_too_narrow_is_reported_and_a_notch_as_narrow_is_not():
     """A notch 5e-6 wide and 1 deep holds one thin region with no piece inside to probe
     (its cells are those of its wider twins), a neck as narrow into a room is a passage."""
@@ -116,8 +138,11 @@ def test_a_passage_is_walls_near_each_other_that_join_only_the_long_way_round():
     # nor does a tooth 3e-4 wide and 1 high: its corners face each other across it
     tooth = Map([(0, 0), (5, 0), (5, 1), (5.0003, 1), (5.0003, 0), (10, 0), (10, 10), (0, 10)])
     assert narrowest_passage(tooth, 1e-2) == math.inf
-    # a notch thin all along is a dead end; a neck as narrow into a room behind is not
-    assert narrowest_passage(_notch(3e-4, 1.0), 1e-2, dead_ends=False) == math.inf
+    # a notch thin all along is a dead end, a strip 1 long (counted beyond a length given);
+    # a neck as narrow into a room behind is a passage
+    assert narrowest_passage(_notch(3e-4, 1.0), 1e-2, dead_ends=False, strips_over=2.0) == math.inf
+    notch = narrowest_passage(_notch(3e-4, 1.0), 1e-2, dead_ends=False, strips_over=0.5)
+    assert notch == pytest.approx(3e-4, rel=1e-9)
     neck = narrowest_passage(_bottle(3e-4), 1e-2, dead_ends=False)
     assert neck == pytest.approx(3e-4, rel=1e-9)
     # walls that touch (two merged blocks meeting at a corner) bound no passage

@@ -408,8 +408,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     Returns:
         0 on success, 2 for a user error (one line on stderr: ``surveil: error: ...``
         naming the value, what was expected and where it came from), 130 when
-        interrupted (Ctrl-C), 143 when stopped by SIGTERM (cleaning up as on Ctrl-C). A
-        traceback means a bug.
+        interrupted (Ctrl-C), 143 when stopped by SIGTERM (cleaning up as on Ctrl-C), 141
+        (128 + SIGPIPE, silently) when the reader of its output left (``surveil maps |
+        head -1``). A traceback means a bug.
     """
     try:
         args = build_parser().parse_args(argv)  # imports for seconds: Ctrl-C lands here too
@@ -421,7 +422,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     with warnings.catch_warnings(), sigterm_as_interrupt():
         warnings.showwarning = _OneLineWarnings(warnings.showwarning)
         try:
-            return int(args.func(args) or 0)
+            code = int(args.func(args) or 0)
+            if sys.stdout is not None:  # a reader gone (`| head`) is met here, not at exit
+                sys.stdout.flush()
+            return code
         except KeyboardInterrupt as exc:
             if str(exc) == "SIGTERM":
                 print("surveil: stopped by SIGTERM", file=sys.stderr)
@@ -429,11 +433,37 @@ def main(argv: Sequence[str] | None = None) -> int:
             print("surveil: interrupted", file=sys.stderr)
             return 130
         except Exception as exc:
+            if isinstance(exc, BrokenPipeError) and _stdout_gone():
+                return 141
             message = user_error(exc)
             if message is None:
                 raise  # a bug: keep the traceback
             print(f"surveil: error: {message}", file=sys.stderr)
             return 2
+
+
+def _stdout_gone() -> bool:
+    """Whether stdout's reader has left (``| head``), not some other pipe: its pending
+    output cannot be flushed, or (unbuffered) polling its pipe reports an error. Then
+    stdout is pointed at the null device, so that the interpreter's own flush at exit
+    does not print "Exception ignored ... BrokenPipeError" either."""
+    import os
+    import select
+
+    try:
+        sys.stdout.flush()
+        poll = select.poll()  # no poll (Windows): only a failed flush tells
+        poll.register(sys.stdout.fileno(), select.POLLOUT)
+        gone = any(event & select.POLLERR for _, event in poll.poll(0))
+    except BrokenPipeError:
+        gone = True
+    except (AttributeError, OSError, ValueError):  # no poll, no file descriptor
+        gone = False
+    if gone:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    return gone
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -284,6 +284,31 @@ def test_evaluate_help_names_the_defaults_it_plays(capsys):
         assert f"default: {default})" in text[at : text.index(" --", at + len(flag) + 2)]
 
 
+@pytest.mark.parametrize("unbuffered", ["1", ""])
+def test_a_reader_that_leaves_is_not_an_error(unbuffered):
+    """``surveil figures --numbers | head -2`` (docs/REPRODUCTION.md's command, looked at
+    with head) ended with "surveil: error: [Errno 32] Broken pipe" and exit 2 (output
+    unbuffered), or Python's "Exception ignored ... BrokenPipeError" at exit (buffered).
+    Now it stops silently with 141 (128 + SIGPIPE), as a shell reports such a command."""
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "PYTHONUNBUFFERED": unbuffered}
+    root = Path(__file__).resolve().parents[2]
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "analysis.cli", "maps"],
+        cwd=root,
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    proc.stdout.close()  # the reader leaves before a line is written (imports take longer)
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=120) == 141, err
+    assert err == ""
+
+
 def test_sigterm_stops_a_command_as_ctrl_c_does(tmp_path, capsys, monkeypatch):
     """``kill`` / ``timeout`` sent SIGTERM's default action: surveil play died at once and
     left its hidden temporary replay (.play.gif.PID.tmp) beside the output, and surveil

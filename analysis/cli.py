@@ -26,6 +26,7 @@ from analysis.arguments import (
     output_dir,
     output_file,
     path_text,
+    reader_gone,
     real,
     set_from_flag,
     sigterm_as_interrupt,
@@ -433,37 +434,13 @@ def main(argv: Sequence[str] | None = None) -> int:
             print("surveil: interrupted", file=sys.stderr)
             return 130
         except Exception as exc:
-            if isinstance(exc, BrokenPipeError) and _stdout_gone():
+            if isinstance(exc, BrokenPipeError) and reader_gone():
                 return 141
             message = user_error(exc)
             if message is None:
                 raise  # a bug: keep the traceback
             print(f"surveil: error: {message}", file=sys.stderr)
             return 2
-
-
-def _stdout_gone() -> bool:
-    """Whether stdout's reader has left (``| head``), not some other pipe: its pending
-    output cannot be flushed, or (unbuffered) polling its pipe reports an error. Then
-    stdout is pointed at the null device, so that the interpreter's own flush at exit
-    does not print "Exception ignored ... BrokenPipeError" either."""
-    import os
-    import select
-
-    try:
-        sys.stdout.flush()
-        poll = select.poll()  # no poll (Windows): only a failed flush tells
-        poll.register(sys.stdout.fileno(), select.POLLOUT)
-        gone = any(event & select.POLLERR for _, event in poll.poll(0))
-    except BrokenPipeError:
-        gone = True
-    except (AttributeError, OSError, ValueError):  # no poll, no file descriptor
-        gone = False
-    if gone:
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-        os.close(devnull)
-    return gone
 
 
 if __name__ == "__main__":  # pragma: no cover

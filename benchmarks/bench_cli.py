@@ -32,7 +32,14 @@ from collections.abc import Callable, Iterator, Sequence
 from multiprocessing.pool import Pool
 from typing import Any
 
-from analysis.arguments import integer, path_text, real, user_error, why_not_a_file
+from analysis.arguments import (
+    integer,
+    path_text,
+    reader_gone,
+    real,
+    user_error,
+    why_not_a_file,
+)
 
 __all__ = ["ArgumentParser", "integer", "path_text", "real", "results_file", "run", "worker_pool"]
 
@@ -104,16 +111,22 @@ def _raise_interrupt(signum: int, frame: object) -> None:
 
 
 def run(main: Callable[[], int | None]) -> int:
-    """``main()``'s exit code; 130 (SIGINT) or 143 (SIGTERM) if stopped, 2 for a user error."""
+    """``main()``'s exit code; 130 (SIGINT) or 143 (SIGTERM) if stopped, 2 for a user error,
+    141 (128 + SIGPIPE, silently) when the reader of its output left (``| head``)."""
     signal.signal(signal.SIGTERM, _raise_interrupt)
     prog = os.path.basename(sys.argv[0])
     try:
-        return int(main() or 0)
+        code = int(main() or 0)
+        if sys.stdout is not None:  # a reader gone (`| head`) is met here, not at exit
+            sys.stdout.flush()
+        return code
     except KeyboardInterrupt as exc:
         name = str(exc) if str(exc) in EXIT_CODE else "SIGINT"
         print(f"{prog}: stopped by {name}", file=sys.stderr)
         return EXIT_CODE[name]
     except Exception as exc:
+        if isinstance(exc, BrokenPipeError) and reader_gone():
+            return 141
         message = user_error(exc)
         if message is None:
             raise  # a bug: keep the traceback

@@ -168,3 +168,21 @@ def test_ctrl_c_stops_a_pool_run_with_one_line(tmp_path) -> None:
         raise
     assert proc.returncode == 130, err
     assert err.strip() == "unseen_worlds.py: stopped by SIGINT"
+
+
+@pytest.mark.parametrize("unbuffered", ["1", ""])
+def test_a_reader_that_leaves_stops_a_run_silently(unbuffered) -> None:
+    # `policy_sets.py compare A B | head -1` said "policy_sets.py: error: [Errno 32] Broken
+    # pipe" (exit 2; unbuffered output) or "Exception ignored ... BrokenPipeError" (exit 120)
+    args = ["--maps", "open_room", "--seeds", "1", "--max-cycles", "3", "--reps", "1"]
+    proc = subprocess.Popen(
+        [sys.executable, "decision_time.py", *args],
+        cwd=BENCHMARKS,
+        env={**os.environ, "PYTHONUNBUFFERED": unbuffered},
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    proc.stdout.close()  # the reader leaves before the first line (imports take longer)
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=120) == 141, err  # 128 + SIGPIPE, as a shell reports it
+    assert err == ""

@@ -27,13 +27,13 @@ import os
 import re
 import signal
 import stat
-import sys
 import tempfile
 import threading
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
+from envs.console import reader_gone
 from envs.errors import InvalidConfigError, MemoryBudgetError, SurveilValueError
 
 __all__ = [
@@ -310,29 +310,6 @@ def _writable_dir(flag: str, text: str, directory: Path) -> None:
         raise InvalidConfigError(
             f"{flag} = {text!r}: cannot write in {str(directory) or '.'!r} ({reason})"
         ) from None
-
-
-def reader_gone() -> bool:
-    """Whether stdout's reader has left (``| head``), not some other pipe: its pending
-    output cannot be flushed, or (unbuffered) polling its pipe reports an error. Then
-    stdout is pointed at the null device, so that the interpreter's own flush at exit
-    does not print "Exception ignored ... BrokenPipeError" either."""
-    import select
-
-    try:
-        sys.stdout.flush()
-        poll = select.poll()  # no poll (Windows): only a failed flush tells
-        poll.register(sys.stdout.fileno(), select.POLLOUT)
-        gone = any(event & select.POLLERR for _, event in poll.poll(0))
-    except BrokenPipeError:
-        gone = True
-    except (AttributeError, OSError, ValueError):  # no poll, no file descriptor
-        gone = False
-    if gone:
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-        os.close(devnull)
-    return gone
 
 
 def user_error(exc: BaseException) -> str | None:

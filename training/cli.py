@@ -16,6 +16,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from envs import validation
+from envs.console import EXIT_READER_GONE, reader_gone
 from envs.errors import InvalidConfigError, SurveilValueError
 from training.config import TrainConfig, load_any_config
 from training.selfplay import self_play
@@ -166,16 +167,25 @@ def run_cli(prog: str, func: Callable[[], int]) -> int:
 
     User errors (the project's ``SurveilValueError``, files that cannot be read or
     written) print one line ``PROG: error: ...`` and return 2; Ctrl-C returns 130;
-    SIGTERM returns 143 (cleaning up as on Ctrl-C); argparse's own exits pass through;
+    SIGTERM returns 143 (cleaning up as on Ctrl-C); a reader of the output that left
+    (``| head``) returns 141 silently; argparse's own exits pass through;
     anything else is a bug and keeps its traceback.
     """
     previous = None
     if threading.current_thread() is threading.main_thread():  # SIGTERM stops as Ctrl-C does
         previous = signal.signal(signal.SIGTERM, _raise_sigterm)
     try:
-        return int(func() or 0)
+        code = int(func() or 0)
+        if sys.stdout is not None:  # a reader gone (`| head`) is met here, not at exit
+            sys.stdout.flush()
+        return code
     except SystemExit as exc:  # argparse: --help (0) or a usage error (2, already printed)
         return exc.code if isinstance(exc.code, int) else 2
+    except BrokenPipeError as exc:
+        if reader_gone():
+            return EXIT_READER_GONE
+        print(f"{prog}: error: {exc}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt as exc:
         if str(exc) == "SIGTERM":
             print(f"{prog}: stopped by SIGTERM", file=sys.stderr)

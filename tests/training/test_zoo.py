@@ -196,6 +196,29 @@ def test_cli_list(capsys):
     assert "[" not in out
 
 
+@pytest.mark.parametrize("unbuffered", ["1", ""])
+def test_python_m_training_zoo_list_piped_into_head_stops_silently(unbuffered):
+    """``python -m training.zoo list | head -1`` said "python -m training.zoo: error:
+    [Errno 32] Broken pipe" (exit 2; unbuffered output) or "Exception ignored ...
+    BrokenPipeError" at exit (120); now 141 and nothing, as ``surveil maps | head -1``."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "training.zoo", "list"],
+        cwd=Path(__file__).resolve().parents[2],
+        env={**os.environ, "PYTHONUNBUFFERED": unbuffered},
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    proc.stdout.close()  # the reader leaves before the first line (imports take longer)
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=120) == 141, err
+    assert err == ""
+
+
 def test_python_m_training_zoo_evaluate_prints_no_python_reprs(capsys):
     """Its causes were a dict ("causes {'too_close': 2}"); its help was reST
     (":mod:`training.zoo`") and said nothing of NAME, --episodes or --seed."""

@@ -50,6 +50,7 @@ to 45 min; it ran over 5 min and 1.8-3.8 GB before it was killed.
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -263,7 +264,14 @@ def check_budget(
     if need <= limit:
         return limit
     total_seconds = sum(s.seconds for s in sizes)
+    ram = physical_memory()
     advice = []
+    if need > ram:  # "SURVEIL_MEMORY_BUDGET=3712723138027099136GB": no budget can give it
+        # said first and as a fact about the solve asked for: "Use --cells-per-lmin <= 57.6;
+        # no budget on this machine fits" read as if 57.6 did not fit either (helper-143)
+        asked = (f"{MemoryBudgetError.KNOB} = {cells_per_lmin:g}"
+                 if cells_per_lmin is not None else "this solve")  # fmt: skip
+        advice.append(f"{asked} fits no budget on this machine: it has {_size(ram)} of memory")
     if resize is not None and cells_per_lmin is not None:
         lo, hi = 0.0, float(cells_per_lmin)
         # the largest resolution that fits, to 1e-9 of it, or none >= 0.1 (named as 0 below):
@@ -279,27 +287,32 @@ def check_budget(
         fit = math.floor(lo * 10) / 10
         K = MemoryBudgetError.KNOB
         if fit > 0:
-            advice.append(f"Use {K} <= {fit:g} (asked: {cells_per_lmin:g})")
+            advice.append(f"Use {K} <= {fit:g} (asked: {cells_per_lmin:g}), which fits the "
+                          f"budget of {_size(limit)}")  # fmt: skip
         elif BASE_BYTES >= limit:  # the interpreter alone is over the budget
             advice.append(f"No {K} fits (the interpreter alone takes {_size(BASE_BYTES)})")
         else:  # a huge map: it said "the interpreter alone" there too
             coarsest = peak(resize(0.1))[0]
             advice.append(f"No {K} fits (even {K} = 0.1 needs about {_size(coarsest)})")
     more = math.ceil(1.2 * need / 1e9)
-    ram = physical_memory()
     if need <= ram:
-        advice.append(
-            f"{'raise' if advice else 'Raise'} the budget with {MemoryBudgetError.BUDGET}"
-        )
-    else:  # "SURVEIL_MEMORY_BUDGET=3712723138027099136GB": no budget this machine can give
-        advice.append(f"{'no' if advice else 'No'} budget on this machine fits (it has "
-                      f"{_size(ram)} of memory)")  # fmt: skip
+        advice.append(f"{'raise' if advice else 'Raise'} the budget with "
+                      f"{MemoryBudgetError.BUDGET}")  # fmt: skip
     advice.append("or solve a smaller map or a smaller L_max / L_min")
+    default = ""  # where the budget came from, when nobody set it
+    if budget is None and not os.environ.get("SURVEIL_MEMORY_BUDGET"):
+        default = ", half of the machine's memory (the default)"
+    first, *rest = advice
+    if need > ram:  # a sentence of its own; the choices follow
+        then = "; ".join(rest[:-1]) + (", " if rest[:-1] else "") + rest[-1]
+        text = first + ". " + then[0].upper() + then[1:]
+    else:
+        text = "; ".join(advice[:-1]) + ", " + advice[-1]
     raise MemoryBudgetError(
         f"{call}: the solve would need about {_size(need)} at its peak, during the "
         f"{at.what} ({'; '.join(s.describe() for s in sizes)}; up to about "
         f"{duration(total_seconds)} in all), more than the memory budget of "
-        f"{_size(limit)}. " + "; ".join(advice[:-1]) + ", " + advice[-1],
+        f"{_size(limit)}{default}. " + text[0].upper() + text[1:],
         knob,
         size=f"{more}GB",
     )

@@ -140,7 +140,21 @@ def test_a_solve_larger_than_the_machine_names_no_budget(monkeypatch):
         solve(s, 40, cache=False, memory_budget="200MB")
     msg = str(err.value)
     assert "Use cells_per_lmin <= " in msg and "memory_budget=" not in msg, msg
-    assert "no budget on this machine fits (it has 1.0 GB of memory)" in msg, msg
+    # the asked resolution fits no budget, said as a sentence of its own before the one that
+    # fits: "Use --cells-per-lmin <= 57.6 (asked: 200); no budget on this machine fits (it
+    # has 25.3 GB of memory)" read as if 57.6 did not fit either (helper-143)
+    said = ". cells_per_lmin = 40 fits no budget on this machine: it has 1.0 GB of memory. Use "
+    assert said in msg, msg
+    assert re.search(r"Use cells_per_lmin <= [\d.]+ \(asked: 40\), which fits the budget of "
+                     r"200 MB, or solve a smaller map", msg), msg  # fmt: skip
+    # the budget nobody set is named as the default it is
+    import strategies.memory as memory
+
+    monkeypatch.setattr(memory, "physical_memory", lambda: 1e9)
+    monkeypatch.delenv("SURVEIL_MEMORY_BUDGET", raising=False)
+    with pytest.raises(MemoryBudgetError) as err:
+        solve(s, 40, cache=False)
+    assert "memory budget of 500 MB, half of the machine's memory (the default). " in str(err.value)
 
 
 def test_each_solver_checks_its_own_budget():

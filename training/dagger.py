@@ -50,6 +50,7 @@ import dataclasses
 import json
 import os
 import re
+import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -594,6 +595,17 @@ def _validate(cfg: DaggerConfig, model, opponent) -> float:
     return wins / cfg.validation_episodes
 
 
+def _episode_bar(cfg: DaggerConfig, first: int, verbose: bool):
+    """A bar over the episodes still to play on stderr, when ``verbose`` on a terminal."""
+    if not (verbose and sys.stderr.isatty()):
+        return None
+    from tqdm import tqdm
+
+    total = cfg.iterations * cfg.episodes
+    return tqdm(total=total, initial=first * cfg.episodes, unit="episode",
+                desc=f"dagger {cfg.role}", file=sys.stderr, dynamic_ncols=True)  # fmt: skip
+
+
 def dagger(cfg: DaggerConfig, *, verbose: bool = False) -> DaggerResult:
     """Run DAgger; writes ``model.zip``, ``provenance.json`` and the curves to ``output_dir``.
 
@@ -602,7 +614,8 @@ def dagger(cfg: DaggerConfig, *, verbose: bool = False) -> DaggerResult:
 
     Args:
         cfg: the run.
-        verbose: print one line per iteration (and the episodes as they end).
+        verbose: print one line per iteration on stdout, and the episodes as they end on
+            stderr (a bar on a terminal, else a line each).
 
     Raises:
         InvalidConfigError: bad names, maps or env parameters (before any rollout), an
@@ -645,7 +658,9 @@ def _dagger(cfg: DaggerConfig, out: Path, t0: float, verbose: bool) -> DaggerRes
         progress["config"] = cfg.to_dict()
         progress["maps"] = _map_fingerprints(cfg)  # checked by _resume; a new stage's too
     opponent = cfg.opponent_policy()
-    for it in range(len(progress["samples"]), cfg.iterations):
+    first = len(progress["samples"])
+    bar = _episode_bar(cfg, first, verbose)
+    for it in range(first, cfg.iterations):
         t_it = time.perf_counter()
         beta = cfg.beta**it
         wins, seen_l, seen_e, records = 0, [], [], []
@@ -660,6 +675,12 @@ def _dagger(cfg: DaggerConfig, out: Path, t0: float, verbose: bool) -> DaggerRes
             r = run_episode(world, pair["pursuer"], pair["evader"], seed, max_cycles=cfg.max_cycles,
                             overrides=env_overrides, start=start)  # fmt: skip
             wins += r.winner == cfg.role
+            if bar is not None:
+                bar.update(1)
+            elif verbose:  # not a terminal: a line per episode (a generalist's take minutes)
+                print(f"dagger {cfg.role} iteration {it} episode {ep + 1}/{cfg.episodes}: "
+                      f"{r.winner} won in {r.steps} steps on {world}",
+                      file=sys.stderr, flush=True)  # fmt: skip
             records.append({"map": world, "start": start, "l_max": r.config.l_max,
                             "opponent": r.evader if other == "evader" else r.pursuer,
                             "winner": r.winner, "steps": r.steps})  # fmt: skip
@@ -687,12 +708,16 @@ def _dagger(cfg: DaggerConfig, out: Path, t0: float, verbose: bool) -> DaggerRes
         progress["wall_seconds"] = round(progress["wall_seconds"] + time.perf_counter() - t_it, 3)
         _write_iteration(out, model, data_obs, data_act, progress, best)
         if verbose:
-            print(f"dagger {cfg.role} iteration {it}: beta {beta:.3f}, samples {len(data_obs)}, "
-                  f"disagreement {progress['disagreement'][-1]:.3f}, fit error "
-                  f"{progress['fit_error'][-1]:.3f}, won {wins}/{cfg.episodes}"
-                  + (f", learner alone won {progress['validation'][-1]:.2f}"
-                     if cfg.validation_episodes else "") + ", "
-                  f"{time.perf_counter() - t_it:.0f} s", flush=True)  # fmt: skip
+            say = print if bar is None else bar.write  # a line above the bar on a terminal
+            say(f"dagger {cfg.role} iteration {it}: beta {beta:.3f}, samples {len(data_obs)}, "
+                f"disagreement {progress['disagreement'][-1]:.3f}, fit error "
+                f"{progress['fit_error'][-1]:.3f}, won {wins}/{cfg.episodes}"
+                + (f", learner alone won {progress['validation'][-1]:.2f}"
+                   if cfg.validation_episodes else "") + ", "
+                f"{time.perf_counter() - t_it:.0f} s", file=sys.stdout)  # fmt: skip
+            sys.stdout.flush()
+    if bar is not None:
+        bar.close()
     provenance = {
         "env_id": ENV_NAME,  # the version it trained on (its model card names it)
         "registry_id": ENV_ID,

@@ -386,6 +386,46 @@ def _checkpoint_callback(config: TrainConfig, out: Path, start: int):
     return Checkpoint()
 
 
+def _progress_callback(config: TrainConfig, start: int):
+    """Progress of a run on stderr: a bar over the timesteps on a terminal, else a line at
+    every tenth of them (a log keeps lines, not a bar's redraws: SB3's rich bar, used
+    before, showed a log only its final state)."""
+    from stable_baselines3.common.callbacks import BaseCallback
+    from tqdm import tqdm
+
+    total = config.total_timesteps
+    label = f"{config.algo} {config.role}"
+
+    class Progress(BaseCallback):
+        def __init__(self) -> None:
+            super().__init__()
+            self.bar = None
+            self.tenth = 10 * start // total  # tenths already reported (a resumed run)
+            self.t0 = time.perf_counter()
+
+        def _on_training_start(self) -> None:
+            if sys.stderr.isatty():
+                self.bar = tqdm(total=total, initial=start, unit="step", desc=label,
+                                file=sys.stderr, dynamic_ncols=True)  # fmt: skip
+
+        def _on_step(self) -> bool:
+            n = min(int(self.model.num_timesteps), total)
+            if self.bar is not None:
+                self.bar.update(n - self.bar.n)
+            elif 10 * n // total > self.tenth:
+                self.tenth = 10 * n // total
+                took = time.perf_counter() - self.t0
+                print(f"{label}: {n:,} of {total:,} timesteps ({took:.0f} s)", file=sys.stderr,
+                      flush=True)  # fmt: skip
+            return True
+
+        def _on_training_end(self) -> None:
+            if self.bar is not None:
+                self.bar.close()
+
+    return Progress()
+
+
 def _checkpoint(model, config: TrainConfig, out: Path) -> None:
     """Write ``checkpoints/ckpt_<timesteps>.zip`` (and SAC's replay buffer), keep the last two."""
     ckdir = out / "checkpoints"
@@ -424,7 +464,8 @@ def train(
         init_model: a model zip to start from instead of fresh weights (self-play warm
             start; ignored when resuming from a checkpoint).
         callbacks: extra SB3 callbacks (run after the checkpoint callback).
-        progress_bar: show SB3's progress bar (needs ``tqdm`` and ``rich``).
+        progress_bar: show the progress on stderr (a bar on a terminal, else a line at
+            every tenth of the timesteps).
 
     Returns:
         The :class:`TrainResult`. If ``output_dir`` already holds a finished run with at
@@ -504,11 +545,12 @@ def _train(config, out, t0, init_model, callbacks, progress_bar) -> TrainResult:
     remaining = config.total_timesteps - model.num_timesteps
     if remaining > 0:
         cbs = [_checkpoint_callback(config, out, model.num_timesteps), *(callbacks or [])]
+        if progress_bar:
+            cbs.append(_progress_callback(config, int(model.num_timesteps)))
         model.learn(
             total_timesteps=remaining,
             callback=cbs,
             reset_num_timesteps=resumed_from is None,
-            progress_bar=progress_bar,
         )
     # model.zip is replaced only beside its provenance, at the end: written first, an
     # interrupt during the evaluation left an extended run's model beside the shorter

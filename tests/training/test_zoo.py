@@ -398,3 +398,37 @@ def test_a_specialist_knows_its_map_by_geometry_not_by_name(tmp_path):
             policy.reset(role="pursuer", map=world, config=env.config, seed=0)
         said = [w for w in got if issubclass(w.category, UnseenMapWarning)]
         assert len(said) == warns, (path, [str(w.message) for w in said])
+
+
+@pytest.mark.parametrize("method", ["dagger", "rl"])
+def test_reproduce_shows_its_progress_unless_told_not_to(tmp_path, monkeypatch, capsys, method):
+    """``python -m training.zoo reproduce`` printed nothing until the end (the shipped
+    generalist retrains for most of an hour) unless given ``--progress``. Now it shows
+    progress by default (not a terminal here: a line per DAgger episode or per tenth of the
+    timesteps, on stderr) and ``--no-progress`` silences it."""
+    from training.train import train
+    from training.zoo.__main__ import main as zoo_main
+
+    monkeypatch.setattr(zoo, "MODELS_DIR", tmp_path / "zoo")
+    if method == "dagger":
+        run = _tiny_dagger_run(tmp_path / "run")
+        expected = ["dagger pursuer iteration 0 episode 1/1: "]
+    else:
+        run = tmp_path / "run"
+        train(TrainConfig(role="pursuer", opponent="evader/straight", total_timesteps=256,
+                          n_steps=128, batch_size=64, eval_episodes=0, checkpoint_freq=10_000,
+                          env={"max_cycles": 40}, output_dir=str(run)))  # fmt: skip
+        expected = [f"ppo pursuer: {n} of 256 timesteps (" for n in
+                    (26, 52, 77, 103, 128, 154, 180, 205, 231, 256)]  # fmt: skip
+    zoo.install("tiny", run)
+    capsys.readouterr()
+    assert zoo_main(["reproduce", "tiny", "--output-dir", str(tmp_path / "a")]) == 0
+    err = capsys.readouterr().err
+    lines = [line for line in err.splitlines() if "Warning" not in line and line.strip()]
+    assert [line[: len(e)] for line, e in zip(lines, expected, strict=False)] == expected, err
+    assert len(lines) == len(expected), err
+    quiet = ["reproduce", "tiny", "--output-dir", str(tmp_path / "b"), "--no-progress"]
+    assert zoo_main(quiet) == 0
+    assert "timesteps (" not in capsys.readouterr().err
+    # the old opt-in flag is still accepted (it is the default now)
+    assert zoo_main(["reproduce", "tiny", "--output-dir", str(tmp_path / "c"), "--progress"]) == 0

@@ -14,7 +14,7 @@ Command line::
 
     python -m training.zoo list
     python -m training.zoo info NAME
-    python -m training.zoo reproduce NAME [--output-dir DIR] [--install]
+    python -m training.zoo reproduce NAME [--output-dir DIR] [--install] [--no-progress]
     python -m training.zoo evaluate NAME --opponent evader/shooting [--episodes 50]
 """
 
@@ -148,7 +148,10 @@ def reproduce(
         install_result: replace the shipped model and provenance with the retrained ones
             (the shipped recipe, config.toml, is kept: it is what was retrained, and the
             run's copy differs only in ``output_dir``).
-        progress_bar: show SB3's progress bar.
+        progress_bar: show the progress on stderr: a bar on a terminal, else a line per
+            DAgger episode or per tenth of an RL run's timesteps (and, for DAgger, a line
+            per iteration on stdout). ``python -m training.zoo reproduce`` shows it unless
+            given ``--no-progress``.
     """
     cfg = config(name).replace(output_dir=os.fspath(output_dir or Path("out/zoo") / name))
     from training.train import ENV_NAME

@@ -306,17 +306,20 @@ def _tip_ties(dec: Decomposition, points: list[np.ndarray]) -> tuple[np.ndarray,
     return None
 
 
-def _warn(dec: Decomposition, violations, lost: np.ndarray, tol: Tolerances) -> None:
-    """One warning naming what went wrong, if anything did (never silent), and, where
-    the cause is a tie the kernel cannot break at floating point, which one."""
+def _problems(dec: Decomposition, tol: Tolerances, violations=()) -> list[str]:
+    """What is not exact about ``dec``, read from its statistics (``violations``, the
+    build's, name the first point)."""
     problems = []
     if dec.unresolved:
         problems.append(f"{dec.unresolved} boundary pieces matched by overlap only")
-    if violations:
-        r, p = violations[0]
+    if dec.stats.get("noncritical_violations"):
+        first = ""
+        if violations:
+            r, p = violations[0]
+            first = f" (first: region {r} at ({p[0]:.6g}, {p[1]:.6g}))"
         problems.append(
-            f"{len(violations)} points whose stops differ from their region's "
-            f"(first: region {r} at ({p[0]:.6g}, {p[1]:.6g}))"
+            f"{dec.stats['noncritical_violations']} points whose stops differ from their "
+            f"region's{first}"
         )
     if dec.stats.get("dangling"):
         problems.append(f"{dec.stats['dangling']} dangling curve pieces")
@@ -332,6 +335,29 @@ def _warn(dec: Decomposition, violations, lost: np.ndarray, tol: Tolerances) -> 
             "by the geometry kernel's length tolerance); a region there may be lost and the "
             f"verdict wrong. Widening that passage to over {wide:.2g} removes it"
         )
+    return problems
+
+
+def warn_cached(dec: Decomposition, tol: Tolerances, path: object) -> None:
+    """The build's warning, for a decomposition read back from the cache file ``path``
+    that is not exact (it loaded silently: only ``summary()`` said UNRELIABLE)."""
+    problems = _problems(dec, tol)
+    if not problems:  # not exact by a check this version does not name: say that much
+        problems = ["an exactness check failed (see stats)"]
+    warnings.warn(
+        f"decompose({dec.map.name!r}, L={dec.L:g}): the arrangement is not exact: "
+        + "; ".join(problems)
+        + f" (read from the cache file {path}; building it warned the same, with the "
+        "points where it failed)",
+        RuntimeWarning,
+        stacklevel=4,
+    )
+
+
+def _warn(dec: Decomposition, violations, lost: np.ndarray, tol: Tolerances) -> None:
+    """One warning naming what went wrong, if anything did (never silent), and, where
+    the cause is a tie the kernel cannot break at floating point, which one."""
+    problems = _problems(dec, tol, violations)
     if not problems:
         return
     where = [b.point for b in dec.boundaries if not b.resolved]

@@ -3,9 +3,10 @@
 Policies and tournaments ask for the same decomposition many times, across processes.
 Files live in ``$SURVEIL_CACHE_DIR`` (default ``~/.cache/surveil``) under ``cspace/``:
 
-* the file name is a SHA-256 of the key: :data:`FORMAT_VERSION`, the tolerances the
-  result depends on, the map's wall digest (:attr:`envs.maps.Map.digest`), L and the
-  chord tolerance, so a changed map or parameter can never hit a stale file;
+* the file name is a SHA-256 of the key: :data:`FORMAT_VERSION`, a digest of every
+  constant the result may depend on (:func:`constants_digest`), the map's wall digest
+  (:attr:`envs.maps.Map.digest`), L and the chord tolerance, so a changed map, parameter
+  or tolerance can never hit a stale file;
 * the file is a one-line JSON header (the key again, the body's length and SHA-256, the
   build's statistics) followed by an ``.npz`` body of plain numeric arrays
   (:mod:`strategies.cspace._serial`), read with ``allow_pickle=False``: loading a cache
@@ -13,6 +14,7 @@ Files live in ``$SURVEIL_CACHE_DIR`` (default ``~/.cache/surveil``) under ``cspa
 * on load the header's key must equal the expected key and the body its checksum; a
   damaged or mismatched file (truncated, a flipped bit, empty, another map's entry
   copied over) is rebuilt and rewritten, with a one-line warning naming the file;
+* a decomposition that is not exact warns when it is read back, as its build did;
 * writes are atomic (a temporary file in the same directory, then ``os.replace``); a
   directory that cannot be written gets one warning per process, then the cache is
   skipped for it.
@@ -43,6 +45,7 @@ __all__ = [
     "CacheWarning",
     "cache_path",
     "cached_decomposition",
+    "constants_digest",
     "resolve_cache_dir",
     "write_cache_file",
 ]
@@ -71,17 +74,63 @@ def _key(world: Map, L: float, chord_tol: float | None) -> dict:
     return json.loads(json.dumps(_raw_key(world, L, chord_tol)))  # as read back from a file
 
 
+_RESULT_MODULES = (
+    "envs.tolerances",
+    "strategies.cspace.tolerances",
+    "strategies.cspace._arcs",
+    "strategies.cspace._batch_arcs",
+    "strategies.cspace._build",
+    "strategies.cspace._candidates",
+    "strategies.cspace._collinear",
+    "strategies.cspace._intersect",
+    "strategies.cspace._noding",
+    "strategies.cspace._paths",
+    "strategies.cspace._probing",
+    "strategies.cspace._rod",
+    "strategies.cspace._samples",
+    "strategies.cspace._shapes",
+    "strategies.cspace.arrangement",
+    "strategies.cspace.curves",
+    "strategies.cspace.decomposition",
+)
+"""The modules whose constants a decomposition may depend on (the kernel's tolerances and
+the build's): every one is in the cache key (:func:`constants_digest`)."""
+
+
+def _constant(value: object) -> bool:
+    """Whether ``value`` is a constant of the build: a number, a tuple of them (or of
+    names), or a non-empty table of numbers by name (not a module's cache, a growing dict)."""
+    if isinstance(value, (int, float)):
+        return True
+    if isinstance(value, tuple):
+        return all(isinstance(v, (int, float, str)) or _constant(v) for v in value)
+    if isinstance(value, dict):
+        return bool(value) and all(
+            isinstance(k, str) and isinstance(v, (int, float)) for k, v in value.items()
+        )
+    return False
+
+
+def constants_digest() -> str:
+    """A SHA-256 of every upper-case constant (a number, a tuple or a table of numbers) of
+    :data:`_RESULT_MODULES`: a change of any tolerance the decomposition depends on
+    (``COLLAPSE_REL`` was not in the key) gives other cache files, not a stale one."""
+    import importlib
+
+    found = {}
+    for name in _RESULT_MODULES:
+        module = importlib.import_module(name)
+        for attr, value in vars(module).items():
+            if attr.lstrip("_")[:1].isupper() and attr.upper() == attr and _constant(value):
+                found[f"{name}.{attr}"] = value
+    text = json.dumps(found, sort_keys=True)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
 def _raw_key(world: Map, L: float, chord_tol: float | None) -> dict:
     key = {
         "format": FORMAT_VERSION,
-        "tolerances": [
-            _tol.CHORD_TOL_REL,
-            _tol.MERGE_REL,
-            _tol.TOUCH_REL,
-            _tol.THIN_REL,
-            _tol.PROBE_REL,
-            sorted(_tol.KERNEL_FLOOR.items()),
-        ],
+        "constants": constants_digest(),
         "map": world.digest,
         "L": float(L).hex(),
         "chord_tol": None if chord_tol is None else float(chord_tol).hex(),
@@ -227,6 +276,10 @@ def cached_decomposition(
     key = _key(world, L, chord_tol)
     path = cache_path(world, L, chord_tol, cache_dir)
     dec = _read(path, key, world)
+    if dec is not None and not dec.exact:  # warned at its build: warned at every load too
+        from strategies.cspace._build import warn_cached
+
+        warn_cached(dec, _tol.Tolerances.of(world, L, chord_tol), path)
     if dec is None:
         if build is None:
             from strategies.cspace._build import build_decomposition

@@ -34,7 +34,12 @@ import numpy as np
 from envs import validation
 from envs.errors import InvalidConfigError, MemoryBudgetError
 from envs.maps import Map
-from strategies.cspace.cache import CacheWarning, resolve_cache_dir, write_cache_file
+from strategies.cspace.cache import (
+    CacheWarning,
+    constants_digest,
+    resolve_cache_dir,
+    write_cache_file,
+)
 from strategies.cspace.grids import check_grid_spacing, grid_bytes, grid_points
 from strategies.cspace.grids import points_at as _points_at
 from strategies.memory import memory_budget as _memory_budget
@@ -422,9 +427,9 @@ def safety_table(
             "resolution",
             size=f"{math.ceil(1.2 * need / 1e9)}GB",
         )
-    key = (
+    key = (  # the decomposition's constants too: a changed tolerance is another table
         f"{TABLE_VERSION}|{SOURCE}|{world.digest}|{float(L).hex()}|{float(resolution).hex()}"
-        f"|{n_bins}" + ("|distinct" if distinct else "")
+        f"|{n_bins}" + ("|distinct" if distinct else "") + f"|{constants_digest()}"
     )
     path = cache_dir() / f"safety_{hashlib.sha256(key.encode()).hexdigest()[:24]}.npz"
     if disk_cache:

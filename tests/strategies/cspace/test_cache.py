@@ -87,6 +87,43 @@ def test_key_depends_on_map_and_parameters(tmp_path):
     assert f"v{cache_mod.FORMAT_VERSION}" in cache_path(a, 2.0, None, tmp_path).name
 
 
+@pytest.mark.parametrize(
+    ("module", "name"),
+    [
+        ("strategies.cspace.tolerances", "COLLAPSE_REL"),  # was not in the key (helper-142)
+        ("strategies.cspace.tolerances", "COLLAPSE_FLOOR_REL"),
+        ("strategies.cspace.tolerances", "PASSAGE_REL"),
+        ("strategies.cspace.tolerances", "RESOLVED_PASSAGE"),
+        ("strategies.cspace.tolerances", "KERNEL_FLOOR"),
+        ("strategies.cspace.tolerances", "PROBE_REL"),
+        ("strategies.cspace._probing", "CUSP_MARGIN"),
+        ("strategies.cspace._rod", "WEDGE_TOL"),
+        ("envs.tolerances", "ANGLE_TOL"),
+    ],
+)
+def test_key_depends_on_every_constant_of_the_build(tmp_path, monkeypatch, module, name):
+    """A changed tolerance must not read the files built with the old one: the key held
+    five of the tolerances module's constants and not COLLAPSE_REL, the speck size."""
+    import importlib
+
+    world = corridor()
+    before = cache_path(world, 2.0, None, tmp_path)
+    value = getattr(importlib.import_module(module), name)
+    changed = {k: 2 * v for k, v in value.items()} if isinstance(value, dict) else 2 * value
+    monkeypatch.setattr(f"{module}.{name}", changed)
+    assert cache_path(world, 2.0, None, tmp_path) != before
+    monkeypatch.undo()
+    assert cache_path(world, 2.0, None, tmp_path) == before
+
+
+def test_the_key_is_the_same_after_a_build(tmp_path):
+    """The constants' digest reads no module cache that a build fills (``_INDEX``...)."""
+    world = open_room()
+    before = cache_mod.constants_digest()
+    decompose(world, 2.0, cache=False)
+    assert cache_mod.constants_digest() == before
+
+
 def _damaged(tmp_path, damage):
     """Build corridor's entry, damage the file, read it again: (path, dec, warnings)."""
     world = corridor()

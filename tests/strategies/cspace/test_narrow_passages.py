@@ -81,6 +81,26 @@ def test_a_slit_too_narrow_to_resolve_is_reported_not_decided_silently():
     assert "UNRELIABLE" in dec.summary()
 
 
+def test_a_cached_decomposition_that_is_not_exact_warns_when_read_back(tmp_path, monkeypatch):
+    """It warned at its build only: read back from the cache it loaded silently, and only
+    ``summary()`` said UNRELIABLE (helper-142)."""
+    world = _slit(5e-6)
+    with pytest.warns(RuntimeWarning, match="a passage 5e-06 wide"):
+        built = decompose(world, 0.5, cache=True, cache_dir=tmp_path)
+
+    def boom(*args, **kwargs):
+        raise AssertionError("rebuilt although cached")
+
+    monkeypatch.setattr("strategies.cspace._build.build_decomposition", boom)
+    with pytest.warns(RuntimeWarning) as caught:
+        again = decompose(world, 0.5, cache=True, cache_dir=tmp_path)
+    (message,) = [str(w.message) for w in caught if w.category is RuntimeWarning]
+    assert message.startswith("decompose('slit', L=0.5): the arrangement is not exact: ")
+    assert "a passage 5e-06 wide between its walls, narrower than it resolves" in message
+    assert "(read from the cache file " in message and str(tmp_path) in message
+    assert not again.exact and again.stats == built.stats
+
+
 @pytest.mark.parametrize(("width", "L"), [(1e-5, 2.0), (5e-6, 0.5)])
 def test_a_room_thinner_than_the_probes_keeps_its_escapes(width, L):
     """A room 10 long and ``width`` wide, no vertex between its ends: the rod lies along
@@ -176,6 +196,6 @@ def test_cache_keys_change_only_for_narrow_passages():
 
     narrow = _raw_key(_slit(2e-5), 1.5, None)
     assert float.fromhex(narrow["passage"]) == pytest.approx(2e-5, rel=1e-9)
-    keys = {"format", "tolerances", "map", "L", "chord_tol"}
+    keys = {"format", "constants", "map", "L", "chord_tol"}
     assert set(_raw_key(builtin_map("corridor"), 2.0, None)) == keys
     assert set(_raw_key(_slit(0.01), 1.5, None)) == keys

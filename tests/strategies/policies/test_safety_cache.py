@@ -89,6 +89,16 @@ def test_a_file_for_other_parameters_is_never_used(cache):
     assert a.free.shape[1] == BINS and b.free.shape[1] == 24
 
 
+def test_a_table_built_with_other_decomposition_tolerances_is_never_used(cache, monkeypatch):
+    """The table is built from the decomposition: its key names the decomposition's
+    constants too (a changed COLLAPSE_REL read the old table back)."""
+    world = builtin_map("corridor")
+    build(world, L, RES, BINS)
+    monkeypatch.setattr("strategies.cspace.tolerances.COLLAPSE_REL", 2e-5)
+    build(world, L, RES, BINS)
+    assert len(list(cache.glob("safety_*.npz"))) == 2
+
+
 @pytest.mark.skipif(os.geteuid() == 0, reason="root writes anywhere")
 def test_an_unwritable_cache_directory_warns_once(tmp_path, monkeypatch):
     ro = tmp_path / "ro"

@@ -155,6 +155,11 @@ class ShootingEvader(BasePolicy):
     # L_min / V_e of game time (2 L_min of travel); see _fallback_stalled
     STALL_WINDOW = 2.0
     STALL_RADIUS = 0.125
+    # how much closer than the body radius (or the target's own distance) to a wall, in
+    # body radii, a path may pass and still count as one the disc follows (the contact
+    # solver lets a disc pressed to a wall overlap it; 0.089-0.095 from walls at radius
+    # 0.1 on random:star:12). See _disc_reaches
+    DISC_SLACK = 0.25
 
     def _reset(self) -> None:
         c = self.config
@@ -223,6 +228,7 @@ class ShootingEvader(BasePolicy):
         leaves it (for a copy fed another episode's states,
         :class:`~strategies.policies.memory_features.MemoryFeatures`)."""
         self._prev, self._steps = None, 0
+        self._rod = self.config.l_min  # the rod's length at the last decision (at least L_min)
         self._wall_last: tuple[float, float, float] | None = None  # (x, y, distance)
         self._forget()
         self.mode = "start"
@@ -291,7 +297,7 @@ class ShootingEvader(BasePolicy):
         return cand, picked, self._corner_points[near], self._corner_rows[near]
 
     def _best_candidate(
-        self, e: np.ndarray, theta: float, in_sight: bool = False
+        self, e: np.ndarray, theta: float, in_sight: bool = False, disc: bool = False
     ) -> tuple[np.ndarray, str] | None:
         """The candidate endpoint with the largest positive escape margin (the first such
         in the order rays, then visible corners), and the pursuer's branch there.
@@ -302,16 +308,23 @@ class ShootingEvader(BasePolicy):
         its first grid point off the free region, and a wall thinner than the grid can
         lie across it (issue 13: random:convex:11, a spike's tip between the evader and
         the probe it ran at for the whole horizon).
+
+        With ``disc``, only a candidate the evader's disc can follow the straight path to
+        (:meth:`_disc_reaches`), the margins against the rod's present length
+        (:meth:`_margins`' ``rod``): the shots that go before a plan promising nothing.
         """
         rays, ray_rows, corners, corner_rows = self._candidates(e)
         n = len(rays)
         rows = np.concatenate([ray_rows, corner_rows])
-        margin, branch = self._margins(e, theta, np.concatenate([rays, corners]), rows)
+        rod = self._rod if disc else None
+        margin, branch = self._margins(e, theta, np.concatenate([rays, corners]), rows, rod)
         if len(self._banned):
             # targets given up after a stall (_fallback_stalled), and points near them
             near = np.concatenate([rays, corners])[:, None, :] - self._banned[None, :, :]
             gone = np.einsum("ijk,ijk->ij", near, near).min(axis=1) <= self._ban_radius**2
             margin[gone] = -np.inf
+        if disc:
+            return self._disc_candidate(e, rays, corners, margin, branch)
         ex, ey = float(e[0]), float(e[1])
         ray, top = -1, 0.0  # the best probe (in sight if asked) and its margin
         if in_sight:
@@ -338,7 +351,50 @@ class ShootingEvader(BasePolicy):
             return None
         return np.concatenate([rays, corners])[best], str(branch[best])
 
-    def _margins(self, e: np.ndarray, theta: float, cand: np.ndarray, rows=None):
+    def _disc_candidate(self, e, rays, corners, margin, branch) -> tuple[np.ndarray, str] | None:
+        """The candidate with the largest positive margin whose straight path the disc can
+        follow (:meth:`_disc_reaches`), and its branch; ``None`` if there is none."""
+        if not len(margin) or margin.max() <= 0.0:
+            return None
+        cand = np.concatenate([rays, corners])
+        # the clearance a path must keep from a wall: the body radius, or the evader's own
+        # distance where it is pressed closer already (the contact solver lets the disc
+        # overlap a wall a little)
+        floor = min(self.config.body_radius, float(self.map.distance_to_walls(e[None])[0]))
+        for i in np.argsort(-margin, kind="stable").tolist():
+            if margin[i] <= 0.0:
+                return None
+            if self._disc_reaches(e, cand[i], floor):
+                return cand[i], str(branch[i])
+        return None
+
+    def _disc_reaches(self, e: np.ndarray, q: np.ndarray, floor: float) -> bool:
+        """Whether the evader's disc can follow the straight path from ``e`` to ``q``.
+
+        Per wall edge near the path (:meth:`Kernel.edges_near_box`), the segment ``e``-``q``
+        keeps at least ``floor`` from it, or as much as ``q`` itself does (a target closer
+        to a wall than the body radius: the disc slides along that wall to beside it), up
+        to ``DISC_SLACK`` body radii; a segment that crosses an edge is at 0 from it. A
+        target past a wall's end or a spike's tip, in sight of the point, is not reached
+        by the disc pressed to that end (issue 13: random:star:12, rho 0.3, seed 967 vs
+        the decomposition pursuer, shots grazing a tip at 0.001-0.027 with the targets
+        0.08-0.1 from the walls, held for 8 D / V_e where the plan escaped at 16.25 s).
+        """
+        ex, ey, qx, qy = float(e[0]), float(e[1]), float(q[0]), float(q[1])
+        pad = floor
+        idx = self.kernel.edges_near_box(
+            min(ex, qx) - pad, min(ey, qy) - pad, max(ex, qx) + pad, max(ey, qy) + pad
+        )
+        if not isinstance(idx, np.ndarray):
+            idx = np.fromiter(idx, dtype=np.int64, count=len(idx))
+        if not len(idx):
+            return True
+        m = self.map
+        seg, end = _segment_distance(e, q, m.edge_start[idx], m.edge_end[idx])
+        slack = self.DISC_SLACK * self.config.body_radius
+        return bool((seg > np.minimum(floor, end) - slack).all())
+
+    def _margins(self, e: np.ndarray, theta: float, cand: np.ndarray, rows=None, rod=None):
         """Escape margin (radians) per candidate, and which way the pursuer would turn.
 
         The margin is ``-inf`` (and the branch meaningless) where it cannot be positive:
@@ -347,8 +403,16 @@ class ShootingEvader(BasePolicy):
         ``alpha - theta = +-pi/2``: ``(V_p / L)(1 - rho)``, a lower bound of every
         rate of its branch) while the evader gets there.
 
+        With ``rod`` (the rod's present length, at least L_min) the pursuer turns at the
+        rate of eq. (6) for the shortest rod it can have by then, ``rod`` shortened at
+        V_p + V_e down to L_min, rather than at L_min's throughout: from a long rod it
+        turns slower (issue 13: random:polygons:7202 and random:convex:7204 at rho 0.2,
+        L in [2, 6], starts the referee certifies evader wins within 1.3-5.2 s with the
+        rod near L_max, held for 8 D / V_e).
+
         Args:
             rows: the candidates' table rows, if known.
+            rod: the rod's length (``None``: L_min).
         """
         c, tab = self.config, self.table
         rows = tab.rows(cand) if rows is None else rows
@@ -371,9 +435,11 @@ class ShootingEvader(BasePolicy):
         dist = _row_norms(d)
         rho = min(self.rho, 1.0)
         k = c.v_pursuer / c.l_min
+        long = rod is not None and rod > c.l_min
         # the Euler rotation below is at least k (1 - rho) dist / V_e each way (up to
-        # rounding, ~1e-14 rad): a candidate needing no more than that has no margin
-        least = k * (1.0 - rho) * dist / c.v_evader
+        # rounding, ~1e-14 rad; k at the longest rod it reckons with): a candidate
+        # needing no more than that has no margin
+        least = (c.v_pursuer / rod if long else k) * (1.0 - rho) * dist / c.v_evader
         up = np.minimum(need_ccw[live], need_cw[live]) - least + 1e-9 > 0
         if not up.any():
             return margin, branch
@@ -387,8 +453,11 @@ class ShootingEvader(BasePolicy):
         alpha2, dt2 = np.concatenate([alpha, alpha]), np.concatenate([dt, dt])
         sign = np.repeat([1.0, -1.0], m)
         th = np.full(2 * m, theta)
-        for _ in range(_EULER):
+        shorten = (c.v_pursuer + c.v_evader) * dt2  # the most the rod shortens a sub-step
+        for j in range(_EULER):
             phi = alpha2 - th
+            if long:  # the shortest rod by the end of this sub-step
+                k = c.v_pursuer / np.maximum(c.l_min, rod - (j + 1) * shorten)
             # (rho <= 1: |rho cos phi| <= 1 after rounding too, so the root's argument is
             # never negative)
             rate = k * (-rho * np.sin(phi) + sign * np.sqrt(1 - (rho * np.cos(phi)) ** 2))
@@ -403,6 +472,7 @@ class ShootingEvader(BasePolicy):
     def _decide(self, snap: Snapshot) -> np.ndarray:
         c = self.config
         e, theta = snap.evader, snap.theta
+        self._rod = max(float(snap.L), c.l_min)
         if not self.memory:
             self._forget()
         if c.rho > 1.0:
@@ -415,7 +485,17 @@ class ShootingEvader(BasePolicy):
         heading = self._plan_heading(e, theta)
         if heading is not None and self.plan.rank[self._plan_cell] < len(self.plan.rank):
             self._shoot_first = False  # a rank below n_cells: a route the disc can take
-        if heading is not None and not self._shoot_first:
+        # a plan whose rank is at least n_cells counts a crossing the disc cannot make and
+        # promises nothing: a shot with a positive margin against the rod's present length
+        # whose path the disc can follow goes first there too, not only from a dead end
+        # (issue 13: random:polygons:7202, rho 0.2, L in [2, 6], from a start the referee
+        # certifies an evader win within 3.9 s, walked a rank-1387 plan for 428 s)
+        void = (
+            heading is not None
+            and not self._shoot_first
+            and self.plan.rank[self._plan_cell] >= len(self.plan.rank)
+        )
+        if heading is not None and not self._shoot_first and not void:
             self.mode = "plan"
             self._arc, self._in_sight = None, False
             self._track.clear()
@@ -436,7 +516,7 @@ class ShootingEvader(BasePolicy):
             and math.hypot(float(e[0]) - last[0], float(e[1]) - last[1]) < c.v_evader * c.dt
         ):
             self._in_sight = True
-        best = self._best_candidate(e, theta, in_sight=self._in_sight)
+        best = self._best_candidate(e, theta, in_sight=self._in_sight, disc=void)
         if best is not None:
             self.mode = "shoot"
             self._shot = (float(e[0]), float(e[1]), self._steps)
@@ -444,6 +524,14 @@ class ShootingEvader(BasePolicy):
             return c.v_evader * self._start_arc(e, theta, *best)
         if heading is not None:
             # no shot: back to the plan (and to the plan first, until the next dead end)
+            if void:
+                # the plan steers: the fallback's track starts again (a stall is counted
+                # over the shots and the pressure since the plan last steered, not over
+                # the plan's own steps: random:star:2017, rho 0.3, seed 849 banned the
+                # target it shot at from a void plan, and the herd that escaped at
+                # 385 s never began)
+                self._track.clear()
+                self._track_targets.clear()
             self._shoot_first = False
             self.mode = "plan"
             self._arc, self._in_sight = None, False
@@ -828,6 +916,31 @@ def herd_corners(m, min_turn: float) -> np.ndarray:
     b = m.edge_normal[m.vertex_next_edge[idx]]
     cos = np.clip(np.einsum("ij,ij->i", a, b), -1.0, 1.0)
     return idx[cos <= math.cos(math.radians(min_turn)) + 1e-12]
+
+
+def _segment_distance(
+    p: np.ndarray, q: np.ndarray, a: np.ndarray, b: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """(k,) distances from the segment ``p``-``q`` to each segment ``a[i]``-``b[i]`` (0
+    where they cross: otherwise the least of the four end-to-segment distances), and from
+    ``q`` to each."""
+
+    def to_seg(x: np.ndarray, s: np.ndarray, t: np.ndarray) -> np.ndarray:
+        st = t - s
+        ll = np.einsum("...j,...j->...", st, st)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            f = np.einsum("...j,...j->...", x - s, st) / ll
+        f = np.clip(np.nan_to_num(f), 0.0, 1.0)
+        return _row_norms(np.broadcast_to(x - s - f[..., None] * st, a.shape))
+
+    end = to_seg(q, a, b)
+    d = np.minimum(np.minimum(to_seg(p, a, b), end), np.minimum(to_seg(a, p, q), to_seg(b, p, q)))
+    pq, ab = q - p, b - a
+    c1 = pq[0] * (a[:, 1] - p[1]) - pq[1] * (a[:, 0] - p[0])
+    c2 = pq[0] * (b[:, 1] - p[1]) - pq[1] * (b[:, 0] - p[0])
+    c3 = ab[:, 0] * (p[1] - a[:, 1]) - ab[:, 1] * (p[0] - a[:, 0])
+    c4 = ab[:, 0] * (q[1] - a[:, 1]) - ab[:, 1] * (q[0] - a[:, 0])
+    return np.where((c1 * c2 < 0.0) & (c3 * c4 < 0.0), 0.0, d), end
 
 
 def _row_norms(d: np.ndarray) -> np.ndarray:

@@ -489,11 +489,17 @@ class ShootingEvader(BasePolicy):
         # promises nothing: a shot with a positive margin against the rod's present length
         # whose path the disc can follow goes first there too, not only from a dead end
         # (issue 13: random:polygons:7202, rho 0.2, L in [2, 6], from a start the referee
-        # certifies an evader win within 3.9 s, walked a rank-1387 plan for 428 s)
+        # certifies an evader win within 3.9 s, walked a rank-1387 plan for 428 s). Only
+        # while the rod is longer than the pursuer can close to L_min in a shot's replan
+        # period (at V_p + V_e): that advantage does not last, and where the rod is near
+        # L_min the shot's margin is L_min's and the plan did at least as well
+        # (two_rooms~rot2.2, rho 0.5, L in [1, 1.5], seed 619 vs decomposition, the rod
+        # 1.12: a shot a step before the base's, occluded at 24.44 s -> held)
         void = (
             heading is not None
             and not self._shoot_first
             and self.plan.rank[self._plan_cell] >= len(self.plan.rank)
+            and self._rod - (c.v_pursuer + c.v_evader) * self.replan * c.dt > c.l_min
         )
         if heading is not None and not self._shoot_first and not void:
             self.mode = "plan"

@@ -14,7 +14,10 @@ Sec. 5 "minimax": its tip meets walls as if the rod were that long):
    cannot make, so the rank promises nothing) the plan can end in a *dead end*, a cell
    whose every via is such a piece; from there on the evader shoots first (step 2) and
    takes the plan only where no shot has a positive margin, until it reaches a cell
-   whose rank is a guarantee.
+   whose rank is a guarantee. Before such a plan, while the rod is longer than the
+   pursuer can close to L_min in a replan period, a shot goes first too: one whose
+   straight path the evader's disc can follow, its margin against the rod's present
+   length (the pursuer turns slower on a long rod).
 2. **Shooting escape**: candidate endpoints (Fig. 13) are points the evader can reach in
    a straight line (probes on rays, and points just past each convex obstacle vertex in
    reach) where the current orientation is not safe. For each, the rotation the pursuer
@@ -377,8 +380,9 @@ class ShootingEvader(BasePolicy):
         to ``DISC_SLACK`` body radii; a segment that crosses an edge is at 0 from it. A
         target past a wall's end or a spike's tip, in sight of the point, is not reached
         by the disc pressed to that end (issue 13: random:star:12, rho 0.3, seed 967 vs
-        the decomposition pursuer, shots grazing a tip at 0.001-0.027 with the targets
-        0.08-0.1 from the walls, held for 8 D / V_e where the plan escaped at 16.25 s).
+        the decomposition pursuer: shots before a void plan at targets 0.08-0.1 from the
+        walls, their paths grazing a tip at 0.001-0.027, held it for 8 D / V_e; walking
+        the plan escapes at 16.25 s).
         """
         ex, ey, qx, qy = float(e[0]), float(e[1]), float(q[0]), float(q[1])
         pad = floor

@@ -1,0 +1,64 @@
+"""What the shooting evader's shots before a void plan check (issue 13): the disc can
+follow the straight path to the target, and the margin is taken against the rod's present
+length (a pursuer on a long rod turns slower than at L_min).
+
+The room: 10 x 10 with a thin wall (0.05 thick) from the floor up to y = 5 at x = 5; the
+evader's body radius 0.1, its centre at the wall's west face just below the tip.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from envs.maps import Map
+from envs.surveillance.config import EnvConfig
+from strategies.policies.shooting import ShootingEvader
+
+_WALL = [(4.975, 0.0), (5.025, 0.0), (5.025, 5.0), (4.975, 5.0)]
+_E = np.array([4.875, 4.9])  # 0.1 from the wall's west face, 0.1 below its tip
+
+
+@pytest.fixture(scope="module")
+def evader() -> ShootingEvader:
+    m = Map([(0, 0), (10, 0), (10, 10), (0, 10)], [_WALL], name="wall_tip", merge=True)
+    ev = ShootingEvader()
+    config = EnvConfig(map=m, l_min=2.0, l_max=6.0, v_pursuer=1.0, v_evader=0.2, body_radius=0.1)
+    ev.reset(role="evader", map=m, config=config, seed=0)
+    return ev
+
+
+@pytest.mark.parametrize("q", [(5.2, 5.3), (5.2, 5.6), (5.0, 5.4)])
+def test_a_target_round_the_tip_in_sight_of_the_point_is_not_one_the_disc_reaches(evader, q):
+    # the straight paths pass 0.015, 0.049 and 0.073 from the tip: the disc (0.1) stops there
+    q = np.array(q)
+    assert evader.kernel.line_of_sight(_E, q)
+    assert not evader._disc_reaches(_E, q, 0.1)
+
+
+@pytest.mark.parametrize("q", [(4.9, 3.0), (4.95, 3.0), (4.5, 6.0)])
+def test_a_target_along_the_wall_or_in_the_open_is_reached(evader, q):
+    # along the wall to a target nearer it than the body radius (0.075, 0.025): the disc
+    # slides along the wall to beside it; (4.5, 6) is clear of everything by 0.1
+    assert evader._disc_reaches(_E, np.array(q), 0.1)
+
+
+def test_a_target_across_the_wall_is_not_reached(evader):
+    assert not evader._disc_reaches(_E, np.array([5.2, 3.0]), 0.1)
+
+
+def test_a_long_rod_leaves_more_margin_than_l_min(evader):
+    # the rod along +x (theta 0) from 0.975 west of the wall: at every candidate 0.3 away
+    # the pursuer must turn it off the wall. Against a rod of 5.5 it turns slower (its
+    # least rod length 5.5 - (V_p + V_e) t, never below L_min, not L_min throughout): every
+    # margin is larger (0.16-0.46 rad at L_min, 0.55-0.90 at 5.5)
+    e = np.array([4.0, 3.0])
+    ang = np.linspace(0.0, 2.0 * np.pi, 48, endpoint=False)
+    cand = e + 0.3 * np.stack([np.cos(ang), np.sin(ang)], axis=1)
+    short, _ = evader._margins(e, 0.0, cand)
+    long, _ = evader._margins(e, 0.0, cand, rod=5.5)
+    assert np.isfinite(short).all()
+    assert (long > short + 0.1).all()
+    # a rod at L_min: L_min's margins exactly
+    same, _ = evader._margins(e, 0.0, cand, rod=2.0)
+    assert np.array_equal(same, short)

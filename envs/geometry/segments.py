@@ -16,7 +16,14 @@ import math
 
 import numpy as np
 
-__all__ = ["point_in_walls", "scan_segment", "segment_contacts"]
+__all__ = [
+    "cross2d",
+    "point_in_walls",
+    "point_segment_distance",
+    "scan_segment",
+    "segment_contacts",
+    "segment_distance",
+]
 
 
 def segment_contacts(
@@ -82,6 +89,38 @@ def segment_contacts(
     along = flat & (lo < t_hi) & (hi > t_lo)
     t_vertex = np.where(along & ~vertex_hit, lo, ta)
     return crossing, t_cross, vertex_hit, t_vertex, along
+
+
+def point_segment_distance(x: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Distance from points ``x`` to segments ``a``-``b`` (``(..., 2)`` arrays, broadcast
+    over the leading axes; a zero-length segment is its point)."""
+    ab = b - a
+    ab2 = np.einsum("...j,...j->...", ab, ab)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.einsum("...j,...j->...", x - a, ab) / ab2
+    t = np.clip(np.nan_to_num(t), 0.0, 1.0)
+    foot = a + t[..., None] * ab
+    return np.hypot(x[..., 0] - foot[..., 0], x[..., 1] - foot[..., 1])
+
+
+def segment_distance(p: np.ndarray, q: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Distance between segments ``p``-``q`` and ``a``-``b`` (``(..., 2)`` arrays,
+    broadcast over the leading axes): 0 where they properly cross, else the least of the
+    four end-to-segment distances (exact for two segments that do not cross)."""
+    d = np.minimum(
+        np.minimum(point_segment_distance(p, a, b), point_segment_distance(q, a, b)),
+        np.minimum(point_segment_distance(a, p, q), point_segment_distance(b, p, q)),
+    )
+    d1 = cross2d(q - p, a - p)
+    d2 = cross2d(q - p, b - p)
+    d3 = cross2d(b - a, p - a)
+    d4 = cross2d(b - a, q - a)
+    return np.where((d1 * d2 < 0) & (d3 * d4 < 0), 0.0, d)
+
+
+def cross2d(u: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """The z component of ``u x w`` (``(..., 2)`` arrays, broadcast)."""
+    return u[..., 0] * w[..., 1] - u[..., 1] * w[..., 0]
 
 
 def point_in_walls(x: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -51,6 +51,7 @@ import numpy as np
 
 from envs import validation
 from envs.geometry import kernel_for
+from envs.geometry.segments import point_segment_distance, segment_distance
 from strategies.control.evasion import capped_step, escape_path
 from strategies.cspace.tolerances import diameter
 from strategies.policies.base import (
@@ -394,7 +395,9 @@ class ShootingEvader(BasePolicy):
         if not len(idx):
             return True
         m = self.map
-        seg, end = _segment_distance(e, q, m.edge_start[idx], m.edge_end[idx])
+        a, b = m.edge_start[idx], m.edge_end[idx]
+        seg = segment_distance(e, q, a, b)
+        end = point_segment_distance(q, a, b)
         slack = self.DISC_SLACK * self.config.body_radius
         return bool((seg > np.minimum(floor, end) - slack).all())
 
@@ -926,31 +929,6 @@ def herd_corners(m, min_turn: float) -> np.ndarray:
     b = m.edge_normal[m.vertex_next_edge[idx]]
     cos = np.clip(np.einsum("ij,ij->i", a, b), -1.0, 1.0)
     return idx[cos <= math.cos(math.radians(min_turn)) + 1e-12]
-
-
-def _segment_distance(
-    p: np.ndarray, q: np.ndarray, a: np.ndarray, b: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """(k,) distances from the segment ``p``-``q`` to each segment ``a[i]``-``b[i]`` (0
-    where they cross: otherwise the least of the four end-to-segment distances), and from
-    ``q`` to each."""
-
-    def to_seg(x: np.ndarray, s: np.ndarray, t: np.ndarray) -> np.ndarray:
-        st = t - s
-        ll = np.einsum("...j,...j->...", st, st)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            f = np.einsum("...j,...j->...", x - s, st) / ll
-        f = np.clip(np.nan_to_num(f), 0.0, 1.0)
-        return _row_norms(np.broadcast_to(x - s - f[..., None] * st, a.shape))
-
-    end = to_seg(q, a, b)
-    d = np.minimum(np.minimum(to_seg(p, a, b), end), np.minimum(to_seg(a, p, q), to_seg(b, p, q)))
-    pq, ab = q - p, b - a
-    c1 = pq[0] * (a[:, 1] - p[1]) - pq[1] * (a[:, 0] - p[0])
-    c2 = pq[0] * (b[:, 1] - p[1]) - pq[1] * (b[:, 0] - p[0])
-    c3 = ab[:, 0] * (p[1] - a[:, 1]) - ab[:, 1] * (p[0] - a[:, 0])
-    c4 = ab[:, 0] * (q[1] - a[:, 1]) - ab[:, 1] * (q[0] - a[:, 0])
-    return np.where((c1 * c2 < 0.0) & (c3 * c4 < 0.0), 0.0, d), end
 
 
 def _row_norms(d: np.ndarray) -> np.ndarray:

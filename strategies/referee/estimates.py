@@ -93,10 +93,11 @@ from scipy.spatial import cKDTree
 from envs import validation as V
 from envs.errors import InvalidConfigError
 from envs.geometry import kernel_for
+from envs.geometry.segments import cross2d
 from strategies.referee._budget import check_budget, estimate_size
 from strategies.referee._fixpoint import shifted
 from strategies.referee.cache import load_arrays, save_arrays
-from strategies.referee.lattice import Lattice, _cross, segment_wall_distance
+from strategies.referee.lattice import Lattice, segment_wall_distance
 from strategies.referee.robust import convex_corners
 from strategies.referee.spec import GameSpec, Resolution, check_cells_per_lmin
 
@@ -163,9 +164,9 @@ def _segment_origin_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def _in_triangle(w, a, b, c) -> np.ndarray:
     """Whether the points w lie in the closed triangles (a, b, c) (arrays (..., 2))."""
-    s1 = _cross(b - a, w - a)
-    s2 = _cross(c - b, w - b)
-    s3 = _cross(a - c, w - c)
+    s1 = cross2d(b - a, w - a)
+    s2 = cross2d(c - b, w - b)
+    s3 = cross2d(a - c, w - c)
     return ((s1 >= 0) & (s2 >= 0) & (s3 >= 0)) | ((s1 <= 0) & (s2 <= 0) & (s3 <= 0))
 
 

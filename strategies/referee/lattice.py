@@ -29,6 +29,7 @@ import shapely
 from numpy.lib.stride_tricks import sliding_window_view
 
 from envs.errors import InvalidConfigError
+from envs.geometry.segments import segment_distance
 from strategies.referee.spec import GameSpec, Resolution
 
 __all__ = [
@@ -56,41 +57,14 @@ def segment_wall_distance(A: np.ndarray, B: np.ndarray, world) -> np.ndarray:
     Returns:
         (k,) distances.
     """
-    a = world.edge_start
-    b = world.edge_end
+    a = world.edge_start[None]
+    b = world.edge_end[None]
     out = np.empty(len(A))
-    chunk = max(1, 2_000_000 // max(1, len(a)))
+    chunk = max(1, 2_000_000 // max(1, a.shape[1]))
     for s in range(0, len(A), chunk):
-        P = A[s : s + chunk, None, :]
-        Q = B[s : s + chunk, None, :]
-        d = np.minimum(
-            np.minimum(_point_segment(P, a[None], b[None]), _point_segment(Q, a[None], b[None])),
-            np.minimum(_point_segment(a[None], P, Q), _point_segment(b[None], P, Q)),
-        )
-        # proper crossings: the endpoints of each segment on strictly opposite sides
-        d1 = _cross(Q - P, a[None] - P)
-        d2 = _cross(Q - P, b[None] - P)
-        d3 = _cross(b[None] - a[None], P - a[None])
-        d4 = _cross(b[None] - a[None], Q - a[None])
-        crossing = (d1 * d2 < 0) & (d3 * d4 < 0)
-        d = np.where(crossing, 0.0, d)
+        d = segment_distance(A[s : s + chunk, None, :], B[s : s + chunk, None, :], a, b)
         out[s : s + chunk] = d.min(axis=1)
     return out
-
-
-def _cross(u: np.ndarray, w: np.ndarray) -> np.ndarray:
-    return u[..., 0] * w[..., 1] - u[..., 1] * w[..., 0]
-
-
-def _point_segment(X: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Distance from points X to segments a-b (broadcasting over leading axes)."""
-    ab = b - a
-    L2 = np.einsum("...j,...j->...", ab, ab)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = np.einsum("...j,...j->...", X - a, ab) / L2
-    t = np.clip(np.nan_to_num(t), 0.0, 1.0)
-    foot = a + t[..., None] * ab
-    return np.hypot(X[..., 0] - foot[..., 0], X[..., 1] - foot[..., 1])
 
 
 def grid_shape(bounds: tuple[float, float, float, float], h: float) -> tuple[int, int, int, int]:

@@ -303,6 +303,7 @@ class DecompositionPursuer(BasePolicy):
         # ORBIT_LOOKAHEAD seconds of (test passed, rod orientation, evader heading)
         self._charging = False
         self._charge_armed = False
+        self._armed_heading = 0.0
         self._charge_log: deque[tuple[bool, float, float]] = deque(
             maxlen=max(1, round(self.ORBIT_LOOKAHEAD / c.dt))
         )
@@ -1190,12 +1191,16 @@ class DecompositionPursuer(BasePolicy):
         enters with the rod within ``CHATTER_ROD`` of where it stood at the test's last
         entry (within ``ORBIT_LOOKAHEAD`` seconds) and the evader's heading has stayed
         within ``CHATTER_HEADING`` of today's since then, the charge is kept while the
-        velocity stays within 70 deg of the rod (``CHARGE_EXIT``): the orbit keeper's
-        turn is carried through. Both stand-still conditions are needed: a hysteresis
-        on every charge (exit at 70 deg, or two steps' hold) lost 11 and 19 herder
-        episodes of the sets for 6 and 11 won, and one armed by the rod alone lost 9 for
-        7 won: a herder heads for a point beyond the pursuer, so its heading turns with
-        the rod (about 2 deg a step) and its charge test is no chatter.
+        velocity stays within 70 deg of the rod (``CHARGE_EXIT``) and its heading within
+        ``CHATTER_HEADING`` of the heading at that entry: the orbit keeper's turn is
+        carried through. Without the last condition a herder armed it at rho 0.3
+        (unseen pillar_centre, combo 1: its heading stood still between two entries,
+        then turned 1.7 deg a step with the held turn; lost at 27.7 s). Both stand-still
+        conditions are needed: a hysteresis on every charge (exit at 70 deg, or two
+        steps' hold) lost 11 and 19 herder episodes of the sets for 6 and 11 won, and
+        one armed by the rod alone lost 9 for 7 won: a herder heads for a point beyond
+        the pursuer, so its heading turns with the rod (about 2 deg a step) and its
+        charge test is no chatter.
         """
         u0, u1 = math.cos(snap.theta), math.sin(snap.theta)
         along = vx * u0 + vy * u1
@@ -1213,8 +1218,13 @@ class DecompositionPursuer(BasePolicy):
                 )
                 if rod_still and heading_still:
                     self._charge_armed = True
+                    self._armed_heading = head
         charging = passed or (
-            self._charging and self._charge_armed and along > self.CHARGE_EXIT * speed
+            self._charging
+            and self._charge_armed
+            and along > self.CHARGE_EXIT * speed
+            # the heading still stands: a herder's turns once the rod swings
+            and abs(math.remainder(head - self._armed_heading, math.tau)) < self.CHATTER_HEADING
         )
         if not charging:
             self._charge_armed = False

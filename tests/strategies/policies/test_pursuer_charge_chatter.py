@@ -81,3 +81,10 @@ def test_a_heading_that_turns_with_the_rod_does_not_arm_it():
 def test_a_rod_that_moved_between_entries_does_not_arm_it():
     seq = [(61, 0), (59, 0), (62, 0), (55, 0), (66, 0)]
     assert _run(_pursuer(), seq) == [False, True, False, True, False]
+
+
+def test_the_charge_held_ends_when_the_heading_turns():
+    # armed as in the fixed-heading chatter, then the heading turns 2 deg: the charge
+    # held at 64 deg off the rod ends (a herder's heading turns with the held turn)
+    seq = [(61, 0), (59, 0), (62, 0), (62.5, 0), (59.2, 0), (66, 2)]
+    assert _run(_pursuer(), seq) == [False, True, False, False, True, False]

@@ -88,3 +88,12 @@ def test_the_charge_held_ends_when_the_heading_turns():
     # held at 64 deg off the rod ends (a herder's heading turns with the held turn)
     seq = [(61, 0), (59, 0), (62, 0), (62.5, 0), (59.2, 0), (66, 2)]
     assert _run(_pursuer(), seq) == [False, True, False, False, True, False]
+
+
+def test_a_heading_that_drifts_like_a_herders_does_not_arm_it():
+    # the chatter of the first test (the angles off the rod 61, 59, 62, 62.3, 59, then
+    # 64), but the heading drifts 0.8 deg between the entries, the rod with it: a
+    # herder's smallest drift between two entries in the sets is 0.71 deg (a walker that
+    # holds its heading: 0.00), so it does not arm and 64 deg is no charge
+    seq = [(61, 0), (59, 0), (62.3, 0.3), (62.9, 0.6), (59.8, 0.8), (64.8, 0.8)]
+    assert _run(_pursuer(), seq) == [False, True, False, False, True, False]

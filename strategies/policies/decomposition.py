@@ -1203,18 +1203,19 @@ class DecompositionPursuer(BasePolicy):
         charge test is no chatter.
 
         The constants, measured at every entry of the test on the base trajectories
-        (helper-138: holds-bench, unseen-p0/p1, heldout-p0 and most of fresh-p0 whole,
-        the herders of the other sets): the straight walker departs from its heading by
-        0.00 deg between two entries, the darter by 0.00 or more than 1 deg (a dart),
-        the orbiter by 0.00 to 0.97 deg, every herder and momentum walker by 0.71 deg or
-        more, so ``CHATTER_HEADING`` (a third of that) arms no herder; at 1 deg it armed
-        herders (no winner changed), at 2 deg it lost pillar_centre's herder again. With
-        the heading fixed the test's edge is fixed and the test enters on the first step
-        inside it, so two entries lie within one step's return turn of each other (0.5
-        to 1.4 deg): ``CHATTER_ROD`` from 1 to 8 deg arms nearly the same episodes.
-        ``CHARGE_EXIT`` from 65 to 80 deg plays the armed episodes alike; at 90 deg
-        (held while the evader closes in at all) it lost holds-bench corner's straight
-        walk, seed 6.
+        of the nine pursuer sets and of the evader sets' episodes against this pursuer
+        (helper-138): the straight walker departs from its heading by 0.00 deg between
+        two entries, the darter by 0.00 or 0.67 deg and more, the orbiter by 0.00 to
+        0.97 deg, the shooting evader by 0.00 or 0.14 to 0.94 deg, every herder and
+        momentum walker by 0.71 deg or more. ``CHATTER_HEADING`` (about a third of
+        that) arms no herder; from 0.25 to 1 deg the sets play alike (at 1 deg herders
+        armed it in 16 episodes, no winner changed), at 2 deg it lost pillar_centre's
+        herder again. With the heading fixed the test's edge is fixed and the test
+        enters on the first step inside it, so two entries lie within one step's return
+        turn of each other (0.5 to 1.4 deg): ``CHATTER_ROD`` from 1 to 8 deg arms nearly
+        the same episodes. ``CHARGE_EXIT`` from 65 to 80 deg plays the armed episodes
+        alike; at 90 deg (held while the evader closes in at all) it lost holds-bench
+        corner's straight walk, seed 6.
         """
         u0, u1 = math.cos(snap.theta), math.sin(snap.theta)
         along = vx * u0 + vy * u1

@@ -17,6 +17,8 @@
   reaches the whole process group; only the parent answers it) from their first
   instruction (a Ctrl-C while they are still importing is no traceback either), closed
   when its ``with`` block ends and terminated when a stop leaves it.
+* :func:`play_rows` plays a script's episodes (in this process, or on such a pool), hands
+  each row to the results file as it completes and prints the progress.
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ import os
 import signal
 import sys
 import threading
+import time
 from collections.abc import Callable, Iterator, Sequence
 from multiprocessing.pool import Pool
 from typing import Any
@@ -41,7 +44,16 @@ from analysis.arguments import (
     why_not_a_file,
 )
 
-__all__ = ["ArgumentParser", "integer", "path_text", "real", "results_file", "run", "worker_pool"]
+__all__ = [
+    "ArgumentParser",
+    "integer",
+    "path_text",
+    "play_rows",
+    "real",
+    "results_file",
+    "run",
+    "worker_pool",
+]
 
 EXIT_CODE = {"SIGINT": 130, "SIGTERM": 143}
 
@@ -178,3 +190,35 @@ def worker_pool(
             pool.terminate()
             pool.join()
             raise
+
+
+def play_rows(
+    todo: Sequence,
+    play: Callable[[Any], dict],
+    write: Callable[[dict], None],
+    won: Callable[[dict], bool],
+    workers: int,
+    initializer: Callable[..., object] | None = None,
+    initargs: tuple = (),
+) -> None:
+    """Play the jobs ``todo`` with ``play`` and ``write`` each row as it completes.
+
+    One worker plays in this process; more play on a :func:`worker_pool` (``initializer``
+    runs in each worker), in completion order. Every 25 rows and at the end, one line:
+    rows played, how many ``won`` says were lost, seconds since the start. A stop leaves
+    the rows written so far (and terminates the pool).
+    """
+    t0 = time.perf_counter()
+    with contextlib.ExitStack() as stack:
+        if workers > 1:
+            pool = stack.enter_context(worker_pool(workers, initializer, initargs))
+            rows = pool.imap_unordered(play, todo)
+        else:
+            rows = map(play, todo)
+        lost = 0
+        for i, row in enumerate(rows, 1):
+            write(row)
+            lost += not won(row)
+            if i % 25 == 0 or i == len(todo):
+                print(f"  {i}/{len(todo)} played, {lost} lost, {time.perf_counter() - t0:.0f} s",
+                      flush=True)  # fmt: skip

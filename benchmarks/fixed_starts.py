@@ -50,7 +50,6 @@ wins per world and opponent, and each loss with the command that replays it.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import json
 import math
 import os
@@ -62,7 +61,7 @@ from collections import Counter, defaultdict
 import episode_rows
 import numpy as np
 import referee_labels
-from bench_cli import ArgumentParser, integer, real, results_file, run, worker_pool
+from bench_cli import ArgumentParser, integer, play_rows, real, results_file, run
 from unseen_opponents import make_opponent
 from unseen_worlds import EVADERS, MAX_CYCLES, PURSUERS, K, diameter, evader_world, pursuer_world
 
@@ -360,21 +359,13 @@ def main(argv=None) -> int:
     done = episode_rows.read(results, row_key)
     todo = selected if args.play_again else [j for j in selected if row_key(j) not in done]
     print(f"{len(selected)} episodes selected, {len(todo)} to play, results in {results}")
-    t0 = time.perf_counter()
-    with episode_rows.appending(results) as write, contextlib.ExitStack() as stack:
-        if args.workers > 1:  # leaving the with block (a stop included) terminates the pool
-            pool = stack.enter_context(worker_pool(args.workers))
-            rows = pool.imap_unordered(play, todo)
-        else:
-            rows = map(play, todo)
-        lost = 0
-        for i, row in enumerate(rows, 1):
+    with episode_rows.appending(results) as write:
+
+        def keep(row: dict) -> None:
             write(row)
             done[row_key(row)] = row
-            lost += not won(row)
-            if i % 25 == 0 or i == len(todo):
-                print(f"  {i}/{len(todo)} played, {lost} lost, {time.perf_counter() - t0:.0f} s",
-                      flush=True)  # fmt: skip
+
+        play_rows(todo, play, keep, won, args.workers)
     report([done[row_key(j)] for j in selected])
     return 0
 

@@ -102,7 +102,6 @@ busy core (load ~4.5 on 2): ``--role pursuer --combos 0`` 10 min, ``--role evade
 
 from __future__ import annotations
 
-import contextlib
 import json
 import math
 import os
@@ -114,7 +113,7 @@ import zlib
 import episode_rows
 import numpy as np
 import referee_labels
-from bench_cli import ArgumentParser, integer, real, results_file, run, worker_pool
+from bench_cli import ArgumentParser, integer, play_rows, real, results_file, run
 from referee_labels import similarity_back
 from unseen_opponents import make_opponent
 
@@ -849,24 +848,13 @@ def main(argv=None) -> int:
     done = episode_rows.read(results, row_key)
     todo = jobs if args.play_again else [j for j in jobs if job_key(j) not in done]
     print(f"{len(jobs)} episodes selected, {len(todo)} to play, results in {results}")
-    t0 = time.perf_counter()
-    with episode_rows.appending(results) as write, contextlib.ExitStack() as stack:
-        if args.workers > 1:  # leaving the with block (a stop included) terminates the pool
-            pool = stack.enter_context(worker_pool(args.workers, _init, (args.max_cycles, args.k)))
-            rows = pool.imap_unordered(play, todo)
-        else:
-            pool, rows = None, map(play, todo)
-        lost = 0
-        for i, row in enumerate(rows, 1):
+    with episode_rows.appending(results) as write:
+
+        def keep(row: dict) -> None:
             write(row)
             done[row_key(row)] = row
-            lost += not _won(row)
-            if i % 25 == 0 or i == len(todo):
-                print(f"  {i}/{len(todo)} played, {lost} lost, {time.perf_counter() - t0:.0f} s",
-                      flush=True)  # fmt: skip
-        if pool is not None:
-            pool.close()
-            pool.join()
+
+        play_rows(todo, play, keep, _won, args.workers, _init, (args.max_cycles, args.k))
     played = [done[job_key(j)] for j in jobs]
     if played:
         report(played, args.referee, args.hindsight, args.max_cycles, args.rotation_bound)

@@ -35,6 +35,8 @@ from collections.abc import Callable, Iterator, Sequence
 from multiprocessing.pool import Pool
 from typing import Any
 
+import episode_rows
+
 from analysis.arguments import (
     integer,
     path_text,
@@ -195,13 +197,16 @@ def worker_pool(
 def play_rows(
     todo: Sequence,
     play: Callable[[Any], dict],
-    write: Callable[[dict], None],
+    results: str | os.PathLike,
+    done: dict,
+    row_key: Callable[[dict], str],
     won: Callable[[dict], bool],
     workers: int,
     initializer: Callable[..., object] | None = None,
     initargs: tuple = (),
 ) -> None:
-    """Play the jobs ``todo`` with ``play`` and ``write`` each row as it completes.
+    """Play the jobs ``todo`` with ``play``, appending each row to ``results`` as it
+    completes and keeping it in ``done`` under ``row_key(row)``.
 
     One worker plays in this process; more play on a :func:`worker_pool` (``initializer``
     runs in each worker), in completion order. Every 25 rows and at the end, one line:
@@ -209,7 +214,7 @@ def play_rows(
     the rows written so far (and terminates the pool).
     """
     t0 = time.perf_counter()
-    with contextlib.ExitStack() as stack:
+    with episode_rows.appending(results) as write, contextlib.ExitStack() as stack:
         if workers > 1:
             pool = stack.enter_context(worker_pool(workers, initializer, initargs))
             rows = pool.imap_unordered(play, todo)
@@ -218,6 +223,7 @@ def play_rows(
         lost = 0
         for i, row in enumerate(rows, 1):
             write(row)
+            done[row_key(row)] = row
             lost += not won(row)
             if i % 25 == 0 or i == len(todo):
                 print(f"  {i}/{len(todo)} played, {lost} lost, {time.perf_counter() - t0:.0f} s",

@@ -359,13 +359,7 @@ def main(argv=None) -> int:
     done = episode_rows.read(results, row_key)
     todo = selected if args.play_again else [j for j in selected if row_key(j) not in done]
     print(f"{len(selected)} episodes selected, {len(todo)} to play, results in {results}")
-    with episode_rows.appending(results) as write:
-
-        def keep(row: dict) -> None:
-            write(row)
-            done[row_key(row)] = row
-
-        play_rows(todo, play, keep, won, args.workers)
+    play_rows(todo, play, results, done, row_key, won, args.workers)
     report([done[row_key(j)] for j in selected])
     return 0
 

@@ -848,13 +848,9 @@ def main(argv=None) -> int:
     done = episode_rows.read(results, row_key)
     todo = jobs if args.play_again else [j for j in jobs if job_key(j) not in done]
     print(f"{len(jobs)} episodes selected, {len(todo)} to play, results in {results}")
-    with episode_rows.appending(results) as write:
-
-        def keep(row: dict) -> None:
-            write(row)
-            done[row_key(row)] = row
-
-        play_rows(todo, play, keep, _won, args.workers, _init, (args.max_cycles, args.k))
+    play_rows(
+        todo, play, results, done, row_key, _won, args.workers, _init, (args.max_cycles, args.k)
+    )
     played = [done[job_key(j)] for j in jobs]
     if played:
         report(played, args.referee, args.hindsight, args.max_cycles, args.rotation_bound)

@@ -38,7 +38,13 @@ def add_train_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentPar
         metavar="ROUNDS",
         help="alternate ROUNDS (>= 1) rounds of pursuer/evader training instead of one run",
     )
-    parser.add_argument("--progress", action="store_true", help="show SB3's progress bar")
+    parser.add_argument(
+        "--no-progress",
+        action="store_true",
+        help="no progress (default: a bar on a terminal, else a line per tenth of the "
+        "timesteps or per DAgger episode, on stderr)",
+    )
+    parser.add_argument("--progress", action="store_true", help=argparse.SUPPRESS)  # the default
     return parser
 
 
@@ -62,6 +68,7 @@ def run_train(args: argparse.Namespace) -> int:
         overrides["seed"] = args.seed
     config = load_any_config(args.config, **overrides)
     _check_output_dir(os.fspath(config.output_dir))
+    progress = not args.no_progress  # as python -m training.zoo reproduce: on unless told
     if not isinstance(config, TrainConfig):  # a DAgger recipe
         if args.timesteps is not None or args.self_play is not None:
             raise InvalidConfigError(
@@ -71,7 +78,7 @@ def run_train(args: argparse.Namespace) -> int:
         from training.dagger import dagger
 
         try:
-            r = dagger(config, verbose=True)
+            r = dagger(config, verbose=progress)
         except KeyboardInterrupt:
             print(_dagger_resume_note(config), file=sys.stderr)
             raise
@@ -82,7 +89,7 @@ def run_train(args: argparse.Namespace) -> int:
         config = config.replace(total_timesteps=args.timesteps)
     if args.self_play is not None:
         try:
-            results = self_play(config, args.self_play, progress_bar=args.progress).stages
+            results = self_play(config, args.self_play, progress_bar=progress).stages
         except KeyboardInterrupt:
             print(
                 "stopped: rerun the same command to resume (finished stages are kept, the "
@@ -92,7 +99,7 @@ def run_train(args: argparse.Namespace) -> int:
             raise
     else:
         try:
-            results = (train(config, progress_bar=args.progress),)
+            results = (train(config, progress_bar=progress),)
         except KeyboardInterrupt:
             print(resume_note(config), file=sys.stderr)
             raise
@@ -145,7 +152,12 @@ def _check_output_dir(text: str) -> None:
 
 
 def cli_train(argv: Sequence[str] | None = None) -> int:
-    """``python -m training CONFIG [--output-dir D] [--timesteps N] [--seed S] [--self-play R]``.
+    """``python -m training CONFIG [--output-dir D] [--timesteps N] [--seed S] [--self-play R]
+    [--no-progress]``.
+
+    Progress goes to stderr unless ``--no-progress``: a bar on a terminal, else a line
+    per tenth of an RL run's timesteps or per DAgger episode (and a DAgger iteration's
+    line on stdout).
 
     Args:
         argv: the arguments (``None``: ``sys.argv[1:]``).

@@ -65,7 +65,7 @@ def self_play(
         rounds: rounds (>= 1); each trains both roles once.
         output_dir: base directory (default ``config.output_dir``).
         warm_start: start each role's later stages from its previous model.
-        progress_bar: show SB3's progress bar.
+        progress_bar: show each stage's progress on stderr (see :func:`training.train.train`).
 
     Returns:
         The :class:`SelfPlayResult`.

@@ -184,3 +184,42 @@ def test_the_summary_names_maps_and_a_pool_as_a_user_writes_them(tiny):
     result = TrainResult(tiny(opponent=("evader/straight", "evader/random")), Path("o"),
                          Path("o/model.zip"), Path("o/p.json"), 64, 1.0, None, None)  # fmt: skip
     assert summary(result).startswith("PPO pursuer vs evader/straight, evader/random on open_room:")
+
+
+def test_cli_train_shows_its_progress_unless_told_not_to(tmp_path, capsys):
+    """``surveil train`` / ``python -m training`` showed progress only given ``--progress``
+    while ``python -m training.zoo reproduce`` shows it by default. Now both do: not a
+    terminal here, so a plain line per tenth of the timesteps on stderr (no bar redraws
+    or escape codes for a log), a line per DAgger episode and iteration; ``--no-progress``
+    silences it and ``--progress`` is still accepted."""
+    from training.dagger import DaggerConfig
+
+    rl = tmp_path / "rl.toml"
+    rl.write_text(
+        'role = "pursuer"\nopponent = "evader/straight"\nn_steps = 32\nbatch_size = 32\n'
+        "eval_episodes = 0\ncheckpoint_freq = 10000\n[env]\nmax_cycles = 30\n"
+    )
+    dag = tmp_path / "dag.toml"
+    dag.write_text(DaggerConfig(role="pursuer", expert="pursuer/greedy",
+                                opponent="evader/straight", maps=("open_room",), iterations=1,
+                                episodes=1, max_cycles=10, epochs=1).to_toml())  # fmt: skip
+    capsys.readouterr()
+    assert cli_train([str(rl), "--output-dir", str(tmp_path / "a"), "--timesteps", "64"]) == 0
+    err = capsys.readouterr().err
+    lines = [line for line in err.splitlines() if line.startswith("ppo pursuer: ")]
+    assert [line.split(" (")[0] for line in lines] == [
+        f"ppo pursuer: {n} of 64 timesteps" for n in (7, 13, 20, 26, 32, 39, 45, 52, 58, 64)
+    ], err
+    assert "\r" not in err and "\x1b" not in err, err
+    assert cli_train([str(dag), "--output-dir", str(tmp_path / "b")]) == 0
+    got = capsys.readouterr()
+    assert "dagger pursuer iteration 0 episode 1/1: " in got.err, got.err
+    assert "iteration 0: " in got.out, got.out
+    quiet = ["--no-progress", "--output-dir"]
+    assert cli_train([str(rl), *quiet, str(tmp_path / "c"), "--timesteps", "64"]) == 0
+    assert cli_train([str(dag), *quiet, str(tmp_path / "d")]) == 0
+    got = capsys.readouterr()
+    assert "timesteps (" not in got.err and "episode 1/1" not in got.err, got.err
+    assert "iteration 0: " not in got.out, got.out
+    assert cli_train([str(rl), "--output-dir", str(tmp_path / "e"), "--timesteps", "64",
+                      "--progress"]) == 0  # fmt: skip

@@ -33,7 +33,7 @@ from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
-from envs.console import reader_gone
+from envs.console import CommandParser, reader_gone
 from envs.errors import InvalidConfigError, MemoryBudgetError, SurveilValueError
 
 __all__ = [
@@ -52,39 +52,6 @@ __all__ = [
 ]
 
 PROG = "surveil"
-
-
-class CommandParser(argparse.ArgumentParser):
-    """``argparse.ArgumentParser`` whose arguments that no parser took are refused by the
-    subcommand they were given to (its usage and help), not by the top-level parser."""
-
-    def parse_args(  # type: ignore[override]
-        self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
-    ) -> argparse.Namespace:
-        """argparse's, but arguments no parser took are refused by the subcommand they
-        were given to: ``surveil policies extra`` points at ``surveil policies --help``
-        (it pointed at ``surveil --help``, whose usage does not show them)."""
-        parsed, extras = self.parse_known_args(args, namespace)
-        if extras:
-            self._chosen(parsed).error(f"unrecognized arguments: {' '.join(extras)}")
-        return parsed
-
-    def _chosen(self, parsed: argparse.Namespace) -> argparse.ArgumentParser:
-        """The (sub)command parser ``parsed`` was read by: the deepest chosen subparser."""
-        parser: argparse.ArgumentParser = self
-        while True:
-            sub = next(
-                (
-                    a
-                    for a in parser._actions  # argparse keeps its subparsers only here
-                    if isinstance(a, argparse._SubParsersAction)
-                ),
-                None,
-            )
-            name = None if sub is None else getattr(parsed, sub.dest or "", None)
-            if sub is None or name not in sub.choices:
-                return parser
-            parser = sub.choices[name]
 
 
 class Parser(CommandParser):

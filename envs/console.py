@@ -1,17 +1,26 @@
-"""A command's standard output whose reader has left (``surveil maps | head -1``).
+"""What every command line of the project shares.
+
+* :func:`reader_gone`: a command's standard output whose reader has left (``surveil maps
+  | head -1``); the command stops silently, with exit code 141 (128 + SIGPIPE, as a
+  shell reports a command killed by it).
+* :class:`CommandParser`: an argument no parser took is refused by the subcommand it was
+  given to (``surveil maps extra``, ``python -m training.zoo list extra``), with that
+  subcommand's usage.
 
 Lives in the bottom layer beside :mod:`envs.pidlock` because the command lines of
 :mod:`analysis` (``surveil``), :mod:`training` (``python -m training``, ``python -m
-training.zoo``) and the benchmark scripts all stop the same way when it happens: silently,
-with exit code 141 (128 + SIGPIPE, as a shell reports a command killed by it).
+training.zoo``) and the benchmark scripts all use it, and :mod:`training` may not import
+:mod:`analysis`.
 """
 
 from __future__ import annotations
 
+import argparse
 import os
 import sys
+from collections.abc import Sequence
 
-__all__ = ["EXIT_READER_GONE", "reader_gone"]
+__all__ = ["EXIT_READER_GONE", "CommandParser", "reader_gone"]
 
 EXIT_READER_GONE = 141  # 128 + SIGPIPE
 
@@ -37,3 +46,36 @@ def reader_gone() -> bool:
         os.dup2(devnull, sys.stdout.fileno())
         os.close(devnull)
     return gone
+
+
+class CommandParser(argparse.ArgumentParser):
+    """``argparse.ArgumentParser`` whose arguments that no parser took are refused by the
+    subcommand they were given to (its usage and help), not by the top-level parser."""
+
+    def parse_args(  # type: ignore[override]
+        self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
+    ) -> argparse.Namespace:
+        """argparse's, but arguments no parser took are refused by the subcommand they
+        were given to: ``surveil policies extra`` points at ``surveil policies --help``
+        (it pointed at ``surveil --help``, whose usage does not show them)."""
+        parsed, extras = self.parse_known_args(args, namespace)
+        if extras:
+            self._chosen(parsed).error(f"unrecognized arguments: {' '.join(extras)}")
+        return parsed
+
+    def _chosen(self, parsed: argparse.Namespace) -> argparse.ArgumentParser:
+        """The (sub)command parser ``parsed`` was read by: the deepest chosen subparser."""
+        parser: argparse.ArgumentParser = self
+        while True:
+            sub = next(
+                (
+                    a
+                    for a in parser._actions  # argparse keeps its subparsers only here
+                    if isinstance(a, argparse._SubParsersAction)
+                ),
+                None,
+            )
+            name = None if sub is None else getattr(parsed, sub.dest or "", None)
+            if sub is None or name not in sub.choices:
+                return parser
+            parser = sub.choices[name]

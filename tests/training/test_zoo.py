@@ -219,6 +219,22 @@ def test_python_m_training_zoo_list_piped_into_head_stops_silently(unbuffered):
     assert err == ""
 
 
+@pytest.mark.parametrize(
+    "argv", [["list", "extra"], ["info", "ppo_pursuer_vs_straight_open_room", "extra"]]
+)
+def test_an_argument_no_subcommand_takes_is_refused_by_its_subcommand(capsys, argv):
+    """``python -m training.zoo list extra`` printed the top-level usage and "python -m
+    training.zoo: error: unrecognized arguments: extra", which does not say that ``list``
+    takes no argument. Now the subcommand refuses it with its own usage, as ``surveil
+    maps extra`` does."""
+    from training.zoo.__main__ import main as zoo_main
+
+    assert zoo_main(argv) == 2
+    err = capsys.readouterr().err
+    assert f"python -m training.zoo {argv[0]}: error: unrecognized arguments: extra" in err
+    assert f"usage: python -m training.zoo {argv[0]} [-h]" in err, err
+
+
 def test_python_m_training_zoo_evaluate_prints_no_python_reprs(capsys):
     """Its causes were a dict ("causes {'too_close': 2}"); its help was reST
     (":mod:`training.zoo`") and said nothing of NAME, --episodes or --seed."""

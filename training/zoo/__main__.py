@@ -7,6 +7,7 @@ import json
 import math
 import sys
 
+from envs.console import CommandParser
 from training import zoo
 from training.cli import run_cli
 from training.train import evaluate_model
@@ -20,7 +21,8 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _main(argv: list[str] | None) -> int:
-    parser = argparse.ArgumentParser(
+    # an argument a subcommand does not take is refused by it (was the top-level usage)
+    parser = CommandParser(
         prog="python -m training.zoo",
         description="The shipped models: list them, show one's provenance, retrain one "
         "from its recipe, or play one against an opponent.",

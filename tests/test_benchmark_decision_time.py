@@ -31,6 +31,40 @@ def test_a_long_map_label_keeps_its_own_column():
         [label, "evader/shooting"],
         [label, "pursuer/greedy"],
     ]
-    assert all(len(r.split()) == 9 for r in rows)  # map, policy and seven figures
+    assert all(len(r.split()) == 10 for r in rows)  # map, policy and eight figures
     # the header's columns line up with the rows': "policy" starts where the names do
     assert {r.index("/") - r.split()[1].index("/") for r in rows} == {header.index("policy")}
+
+
+def test_random_maps_and_other_policies_get_their_own_rows_and_tail_lines():
+    # hidden tests may time decisions on random:* worlds and the other analytic policies
+    out = subprocess.run(
+        [
+            *(sys.executable, "decision_time.py", "--maps", "random:convex:7204"),
+            *("--seeds", "1", "--max-cycles", "3", "--reps", "1", "--clock", "cpu"),
+            *("--others", "evader/straight", "pursuer/tractrix", "evader/shooting"),
+        ],
+        cwd=BENCHMARKS,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=True,
+    ).stdout.splitlines()
+    rows = [line.split() for line in out if line.startswith("random:convex:7204")]
+    # the players, the others once each (a player named again is not replayed twice), the
+    # reference last
+    assert [r[1] for r in rows] == [
+        "pursuer/decomposition",
+        "evader/shooting",
+        "evader/straight",
+        "pursuer/tractrix",
+        "pursuer/greedy",
+    ]
+    assert all(len(r) == 10 and int(r[2]) == 2 for r in rows)  # 3 steps, the first apart
+    tails = [line.split(":")[0] for line in out if line.startswith("tail ")]
+    assert tails == [
+        "tail pursuer/decomposition",
+        "tail evader/shooting",
+        "tail evader/straight",
+        "tail pursuer/tractrix",
+    ]

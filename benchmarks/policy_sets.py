@@ -22,6 +22,16 @@ says when a side's rows come from more than one code version, and exits with sta
 when the candidate lost an episode the base won (0 otherwise; 2 for a
 bad directory or file), so a session can gate on it.
 
+``label DIR`` asks the referee about every start of the pursuer sets in DIR (one solve per
+game, cached on disk; ``--cpl 16 24``: a start undecided at 16 is labelled at 24) and
+prints per set the losses no pursuer could avoid (an escape certified within the
+horizon), those from starts certified for the pursuer (the policy's regrets), the
+undecided ones, and the regret: regrets / episodes from starts certified for the pursuer
+(``benchmarks/set_labels.py``; labels kept in ``SET.labels.jsonl``, ``--labels LDIR``, a
+rerun resumes; ``--losses-only`` labels the lost starts alone)::
+
+    python benchmarks/policy_sets.py label out/base --cpl 16 24 --losses-only
+
 Which side won, per script (their rows differ): ``pursuer_holds.py`` keeps
 ``out["pursuer/decomposition"] = [winner, cause, time, ...]``; ``unseen_worlds.py`` keeps
 ``winner``, ``cause`` and ``t`` (an ``error`` row, a crash, is a loss); ``evader_escapes.py``
@@ -43,7 +53,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import episode_rows
-from bench_cli import integer, path_text, run
+from bench_cli import integer, path_text, real, run
 
 from analysis.arguments import CommandParser, output_dir
 from envs.errors import InvalidConfigError
@@ -352,6 +362,37 @@ def compare(base: str, cand: str, sets: Mapping[str, PolicySet] = SETS) -> int:
     return 1 if lost_any else 0
 
 
+def label(directory: str, names: Sequence[str], cpls: Sequence[float], labels_dir: str | None,
+          losses_only: bool = False, sets: Mapping[str, PolicySet] = SETS) -> int:  # fmt: skip
+    """Label the starts of the pursuer sets ``names`` (default: every pursuer set) in
+    ``directory`` with the referee (:mod:`set_labels`), into ``labels_dir`` (default
+    ``directory``), and print each set's losses, unavoidable ones, regrets, undecided
+    ones and regret.
+
+    Raises:
+        InvalidConfigError: the directory holds no set, a named set is not in it or is not
+            a pursuer set, or a ``cpls`` value is not a resolution.
+    """
+    import set_labels
+
+    cpls = set_labels.check_cpls(cpls)
+    present = _sets_in(directory, sets)
+    for n in names:
+        if n not in present:
+            raise InvalidConfigError(f"{directory!r} holds no results file of set {n} "
+                                     f"({n}.jsonl); it holds {', '.join(present)}")  # fmt: skip
+        set_labels.starts_of(sets[n], {})  # a set of the other role is refused before any solve
+    chosen = list(dict.fromkeys(names)) or [n for n in present if sets[n].role == "pursuer"]
+    if not chosen:
+        raise InvalidConfigError(f"{directory!r} holds no pursuer set ({', '.join(present)}); "
+                                 "expected results of a pursuer set to label")  # fmt: skip
+    out = labels_dir or directory
+    output_dir("--labels", out)
+    read = {n: read_set(os.path.join(directory, f"{n}.jsonl"), sets[n]) for n in chosen}
+    set_labels.label_sets(sets, read, cpls, out, losses_only)
+    return 0
+
+
 def _playing_here() -> dict[str, str]:
     """The environment of a script that plays this checkout's code: :data:`ROOT` first on
     ``PYTHONPATH``. ``python benchmarks/X.py`` puts ``benchmarks/`` on the import path, not
@@ -426,6 +467,20 @@ def main(argv=None) -> int:
     p = sub.add_parser("totals", help="per set in DIR: wins / episodes, code versions")
     p.add_argument("dir", type=path_text("a directory"), metavar="DIR",
                    help="a directory 'run --out DIR' wrote")  # fmt: skip
+    p = sub.add_parser("label", help="the referee's label of each start of pursuer sets in DIR: "
+                       "losses unavoidable, regrets, undecided; the regret per set")  # fmt: skip
+    p.add_argument("dir", type=path_text("a directory"), metavar="DIR",
+                   help="a directory 'run --out DIR' wrote")  # fmt: skip
+    p.add_argument("sets", nargs="*", type=_set_name, metavar="SET",
+                   help="pursuer sets to label (default: every pursuer set in DIR)")  # fmt: skip
+    p.add_argument("--cpl", nargs="+", type=real(0), default=[16.0], metavar="CPL",
+                   help="the referee's cells per L_min (default 16); several: a start "
+                   "undecided at one is labelled at the next")  # fmt: skip
+    p.add_argument("--labels", type=path_text("a directory"), metavar="LDIR",
+                   help="where SET.labels.jsonl go (default: DIR; a rerun resumes)")  # fmt: skip
+    p.add_argument("--losses-only", action="store_true",
+                   help="label the lost starts only (no regret: the winnable starts are "
+                   "not counted)")  # fmt: skip
     p = sub.add_parser("compare", help="per episode: winner changed from BASE to CAND "
                        "(exit 1 when CAND lost one BASE won)")  # fmt: skip
     p.add_argument("base", type=path_text("a directory"), metavar="BASE",
@@ -438,6 +493,8 @@ def main(argv=None) -> int:
         return run_sets(list(dict.fromkeys(args.sets)), args.out, args.workers)
     if args.command == "totals":
         return totals(args.dir)
+    if args.command == "label":
+        return label(args.dir, args.sets, args.cpl, args.labels, args.losses_only)
     return compare(args.base, args.cand)
 
 

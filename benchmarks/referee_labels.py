@@ -28,7 +28,15 @@ import numpy as np
 from envs.errors import InfeasibleError, InvalidPlacementError, MemoryBudgetError
 from envs.maps import Map
 
-__all__ = ["MEANING", "hindsight_summary", "similarity_back", "summary", "tally", "verdict"]
+__all__ = [
+    "MEANING",
+    "hindsight_summary",
+    "judge",
+    "similarity_back",
+    "summary",
+    "tally",
+    "verdict",
+]
 
 # the referee's resolution besides CPL: a fine evader lattice (as pursuer_holds.py always had)
 SOLVE = {"evader_coarse": 2, "evader_steps": 1}
@@ -83,14 +91,29 @@ def verdict(
     ``m`` when the start was played on a similar world. ``"not solved"`` when the solve
     would exceed the memory budget (the reason is printed once per world): the other
     worlds are still labelled."""
+    return judge(m, overrides, start, cpl, back)[0]
+
+
+def judge(
+    m: Map,
+    overrides: Mapping[str, float],
+    start: Mapping[str, object],
+    cpl: float,
+    back: Callable[[object], np.ndarray] | None = None,
+) -> tuple[str, float | None]:
+    """(:func:`verdict`'s label, the certified escape time): for a start certified for
+    the evader, a bound on the time the evader needs to break surveillance against any
+    pursuer (:meth:`Referee.escape_time`, seconds of the game), else None."""
     back = back or (lambda q: np.asarray(q, float))
     ref = _referee(m, overrides, cpl)
     if isinstance(ref, InfeasibleError):
-        return "not solved"
+        return "not solved", None
+    p, e = back(start["pursuer"]), back(start["evader"])
     try:
-        return ref.classify(back(start["pursuer"]), back(start["evader"]))
+        label = ref.classify(p, e)
     except InvalidPlacementError:
-        return "not a start"
+        return "not a start", None
+    return label, ref.escape_time(p, e) if label == "evader" else None
 
 
 def tally(verdicts: Iterable[str], gap: str = MEANING["unknown"]) -> tuple[int, str]:

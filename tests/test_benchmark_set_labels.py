@@ -1,0 +1,200 @@
+"""benchmarks/policy_sets.py label (benchmarks/set_labels.py): the referee's label of each
+start of a pursuer set's rows, the losses it says no pursuer could avoid, the regrets, and
+the regret per set; on rows of ``unseen_worlds.py`` whose starts come from real solves."""
+
+from __future__ import annotations
+
+import importlib
+import json
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from envs.errors import InvalidConfigError
+
+BENCHMARKS = Path(__file__).resolve().parents[1] / "benchmarks"
+
+# open_room~x0.5rot1off(3,-2) at (rho 0.2, L_max 2 L_min, L_min 2) is the open room's game
+# at L in [2, 4], V_p 1, r 0.1 (judged untransformed); the rotated corner's at rho 0.5 the
+# corner's. At 12 cells per L_min the referee certifies pursuer starts in the open room (at
+# 8 none), at 8 a few evader starts in the corner: 2.5 s and 1.3 s a solve.
+ROOM, ROOM_COMBO = "open_room~x0.5rot1off(3,-2)", [0.2, 2.0, 2.0]
+CORNER, CORNER_COMBO = "corner~rot0.37", [0.5, 2.0, 2.0]
+
+
+@pytest.fixture
+def ps(monkeypatch):
+    monkeypatch.syspath_prepend(str(BENCHMARKS))
+    return importlib.import_module("policy_sets")
+
+
+def _solve(name: str, rho: float, cpl: float):
+    from envs.errors import VacuousBoundWarning
+    from envs.maps import builtin_info
+    from strategies.referee import GameSpec, solve
+
+    spec = GameSpec(builtin_info(name).map, 2.0, 4.0, v_pursuer=1.0, v_evader=rho,
+                    body_radius=0.1)  # fmt: skip
+    with warnings.catch_warnings():  # rho 0.5: the pursuer bound certifies nothing (known)
+        warnings.simplefilter("ignore", VacuousBoundWarning)
+        return solve(spec, cpl, evader_coarse=2, evader_steps=1, dt=0.1)  # referee_labels'
+
+
+def ps_similarity_back(rot: float, scale: float, offset):
+    return importlib.import_module("referee_labels").similarity_back(rot, scale, offset)
+
+
+def _forward(rot: float, scale: float, offset):
+    c, s = math.cos(rot), math.sin(rot)
+    r = np.array([[c, -s], [s, c]])
+    return lambda q: (scale * r @ np.asarray(q, float) + offset).tolist()
+
+
+def _pick(ref, kind: str, fwd, back, k: int = 0):
+    """The ``k``-th lattice start of ``kind`` whose played positions (``fwd``: the
+    similarity; ``back`` its inverse, as the tool maps them) the referee labels so."""
+    starts = ref.lattice_starts()
+    found = []
+    for i in np.flatnonzero(starts.label == kind):
+        p, e = starts.pursuer[i], starts.evader[i]
+        if ref.classify(back(fwd(p)), back(fwd(e))) == kind:
+            found.append((p, e))
+            if len(found) > k:
+                return found[k]
+    raise AssertionError(f"no {kind} start")
+
+
+def _row(world, combo, opponent, seed, won, start, horizon=600, t=3.0) -> dict:
+    return {"role": "pursuer", "world": world, "combo": combo, "opponent": opponent,
+            "seed": seed, "horizon": horizon, "winner": "pursuer" if won else "evader",
+            "cause": None if won else "too_close", "t": None if won else t,
+            "steps": horizon if won else round(10 * t), "start": start}  # fmt: skip
+
+
+@pytest.fixture
+def tiny(ps, tmp_path, monkeypatch):
+    """A pursuer set of 7 episodes from 4 starts: in the open room, a start certified for
+    the pursuer lost once and won once, another such start won, an uncertified start lost;
+    in the corner, a start certified for the evader (at 8 cells per L_min) lost within
+    and beyond its certified escape time. (sets, their directory, the escape bound, the
+    shorter horizon in steps)."""
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", str(tmp_path / "cache"))
+    room, corner = _solve("open_room", 0.2, 12), _solve("corner", 0.5, 8)
+    to_room = _forward(1.0, 0.5, (3.0, -2.0))
+    to_corner = _forward(0.37, 1.0, (0.0, 0.0))
+    from_room = ps_similarity_back(1.0, 0.5, (3.0, -2.0))
+    from_corner = ps_similarity_back(0.37, 1.0, (0.0, 0.0))
+
+    def start(fwd, p, e):
+        return {"pursuer": fwd(p), "evader": fwd(e)}
+
+    held, held2 = _pick(room, "pursuer", to_room, from_room), _pick(room, "pursuer", to_room,
+                                                                    from_room, 1)  # fmt: skip
+    gap = _pick(room, "unknown", to_room, from_room)
+    lost = _pick(corner, "evader", to_corner, from_corner)
+    bound = corner.escape_time(*lost)
+    assert bound is not None and 0 < bound < 60
+    late = math.ceil(bound / 0.1) - 1  # a horizon one step short of the certified escape
+    rows = [
+        _row(ROOM, ROOM_COMBO, "herder", 101, False, start(to_room, *held)),
+        _row(ROOM, ROOM_COMBO, "darter", 101, True, start(to_room, *held)),
+        _row(ROOM, ROOM_COMBO, "herder", 104, True, start(to_room, *held2)),
+        _row(ROOM, ROOM_COMBO, "herder", 102, False, start(to_room, *gap)),
+        _row(CORNER, CORNER_COMBO, "herder", 103, False, start(to_corner, *lost)),
+        _row(CORNER, CORNER_COMBO, "darter", 103, False, start(to_corner, *lost), late, 0.5),
+        _row(CORNER, CORNER_COMBO, "herder", 105, True, start(to_corner, *lost)),
+    ]
+    d = tmp_path / "sets"
+    d.mkdir()
+    (d / "tiny.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+    s = ps.PolicySet("tiny", "unseen_worlds.py", ("--role", "pursuer"), "pursuer", 3, 7, "-")
+    return {"tiny": s}, d, bound, late
+
+
+def _table_row(text: str, name: str) -> list[str]:
+    return next(line for line in text.splitlines() if line.startswith(name + " ")).split()
+
+
+def _labels(path: Path) -> list[dict]:
+    return [json.loads(line) for line in path.read_text().splitlines()]
+
+
+def test_label_counts_unavoidable_losses_regrets_and_the_regret(ps, tiny, tmp_path, capsys):
+    """Each start is labelled at 8 cells per L_min, and at 12 only while undecided: the
+    room's starts are certified for the pursuer at 12 (not at 8), the corner's for the
+    evader at 8. The loss from a pursuer start is the regret (1 of the 3 episodes from such
+    starts), the corner's loss within the escape bound unavoidable, the one whose horizon
+    ends before it ``late``, the loss from the uncertified start undecided. A second run
+    labels nothing."""
+    sets, d, bound, late = tiny
+    out = tmp_path / "labels"
+    assert ps.label(str(d), [], [8.0, 12.0], str(out), sets=sets) == 0
+    text = capsys.readouterr().out
+    # episodes, losses, unavoidable, late, regrets, undecided, REGRET
+    assert _table_row(text, "tiny") == ["tiny", "7", "4", "1", "1", "1", "1", "1/3", "=",
+                                        "0.333"]  # fmt: skip
+    assert "cpl 8: 4 starts to label in 2 games" in text
+    assert "cpl 12: 3 starts to label in 1 games" in text  # the corner's start is certified
+    assert "  tiny undecided: 1 unknown" in text
+    assert (f"  regret: tiny {ROOM} {ROOM_COMBO} herder seed=101: too_close at 3.0 s; referee: "
+            "pursuer (cpl 12)") in text  # fmt: skip
+    assert (f"  unavoidable: tiny {CORNER} {CORNER_COMBO} herder seed=103: too_close at 3.0 s; "
+            f"referee: evader (cpl 8), escape within {bound:.1f} s of 60") in text  # fmt: skip
+    assert (f"  late: tiny {CORNER} {CORNER_COMBO} darter seed=103: too_close at 0.5 s; referee: "
+            f"evader (cpl 8), escape within {bound:.1f} s of {late / 10:g}") in text  # fmt: skip
+    assert f"  unknown: tiny {ROOM} {ROOM_COMBO} herder seed=102" in text
+    assert "regrets: 1" in text
+    labels = _labels(out / "tiny.labels.jsonl")
+    assert sorted((x["cpl"], x["label"]) for x in labels) == [
+        (8.0, "evader"), (8.0, "unknown"), (8.0, "unknown"), (8.0, "unknown"),
+        (12.0, "pursuer"), (12.0, "pursuer"), (12.0, "unknown"),
+    ]  # fmt: skip
+    assert ps.label(str(d), ["tiny"], [8.0, 12.0], str(out), sets=sets) == 0
+    again = capsys.readouterr().out
+    assert "cpl 8: 0 starts to label" in again and "cpl 12: 0 starts to label" in again
+    assert _table_row(again, "tiny") == _table_row(text, "tiny")
+    assert len(_labels(out / "tiny.labels.jsonl")) == 7
+
+
+def test_losses_only_labels_the_lost_starts_and_gives_no_regret(ps, tiny, tmp_path, capsys):
+    """``--losses-only``: the start only won (seed 104) is not labelled, so the winnable
+    episodes are not counted: no regret, said so; the regret is still listed."""
+    sets, d, *_ = tiny
+    out = tmp_path / "labels"
+    assert ps.label(str(d), ["tiny"], [12.0], str(out), losses_only=True, sets=sets) == 0
+    text = capsys.readouterr().out
+    assert "cpl 12: 3 lost starts to label in 2 games" in text
+    row = _table_row(text, "tiny")
+    assert row[:7] == ["tiny", "7", "4", "1", "1", "1", "1"]
+    assert "n/a (--losses-only: the winnable starts are not labelled)" in text
+    assert len(_labels(out / "tiny.labels.jsonl")) == 3
+
+
+def test_label_refuses_what_it_cannot_judge(ps, tiny, tmp_path):
+    """An evader set, a set the directory lacks, resolutions that do not increase: refused
+    before any solve, naming what was expected."""
+    sets, d, *_ = tiny
+    ev = ps.PolicySet("ev", "unseen_worlds.py", ("--role", "evader"), "evader", 0, 1, "-")
+    (d / "ev.jsonl").write_text("")
+    both = {**sets, "ev": ev}
+    with pytest.raises(InvalidConfigError, match="expected a pursuer set"):
+        ps.label(str(d), ["ev"], [12.0], None, sets=both)
+    absent = ps.PolicySet("absent", "unseen_worlds.py", ("--role", "pursuer"), "pursuer", 0, 1,
+                          "-")  # fmt: skip
+    with pytest.raises(InvalidConfigError, match="holds no results file of set absent"):
+        ps.label(str(d), ["absent"], [12.0], None, sets={**both, "absent": absent})
+    with pytest.raises(InvalidConfigError, match="expected increasing resolutions"):
+        ps.label(str(d), ["tiny"], [12.0, 8.0], None, sets=sets)
+    with pytest.raises(InvalidConfigError, match="no such directory"):
+        ps.label(str(tmp_path / "nope"), [], [12.0], None, sets=sets)
+    assert not (d / "tiny.labels.jsonl").exists()
+
+
+def test_a_bad_cpl_is_a_usage_error(ps, tmp_path, capsys):
+    with pytest.raises(SystemExit) as exc:
+        ps.main(["label", str(tmp_path), "--cpl", "0"])
+    assert exc.value.code == 2
+    assert "--cpl" in capsys.readouterr().err

@@ -14,13 +14,14 @@ payoff matrices, Nash, ratings, paired tests), :mod:`.report` (Markdown and HTML
 
 from analysis.tournament.driver import RunSummary, default_store, run_tournament
 from analysis.tournament.spec import Spec, load_spec, spec_from_dict
-from analysis.tournament.store import Store, StoreBusyError
+from analysis.tournament.store import Store, StoreBusyError, StoreError
 
 __all__ = [
     "RunSummary",
     "Spec",
     "Store",
     "StoreBusyError",
+    "StoreError",
     "default_store",
     "load_spec",
     "run_tournament",

@@ -19,6 +19,7 @@ run goes.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import os
 import signal
@@ -33,7 +34,7 @@ from typing import Any
 from analysis.tournament.executors import Executor, SerialExecutor, check_backend, make_executor
 from analysis.tournament.identity import plan
 from analysis.tournament.spec import Spec, load_spec, unseen_games
-from analysis.tournament.store import Store
+from analysis.tournament.store import Store, StoreError
 from analysis.tournament.worker import context_for
 
 __all__ = ["RunSummary", "Sequential", "default_store", "run_tournament"]
@@ -167,7 +168,16 @@ def run_tournament(
         ctx = context_for(spec)
         ex = executor or make_executor(backend, workers=workers, address=address)
         summary.backend = ex.describe()
-        _play(db, spec, todo, ctx, ex, summary, progress, test)
+        try:
+            _play(db, spec, todo, ctx, ex, summary, progress, test)
+        except StoreError as exc:  # a full disk: say what is kept and how to go on
+            with contextlib.suppress(StoreError):  # not 'running' when nothing runs it
+                db.end_run(spec.run_id, "interrupted")
+            hint = resume_hint or "run the same spec on the same store again"
+            raise StoreError(
+                f"{exc} ({summary.reused + summary.played} of {summary.planned} matches "
+                f"are stored; the matches in play were lost; to resume: {hint})"
+            ) from exc
         status = "interrupted" if summary.interrupted else "finished"
         if summary.decided and not summary.interrupted:
             status = "decided"

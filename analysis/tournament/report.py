@@ -223,11 +223,7 @@ def _replay(db: Store, run: dict[str, Any], row: dict[str, Any]) -> Replay | Non
     from strategies.policies import make_policy
     from strategies.runner import run_episode
 
-    ident = json.loads(
-        db.conn.execute(
-            "SELECT identity FROM matches WHERE match_id = ?", (row["match_id"],)
-        ).fetchone()[0]
-    )
+    ident = db.identity(row["match_id"])
     geometry = db.map_geometry(ident["map"])
     if geometry is None:
         return None

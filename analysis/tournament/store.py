@@ -21,17 +21,24 @@ every match it has in common and never sees the others.
 One writer at a time: :meth:`Store.lock` takes an exclusive POSIX lock on ``STORE.lock``
 (released by the kernel if the driver dies, not inherited by its workers); a second
 driver is refused with a message naming the holder. Readers (reports, exports) need no
-lock: WAL lets them read while a run writes.
+lock: WAL lets them read while a run writes. A reader writes no schema and no row, and
+reads a store it cannot write (another user's, on a read-only file system) as it is.
+
+A store that cannot be written (read-only, a full disk), is damaged or cannot be read
+raises :class:`StoreError` naming the file, what SQLite said and what to do, wherever
+it happens (opening it, or the thousandth match of a run), never SQLite's bare error.
 """
 
 from __future__ import annotations
 
 import contextlib
 import csv
+import functools
 import json
 import os
 import sqlite3
 import time
+import urllib.parse
 from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
@@ -40,7 +47,7 @@ from analysis.arguments import why_not_a_file
 from envs import pidlock
 from envs.errors import InvalidConfigError, SurveilValueError
 
-__all__ = ["RESULT_FIELDS", "SCHEMA_VERSION", "Store", "StoreBusyError"]
+__all__ = ["RESULT_FIELDS", "SCHEMA_VERSION", "Store", "StoreBusyError", "StoreError"]
 
 SCHEMA_VERSION = 1
 
@@ -103,15 +110,103 @@ class StoreBusyError(SurveilValueError):
     """Another driver holds the store's write lock."""
 
 
+class StoreError(InvalidConfigError):
+    """The store file cannot be written or read: read-only, a full disk, damaged.
+
+    The message names the file, what SQLite (or the system) said and what to do.
+    """
+
+
+# SQLite's primary result codes (https://sqlite.org/rescode.html) a store can meet:
+# 3 PERM, 8 READONLY, 10 IOERR, 11 CORRUPT, 13 FULL, 14 CANTOPEN, 26 NOTADB. Python 3.10
+# has no ``sqlite_errorcode``: its message text is matched
+_SQLITE_TEXT = (
+    ("readonly", 8),
+    ("read-only", 8),
+    ("disk or database is full", 13),
+    ("database or disk is full", 13),
+    ("malformed", 11),
+    ("not a database", 26),
+    ("unable to open", 14),
+    ("disk i/o error", 10),
+)
+
+
+_OS_ERRNO = {1: 3, 13: 3, 28: 13, 30: 8}
+"""The SQLite code of an ``OSError``'s errno: EPERM, EACCES, ENOSPC, EROFS."""
+
+
+def _sqlite_code(exc: BaseException) -> int | None:
+    """SQLite's primary result code of ``exc`` (``None`` if it has none we know)."""
+    code = getattr(exc, "sqlite_errorcode", None)
+    if code is not None:
+        return code & 0xFF
+    text = str(exc).lower()
+    return next((c for t, c in _SQLITE_TEXT if t in text), None)
+
+
+def _problem(
+    path: Path, exc: BaseException, *, writing: bool, errno: int | None = None
+) -> str | None:
+    """The message of a store that cannot be used (``None``: not such an error); an
+    ``OSError`` is read by its ``errno`` (the disk full, no permission, read-only)."""
+    code = _OS_ERRNO.get(errno) if errno is not None else _sqlite_code(exc)
+    if code is None and errno is not None:
+        return f"store {str(path)!r}: cannot write {exc}"
+    said = "SQLite" if errno is None else "the system"
+    if code == 26:
+        return f"store {str(path)!r} is not a tournament store (SQLite): {exc}"
+    if code == 11:
+        return (
+            f"store {str(path)!r} is damaged ({said}: {exc}); the rows still readable can "
+            f"be saved with: sqlite3 {path} .recover > recovered.sql; play into a new --store"
+        )
+    if code == 13:
+        return (
+            f"store {str(path)!r}: the disk is full ({said}: {exc}); what was stored before "
+            "is kept: free some space, then rerun the same command to resume"
+        )
+    if code in (3, 8, 14):
+        if writing:
+            return (
+                f"store {str(path)!r} cannot be written here ({said}: {exc}); a tournament "
+                "writes its store: give --store a file in a place you can write"
+                + (" (surveil report and export read this one as it is)" if path.exists() else "")
+            )
+        return f"store {str(path)!r} cannot be read ({said}: {exc})"
+    if code == 10:
+        return f"store {str(path)!r}: the disk failed to read or write it ({said}: {exc})"
+    return None
+
+
+def _guarded(method: Any) -> Any:
+    """Raise :class:`StoreError` for a SQLite error that means the file cannot be used."""
+
+    @functools.wraps(method)
+    def guarded(self: Store, *args: Any, **kwargs: Any) -> Any:
+        try:
+            return method(self, *args, **kwargs)
+        except sqlite3.DatabaseError as exc:
+            message = _problem(self.path, exc, writing=self.writer)
+            if message is None:
+                raise  # another error: a bug, keep its traceback
+            raise StoreError(message) from exc
+
+    return guarded
+
+
 class Store:
     """A tournament store at ``path`` (created on first use).
 
     Args:
         path: the SQLite file.
-        create: create it if missing (readers pass ``False``).
+        create: create it if missing and write to it (a run); ``False``, a reader
+            (reports, exports), writes no schema and no row, and reads a store it
+            cannot write.
 
     Raises:
         InvalidConfigError: the file is not a tournament store, or of another schema.
+        StoreError: it cannot be written (a writer) or read, or is damaged.
     """
 
     def __init__(self, path: str | os.PathLike[str], *, create: bool = True) -> None:
@@ -121,24 +216,56 @@ class Store:
             # a device (/dev/null) was "no such file" to readers, an SQLite I/O error to
             # writers; a writer creates a missing file
             raise InvalidConfigError(f"store {str(self.path)!r}: {problem}")
-        if create:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
+        self.writer = create
         self._lock_file = None
+        self.conn: sqlite3.Connection | None = None
         try:
-            self.conn = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
+            if create:
+                self.path.parent.mkdir(parents=True, exist_ok=True)
+            self.conn = self._connect()
             self.conn.row_factory = sqlite3.Row
             self._check_foreign(create)
-            mode = self.conn.execute("PRAGMA journal_mode=WAL").fetchone()[0]
-            if mode.lower() != "wal":  # pragma: no cover - e.g. a network file system
-                raise InvalidConfigError(f"store {self.path}: cannot use WAL mode (got {mode})")
-            # NORMAL in WAL mode: a committed match survives any crash of this process
-            self.conn.execute("PRAGMA synchronous=NORMAL")
+            if create:
+                mode = self.conn.execute("PRAGMA journal_mode=WAL").fetchone()[0]
+                if mode.lower() != "wal":  # pragma: no cover - e.g. a network file system
+                    raise InvalidConfigError(f"store {self.path}: cannot use WAL mode (got {mode})")
+                # NORMAL in WAL mode: a committed match survives any crash of this process
+                self.conn.execute("PRAGMA synchronous=NORMAL")
             self.conn.execute("PRAGMA foreign_keys=ON")
             self._init_schema()
-        except sqlite3.DatabaseError as exc:
-            raise InvalidConfigError(
+        except (sqlite3.DatabaseError, OSError) as exc:
+            if self.conn is not None:
+                self.conn.close()
+            if isinstance(exc, OSError):  # making its folder
+                if exc.errno not in _OS_ERRNO:
+                    raise  # said with the folder's name
+                raise StoreError(_problem(self.path, exc, writing=create, errno=exc.errno)) from exc
+            message = _problem(self.path, exc, writing=create) or (
                 f"store {str(self.path)!r} is not a tournament store (SQLite): {exc}"
-            ) from exc
+            )
+            raise StoreError(message) from exc
+
+    def _connect(self) -> sqlite3.Connection:
+        """A connection: a writer's, or a reader's, which writes nothing (and still reads a
+        store it cannot write: another user's, on a read-only file system)."""
+        plain = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
+        if self.writer:
+            return plain
+        try:  # as a writer's (it tidies the -wal and -shm files away on closing)
+            plain.execute("SELECT COUNT(*) FROM sqlite_master").fetchone()
+            return plain
+        except sqlite3.OperationalError as exc:
+            plain.close()
+            if _sqlite_code(exc) not in (8, 14):
+                raise
+        uri = "file:" + urllib.parse.quote(str(self.path.resolve())) + "?mode=ro"
+        if not os.path.exists(f"{self.path}-shm"):
+            # a WAL file nobody has open in a place this user cannot write
+            # (SQLITE_READONLY_DIRECTORY, or CANTOPEN on a read-only file system): SQLite
+            # cannot make the -shm a reader needs, and no writer has it open (its -shm
+            # would be there), so read the file as it is
+            uri += "&immutable=1"
+        return sqlite3.connect(uri, uri=True, timeout=30.0, isolation_level=None)
 
     def _check_foreign(self, create: bool) -> None:
         """Refuse, before writing anything (the schema, WAL mode), a SQLite file that is
@@ -156,13 +283,17 @@ class Store:
         )
 
     def _init_schema(self) -> None:
-        with self.transaction() as c:
-            for stmt in _SCHEMA.strip().split(";"):
-                if stmt.strip():
-                    c.execute(stmt)
-            c.execute("INSERT OR IGNORE INTO meta VALUES ('schema', ?)", (str(SCHEMA_VERSION),))
-            row = c.execute("SELECT value FROM meta WHERE key = 'schema'").fetchone()
-        if int(row[0]) != SCHEMA_VERSION:
+        if not self.writer:  # _check_foreign saw its tables
+            row = self.conn.execute("SELECT value FROM meta WHERE key = 'schema'").fetchone()
+            row = row or ("none",)
+        else:
+            with self.transaction() as c:
+                for stmt in _SCHEMA.strip().split(";"):
+                    if stmt.strip():
+                        c.execute(stmt)
+                c.execute("INSERT OR IGNORE INTO meta VALUES ('schema', ?)", (str(SCHEMA_VERSION),))
+                row = c.execute("SELECT value FROM meta WHERE key = 'schema'").fetchone()
+        if str(row[0]) != str(SCHEMA_VERSION):
             raise InvalidConfigError(
                 f"store {self.path} has schema version {row[0]}, this surveil reads "
                 f"{SCHEMA_VERSION}; use a new store or export the old one with its version"
@@ -204,14 +335,20 @@ class Store:
         # beside the file the path resolves to: a symlink to the store (or another
         # spelling of its path) takes the same lock, not one of its own
         real = self.path.resolve()
+        lock = real.with_name(real.name + ".lock")
         try:
-            self._lock_file = pidlock.acquire(real.with_name(real.name + ".lock"))
+            self._lock_file = pidlock.acquire(lock)
         except pidlock.LockHeldError as e:
             raise StoreBusyError(
                 f"store {self.path} is being written by {e.holder}; wait for that run to "
                 "finish (or stop it) before starting another on this store, or use --store "
                 "with another file"
             ) from None
+        except OSError as exc:  # was a bare "[Errno 28] No space left on device"
+            why = f"its lock file {lock}: {exc.strerror or exc}"
+            raise StoreError(
+                _problem(self.path, OSError(why), writing=True, errno=exc.errno)
+            ) from exc
 
     def unlock(self) -> None:
         """Release the write lock (idempotent)."""
@@ -220,6 +357,7 @@ class Store:
             self._lock_file = None
 
     # ---------------------------------------------------------------- runs
+    @_guarded
     def begin_run(
         self,
         run_id: str,
@@ -268,6 +406,7 @@ class Store:
             c.executemany("INSERT OR IGNORE INTO run_matches VALUES (?,?,?,?,?,?,?,?,?)", rows)
         return self.finished(run_id)
 
+    @_guarded
     def finished(self, run_id: str, *, include_errors: bool = True) -> set[str]:
         """Match ids of ``run_id`` that have a result (``error`` ones unless excluded)."""
         sql = (
@@ -278,6 +417,7 @@ class Store:
             sql += " AND s.status != 'error'"
         return {row[0] for row in self.conn.execute(sql, (run_id,))}
 
+    @_guarded
     def end_run(self, run_id: str, status: str) -> None:
         """Mark a run ``finished``, ``interrupted`` or ``decided``."""
         with self.transaction() as c:
@@ -286,6 +426,7 @@ class Store:
                 (status, time.time(), run_id),
             )
 
+    @_guarded
     def runs(self) -> list[dict[str, Any]]:
         """Every run, newest first, with its counts of planned and finished matches."""
         out = []
@@ -317,6 +458,7 @@ class Store:
         return hits[0]
 
     # ---------------------------------------------------------------- results
+    @_guarded
     def record(self, run_id: str, outcome: Mapping[str, Any]) -> None:
         """Store one finished match (one transaction); errors also go to ``errors``."""
         values = [outcome.get(k) for k in RESULT_FIELDS]
@@ -338,6 +480,7 @@ class Store:
                     ),
                 )
 
+    @_guarded
     def log_error(self, run_id: str, match_id: str | None, kind: str, message: str) -> None:
         """Record a failure that left no result (a crashed or killed worker)."""
         with self.transaction() as c:
@@ -346,6 +489,7 @@ class Store:
                 (run_id, match_id, kind, message, time.time()),
             )
 
+    @_guarded
     def rows(self, run_id: str) -> list[dict[str, Any]]:
         """The finished matches of ``run_id`` (in plan order) as flat dicts."""
         cols = ", ".join(
@@ -360,11 +504,13 @@ class Store:
         )
         return [dict(r) for r in self.conn.execute(sql, (run_id,))]
 
+    @_guarded
     def errors(self, run_id: str) -> list[dict[str, Any]]:
         """The failures logged by ``run_id``, oldest first."""
         sql = "SELECT * FROM errors WHERE run_id = ? ORDER BY id"
         return [dict(r) for r in self.conn.execute(sql, (run_id,))]
 
+    @_guarded
     def record_of(self, match_id: str) -> dict[str, Any] | None:
         """The stored episode record of one match (``None`` if not played)."""
         row = self.conn.execute(
@@ -372,12 +518,22 @@ class Store:
         ).fetchone()
         return None if row is None or row[0] is None else json.loads(row[0])
 
+    @_guarded
+    def identity(self, match_id: str) -> dict[str, Any] | None:
+        """The identity document of one match (``None`` if the store has none)."""
+        row = self.conn.execute(
+            "SELECT identity FROM matches WHERE match_id = ?", (match_id,)
+        ).fetchone()
+        return None if row is None else json.loads(row[0])
+
+    @_guarded
     def map_geometry(self, digest: str) -> dict[str, Any] | None:
         """The stored geometry (``envs.maps.io.map_to_dict`` form) of a map digest."""
         row = self.conn.execute("SELECT geometry FROM maps WHERE digest = ?", (digest,)).fetchone()
         return None if row is None else json.loads(row[0])
 
     # ---------------------------------------------------------------- export
+    @_guarded
     def export(self, run_id: str, path: str | os.PathLike[str]) -> Path:
         """Write a run's results as CSV (``.csv``) or JSON lines (``.jsonl``/``.ndjson``).
 

@@ -32,8 +32,10 @@ at every instant of it; where the evader's motion within a step is not the chord
 path (a wall deflected it), the rod's net turn still differs from the chord's by no more
 than the Lipschitz slack, for the evader's displacement is the chord's and, with
 ``V_p > V_e``, ``V_p - c > 0`` throughout (at ``rho >= 1`` the cap at 0 is a chord-only
-approximation). The sign of ``c`` and the slack are checked against the closed form of an
-orbit round a disc (``tests/strategies/referee/test_rotation_bound.py``).
+approximation). The sign of ``c`` is checked against the closed form of an orbit round a
+disc, the slack against the integrated turn of a rod held at ``L_min`` over one step,
+which the rate at the step's start alone falls short of
+(``tests/strategies/referee/test_rotation_bound.py``).
 
 Where the evader circles an obstacle small enough, the obstacle's shadow (its blocked arc)
 turns with it faster than any rod can turn on the average, and the set empties

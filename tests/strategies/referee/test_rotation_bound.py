@@ -132,7 +132,8 @@ def _relaxed_hold(radius: float, pillar: float, *, faster: float = 0.0, wider: f
     [(0.35, 0.1), (0.4, 0.1), (0.5, 0.2), (0.45, 0.3), (0.6, 0.3), (0.833, 0.1)],
 )
 def test_the_bound_brackets_the_closed_form_of_an_orbit_round_a_disc(radius, pillar):
-    # an independent check of the sign conventions and the slack: no rod turning as eq. 5
+    # an independent check of the sign conventions (not of the slack: these orbits pass
+    # without it; see the next test): no rod turning as eq. 5
     # allows holds past the closed form, so the bound (an over-approximation of that rod)
     # may not empty before it; and it empties no later than the same rod turning faster by
     # the bound's slack per second (the Lipschitz term and two bins a step) against a
@@ -150,6 +151,55 @@ def test_the_bound_brackets_the_closed_form_of_an_orbit_round_a_disc(radius, pil
         assert got is None
     else:
         assert exact <= got <= _relaxed_hold(radius, pillar, faster=slack, wider=bw) + 0.2
+
+
+def _keyhole(evader: np.ndarray, direction: float, half_angle: float) -> Map:
+    """A round room of radius 1.2 round ``evader`` with a straight corridor out of it in
+    ``direction``: a rod of L_min = 2 from ``evader`` is clear only within about
+    ``half_angle`` of ``direction`` (it leaves the room everywhere else)."""
+    u = np.array([math.cos(direction), math.sin(direction)])
+    n = np.array([-u[1], u[0]])
+    h = 2.0 * math.sin(half_angle)  # the corridor's half width
+    eps = math.asin(h / 1.2)
+    arc = np.linspace(direction + eps, direction - eps + 2.0 * math.pi, 96)
+    room = [evader + 1.2 * np.array([math.cos(a), math.sin(a)]) for a in arc]
+    ring = [evader + 3.0 * u + h * n, *room, evader + 3.0 * u - h * n]
+    return Map([tuple(p) for p in ring], name="keyhole")
+
+
+def test_the_lipschitz_slack_keeps_every_orientation_a_rod_can_turn_to_in_a_step():
+    # c = cross(u, v_E) changes as the rod turns within a step, and the bound grows each
+    # bin by eq. 5's rate at the step's start plus a Lipschitz slack for that change
+    # (V_e times the turn and the bin). An independent check: integrate the turn of a rod
+    # held at L_min by a pursuer at full speed (matching the evader's motion along the
+    # rod, the rest across it: theta' = (sqrt(V_p^2 - r^2) - c) / L_min, r = dot(u, v_E))
+    # over one step of 1 s, the evader moving at V_e 40 degrees clockwise of the rod
+    # (towards the pursuer). That rod reaches 0.6926 rad; the rate at the step's start
+    # alone gives 0.6607. A frame whose only clear rods lie in [0.6696, 0.6856] therefore
+    # proves nothing; dropping the slack or flipping its sign proved the evader's win
+    # there (1.0 s). The same frame with the corridor at 1.2 rad, beyond the turn (the
+    # bound's own reach: 0.85), is proven: the keyhole blocks every other rod.
+    from scipy.integrate import solve_ivp
+
+    vp, ve, lmin, dt = 1.0, 0.5, 2.0, 1.0
+    a = math.radians(-40.0)
+    v = ve * np.array([math.cos(a), math.sin(a)])
+
+    def rate(t, y):
+        u = np.array([math.cos(y[0]), math.sin(y[0])])
+        c, r = u[0] * v[1] - u[1] * v[0], float(u @ v)
+        return [(math.sqrt(vp * vp - r * r) - c) / lmin]
+
+    reach = float(solve_ivp(rate, (0.0, dt), [0.0], rtol=1e-12, atol=1e-12).y[0, -1])
+    assert reach == pytest.approx(0.6926, abs=1e-4)
+    e1 = np.array([8.0, 8.0])
+    path = np.stack([e1 - v * dt, e1])
+    start = path[0] + np.array([2.0, 0.0])  # the rod at theta = 0
+    for window, proven in ((reach - 0.015, None), (1.2, dt)):
+        world = _keyhole(e1, window, 0.008)
+        config = EnvConfig(map=world, l_min=lmin, l_max=4.0, v_pursuer=vp, v_evader=ve,
+                           body_radius=0.01, dt=dt)  # fmt: skip
+        assert rotation_bound(config, path, start) == proven, window
 
 
 def test_a_standing_evader_in_an_open_room_proves_nothing():

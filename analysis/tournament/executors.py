@@ -157,10 +157,17 @@ def _die_with_parent(parent: int) -> None:
     threading.Thread(target=watch, daemon=True).start()
 
 
+_STOP_SIGNALS = {signal.SIGINT, signal.SIGTERM}
+
+
 def _worker_main(conn: Connection, ctx: Context, parent: int, board: Board) -> None:
-    _die_with_parent(parent)
+    # born with these blocked (see _Worker): the driver's handlers, which a forked worker
+    # inherits, must never run here
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the driver's business
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    if hasattr(signal, "pthread_sigmask"):
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, _STOP_SIGNALS)
+    _die_with_parent(parent)
     warm_up(ctx)  # before the first match's clock starts, as a Ray worker does
     while True:
         try:
@@ -185,7 +192,19 @@ class _Worker:
             daemon=True,
             name="surveil-tournament-worker",
         )
-        self.proc.start()
+        # A forked worker inherits the driver's SIGINT and SIGTERM handlers until
+        # _worker_main replaces them: a SIGTERM from close() (a Ctrl-C as the pool
+        # starts) ran the driver's handler there, so the worker lived on until killed a
+        # second later, or printed "KeyboardInterrupt: SIGTERM" with a traceback. Born with
+        # both blocked, it takes them only once its own dispositions are in place.
+        masked = hasattr(signal, "pthread_sigmask")
+        if masked:
+            before = signal.pthread_sigmask(signal.SIG_BLOCK, _STOP_SIGNALS)
+        try:
+            self.proc.start()
+        finally:
+            if masked:
+                signal.pthread_sigmask(signal.SIG_SETMASK, before)
         child.close()
         self.batch: collections.deque[Match] = collections.deque()
         self.current: Match | None = None

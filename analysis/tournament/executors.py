@@ -520,6 +520,8 @@ class RayExecutor(Executor):
             raise InvalidConfigError("--backend ray needs Ray: pip install 'surveil[ray]'") from exc
         self.ray = ray
         self.started = False
+        self.inflight: dict[Any, _RayTask] = {}  # task (an ObjectRefGenerator): its state
+        self.mailbox: Any = None
         if not ray.is_initialized():
             kwargs: dict[str, Any] = {
                 "include_dashboard": False,
@@ -528,9 +530,12 @@ class RayExecutor(Executor):
             }
             if address is None:
                 kwargs["num_cpus"] = num_cpus
-            ray.init(address=address, **kwargs)
-            self.started = True
-        self.cluster_cpus = max(1, int(ray.cluster_resources().get("CPU", 1)))
+            self._init(address, kwargs)
+        try:
+            self.cluster_cpus = max(1, int(ray.cluster_resources().get("CPU", 1)))
+        except BaseException:  # a Ctrl-C here too: the caller has no executor to close
+            self.close()
+            raise
         # num_cpus also caps the work in flight on a cluster (--address) or on an instance
         # this process had started: it was ignored there, and every CPU was used
         self.cpus = self.cluster_cpus if num_cpus is None else min(num_cpus, self.cluster_cpus)
@@ -538,8 +543,29 @@ class RayExecutor(Executor):
         # second task would run on a CPU of the cluster's beyond it)
         self.max_inflight = 2 * self.cpus if self.cpus == self.cluster_cpus else self.cpus
         self.task = ray.remote(num_cpus=1, max_retries=0)(_ray_play)
-        self.inflight: dict[Any, _RayTask] = {}  # task (an ObjectRefGenerator): its state
-        self.mailbox: Any = None
+
+    def _init(self, address: str | None, kwargs: dict[str, Any]) -> None:
+        """``ray.init``, stopped cleanly by Ctrl-C or SIGTERM (it takes seconds).
+
+        ``ray.init`` sets a SIGTERM handler of its own (``sys.exit(15)``): a SIGTERM while
+        Ray started, or before the run's own handler was in place, ended ``surveil`` with
+        exit code 15, no message, and Ray's dashboard and runtime-env agents alive after
+        it (a Ctrl-C then left them too). The handler that was there is put back, and an
+        interrupted start shuts down what it started.
+        """
+        main = threading.current_thread() is threading.main_thread()
+        previous = signal.getsignal(signal.SIGTERM) if main else None
+        try:
+            self.started = True  # from the first process it starts: close() shuts it down
+            self.ray.init(address=address, **kwargs)
+        except BaseException as exc:
+            self.close()
+            if isinstance(exc, SystemExit) and exc.code == signal.SIGTERM:  # Ray's handler
+                raise KeyboardInterrupt("SIGTERM") from None
+            raise
+        finally:
+            if previous is not None:
+                signal.signal(signal.SIGTERM, previous)
 
     def describe(self) -> str:
         if self.cpus < self.cluster_cpus:
@@ -646,8 +672,9 @@ class RayExecutor(Executor):
             with contextlib.suppress(Exception):
                 self.ray.kill(self.mailbox)
             self.mailbox = None
-        if self.started and self.ray.is_initialized():
-            self.ray.shutdown()
+        if self.started:  # (even half started: an interrupted ray.init)
+            with contextlib.suppress(Exception):
+                self.ray.shutdown()
             self.started = False
 
 

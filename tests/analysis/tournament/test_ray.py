@@ -2,7 +2,13 @@
 
 from __future__ import annotations
 
+import contextlib
+import os
+import signal
+import subprocess
+import sys
 import time
+from pathlib import Path
 
 import pytest
 
@@ -262,3 +268,58 @@ def test_a_slow_worker_start_is_not_counted_as_an_overrun(tmp_path, monkeypatch)
     with Store(tmp_path / "r.sqlite") as db:
         (row,) = db.rows(s.run_id)
     assert row["status"] == "ok", row["error"]
+
+
+def _session_names(sid: int) -> list[str]:
+    names = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            with contextlib.suppress(OSError, IndexError):
+                fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
+                if int(fields[3]) == sid:  # the session id
+                    names.append((entry / "comm").read_text().strip())
+    return names
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="reads processes from /proc")
+def test_sigterm_while_ray_starts_stops_as_sigterm_does_elsewhere(tmp_path):
+    """``ray.init`` sets its own SIGTERM handler (``sys.exit(15)``): a SIGTERM while Ray
+    started (or before the run's handler was in place) ended ``surveil tournament`` with
+    exit code 15 and not a word. It now stops as on any other SIGTERM: exit code 143,
+    'stopped by SIGTERM', no traceback. (Ray's dashboard and runtime-env agents, started by
+    the raylet, outlive an interrupted start by about a minute before they notice.)"""
+    spec = tmp_path / "s.toml"
+    spec.write_text(
+        'name = "s"\nmaps = ["open_room"]\nseeds = 2\nstart = "valid"\n'
+        'pursuers = ["pursuer/greedy"]\nevaders = ["evader/random"]\n'
+    )
+    root = Path(__file__).resolve().parents[3]
+    command = [sys.executable, "-m", "analysis.cli", "tournament", str(spec), "--backend", "ray"]
+    command += ["--workers", "1", "--store", str(tmp_path / "s.sqlite"), "--no-progress"]
+    env = {**os.environ, "PYTHONPATH": str(root), "SDL_VIDEODRIVER": "dummy", "MPLBACKEND": "Agg"}
+    proc = subprocess.Popen(
+        [*command, "--no-report"],
+        env=env,
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+    )
+    try:
+        deadline = time.monotonic() + 120
+        while "raylet" not in _session_names(proc.pid):  # Ray is starting
+            assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:  # pragma: no cover - the assertion below says why
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert "Traceback" not in err, err
+    assert proc.returncode == 143, (proc.returncode, err)
+    assert "surveil: stopped by SIGTERM" in err
+    deadline = time.monotonic() + 30
+    while {"raylet", "gcs_server"} & set(_session_names(proc.pid)):  # shut down, not left
+        assert time.monotonic() < deadline, _session_names(proc.pid)
+        time.sleep(0.1)

@@ -164,7 +164,7 @@ def _problem(
     if code == 13:
         return (
             f"store {str(path)!r}: the disk is full ({said}: {exc}); what was stored before "
-            "is kept: free some space, then rerun the same command to resume"
+            "is kept: free some space, then run the same command again"
         )
     if code in (3, 8, 14):
         if writing:

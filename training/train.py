@@ -251,8 +251,12 @@ _RESUME_FREE = {"total_timesteps", "eval_episodes", "eval_start", "checkpoint_fr
 
 
 def _check_resumable(config: TrainConfig, out: Path) -> None:
+    """Refuse to continue a run of another config. Only a run with something learned
+    (a checkpoint or a model) is one: a run stopped before its first checkpoint (an
+    opponent model that failed to load at the first reset, an early Ctrl-C) left its
+    ``config.toml`` and nothing to continue, and the corrected rerun starts afresh."""
     stored = out / "config.toml"
-    if not stored.is_file():
+    if not stored.is_file() or not _latest_checkpoint_exists(out):
         return
     before = load_config(stored).to_dict()
     now = config.to_dict()

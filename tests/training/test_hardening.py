@@ -212,6 +212,43 @@ def test_an_unknown_opponent_leaves_no_config_that_refuses_the_fixed_rerun(tmp_p
     assert cli_train([str(cfg)]) == 0
 
 
+def test_an_opponent_model_that_fails_to_load_does_not_refuse_the_fixed_rerun(tmp_path, capsys):
+    """An opponent model that passes the config's checks (a zip with SB3's 'data') but
+    fails at the first reset (here its weights cut short) stopped the run after it wrote
+    config.toml: the corrected command was refused ('holds a run with a different
+    config') though nothing had been learned."""
+    import zipfile
+
+    from training import zoo
+
+    damaged = tmp_path / "damaged.zip"
+    with (
+        zipfile.ZipFile(zoo.model_path("ppo_evader_vs_greedy_open_room")) as src,
+        zipfile.ZipFile(damaged, "w") as dst,
+    ):
+        for item in src.infolist():
+            data = src.read(item.filename)
+            dst.writestr(item, data[: len(data) // 2] if item.filename == "policy.pth" else data)
+    out = tmp_path / "run"
+    cfg = tmp_path / "c.toml"
+    body = 'role = "pursuer"\ntotal_timesteps = 64\nn_steps = 32\nbatch_size = 32\n'
+    body += f'eval_episodes = 0\noutput_dir = "{out}"\n[env]\nmax_cycles = 20\n'
+    cfg.write_text(f'opponent = "{damaged}"\n' + body)
+    assert cli_train([str(cfg)]) == 2
+    assert "cannot load the model file" in capsys.readouterr().err
+    cfg.write_text('opponent = "evader/straight"\n' + body)
+    assert cli_train([str(cfg)]) == 0, capsys.readouterr().err
+    assert (out / "model.zip").is_file()
+
+
+def test_a_run_with_a_checkpoint_still_refuses_another_config(tiny):
+    """The other side of the test above: once something is learned, a rerun of another
+    config is refused, naming the field."""
+    train(tiny(total_timesteps=64, eval_episodes=0))
+    with pytest.raises(InvalidConfigError, match=r"different config \(fields \['seed'\]"):
+        train(tiny(total_timesteps=128, eval_episodes=0, seed=5))
+
+
 def test_an_interrupted_run_says_what_it_kept_and_the_rerun_resumes(tmp_path, capsys, monkeypatch):
     # Ctrl-C said only "interrupted": not that the run resumes, nor from where
     import re

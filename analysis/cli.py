@@ -22,6 +22,7 @@ from analysis.arguments import (
     Parser,
     check_env_options,
     integer,
+    interrupts_recorded,
     json_object,
     output_dir,
     output_file,
@@ -414,7 +415,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         head -1``). A traceback means a bug.
     """
     try:
-        args = build_parser().parse_args(argv)  # imports for seconds: Ctrl-C lands here too
+        with interrupts_recorded() as ctrl_c:
+            args = build_parser().parse_args(argv)  # imports for seconds: Ctrl-C lands here
+            if ctrl_c.seen:  # one CPython discarded in an import's callback: honoured now
+                raise KeyboardInterrupt
     except SystemExit as exc:  # argparse: --help (0) or a usage error (2, already printed)
         return int(exc.code or 0) if not isinstance(exc.code, str) else 2
     except KeyboardInterrupt:

@@ -184,8 +184,10 @@ def card(name: str, role: str, rows, args, decide=None, measured=None) -> str:
     ]
     ref = "pursuer/decomposition" if role == "pursuer" else "evader/shooting"
     opponents = EVADERS if role == "pursuer" else PURSUERS
-    for label, maps in (("seen: " + ", ".join(seen), seen), ("held out: " + ", ".join(HELD_OUT),
-                        HELD_OUT)):  # fmt: skip
+    played = {r["map"] for r in rows}
+    held_out = [m for m in HELD_OUT if m in played]  # a --maps run names what it played
+    for label, maps in (("seen: " + ", ".join(seen), seen),
+                        ("held out: " + ", ".join(held_out), held_out)):  # fmt: skip
         if not any(r["map"] in maps for r in rows):
             continue
         for o in opponents:
@@ -248,7 +250,7 @@ def main(argv=None) -> int:
     for gname, maps in groups.items():
         if not played & set(maps):
             continue
-        print(f"\n== {gname}: {', '.join(maps)}")
+        print(f"\n== {gname}: {', '.join(m for m in maps if m in played)}")
         for p in PURSUERS + learned["pursuer"]:
             for e in EVADERS + learned["evader"]:
                 if (

@@ -127,3 +127,18 @@ def test_a_run_on_none_of_a_models_card_maps_leaves_its_card(lva, tmp_zoo, tmp_p
     assert card.read_text() == before
     out = capsys.readouterr().out
     assert f"card: {card} left as it was: this run played none of the maps {MODEL} " in out
+
+
+def test_a_run_on_some_held_out_maps_names_only_those(lva, tmp_zoo, tmp_path, capsys):
+    """``--maps corridor pillars``: the printed group and the card's rows were labelled
+    'held out: pillars, random:9001, random:9002, random:rectangles:9003' over matches
+    played on pillars alone."""
+    argv = ["--models", MODEL, "--seeds", "1", "--max-cycles", "20", "--maps", "corridor",
+            "pillars", "--workers", "1", "--store", str(tmp_path / "s.sqlite"),
+            "--cards"]  # fmt: skip
+    assert lva.main(argv) == 0
+    out = capsys.readouterr().out
+    assert "\n== held out: pillars\n" in out
+    text = (tmp_zoo / MODEL / "CARD.md").read_text()
+    assert "| held out: pillars | evader/shooting |" in text
+    assert "random:9001" not in out and "random:9001" not in text

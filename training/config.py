@@ -39,7 +39,7 @@ else:  # pragma: no cover - Python 3.10 reads TOML with the tomli backport
     import tomli as tomllib
 
 from envs import validation
-from envs.errors import InvalidConfigError
+from envs.errors import InvalidConfigError, UnknownNameError
 from envs.surveillance.config import EnvConfig, env_parameters
 from strategies.policies.base import check_role
 from strategies.policies.model_files import model_policy_name
@@ -75,6 +75,27 @@ _ALGO_MANAGED = {
     "_init_setup_model",
 }
 """SB3 constructor arguments set from dedicated fields, so not allowed in ``algo_kwargs``."""
+
+
+def opponent_name(name: str, role: str, what: str) -> str:
+    """The registry's name of an opponent as a config names it (:func:`model_policy_name`:
+    a model as ``zoo:NAME`` or a ``.zip``, checked), a registered name checked too: a
+    misspelt one is refused here, as a field of the config (its file named by
+    :func:`load_config`), not when the first env is built.
+
+    Raises:
+        InvalidConfigError: no such policy or model, or a model of the other role (the
+            message starts with ``what``).
+    """
+    resolved = model_policy_name(name, role, what)
+    if resolved == name and not name.partition("/")[2].startswith("sb3:"):
+        from strategies.policies.registry import policy_spec
+
+        try:
+            policy_spec(name)
+        except UnknownNameError as exc:
+            raise InvalidConfigError(f"{what}: {exc}") from None
+    return resolved
 
 
 @dataclass(frozen=True)
@@ -138,7 +159,7 @@ class TrainConfig:
         for name in pool:
             check.string("opponent", name)
             # a model as play, evaluate and tournaments take it: zoo:NAME or a .zip
-            if model_policy_name(name, other, f"opponent = {name!r}").partition("/")[0] != other:
+            if opponent_name(name, other, f"opponent = {name!r}").partition("/")[0] != other:
                 article = "an" if self.role == "evader" else "a"
                 raise InvalidConfigError(
                     f"opponent: {article} {self.role} learner needs a '{other}/KIND' policy "

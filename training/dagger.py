@@ -65,7 +65,7 @@ from strategies.policies.base import check_role
 from strategies.policies.learner_inputs import LearnerInputs, check_features
 from strategies.policies.model_files import model_policy_name
 from strategies.runner import check_observation_options, run_episode
-from training.config import check_same_maps, map_fingerprints
+from training.config import check_same_maps, map_fingerprints, opponent_name
 
 __all__ = ["DaggerConfig", "DaggerResult", "dagger", "load_dagger_config"]
 
@@ -564,7 +564,7 @@ def _plays(name: Any, role: str, where: str) -> bool:
     for, raising InvalidConfigError)."""
     if not isinstance(name, str):
         return False
-    return model_policy_name(name, role, f"{where} = {name!r}").startswith(role + "/")
+    return opponent_name(name, role, f"{where} = {name!r}").startswith(role + "/")
 
 
 def _validate(cfg: DaggerConfig, model, opponent) -> float:

@@ -212,6 +212,32 @@ def test_an_unknown_opponent_leaves_no_config_that_refuses_the_fixed_rerun(tmp_p
     assert cli_train([str(cfg)]) == 0
 
 
+@pytest.mark.parametrize(
+    ("body", "field"),
+    [
+        ('role = "pursuer"\nopponent = ["evader/straight", "evader/nope"]\n', "opponent"),
+        (
+            'method = "dagger"\nrole = "pursuer"\nexpert = "pursuer/greedy"\n'
+            'opponent = "evader/straight"\nvalidation_opponent = "evader/nope"\n',
+            "DaggerConfig: validation_opponent",
+        ),
+    ],
+)
+def test_an_unknown_opponent_is_refused_as_a_field_of_the_file(tmp_path, capsys, body, field):
+    """A misspelt registered opponent was refused only when the first env was built, without
+    the file or the field ('unknown policy 'evader/nope'; known policies: ...'), after
+    output_dir and its train.lock had been made."""
+    out = tmp_path / "run"
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(body + f'output_dir = "{out}"\n')
+    assert cli_train([str(cfg)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(
+        f"python -m training: error: {cfg}: {field} = 'evader/nope': unknown policy 'evader/nope'"
+    ), err
+    assert not out.exists()
+
+
 def test_an_opponent_model_that_fails_to_load_does_not_refuse_the_fixed_rerun(tmp_path, capsys):
     """An opponent model that passes the config's checks (a zip with SB3's 'data') but
     fails at the first reset (here its weights cut short) stopped the run after it wrote

@@ -103,6 +103,16 @@ _NEAR_POINTS = 256  # ... and calls with at least this many points (fewer: brute
 _NEAR_CHUNK = 1 << 16  # points per batch of the indexed distances
 
 
+def _finite_points(points: np.ndarray | Sequence[Sequence[float]], what: str) -> np.ndarray:
+    """``points`` as a (k, 2) float array, refused (naming the first bad coordinate) when
+    one is NaN or infinite. The check is one pass over the points; the query after it is
+    a pass over points x edges."""
+    p = np.atleast_2d(np.asarray(points, dtype=float))
+    if not np.isfinite(p).all():
+        validation.points(what, p)  # raises: "... expected finite values, got nan at ..."
+    return p
+
+
 def _clean_ring(ring: np.ndarray, scale: float, what: str) -> np.ndarray:
     """Drop repeated and straight (collinear) vertices; reject degenerate rings."""
     keep = np.linalg.norm(ring - np.roll(ring, 1, axis=0), axis=1) > REL_LENGTH_TOL * scale
@@ -419,11 +429,18 @@ class Map:
 
         Returns:
             (k,) bool array.
+
+        Raises:
+            InvalidConfigError: a coordinate is NaN or infinite (numpy's comparisons
+                read such a point as outside, which hid a position gone bad upstream).
         """
-        p = np.atleast_2d(np.asarray(points, dtype=float))
+        return self._contains(_finite_points(points, "contains points"))
+
+    def _contains(self, p: np.ndarray) -> np.ndarray:
+        """:meth:`contains` of a finite (k, 2) float array."""
         step = self._chunk()
         if len(p) > step:  # bounded memory: (points x edges) temporaries a chunk at a time
-            return np.concatenate([self.contains(p[s : s + step]) for s in range(0, len(p), step)])
+            return np.concatenate([self._contains(p[s : s + step]) for s in range(0, len(p), step)])
         a = self.edge_start[None, :, :]
         b = self.edge_end[None, :, :]
         px = p[:, None, 0]
@@ -432,7 +449,7 @@ class Map:
         with np.errstate(divide="ignore", invalid="ignore"):
             xint = a[..., 0] + (py - a[..., 1]) * (b[..., 0] - a[..., 0]) / (b[..., 1] - a[..., 1])
         inside = np.count_nonzero(cond & (px < xint), axis=1) % 2 == 1
-        return inside | (self.distance_to_walls(p) <= REL_LENGTH_TOL * self.scale)
+        return inside | (self._distance_to_walls(p) <= REL_LENGTH_TOL * self.scale)
 
     def _chunk(self) -> int:
         """Points per batch of :meth:`contains` / :meth:`distance_to_walls`: each builds a
@@ -441,14 +458,22 @@ class Map:
         return max(1, _PAIRS // len(self.edge_start))
 
     def distance_to_walls(self, points: np.ndarray | Sequence[Sequence[float]]) -> np.ndarray:
-        """Euclidean distance from each point to the nearest wall edge."""
-        p = np.atleast_2d(np.asarray(points, dtype=float))
-        if len(p) >= _NEAR_POINTS and self.n_edges >= _NEAR_EDGES and np.isfinite(p).all():
+        """Euclidean distance from each point to the nearest wall edge.
+
+        Raises:
+            InvalidConfigError: a coordinate is NaN or infinite (the distance was nan or
+                inf).
+        """
+        return self._distance_to_walls(_finite_points(points, "distance_to_walls points"))
+
+    def _distance_to_walls(self, p: np.ndarray) -> np.ndarray:
+        """:meth:`distance_to_walls` of a finite (k, 2) float array."""
+        if len(p) >= _NEAR_POINTS and self.n_edges >= _NEAR_EDGES:
             return self._near_distances(p)
         step = self._chunk()
         if len(p) > step:  # bounded memory (see _chunk)
             return np.concatenate(
-                [self.distance_to_walls(p[s : s + step]) for s in range(0, len(p), step)]
+                [self._distance_to_walls(p[s : s + step]) for s in range(0, len(p), step)]
             )
         rel = p[:, None, :] - self.edge_start[None, :, :]
         t = np.clip(np.einsum("kej,ej->ke", rel, self.edge_dir), 0.0, self.edge_length)

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from envs.errors import InvalidMapError, UnknownNameError
+from envs.errors import InvalidConfigError, InvalidMapError, UnknownNameError
 from envs.maps import Map, load_map
 from envs.maps.io import map_from_wkt
 
@@ -53,3 +53,25 @@ def test_wkt_requires_text(text):
 def test_load_map_rejects_non_names(value):
     with pytest.raises(UnknownNameError, match=repr(value).replace("[", r"\[")):
         load_map(value)
+
+
+@pytest.mark.parametrize("bad", [math.nan, math.inf, -math.inf])
+@pytest.mark.parametrize("n", [2, 20_000])
+def test_point_queries_refuse_a_point_that_is_not_finite(bad, n):
+    """``Map.contains`` and ``Map.distance_to_walls`` answered numpy's way: a NaN or
+    infinite point was outside the map (False) at distance nan or inf, so a position
+    gone NaN upstream read as a position off the map. They raise, as the kernel's point
+    queries do, naming the first such coordinate; a batch of many points (chunked, or
+    through the walls' spatial index) alike."""
+    angles = np.linspace(0.0, 2.0 * math.pi, 200, endpoint=False)  # 204 edges: the index
+    m = Map(SQUARE, [np.c_[2.0 + 0.5 * np.cos(angles), 2.0 + 0.5 * np.sin(angles)]])
+    points = np.full((n, 2), 0.5)
+    points[-1, 1] = bad
+    got = rf"got {bad} at index \({n - 1}, 1\)"
+    with pytest.raises(InvalidConfigError, match=rf"contains points = .*: expected finite .*{got}"):
+        m.contains(points)
+    with pytest.raises(InvalidConfigError, match=rf"distance_to_walls points = .*{got}"):
+        m.distance_to_walls(points)
+    points[-1, 1] = 3.0  # finite points are answered as before
+    assert m.contains(points).all()
+    assert (m.distance_to_walls(points) == 0.5).all()

@@ -14,10 +14,11 @@ Sec. 5 "minimax": its tip meets walls as if the rod were that long):
    cannot make, so the rank promises nothing) the plan can end in a *dead end*, a cell
    whose every via is such a piece; from there on the evader shoots first (step 2) and
    takes the plan only where no shot has a positive margin, until it reaches a cell
-   whose rank is a guarantee. Before such a plan, while the rod is longer than the
-   pursuer can close to L_min in a replan period, a shot goes first too: one whose
-   straight path the evader's disc can follow, its margin against the rod's present
-   length (the pursuer turns slower on a long rod).
+   whose rank is a guarantee. Before any plan, while the rod is longer than the pursuer
+   can close to L_min in a replan period, a shot goes first too: one whose straight path
+   the evader's disc can follow, its margin against the rod's present length (the
+   pursuer turns slower on a long rod, and a step past a wall's corner near the evader
+   swings the far end of a long rod a long way).
 2. **Shooting escape**: candidate endpoints (Fig. 13) are points the evader can reach in
    a straight line (probes on rays, and points just past each convex obstacle vertex in
    reach) where the current orientation is not safe. For each, the rotation the pursuer
@@ -28,6 +29,8 @@ Sec. 5 "minimax": its tip meets walls as if the rod were that long):
    (:func:`strategies.control.evasion.solve_escape`, for the branch the pursuer would
    turn) and the evader follows that arc (where no bounded arc reaches the candidate,
    as near rho = 1 most do not, the straight path), replanning every ``replan`` steps.
+   Where there is no plan and no such shot, while the rod is long (as in step 1), a
+   shot the disc can follow, its margin against the rod's length, goes before steps 3-4.
 3. **Witness region** (Prop. 2 holds on the map): from a region that is not one, walk a
    shortest grid path to a region whose cells are all escapable
    (``Decomposition.witness_regions``).
@@ -315,7 +318,8 @@ class ShootingEvader(BasePolicy):
 
         With ``disc``, only a candidate the evader's disc can follow the straight path to
         (:meth:`_disc_reaches`), the margins against the rod's present length
-        (:meth:`_margins`' ``rod``): the shots that go before a plan promising nothing.
+        (:meth:`_margins`' ``rod``): the shots that go before a plan, or instead of
+        pressure, while the rod is long.
         """
         rays, ray_rows, corners, corner_rows = self._candidates(e)
         n = len(rays)
@@ -492,23 +496,23 @@ class ShootingEvader(BasePolicy):
         heading = self._plan_heading(e, theta)
         if heading is not None and self.plan.rank[self._plan_cell] < len(self.plan.rank):
             self._shoot_first = False  # a rank below n_cells: a route the disc can take
-        # a plan whose rank is at least n_cells counts a crossing the disc cannot make and
-        # promises nothing: a shot with a positive margin against the rod's present length
-        # whose path the disc can follow goes first there too, not only from a dead end
-        # (issue 13: random:polygons:7202, rho 0.2, L in [2, 6], from a start the referee
-        # certifies an evader win within 3.9 s, walked a rank-1387 plan for 428 s). Only
         # while the rod is longer than the pursuer can close to L_min in a shot's replan
-        # period (at V_p + V_e): that advantage does not last, and where the rod is near
-        # L_min the shot's margin is L_min's and the plan did at least as well
-        # (two_rooms~rot2.2, rho 0.5, L in [1, 1.5], seed 619 vs decomposition, the rod
-        # 1.12: a shot a step before the base's, occluded at 24.44 s -> held)
-        void = (
-            heading is not None
-            and not self._shoot_first
-            and self.plan.rank[self._plan_cell] >= len(self.plan.rank)
-            and self._rod - (c.v_pursuer + c.v_evader) * self.replan * c.dt > c.l_min
-        )
-        if heading is not None and not self._shoot_first and not void:
+        # period (at V_p + V_e), a shot whose path the disc can follow, its margin against
+        # the rod's present length, goes before the plan, whatever its rank: the pursuer on
+        # a long rod turns slowly, and a step past a wall's corner near the evader swings
+        # the rod's far end a long way. A plan whose rank is at least n_cells promises
+        # nothing anyway (issue 13: random:polygons:7202, rho 0.2, L in [2, 6], from a start
+        # the referee certifies an evader win within 3.9 s, walked a rank-1387 plan for
+        # 428 s); a guaranteed plan can be slow (random:rectangles:7303, the same game, four
+        # certified starts (1.3-2.6 s): a rank-8 plan walked cell by cell for 21-105 s,
+        # a shot past a rectangle's corner occludes in 0.3-1.4 s). Only while the rod is
+        # long: where it is near L_min the shot's margin is L_min's and the plan did at
+        # least as well (two_rooms~rot2.2, rho 0.5, L in [1, 1.5], seed 619 vs
+        # decomposition, the rod 1.12: a shot a step before the base's, occluded at
+        # 24.44 s -> held)
+        long_rod = self._rod - (c.v_pursuer + c.v_evader) * self.replan * c.dt > c.l_min
+        first = heading is not None and not self._shoot_first and long_rod
+        if heading is not None and not self._shoot_first and not first:
             self.mode = "plan"
             self._arc, self._in_sight = None, False
             self._track.clear()
@@ -529,7 +533,15 @@ class ShootingEvader(BasePolicy):
             and math.hypot(float(e[0]) - last[0], float(e[1]) - last[1]) < c.v_evader * c.dt
         ):
             self._in_sight = True
-        best = self._best_candidate(e, theta, in_sight=self._in_sight, disc=void)
+        best = self._best_candidate(e, theta, in_sight=self._in_sight, disc=first)
+        if best is None and heading is None and long_rod:
+            # no plan and no shot at L_min's margins: on a long rod, a shot the disc can
+            # follow with a positive margin against the rod's length before the witness
+            # walk and pressure (issue 13: random:polygons:7302, the same game, starts the
+            # referee certifies within 1.3 s, the rod 5.0 and 5.6 grazing the corner of
+            # the obstacle beside the evader: pressure from the first step, held for
+            # 8 D / V_e; a shot 0.3 m past the corner occludes at 0.51 and 1.19 s)
+            best = self._best_candidate(e, theta, disc=True)
         if best is not None:
             self.mode = "shoot"
             self._shot = (float(e[0]), float(e[1]), self._steps)
@@ -537,7 +549,7 @@ class ShootingEvader(BasePolicy):
             return c.v_evader * self._start_arc(e, theta, *best)
         if heading is not None:
             # no shot: back to the plan (and to the plan first, until the next dead end)
-            if void:
+            if first:
                 # the plan steers: the fallback's track starts again (a stall is counted
                 # over the shots and the pressure since the plan last steered, not over
                 # the plan's own steps: random:star:2017, rho 0.3, seed 849 banned the

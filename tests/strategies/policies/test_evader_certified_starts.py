@@ -8,6 +8,15 @@ n_cells and promise nothing; the evader walked them and was held for 8 D / V_e (
 escaped after minutes). Now a shot goes before such a plan when its disc can follow the
 straight path to the target and the margin is positive against the rod's present length
 (the rod near L_max at these starts: the pursuer turns slower than at L_min).
+
+Session 24 (helper-146, helper-139's starts on six more worlds, same game): the referee's
+own evader escapes the last misses with one short straight step past the corner of an
+obstacle the long rod grazes (the rod pivots about the corner: its far end, 5 m out,
+swings many times as far as the evader steps, more than the pursuer, 5 times as fast, can
+follow). From random:polygons:7302 the shooting evader had no plan and no shot with a
+positive margin at L_min's rate (pressure from the first step, held); from
+random:rectangles:7303 it walked a guaranteed (rank-8) plan cell by cell for 21-105 s.
+Now such a shot goes first while the rod is long, plan or no plan.
 """
 
 from __future__ import annotations
@@ -30,10 +39,22 @@ _STARTS = [
     ("random:convex:7204", 1330,
      {"pursuer": [7.063932052297361, 7.109369883830196],
       "evader": [3.7995557939733224, 2.7995557939733224]}, 26),
+    # certified within 1.3 s (the referee's evader: 0.73 s); a3657e8: pressure from the
+    # first step, held for 8 D / V_e; now occluded at 0.51 s
+    ("random:polygons:7302", 1333,
+     {"pursuer": [8.0023122183654, 6.055129488827748],
+      "evader": [3.7995557939733224, 8.799555793973322]}, 13),
+    # certified within 2.6 s (the referee's evader: 1.64 s); a3657e8: a rank-8 plan,
+    # occluded at 21.02 s; now at 1.38 s
+    ("random:rectangles:7303", 1331,
+     {"pursuer": [13.058160792531037, 15.075358382327751],
+      "evader": [12.549555793973322, 10.799555793973322]}, 26),
 ]  # fmt: skip
 
 
-@pytest.mark.parametrize(("world", "seed", "start", "steps"), _STARTS, ids=["7202", "7204"])
+@pytest.mark.parametrize(
+    ("world", "seed", "start", "steps"), _STARTS, ids=["7202", "7204", "7302", "7303"]
+)
 def test_escapes_within_the_referee_s_certified_time(world, seed, start, steps):
     ev = ShootingEvader()
     r = run_episode(world, "pursuer/decomposition", ev, seed, max_cycles=steps,

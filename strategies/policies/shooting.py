@@ -421,12 +421,70 @@ class ShootingEvader(BasePolicy):
         L in [2, 6], starts the referee certifies evader wins within 1.3-5.2 s with the
         rod near L_max, held for 8 D / V_e).
 
+        A rod longer than L_min also bounds the pursuer's reach: where the margin against
+        that (:meth:`_reach_margins`) is the larger, it is the margin (each is the need
+        less a bound on how far the pursuer can turn the rod by then; the larger holds
+        against the tighter bound). From the rod's own direction to a corner beside the
+        evader, eq. (6) lets the pursuer shorten the rod at V_p + V_e and turn it at the
+        short rod's rate at once, which its speed does not allow (issue 13:
+        random:convex:7308 at rho 0.2, L in [2, 6], a start the referee certifies within
+        5.2 s, the rod 5.9: no margin was positive and the evader was held for 8 D / V_e;
+        against the reach, a shot under the obstacle beside it occludes at 1.53 s).
+
         Args:
             rows: the candidates' table rows, if known.
             rod: the rod's length (``None``: L_min).
         """
+        rows = self.table.rows(cand) if rows is None else rows
+        margin, branch = self._rate_margins(e, theta, cand, rows, rod)
+        if rod is not None and rod > self.config.l_min:
+            reach, side = self._reach_margins(e, theta, cand, rows, rod)
+            better = reach > margin
+            if better.any():
+                margin = np.where(better, reach, margin)
+                branch = np.where(better, side, branch)
+        return margin, branch
+
+    def _reach_margins(self, e: np.ndarray, theta: float, cand: np.ndarray, rows, rod: float):
+        """Escape margin per candidate against the pursuer's reach, and its branch.
+
+        By the time the evader gets to a candidate ``q`` (``|q - e| / V_e``), the pursuer
+        is within ``R = V_p |q - e| / V_e`` of where it is now (``e`` plus ``rod`` along
+        ``theta``), so the rod's orientation at ``q`` is within ``asin(R / d)`` of the
+        direction from ``q`` to the pursuer now (``d`` their distance; walls and the
+        range only narrow that). The margin is the rotation each way from that direction
+        to a safe orientation at ``q`` (the table's) less that angle, the smaller of the
+        two; ``-inf`` where the direction is safe already, ``R >= d`` or ``q`` is off the
+        grid.
+        """
         c, tab = self.config, self.table
-        rows = tab.rows(cand) if rows is None else rows
+        margin = np.full(len(cand), -np.inf)
+        branch = np.full(len(cand), "-")
+        p = e + rod * np.array([math.cos(theta), math.sin(theta)])
+        ok = np.flatnonzero(rows >= 0)
+        to_p = p - cand[ok]
+        d = _row_norms(to_p)
+        reach = c.v_pursuer * _row_norms(cand[ok] - e) / c.v_evader
+        far = d > reach
+        ok, to_p, d, reach = ok[far], to_p[far], d[far], reach[far]
+        if not len(ok):
+            return margin, branch
+        beta = np.arctan2(to_p[:, 1], to_p[:, 0])
+        # tab.bin_of of each direction
+        b = (((beta + math.pi) % (2.0 * math.pi)) / tab.bin_width).astype(np.int64) % tab.n_bins
+        r = rows[ok]
+        bins_ccw, bins_cw = tab.ccw[r, b], tab.cw[r, b]
+        live = (bins_ccw > 0) | (bins_cw > 0)
+        turn = np.arcsin(reach / d)
+        left = self._radians[bins_ccw] - turn
+        right = self._radians[bins_cw] - turn
+        margin[ok[live]] = np.minimum(left, right)[live]
+        branch[ok[live]] = np.where(left < right, "+", "-")[live]
+        return margin, branch
+
+    def _rate_margins(self, e: np.ndarray, theta: float, cand: np.ndarray, rows, rod):
+        """:meth:`_margins` by the rate of eq. (6) along the straight path."""
+        c, tab = self.config, self.table
         ok = rows >= 0
         margin = np.full(len(cand), -np.inf)
         branch = np.full(len(cand), "-")

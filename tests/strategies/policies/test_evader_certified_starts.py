@@ -16,7 +16,9 @@ swings many times as far as the evader steps, more than the pursuer, 5 times as 
 follow). From random:polygons:7302 the shooting evader had no plan and no shot with a
 positive margin at L_min's rate (pressure from the first step, held); from
 random:rectangles:7303 it walked a guaranteed (rank-8) plan cell by cell for 21-105 s.
-Now such a shot goes first while the rod is long, plan or no plan.
+Now such a shot goes first while the rod is long, plan or no plan, and its margin is also
+taken against where the pursuer can be by then (random:convex:7308: no margin against the
+rate of eq. 6 was positive there).
 """
 
 from __future__ import annotations
@@ -49,11 +51,17 @@ _STARTS = [
     ("random:rectangles:7303", 1331,
      {"pursuer": [13.058160792531037, 15.075358382327751],
       "evader": [12.549555793973322, 10.799555793973322]}, 26),
+    # certified within 5.2 s (the referee's evader: 4.83 s, 0.75 m east under an obstacle,
+    # then 0.17 m north past its bottom corner); a3657e8 and eq. 6's margins alone: held
+    # for 8 D / V_e; against the pursuer's reach, occluded at 1.53 s
+    ("random:convex:7308", 1335,
+     {"pursuer": [3.0418897865750254, 9.009510688927215],
+      "evader": [4.549555793973322, 3.2995557939733224]}, 52),
 ]  # fmt: skip
 
 
 @pytest.mark.parametrize(
-    ("world", "seed", "start", "steps"), _STARTS, ids=["7202", "7204", "7302", "7303"]
+    ("world", "seed", "start", "steps"), _STARTS, ids=["7202", "7204", "7302", "7303", "7308"]
 )
 def test_escapes_within_the_referee_s_certified_time(world, seed, start, steps):
     ev = ShootingEvader()

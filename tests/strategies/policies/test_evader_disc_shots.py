@@ -62,3 +62,49 @@ def test_a_long_rod_leaves_more_margin_than_l_min(evader):
     # a rod at L_min: L_min's margins exactly
     same, _ = evader._margins(e, 0.0, cand, rod=2.0)
     assert np.array_equal(same, short)
+
+
+def _grazing(evader):
+    """A rod of 5 from (4.7, 5.3) down to the right, 0.027 clear of the wall's tip: the
+    pursuer at (8.53, 2.09), the candidates 0.3, 0.6 and 0.9 away (24 directions)."""
+    e, theta, rod = np.array([4.7, 5.3]), np.radians(-40.0), 5.0
+    ang = np.linspace(0.0, 2.0 * np.pi, 24, endpoint=False)
+    ring = np.stack([np.cos(ang), np.sin(ang)], axis=1)
+    cand = np.concatenate([e + r * ring for r in (0.3, 0.6, 0.9)])
+    return e, theta, rod, cand, evader.table.rows(cand)
+
+
+def test_against_the_reach_a_step_past_the_tip_a_long_rod_grazes_has_a_margin(evader):
+    # a step west of the tip puts it across the rod: the pursuer 5 m out must swing the
+    # rod's far end round the tip. Eq. 6 lets it shorten the rod at V_p + V_e and turn at
+    # the short rod's rate at once: no candidate 0.6 away has a margin; against where
+    # it can be by then (within V_p t of where it is), five do, and the margins are the
+    # larger of the two
+    e, theta, rod, cand, rows = _grazing(evader)
+    rate, _ = evader._rate_margins(e, theta, cand, rows, rod)
+    reach, _ = evader._reach_margins(e, theta, cand, rows, rod)
+    mid = slice(24, 48)
+    assert (rate[mid] <= 0.0).all()
+    assert (reach[mid] > 0.0).sum() == 5
+    both, _ = evader._margins(e, theta, cand, rows, rod)
+    assert np.array_equal(both, np.maximum(rate, reach))
+
+
+def test_a_reach_margin_is_positive_only_where_no_orientation_in_reach_is_safe(evader):
+    # the orientations the pursuer can give the rod at q: within asin(R / d) of the
+    # direction from q to where it is now; bin by bin, a safe one among them exactly
+    # where the margin is not positive
+    e, theta, rod, cand, rows = _grazing(evader)
+    reach, _ = evader._reach_margins(e, theta, cand, rows, rod)
+    tab = evader.table
+    p = e + rod * np.array([np.cos(theta), np.sin(theta)])
+    finite = np.flatnonzero(np.isfinite(reach))
+    assert len(finite) > 20 and (reach[finite] > 0).any() and (reach[finite] <= 0).any()
+    for i in finite.tolist():
+        q = cand[i]
+        d = np.linalg.norm(p - q)
+        turn = np.arcsin(1.0 * np.linalg.norm(q - e) / 0.2 / d)  # R = V_p |q - e| / V_e
+        b = tab.bin_of(float(np.arctan2(*(p - q)[::-1])))
+        k = int(turn // tab.bin_width)
+        reachable = [(b + j) % tab.n_bins for j in range(-k, k + 1)]
+        assert tab.safe[rows[i], reachable].any() == (reach[i] <= 0.0), (q, reach[i])

@@ -27,8 +27,13 @@ region_u        direction to the next grid point of the walk to a witness region
 region_n        the evader is outside one (its grid point and its cell's region) and the
                 walk exists (0, 0 otherwise)
 shot_u          direction to the shooting candidate with the largest positive escape margin
-shot_n          (0, 0 where none has a positive margin)
-shot_margin     that margin (radians the pursuer lacks, eq. 6) over pi, clipped to [0, 1]
+shot_n          (0, 0 where none has a positive margin); on a rod longer than the pursuer
+                can close to L_min in a replan period, the one the evader's disc can follow
+                with the largest margin against the rod's length where the evader shoots
+                there (before a plan; with no plan, where no candidate has a margin at
+                L_min's rate)
+shot_margin     that margin (radians the pursuer lacks, eq. 6 or its reach) over pi,
+                clipped to [0, 1]
 shot_branch     the way the pursuer would turn there: +1 counter-clockwise, -1 clockwise, 0
 =============== ==============================================================================
 
@@ -118,6 +123,7 @@ class PlanFeatures:
         ev, plan, c = self.evader, self.evader.plan, self.config
 
         cell = plan.cell_at(e, theta)
+        w = None
         if cell >= 0:
             rank = int(plan.rank[cell])
             out[0] = 1.0 if rank >= 0 else -1.0
@@ -142,10 +148,23 @@ class PlanFeatures:
             nxt = int(plan.region_next[row])
             if nxt >= 0:
                 out[5], out[6] = line_of_sight_frame(plan.points[nxt] - e, u)
-        best = ev._best_candidate(e, theta)
+        # the shot the evader takes: on a long rod, one its disc can follow with a margin
+        # against the rod's length, before the plan, or where there is neither a plan nor
+        # a shot at L_min's margins (ShootingEvader._decide)
+        planned = w is not None
+        rod_len = max(dist, c.l_min)
+        long_rod = ev._long(rod_len)
+        ev._rod = rod_len
+        best, against = None, None
+        if planned and long_rod:
+            best, against = ev._best_candidate(e, theta, disc=True), rod_len
+        if best is None:
+            best, against = ev._best_candidate(e, theta), None
+        if best is None and not planned and long_rod:
+            best, against = ev._best_candidate(e, theta, disc=True), rod_len
         if best is not None:
             q, branch = best
-            margin, _ = ev._margins(e, theta, q[None])
+            margin, _ = ev._margins(e, theta, q[None], rod=against)
             out[7], out[8] = line_of_sight_frame(q - e, u)
             out[9] = min(max(float(margin[0]) / math.pi, 0.0), 1.0)
             out[10] = 1.0 if branch == "+" else -1.0

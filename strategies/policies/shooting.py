@@ -568,7 +568,7 @@ class ShootingEvader(BasePolicy):
         # least as well (two_rooms~rot2.2, rho 0.5, L in [1, 1.5], seed 619 vs
         # decomposition, the rod 1.12: a shot a step before the base's, occluded at
         # 24.44 s -> held)
-        long_rod = self._rod - (c.v_pursuer + c.v_evader) * self.replan * c.dt > c.l_min
+        long_rod = self._long(self._rod)
         first = heading is not None and not self._shoot_first and long_rod
         if heading is not None and not self._shoot_first and not first:
             self.mode = "plan"
@@ -674,6 +674,13 @@ class ShootingEvader(BasePolicy):
             d = self.map.distance_to_walls(np.stack([e + h * s, e - h * s]))
             return c.v_evader * (-s if d[1] - d[0] > _PRESSING * h else s)
         return c.v_evader * u
+
+    def _long(self, rod: float) -> bool:
+        """Whether a rod of length ``rod`` is longer than the pursuer can close to L_min in
+        a shot's replan period (at V_p + V_e): then a shot the disc can follow, its margin
+        against the rod's length, goes first (see :meth:`_decide`)."""
+        c = self.config
+        return rod - (c.v_pursuer + c.v_evader) * self.replan * c.dt > c.l_min
 
     def _fallback_stalled(self, e: np.ndarray) -> bool:
         """Record ``e`` as a fallback position and tell whether the fallback stalled: over

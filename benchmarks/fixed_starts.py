@@ -87,13 +87,18 @@ CERTIFY = {
         ("random:convex:7204", (0.2, 3.0, 2.0)),
         ("random:rectangles:7203", (0.2, 3.0, 2.0)),
         ("plus_w1.6a4.5", (0.2, 3.0, 2.0)),
+        ("random:polygons:7302", (0.2, 3.0, 2.0)),
+        ("random:convex:7308", (0.2, 3.0, 2.0)),
     ],
 }
 """The worlds certified, per role of the certified player: (label, (rho, L_max / L_min,
 L_min)). The pursuer's: rooms where the referee's pursuer bound certifies starts at rho
 0.2 or 0.3 (it certifies none at rho >= 0.35); the evader's: two worlds open only to a
 point evader (no escape region a body can cross into; the shooting evader missed
-certified escapes there in session 22) and two open to a body."""
+certified escapes there in session 22), two open to a body, and two where it missed
+certified escapes in session 23 (helper-139's: the referee's evader steps past the corner
+of an obstacle the long rod grazes; random:polygons:7302 starts 3 and 5, random:convex:7308
+start 5)."""
 
 OPPONENTS = {"pursuer": EVADERS, "evader": PURSUERS}
 """Who plays against the certified player's policy: every opponent of ``unseen_worlds.py``

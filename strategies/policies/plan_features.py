@@ -154,14 +154,13 @@ class PlanFeatures:
         planned = w is not None
         rod_len = max(dist, c.l_min)
         long_rod = ev._long(rod_len)
-        ev._rod = rod_len
         best, against = None, None
         if planned and long_rod:
-            best, against = ev._best_candidate(e, theta, disc=True), rod_len
+            best, against = ev._best_candidate(e, theta, rod=rod_len), rod_len
         if best is None:
             best, against = ev._best_candidate(e, theta), None
         if best is None and not planned and long_rod:
-            best, against = ev._best_candidate(e, theta, disc=True), rod_len
+            best, against = ev._best_candidate(e, theta, rod=rod_len), rod_len
         if best is not None:
             q, branch = best
             margin, _ = ev._margins(e, theta, q[None], rod=against)

@@ -304,7 +304,7 @@ class ShootingEvader(BasePolicy):
         return cand, picked, self._corner_points[near], self._corner_rows[near]
 
     def _best_candidate(
-        self, e: np.ndarray, theta: float, in_sight: bool = False, disc: bool = False
+        self, e: np.ndarray, theta: float, in_sight: bool = False, rod: float | None = None
     ) -> tuple[np.ndarray, str] | None:
         """The candidate endpoint with the largest positive escape margin (the first such
         in the order rays, then visible corners), and the pursuer's branch there.
@@ -316,22 +316,21 @@ class ShootingEvader(BasePolicy):
         lie across it (issue 13: random:convex:11, a spike's tip between the evader and
         the probe it ran at for the whole horizon).
 
-        With ``disc``, only a candidate the evader's disc can follow the straight path to
-        (:meth:`_disc_reaches`), the margins against the rod's present length
-        (:meth:`_margins`' ``rod``): the shots that go before a plan, or instead of
+        With ``rod`` (the rod's present length), only a candidate the evader's disc can
+        follow the straight path to (:meth:`_disc_reaches`), the margins against that
+        length (:meth:`_margins`' ``rod``): the shots that go before a plan, or instead of
         pressure, while the rod is long.
         """
         rays, ray_rows, corners, corner_rows = self._candidates(e)
         n = len(rays)
         rows = np.concatenate([ray_rows, corner_rows])
-        rod = self._rod if disc else None
         margin, branch = self._margins(e, theta, np.concatenate([rays, corners]), rows, rod)
         if len(self._banned):
             # targets given up after a stall (_fallback_stalled), and points near them
             near = np.concatenate([rays, corners])[:, None, :] - self._banned[None, :, :]
             gone = np.einsum("ijk,ijk->ij", near, near).min(axis=1) <= self._ban_radius**2
             margin[gone] = -np.inf
-        if disc:
+        if rod is not None:
             return self._disc_candidate(e, rays, corners, margin, branch)
         ex, ey = float(e[0]), float(e[1])
         ray, top = -1, 0.0  # the best probe (in sight if asked) and its margin
@@ -591,7 +590,9 @@ class ShootingEvader(BasePolicy):
             and math.hypot(float(e[0]) - last[0], float(e[1]) - last[1]) < c.v_evader * c.dt
         ):
             self._in_sight = True
-        best = self._best_candidate(e, theta, in_sight=self._in_sight, disc=first)
+        best = self._best_candidate(
+            e, theta, in_sight=self._in_sight, rod=self._rod if first else None
+        )
         if best is None and heading is None and long_rod:
             # no plan and no shot at L_min's margins: on a long rod, a shot the disc can
             # follow with a positive margin against the rod's length before the witness
@@ -599,7 +600,7 @@ class ShootingEvader(BasePolicy):
             # referee certifies within 1.3 s, the rod 5.0 and 5.6 grazing the corner of
             # the obstacle beside the evader: pressure from the first step, held for
             # 8 D / V_e; a shot 0.3 m past the corner occludes at 0.51 and 1.19 s)
-            best = self._best_candidate(e, theta, disc=True)
+            best = self._best_candidate(e, theta, rod=self._rod)
         if best is not None:
             self.mode = "shoot"
             self._shot = (float(e[0]), float(e[1]), self._steps)

@@ -39,7 +39,7 @@ def _pressing(m, params, seed=0, after=True) -> ShootingEvader:
     ev = ShootingEvader()
     ev.reset(role="evader", map=m, config=EnvConfig(map=m, **params), seed=seed)
     ev._plan_heading = lambda e, theta: None
-    ev._best_candidate = lambda e, theta, in_sight=False, disc=False: None
+    ev._best_candidate = lambda e, theta, in_sight=False, rod=None: None
     ev._region_walk = lambda e: None
     ev._pressed = math.ceil(ev._herd_after) + 1 if after else 0
     return ev

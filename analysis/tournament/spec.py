@@ -63,7 +63,7 @@ from typing import Any
 from analysis.arguments import why_not_a_file
 from envs.errors import InvalidConfigError
 from envs.validation import choice, integer, mapping, positive, string, unit_interval
-from strategies.policies.model_files import is_model_reference, model_path
+from strategies.policies.model_files import is_model_reference, model_path, warn_no_provenance
 
 __all__ = [
     "ENV_FIELDS",
@@ -573,6 +573,8 @@ def _entry(item: Any, role: str, where: str, base: Path) -> PolicyEntry:
     path = model_file(text, where, base)
     digest = hashlib.sha256(path.read_bytes()).hexdigest()
     provenance = _provenance(path)
+    if not (path.parent / "provenance.json").is_file():
+        warn_no_provenance(f"{where}: model = {text!r}", path)
     if provenance.get("role") not in (None, role):
         raise InvalidConfigError(
             f"{where}: model {text!r} was trained as the {provenance['role']}, not the {role}"

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import warnings
 import zipfile
 from pathlib import Path
 from typing import Any
@@ -26,6 +27,7 @@ from typing import Any
 from envs.errors import InvalidConfigError
 
 __all__ = [
+    "NoProvenanceWarning",
     "is_model_reference",
     "model_path",
     "model_policy_name",
@@ -35,6 +37,24 @@ __all__ = [
 
 _SB3 = "sb3:"
 """The registry's prefix of a model file's kind (``ROLE/sb3:PATH``)."""
+
+
+class NoProvenanceWarning(UserWarning):
+    """A model file has no ``provenance.json`` beside it: the role it was trained for
+    and the observation it was trained on are unknown, so neither is checked."""
+
+
+def warn_no_provenance(what: str, path: Path) -> None:
+    """Warn (:class:`NoProvenanceWarning`) that the model ``what`` names, at ``path``,
+    has no ``provenance.json`` beside it."""
+    warnings.warn(
+        f"{what}: no provenance.json beside {path}: the role and the observation this "
+        "model was trained for are unknown and unchecked (a model of the other role, or "
+        "given another observation, plays without a word); put the provenance.json its "
+        "training wrote beside it",
+        NoProvenanceWarning,
+        stacklevel=3,
+    )
 
 
 def zoo_dir() -> Path | None:
@@ -98,7 +118,10 @@ def model_policy_name(text: str, role: str, what: str) -> str:
     if not is_model_reference(text):
         return text
     path = model_path(text, what)
-    trained = (read_provenance(path) or {}).get("role")
+    provenance = read_provenance(path)
+    if provenance is None:
+        warn_no_provenance(what, path)
+    trained = (provenance or {}).get("role")
     if trained is not None and trained != role:
         raise InvalidConfigError(
             f"{what}: this model was trained as the {trained} (its provenance.json says "

@@ -347,6 +347,25 @@ def test_a_ctrl_c_cpython_discards_while_the_parser_imports_still_stops_the_run(
     assert "corridor" not in run.stdout  # the maps were not listed
 
 
+def test_a_model_without_its_provenance_is_said_so_as_it_plays(tmp_path, capsys, monkeypatch):
+    """A pursuer model copied without its provenance.json played the evader without a word
+    ('pursuer/decomposition vs bare/p.zip: pursuer kept surveillance'): nothing can check
+    its role or observation."""
+    import shutil
+
+    from strategies.policies.model_files import zoo_dir
+
+    shutil.copy(zoo_dir() / "dagger_pursuer_corridor" / "model.zip", tmp_path / "p.zip")
+    monkeypatch.chdir(tmp_path)
+    assert main(["play", "--evader", "p.zip", "--no-gif", "--max-cycles", "3"]) == 0
+    err = capsys.readouterr().err
+    assert err.startswith(
+        f"surveil: warning: --evader: model = 'p.zip': no provenance.json beside "
+        f"{tmp_path / 'p.zip'}: the role and the observation this model was trained for "
+        "are unknown and unchecked"
+    ), err
+
+
 EVALUATE = ["evaluate", "--maps", "corridor", "--pursuers", "pursuer/greedy", "--evaders",
             "evader/straight", "--seeds", "1", "--max-cycles", "5", "--no-progress"]  # fmt: skip
 

@@ -9,6 +9,7 @@ import json
 import re
 import shutil
 import sqlite3
+import warnings
 
 import pytest
 
@@ -485,3 +486,22 @@ def test_an_older_run_from_another_checkout_is_said_so(tmp_path):
     s = run_tournament(spec_from_dict(zoo), store, backend="serial", progress=False)
     assert (s.reused, s.played) == (0, 2)
     assert "run 40ffb68c9c0885cf in " in s.describe() and "older surveil" in s.describe()
+
+
+def test_a_model_without_its_provenance_is_said_so(tmp_path):
+    """A model zip copied without its provenance.json played without a word, though
+    nothing checked its role or observation: a pursuer model entered as an evader played
+    garbage, and a lidar model given the state forfeited every match."""
+    from strategies.policies.model_files import NoProvenanceWarning
+
+    (tmp_path / "bare").mkdir()
+    shutil.copy(zoo_dir() / "dagger_pursuer_corridor" / "model.zip", tmp_path / "bare" / "p.zip")
+    d = {"maps": ["corridor"], "pursuers": ["pursuer/greedy"], "seeds": 1}
+    with pytest.warns(NoProvenanceWarning, match=r"\[evaders #1\]: model = 'bare/p.zip': no "
+                      r"provenance.json beside .*role and the observation"):  # fmt: skip
+        spec_from_dict({**d, "evaders": [{"model": "bare/p.zip"}]}, base_dir=tmp_path)
+    shutil.copytree(zoo_dir() / "dagger_pursuer_corridor", tmp_path / "whole")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", NoProvenanceWarning)  # with it: not a word
+        spec_from_dict({**d, "pursuers": [{"model": "whole/model.zip"}], "evaders":
+                        ["evader/straight"]}, base_dir=tmp_path)  # fmt: skip

@@ -96,7 +96,9 @@ _HOLDS = "--seeds 8 --rho 0.5 --no-greedy"
 _HELDOUT_P = "--worlds @benchmarks/heldout_worlds_pursuer.txt"
 _BASE = "34fa4ca"
 """The commit every figure below holds at (all fifteen sets played there, compared per
-episode with 1283649: holds-bench +1, certified-e +2, nothing lost). Before: all twelve
+episode with 1283649: holds-bench +1, certified-e +2, nothing lost; played again at
+686fe46, the shooting evader's long-rod shots before any plan and reach margins: every
+episode's winner as at 34fa4ca, escape times moved). Before: all twelve
 sets were played at 94c5063;
 5b239ab's pursuer change (probes round a small obstacle an evader circles) changed only
 fresh-p0 (549 -> 552); 4d0ccce's (the way to room once a ride against a charge stalls)
@@ -111,7 +113,8 @@ episodes) and, together, on the evader sets' episodes against the decomposition 
 and the pursuer sets' against the shooting evader: no figure changed (ddb7e92)."""
 _FIXED = "34fa4ca"
 """Where the three sets of ``fixed_starts.py`` were last played (first at c427419, 1283649's
-policies: certified-e 310/312 there): the
+policies: certified-e 310/312 there; certified-e grew to 468 episodes at ea81a89, played
+at 34c7663): the
 corner world's default starts (the reproduction report's episodes) and the referee's
 certified starts (``benchmarks/certified_starts.json``)."""
 
@@ -155,7 +158,7 @@ SETS: dict[str, PolicySet] = {
              "fixed_starts.py --starts default --world corner --seeds 0-39"),
         _set("certified-p", "certp", "pursuer", "288/288", _FIXED,
              "fixed_starts.py --starts certified --role pursuer"),
-        _set("certified-e", "certe", "evader", "312/312", _FIXED,
+        _set("certified-e", "certe", "evader", "468/468", "34c7663",
              "fixed_starts.py --starts certified --role evader"),
     )
 }  # fmt: skip

@@ -35,6 +35,7 @@ from analysis.arguments import (
 )
 from analysis.figures import cli as figures_cli
 from analysis.replay import MAX_FPS
+from envs.console import OneLineWarnings
 from envs.errors import InvalidConfigError, SurveilValueError, UnknownNameError
 
 __all__ = ["build_parser", "main"]
@@ -383,27 +384,6 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-class _OneLineWarnings:
-    """Show each distinct warning once, as one line: ``surveil: warning: ...``.
-
-    Deprecation warnings (a library's business, not the user's) go to the handler that
-    was installed before.
-    """
-
-    def __init__(self, previous) -> None:
-        self.previous = previous
-        self.seen: set[str] = set()
-
-    def __call__(self, message, category, filename, lineno, file=None, line=None) -> None:
-        if issubclass(category, (DeprecationWarning, PendingDeprecationWarning)):
-            self.previous(message, category, filename, lineno, file, line)
-            return
-        text = str(message)
-        if text not in self.seen:
-            self.seen.add(text)
-            print(f"surveil: warning: {text}", file=sys.stderr if file is None else file)
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``surveil`` console script.
 
@@ -425,7 +405,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("surveil: interrupted", file=sys.stderr)
         return 130
     with warnings.catch_warnings(), sigterm_as_interrupt():
-        warnings.showwarning = _OneLineWarnings(warnings.showwarning)
+        warnings.showwarning = OneLineWarnings(warnings.showwarning, "surveil")
         try:
             code = int(args.func(args) or 0)
             if sys.stdout is not None:  # a reader gone (`| head`) is met here, not at exit

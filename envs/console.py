@@ -6,6 +6,7 @@
 * :class:`CommandParser`: an argument no parser took is refused by the subcommand it was
   given to (``surveil maps extra``, ``python -m training.zoo list extra``), with that
   subcommand's usage.
+* :class:`OneLineWarnings`: each distinct warning once, as one line ``PROG: warning: ...``.
 
 Lives in the bottom layer beside :mod:`envs.pidlock` because the command lines of
 :mod:`analysis` (``surveil``), :mod:`training` (``python -m training``, ``python -m
@@ -20,7 +21,7 @@ import os
 import sys
 from collections.abc import Sequence
 
-__all__ = ["EXIT_READER_GONE", "CommandParser", "reader_gone"]
+__all__ = ["EXIT_READER_GONE", "CommandParser", "OneLineWarnings", "reader_gone"]
 
 EXIT_READER_GONE = 141  # 128 + SIGPIPE
 
@@ -79,3 +80,27 @@ class CommandParser(argparse.ArgumentParser):
             if sub is None or name not in sub.choices:
                 return parser
             parser = sub.choices[name]
+
+
+class OneLineWarnings:
+    """A ``warnings.showwarning`` that shows each distinct warning once, as one line:
+    ``PROG: warning: ...`` (Python's own shows the file, the line number and the source
+    line, and repeats a warning whose text it has shown from another place).
+
+    Deprecation warnings (a library's business, not the user's) go to the handler that
+    was installed before.
+    """
+
+    def __init__(self, previous, prog: str) -> None:
+        self.previous = previous
+        self.prog = prog
+        self.seen: set[str] = set()
+
+    def __call__(self, message, category, filename, lineno, file=None, line=None) -> None:
+        if issubclass(category, (DeprecationWarning, PendingDeprecationWarning)):
+            self.previous(message, category, filename, lineno, file, line)
+            return
+        text = str(message)
+        if text not in self.seen:
+            self.seen.add(text)
+            print(f"{self.prog}: warning: {text}", file=sys.stderr if file is None else file)

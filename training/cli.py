@@ -12,11 +12,12 @@ import os
 import signal
 import sys
 import threading
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from envs import validation
-from envs.console import EXIT_READER_GONE, reader_gone
+from envs.console import EXIT_READER_GONE, OneLineWarnings, reader_gone
 from envs.errors import InvalidConfigError, SurveilValueError
 from training.config import TrainConfig, load_any_config
 from training.selfplay import self_play
@@ -186,6 +187,8 @@ def run_cli(prog: str, func: Callable[[], int]) -> int:
     previous = None
     if threading.current_thread() is threading.main_thread():  # SIGTERM stops as Ctrl-C does
         previous = signal.signal(signal.SIGTERM, _raise_sigterm)
+    shown = warnings.showwarning  # each warning once, one line, as surveil shows them
+    warnings.showwarning = OneLineWarnings(shown, prog)
     try:
         code = int(func() or 0)
         if sys.stdout is not None:  # a reader gone (`| head`) is met here, not at exit
@@ -212,6 +215,7 @@ def run_cli(prog: str, func: Callable[[], int]) -> int:
         print(f"{prog}: error: {message}", file=sys.stderr)
         return 2
     finally:
+        warnings.showwarning = shown
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
 

@@ -238,6 +238,30 @@ def test_an_unknown_opponent_is_refused_as_a_field_of_the_file(tmp_path, capsys,
     assert not out.exists()
 
 
+def test_warnings_are_one_line_each_shown_once(tmp_path):
+    """python -m training (and python -m training.zoo) showed warnings in Python's own
+    format, the file and source line included ('/.../base.py:217: UnseenParametersWarning:
+    ...' then '  self._reset()'), the same one three times over, where surveil shows
+    'surveil: warning: ...' once."""
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(
+        'role = "pursuer"\nopponent = "zoo:ppo_evader_vs_greedy_open_room"\nmap = "open_room"\n'
+        'start = "valid"\ntotal_timesteps = 64\nn_steps = 32\nbatch_size = 32\nn_envs = 2\n'
+        f'eval_episodes = 0\noutput_dir = "{tmp_path / "run"}"\n'
+        "[env]\nmax_cycles = 20\nv_evader = 0.4\n"
+    )
+    run = subprocess.run(
+        [sys.executable, "-m", "training", str(cfg), "--no-progress"],
+        capture_output=True, text=True, cwd=ROOT, timeout=300,
+    )  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    lines = run.stderr.splitlines()
+    unseen = [line for line in lines if "this model plays a game it was not trained at" in line]
+    assert len(unseen) == 1, run.stderr
+    assert unseen[0].startswith("python -m training: warning: "), run.stderr
+    assert all(line.startswith("python -m training: warning: ") for line in lines), run.stderr
+
+
 def test_an_opponent_model_that_fails_to_load_does_not_refuse_the_fixed_rerun(tmp_path, capsys):
     """An opponent model that passes the config's checks (a zip with SB3's 'data') but
     fails at the first reset (here its weights cut short) stopped the run after it wrote

@@ -440,7 +440,7 @@ def test_reproduce_shows_its_progress_unless_told_not_to(tmp_path, monkeypatch, 
     capsys.readouterr()
     assert zoo_main(["reproduce", "tiny", "--output-dir", str(tmp_path / "a")]) == 0
     err = capsys.readouterr().err
-    lines = [line for line in err.splitlines() if "Warning" not in line and line.strip()]
+    lines = [line for line in err.splitlines() if line.strip() and ": warning: " not in line]
     assert [line[: len(e)] for line, e in zip(lines, expected, strict=False)] == expected, err
     assert len(lines) == len(expected), err
     quiet = ["reproduce", "tiny", "--output-dir", str(tmp_path / "b"), "--no-progress"]

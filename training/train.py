@@ -541,6 +541,10 @@ def _train(config, out, t0, init_model, callbacks, progress_bar) -> TrainResult:
         model = cls.load(str(init_model), env=vec_env, device="cpu")
         model.set_random_seed(config.seed)
         model._last_obs = None
+        # a warm start is a new run of total_timesteps: the loaded counter (the earlier
+        # run's) left none to train, and self-play's later rounds returned their warm
+        # start unchanged
+        model.num_timesteps = 0
         done = 0
     else:
         model = _new_model(config, vec_env)

@@ -34,6 +34,27 @@ def test_two_rounds_alternate_against_latest_models(tiny, tmp_path):
     assert [s.wall_time for s in again.stages] == [0.0] * 4
 
 
+def test_a_warm_started_round_trains(tiny, tmp_path):
+    """A warm start loaded the earlier model's timestep counter, which left no timestep to
+    train: every round after the first returned its warm start unchanged (same weights,
+    'trained' in 0.04 s), whatever the new opponent."""
+    import hashlib
+    import zipfile
+
+    config = tiny(total_timesteps=64, eval_episodes=0, output_dir=str(tmp_path / "sp"))
+    stages = self_play(config, rounds=2).stages
+
+    def weights(stage):
+        with zipfile.ZipFile(stage.model_path) as z:
+            return hashlib.sha256(z.read("policy.pth")).hexdigest()
+
+    for later, earlier in ((stages[2], stages[0]), (stages[3], stages[1])):
+        prov = json.loads(later.provenance_path.read_text())
+        assert prov["init_model"] == str(earlier.model_path)
+        assert weights(later) != weights(earlier)
+        assert later.timesteps == 64
+
+
 def test_bad_rounds(tiny):
     with pytest.raises(InvalidConfigError, match="rounds"):
         self_play(tiny(), rounds=0)

@@ -179,3 +179,34 @@ def test_a_lazy_tables_grid_is_allocated_where_it_is_looked_up():
     assert np.array_equal(rl < 0, rr < 0) and (rr >= 0).sum() > 1000
     for name_ in ("free", "safe", "guaranteed", "ccw", "cw"):
         assert np.array_equal(getattr(lazy, name_)[rl[rl >= 0]], getattr(ref, name_)[rr[rr >= 0]])
+
+
+def test_a_lazy_table_builds_its_point_location_at_reset():
+    # the region grid and the cells' stop-code index were built by the first
+    # classification: ~60 ms of the pursuer's first decision on a 300-vertex floor plan
+    lazy = LazySafetyTable(_world("l_hall", 0.61), 2.2, 0.25, 48)
+    dec = lazy.decomposition
+    assert dec._grid is not None and "_batch_cell_keys" in dec.__dict__
+    assert lazy.classified == 0  # (nothing classified yet)
+
+
+def test_the_pursuers_batched_wall_clearances_are_the_node_by_node_ones():
+    world = _world("corridor", 0.3)
+    r = run_episode(world, "pursuer/decomposition", "evader/shooting", 4, max_cycles=2)
+    pols = []
+    for table in ("lazy", "lazy", "eager"):
+        p = make_policy("pursuer/decomposition", table=table)
+        p.reset(role="pursuer", map=world, config=r.config, seed=0)
+        pols.append(p)
+    batched, single, eager = pols
+    nx, ny = eager.table.shape
+    rng = np.random.default_rng(3)
+    i = rng.integers(0, nx, 300)
+    j = rng.integers(0, ny, 300)
+    i[-20:], j[-20:] = i[:20], j[:20]  # repeated nodes, memoised in the same call
+    got = batched._memo_clearances(i, j)
+    want = [single._memo_clearance(int(a), int(b)) for a, b in zip(i, j, strict=True)]
+    assert got.tolist() == want  # the same floats
+    assert np.array_equal(got, eager._clear[i, j])  # as the eager table's grid
+    assert (got == 0.0).any() and (got > 0.0).any()  # nodes off and in the free region
+    assert batched._memo_clearances(i[:0], j[:0]).shape == (0,)

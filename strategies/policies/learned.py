@@ -29,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from envs import validation
 from envs.errors import InvalidConfigError, InvalidObservationError
 from strategies.policies.base import BasePolicy
 from strategies.policies.learner_inputs import LearnerInputs, check_features
@@ -36,6 +37,7 @@ from strategies.policies.model_files import read_provenance
 
 __all__ = [
     "SB3_ALGORITHMS",
+    "SB3_PARAMS",
     "SB3Policy",
     "UnseenMapWarning",
     "UnseenParametersWarning",
@@ -50,6 +52,9 @@ __all__ = [
 
 SB3_ALGORITHMS = ("A2C", "DDPG", "PPO", "SAC", "TD3")
 """Algorithms :class:`SB3Policy` can load (continuous actions)."""
+
+SB3_PARAMS = ("algo", "deterministic", "inputs")
+"""The parameters a model takes as a policy (``--pursuer-params``, a spec's entry)."""
 
 
 _PLAY_ONLY = {"lr_schedule": 0.0, "learning_rate": 0.0, "clip_range": 0.0}
@@ -204,7 +209,8 @@ class SB3Policy(BasePolicy):
         if algo is not None and algo.upper() not in SB3_ALGORITHMS:
             raise InvalidConfigError(f"algo must be one of {SB3_ALGORITHMS}, got {algo!r}")
         self.algo = algo.upper() if algo else None
-        self.deterministic = bool(deterministic)
+        # bool("no") is True: a string or a number was taken for its truth
+        self.deterministic = validation.boolean("deterministic", deterministic, where=self.name)
         self.model: Any = None
         self._warned: set[str] = set()
         self._digests: set[str] | None = None

@@ -217,8 +217,14 @@ def make_policy(name: str, **params: Any) -> BasePolicy:
     name = validation.string("policy name", name)
     role, _, kind = name.partition("/")
     if kind.startswith(SB3_PREFIX) and role in ROLES:
-        from strategies.policies.learned import SB3Policy
+        from strategies.policies.learned import SB3_PARAMS, SB3Policy
 
+        unknown = sorted(set(params) - set(SB3_PARAMS))
+        if unknown:  # was SB3Policy's TypeError (a traceback), 'role' and 'name' too
+            raise InvalidConfigError(
+                f"policy {name!r} has no parameter(s) {unknown}; a model's parameters are "
+                f"{list(SB3_PARAMS)}"
+            )
         return SB3Policy(kind[len(SB3_PREFIX) :], role=role, name=name, **params)
     spec = policy_spec(name)
     unknown = sorted(set(params) - set(spec.params))

@@ -366,6 +366,25 @@ def test_a_model_without_its_provenance_is_said_so_as_it_plays(tmp_path, capsys,
     ), err
 
 
+@pytest.mark.parametrize(
+    ("params", "needle"),
+    [
+        # the first two were SB3Policy's TypeError tracebacks; "no" played as true
+        ('{"foo": 1}', "has no parameter(s) ['foo']; a model's parameters are ['algo', "),
+        ('{"role": "pursuer"}', "has no parameter(s) ['role']"),
+        ('{"deterministic": "no"}', "deterministic = 'no': expected true or false"),
+        ('{"deterministic": 0}', "deterministic = 0: expected true or false"),
+    ],
+)
+def test_a_models_bad_parameters_are_one_line(capsys, params, needle) -> None:
+    argv = ["play", "--evader", "zoo:ppo_evader_vs_greedy_open_room", "--evader-params", params,
+            "--no-gif", "--max-cycles", "2"]  # fmt: skip
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("surveil: error: --evader-params: ") and needle in err, err
+    assert len(err.splitlines()) == 1
+
+
 EVALUATE = ["evaluate", "--maps", "corridor", "--pursuers", "pursuer/greedy", "--evaders",
             "evader/straight", "--seeds", "1", "--max-cycles", "5", "--no-progress"]  # fmt: skip
 

@@ -99,7 +99,8 @@ def make_opponent(opponent: str | Policy, role: str) -> Policy:
         name = model_policy_name(opponent, want, f"opponent = {opponent!r}")
         if name.partition("/")[0] != want:
             raise InvalidConfigError(
-                f"opponent: a {role} learner needs a {want!r} policy ('{want}/KIND', "
+                f"opponent: {'an' if role == 'evader' else 'a'} {role} learner needs "
+                f"{'an' if want == 'evader' else 'a'} {want!r} policy ('{want}/KIND', "
                 f"'zoo:NAME' or a model .zip), got {opponent!r}"
             )
         return make_policy(name, **sb3_params(name))

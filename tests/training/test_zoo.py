@@ -448,3 +448,24 @@ def test_reproduce_shows_its_progress_unless_told_not_to(tmp_path, monkeypatch, 
     assert "timesteps (" not in capsys.readouterr().err
     # the old opt-in flag is still accepted (it is the default now)
     assert zoo_main(["reproduce", "tiny", "--output-dir", str(tmp_path / "c"), "--progress"]) == 0
+
+
+@pytest.mark.parametrize(
+    ("model", "opponent", "message"),
+    [
+        # was "unknown policy 'evader/shootin'; ..." without the flag
+        ("dagger_pursuer_corridor", "evader/shootin",
+         "--opponent = 'evader/shootin': unknown policy 'evader/shootin'; known policies: "),
+        # was "a pursuer learner needs a 'evader' policy" / "an evader learner" read "a evader"
+        ("dagger_pursuer_corridor", "pursuer/greedy",
+         "opponent: a pursuer learner needs an 'evader' policy ('evader/KIND', "),
+        ("dagger_evader_two_rooms", "evader/straight",
+         "opponent: an evader learner needs a 'pursuer' policy ('pursuer/KIND', "),
+    ],
+)  # fmt: skip
+def test_evaluate_names_a_bad_opponent_as_the_flag(capsys, model, opponent, message):
+    from training.zoo.__main__ import main as zoo_main
+
+    assert zoo_main(["evaluate", model, "--opponent", opponent, "--episodes", "1"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"python -m training.zoo: error: {message}"), err

@@ -10,6 +10,7 @@ import sys
 from envs.console import CommandParser
 from training import zoo
 from training.cli import run_cli
+from training.config import opponent_name
 from training.train import evaluate_model
 
 _NAME_HELP = "a shipped model (python -m training.zoo list)"
@@ -89,6 +90,9 @@ def _main(argv: list[str] | None) -> int:
         # named as the flags (was "episodes: ..." and, for --seed -3, numpy's traceback)
         validation.integer("--episodes", args.episodes, minimum=1)
         validation.integer("--seed", args.seed, minimum=0)
+        other = "evader" if zoo.info(args.name)["role"] == "pursuer" else "pursuer"
+        # a misspelt opponent named as the flag (was "unknown policy ..." alone)
+        opponent_name(args.opponent, other, f"--opponent = {args.opponent!r}")
         ev = evaluate_model(
             zoo.model_path(args.name),
             args.opponent,

@@ -140,6 +140,13 @@ def test_sigterm_stops_a_run_with_one_line() -> None:
     assert "Traceback" not in err
 
 
+def _ctrl_c_as_in_a_terminal() -> None:
+    # A foreground job takes SIGINT; a test run started in the background (`nohup pytest
+    # ... &` from a script) ignores it, its children inherit that, and Python then installs
+    # no KeyboardInterrupt handler: the Ctrl-C below would go unseen
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def test_ctrl_c_stops_a_pool_run_with_one_line(tmp_path) -> None:
     """Ctrl-C (SIGINT to the whole process group) stops ``unseen_worlds.py --workers 2``
     with exit code 130 and one line: no worker traceback, no leaked-semaphore warning. An
@@ -157,6 +164,7 @@ def test_ctrl_c_stops_a_pool_run_with_one_line(tmp_path) -> None:
         text=True,
         env=env,
         start_new_session=True,  # its own process group, as a terminal's job
+        preexec_fn=_ctrl_c_as_in_a_terminal,
     )
     for line in proc.stdout:  # the pool starts after this line
         if "to play" in line:

@@ -321,6 +321,9 @@ def test_a_ctrl_c_cpython_discards_while_the_parser_imports_still_stops_the_run(
     SIGINT is delivered inside such a callback while the parser is built."""
     script = """if True:
         import gc, signal, sys, weakref
+        # as a terminal's foreground job: a test run started in the background ignores
+        # SIGINT, and so would this child
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         import analysis.cli
 
         real = analysis.cli.build_parser

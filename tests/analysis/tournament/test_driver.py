@@ -522,7 +522,6 @@ _WARM = textwrap.dedent(
     import sys
     from analysis.tournament import Store, run_tournament, spec_from_dict
     from analysis.tournament.executors import ProcessExecutor
-from strategies.runner import run_episode
     from strategies.policies import register_policy
     from strategies.policies.baselines import RandomPolicy
 

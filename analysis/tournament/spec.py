@@ -63,7 +63,12 @@ from typing import Any
 from analysis.arguments import why_not_a_file
 from envs.errors import InvalidConfigError
 from envs.validation import choice, integer, mapping, positive, string, unit_interval
-from strategies.policies.model_files import is_model_reference, model_path, warn_no_provenance
+from strategies.policies.model_files import (
+    is_model_reference,
+    model_input_shape,
+    model_path,
+    warn_no_provenance,
+)
 
 __all__ = [
     "ENV_FIELDS",
@@ -354,8 +359,10 @@ def spec_from_dict(
     )
     seen: dict[str, str] = {}
     fast: list[str] = []
+    every: list[dict[str, Any]] = []  # the env config of each (map, variant)
     for m in spec.maps:  # every (map, variant) must make a valid env config
         configs = [spec.env_config(m, v) for v in spec.variants]
+        every += configs
         fast += [
             f"{m.label} {v.label}".strip()
             for v, c in zip(spec.variants, configs, strict=True)
@@ -369,6 +376,9 @@ def spec_from_dict(
                 f"same parameters (digest {m.digest[:12]}); list it once"
             )
         seen[key] = m.label
+    for role, flag in (("pursuer", flags.get("pursuers")), ("evader", flags.get("evaders"))):
+        for entry in getattr(spec, f"{role}s"):
+            _check_model_input(entry, every, flag or f"{source} [{role}s]")
     if fast:
         from envs.errors import RhoAboveOneWarning
 
@@ -378,6 +388,41 @@ def spec_from_dict(
             stacklevel=2,
         )
     return spec
+
+
+def _check_model_input(entry: PolicyEntry, games: list[dict[str, Any]], where: str) -> None:
+    """Refuse a model ``entry`` whose zip takes observations of another shape than the
+    ones the spec's games (env configs) give it: it failed its first act() in every match,
+    each a forfeit (a model without its provenance.json is given the env's observation).
+
+    Raises:
+        InvalidConfigError: naming the entry, the model's input shape and the one given.
+    """
+    if entry.model is None or "inputs" in entry.params:
+        return  # a model of analytic features builds its input from the state itself
+    want = model_input_shape(Path(entry.model))
+    if want is None:
+        return
+    from envs.surveillance.observations import STATE_SIZE, lidar_layout
+
+    opts = entry.observation or {}
+    for game in games:
+        kind = opts.get("observation", game["observation"])
+        if kind == "state":
+            given, told = (STATE_SIZE,), "observation 'state'"
+        else:
+            rays = int(opts.get("n_rays", game["n_rays"]))
+            given = (lidar_layout(rays, track=kind == "lidar_track")["time"].stop,)
+            told = f"observation {kind!r} with n_rays = {rays}"
+        if given != want:
+            by = "its entry's" if "observation" in opts else "the spec's env"
+            raise InvalidConfigError(
+                f"{where}: {entry.label!r}: model {entry.model} takes observations of shape "
+                f"{want}, but {by} {told} has shape {given}: every match would be a "
+                "forfeit; give the entry the observation it was trained on (observation = "
+                "{ observation = ..., n_rays = ... }), or put the provenance.json its "
+                "training wrote beside it"
+            )
 
 
 def _sprt(value: Any, where: str, rosters: Mapping[str, tuple[PolicyEntry, ...]]) -> dict:

@@ -29,6 +29,7 @@ from envs.errors import InvalidConfigError
 __all__ = [
     "NoProvenanceWarning",
     "is_model_reference",
+    "model_input_shape",
     "model_path",
     "model_policy_name",
     "read_provenance",
@@ -104,6 +105,28 @@ def model_path(text: str, what: str, base: Path | None = None) -> Path:
     except (OSError, KeyError, zipfile.BadZipFile) as exc:
         raise InvalidConfigError(f"{what}: not a stable-baselines3 model zip ({exc})") from None
     return path
+
+
+def model_input_shape(path: Path) -> tuple[int, ...] | None:
+    """The shape of the observations the SB3 model zip at ``path`` takes, as its
+    ``data`` entry records it (without loading torch), or None when it records none
+    (another space than a Box, or an older format).
+
+    Raises:
+        InvalidConfigError: the file is not a zip with a readable JSON ``data`` entry.
+    """
+    try:
+        with zipfile.ZipFile(path) as zf:
+            data = json.loads(zf.read("data"))
+    except (OSError, KeyError, ValueError, zipfile.BadZipFile) as exc:
+        raise InvalidConfigError(f"{path}: not a stable-baselines3 model zip ({exc})") from None
+    space = data.get("observation_space") if isinstance(data, dict) else None
+    shape = space.get("_shape") if isinstance(space, dict) else None
+    if not isinstance(shape, list) or not all(
+        isinstance(n, int) and not isinstance(n, bool) for n in shape
+    ):
+        return None
+    return tuple(shape)
 
 
 def model_policy_name(text: str, role: str, what: str) -> str:

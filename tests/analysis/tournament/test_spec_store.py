@@ -505,3 +505,38 @@ def test_a_model_without_its_provenance_is_said_so(tmp_path):
         warnings.simplefilter("error", NoProvenanceWarning)  # with it: not a word
         spec_from_dict({**d, "pursuers": [{"model": "whole/model.zip"}], "evaders":
                         ["evader/straight"]}, base_dir=tmp_path)  # fmt: skip
+
+
+def test_a_model_given_another_observation_is_refused_as_the_spec_is_read(tmp_path):
+    """A lidar model zip without its provenance.json was given the env's state and failed
+    its first act() in every match: the spec loaded and every match was a forfeit. The
+    zip's ``data`` records the input shape: the spec is refused, naming both shapes."""
+    from strategies.policies.model_files import NoProvenanceWarning
+
+    (tmp_path / "bare").mkdir()
+    for name, short in (("dagger_pursuer_generalist", "g"), ("dagger_pursuer_corridor", "c")):
+        shutil.copy(zoo_dir() / name / "model.zip", tmp_path / "bare" / f"{short}.zip")
+    d = {"maps": ["corridor"], "evaders": ["evader/straight"], "seeds": 1}
+    lidar = {"model": "bare/g.zip", "label": "g"}  # lidar_track, 32 rays: 40 inputs
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NoProvenanceWarning)
+        refused = (r"^<spec> \[pursuers\]: 'g': model .*g\.zip takes observations of shape "
+                   r"\(40,\), but the spec's env observation 'state' has shape \(13,\): every "
+                   "match would be a forfeit")  # fmt: skip
+        with pytest.raises(InvalidConfigError, match=refused):
+            spec_from_dict({**d, "pursuers": [lidar]}, base_dir=tmp_path)
+        with pytest.raises(InvalidConfigError, match=r"\(40,\), but its entry's observation "
+                           r"'lidar_track' with n_rays = 16 has shape \(24,\)"):  # fmt: skip
+            spec_from_dict({**d, "pursuers": [{**lidar, "observation": {
+                "observation": "lidar_track", "n_rays": 16}}]}, base_dir=tmp_path)  # fmt: skip
+        with pytest.raises(InvalidConfigError, match=r"'bare/c.zip': model .*c\.zip takes "
+                           r"observations of shape \(13,\), but the spec's env observation "
+                           r"'lidar' with n_rays = 32 has shape \(38,\)"):  # fmt: skip
+            spec_from_dict({**d, "pursuers": ["bare/c.zip"], "env": {"observation": "lidar"}},
+                           base_dir=tmp_path)  # fmt: skip
+        given = {"observation": "lidar_track", "n_rays": 32}  # what it was trained on: plays
+        spec = spec_from_dict({**d, "pursuers": [{**lidar, "observation": given}]},
+                              base_dir=tmp_path)  # fmt: skip
+    assert spec.pursuers[0].observation == given
+    whole = {"model": "zoo:dagger_pursuer_generalist"}  # its provenance gives the observation
+    assert spec_from_dict({**d, "pursuers": [whole]}).pursuers[0].observation["n_rays"] == 32

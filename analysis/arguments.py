@@ -33,7 +33,7 @@ from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
-from envs.console import CommandParser, reader_gone
+from envs.console import CommandParser, RecordedInterrupt, interrupts_recorded, reader_gone
 from envs.errors import InvalidConfigError, MemoryBudgetError, SurveilValueError
 
 __all__ = [
@@ -319,42 +319,6 @@ def set_from_flag(config: dict[str, Any], key: str, flag: str, value: Any) -> No
             f"{flag} {value!r} and --config {key} = {config[key]!r}: give {key} once"
         )
     config[key] = value
-
-
-class RecordedInterrupt:
-    """A SIGINT handler that raises ``KeyboardInterrupt`` as Python's own does, and
-    records that it did (:attr:`seen`)."""
-
-    def __init__(self) -> None:
-        self.seen = False
-
-    def __call__(self, signum: int, frame: object) -> None:
-        self.seen = True
-        raise KeyboardInterrupt
-
-
-@contextlib.contextmanager
-def interrupts_recorded() -> Iterator[RecordedInterrupt]:
-    """Within the block, Ctrl-C raises ``KeyboardInterrupt`` as usual and is recorded too:
-    check :attr:`RecordedInterrupt.seen` where the block's work is done. CPython discards
-    an exception raised where none can propagate (a weakref callback of importlib's
-    module locks, a ``__del__``: "Exception ignored in ...") and goes on: 2 of 20 Ctrl-Cs
-    1.5-4 s after ``surveil tournament`` started, in its parser's imports under load, were
-    lost so and the run played on. A SIGINT that Python does not turn into
-    ``KeyboardInterrupt`` (ignored in a background job, or a handler of the caller's)
-    is left as it is, as off the main thread."""
-    record = RecordedInterrupt()
-    if (
-        threading.current_thread() is not threading.main_thread()
-        or signal.getsignal(signal.SIGINT) is not signal.default_int_handler
-    ):
-        yield record
-        return
-    previous = signal.signal(signal.SIGINT, record)
-    try:
-        yield record
-    finally:
-        signal.signal(signal.SIGINT, previous)
 
 
 def _raise_sigterm(signum: int, frame: object) -> None:

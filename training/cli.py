@@ -17,7 +17,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from envs import validation
-from envs.console import EXIT_READER_GONE, OneLineWarnings, reader_gone
+from envs.console import EXIT_READER_GONE, OneLineWarnings, interrupts_recorded, reader_gone
 from envs.errors import InvalidConfigError, SurveilValueError
 from training.config import TrainConfig, load_any_config
 from training.selfplay import self_play
@@ -67,7 +67,11 @@ def run_train(args: argparse.Namespace) -> int:
         overrides["output_dir"] = args.output_dir
     if args.seed is not None:
         overrides["seed"] = args.seed
-    config = load_any_config(args.config, **overrides)
+    with interrupts_recorded() as ctrl_c:  # imports for seconds: a Ctrl-C lands here
+        config = load_any_config(args.config, **overrides)
+        import stable_baselines3  # noqa: F401  (training's import, torch's: seconds)
+    if ctrl_c.seen:  # one CPython discarded in an import's callback: honoured now
+        raise KeyboardInterrupt
     _check_output_dir(os.fspath(config.output_dir))
     progress = not args.no_progress  # as python -m training.zoo reproduce: on unless told
     if not isinstance(config, TrainConfig):  # a DAgger recipe

@@ -484,3 +484,63 @@ def test_a_second_run_in_a_busy_output_dir_is_refused_naming_the_first(tiny):
         assert not (out / "config.toml").exists()  # nothing written
     assert train(config).timesteps == 256  # the lock is released with its holder
     assert (out / "train.lock").read_text() == ""  # and ours when the run ends
+
+
+_DISCARDED_CTRL_C = """if True:
+    import gc, signal, sys, weakref
+    # as a terminal's foreground job: a test run started in the background ignores
+    # SIGINT, and so would this child
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    import {module} as target
+
+    real = target.{name}
+
+    class Thing:
+        pass
+
+    def patched(*args, **kwargs):  # SIGINT delivered in a weakref callback, as in imports
+        thing = Thing()
+        keep = weakref.ref(thing, lambda ref: signal.raise_signal(signal.SIGINT))
+        del thing
+        gc.collect()
+        return real(*args, **kwargs)
+
+    target.{name} = patched
+    sys.exit({main}({argv!r}))
+"""
+
+
+@pytest.mark.parametrize(
+    ("module", "name", "main", "prog", "argv"),
+    [
+        ("training.cli", "load_any_config", "target.cli_train", "python -m training",
+         ["CONFIG", "--no-progress"]),
+        ("training.zoo.__main__", "CommandParser.parse_args", "target.main",
+         "python -m training.zoo",
+         ["evaluate", "ppo_evader_vs_greedy_open_room", "--opponent", "pursuer/greedy",
+          "--episodes", "1"]),
+    ],
+)  # fmt: skip
+def test_a_ctrl_c_cpython_discards_while_it_imports_still_stops_the_command(
+    tmp_path, module, name, main, prog, argv
+):
+    """A Ctrl-C whose KeyboardInterrupt is raised inside a weakref callback (as importlib's
+    module-lock callbacks run during the seconds of imports before a run) is discarded by
+    CPython ("Exception ignored in ...") and the command ran on: training trained, the zoo
+    played. surveil records such a Ctrl-C and honours it (analysis.cli.main); python -m
+    training and python -m training.zoo now do too. Reproduced without the timing."""
+    out = tmp_path / "run"
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(
+        'role = "pursuer"\nopponent = "evader/straight"\ntotal_timesteps = 64\nn_steps = 32\n'
+        f'batch_size = 32\neval_episodes = 0\noutput_dir = "{out}"\n[env]\nmax_cycles = 20\n'
+    )
+    argv = [str(cfg) if a == "CONFIG" else a for a in argv]
+    script = _DISCARDED_CTRL_C.format(module=module, name=name, main=main, argv=argv)
+    run = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, cwd=ROOT, timeout=300
+    )
+    assert "Exception ignored" in run.stderr  # the KeyboardInterrupt CPython discarded
+    assert run.returncode == 130, run.stderr
+    assert run.stderr.endswith(f"{prog}: interrupted\n")
+    assert run.stdout == "" and not out.exists()  # nothing played, nothing trained

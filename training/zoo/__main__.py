@@ -7,7 +7,7 @@ import json
 import math
 import sys
 
-from envs.console import CommandParser
+from envs.console import CommandParser, interrupts_recorded
 from training import zoo
 from training.cli import run_cli
 from training.config import opponent_name
@@ -59,7 +59,12 @@ def _main(argv: list[str] | None) -> int:
         choices=["env", "valid", "safe"],
         help="starts: the env's random one, or sample_start's valid or safe (default)",
     )
-    args = parser.parse_args(argv)
+    with interrupts_recorded() as ctrl_c:  # imports for seconds: a Ctrl-C lands here
+        args = parser.parse_args(argv)
+        if args.command in ("reproduce", "evaluate"):
+            import stable_baselines3  # noqa: F401  (what they play or train: torch's import)
+    if ctrl_c.seen:  # one CPython discarded in an import's callback: honoured now
+        raise KeyboardInterrupt
     if args.command == "list":
         for name in zoo.list_models():
             prov = zoo.info(name)

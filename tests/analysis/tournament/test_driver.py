@@ -563,3 +563,49 @@ def test_a_process_worker_imports_what_a_match_needs_before_its_first_match(tmp_
     )  # fmt: skip
     assert out.returncode == 0, out.stderr[-2000:]
     assert out.stdout.split() == ["ok", "None"], out.stdout
+
+
+def test_a_worker_builds_each_maps_set_up_before_its_first_match(tmp_path, monkeypatch):
+    # A worker's first match on a map built the map's geometry kernel and the start
+    # sampler's room check in the harness's first stretch, on the match's watch (0.4 s on a
+    # 1000-wall room at load 10, against a stretch of time_limit + 1 s): a short limit
+    # could store a MatchTimeout error for a match that never hung.
+    import numpy as np
+
+    from analysis.tournament import worker
+    from analysis.tournament.identity import plan
+    from envs.geometry import kernel as kernel_module
+    from envs.maps import Map
+    from envs.maps.io import save_map
+
+    paths = []
+    for n, r in ((61, 9.71), (67, 8.93)):  # walls no other test draws: nothing cached
+        a = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
+        paths.append(tmp_path / f"round{n}.json")
+        save_map(Map(np.c_[r * np.cos(a), r * np.sin(a)], [], name=f"round{n}"), paths[-1])
+    spec = spec_from_dict(
+        {"maps": [str(p) for p in paths], "pursuers": ["pursuer/greedy"],
+         "evaders": ["evader/random"], "seeds": [3], "start": "valid",
+         "env": {"max_cycles": 5}}
+    )  # fmt: skip
+    ctx = worker.context_for(spec)
+    built = []
+    kernel_init, free_region = kernel_module.Kernel.__init__, Map.free_region
+
+    def counted_kernel(self, world):
+        built.append(("kernel", world.name))
+        kernel_init(self, world)
+
+    def counted_region(self):
+        built.append(("free region", self.name))  # what check_room buffers, once per map
+        return free_region.fget(self)
+
+    monkeypatch.setattr(kernel_module.Kernel, "__init__", counted_kernel)
+    monkeypatch.setattr(Map, "free_region", property(counted_region))
+    worker.warm_up(ctx)
+    assert {what for what, _ in built} == {"kernel", "free region"}
+    assert {name for _, name in built} == {"round61", "round67"}
+    built.clear()
+    outcomes = [worker.play(match, ctx) for match, _ in plan(spec)]
+    assert [o["status"] for o in outcomes] == ["ok", "ok"], outcomes
+    assert built == []  # all of it was on no match's watch

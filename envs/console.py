@@ -61,6 +61,13 @@ def reader_gone() -> bool:
     return gone
 
 
+def progress_flags(parser: argparse.ArgumentParser, help: str) -> None:
+    """``--no-progress`` (described by ``help``) and the hidden ``--progress``, accepted for
+    the runs that showed progress only when asked (progress is the default now)."""
+    parser.add_argument("--no-progress", action="store_true", help=help)
+    parser.add_argument("--progress", action="store_true", help=argparse.SUPPRESS)
+
+
 class CommandParser(argparse.ArgumentParser):
     """``argparse.ArgumentParser`` whose arguments that no parser took are refused by the
     subcommand they were given to (its usage and help), not by the top-level parser."""

@@ -17,7 +17,13 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from envs import validation
-from envs.console import EXIT_READER_GONE, OneLineWarnings, interrupts_recorded, reader_gone
+from envs.console import (
+    EXIT_READER_GONE,
+    OneLineWarnings,
+    interrupts_recorded,
+    progress_flags,
+    reader_gone,
+)
 from envs.errors import InvalidConfigError, SurveilValueError
 from training.config import TrainConfig, load_any_config
 from training.selfplay import self_play
@@ -39,13 +45,11 @@ def add_train_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentPar
         metavar="ROUNDS",
         help="alternate ROUNDS (>= 1) rounds of pursuer/evader training instead of one run",
     )
-    parser.add_argument(
-        "--no-progress",
-        action="store_true",
-        help="no progress (default: a bar on a terminal, else a line per tenth of the "
+    progress_flags(
+        parser,
+        "no progress (default: a bar on a terminal, else a line per tenth of the "
         "timesteps or per DAgger episode, on stderr)",
     )
-    parser.add_argument("--progress", action="store_true", help=argparse.SUPPRESS)  # the default
     return parser
 
 

@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import sys
 
-from envs.console import CommandParser, interrupts_recorded
+from envs.console import CommandParser, interrupts_recorded, progress_flags
 from training import zoo
 from training.cli import run_cli
 from training.config import opponent_name
@@ -36,13 +35,11 @@ def _main(argv: list[str] | None) -> int:
     p_rep.add_argument("name", help=_NAME_HELP)
     p_rep.add_argument("--output-dir", default=None, help="default: out/zoo/NAME")
     p_rep.add_argument("--install", action="store_true", help="replace the shipped model")
-    p_rep.add_argument(
-        "--no-progress",
-        action="store_true",
-        help="no progress (default: a bar on a terminal, else a line per episode or per "
+    progress_flags(
+        p_rep,
+        "no progress (default: a bar on a terminal, else a line per episode or per "
         "tenth of the timesteps, on stderr; a shipped model retrains in 2 to 50 minutes)",
     )
-    p_rep.add_argument("--progress", action="store_true", help=argparse.SUPPRESS)  # the default
     p_ev = sub.add_parser("evaluate", help="play a model against an opponent")
     p_ev.add_argument("name", help=_NAME_HELP)
     p_ev.add_argument(

@@ -121,7 +121,8 @@ def check_step(
     if body_radius is None:
         return
     travel = max_speed * dt
-    need = travel / (MAX_SUBSTEP_TRAVEL * body_radius)  # inf for a radius of 1e-320
+    reach = MAX_SUBSTEP_TRAVEL * body_radius  # 0.0 for the subnormal 5e-324: need is inf
+    need = travel / reach if reach > 0.0 else math.inf  # inf for a radius of 1e-320
     if need * (1.0 - 1e-12) > MAX_SUBSTEPS:  # substeps_for's slack: 2e-06 fits exactly
         raise InvalidConfigError(
             f"body_radius = {body_radius!r} with max(v_pursuer, v_evader) dt = {travel:g}: "

@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from envs import surveillance_v1
 from envs.errors import InvalidConfigError
 from envs.surveillance.physics import MAX_SUBSTEP_TRAVEL, World, substeps_for
 from tests.envs.surveillance._worlds import open_room, pillar_room, spiky_room
@@ -123,18 +124,23 @@ def test_a_step_that_crosses_the_map_is_refused(over, speed) -> None:
     env.close()  # a step within the map's diameter is the user's choice
 
 
-@pytest.mark.parametrize("radius", [1e-12, 1e-300])
+@pytest.mark.parametrize("radius", [1e-12, 1e-300, 5e-324])
 def test_a_step_of_too_many_substeps_is_refused(radius) -> None:
     """``surveil play --config '{"body_radius": 1e-12}'`` hung: 2e11 physics substeps a
     step (a body moves at most half its radius a substep). Refused beyond MAX_SUBSTEPS,
-    naming the smallest radius that fits, which builds."""
+    naming the smallest radius that fits, which builds. The subnormal 5e-324 (half of it
+    is 0.0) raised ZeroDivisionError from the env's constructor instead."""
     from envs.surveillance.physics import MAX_SUBSTEPS
 
-    with pytest.raises(InvalidConfigError, match=(
+    refused = (
         rf"^body_radius = {radius!r} with max\(v_pursuer, v_evader\) dt = 0.1: a step would "
-        r"take [\d.e+]+ physics substeps .* more than 100,000 .* expected body_radius >= 2e-06"
-    )):  # fmt: skip
+        r"take (?:[\d.e+]+|inf) physics substeps .* more than 100,000 .* expected body_radius "
+        r">= 2e-06"
+    )
+    with pytest.raises(InvalidConfigError, match=refused):
         World(open_room(), radius, 0.1, 1.0)
+    with pytest.raises(InvalidConfigError, match=refused):  # through the env's config
+        surveillance_v1.parallel_env(map=open_room(), body_radius=radius)
     assert World(open_room(), 2e-6, 0.1, 1.0).n_substeps == MAX_SUBSTEPS
 
 
@@ -194,7 +200,7 @@ def test_a_break_after_a_body_stopped_at_a_wall_is_timed_on_its_path(dt) -> None
     over the whole step). Now within one substep's travel (r / 2 = 0.05 of wall
     penetration, the physics' own, 0.1 s at the evader's 0.5) of the truth; a step
     without contact keeps the single sweep. v0, retired, keeps the chord."""
-    from envs import surveillance_v0, surveillance_v1
+    from envs import surveillance_v0
 
     def break_at(module) -> float:
         env = module.parallel_env(map="corridor", dt=dt, spawn_margin_steps=0)

@@ -123,9 +123,12 @@ def tractrix_numeric(
     """The same motion by RK4 on the follower position: ``ṗ = (ė·u) u``, ``u = (p - e)/|p - e|``.
 
     An independent check of :func:`tractrix` (a different ODE: positions, not θ).
-    ``t`` must be increasing; ``substeps`` RK4 steps are taken between samples.
+    ``t`` must be increasing; ``substeps`` RK4 steps (an integer >= 1) are taken between
+    samples.
     """
     tt, L, v_e, theta0, alpha, start = _tractrix_args(t, L, v_e, theta0, alpha, leader_start)
+    # 0 or fewer steps returned the start at every time, 2.0 a TypeError from range()
+    substeps = validation.integer("substeps", substeps, minimum=1, where="tractrix_numeric")
     if np.any(np.diff(tt) < 0):
         raise SurveilValueError("t must be non-decreasing for tractrix_numeric")
     ev = v_e * np.array([math.cos(alpha), math.sin(alpha)])

@@ -237,6 +237,16 @@ def test_bad_input():
         straight_leader_time(0.0, 1.0, alpha=0.0, L=1.0, v_p=1.0, rho=-0.5)
 
 
+@pytest.mark.parametrize("substeps", [0, -3, 2.0, True, "10"])
+def test_tractrix_numeric_refuses_a_step_count_that_is_no_positive_integer(substeps):
+    # 0 and -3 integrated nothing (the follower stood at its start: no error), 2.0 and
+    # "10" raised TypeError from range(), True integrated one step
+    with pytest.raises(
+        SurveilValueError, match=rf"substeps = {substeps!r}: expected an integer >= 1"
+    ):
+        tractrix_numeric([0.0, 1.0], substeps=substeps)
+
+
 def test_tractrix_refuses_a_leader_travel_that_overflows():
     # v_e t = 1e300 * 1e300 was inf: the leader at inf, the follower nan (no error)
     with pytest.raises(SurveilValueError, match=r"v_e = 1e\+300 .* overflows"):

@@ -64,8 +64,8 @@ from analysis.arguments import why_not_a_file
 from envs.errors import InvalidConfigError
 from envs.validation import choice, integer, mapping, positive, string, unit_interval
 from strategies.policies.model_files import (
+    check_model_input,
     is_model_reference,
-    model_input_shape,
     model_path,
     warn_no_provenance,
 )
@@ -400,29 +400,16 @@ def _check_model_input(entry: PolicyEntry, games: list[dict[str, Any]], where: s
     """
     if entry.model is None or "inputs" in entry.params:
         return  # a model of analytic features builds its input from the state itself
-    want = model_input_shape(Path(entry.model))
-    if want is None:
-        return
-    from envs.surveillance.observations import STATE_SIZE, lidar_layout
-
     opts = entry.observation or {}
-    for game in games:
-        kind = opts.get("observation", game["observation"])
-        if kind == "state":
-            given, told = (STATE_SIZE,), "observation 'state'"
-        else:
-            rays = int(opts.get("n_rays", game["n_rays"]))
-            given = (lidar_layout(rays, track=kind == "lidar_track")["time"].stop,)
-            told = f"observation {kind!r} with n_rays = {rays}"
-        if given != want:
-            by = "its entry's" if "observation" in opts else "the spec's env"
-            raise InvalidConfigError(
-                f"{where}: {entry.label!r}: model {entry.model} takes observations of shape "
-                f"{want}, but {by} {told} has shape {given}: every match would be a "
-                "forfeit; give the entry the observation it was trained on (observation = "
-                "{ observation = ..., n_rays = ... }), or put the provenance.json its "
-                "training wrote beside it"
-            )
+    check_model_input(
+        Path(entry.model),
+        ({k: opts.get(k, game[k]) for k in ("observation", "n_rays")} for game in games),
+        f"{where}: {entry.label!r}",
+        given_by="its entry's" if "observation" in opts else "the spec's env",
+        then="every match would be a forfeit; give the entry the observation it was "
+        "trained on (observation = { observation = ..., n_rays = ... }), or put the "
+        "provenance.json its training wrote beside it",
+    )
 
 
 def _sprt(value: Any, where: str, rosters: Mapping[str, tuple[PolicyEntry, ...]]) -> dict:

@@ -59,6 +59,7 @@ __all__ = [
     "decode_state",
     "lidar_layout",
     "lidar_space",
+    "observation_size",
     "state_space",
 ]
 
@@ -105,6 +106,21 @@ def lidar_layout(n_rays: int, track: bool = False) -> dict[str, slice]:
     }
 
 
+def observation_size(observation: str, n_rays: int) -> int:
+    """How many numbers an ``observation`` (``EnvConfig.observation``) of ``n_rays`` rays
+    holds (``n_rays`` is not read for ``"state"``).
+
+    Examples:
+        >>> observation_size("state", 32), observation_size("lidar", 32)
+        (13, 38)
+        >>> observation_size("lidar_track", 32)
+        40
+    """
+    if observation == "state":
+        return STATE_SIZE
+    return lidar_layout(n_rays, track=observation == "lidar_track")["time"].stop
+
+
 def _max_distance_ratio(config: EnvConfig) -> float:
     xmin, ymin, xmax, ymax = config.map.bounds
     return math.hypot(xmax - xmin, ymax - ymin) / config.l_max
@@ -125,7 +141,7 @@ def state_space(config: EnvConfig) -> Box:
 def lidar_space(config: EnvConfig) -> Box:
     """The Box of ``"lidar"`` / ``"lidar_track"`` observations (a new object each call)."""
     layout = lidar_layout(config.n_rays, track=config.observation == "lidar_track")
-    size = layout["time"].stop
+    size = observation_size(config.observation, config.n_rays)
     low = np.full(size, -1.0, dtype=np.float32)
     high = np.full(size, 1.0, dtype=np.float32)
     for name in ("rays", "visible", "time"):

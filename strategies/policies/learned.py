@@ -33,7 +33,7 @@ from envs import validation
 from envs.errors import InvalidConfigError, InvalidObservationError
 from strategies.policies.base import BasePolicy
 from strategies.policies.learner_inputs import LearnerInputs, check_features
-from strategies.policies.model_files import read_provenance
+from strategies.policies.model_files import check_model_input, read_provenance
 
 __all__ = [
     "SB3_ALGORITHMS",
@@ -282,7 +282,30 @@ class SB3Policy(BasePolicy):
                     f"({type(exc).__name__}: {exc})"
                 ) from exc
 
+    def check_observation(self, config: Any) -> None:
+        """Refuse a game whose observation (``config``'s, as the runner resets this
+        policy with it) has another shape than the model's input, before the model loads:
+        it would fail its first :meth:`act` (a model without its provenance.json is given
+        the env's own observation). A model of analytic features is not checked here (it
+        builds its input from the state; :meth:`act` checks what it builds).
+
+        Raises:
+            InvalidConfigError: naming the model, its input shape and the one given.
+        """
+        if self._inputs is not None or not self.path.is_file():
+            return  # no file: load() says so
+        check_model_input(
+            self.path,
+            [{"observation": config.observation, "n_rays": config.n_rays}],
+            self.name,
+            given_by="the game's",
+            then="it would fail its first step; give it the observation it was trained "
+            "on (the env's observation and n_rays), or put the provenance.json its "
+            "training wrote beside it (the runner then gives it that observation)",
+        )
+
     def _reset(self) -> None:
+        self.check_observation(self.config)
         self.load()
         seed = int(self.rng.integers(2**31 - 1))
         self.model.set_random_seed(seed)

@@ -21,6 +21,7 @@ import importlib.util
 import json
 import warnings
 import zipfile
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -28,6 +29,7 @@ from envs.errors import InvalidConfigError
 
 __all__ = [
     "NoProvenanceWarning",
+    "check_model_input",
     "is_model_reference",
     "model_input_shape",
     "model_path",
@@ -127,6 +129,48 @@ def model_input_shape(path: Path) -> tuple[int, ...] | None:
     ):
         return None
     return tuple(shape)
+
+
+def check_model_input(
+    path: Path,
+    observations: Iterable[Mapping[str, Any]],
+    what: str,
+    *,
+    given_by: str,
+    then: str,
+) -> None:
+    """Refuse the SB3 model zip at ``path`` if any of the ``observations`` it would be
+    given has another shape than the one its ``data`` entry records (read without
+    torch): without this, it plays until its first ``act()`` and fails there (a lidar
+    model without its provenance.json given the env's state).
+
+    Args:
+        path: the model zip.
+        observations: observation settings, each a mapping of ``observation`` (the kind)
+            and ``n_rays`` (read for a lidar), as ``EnvConfig`` names them.
+        what: how the caller names the model, the start of the message.
+        given_by: whose observation it is, as the message says it (``"the game's"``).
+        then: what would happen and how to put it right, the end of the message.
+
+    Raises:
+        InvalidConfigError: naming ``what``, the model, its input shape and the one given.
+    """
+    want = model_input_shape(path)
+    if want is None:
+        return
+    from envs.surveillance.observations import observation_size
+
+    for opts in observations:
+        kind = opts["observation"]
+        given = (observation_size(kind, int(opts.get("n_rays", 0))),)
+        if given != want:
+            told = f"observation {kind!r}"
+            if kind != "state":
+                told += f" with n_rays = {int(opts['n_rays'])}"
+            raise InvalidConfigError(
+                f"{what}: model {path} takes observations of shape {want}, but {given_by} "
+                f"{told} has shape {given}: {then}"
+            )
 
 
 def model_policy_name(text: str, role: str, what: str) -> str:

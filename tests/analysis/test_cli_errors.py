@@ -567,3 +567,27 @@ def test_an_empty_file_or_map_name_is_refused(argv, needle, capsys, tmp_path, mo
     monkeypatch.chdir(tmp_path)
     assert_fails(capsys, argv, needle, "expected")
     assert not any(tmp_path.iterdir())  # nothing written
+
+
+def test_a_model_given_observations_of_another_shape_is_one_line_before_play(
+    tmp_path, capsys, monkeypatch
+):
+    """surveil play gave a lidar model copied without its provenance.json the state and
+    it failed at its first step ('failed at step 0: InvalidObservationError: ...'): the
+    shape its zip records is checked as it is reset, a configuration error."""
+    import shutil
+
+    from strategies.policies.model_files import zoo_dir
+
+    shutil.copy(zoo_dir() / "dagger_pursuer_generalist" / "model.zip", tmp_path / "g.zip")
+    monkeypatch.chdir(tmp_path)
+    assert main(["play", "--pursuer", "g.zip", "--no-gif", "--max-cycles", "3"]) == 2
+    out, err = capsys.readouterr()
+    lines = err.strip().splitlines()
+    assert [line.split(":")[1] for line in lines] == [" warning", " error"], err
+    assert lines[1].startswith(
+        f"surveil: error: g.zip: model {tmp_path / 'g.zip'} takes observations of shape "
+        "(40,), but the game's observation 'state' has shape (13,): it would fail its first "
+        "step; give it the observation it was trained on"
+    ), err
+    assert out == ""  # no episode played

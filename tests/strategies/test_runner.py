@@ -330,3 +330,32 @@ def test_a_transformed_built_in_plays_at_its_scaled_recommendations():
     r = run_episode("corridor~x10", "pursuer/greedy", "evader/random", 0, max_cycles=5,
                     overrides={"l_min": 15.0})  # fmt: skip
     assert (r.config.l_min, r.config.l_max) == (15.0, 40.0)
+
+
+def test_a_model_given_observations_of_another_shape_is_refused_before_it_loads(tmp_path):
+    # A lidar_track model copied without its provenance.json (the registry's
+    # pursuer/sb3:PATH, surveil play, zoo evaluate, a training opponent) was given the
+    # env's state and failed its first act(), a forfeit: "failed at step 0:
+    # InvalidObservationError: ... observation of shape (13,), but the model was trained
+    # on shape (40,)". The zip records its input shape: refused as it is reset, unloaded.
+    import shutil
+
+    from strategies.policies import make_policy
+    from strategies.policies.model_files import zoo_dir
+
+    bare = tmp_path / "g.zip"
+    shutil.copy(zoo_dir() / "dagger_pursuer_generalist" / "model.zip", bare)
+    pol = make_policy(f"pursuer/sb3:{bare}")
+    state = (r"^pursuer/sb3:.*g\.zip: model .*g\.zip takes observations of shape \(40,\), "
+             r"but the game's observation 'state' has shape \(13,\): it would fail its "
+             "first step")  # fmt: skip
+    with pytest.raises(InvalidConfigError, match=state):
+        run_episode(MAP, pol, "evader/straight", 0, max_cycles=3)
+    assert pol.model is None  # refused before torch and the model were loaded
+    rays16 = {"observation": "lidar_track", "n_rays": 16}
+    with pytest.raises(InvalidConfigError, match=r"'lidar_track' with n_rays = 16 has shape "
+                       r"\(24,\)"):  # fmt: skip
+        run_episode(MAP, pol, "evader/straight", 0, max_cycles=3, overrides=rays16)
+    trained = {"observation": "lidar_track", "n_rays": 32}  # what it was trained on: plays
+    r = run_episode(MAP, pol, "evader/straight", 0, max_cycles=3, overrides=trained)
+    assert r.steps == 3 and r.observations["pursuer"]["n_rays"] == 32

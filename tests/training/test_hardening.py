@@ -80,9 +80,14 @@ def test_a_model_checks_its_role_and_observation(tiny):
     assert policy.observation_options == {"observation": "state"}
     env = surveillance_v1.parallel_env(map="open_room", observation="lidar", n_rays=8)
     obs, _ = env.reset(seed=0)
-    policy.reset(role="pursuer", map=env.config.map, config=env.config, seed=0)
+    with pytest.raises(InvalidConfigError, match=r"shape \(13,\), but the game's observation "
+                       r"'lidar' with n_rays = 8 has shape \(14,\)"):  # fmt: skip
+        policy.reset(role="pursuer", map=env.config.map, config=env.config, seed=0)
+    assert policy.model is None  # refused before it loaded
+    state = surveillance_v1.parallel_env(map="open_room").config
+    policy.reset(role="pursuer", map=state.map, config=state, seed=0)
     with pytest.raises(InvalidObservationError, match="trained on shape"):
-        policy.act(obs["pursuer_0"])
+        policy.act(obs["pursuer_0"])  # act() still checks what it is given
     env.close()
 
 

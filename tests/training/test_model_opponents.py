@@ -143,3 +143,16 @@ def test_a_model_opponent_sees_the_observation_it_was_trained_on(learner_observa
         done, steps = terminated or truncated, steps + 1
         assert obs.shape == env.observation_space.shape
     assert steps > 1
+
+
+def test_a_model_opponent_given_observations_of_another_shape_is_refused(tmp_path) -> None:
+    # training (and python -m training.zoo evaluate --opponent) against a lidar model
+    # without its provenance.json gave it the learner's state: InvalidObservationError at
+    # the first step; now refused as the episode starts, before the model loads
+    bare = _zip_copy(tmp_path, "dagger_pursuer_generalist", provenance=False)
+    with pytest.warns(UserWarning, match="no provenance.json"):
+        env = SingleAgentEnv("evader", str(bare), map="open_room", max_cycles=5)
+    with pytest.raises(InvalidConfigError, match=r"takes observations of shape \(40,\), but "
+                       r"the game's observation 'state' has shape \(13,\)"):  # fmt: skip
+        env.reset(seed=0)
+    assert env.opponent.model is None

@@ -44,7 +44,8 @@ _SB3 = "sb3:"
 
 class NoProvenanceWarning(UserWarning):
     """A model file has no ``provenance.json`` beside it: the role it was trained for
-    and the observation it was trained on are unknown, so neither is checked."""
+    and the observation it was trained on are unknown, so neither is checked (only the
+    input shape its zip records: :func:`check_model_input`)."""
 
 
 def warn_no_provenance(what: str, path: Path) -> None:
@@ -52,8 +53,9 @@ def warn_no_provenance(what: str, path: Path) -> None:
     has no ``provenance.json`` beside it."""
     warnings.warn(
         f"{what}: no provenance.json beside {path}: the role and the observation this "
-        "model was trained for are unknown and unchecked (a model of the other role, or "
-        "given another observation, plays without a word); put the provenance.json its "
+        "model was trained for are unknown and unchecked (a model of the other role plays "
+        "without a word, and so does one given another observation of the size it takes; "
+        "only observations of another size are refused); put the provenance.json its "
         "training wrote beside it",
         NoProvenanceWarning,
         stacklevel=3,

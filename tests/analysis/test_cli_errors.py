@@ -591,3 +591,23 @@ def test_a_model_given_observations_of_another_shape_is_one_line_before_play(
         "step; give it the observation it was trained on"
     ), err
     assert out == ""  # no episode played
+
+
+def test_the_no_provenance_warning_says_what_is_still_checked(tmp_path, capsys, monkeypatch):
+    """NoProvenanceWarning said a model 'given another observation, plays without a word'
+    just before the same model was refused for the shape of its observation."""
+    import shutil
+
+    from strategies.policies.model_files import zoo_dir
+
+    shutil.copy(zoo_dir() / "dagger_pursuer_generalist" / "model.zip", tmp_path / "g.zip")
+    monkeypatch.chdir(tmp_path)
+    assert main(["play", "--pursuer", "g.zip", "--no-gif", "--max-cycles", "3"]) == 2
+    warning, error = capsys.readouterr().err.strip().splitlines()
+    assert "given another observation, plays without a word" not in warning
+    assert (
+        "are unknown and unchecked (a model of the other role plays without a word, and so "
+        "does one given another observation of the size it takes; only observations of "
+        "another size are refused)" in warning
+    ), warning
+    assert "takes observations of shape (40,)" in error

@@ -35,7 +35,8 @@ Usage::
 Each failure (the pursuer held) is printed as it happens, and a progress line every 20
 jobs (``--progress``: a line per job). With ``--results F.jsonl`` every job (the shooting
 evader's episode and the simple evaders' from the same start) is appended to F as it
-completes (JSON lines, ``benchmarks/episode_rows.py``); the same command with the same F
+completes (JSON lines, ``benchmarks/episode_rows.py``; ``start_drawn``: the start the
+seed drew, which ``policy_sets.py label`` judges); the same command with the same F
 after a stop plays only the jobs missing from it and reports over all of them.
 
 The simple evaders play only the first ``--simple-seeds`` seeds (they lose often, and a
@@ -146,7 +147,8 @@ def _play(job):
         s = run_episode(m, _policy(pursuer), _policy(e), seed, max_cycles=max_cycles,
                         overrides=params, start=start)  # fmt: skip
         out[e] = [s.winner, s.escape_time, s.decide_seconds["evader"], s.steps]
-    return {**dict(zip(_KEY, job, strict=True)), "out": out}
+    start_drawn = {k: [float(x) for x in v] for k, v in r.start.items()}  # the referee's labels
+    return {**dict(zip(_KEY, job, strict=True)), "out": out, "start_drawn": start_drawn}
 
 
 _KEY = ("world", "variant", "pursuer", "seed", "k", "start", "simple")

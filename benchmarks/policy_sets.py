@@ -22,13 +22,16 @@ says when a side's rows come from more than one code version, and exits with sta
 when the candidate lost an episode the base won (0 otherwise; 2 for a
 bad directory or file), so a session can gate on it.
 
-``label DIR`` asks the referee about every start of the pursuer sets in DIR (one solve per
+``label DIR`` asks the referee about every start of the sets in DIR (one solve per
 game, cached on disk; ``--cpl 16 24``: a start undecided at 16 is labelled at 24) and
-prints per set the losses no pursuer could avoid (an escape certified within the
-horizon), those from starts certified for the pursuer (the policy's regrets), the
-undecided ones, and the regret: regrets / episodes from starts certified for the pursuer
-(``benchmarks/set_labels.py``; labels kept in ``SET.labels.jsonl``, ``--labels LDIR``, a
-rerun resumes; ``--losses-only`` labels the lost starts alone)::
+prints per set the losses no policy of the set's side could avoid (a pursuer set's: an
+escape certified within the horizon; an evader set's: a start certified for the
+pursuer), those from starts certified for the set's side (the policy's regrets: a
+pursuer set's from starts the pursuer holds forever, an evader set's from starts with
+an escape certified within the horizon), the undecided ones, and the regret: regrets /
+episodes from such starts (``benchmarks/set_labels.py``; labels kept in
+``SET.labels.jsonl``, ``--labels LDIR``, a rerun resumes; ``--losses-only`` labels the
+lost starts alone)::
 
     python benchmarks/policy_sets.py label out/base --cpl 16 24 --losses-only
 
@@ -367,14 +370,14 @@ def compare(base: str, cand: str, sets: Mapping[str, PolicySet] = SETS) -> int:
 
 def label(directory: str, names: Sequence[str], cpls: Sequence[float], labels_dir: str | None,
           losses_only: bool = False, sets: Mapping[str, PolicySet] = SETS) -> int:  # fmt: skip
-    """Label the starts of the pursuer sets ``names`` (default: every pursuer set) in
+    """Label the starts of the sets ``names`` (default: every set) in
     ``directory`` with the referee (:mod:`set_labels`), into ``labels_dir`` (default
     ``directory``), and print each set's losses, unavoidable ones, regrets, undecided
     ones and regret.
 
     Raises:
         InvalidConfigError: the directory holds no set, a named set is not in it or is not
-            a pursuer set, or a ``cpls`` value is not a resolution.
+            a set whose rows give starts, or a ``cpls`` value is not a resolution.
     """
     import set_labels
 
@@ -384,11 +387,8 @@ def label(directory: str, names: Sequence[str], cpls: Sequence[float], labels_di
         if n not in present:
             raise InvalidConfigError(f"{directory!r} holds no results file of set {n} "
                                      f"({n}.jsonl); it holds {', '.join(present)}")  # fmt: skip
-        set_labels.starts_of(sets[n], {})  # a set of the other role is refused before any solve
-    chosen = list(dict.fromkeys(names)) or [n for n in present if sets[n].role == "pursuer"]
-    if not chosen:
-        raise InvalidConfigError(f"{directory!r} holds no pursuer set ({', '.join(present)}); "
-                                 "expected results of a pursuer set to label")  # fmt: skip
+        set_labels.starts_of(sets[n], {})  # a set it cannot judge is refused before any solve
+    chosen = list(dict.fromkeys(names)) or present
     out = labels_dir or directory
     output_dir("--labels", out)
     read = {n: read_set(os.path.join(directory, f"{n}.jsonl"), sets[n]) for n in chosen}
@@ -470,12 +470,12 @@ def main(argv=None) -> int:
     p = sub.add_parser("totals", help="per set in DIR: wins / episodes, code versions")
     p.add_argument("dir", type=path_text("a directory"), metavar="DIR",
                    help="a directory 'run --out DIR' wrote")  # fmt: skip
-    p = sub.add_parser("label", help="the referee's label of each start of pursuer sets in DIR: "
+    p = sub.add_parser("label", help="the referee's label of each start of the sets in DIR: "
                        "losses unavoidable, regrets, undecided; the regret per set")  # fmt: skip
     p.add_argument("dir", type=path_text("a directory"), metavar="DIR",
                    help="a directory 'run --out DIR' wrote")  # fmt: skip
     p.add_argument("sets", nargs="*", type=_set_name, metavar="SET",
-                   help="pursuer sets to label (default: every pursuer set in DIR)")  # fmt: skip
+                   help="sets to label (default: every set in DIR)")  # fmt: skip
     p.add_argument("--cpl", nargs="+", type=real(0), default=[16.0], metavar="CPL",
                    help="the referee's cells per L_min (default 16); several: a start "
                    "undecided at one is labelled at the next")  # fmt: skip

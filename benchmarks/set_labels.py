@@ -1,29 +1,46 @@
-"""The referee's labels of a pursuer set's starts: which losses no pursuer could avoid, and
-the decomposition pursuer's regret (``policy_sets.py label``).
+"""The referee's labels of a policy set's starts: which losses no policy of the set's side
+could avoid, and the policy's regret (``policy_sets.py label``).
 
-Each episode of a pursuer set starts from a start (the pursuer's and the evader's
-positions) in one game (world, L range, speeds, body radius). The referee
-(:mod:`strategies.referee`, through ``referee_labels.py``: the bounded-speed ground truth
-at ``CPL`` cells per L_min, with a fine evader lattice) labels each start:
+Each episode of a set starts from a start (the pursuer's and the evader's positions) in
+one game (world, L range, speeds, body radius). The referee (:mod:`strategies.referee`,
+through ``referee_labels.py``: the bounded-speed ground truth at ``CPL`` cells per
+L_min, with a fine evader lattice) labels each start:
 
 * ``evader``: certified for the evader, with a certified escape time T (no pursuer of
-  speed V_p holds it longer against the best evader). A loss from it is *unavoidable*
-  when T is within the episode's horizon; when T is beyond it (``late``: the bound is
-  loose, a multiple of the referee's step), some pursuer might still have held to the
+  speed V_p holds it longer against the best evader). The best evader escapes within
+  the episode's horizon when T is within it; when T is beyond it (``late``: the bound
+  is loose, a multiple of the referee's step), some pursuer might still hold to the
   horizon.
 * ``pursuer``: certified for the pursuer (some pursuer of speed V_p holds it forever,
-  against every evader). A loss from it is the policy's *regret*.
+  against every evader).
 * ``unknown`` (the referee's resolution error), ``not solved`` (over the memory budget,
   ``$SURVEIL_MEMORY_BUDGET``), ``not a start`` (surveillance does not hold there: a
   start the runner drew that the referee's margins refuse), ``no start`` (a crashed
   episode's row records none): undecided.
 
-The *regret* of a set is regrets / certified-winnable episodes (episodes from starts
-certified for the pursuer; issue 13's regret, :class:`strategies.referee.Regret`). At rho
->= 0.35 the pursuer bound has certified nothing at any resolution tried
-(``strategies.referee.pursuer_bound``): there no start is certified winnable, a loss is
-unavoidable or undecided, and the regret is undefined. "Unavoidable" is against the best
-evader: a weaker evader (a zig-zag, a herder) might have been held from such a start.
+A loss of a *pursuer set* (the decomposition pursuer did not hold) is *unavoidable*
+from an ``evader`` start with T within the horizon, ``late`` from one with T beyond it,
+and the policy's *regret* from a ``pursuer`` start. A loss of an *evader set* (the
+shooting evader did not escape by the horizon) is *unavoidable* from a ``pursuer``
+start, the policy's *regret* from an ``evader`` start with T within the horizon, and
+``late`` from one with T beyond it (undecided: a certificate of an escape, not of one
+within the horizon). Starts are *winnable* for the set's side when a loss from them is
+a regret.
+
+The *regret* of a set is regrets / certified-winnable episodes (episodes from such
+starts; issue 13's regret, :class:`strategies.referee.Regret`). At rho >= 0.35 the
+pursuer bound has certified nothing at any resolution tried
+(``strategies.referee.pursuer_bound``): there no start is certified for the pursuer, so a
+pursuer set's loss is unavoidable or undecided and its regret undefined, and an evader
+set's loss is a regret or undecided. "Unavoidable" is against the best opponent: a
+weaker evader (a zig-zag, a herder) might have been held, a weaker pursuer (a greedy
+follower) escaped, from such a start.
+
+The starts: ``unseen_worlds.py`` and ``fixed_starts.py`` rows record the start played;
+``evader_escapes.py`` rows record none before ``start_drawn`` (the episode seed drew a
+safe start): it is drawn again as the runner draws it (``strategies.runner``'s start
+seed), which is the start played while the start sampler has not changed since the row
+(its ``code``).
 
 The referee's resolution (its error bound): the opponent is known to a cell of side
 h = L_min / CPL (its position within h / sqrt(2)); the certified player moves on a
@@ -46,6 +63,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import math
 import os
 import time
 import warnings
@@ -53,6 +71,7 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 import episode_rows
+import numpy as np
 import referee_labels
 
 from envs.errors import InvalidConfigError, VacuousBoundWarning
@@ -74,6 +93,8 @@ class Start:
 
     key: str
     """The start's identity: its game and positions (the episodes of one start share it)."""
+    role: str
+    """The side the set measures (``"pursuer"`` or ``"evader"``): whose loss it judges."""
     game: str
     """The game's identity (one solve): the untransformed world and its parameters."""
     world: str
@@ -93,33 +114,50 @@ def _judged_game(m: Map, ov: Mapping[str, float]) -> str:
     return json.dumps([m.digest, *(float(ov[k]) for k in sorted(ov))])
 
 
+def _dt() -> float:
+    from envs.surveillance.config import EnvConfig
+
+    return EnvConfig.__dataclass_fields__["dt"].default
+
+
+def _evader_horizon(m: Map, ov: Mapping[str, float], k: float) -> float:
+    """The horizon in seconds of an evader-role episode of ``k`` D / V_e on the played
+    world (``math.ceil`` of it in steps, as the scripts play it)."""
+    import unseen_worlds as uw
+
+    return math.ceil(k * uw.diameter(m) / ov["v_evader"] / _dt()) * _dt()
+
+
 def _unseen(row: dict) -> Start:
     import unseen_worlds as uw
     from referee_labels import similarity_back
 
-    from envs.surveillance.config import EnvConfig
-
+    world = f"{row['world']} {row['combo']}"
+    if row["role"] == "evader":
+        rho, ratio, l_min = row["combo"]
+        sim = uw.evader_similarity_of(row["world"])
+        m, ov = uw.evader_world(row["world"], l_min, rho, ratio, untransformed=True)
+        horizon = _evader_horizon(*uw.evader_world(row["world"], l_min, rho, ratio),
+                                  row.get("horizon", uw.K))  # fmt: skip
+        back = None if sim is None else similarity_back(*sim[1:])
+        return _start("evader", world, m, ov, back, row.get("start"), horizon)
     sim = uw.similarity_of(row["world"])
     m, ov = uw.pursuer_world(row["world"], row["combo"], untransformed=True)
     back = None if sim is None else similarity_back(*sim[1:])
-    dt = EnvConfig.__dataclass_fields__["dt"].default
-    horizon = row.get("horizon", uw.MAX_CYCLES) * dt
-    return _start(f"{row['world']} {row['combo']}", m, ov, back, row.get("start"), horizon)
+    horizon = row.get("horizon", uw.MAX_CYCLES) * _dt()
+    return _start("pursuer", world, m, ov, back, row.get("start"), horizon)
 
 
 def _holds(row: dict) -> Start:
     import pursuer_holds as ph
     from referee_labels import similarity_back
 
-    from envs.surveillance.config import EnvConfig
-
     out = row["out"]["pursuer/decomposition"]
     world = f"{row['world']} [{row['variant']}] rho={row['rho']}"
-    dt = EnvConfig.__dataclass_fields__["dt"].default
     if row["l_min"] is not None:
         return Start(
-            json.dumps([world, row["seed"], row["l_min"]]), "", world, row["rho"],
-            row["max_cycles"] * dt, None, None,
+            json.dumps([world, row["seed"], row["l_min"]]), "pursuer", "", world, row["rho"],
+            row["max_cycles"] * _dt(), None, None,
             "played at --l-min: the referee judges the world's own L_min only",
         )  # fmt: skip
     _, rot, scale, offset = next(v for v in ph.VARIANTS if v[0] == row["variant"])
@@ -128,7 +166,37 @@ def _holds(row: dict) -> Start:
           "v_evader": row["rho"] * params["v_pursuer"], "body_radius": 0.2}  # fmt: skip
     start = out[4] if len(out) > 4 else None
     back = similarity_back(rot, scale, offset)
-    return _start(world, m, ov, back, start, row["max_cycles"] * dt)
+    return _start("pursuer", world, m, ov, back, start, row["max_cycles"] * _dt())
+
+
+def _escapes(row: dict) -> Start:
+    """An ``evader_escapes.py`` row: the world variant judged untransformed (its lengths
+    and speeds scale with it), the start the row records or, in an older row, the one
+    its episode seed draws."""
+    import evader_escapes as ee
+    from referee_labels import similarity_back
+
+    world = f"{row['world']} [{row['variant']}]"
+    played, played_ov = ee.world(row["world"], row["variant"])
+    horizon = _evader_horizon(played, played_ov, row["k"])
+    m, ov = ee.world(row["world"], "as is")
+    start = row.get("start_drawn")
+    if start is None:
+        start = _drawn_start(played, played_ov, row["seed"], row["start"])
+    back = similarity_back(*ee.VARIANTS[row["variant"]])
+    return _start("evader", world, m, ov, back, start, horizon)
+
+
+def _drawn_start(m: Map, ov: Mapping[str, float], seed: int, kind: str) -> dict:
+    """The start ``run_episode(m, ..., seed, overrides=ov, start=kind)`` plays: the start
+    sampler's draw from the episode's start seed, on the env's state config."""
+    from envs.surveillance.config import EnvConfig
+    from strategies.policies.starts import sample_start
+    from strategies.runner import episode_seeds
+
+    drawn = sample_start(EnvConfig(map=m, **ov), np.random.default_rng(episode_seeds(seed)[1]),
+                         kind=kind)  # fmt: skip
+    return {k: [float(x) for x in drawn[k]] for k in ("pursuer", "evader")}
 
 
 def _fixed(row: dict) -> Start:
@@ -140,26 +208,29 @@ def _fixed(row: dict) -> Start:
         cfg = EnvConfig(map=row["world"])
         ov = {k: getattr(cfg, k) for k in ("l_min", "l_max", "v_pursuer", "v_evader",
                                            "body_radius")}  # fmt: skip
-        return _start(row["world"], cfg.map, ov, None, row.get("start_drawn"),
+        return _start(row["role"], row["world"], cfg.map, ov, None, row.get("start_drawn"),
                       cfg.max_cycles * cfg.dt)  # fmt: skip
     m, ov = fs.world(row["role"], row["world"], row["combo"])
-    dt = EnvConfig.__dataclass_fields__["dt"].default
-    return _start(f"{row['world']} {row['combo']}", m, ov, None, row["start"],
-                  row["horizon"] * dt)  # fmt: skip
+    horizon = row["horizon"] * _dt()
+    if row["role"] == "evader":
+        horizon = _evader_horizon(m, ov, row["horizon"])
+    return _start(row["role"], f"{row['world']} {row['combo']}", m, ov, None, row["start"],
+                  horizon)  # fmt: skip
 
 
-def _start(world: str, m: Map, ov: dict, back, start, horizon: float) -> Start:
+def _start(role: str, world: str, m: Map, ov: dict, back, start, horizon: float) -> Start:
     game = _judged_game(m, ov)
     rho = ov["v_evader"] / ov["v_pursuer"]
     if start is None:
-        return Start(json.dumps([world, None]), game, world, rho, horizon, None, None,
+        return Start(json.dumps([world, None]), role, game, world, rho, horizon, None, None,
                      "the row records no start (a crash)")  # fmt: skip
     key = json.dumps([game, world, start])
-    return Start(key, game, world, rho, horizon, lambda: (m, ov, back), start)
+    return Start(key, role, game, world, rho, horizon, lambda: (m, ov, back), start)
 
 
-STARTS = {"unseen_worlds.py": _unseen, "pursuer_holds.py": _holds, "fixed_starts.py": _fixed}
-"""How a pursuer set's row gives its start, per script."""
+STARTS = {"unseen_worlds.py": _unseen, "pursuer_holds.py": _holds, "fixed_starts.py": _fixed,
+          "evader_escapes.py": _escapes}  # fmt: skip
+"""How a set's row gives its start, per script."""
 
 
 def starts_of(policy_set, episodes: Mapping[str, object]) -> dict[str, Start]:
@@ -167,12 +238,13 @@ def starts_of(policy_set, episodes: Mapping[str, object]) -> dict[str, Start]:
     episode's key.
 
     Raises:
-        InvalidConfigError: the set is not a pursuer set (naming it and what is labelled).
+        InvalidConfigError: the set's script is not one whose rows give starts (naming it
+            and the scripts that do).
     """
-    if policy_set.role != "pursuer" or policy_set.script not in STARTS:
+    if policy_set.script not in STARTS:
         raise InvalidConfigError(
-            f"set {policy_set.name} measures the {policy_set.role} ({policy_set.script}); "
-            "expected a pursuer set: label judges the pursuer's starts only"
+            f"set {policy_set.name} is played by {policy_set.script}; expected a set of "
+            f"{', '.join(STARTS)}, whose rows give their starts"
         )
     of = STARTS[policy_set.script]
     return {k: of(e.row) for k, e in episodes.items()}
@@ -215,14 +287,29 @@ def _final(start: Start, labels: Mapping[str, dict], cpls: Sequence[float]) -> d
     return got[-1] if got else {"label": "not labelled", "cpl": None, "escape_bound": None}
 
 
+def _in_time(start: Start, final: dict) -> bool:
+    """``final`` certifies an escape from ``start`` within the episode's horizon."""
+    bound = final["escape_bound"]
+    return final["label"] == "evader" and bound is not None and bound <= start.horizon + 1e-9
+
+
+def _winnable(start: Start, final: dict) -> bool:
+    """The referee certifies that the set's side can win from ``start`` within the
+    episode: the pursuer holds forever, the evader escapes within the horizon."""
+    if start.role == "pursuer":
+        return final["label"] == "pursuer"
+    return _in_time(start, final)
+
+
 def _outcome(start: Start, final: dict) -> str:
     """The report's column of a lost start: ``unavoidable``, ``regret`` or an undecided
     kind (``late`` for an escape certified beyond the horizon)."""
     label = final["label"]
-    if label == "evader":
-        bound = final["escape_bound"]
-        return "unavoidable" if bound is not None and bound <= start.horizon + 1e-9 else "late"
-    return "regret" if label == "pursuer" else label
+    if _winnable(start, final):
+        return "regret"
+    if label == "evader":  # a pursuer set's loss within the bound, or an escape too late
+        return "unavoidable" if _in_time(start, final) else "late"
+    return "unavoidable" if label == "pursuer" else label
 
 
 # ------------------------------------------------------------------ labelling
@@ -303,7 +390,8 @@ class SetLabels:
     regrets: int
     undecided: dict[str, int]
     winnable: int | None
-    """Episodes from starts certified for the pursuer (None: not every start labelled)."""
+    """Episodes from starts certified winnable for the set's side (None: not every start
+    labelled)."""
     rhos: tuple[float, ...]
 
     def regret(self) -> str:
@@ -330,7 +418,7 @@ def tally(name: str, episodes: Mapping[str, object], starts: Mapping[str, Start]
         final = _final(s, labels, cpls)
         if final["label"] == "not labelled" and (not e.won or not losses_only):
             complete = False
-        winnable += final["label"] == "pursuer"
+        winnable += _winnable(s, final)
         if e.won:
             continue
         losses += 1
@@ -347,6 +435,8 @@ def tally(name: str, episodes: Mapping[str, object], starts: Mapping[str, Start]
         bound = final["escape_bound"]
         extra = "" if bound is None else f", escape within {bound:.1f} s of {s.horizon:g}"
         cause = f"{e.cause} at {e.t:.1f} s" if e.t is not None else str(e.cause)
+        if e.t is None and e.cause is None:  # an evader set's miss
+            cause = "held to the horizon"
         lines.append(f"  {kind}: {name} {e.world} {e.opponent} seed={e.seed}: {cause}; "
                      f"referee: {final['label']}{at}{extra}")  # fmt: skip
     rhos = tuple(sorted({s.rho for s in starts.values()}))
@@ -371,13 +461,18 @@ def label_sets(sets: Mapping[str, object], read: Mapping[str, Mapping[str, objec
         if min((s.rho for s in starts.values()), default=0.0) >= VACUOUS_RHO:
             print(f"  rho >= {VACUOUS_RHO:g}: the referee's pursuer bound certifies nothing "
                   "here, so its labels are 'evader' or 'unknown'", flush=True)  # fmt: skip
+        if sets[name].role == "evader":
+            print("  an evader set: a loss from a start certified for the pursuer is "
+                  "unavoidable, from one certified for the evader (escape within the "
+                  "horizon) a regret", flush=True)  # fmt: skip
         labels = label_starts(list(starts.values()), lost, cpls, path, losses_only)
         out.append(tally(name, episodes, starts, labels, cpls, losses_only, lines))
     cpl = "/".join(f"{c:g}" for c in cpls)
     print(
-        f"referee labels at cpl {cpl}, in episodes (unavoidable: certified for the evader, "
-        "escape within the horizon; late: certified for the evader, escape bound beyond "
-        "it; regret: lost from a start certified for the pursuer; REGRET: regrets / "
+        f"referee labels at cpl {cpl}, in episodes (unavoidable: lost from a start certified "
+        "for the other side, an evader's escape within the horizon; late: certified for the "
+        "evader, escape bound beyond the horizon; regret: lost from a start certified for "
+        "the set's side, an evader's escape within the horizon; REGRET: regrets / "
         "episodes from such starts)"
     )
     head = ("set", "episodes", "losses", "unavoidable", "late", "regrets", "undecided")

@@ -303,15 +303,28 @@ def pursuer_world(key: str, combo, *, untransformed: bool = False) -> tuple[Map,
     return m, ov
 
 
-def evader_world(key: str, l_min: float, rho: float, ratio: float) -> tuple[Map, dict]:
-    """(map, env overrides) of an evader-role world (V_p = 1, lengths times the scale)."""
+def evader_similarity_of(key: str) -> tuple[str, float, float, tuple[float, float]] | None:
+    """(built-in name, rotation, scale, offset) when the evader-role world ``key`` is a
+    built-in world transformed (``two_rooms~VARIANT``, ``office~VARIANT``,
+    ``NAME~[xS][rotR][off(X,Y)]``), else None."""
+    if "~" not in key:
+        return None
+    name, variant = key.split("~", 1)
+    if name in ("two_rooms", "office") and variant in BVARS:
+        return name, *BVARS[variant]
+    return transform_of(key)
+
+
+def evader_world(key: str, l_min: float, rho: float, ratio: float, *,
+                 untransformed: bool = False) -> tuple[Map, dict]:  # fmt: skip
+    """(map, env overrides) of an evader-role world (V_p = 1, lengths times the scale);
+    with ``untransformed``, a transformed built-in world's game before its similarity (the
+    same game: lengths and speeds scaled alike, the plane moved)."""
     scale = 1.0
-    if "~" in key:  # two_rooms~VARIANT, office~VARIANT, NAME~[xS][rotR][off(X,Y)]
-        name, variant = key.split("~", 1)
-        if name in ("two_rooms", "office") and variant in BVARS:
-            rot, scale, offset = BVARS[variant]
-        else:
-            name, rot, scale, offset = transform_of(key)
+    if (sim := evader_similarity_of(key)) is not None:
+        name, rot, scale, offset = sim
+        if untransformed:
+            rot, scale, offset = 0.0, 1.0, (0.0, 0.0)
         m = builtin_info(name).map.transformed(_rotm(rot, scale), offset)
     elif key.startswith("random:"):
         m = load_map(key)

@@ -1,6 +1,7 @@
 """benchmarks/policy_sets.py label (benchmarks/set_labels.py): the referee's label of each
-start of a pursuer set's rows, the losses it says no pursuer could avoid, the regrets, and
-the regret per set; on rows of ``unseen_worlds.py`` whose starts come from real solves."""
+start of a set's rows, the losses it says no policy of the set's side could avoid, the
+regrets, and the regret per set; on rows of ``unseen_worlds.py`` (both roles) whose starts
+come from real solves, and the starts of ``evader_escapes.py`` rows."""
 
 from __future__ import annotations
 
@@ -173,15 +174,106 @@ def test_losses_only_labels_the_lost_starts_and_gives_no_regret(ps, tiny, tmp_pa
     assert len(_labels(out / "tiny.labels.jsonl")) == 3
 
 
+def _evader_row(world, combo, opponent, seed, won, start, k=8.0, t=3.0) -> dict:
+    return {"role": "evader", "world": world, "combo": combo, "opponent": opponent,
+            "seed": seed, "horizon": k, "winner": "evader" if won else "pursuer",
+            "cause": "occluded" if won else None, "t": t if won else None,
+            "steps": 30 if won else 10**4, "start": start}  # fmt: skip
+
+
+def test_an_evader_set_s_misses_are_unavoidable_from_pursuer_starts_regrets_from_evader_ones(
+    ps, tiny, tmp_path, capsys
+):
+    """The same starts played by the shooting evader (``unseen_worlds.py --role evader``
+    rows; the evader role's worlds are the same games: open_room~x0.5rot1off(3,-2) at
+    L_min 2, rho 0.2 is the open room at [2, 4], V_p 1): a miss from the start certified
+    for the pursuer is unavoidable; a miss from the corner's start certified for the
+    evader is the evader's regret when its escape bound is within the horizon (k = 8
+    D / V_e) and ``late`` when the horizon (k steps short of it) ends first; a miss from
+    the uncertified start is undecided. The regret counts the episodes from the corner
+    start within the horizon (2: the miss and a win), not the late one."""
+    import unseen_worlds as uw
+
+    sets, d, bound, _ = tiny
+    pursuer_rows = [json.loads(line) for line in (d / "tiny.jsonl").read_text().splitlines()]
+    held, gap, lost = (pursuer_rows[i]["start"] for i in (0, 3, 4))
+    m, ov = uw.evader_world(CORNER, CORNER_COMBO[2], *CORNER_COMBO[:2])
+    unit = uw.diameter(m) / ov["v_evader"]
+    short = (math.ceil(bound / 0.1) - 1) * 0.1 / unit * (1 - 1e-9)  # one step short of it
+    rows = [
+        _evader_row(ROOM, ROOM_COMBO, "pursuer/greedy", 201, False, held),
+        _evader_row(ROOM, ROOM_COMBO, "still", 201, True, held),
+        _evader_row(ROOM, ROOM_COMBO, "pursuer/greedy", 202, False, gap),
+        _evader_row(CORNER, CORNER_COMBO, "pursuer/decomposition", 203, False, lost),
+        _evader_row(CORNER, CORNER_COMBO, "pursuer/decomposition", 203, False, lost, short),
+        _evader_row(CORNER, CORNER_COMBO, "still", 203, True, lost),
+    ]
+    (d / "tinye.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+    ev = ps.PolicySet("tinye", "unseen_worlds.py", ("--role", "evader"), "evader", 2, 6, "-")
+    out = tmp_path / "labels"
+    assert ps.label(str(d), ["tinye"], [8.0, 12.0], str(out), sets={**sets, "tinye": ev}) == 0
+    text = capsys.readouterr().out
+    assert "an evader set: a loss from a start certified for the pursuer is unavoidable" in text
+    # episodes, losses, unavoidable, late, regrets, undecided, REGRET
+    assert _table_row(text, "tinye") == ["tinye", "6", "4", "1", "1", "1", "1", "1/2", "=",
+                                         "0.500"]  # fmt: skip
+    held = "held to the horizon; referee:"
+    assert (f"  unavoidable: tinye {ROOM} {ROOM_COMBO} pursuer/greedy seed=201: {held} pursuer "
+            "(cpl 12)") in text  # fmt: skip
+    horizon = math.ceil(8 * unit / 0.1) * 0.1
+    assert (f"  regret: tinye {CORNER} {CORNER_COMBO} pursuer/decomposition seed=203: {held} "
+            f"evader (cpl 8), escape within {bound:.1f} s of {horizon:g}") in text  # fmt: skip
+    assert (f"  late: tinye {CORNER} {CORNER_COMBO} pursuer/decomposition seed=203: {held} "
+            f"evader (cpl 8), escape within {bound:.1f} s of "
+            f"{(math.ceil(bound / 0.1) - 1) * 0.1:g}") in text  # fmt: skip
+    assert f"  unknown: tinye {ROOM} {ROOM_COMBO} pursuer/greedy seed=202" in text
+    assert "regrets: 1" in text
+    # the default labels every set in the directory, both roles (the labels are on file)
+    assert ps.label(str(d), [], [8.0, 12.0], str(out), sets={**sets, "tinye": ev}) == 0
+    text = capsys.readouterr().out
+    assert _table_row(text, "tiny")[:2] == ["tiny", "7"] and _table_row(text, "tinye")[1] == "6"
+
+
+def test_an_evader_escapes_row_is_judged_untransformed_from_the_start_its_seed_drew(
+    ps, monkeypatch, tmp_path
+):
+    """evader_escapes.py rows record the start played (``start_drawn``); an older row
+    without it is given the start its episode seed draws, the same one. A variant's
+    start is judged in the untransformed world: the rotated T-junction's row and the
+    one as is share a game, and its start maps back onto the one as is played."""
+    import evader_escapes as ee
+    import set_labels
+
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", str(tmp_path / "cache"))
+    rows = [ee._play(("tee", v, "still", 3, 0.05, "safe", [])) for v in ("as is", "rot 0.37")]
+    s = ps.PolicySet("esc", "evader_escapes.py", (), "evader", 0, 2, "-")
+    starts = set_labels.starts_of(s, {str(i): ps._episode(s.script, r, str(i))
+                                      for i, r in enumerate(rows)})  # fmt: skip
+    older = {k: v for k, v in rows[1].items() if k != "start_drawn"}
+    redrawn = set_labels.starts_of(s, {"1": ps._episode(s.script, older, "1")})["1"]
+    assert redrawn.start == rows[1]["start_drawn"] == starts["1"].start
+    assert starts["0"].game == starts["1"].game and starts["0"].role == "evader"
+    m, ov, back = starts["1"].build()
+    assert (m.digest, ov) == (ee.world("tee")[0].digest, ee.world("tee")[1])
+    p, e = (back(rows[1]["start_drawn"][who]) for who in ("pursuer", "evader"))
+    x0, y0, x1, y1 = m.bounds  # the rotated start, turned back: in the tee as is, as far apart
+    assert all(x0 < q[0] < x1 and y0 < q[1] < y1 for q in (p, e))
+    assert np.linalg.norm(p - e) == pytest.approx(math.dist(*rows[1]["start_drawn"].values()))
+    played = ee.world("tee", "rot 0.37")
+    assert starts["1"].horizon == pytest.approx(
+        math.ceil(0.05 * ee.diameter(played[0]) / played[1]["v_evader"] / 0.1) * 0.1
+    )
+
+
 def test_label_refuses_what_it_cannot_judge(ps, tiny, tmp_path):
-    """An evader set, a set the directory lacks, resolutions that do not increase: refused
-    before any solve, naming what was expected."""
+    """A set of a script whose rows give no start, a set the directory lacks, resolutions
+    that do not increase: refused before any solve, naming what was expected."""
     sets, d, *_ = tiny
-    ev = ps.PolicySet("ev", "unseen_worlds.py", ("--role", "evader"), "evader", 0, 1, "-")
-    (d / "ev.jsonl").write_text("")
-    both = {**sets, "ev": ev}
-    with pytest.raises(InvalidConfigError, match="expected a pursuer set"):
-        ps.label(str(d), ["ev"], [12.0], None, sets=both)
+    other = ps.PolicySet("other", "nowhere.py", (), "evader", 0, 1, "-")
+    (d / "other.jsonl").write_text("")
+    both = {**sets, "other": other}
+    with pytest.raises(InvalidConfigError, match=r"is played by nowhere\.py; expected a set of"):
+        ps.label(str(d), ["other"], [12.0], None, sets=both)
     absent = ps.PolicySet("absent", "unseen_worlds.py", ("--role", "pursuer"), "pursuer", 0, 1,
                           "-")  # fmt: skip
     with pytest.raises(InvalidConfigError, match="holds no results file of set absent"):

@@ -42,7 +42,7 @@ from envs import validation
 from envs.errors import InvalidConfigError, UnknownNameError
 from envs.surveillance.config import EnvConfig, env_parameters
 from strategies.policies.base import check_role
-from strategies.policies.model_files import model_policy_name
+from strategies.policies.model_files import absolute_model_name, model_policy_name
 from training.single_agent import START_CHOICES
 
 __all__ = [
@@ -107,8 +107,8 @@ class TrainConfig:
     opponent: str | tuple[str, ...]
     """The other role's policy name (``"evader/straight"``, ``"pursuer/sb3:PATH"``...), a
     model as ``surveil play`` takes one (``"zoo:NAME"``, a ``.zip`` path relative to the
-    current directory), or several: a pool (:class:`training.pool.OpponentPool`), one
-    drawn per episode."""
+    current directory, kept as its absolute path), or several: a pool
+    (:class:`training.pool.OpponentPool`), one drawn per episode."""
     map: str | tuple[str, ...] = "open_room"
     """Built-in map name, map file path or ``random:SEED``; or several, one per episode."""
     env: dict[str, Any] = field(default_factory=dict)
@@ -165,6 +165,9 @@ class TrainConfig:
                     f"opponent: {article} {self.role} learner needs a '{other}/KIND' policy "
                     f"(a model: 'zoo:NAME' or a .zip path), got {name!r}"
                 )
+        # stored with a model file's absolute path: a rerun (of config.toml, from another
+        # directory) plays the file this run played, or is refused as another config
+        pool = tuple(absolute_model_name(name) for name in pool)
         put("opponent", pool[0] if len(pool) == 1 and isinstance(self.opponent, str) else pool)
         put("opponent_weights", tuple(self.opponent_weights))
         if self.opponent_weights:

@@ -63,7 +63,7 @@ from envs.errors import InvalidConfigError
 from strategies.policies import make_policy
 from strategies.policies.base import check_role
 from strategies.policies.learner_inputs import LearnerInputs, check_features
-from strategies.policies.model_files import model_policy_name
+from strategies.policies.model_files import absolute_model_name, model_policy_name
 from strategies.runner import check_observation_options, run_episode
 from training.config import check_same_maps, map_fingerprints, opponent_name
 
@@ -150,6 +150,7 @@ class DaggerConfig:
                 f"{where}: opponent = {self.opponent!r}: expected one or more "
                 f"'{other}/KIND' policy names (or models: 'zoo:NAME', a .zip path)"
             )
+        pool = tuple(absolute_model_name(o) for o in pool)  # a rerun plays the same files
         put("opponent", pool[0] if len(pool) == 1 else pool)
         put("opponent_weights", tuple(float(w) for w in self.opponent_weights))
         if self.opponent_weights:
@@ -172,6 +173,7 @@ class DaggerConfig:
                 f"{where}: validation_opponent = {vo!r}: expected '{other}/KIND' policy names "
                 "(or models: 'zoo:NAME', a .zip path)"
             )
+        vpool = tuple(absolute_model_name(o) for o in vpool)
         put("validation_opponent", vpool[0] if len(vpool) == 1 else vpool)
         validation.mapping("env", self.env, where=where)
         validation.mapping("expert_params", self.expert_params, where=where)

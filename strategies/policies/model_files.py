@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import os
 import warnings
 import zipfile
 from collections.abc import Iterable, Mapping
@@ -29,6 +30,7 @@ from envs.errors import InvalidConfigError
 
 __all__ = [
     "NoProvenanceWarning",
+    "absolute_model_name",
     "check_model_input",
     "is_model_reference",
     "model_input_shape",
@@ -77,6 +79,29 @@ def is_model_reference(text: str) -> bool:
     if text.startswith((f"pursuer/{_SB3}", f"evader/{_SB3}")):
         return False
     return text.startswith("zoo:") or text.lower().endswith(".zip")
+
+
+def absolute_model_name(text: str) -> str:
+    """``text`` with a relative model file path made absolute against the current
+    directory (a ``.zip`` or the registry's ``ROLE/sb3:PATH``; ``zoo:NAME`` and policy
+    names unchanged), for a run's stored config: a rerun from another directory then
+    plays the same file.
+
+    Examples:
+        >>> import os
+        >>> absolute_model_name("m.zip") == os.path.join(os.getcwd(), "m.zip")
+        True
+        >>> absolute_model_name("zoo:x"), absolute_model_name("evader/straight")
+        ('zoo:x', 'evader/straight')
+        >>> absolute_model_name("evader/sb3:/models/m.zip")
+        'evader/sb3:/models/m.zip'
+    """
+    role, sep, path = text.partition(f"/{_SB3}")
+    if sep and path and role in ("pursuer", "evader"):
+        return f"{role}{sep}{os.path.abspath(path)}"
+    if is_model_reference(text) and not text.startswith("zoo:"):
+        return os.path.abspath(text)
+    return text
 
 
 def model_path(text: str, what: str, base: Path | None = None) -> Path:

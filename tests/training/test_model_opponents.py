@@ -156,3 +156,34 @@ def test_a_model_opponent_given_observations_of_another_shape_is_refused(tmp_pat
                        r"the game's observation 'state' has shape \(13,\)"):  # fmt: skip
         env.reset(seed=0)
     assert env.opponent.model is None
+
+
+def test_a_rerun_from_another_directory_plays_the_same_opponent_file(
+    tmp_path, tiny, monkeypatch
+) -> None:
+    # config.toml kept a relative opponent path as written ('m/model.zip'): a rerun of
+    # it from another directory looked for the file there (refused as no such file, or
+    # trained on against another file of that name); now the run stores it absolute
+    from training.train import train
+
+    here, elsewhere = tmp_path / "here", tmp_path / "elsewhere"
+    here.mkdir()
+    elsewhere.mkdir()
+    model = _zip_copy(here, "ppo_evader_vs_greedy_open_room")
+    monkeypatch.chdir(here)
+    relative = "ppo_evader_vs_greedy_open_room/model.zip"
+    first = train(tiny(opponent=relative, total_timesteps=64, eval_episodes=0))
+    monkeypatch.chdir(elsewhere)
+    stored = load_config(first.model_path.parent / "config.toml", total_timesteps=128)
+    assert stored.opponent == str(model)
+    again = train(stored)
+    assert again.resumed_from is not None and again.timesteps == 128
+    prov = json.loads((again.model_path.parent / "provenance.json").read_text())
+    assert prov["config"]["opponent"] == str(model)
+    monkeypatch.chdir(here)  # the pools and DAgger's opponents alike
+    base = dict(role="pursuer", expert="pursuer/decomposition", output_dir=str(tmp_path))
+    cfg = DaggerConfig(**base, opponent=[relative, "evader/straight"],
+                       validation_opponent=f"evader/sb3:{relative}")  # fmt: skip
+    assert cfg.opponent == (str(model), "evader/straight")
+    assert cfg.validation_opponent == f"evader/sb3:{model}"
+    assert tiny(opponent=(relative, EVADER)).opponent == (str(model), EVADER)

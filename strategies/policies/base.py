@@ -195,14 +195,32 @@ class BasePolicy:
             seed: seeds this policy's own RNG (``None``: fresh entropy).
 
         Raises:
-            InvalidConfigError: the role is unknown or this policy cannot play it, or the
-                env does not give the ``"state"`` observation an analytic policy needs.
+            InvalidConfigError: the role is unknown or this policy cannot play it, the
+                map is no :class:`~envs.maps.Map`, the config no ``EnvConfig``, the seed
+                no integer >= 0, or the env does not give the ``"state"`` observation an
+                analytic policy needs. A refused reset (this or any error of the
+                policy's own set-up) leaves the policy un-reset: :meth:`act` then asks
+                for a reset instead of playing the previous episode's state.
         """
+        from envs.maps import Map
+        from envs.surveillance.config import EnvConfig
+
+        where = f"policy {self.name!r}: reset"
         check_role(role)
         if role not in self.roles:
             raise InvalidConfigError(
                 f"policy {self.name!r} plays {self.roles}, cannot play {role!r}"
             )
+        if not isinstance(map, Map):
+            raise InvalidConfigError(
+                f"{where}: map = {map!r}: expected the env's Map (env.config.map)"
+            )
+        if not isinstance(config, EnvConfig):
+            raise InvalidConfigError(
+                f"{where}: config = {config!r}: expected the env's EnvConfig (env.config)"
+            )
+        if seed is not None:  # numpy's own refusal named no argument
+            seed = validation.integer("seed", seed, minimum=0, where=where)
         if self.uses_state and getattr(config, "observation", "state") != "state":
             raise InvalidConfigError(
                 f"policy {self.name!r} reads the 'state' observation, but the env gives "
@@ -214,7 +232,11 @@ class BasePolicy:
         self.rng = np.random.default_rng(seed)
         self._prev = None
         self._steps = 0
-        self._reset()
+        try:
+            self._reset()
+        except BaseException:
+            self.role = None  # half set up: act() must not play on (AttributeError deep in)
+            raise
 
     def act(self, observation: np.ndarray) -> np.ndarray:
         """Return the normalised action for one observation.

@@ -87,6 +87,46 @@ def test_bad_parameters_and_roles_raise(box_config):
         make_policy("pursuer/greedy").act(state_observations(box_config)[0])
 
 
+@pytest.mark.parametrize("name", ALL)
+@pytest.mark.parametrize(
+    ("bad", "message"),
+    [
+        ({"seed": -5}, r"reset: seed = -5: expected an integer >= 0"),
+        ({"seed": 1.5}, r"reset: seed = 1.5: expected an integer >= 0"),
+        ({"map": None}, r"reset: map = None: expected the env's Map"),
+        ({"config": None}, r"reset: config = None: expected the env's EnvConfig"),
+        ({"config": {"l_min": 2.0}}, r"reset: config = \{'l_min': 2.0\}: expected the env's"),
+    ],
+)
+def test_a_reset_with_a_bad_seed_map_or_config_is_refused_by_name(name, bad, message, box_config):
+    # seed -5 was numpy's 'expected non-negative integer' (no argument named); map=None
+    # and config=None an AttributeError deep in a policy's set-up (edge_ring, l_min...)
+    pol = make_policy(name)
+    args = {"role": name.split("/")[0], "map": box_config.map, "config": box_config, "seed": 0}
+    with pytest.raises(InvalidConfigError, match=message):
+        pol.reset(**{**args, **bad})
+    with pytest.raises(InvalidConfigError, match=r"call reset\(\) before act\(\)"):
+        pol.act(state_observations(box_config)[0])
+
+
+def test_a_failed_reset_leaves_the_policy_asking_for_a_reset(box_config, tmp_path):
+    # the set-up raised after the role was taken: act() then played on a half-built
+    # policy (an SB3 policy without its model: AttributeError 'NoneType' object has no
+    # attribute 'observation_space')
+    obs = state_observations(box_config)[0]
+    pol = make_policy(f"pursuer/sb3:{tmp_path / 'missing.zip'}")
+    with pytest.raises(InvalidConfigError, match="no model file"):
+        pol.reset(role="pursuer", map=box_config.map, config=box_config, seed=0)
+    with pytest.raises(InvalidConfigError, match=r"call reset\(\) before act\(\)"):
+        pol.act(obs)
+    greedy = make_policy("pursuer/greedy")
+    greedy.reset(role="pursuer", map=box_config.map, config=box_config, seed=0)
+    greedy.act(obs)
+    with pytest.raises(InvalidConfigError, match="seed"):  # a refused reset of a played one
+        greedy.reset(role="pursuer", map=box_config.map, config=box_config, seed=-1)
+    assert np.all(np.isfinite(greedy.act(obs)))  # refused before anything changed
+
+
 def test_policy_names_by_role_and_descriptions():
     assert set(policy_names("pursuer")) | set(policy_names("evader")) == set(ALL)
     assert all(n.startswith("pursuer/") for n in policy_names("pursuer"))

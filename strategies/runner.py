@@ -160,8 +160,10 @@ class EpisodeResult:
         start_kind: ``"safe"``, ``"valid"`` or ``"given"``.
         overrides: env config overrides used (besides the map's recommended parameters).
         observations: the observation settings each role was given.
-        decide_seconds: mean wall-clock seconds per ``act`` call, per role.
+        decide_seconds: mean wall-clock seconds per ``act`` call, per role (its
+            ``reset`` is in ``reset_seconds``; a ``time_limit``'s clock counts both).
         decide_max: the longest ``act`` call, per role.
+        reset_seconds: wall-clock seconds of the policy's ``reset``, per role.
         wall_seconds: wall-clock time of the whole episode.
         trajectory: (steps + 1, 2, 2) positions ``[pursuer, evader]`` per step, exact.
         map_obj: the :class:`Map` (for replays; not serialised).
@@ -186,6 +188,7 @@ class EpisodeResult:
     observations: dict[str, dict[str, Any]] = field(default_factory=dict)
     decide_seconds: dict[str, float] = field(default_factory=dict)
     decide_max: dict[str, float] = field(default_factory=dict)
+    reset_seconds: dict[str, float] = field(default_factory=dict)
     wall_seconds: float = 0.0
     trajectory: np.ndarray | None = field(default=None, repr=False)
     map_obj: Any = field(default=None, repr=False)
@@ -488,6 +491,7 @@ def run_episode(
                 f"start: expected one of {list(START_KINDS)} or "
                 f"{{'pursuer': (x, y), 'evader': (x, y)}}, got {start!r}"
             )
+        reset_seconds = {}
         for role, pol in policies.items():
             t0 = clocks.start(role)
             try:
@@ -506,7 +510,7 @@ def run_episode(
                 clocks.check(role, _name(pol), -1, t0, exc)
                 raise PolicyFailure(role, _name(pol), -1, _describe(exc)) from exc
             finally:
-                clocks.stop(role, t0)
+                reset_seconds[role] = clocks.stop(role, t0)
             clocks.check(role, _name(pol), -1)
         obs, infos = env.reset(seed=s_env, options=placement)
         frames: list[np.ndarray] | None = [] if record else None
@@ -568,6 +572,7 @@ def run_episode(
         observations={r: dict(o.options) for r, o in observers.items()},
         decide_seconds={k: v / max(steps, 1) for k, v in spent.items()},
         decide_max=dict(slowest),
+        reset_seconds=reset_seconds,
         wall_seconds=time.perf_counter() - t_start,
         trajectory=np.asarray(traj, dtype=float),
         map_obj=config.map,

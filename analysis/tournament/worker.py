@@ -15,7 +15,10 @@ match into an *outcome* dict for :meth:`Store.record`:
 each role may spend ``time_limit`` seconds deciding in a match, its policy's ``reset``
 and ``act`` calls; building the env and the policy objects, drawing the start, the
 observations and the env's steps are on no clock. A role whose clock runs out forfeits,
-whichever side was slower overall.
+whichever side was slower overall. What a policy builds of a map once and caches is built
+before its first match there in the process, on no clock (:func:`_set_up`). A stored row's
+``decide_pursuer`` / ``decide_evader`` is the mean ``act`` call; the record's
+``reset_seconds`` holds each reset.
 
 A hang is cut short twice. A ``SIGALRM`` interrupts a call :data:`ALARM_GRACE` seconds
 after the deciding role's clock ran out (where the platform allows it: the main thread of
@@ -39,6 +42,7 @@ import threading
 import time
 import traceback
 import warnings
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -259,6 +263,20 @@ class _Watch:
         if self.board is not None:
             self.board.write(HARNESS if role is None else ROLE_CODES[role], due - ALARM_GRACE)
 
+    @contextlib.contextmanager
+    def setting_up(self, role: str) -> Iterator[None]:
+        """A policy's one-time set-up (:func:`_set_up`): watched as a call of ``role``
+        with a whole time limit, on no clock (the least time left on a clock unchanged;
+        an alarm it rang is spent)."""
+        low = self.low
+        self(role, self.limit)
+        try:
+            yield
+        finally:
+            self.armed = math.inf
+            self(None, None)
+            self.low = low
+
     def _arm(self, at: float, now: float) -> None:
         self.armed = at
         signal.setitimer(signal.ITIMER_REAL, min(max(at - now, 1e-3), ALARM_MAX))
@@ -369,6 +387,50 @@ def _prepare_map(world: Any, overrides: dict[str, Any]) -> None:
         env.close()
 
 
+_SET_UP: set[tuple[str, ...]] = set()
+"""The (policy, map, env parameters) whose one-time set-up this process has done."""
+
+
+def _set_up(ctx: Context, match: Match, entries: tuple[PolicyEntry, ...], watch: _Watch) -> None:
+    """Do each policy's one-time set-up of the match's map before its clock starts: the
+    first time this process plays a policy on a map (and its parameters), a throwaway
+    copy of the policy is reset there, as the match will reset its own.
+
+    A policy caches what it builds from the map (the shooting evader's escape plan and
+    safety table, the decomposition pursuer's table: 9 s of CPU, 72 s of wall time at load
+    14, for the shooting evader on a 1000-wall room, then 0.03 s of CPU a reset), and its
+    first match there built it in its reset, on its clock: a 30 s limit forfeited it. The
+    set-up is on no clock, watched as a call of its role given a whole time limit (past
+    it, interrupted or its worker killed, as a match's call is); one that fails or is
+    interrupted is left to the match, whose reset says why on its clock. A learned model's
+    set-up is its load (:func:`warm_up`).
+    The caches are bounded (eight escape plans): a worker that plays more maps in turn
+    than they hold builds an evicted map's again in a match, on its clock, as before.
+    """
+    from strategies.runner import build_env, observation_options
+
+    world, overrides = ctx.maps[match.map], ctx.envs[(match.map, match.variant)]
+    for entry in entries:
+        params, game = (
+            json.dumps(x, sort_keys=True, default=str) for x in (entry.params, overrides)
+        )
+        key = (entry.role, entry.name, params, world.digest, game)
+        if entry.model is not None or key in _SET_UP:
+            continue
+        _SET_UP.add(key)
+        with watch.setting_up(entry.role), contextlib.suppress(Exception):
+            # a failure (a hang interrupted too) is left to the match's reset, which says why
+            policy = build_policy(ctx, entry)
+            if hasattr(policy, "select"):  # a mixture: its pick is the match's
+                continue
+            opts = entry.observation or observation_options(policy) or {}
+            env = build_env(world, {**overrides, **opts})
+            try:
+                policy.reset(role=entry.role, map=env.config.map, config=env.config, seed=0)
+            finally:
+                env.close()
+
+
 def play(match: Match, ctx: Context, board: Board | None = None) -> dict[str, Any]:
     """Play one match; never raises for a failure of the match itself (see the module).
 
@@ -387,6 +449,7 @@ def play(match: Match, ctx: Context, board: Board | None = None) -> dict[str, An
         observations = {"pursuer": p.observation, "evader": e.observation}
         with _Watch(ctx.time_limit, board) as watch, warnings.catch_warnings():
             warnings.simplefilter("ignore", RhoAboveOneWarning)  # said once, at spec load
+            _set_up(ctx, match, (p, e), watch)
             result = run_episode(
                 ctx.maps[match.map],
                 build_policy(ctx, p),

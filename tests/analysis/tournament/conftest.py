@@ -75,6 +75,18 @@ class SlowResetPursuer(RandomPolicy):
         time.sleep(1.5)
 
 
+class MapSetUpPursuer(RandomPolicy):
+    """A random pursuer whose reset builds something of the map once per process, in
+    1.5 s (as the shooting evader builds its escape plan), then finds it built."""
+
+    built: ClassVar[set[str]] = set()  # the digests of the maps built in this process
+
+    def _reset(self):
+        if self.map.digest not in self.built:
+            time.sleep(1.5)
+            self.built.add(self.map.digest)
+
+
 class WrappingHangPursuer(RandomPolicy):
     """Its reset hangs, and it reports whatever interrupts it as a configuration error of
     its own, as a model loader reports any failure of its load as a bad model file."""
@@ -119,6 +131,7 @@ TEST_POLICIES = {
     "evader/test_lidar": LidarEvader,
     "evader/test_slow_act": SlowActEvader,
     "pursuer/test_slow_reset": SlowResetPursuer,
+    "pursuer/test_map_set_up": MapSetUpPursuer,
     "pursuer/test_wrapping_hang": WrappingHangPursuer,
     "pursuer/test_slow": SlowPursuer,
 }

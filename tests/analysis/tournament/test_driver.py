@@ -296,6 +296,34 @@ def test_a_policy_past_its_own_clock_forfeits_though_the_other_decided_slower(
 
 
 @pytest.mark.parametrize("backend", ["serial", "process"])
+def test_a_policys_one_time_set_up_of_a_map_is_on_no_clock(
+    tmp_path, test_policies, backend, monkeypatch
+):
+    # The shooting evader builds its escape plan of a map in its first reset there and
+    # caches it (9 s of CPU, 72 s of wall time at load 14 on a 1000-wall room; later resets
+    # 0.03 s of CPU): each worker's first match on that map paid it on its clock, and a
+    # limit of 30 s forfeited it. This pursuer's first reset on a map takes 1.5 s.
+    from analysis.tournament import worker
+
+    monkeypatch.setattr(worker, "_SET_UP", set(), raising=False)  # a fresh process's
+    monkeypatch.setattr(test_policies["pursuer/test_map_set_up"], "built", set())
+    d = {
+        "maps": ["open_room"],
+        "pursuers": ["pursuer/test_map_set_up"],
+        "evaders": ["evader/random"],
+        "seeds": 2,
+        "start": "valid",
+        "time_limit": 1.0,
+        "env": {"max_cycles": 10},
+    }
+    _, rows = _play(tmp_path, d, backend)
+    assert [r["status"] for r in rows] == ["ok", "ok"], [r["error"] for r in rows]
+    with Store(tmp_path / "s.sqlite") as db:  # the record says what each reset took
+        resets = [db.record_of(r["match_id"])["reset_seconds"] for r in rows]
+    assert all(set(t) == {"pursuer", "evader"} and t["pursuer"] < 1.0 for t in resets), resets
+
+
+@pytest.mark.parametrize("backend", ["serial", "process"])
 def test_a_hang_a_policy_reports_as_its_own_error_forfeits_on_its_clock(
     tmp_path, test_policies, backend
 ):

@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from envs import validation
-from envs.errors import InvalidConfigError, InvalidObservationError
+from envs.errors import InvalidConfigError, InvalidObservationError, SurveilValueError
 from strategies.policies.base import BasePolicy
 from strategies.policies.learner_inputs import LearnerInputs, check_features
 from strategies.policies.model_files import check_model_input, read_provenance
@@ -352,14 +352,22 @@ class SB3Policy(BasePolicy):
         """The model's action for one observation, clipped to [-1, 1].
 
         Raises:
-            InvalidObservationError: the observation's shape is not the one the model
-                was trained on (another observation kind or ray count).
+            InvalidObservationError: the observation is not an array of finite real
+                numbers, or its shape is not the one the model was trained on (another
+                observation kind or ray count; for a model of analytic features, no
+                ``"state"`` vector).
         """
         if self.role is None:
             raise InvalidConfigError(f"policy {self.name!r}: call reset() before act()")
+        _check_finite(observation, self.name)  # NaN was torch's or int()'s ValueError
         obs = np.asarray(observation)
         if self._inputs is not None:
-            obs = self._inputs(obs)
+            try:
+                obs = self._inputs(obs)
+            except SurveilValueError:
+                raise
+            except ValueError as exc:  # decode_state's shape check, as analytic policies say it
+                raise InvalidObservationError(f"{self.name}: observation: {exc}") from exc
         want = self.model.observation_space.shape
         if obs.shape != want:
             raise InvalidObservationError(
@@ -368,6 +376,29 @@ class SB3Policy(BasePolicy):
             )
         action, _ = self.model.predict(obs, deterministic=self.deterministic)
         return np.clip(np.asarray(action, dtype=np.float32), -1.0, 1.0)
+
+
+def _check_finite(observation: Any, name: str) -> None:
+    """Refuse an observation that is not an array of finite real numbers, naming the
+    first bad entry (as :func:`strategies.policies.observe.read_state` does for the
+    analytic policies).
+
+    Raises:
+        InvalidObservationError: not numbers, or a NaN or infinite entry.
+    """
+    try:
+        values = np.asarray(observation, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InvalidObservationError(
+            f"{name}: observation: expected an array of real numbers, got "
+            f"{type(observation).__name__} {observation!r}"[:200]
+        ) from exc
+    if not np.all(np.isfinite(values)):
+        bad = np.flatnonzero(~np.isfinite(values.ravel()))
+        raise InvalidObservationError(
+            f"{name}: observation: expected finite values, got {values.ravel()[bad[0]]} at "
+            f"index {int(bad[0])} ({len(bad)} non-finite of {values.size})"
+        )
 
 
 def trained_observation(provenance: Mapping[str, Any] | None) -> dict[str, Any] | None:

@@ -16,6 +16,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from envs import surveillance_v1
@@ -98,6 +99,36 @@ def test_a_damaged_model_file_names_the_file(tmp_path):
     env = surveillance_v1.parallel_env(map="open_room")
     with pytest.raises(InvalidConfigError, match=str(bad)):
         policy.reset(role="pursuer", map=env.config.map, config=env.config, seed=0)
+
+
+@pytest.mark.parametrize("model", ["ppo_evader_vs_greedy_open_room", "dagger_evader_memory"])
+@pytest.mark.parametrize(
+    ("bad", "message"),
+    [
+        ("nan", r"observation: expected finite values, got nan at index 3 \(1 non-finite of 13\)"),
+        ("inf", r"observation: expected finite values, got inf at index 3"),
+        ("short", r"\(5,\)"),
+        ("text", r"observation: expected an array of real numbers, got str"),
+    ],
+)
+def test_a_model_refuses_an_observation_that_is_no_finite_vector_by_name(model, bad, message):
+    # a NaN reached torch ('Expected parameter loc ... to satisfy the constraint Real()') or,
+    # for a model of analytic features, int() ('cannot convert float NaN to integer'); a
+    # short state vector was decode_state's bare ValueError: not the InvalidObservationError
+    # the analytic policies raise
+    from strategies.policies.model_files import model_policy_name
+
+    env = surveillance_v1.parallel_env(map="open_room")
+    env.reset(seed=0)
+    state = env.state()
+    obs = {"nan": state.copy(), "inf": state.copy(), "short": state[:5], "text": "abc"}[bad]
+    if bad in ("nan", "inf"):
+        obs[3] = float(bad)
+    policy = make_policy(model_policy_name(f"zoo:{model}", "evader", "evader"))
+    policy.reset(role="evader", map=env.config.map, config=env.config, seed=0)
+    with pytest.raises(InvalidObservationError, match=message):
+        policy.act(obs)
+    assert np.all(np.isfinite(policy.act(state)))  # the policy plays on
 
 
 @pytest.mark.parametrize(

@@ -383,13 +383,21 @@ class Observer:
 
 def _make(policy: Any, role: str):
     from strategies.policies import Policy, make_policy
+    from strategies.policies.model_files import is_model_reference, model_policy_name
 
     if isinstance(policy, str):
+        given = policy
+        if is_model_reference(policy):  # zoo:NAME or a model .zip, as surveil play takes them
+            policy = model_policy_name(policy, role, f"{role}: model = {policy!r}")
         if policy.partition("/")[0] != role:
             raise InvalidConfigError(
-                f"{role}: expected a '{role}/KIND' policy name, got {policy!r}"
+                f"{role}: expected a '{role}/KIND' policy name, 'zoo:NAME' or a model .zip, "
+                f"got {policy!r}"
             )
-        return make_policy(policy)
+        made = make_policy(policy)
+        if policy != given:  # records and errors name the model as the caller did
+            made.name = given
+        return made
     if isinstance(policy, Policy) or hasattr(policy, "select"):
         return policy
     raise InvalidConfigError(
@@ -418,8 +426,10 @@ def run_episode(
 
     Args:
         map: built-in name, map file path or :class:`~envs.maps.Map`.
-        pursuer, evader: registered names (``"pursuer/decomposition"``), policies, or
-            mixtures (anything with ``select(seed) -> Policy``).
+        pursuer, evader: registered names (``"pursuer/decomposition"``), shipped or
+            saved models (``"zoo:NAME"``, a model ``.zip``: its ``provenance.json`` must
+            not name the other role), policies, or mixtures (anything with
+            ``select(seed) -> Policy``).
         seed: the episode seed (see the module docstring).
         max_cycles: episode horizon in steps (``None``: the overrides' or the default).
         overrides: env config overrides, e.g. ``{"v_evader": 0.8}``; a built-in map's

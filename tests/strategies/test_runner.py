@@ -358,3 +358,36 @@ def test_a_model_given_observations_of_another_shape_is_refused_before_it_loads(
     trained = {"observation": "lidar_track", "n_rays": 32}  # what it was trained on: plays
     r = run_episode(MAP, pol, "evader/straight", 0, max_cycles=3, overrides=trained)
     assert r.steps == 3 and r.observations["pursuer"]["n_rays"] == 32
+
+
+def test_shipped_and_saved_models_play_by_the_names_surveil_play_takes(tmp_path):
+    # run_episode("corridor", "zoo:NAME", ...) said "pursuer: expected a 'pursuer/KIND'
+    # policy name, got 'zoo:dagger_pursuer_generalist'" while surveil play, evaluate,
+    # tournaments and training opponents all take zoo:NAME and model .zip paths
+    import shutil
+    import warnings
+
+    from strategies.policies.model_files import zoo_dir
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the models' unseen map/parameter warnings
+        r = run_episode(MAP, "zoo:dagger_pursuer_generalist", "zoo:dagger_evader_memory", 0,
+                        max_cycles=3)  # fmt: skip
+        assert (r.pursuer, r.evader, r.steps) == ("zoo:dagger_pursuer_generalist",
+                                                  "zoo:dagger_evader_memory", 3)  # fmt: skip
+        assert r.observations["pursuer"]["observation"] == "lidar_track"  # its provenance's
+        saved = tmp_path / "m" / "model.zip"
+        saved.parent.mkdir()
+        src = zoo_dir() / "ppo_evader_vs_greedy_open_room"
+        shutil.copy(src / "model.zip", saved)
+        shutil.copy(src / "provenance.json", saved.parent / "provenance.json")
+        again = run_episode(MAP, "pursuer/greedy", str(saved), 0, max_cycles=3)
+        named = run_episode(MAP, "pursuer/greedy", "zoo:ppo_evader_vs_greedy_open_room", 0,
+                            max_cycles=3)  # fmt: skip
+    assert again.evader == str(saved)
+    assert again.trajectory.tobytes() == named.trajectory.tobytes()  # the same model
+    with pytest.raises(InvalidConfigError, match=r"^evader: model = 'zoo:dagger_pursuer_generalist'"
+                       r": this model was trained as the pursuer"):  # fmt: skip
+        run_episode(MAP, "pursuer/greedy", "zoo:dagger_pursuer_generalist", 0, max_cycles=3)
+    with pytest.raises(InvalidConfigError, match=r"^pursuer: model = 'zoo:nope': no zoo model"):
+        run_episode(MAP, "zoo:nope", "evader/straight", 0, max_cycles=3)

@@ -27,6 +27,7 @@ __all__ = [
     "PLACEMENT_KEYS",
     "check_option_keys",
     "check_room",
+    "in_sensor_range",
     "random_start",
     "spawn_margins",
     "validate_placement",
@@ -211,6 +212,19 @@ def check_room(m: Any, body_radius: float, length: float, where: str = "start") 
             f"body_radius = {body_radius:g} from the walls are L = {length:.4g} apart (at "
             f"most {diameter:.4g}); lower l_min (or the start's L) or use a larger map"
         )
+
+
+def in_sensor_range(config: EnvConfig, pursuer: Any, evader: Any) -> bool:
+    """Whether the distance of two centres lies in [L_min, L_max] as
+    :func:`validate_placement` computes it (``math.hypot`` of the difference).
+
+    A proposal drawn at L = L_max exactly (a zero range margin) lands a rounding error
+    beyond it about half of the time, and ``reset(options=...)`` then refuses it:
+    samplers that draw at a range end keep only proposals this accepts
+    (:func:`strategies.policies.starts.sample_start`).
+    """
+    d = math.hypot(pursuer[0] - evader[0], pursuer[1] - evader[1])
+    return rules.in_range(d, config.l_min, config.l_max) is None
 
 
 def random_start(

@@ -71,7 +71,12 @@ from envs.errors import (
     RelaxedStartWarning,
 )
 from envs.geometry import kernel_for
-from envs.surveillance.placement import check_room, random_start, spawn_margins
+from envs.surveillance.placement import (
+    check_room,
+    in_sensor_range,
+    random_start,
+    spawn_margins,
+)
 from strategies.policies.lazy_table import LazySafetyTable
 
 __all__ = ["START_KINDS", "has_retreat_clearance", "retreat_clearance_required", "sample_start"]
@@ -202,7 +207,9 @@ def _near_l_min(config, kernel, rng, judge, tab, angle_margin, escapable=False):
                 t = np.clip((convex - e[i]) @ d / (d @ d), 0.0, 1.0)
                 if np.min(np.linalg.norm(convex - (e[i] + t[:, None] * d), axis=1)) < rod_clearance:
                     continue
-            if not kernel.line_of_sight(p[i], e[i]):
+            # the range as reset(options=...) checks it: at L = L_max exactly (a zero
+            # range margin) half of the proposals are a rounding error beyond it
+            if not in_sensor_range(config, p[i], e[i]) or not kernel.line_of_sight(p[i], e[i]):
                 continue
             # the rod at its real start length (plus the pursuer's disc) is free, with
             # the same angular margin, not only the table's shorter one

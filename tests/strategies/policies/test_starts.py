@@ -30,6 +30,23 @@ def test_starts_lie_inside_the_sensor_range_and_reset_accepts_them(kind, l_min, 
     env.close()
 
 
+@pytest.mark.parametrize("kind", ["valid", "safe"])
+def test_starts_without_a_range_margin_are_accepted_by_reset(kind):
+    # spawn_margin_steps = 0 leaves no range margin: a safe start is drawn at L = L_max
+    # exactly when the pursuer's target length lies beyond L_max, and half of those
+    # proposals were a rounding error too far ("distance 0.1 is not in [l_min, l_max] =
+    # [0.05, 0.1] (too_far)": run_episode(start="safe") raised InvalidPlacementError)
+    env = surveillance_v1.parallel_env(
+        map="open_room", l_min=2.0, l_max=2.2, v_evader=2.0, spawn_margin_steps=0
+    )
+    rng = np.random.default_rng(0)
+    for _ in range(12):
+        start = sample_start(env.config, rng, kind=kind)
+        _, infos = env.reset(seed=0, options=start)  # InvalidPlacementError if not valid
+        assert 2.0 <= infos["pursuer_0"]["distance"] <= 2.2
+    env.close()
+
+
 def test_same_generator_state_same_start():
     env = surveillance_v1.parallel_env(map="corridor")
     a = sample_start(env.config, np.random.default_rng(3), kind="safe")

@@ -214,6 +214,7 @@ class SB3Policy(BasePolicy):
         self.model: Any = None
         self._warned: set[str] = set()
         self._digests: set[str] | None = None
+        self._fits: set[tuple[str, int]] = set()  # observations found to fit the model
         self.provenance = read_provenance(self.path)
         trained = None if self.provenance is None else self.provenance.get("role")
         if trained is not None and trained != role:
@@ -292,17 +293,20 @@ class SB3Policy(BasePolicy):
         Raises:
             InvalidConfigError: naming the model, its input shape and the one given.
         """
-        if self._inputs is not None or not self.path.is_file():
+        given = {"observation": config.observation, "n_rays": config.n_rays}
+        seen = (given["observation"], given["n_rays"])
+        if self._inputs is not None or seen in self._fits or not self.path.is_file():
             return  # no file: load() says so
         check_model_input(
             self.path,
-            [{"observation": config.observation, "n_rays": config.n_rays}],
+            [given],
             self.name,
             given_by="the game's",
             then="it would fail its first step; give it the observation it was trained "
             "on (the env's observation and n_rays), or put the provenance.json its "
             "training wrote beside it (the runner then gives it that observation)",
         )
+        self._fits.add(seen)  # the zip is read once, not at every reset
 
     def _reset(self) -> None:
         self.check_observation(self.config)

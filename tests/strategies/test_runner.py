@@ -391,3 +391,19 @@ def test_shipped_and_saved_models_play_by_the_names_surveil_play_takes(tmp_path)
         run_episode(MAP, "pursuer/greedy", "zoo:dagger_pursuer_generalist", 0, max_cycles=3)
     with pytest.raises(InvalidConfigError, match=r"^pursuer: model = 'zoo:nope': no zoo model"):
         run_episode(MAP, "zoo:nope", "evader/straight", 0, max_cycles=3)
+
+
+def test_a_models_input_shape_is_read_once_not_at_every_reset(tmp_path):
+    # f626799's check read the zip's data entry at every reset (0.56 ms at load 13, on the
+    # clock), and so a loaded model whose file was then rewritten failed its next reset
+    import shutil
+
+    from strategies.policies import make_policy
+    from strategies.policies.model_files import zoo_dir
+
+    path = tmp_path / "c.zip"
+    shutil.copy(zoo_dir() / "dagger_pursuer_corridor" / "model.zip", path)
+    pol = make_policy(f"pursuer/sb3:{path}")
+    run_episode(MAP, pol, "evader/straight", 0, max_cycles=2)
+    path.write_bytes(b"rewritten")  # the model is in memory: it plays on
+    assert run_episode(MAP, pol, "evader/straight", 1, max_cycles=2).steps == 2

@@ -11,7 +11,10 @@ within 1e-12 rad), the regions by the decomposition's locate grid (vectorised; t
 point it cannot answer asks ``Decomposition.locate``), the cells by the same stop-pair
 match as ``Decomposition._match``, and the bins by the same comparison as
 ``safety._arc_bins``. A point with an arc it cannot match (on a critical curve) is
-handed to ``_classified`` itself, which nudges it off the curve.
+handed to ``_classified`` itself, which nudges it off the curve. A lazy table's batches
+(a few dozen to a few hundred points) take
+:func:`~strategies.cspace._batch_arcs.free_arcs_few`, the same arrays in fewer numpy
+calls: a batch's cost there is mostly per call, not per point.
 
 :func:`distinct_rows` classifies a whole grid in chunks and keeps each distinct row once
 (``safety_table(..., distinct=True)``).
@@ -24,11 +27,14 @@ import math
 import numpy as np
 import shapely
 
-from strategies.cspace._batch_arcs import free_arcs_batch, stop_code
+from envs.geometry import kernel_for
+from strategies.cspace._batch_arcs import free_arcs_batch, free_arcs_few, stop_code
+from strategies.cspace._candidates import wall_index
 
 __all__ = ["classify_points", "distinct_rows"]
 
 _TWO_PI = 2.0 * math.pi
+FEW = 4096  # batches up to this size (a lazy table's) take free_arcs_few
 
 
 def _regions(dec, pts: np.ndarray) -> np.ndarray:
@@ -47,6 +53,8 @@ def _regions(dec, pts: np.ndarray) -> np.ndarray:
         lab = np.full(k, -2, dtype=np.int64)
         lab[inr] = grid.labels[i[inr], j[inr]]
         out[lab >= 0] = lab[lab >= 0]
+        if (lab >= 0).all():  # (most batches)
+            return out
         # unlabelled squares: the one candidate polygon holding the point, if one does
         und = np.flatnonzero(lab == -1)
         sq = i[und] * ny + j[und]
@@ -92,6 +100,10 @@ class _CellKeys:
         self.sorted_keys, self.key_cell = key[order], order
         self.n_cells = np.array([len(r.cells) for r in dec.regions] + [-1], dtype=np.int64)
         self.escapable = np.array([c.escapable for c in cells], dtype=bool)
+        # the map's wall index and kernel tolerance (free_arcs_few's; their look-ups
+        # hash the map's vertices, ~0.1 ms a call on a 300-vertex floor plan)
+        self.tree = wall_index(dec.map).tree
+        self.eps = kernel_for(dec.map).eps
 
     def _key(self, reg: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
         """Integer keys of (region, code, code) triples (-1 where a code is no cell's)."""
@@ -158,10 +170,13 @@ def classify_points(
     safe = np.zeros((k, nb), dtype=bool)
     if not k:
         return free, safe
-    batch = free_arcs_batch(dec.map, pts, dec.L)
+    index = _cell_keys(dec)
+    if k <= FEW:  # (a lazy table's lookups)
+        batch = free_arcs_few(dec.map, pts, dec.L, index.tree, index.eps)
+    else:
+        batch = free_arcs_batch(dec.map, pts, dec.L)
     counts = np.diff(batch.offsets)
     regions = _regions(dec, pts)
-    index = _cell_keys(dec)
     # Decomposition._match: a point whose arcs are exactly its region's cells (most),
     # vectorised; the others through the neighbours, point by point
     owner = np.repeat(np.arange(k), counts)
@@ -172,11 +187,13 @@ def classify_points(
     state = np.full(len(batch.lo), 2, dtype=np.int8)
     at = fast[owner]
     state[at] = index.escapable[cell[at]]
-    code_lo, code_hi = batch.code_lo.tolist(), batch.code_hi.tolist()
-    offs = batch.offsets.tolist()
-    cells = dec.cells
     nudge = []
-    for i in np.flatnonzero(~fast).tolist():
+    slow = np.flatnonzero(~fast)
+    if len(slow):
+        code_lo, code_hi = batch.code_lo.tolist(), batch.code_hi.tolist()
+        offs = batch.offsets.tolist()
+        cells = dec.cells
+    for i in slow.tolist():
         s, e = offs[i], offs[i + 1]
         r = int(regions[i])
         if s == e:
@@ -198,12 +215,17 @@ def classify_points(
     else:
         d %= _TWO_PI
     inarc = d <= (hi - lo)
-    rank = _rank(owner)
-    for n in range(int(counts.max())):  # each point's n-th arc
-        at = np.flatnonzero(rank == n)
-        free[owner[at]] |= inarc[at]
-        ok = at[state[at] == 0]
-        safe[owner[ok]] |= inarc[ok]
+    inarc_safe = inarc & (state == 0)[:, None]
+    # each point's arcs or-ed together: its n-th arc is at offsets[i] + n
+    has = np.flatnonzero(counts)
+    at = batch.offsets[has]
+    free[has] = inarc[at]
+    safe[has] = inarc_safe[at]
+    for n in range(1, int(counts.max()) if k else 0):
+        has = has[counts[has] > n]
+        at = batch.offsets[has] + n
+        free[has] |= inarc[at]
+        safe[has] |= inarc_safe[at]
     for i in nudge:  # as the eager build, point by point
         arcs, safe_arcs = _classified(dec, pts[i], step)
         free[i] = _arc_bins(arcs, centres)

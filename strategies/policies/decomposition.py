@@ -176,6 +176,7 @@ class DecompositionPursuer(BasePolicy):
     CHARGE_EXIT = math.cos(math.radians(70.0))  # ... and, against a chatter, keeps charging
     CHATTER_ROD = math.radians(2.0)  # the rod "stands still" between two entries of the test
     CHATTER_HEADING = math.radians(0.25)  # the evader's heading "stands still" meanwhile
+    LOOKAHEAD_STEPS = 4  # steps of the evader's probes a lazy table classifies ahead (below)
     WALL_HORIZON = 2.0  # seconds the pursuer's path is checked for walls (no circle in reach)
     WALL_STEP = 0.1  # spacing in seconds of the points checked on that path
     CORNER_HUG = 2  # grid steps of clearance beyond its body within which the evader hugs a wall
@@ -348,7 +349,8 @@ class DecompositionPursuer(BasePolicy):
         sampler's judge, the learners' table features) the values are as before."""
         tab = self.table
         value = np.full(tab.n_bins, self.horizon)
-        value = np.minimum(value, self._probe_values(evader))
+        step = None if velocity is None else self.config.dt * np.asarray(velocity, dtype=float)
+        value = np.minimum(value, self._probe_values(evader, step=step))
         if velocity is not None:
             for start, delay, shadow, sense in self._corners_in_reach(evader, velocity):
                 value = np.minimum(value, self._probe_values(start, delay, shadow, sense))
@@ -538,12 +540,17 @@ class DecompositionPursuer(BasePolicy):
         delay: float = 0.0,
         rays: np.ndarray | None = None,
         sense: int = 0,
+        step: np.ndarray | None = None,
     ) -> np.ndarray:
         """The least margin over the probes on rays from ``origin`` (see above); the
         evader reaches ``origin`` itself after ``delay`` seconds (probes beyond the horizon
         then drop out), only the rays ``rays`` (bool, per ray) count if given, and the
         rotation is counted ccw (``sense`` > 0) or cw (< 0) only if given (a probe with
-        no safe orientation then counts as a full turn, more than any turn that way)."""
+        no safe orientation then counts as a full turn, more than any turn that way).
+
+        ``step``: the evader's displacement a step (a lazy table then classifies the
+        probes of its next ``LOOKAHEAD_STEPS`` steps along it with this one's new nodes:
+        the same values, fewer classification batches)."""
         tab = self.table
         offsets, n_rays, n_r = self._offsets, self.rays, self._n_r
         cols, t_e = self._probe_cols, self._t_e
@@ -579,13 +586,17 @@ class DecompositionPursuer(BasePolicy):
             need = need.max(axis=0)
             v = t_e[:, None] - (self._way_lut if sense else self._turn_lut)[need]
             return v.min(axis=0)
-        inside = tab.inside(points).reshape(n_rays, n_r)
+        # a lazy table: the nodes of the next steps' probes along the evader's step join
+        # the batches of this one's new nodes
+        lazy = step is not None and isinstance(tab, LazySafetyTable)
+        ahead = (step, self.LOOKAHEAD_STEPS) if lazy else ()
+        inside = tab.inside(points, *ahead).reshape(n_rays, n_r)
         reach = np.cumsum(~inside, axis=1) == 0  # a ray stops at the first wall
         sub_ok = reach[:, cols]
         if not sub_ok.any():
             return np.full(tab.n_bins, self.horizon)
         probes = points.reshape(n_rays, n_r, 2)[:, cols][sub_ok]
-        r = tab.rows(probes)  # only the probes' orientations are looked up
+        r = tab.rows(probes, *ahead)  # only the probes' orientations are looked up
         t_e = np.broadcast_to(t_e, sub_ok.shape)[sub_ok]
         # lut: seconds to turn by a number of bins; a safe bin (0) never threatens
         needs = tab.need if not sense else (tab.ccw if sense > 0 else tab.cw)
@@ -691,10 +702,24 @@ class DecompositionPursuer(BasePolicy):
         k = self._orbit_k * L
         nx, ny = -math.sin(theta) * k, math.cos(theta) * k
         need = self._orbit_R * L + self._orbit_pad
-        return (
-            self._clearance_at(ex + nx, ey + ny) - need,
-            self._clearance_at(ex - nx, ey - ny) - need,
-        )
+        if self._clear is not None:
+            return (
+                self._clearance_at(ex + nx, ey + ny) - need,
+                self._clearance_at(ex - nx, ey - ny) - need,
+            )
+        # a lazy table: the two centres' nodes measured in one batch (the same values)
+        tab = self.table
+        ox, oy, h = float(tab.origin[0]), float(tab.origin[1]), tab.resolution
+        i = [round((ex + nx - ox) / h), round((ex - nx - ox) / h)]
+        j = [round((ey + ny - oy) / h), round((ey - ny - oy) / h)]
+        on = [0 <= a < tab.shape[0] and 0 <= b < tab.shape[1] for a, b in zip(i, j, strict=True)]
+        d = [0.0, 0.0]
+        if any(on):
+            at = [k for k in (0, 1) if on[k]]
+            got = self._memo_clearances(np.array([i[k] for k in at]), np.array([j[k] for k in at]))
+            for k, v in zip(at, got.tolist(), strict=True):
+                d[k] = v
+        return d[0] - need, d[1] - need
 
     def _clearance_at(self, x: float, y: float) -> float:
         """Wall distance at the table's grid node nearest ``(x, y)`` (0 off the grid)."""

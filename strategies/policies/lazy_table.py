@@ -6,9 +6,10 @@ about 1 GB and 200 s. A pursuer only ever looks at the points around the evader 
 probes reach ``V_e pi / omega``), so :class:`LazySafetyTable` has the same grid, the
 same rows and the same answers as the eager table, but classifies a grid point the first
 time a lookup touches it (the points new to a lookup in one vectorised batch,
-:func:`~strategies.policies._batch_classify.classify_points`, about 20 us a point) and
-keeps it. Ready as soon as the decomposition is; memory grows with
-the area the evader has visited, not with the map.
+:func:`~strategies.policies._batch_classify.classify_points`: ~0.2 ms a batch and ~1 us
+a point more, so a caller that knows where it looks next passes those points too,
+``rows(points, step, steps)``) and keeps it. Ready as soon as the decomposition is;
+memory grows with the area the evader has visited, not with the map.
 
 Example:
     >>> from envs.maps import builtin_map
@@ -36,7 +37,7 @@ from envs.tolerances import REL_LENGTH_TOL
 from strategies.cspace.grids import check_grid_spacing, grid_axis, grid_size
 from strategies.memory import memory_budget
 from strategies.policies._batch_classify import _cell_keys, classify_points
-from strategies.policies.safety import SafetyTable, _circular_distance
+from strategies.policies.safety import NO_PATH, SafetyTable
 
 __all__ = ["LAZY_POINTS", "LazySafetyTable"]
 
@@ -161,27 +162,50 @@ class LazySafetyTable:
         """Grid points classified so far (inside the free region)."""
         return self._n
 
-    def inside(self, points: np.ndarray) -> np.ndarray:
+    def inside(
+        self, points: np.ndarray, step: np.ndarray | None = None, steps: int = 0
+    ) -> np.ndarray:
         """Whether the grid points nearest to (k, 2) points lie in the free region.
 
         Membership only (a vectorised point-in-polygon test per new node, memoised):
-        the orientations are classified when :meth:`rows` asks for them.
+        the orientations are classified when :meth:`rows` asks for them. ``step`` and
+        ``steps``: as :meth:`rows` (the new nodes ahead tested in the same batch).
         """
-        idx, ok = self.grid_index(points)
-        out = np.zeros(len(idx), dtype=bool)
-        at = self._slots(idx[ok])
-        member = self._member[at]
-        if (member == 0).any():
-            todo = np.unique(idx[ok][member == 0], axis=0)
-            self._membership(todo)
-            member = self._member[at]
+        ix, iy, ok = self._nodes(points)
+        out = np.zeros(len(ok), dtype=bool)
+        flat = self._slots(ix, iy)
+        member = self._member.reshape(-1)[flat]
+        unknown = member == 0
+        if unknown.any():
+            ux, uy, uf = ix[unknown], iy[unknown], flat[unknown]
+            if steps and step is not None:
+                ax, ay, _ = self._nodes(_ahead(points, step, steps))
+                at = self._slots(ax, ay)
+                new = self._member.reshape(-1)[at] == 0
+                ux, uy = np.concatenate([ux, ax[new]]), np.concatenate([uy, ay[new]])
+                uf = np.concatenate([uf, at[new]])
+            _, first = np.unique(uf, return_index=True)
+            self._membership(ux[first], uy[first], uf[first])
+            member = self._member.reshape(-1)[flat]
         out[ok] = member == 1
         return out
 
-    def _slots(self, nodes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Where grid nodes (k, 2) are kept in ``_cell`` and ``_member`` (an index
-        tuple), their tiles allocated first (unknown nodes)."""
-        ti, tj = nodes[:, 0] // _TILE, nodes[:, 1] // _TILE
+    def _nodes(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Grid indices ``(i, j)`` of the nodes nearest to (k, 2) points that lie on the
+        grid, and which do (``grid_index``'s nodes, as ``SafetyTable.rows`` tests them)."""
+        idx = np.rint((np.asarray(points, dtype=float) - self.origin) / self.resolution).astype(
+            np.int64
+        )
+        ix, iy = idx[:, 0], idx[:, 1]
+        ok = (ix.view(np.uint64) < self.shape[0]) & (iy.view(np.uint64) < self.shape[1])
+        if not ok.all():
+            ix, iy = ix[ok], iy[ok]
+        return ix, iy, ok
+
+    def _slots(self, ix: np.ndarray, iy: np.ndarray) -> np.ndarray:
+        """Where grid nodes ``(ix, iy)`` are kept in ``_cell`` and ``_member`` (flat
+        indices), their tiles allocated first (unknown nodes)."""
+        ti, tj = ix // _TILE, iy // _TILE
         slab = self._tiles[ti, tj]
         if (slab < 0).any():
             new = np.unique(np.stack([ti[slab < 0], tj[slab < 0]], axis=1), axis=0)
@@ -196,56 +220,78 @@ class LazySafetyTable:
             self._tiles[new[:, 0], new[:, 1]] = np.arange(self._n_tiles, n)
             self._n_tiles = n
             slab = self._tiles[ti, tj]
-        return slab, nodes[:, 0] % _TILE, nodes[:, 1] % _TILE
+        return (slab * _TILE + ix % _TILE) * _TILE + iy % _TILE
 
-    def _membership(self, nodes: np.ndarray) -> np.ndarray:
-        """Decide (and memoise) which grid nodes (k, 2) lie in the free region."""
-        x, y = self._xs[nodes[:, 0]], self._ys[nodes[:, 1]]
+    def _membership(self, ix: np.ndarray, iy: np.ndarray, flat: np.ndarray) -> np.ndarray:
+        """Decide (and memoise) which grid nodes ``(ix, iy)`` (kept at ``flat``) lie in
+        the free region."""
+        x, y = self._xs[ix], self._ys[iy]
         inside = shapely.contains_xy(self.map.prepared_free_region, x, y)
         at = np.flatnonzero(inside)
         inside[at] = ~shapely.dwithin(self._walls, shapely.points(x[at], y[at]), self._eps)
-        self._member[self._slots(nodes)] = np.where(inside, 1, 2)
+        self._member.reshape(-1)[flat] = np.where(inside, 1, 2)
         return inside
 
-    def rows(self, points: np.ndarray) -> np.ndarray:
-        """Table rows of the grid points nearest to (k, 2) points (-1 outside)."""
-        idx, ok = self.grid_index(points)
-        out = np.full(len(idx), -1, dtype=np.int64)
-        at = self._slots(idx[ok])
-        vals = self._cell[at]
-        if (vals == _UNKNOWN).any():
-            todo = np.unique(idx[ok][vals == _UNKNOWN], axis=0)
-            self._classify(todo)
-            vals = self._cell[at]
+    def rows(
+        self, points: np.ndarray, step: np.ndarray | None = None, steps: int = 0
+    ) -> np.ndarray:
+        """Table rows of the grid points nearest to (k, 2) points (-1 outside).
+
+        ``step`` (2,) and ``steps``: where the caller looks next, ``points + k step`` for
+        k = 1 .. ``steps`` (an evader's probes along its velocity). When ``points`` meet
+        new nodes, the new nodes ahead are classified in the same batch: a batch costs
+        ~0.2 ms however few its points and ~1 us a point more, so the next lookups find
+        their nodes ready instead of paying for a batch a decision. Every node's entries
+        are the same either way (its classification does not depend on its batch; the
+        rows are numbered in the order the nodes were classified).
+        """
+        ix, iy, ok = self._nodes(points)
+        out = np.full(len(ok), -1, dtype=np.int64)
+        flat = self._slots(ix, iy)
+        vals = self._cell.reshape(-1)[flat]
+        unknown = vals == _UNKNOWN
+        if unknown.any():
+            ux, uy = ix[unknown], iy[unknown]
+            if steps and step is not None:
+                ax, ay, _ = self._nodes(_ahead(points, step, steps))
+                at = self._slots(ax, ay)
+                new = self._cell.reshape(-1)[at] == _UNKNOWN
+                ux, uy = np.concatenate([ux, ax[new]]), np.concatenate([uy, ay[new]])
+            # each node once, in (i, j) order (as np.unique of the (i, j) pairs)
+            ny = np.int64(self.shape[1])
+            key = np.unique(ux * ny + uy)
+            self._classify(key // ny, key % ny)
+            vals = self._cell.reshape(-1)[flat]
         out[ok] = vals
         return out
 
-    def _classify(self, nodes: np.ndarray) -> None:
-        """Classify grid nodes (k, 2) as the eager table's build does."""
-        x, y = self._xs[nodes[:, 0]], self._ys[nodes[:, 1]]
-        at = self._slots(nodes)
-        member = self._member[at]
+    def _classify(self, ix: np.ndarray, iy: np.ndarray) -> None:
+        """Classify grid nodes ``(ix, iy)`` as the eager table's build does."""
+        flat = self._slots(ix, iy)
+        member = self._member.reshape(-1)[flat]
         inside = member == 1
-        if (member == 0).any():
-            inside[member == 0] = self._membership(nodes[member == 0])
-        self._cell[tuple(a[~inside] for a in at)] = -1
-        new = nodes[inside]
-        if not len(new):
+        unknown = member == 0
+        if unknown.any():
+            inside[unknown] = self._membership(ix[unknown], iy[unknown], flat[unknown])
+        cell = self._cell.reshape(-1)
+        cell[flat[~inside]] = -1
+        if not inside.all():
+            ix, iy, flat = ix[inside], iy[inside], flat[inside]
+        k = len(flat)
+        if not k:
             return
-        self._grow(self._n + len(new))
-        pts = np.stack([x[inside], y[inside]], axis=1)
-        sl = slice(self._n, self._n + len(new))
-        self._free[sl], self._safe[sl] = classify_points(
-            self.decomposition, pts, self.resolution, self._centres
-        )
-        g = self._safe[sl].any(axis=1)
-        self._guaranteed[sl] = g
-        self._safe[sl] = np.where(g[:, None], self._safe[sl], self._free[sl])
-        self._ccw[sl] = _circular_distance(self._safe[sl], +1)
-        self._cw[sl] = _circular_distance(self._safe[sl], -1)
-        self._need[sl] = np.minimum(self._ccw[sl], self._cw[sl])
-        self._cell[tuple(a[inside] for a in at)] = np.arange(self._n, self._n + len(new))
-        self._n += len(new)
+        self._grow(self._n + k)
+        pts = np.stack([self._xs[ix], self._ys[iy]], axis=1)
+        free, safe = classify_points(self.decomposition, pts, self.resolution, self._centres)
+        g = safe.any(axis=1)
+        safe = np.where(g[:, None], safe, free)
+        ccw, cw = _both_ways(safe)
+        sl = slice(self._n, self._n + k)
+        self._free[sl], self._safe[sl], self._guaranteed[sl] = free, safe, g
+        self._ccw[sl], self._cw[sl] = ccw, cw
+        np.minimum(ccw, cw, out=self._need[sl])
+        cell[flat] = np.arange(self._n, self._n + k)
+        self._n += k
 
     def _grow(self, n: int) -> None:
         cap = len(self._guaranteed)
@@ -258,3 +304,36 @@ class LazySafetyTable:
             new = np.zeros((cap, *old.shape[1:]), dtype=old.dtype)
             new[: self._n] = old[: self._n]
             setattr(self, name, new)
+
+
+def _ahead(points: np.ndarray, step: np.ndarray, steps: int) -> np.ndarray:
+    """``points + k step`` for k = 1 .. ``steps``, (steps k, 2)."""
+    shift = np.arange(1, steps + 1)[:, None, None] * np.asarray(step, dtype=float)
+    return (np.asarray(points, dtype=float).reshape(-1, 2) + shift).reshape(-1, 2)
+
+
+def _both_ways(safe: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``safety._circular_distance(safe, +1)`` and ``(safe, -1)`` of a batch of rows at
+    once: the same bins to the next safe bin at or after each bin and to the last at or
+    before it (``NO_PATH`` where a row has none). A row safe all round is 0 both ways
+    and one with no safe bin ``NO_PATH`` (most of a lazy table's rows, away from the
+    walls, are one or the other); the others are found on one doubled circle, in int16."""
+    k, nb = safe.shape
+    n_safe = np.count_nonzero(safe, axis=1)
+    ccw = np.where(n_safe[:, None] == 0, np.uint8(NO_PATH), np.uint8(0))
+    ccw = np.broadcast_to(ccw, (k, nb)).copy()
+    mixed = np.flatnonzero((n_safe > 0) & (n_safe < nb))
+    if not len(mixed):
+        return ccw, ccw.copy()
+    cw = ccw.copy()
+    part = safe[mixed]
+    dtype = np.int16 if 4 * nb < np.iinfo(np.int16).max else np.int64
+    ar = np.arange(2 * nb, dtype=dtype)
+    doubled = np.concatenate([part, part], axis=1)
+    none = dtype(4 * nb)
+    ahead = np.minimum.accumulate(np.where(doubled, ar, none)[:, ::-1], axis=1)[:, : nb - 1 : -1]
+    behind = np.maximum.accumulate(np.where(doubled, ar, -none), axis=1)[:, nb:]
+    # a mixed row has a safe bin within nb - 1 bins either way
+    ccw[mixed] = np.minimum(ahead - ar[:nb], NO_PATH)
+    cw[mixed] = np.minimum(ar[nb:] - behind, NO_PATH)
+    return ccw, cw

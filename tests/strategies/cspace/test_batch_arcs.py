@@ -15,8 +15,8 @@ import pytest
 
 from envs.geometry import kernel_for
 from envs.maps import builtin_map, floor_plan, random_map
-from strategies.cspace import decompose
-from strategies.cspace._batch_arcs import free_arcs_batch, stop_code, stop_of
+from strategies.cspace import _batch_arcs, decompose
+from strategies.cspace._batch_arcs import free_arcs_batch, free_arcs_few, stop_code, stop_of
 from tests.strategies.cspace._oracle import hexagons, stars, tilted_block
 
 WORLDS = {
@@ -67,3 +67,61 @@ def test_stop_codes_round_trip():
         for stop in (arc.stop_lo, arc.stop_hi):
             assert stop_of(stop_code(stop)) == stop
     assert stop_of(stop_code(None)) is None
+
+
+@pytest.mark.parametrize("name", list(WORLDS))
+def test_the_few_points_arcs_are_the_batchs_bit_for_bit(name, monkeypatch):
+    """free_arcs_few (a lazy table's batches: a few dozen points, one index query, one
+    padded sweep) returns the batch's arrays exactly: at random points, on critical
+    curves, at and on walls, at distance L from vertices, outside the free region, in
+    batches of 1 to 80 points, at L where chains of edges fit in the disk and merge."""
+    make, L = WORLDS[name]
+    world = make()
+    xmin, ymin, xmax, ymax = world.bounds
+    dec = decompose(world, L)
+    rng = np.random.default_rng(5)
+    ang = rng.uniform(-math.pi, math.pi, len(world.vertices))
+    pts = np.vstack(
+        [
+            rng.uniform([xmin - 1, ymin - 1], [xmax + 1, ymax + 1], size=(600, 2)),
+            [b.point for b in dec.boundaries[:150]],
+            world.vertices,
+            0.5 * (world.edge_start + world.edge_end),
+            world.vertices + 1e-3 * world.edge_normal,
+            world.vertices + L * np.column_stack([np.cos(ang), np.sin(ang)]),
+        ]
+    )
+    pts = pts[rng.permutation(len(pts))]
+    span = max(xmax - xmin, ymax - ymin)
+    seen = {"wall": 0, "gaps": 0, "none": 0, "merged": 0}
+    chains = _batch_arcs._chains
+
+    def counted(*args):
+        seen["merged"] += 1
+        return chains(*args)
+
+    monkeypatch.setattr(_batch_arcs, "_chains", counted)
+    for length in (L, 0.3 * L, 0.45 * span):
+        s = 0
+        while s < len(pts):
+            k = int(rng.integers(1, 81))
+            p = pts[s : s + k]
+            s += k
+            want, got = free_arcs_batch(world, p, length), free_arcs_few(world, p, length)
+            for f in ("offsets", "lo", "hi", "code_lo", "code_hi"):
+                assert np.array_equal(getattr(want, f), getattr(got, f)), (f, length, s)
+                assert getattr(want, f).dtype == getattr(got, f).dtype, f
+            counts = np.diff(got.offsets)
+            seen["gaps"] += int((counts > 1).sum())
+            seen["none"] += int((counts == 0).sum())
+            seen["wall"] += int(world.distance_to_walls(p).min() <= 1e-9)
+    assert all(seen.values()), seen
+    # a large batch (one chunk of the batch's), and batches it takes in several chunks
+    # (its chunk size made small: the few points' answer is then the batch's own)
+    many = np.vstack([pts + rng.normal(0.0, 0.05, pts.shape) for _ in range(3)])
+    for chunk in (_batch_arcs._CHUNK, len(many) // 2):  # (then at least two chunks)
+        monkeypatch.setattr(_batch_arcs, "_CHUNK", chunk)
+        for p in (many, many[:700]):
+            want, got = free_arcs_batch(world, p, L), free_arcs_few(world, p, L)
+            for f in ("offsets", "lo", "hi", "code_lo", "code_hi"):
+                assert np.array_equal(getattr(want, f), getattr(got, f)), (f, chunk, len(p))

@@ -48,6 +48,46 @@ def test_batch_classification_is_the_point_by_points(name, angle):
     assert nudged > 0 or name != "corridor"  # the corridor's curves hold unmatched points
 
 
+@pytest.mark.parametrize("name", ["floor_plan", "office", "random"])
+def test_a_lazy_tables_small_batches_are_the_point_by_points(name):
+    """A lazy table classifies a few dozen points a batch (free_arcs_few, the cells
+    matched per region, each point's arcs or-ed together): the same bins as the eager
+    build's point by point classification, at random points, near walls and corners,
+    and on critical curves, in batches of 1 to 60 points."""
+    from envs.maps import floor_plan, random_map
+
+    world = {
+        "floor_plan": lambda: floor_plan(0, n_vertices=200, size=(40.0, 40.0)),
+        "office": lambda: builtin_map("office"),
+        "random": lambda: random_map(6, n_vertices=20),
+    }[name]()
+    dec = decompose(world, 2.2)
+    nb = 144
+    centres = -math.pi + (np.arange(nb) + 0.5) * (2.0 * math.pi / nb)
+    x0, y0, x1, y1 = world.bounds
+    rng = np.random.default_rng(7)
+    near = world.vertices + rng.normal(0.0, 0.05, world.vertices.shape)
+    pts = np.vstack(
+        [
+            rng.uniform((x0, y0), (x1, y1), size=(500, 2)),
+            near,
+            [b.point for b in dec.boundaries[:100]],
+        ]
+    )
+    pts = pts[world.contains(pts)]
+    pts = pts[rng.permutation(len(pts))]
+    s = 0
+    while s < len(pts):
+        k = int(rng.integers(1, 61))
+        free, safe = classify_points(dec, pts[s : s + k], 0.1, centres)
+        for i, p in enumerate(pts[s : s + k]):
+            arcs, safe_arcs = _classified(dec, p, 0.1)
+            assert np.array_equal(free[i], _arc_bins(arcs, centres)), (s, i)
+            want = free[i] & _arc_bins(safe_arcs, centres) if safe_arcs is not None else 0
+            assert np.array_equal(safe[i], want & free[i]), (s, i)
+        s += k
+
+
 @pytest.mark.parametrize(("name", "angle"), [("corridor", 0.3), ("l_hall", 0.61)])
 def test_distinct_rows_answer_as_the_eager_table_at_every_node(name, angle):
     world = _world(name, angle)

@@ -468,7 +468,7 @@ def run_episode(
         from envs.validation import positive
 
         time_limit = positive("time_limit", time_limit)
-    overrides = dict(overrides or {})
+    overrides = dict(_mapping("overrides", overrides, "{'v_evader': 0.8}"))
     if max_cycles is not None:
         overrides["max_cycles"] = max_cycles
     s_env, s_start, s_p, s_e = episode_seeds(seed)
@@ -653,7 +653,7 @@ def _requests(
     overrides: Mapping[str, Any],
     explicit: Mapping[str, Mapping[str, Any] | None] | None,
 ) -> dict[str, dict[str, Any]]:
-    explicit = dict(explicit or {})
+    explicit = dict(_mapping("observations", explicit, "{'pursuer': {'observation': 'lidar'}}"))
     unknown = sorted(set(explicit) - {"pursuer", "evader"})
     if unknown:
         raise InvalidConfigError(f"observations: keys must be 'pursuer' or 'evader', got {unknown}")
@@ -667,6 +667,18 @@ def _requests(
             req = observation_options(pol)
         out[role] = dict(default) if req is None else req
     return out
+
+
+def _mapping(name: str, value: Any, example: str) -> Mapping[str, Any]:
+    """``value`` if it is a mapping (``None``: an empty one); a list or a string was
+    dict()'s TypeError or ValueError ('dictionary update sequence element #0 ...')."""
+    if value is None:
+        return {}
+    if not isinstance(value, Mapping):
+        raise InvalidConfigError(
+            f"{name} = {value!r}: expected a mapping such as {example}, got {type(value).__name__}"
+        )
+    return value
 
 
 def _replace(config: Any, **changes: Any) -> Any:

@@ -300,6 +300,23 @@ def test_bad_arguments_are_clear_errors():
     assert r.start_kind == "given" and r.start["pursuer"] == [3.0, 5.0]
 
 
+@pytest.mark.parametrize(
+    ("bad", "message"),
+    [
+        ({"observations": [1]}, r"^observations = \[1\]: expected a mapping such as \{'pursuer'"),
+        ({"observations": "state"}, r"^observations = 'state': expected a mapping"),
+        ({"overrides": "abc"}, r"^overrides = 'abc': expected a mapping such as \{'v_evader'"),
+        ({"overrides": [("l_min", 2.0)]}, r"^overrides = \[\('l_min', 2.0\)\]: expected a mapping"),
+    ],
+)
+def test_overrides_and_observations_that_are_no_mapping_are_refused_by_name(bad, message):
+    # observations=[1] was dict()'s TypeError 'cannot convert dictionary update sequence
+    # element #0 to a sequence', overrides='abc' its ValueError '... has length 1; 2 is
+    # required', neither naming the argument
+    with pytest.raises(InvalidConfigError, match=message):
+        run_episode(MAP, "pursuer/greedy", "evader/random", 0, max_cycles=3, **bad)
+
+
 @pytest.mark.parametrize("limit", [-1.0, 0.0, float("nan"), "5", True])
 def test_a_bad_time_limit_is_refused_not_blamed_on_a_policy(limit):
     # time_limit = -1 (or 0) made the pursuer forfeit at step 1 with EpisodeTimeout

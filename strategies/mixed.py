@@ -176,8 +176,10 @@ class MixedPolicy:
         seed: seeds the mixture's own generator (used when ``reset`` gets no seed).
 
     Raises:
-        InvalidConfigError: no components, weights of the wrong length or negative, or
-            components of different roles.
+        InvalidConfigError: no components, ``policies`` a single string rather than a
+            list, a component that is neither a name nor a policy, weights of the wrong
+            length or negative, components of different roles, or a seed that is no
+            integer >= 0.
 
     Examples:
         >>> mix = MixedPolicy(["evader/straight", "evader/random"], [0.25, 0.75])
@@ -193,9 +195,25 @@ class MixedPolicy:
         name: str | None = None,
         seed: int | None = None,
     ) -> None:
-        from strategies.policies import make_policy
+        from envs import validation
+        from strategies.policies import Policy, make_policy
 
+        if isinstance(policies, (str, bytes)) or not hasattr(policies, "__iter__"):
+            # a lone name was iterated as its letters ("unknown policy 'e'")
+            raise InvalidConfigError(
+                f"MixedPolicy: policies = {policies!r}: expected a list of policy names or "
+                f"policies, e.g. ['evader/straight', 'evader/random'], got "
+                f"{type(policies).__name__}"
+            )
         pols = [make_policy(p) if isinstance(p, str) else p for p in policies]
+        odd = [p for p in pols if not (isinstance(p, Policy) or hasattr(p, "select"))]
+        if odd:  # was taken, and failed as the first episode reset it
+            raise InvalidConfigError(
+                f"MixedPolicy: components must be policy names or policies (reset, act, "
+                f"predict), got {odd[0]!r} ({type(odd[0]).__name__})"
+            )
+        if seed is not None:  # numpy's own refusal named no argument
+            seed = validation.integer("seed", seed, minimum=0, where="MixedPolicy")
         if not pols:
             raise InvalidConfigError("MixedPolicy: expected at least one component policy")
         w = np.ones(len(pols)) if weights is None else _mixture("weights", weights, len(pols))
@@ -247,7 +265,15 @@ class MixedPolicy:
         return opts[0] if all(o == opts[0] for o in opts) else None
 
     def reset(self, *, role: str, map: Any, config: Any, seed: int | None = None) -> None:
-        """Draw this episode's component and reset it (its seed derives from ``seed``)."""
+        """Draw this episode's component and reset it (its seed derives from ``seed``).
+
+        Raises:
+            InvalidConfigError: ``seed`` is not None or an integer >= 0 (nothing drawn).
+        """
+        if seed is not None:
+            from envs import validation
+
+            seed = validation.integer("seed", seed, minimum=0, where=f"policy {self.name!r}: reset")
         rng = self.rng if seed is None else np.random.default_rng(seed)
         chosen = self.select(int(rng.integers(2**63)))
         self.role = role

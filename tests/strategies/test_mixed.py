@@ -106,6 +106,34 @@ def test_mixed_policy_samples_its_weights_reproducibly():
         MixedPolicy([])
 
 
+@pytest.mark.parametrize(
+    ("make", "message"),
+    [
+        # a lone name was iterated letter by letter: "unknown policy 'e'"
+        (lambda: MixedPolicy("evader/straight"), r"policies = 'evader/straight': expected a list"),
+        (lambda: MixedPolicy(3), r"policies = 3: expected a list"),
+        # a component that is no policy was taken, and failed at the first episode
+        (lambda: MixedPolicy(["evader/straight", 3]), r"components must be policy names or "),
+        # numpy's bare 'expected non-negative integer', naming no argument
+        (lambda: MixedPolicy(["evader/straight"], seed=-1), r"MixedPolicy: seed = -1: expected"),
+    ],
+)
+def test_a_mixture_of_no_policies_or_a_bad_seed_is_refused_by_name(make, message):
+    with pytest.raises(InvalidConfigError, match=message):
+        make()
+
+
+def test_a_mixture_reset_with_a_bad_seed_is_refused_by_name():
+    from envs import surveillance_v1
+
+    config = surveillance_v1.parallel_env(map="corridor").config
+    mix = MixedPolicy(["evader/straight", "evader/random"])
+    with pytest.raises(InvalidConfigError, match=r"reset: seed = -3: expected an integer >= 0"):
+        mix.reset(role="evader", map=config.map, config=config, seed=-3)
+    assert mix.current is None  # nothing drawn
+    assert MixedPolicy(p for p in ["evader/straight"]).components[0].name == "evader/straight"
+
+
 def test_mixed_policy_plays_through_the_policy_protocol():
     from envs import surveillance_v1
 

@@ -48,6 +48,9 @@ steps the table reads the rod's own orientation as blocked, :func:`crossable_ste
 5. Near a wall that faces it along the rod, it holds the distance longer by the
    evader's overlap with that wall, which the physics gives back in one step when the
    evader turns away (:meth:`DecompositionPursuer._wall_push`).
+6. On a lap round an obstacle small enough to circle (a lap no longer than the rod's
+   full turn), the rod turns the walk's way up to the far end of its free arc instead of
+   idling at the decomposition's target (:meth:`DecompositionPursuer._walk_lead`).
 """
 
 from __future__ import annotations
@@ -181,6 +184,7 @@ class DecompositionPursuer(BasePolicy):
     WALL_STEP = 0.1  # spacing in seconds of the points checked on that path
     CORNER_HUG = 2  # grid steps of clearance beyond its body within which the evader hugs a wall
     CORNER_HEADING = 0.9  # least cosine between the evader's heading and a corner it rounds
+    LEAD_MARGIN = 4  # bins the rod keeps off its free arc's leading end on a lap (_walk_lead)
 
     def __init__(
         self,
@@ -460,30 +464,11 @@ class DecompositionPursuer(BasePolicy):
         way the walk turns (as the second corner of :meth:`_corners_in_reach`), except the
         ``done`` corners that method probes already.
         """
-        small = self._small
-        if small is None:
+        walk = self._walk(evader, vx, vy, speed)
+        if walk is None:
             return []
-        c = self.config
-        e, dist, _, _ = _nearest_edge(evader, small.wall)
-        if dist > c.body_radius + self.CORNER_HUG * self.table.resolution:
-            return []
-        ring = int(small.wall.ring[e])
-        hull = small.hull[ring]
-        e, _, t, g = _nearest_edge(evader, hull)
-        # the walk's tangent, forward along the hull (oriented as the map's rings, free
-        # space on its left): away from the hull turned by -90 degrees outside it, the
-        # hull edge's direction on it or inside it (in a pocket of the obstacle)
-        gn = math.hypot(*g)
-        hdir = hull.dir[e]
-        if gn > 1e-9 and g[1] * hdir[0] - g[0] * hdir[1] >= 0.0:
-            tx, ty = g[1] / gn, -g[0] / gn
-        else:
-            tx, ty = float(hdir[0]), float(hdir[1])
-        along = vx * tx + vy * ty
-        if abs(along) < self.CORNER_HEADING * speed:
-            return []
-        s = float(hull.pos[e]) + t
-        forward = along > 0.0
+        small, c = self._small, self.config
+        ring, s, forward = walk
         lap = small.perimeter[ring]
         pos = small.corner_pos[ring]
         walk = (pos - s) % lap if forward else (s - pos) % lap
@@ -504,6 +489,39 @@ class DecompositionPursuer(BasePolicy):
             sense = 1 if side > 0 else -1
             out.append((start, w / c.v_evader, cross * side > 0.0, sense))
         return out
+
+    def _walk(
+        self, evader: np.ndarray, vx: float, vy: float, speed: float
+    ) -> tuple[int, float, bool] | None:
+        """The walk round a small obstacle :meth:`_walk_corners` probes: ``(ring, s,
+        forward)``, the obstacle's ring, the evader's place along its hull (the hull's
+        arc length) and whether it walks the hull's way (the map's rings' orientation,
+        free space on the left: clockwise round the obstacle); None where the evader does
+        not hug a small obstacle (within ``CORNER_HUG`` grid steps of its body) walking
+        round it (its heading within ``CORNER_HEADING`` of the hull's tangent)."""
+        small = self._small
+        if small is None or speed == 0.0:
+            return None
+        c = self.config
+        e, dist, _, _ = _nearest_edge(evader, small.wall)
+        if dist > c.body_radius + self.CORNER_HUG * self.table.resolution:
+            return None
+        ring = int(small.wall.ring[e])
+        hull = small.hull[ring]
+        e, _, t, g = _nearest_edge(evader, hull)
+        # the walk's tangent, forward along the hull (oriented as the map's rings, free
+        # space on its left): away from the hull turned by -90 degrees outside it, the
+        # hull edge's direction on it or inside it (in a pocket of the obstacle)
+        gn = math.hypot(*g)
+        hdir = hull.dir[e]
+        if gn > 1e-9 and g[1] * hdir[0] - g[0] * hdir[1] >= 0.0:
+            tx, ty = g[1] / gn, -g[0] / gn
+        else:
+            tx, ty = float(hdir[0]), float(hdir[1])
+        along = vx * tx + vy * ty
+        if abs(along) < self.CORNER_HEADING * speed:
+            return None
+        return ring, float(hull.pos[e]) + t, along > 0.0
 
     def _corner_after(self, k: int, vx: float, vy: float) -> int:
         """The corner at the far end of the wall an evader walking ``(vx, vy)`` along a
@@ -646,6 +664,9 @@ class DecompositionPursuer(BasePolicy):
                 ccw_steps, cw_steps = steps_from(free)
         if not ccw_steps.size and not cw_steps.size:
             return 0.0, b0
+        lead = self._walk_lead(snap, ccw_steps, cw_steps)
+        if lead is not None:
+            ccw_steps, cw_steps = lead
         cand_bins = np.concatenate([(b0 + ccw_steps) % nb, (b0 - cw_steps) % nb])
         steps = np.concatenate([ccw_steps, cw_steps])
         score = value[cand_bins] - self._turn_penalty[steps]
@@ -665,6 +686,40 @@ class DecompositionPursuer(BasePolicy):
         elif rot < 0 and offset > 0:
             offset -= 2.0 * math.pi
         return offset, target
+
+    def _walk_lead(
+        self, snap: Snapshot, ccw: np.ndarray, cw: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray] | None:
+        """On a lap round a small obstacle, the one candidate: the far end of the rod's
+        free arc the way the walk turns, less ``LEAD_MARGIN`` bins (issue 13).
+
+        Small (:meth:`_walk_corners`): a lap takes about as long as the rod's full turn at
+        its least rate, or less, so the rod cannot keep pace with the walk for ever; it
+        must turn the walk's way at the lap's rate on average, and each second it idles
+        the evader's heading runs ahead of it. The decomposition's target is the best bin
+        against a straight-line evader; reached, the rod stood still while the walk went
+        on (rand:convex:2005:3.5, orbit:1:0.25, from hindsight's pursuer at 6 s: the rod
+        led the walk by 15 degrees, turned back 20 to its target and idled 2 s while the
+        walk's heading turned 90; occluded at 14.9 s where hindsight's pursuer held to
+        23.7). Leading as far as the rod is free keeps the lead a pursuer has once the
+        walk's way is known (19.6 s there). Returns ``(ccw, cw)`` candidates for
+        :meth:`_target`, or None off a lap (its own candidates stand).
+        """
+        ve = snap.evader_velocity
+        vx, vy = float(ve[0]), float(ve[1])
+        walk = self._walk(snap.evader, vx, vy, math.hypot(vx, vy))
+        if walk is None:
+            return None
+        sense = -1 if walk[2] else 1
+        way = ccw if sense > 0 else cw
+        if not way.size:
+            return None
+        k = max(int(way.max()) - self.LEAD_MARGIN, 0)
+        k = min(k, self.table.n_bins // 2)
+        if k == 0:
+            return np.array([0]), cw[:0]
+        one = np.array([k])
+        return (one, cw[:0]) if sense > 0 else (ccw[:0], one)
 
     def _rod_room(self, snap: Snapshot) -> tuple[float, float] | None:
         """How far (radians) the real rod can turn counter-clockwise and clockwise.

@@ -444,7 +444,10 @@ class ShootingEvader(BasePolicy):
                 branch = np.where(better, side, branch)
         return margin, branch
 
-    def _reach_margins(self, e: np.ndarray, theta: float, cand: np.ndarray, rows, rod: float):
+    def _reach_margins(
+        self, e: np.ndarray, theta: float, cand: np.ndarray, rows, rod: float, p=None,
+        lead: float = 0.0,
+    ):  # fmt: skip
         """Escape margin per candidate against the pursuer's reach, and its branch.
 
         By the time the evader gets to a candidate ``q`` (``|q - e| / V_e``), the pursuer
@@ -455,15 +458,20 @@ class ShootingEvader(BasePolicy):
         to a safe orientation at ``q`` (the table's) less that angle, the smaller of the
         two; ``-inf`` where the direction is safe already, ``R >= d`` or ``q`` is off the
         grid.
+
+        With ``p`` (the pursuer now) and ``lead`` (seconds), the evader is at ``e`` only
+        ``lead`` from now (the first leg of a two-leg shot): the pursuer's reach grows by
+        ``V_p lead``.
         """
         c, tab = self.config, self.table
         margin = np.full(len(cand), -np.inf)
         branch = np.full(len(cand), "-")
-        p = e + rod * np.array([math.cos(theta), math.sin(theta)])
+        if p is None:
+            p = e + rod * np.array([math.cos(theta), math.sin(theta)])
         ok = np.flatnonzero(rows >= 0)
         to_p = p - cand[ok]
         d = _row_norms(to_p)
-        reach = c.v_pursuer * _row_norms(cand[ok] - e) / c.v_evader
+        reach = c.v_pursuer * (_row_norms(cand[ok] - e) / c.v_evader + lead)
         far = d > reach
         ok, to_p, d, reach = ok[far], to_p[far], d[far], reach[far]
         if not len(ok):
@@ -601,6 +609,19 @@ class ShootingEvader(BasePolicy):
             # the obstacle beside the evader: pressure from the first step, held for
             # 8 D / V_e; a shot 0.3 m past the corner occludes at 0.51 and 1.19 s)
             best = self._best_candidate(e, theta, rod=self._rod)
+        if best is None and long_rod and (first or heading is None):
+            # no shot in a straight line on a long rod: one in two legs, first to the point
+            # beside a convex corner near the evader, then a shot from there (issue 13:
+            # random:polygons:7306, rho 0.2, L in [2, 6], a start the referee certifies
+            # within 11.7 s, its evader 0.25 m south then east under an obstacle's corner
+            # 0.2 m away: every straight path past the corner grazes it closer than the
+            # body radius, and the evader walked a plan that promises nothing for 130 s)
+            via = self._via_corner(e, theta, snap.pursuer, self._rod)
+            if via is not None:
+                self.mode = "shoot"
+                self._shot = (float(e[0]), float(e[1]), self._steps)
+                self._track_targets.append(via)
+                return c.v_evader * self._straight_arc(e, via)
         if best is not None:
             self.mode = "shoot"
             self._shot = (float(e[0]), float(e[1]), self._steps)
@@ -675,6 +696,82 @@ class ShootingEvader(BasePolicy):
             d = self.map.distance_to_walls(np.stack([e + h * s, e - h * s]))
             return c.v_evader * (-s if d[1] - d[0] > _PRESSING * h else s)
         return c.v_evader * u
+
+    def _via_corner(
+        self, e: np.ndarray, theta: float, p: np.ndarray, rod: float
+    ) -> np.ndarray | None:
+        """The first leg of a two-leg shot on a rod of length ``rod``: the point beside a
+        convex corner (:attr:`_corner_points`, nearest first) that the evader's disc
+        reaches in a straight line, from which a shot the disc can follow has a positive
+        margin once the pursuer has used the first leg; ``None`` if there is none.
+
+        From the corner's point the margins are those of a shot from there
+        (:meth:`_margins` with the rod as short as the pursuer can make it by then),
+        less the most the pursuer can turn the rod during the first leg (eq. 6's
+        largest rate, ``(V_p + V_e) / L``, on that shortening rod), or, against its
+        reach, the rotation from the direction to where the pursuer is now less the
+        angle its reach over both legs covers (:meth:`_reach_margins`); the larger.
+        Corners are tried while the first leg leaves the pursuer less than half a turn.
+        """
+        c = self.config
+        pts = self._corner_points
+        if not len(pts):
+            return None
+        dist = _row_norms(pts - e)
+        reach = self._n_r * self.table.resolution
+        step = c.v_evader * c.dt
+        floor = min(c.body_radius, float(self.map.distance_to_walls(e[None])[0]))
+        ex, ey = float(e[0]), float(e[1])
+        for i in np.argsort(dist, kind="stable").tolist():
+            if dist[i] > reach:
+                break
+            t1 = float(dist[i]) / c.v_evader
+            turn1 = _most_turn(c.v_pursuer + c.v_evader, rod, c.l_min, t1)
+            if turn1 >= math.pi:
+                break
+            q0 = pts[i]
+            if dist[i] <= step or self._corner_rows[i] < 0:
+                continue
+            if len(self._banned):
+                gone = self._banned - q0
+                if float(np.einsum("ij,ij->i", gone, gone).min()) <= self._ban_radius**2:
+                    continue
+            if not self.kernel.line_of_sight((ex, ey), (float(q0[0]), float(q0[1]))):
+                continue
+            if not self._disc_reaches(e, q0, floor):
+                continue
+            rays, ray_rows, corners, corner_rows = self._candidates(q0)
+            cand = np.concatenate([rays, corners])
+            rows = np.concatenate([ray_rows, corner_rows])
+            rod1 = max(c.l_min, rod - (c.v_pursuer + c.v_evader) * t1)
+            margin, _ = self._rate_margins(q0, theta, cand, rows, rod1)
+            margin = margin - turn1
+            reach_margin, _ = self._reach_margins(q0, theta, cand, rows, rod, p=p, lead=t1)
+            margin = np.maximum(margin, reach_margin)
+            if len(self._banned):
+                near = cand[:, None, :] - self._banned[None, :, :]
+                gone = np.einsum("ijk,ijk->ij", near, near).min(axis=1) <= self._ban_radius**2
+                margin[gone] = -np.inf
+            if not len(margin) or margin.max() <= 0.0:
+                continue
+            floor1 = min(c.body_radius, float(self.map.distance_to_walls(q0[None])[0]))
+            for k in np.argsort(-margin, kind="stable").tolist():
+                if margin[k] <= 0.0:
+                    break
+                if self._disc_reaches(q0, cand[k], floor1):
+                    return q0.copy()
+        return None
+
+    def _straight_arc(self, e: np.ndarray, target: np.ndarray) -> np.ndarray:
+        """Follow the straight path from ``e`` to ``target`` like an arc (until the
+        replan or its end); its first heading."""
+        d = target - e
+        n = 1 + math.ceil(math.hypot(d[0], d[1]) / (self.config.v_evader * self.config.dt))
+        f = np.linspace(0.0, 1.0, n + 1)[:, None]
+        self._arc = (e.copy(), math.atan2(d[1], d[0]), e + f * d)
+        self._arc_length = _arc_lengths(self._arc[2])
+        self._arc_age = 1
+        return self._arc_heading(e)
 
     def _long(self, rod: float) -> bool:
         """Whether a rod of length ``rod`` is longer than the pursuer can close to L_min in
@@ -1007,6 +1104,16 @@ def herd_corners(m, min_turn: float) -> np.ndarray:
     b = m.edge_normal[m.vertex_next_edge[idx]]
     cos = np.clip(np.einsum("ij,ij->i", a, b), -1.0, 1.0)
     return idx[cos <= math.cos(math.radians(min_turn)) + 1e-12]
+
+
+def _most_turn(closing: float, rod: float, l_min: float, t: float) -> float:
+    """The most a rod of length ``rod`` turns in ``t`` seconds at eq. (6)'s largest rate,
+    ``closing / L`` (``closing`` = V_p + V_e), the rod shortening at ``closing`` down to
+    ``l_min``: ``ln(rod / L(t))`` while it shortens, ``closing / l_min`` a second after."""
+    t_short = max(0.0, rod - l_min) / closing  # when it reaches l_min
+    if t <= t_short:
+        return math.log(rod / (rod - closing * t))
+    return math.log(rod / l_min) + closing * (t - t_short) / l_min
 
 
 def _row_norms(d: np.ndarray) -> np.ndarray:

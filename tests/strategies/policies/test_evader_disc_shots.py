@@ -108,3 +108,14 @@ def test_a_reach_margin_is_positive_only_where_no_orientation_in_reach_is_safe(e
         k = int(turn // tab.bin_width)
         reachable = [(b + j) % tab.n_bins for j in range(-k, k + 1)]
         assert tab.safe[rows[i], reachable].any() == (reach[i] <= 0.0), (q, reach[i])
+
+
+@pytest.mark.parametrize(("rod", "t"), [(5.8, 1.2), (5.8, 4.0), (2.0, 1.0), (3.0, 0.5)])
+def test_the_most_a_shortening_rod_turns_is_eq_6_s_largest_rate_integrated(rod, t):
+    # (V_p + V_e) / L(t), L shortening at V_p + V_e from `rod` down to L_min: the bound a
+    # two-leg shot takes off its margins for the first leg (V_p 1, V_e 0.2, L_min 2)
+    from strategies.policies.shooting import _most_turn
+
+    s = (np.arange(200_000) + 0.5) * t / 200_000
+    rate = 1.2 / np.maximum(2.0, rod - 1.2 * s)
+    assert _most_turn(1.2, rod, 2.0, t) == pytest.approx(rate.sum() * t / 200_000, rel=1e-6)

@@ -54,3 +54,20 @@ def unseen(monkeypatch):
     parameter combos and opponents, for replaying a benchmark episode in a test."""
     monkeypatch.syspath_prepend(str(BENCHMARKS))
     return importlib.import_module("unseen_worlds")
+
+
+def orbit_episode(unseen, world: str, max_cycles: int, start="safe"):
+    """The decomposition pursuer against the orbit at offset 0.25 (ccw, seed 101) on an
+    unseen-worlds ``world`` with combo 0's parameters, as unseen-p0 / fresh-p0 play it."""
+    from strategies.runner import run_episode
+
+    m, ov = unseen.pursuer_world(world, unseen.PURSUER_COMBOS[0])
+    return run_episode(
+        m,
+        "pursuer/decomposition",
+        unseen.make_opponent("evader/orbit:1:0.25"),
+        101,
+        max_cycles=max_cycles,
+        overrides=ov,
+        start=start,
+    )

@@ -16,7 +16,8 @@ import pytest
 from envs.maps import Map
 from envs.surveillance.config import EnvConfig
 from strategies.policies import make_policy
-from strategies.runner import build_env, run_episode
+from strategies.runner import build_env
+from tests.strategies.policies.conftest import orbit_episode
 
 
 def _pursuer(world: Map, rho: float = 0.5, body: float = 0.1):
@@ -44,16 +45,7 @@ def test_an_evader_circling_a_small_obstacle_is_held(unseen, world, seconds, bas
     # regrets by hindsight; before the walk's corners were probed, occluded at 14.0 s and
     # 17.0 s (the rod idled at a near target, then the best orientation jumped ~120
     # degrees ahead of it); held beyond that now
-    m, ov = unseen.pursuer_world(world, unseen.PURSUER_COMBOS[0])
-    r = run_episode(
-        m,
-        "pursuer/decomposition",
-        unseen.make_opponent("evader/orbit:1:0.25"),
-        101,
-        max_cycles=round(seconds / 0.1),
-        overrides=ov,
-        start="safe",
-    )
+    r = orbit_episode(unseen, world, round(seconds / 0.1))
     assert r.winner == "pursuer", (r.summary(), base_loss)
 
 

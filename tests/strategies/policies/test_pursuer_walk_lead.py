@@ -14,7 +14,7 @@ import pytest
 from envs.maps import Map
 from envs.surveillance.config import EnvConfig
 from strategies.policies import make_policy
-from strategies.runner import run_episode
+from tests.strategies.policies.conftest import orbit_episode
 
 # rand:convex:2005:3.5 (held-out, rho 0.5, L in [2, 4]) at 6 s of the orbit at 0.25 (ccw,
 # seed 101) as hindsight's pursuer (cell 0.02) played it: the evader has begun its lap
@@ -27,15 +27,8 @@ def test_a_lead_on_a_lap_is_kept(unseen):
     # before: the rod turned back 20 degrees to the decomposition's target and idled
     # 2 s while the lap turned the evader's heading 90 degrees; occluded 8.9 s on
     # (hindsight's pursuer holds 17.7 s on); held 13.6 s now
-    m, ov = unseen.pursuer_world("rand:convex:2005:3.5", unseen.PURSUER_COMBOS[0])
-    r = run_episode(
-        m,
-        "pursuer/decomposition",
-        unseen.make_opponent("evader/orbit:1:0.25"),
-        101,
-        max_cycles=125,
-        overrides=ov,
-        start={"pursuer": list(_P6), "evader": list(_E6)},
+    r = orbit_episode(
+        unseen, "rand:convex:2005:3.5", 125, start={"pursuer": list(_P6), "evader": list(_E6)}
     )
     assert r.winner == "pursuer", r.summary()
 
@@ -46,16 +39,7 @@ def test_a_lead_on_a_lap_is_kept(unseen):
 def test_a_lap_from_the_safe_start_lasts_longer(unseen, world, seconds):
     # the orbit losses of unseen-p0 and fresh-p0: occluded at 17.9 s and 8.4 s before,
     # at 20.9 s and 10.9 s now (hindsight: a pursuer holds 27.8 s on the first)
-    m, ov = unseen.pursuer_world(world, unseen.PURSUER_COMBOS[0])
-    r = run_episode(
-        m,
-        "pursuer/decomposition",
-        unseen.make_opponent("evader/orbit:1:0.25"),
-        101,
-        max_cycles=round(seconds / 0.1),
-        overrides=ov,
-        start="safe",
-    )
+    r = orbit_episode(unseen, world, round(seconds / 0.1))
     assert r.winner == "pursuer", r.summary()
 
 

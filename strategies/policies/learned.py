@@ -34,6 +34,7 @@ from envs.errors import InvalidConfigError, InvalidObservationError, SurveilValu
 from strategies.policies.base import BasePolicy
 from strategies.policies.learner_inputs import LearnerInputs, check_features
 from strategies.policies.model_files import check_model_input, read_provenance
+from strategies.policies.observe import finite_observation
 
 __all__ = [
     "SB3_ALGORITHMS",
@@ -363,7 +364,8 @@ class SB3Policy(BasePolicy):
         """
         if self.role is None:
             raise InvalidConfigError(f"policy {self.name!r}: call reset() before act()")
-        _check_finite(observation, self.name)  # NaN was torch's or int()'s ValueError
+        # NaN was torch's or int()'s ValueError
+        finite_observation(observation, f"{self.name}: observation")
         obs = np.asarray(observation)
         if self._inputs is not None:
             try:
@@ -380,29 +382,6 @@ class SB3Policy(BasePolicy):
             )
         action, _ = self.model.predict(obs, deterministic=self.deterministic)
         return np.clip(np.asarray(action, dtype=np.float32), -1.0, 1.0)
-
-
-def _check_finite(observation: Any, name: str) -> None:
-    """Refuse an observation that is not an array of finite real numbers, naming the
-    first bad entry (as :func:`strategies.policies.observe.read_state` does for the
-    analytic policies).
-
-    Raises:
-        InvalidObservationError: not numbers, or a NaN or infinite entry.
-    """
-    try:
-        values = np.asarray(observation, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InvalidObservationError(
-            f"{name}: observation: expected an array of real numbers, got "
-            f"{type(observation).__name__} {observation!r}"[:200]
-        ) from exc
-    if not np.all(np.isfinite(values)):
-        bad = np.flatnonzero(~np.isfinite(values.ravel()))
-        raise InvalidObservationError(
-            f"{name}: observation: expected finite values, got {values.ravel()[bad[0]]} at "
-            f"index {int(bad[0])} ({len(bad)} non-finite of {values.size})"
-        )
 
 
 def trained_observation(provenance: Mapping[str, Any] | None) -> dict[str, Any] | None:

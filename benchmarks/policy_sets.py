@@ -97,11 +97,14 @@ FRESH_WORLDS = " ".join(
 """32 random maps nobody had used (README: "On 32 random maps nobody had used")."""
 _HOLDS = "--seeds 8 --rho 0.5 --no-greedy"
 _HELDOUT_P = "--worlds @benchmarks/heldout_worlds_pursuer.txt"
-_BASE = "34fa4ca"
+_BASE = "8bef7db"
 """The commit every figure below holds at (all fifteen sets played there, compared per
+episode with 3765f76: fresh-p0 +1 (0fee8e2, the pursuer's lead on a lap round a small
+obstacle: rand:star:3007:3.0 against the herder), nothing lost; 37bf9d1's two-leg shots
+moved escape times only). Before: at 34fa4ca, compared per
 episode with 1283649: holds-bench +1, certified-e +2, nothing lost; played again at
 686fe46, the shooting evader's long-rod shots before any plan and reach margins: every
-episode's winner as at 34fa4ca, escape times moved). Before: all twelve
+episode's winner as at 34fa4ca, escape times moved; and at 3765f76. Before: all twelve
 sets were played at 94c5063;
 5b239ab's pursuer change (probes round a small obstacle an evader circles) changed only
 fresh-p0 (549 -> 552); 4d0ccce's (the way to room once a ride against a charge stalls)
@@ -114,10 +117,10 @@ cdb9eac's (a stalled fallback gives up its targets) and ddb7e92's (two guards on
 stall) were each played on all twelve (the evader's on the pursuer sets' shooting
 episodes) and, together, on the evader sets' episodes against the decomposition pursuer
 and the pursuer sets' against the shooting evader: no figure changed (ddb7e92)."""
-_FIXED = "34fa4ca"
+_FIXED = _BASE
 """Where the three sets of ``fixed_starts.py`` were last played (first at c427419, 1283649's
 policies: certified-e 310/312 there; certified-e grew to 468 episodes at ea81a89, played
-at 34c7663): the
+at 34c7663, 3765f76 and 8bef7db): the
 corner world's default starts (the reproduction report's episodes) and the referee's
 certified starts (``benchmarks/certified_starts.json``)."""
 
@@ -149,7 +152,7 @@ SETS: dict[str, PolicySet] = {
              f"unseen_worlds.py --role pursuer {_HELDOUT_P} --combos 1"),
         _set("heldout-p2", "ph2", "pursuer", "666/666", _BASE,
              f"unseen_worlds.py --role pursuer {_HELDOUT_P} --combos 2"),
-        _set("fresh-p0", "fresh_p0", "pursuer", "555/576", _BASE,
+        _set("fresh-p0", "fresh_p0", "pursuer", "556/576", _BASE,
              f"unseen_worlds.py --role pursuer --combos 0 --worlds {FRESH_WORLDS}"),
         _set("unseen-e", "eunseen", "evader", "1188/1189", _BASE,
              "unseen_worlds.py --role evader"),
@@ -161,7 +164,7 @@ SETS: dict[str, PolicySet] = {
              "fixed_starts.py --starts default --world corner --seeds 0-39"),
         _set("certified-p", "certp", "pursuer", "288/288", _FIXED,
              "fixed_starts.py --starts certified --role pursuer"),
-        _set("certified-e", "certe", "evader", "468/468", "34c7663",
+        _set("certified-e", "certe", "evader", "468/468", _FIXED,
              "fixed_starts.py --starts certified --role evader"),
     )
 }  # fmt: skip

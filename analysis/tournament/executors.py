@@ -160,6 +160,22 @@ def _die_with_parent(parent: int) -> None:
 _STOP_SIGNALS = {signal.SIGINT, signal.SIGTERM}
 
 
+def _one_torch_thread_after_fork() -> None:
+    """Keep torch to one thread in a worker forked from a driver that had used it.
+
+    A driver that had run torch on its OpenMP threads (a notebook, a suite, any caller
+    that trained or evaluated a model first) forks workers holding that thread team's
+    state without its threads: the worker's first parallel region (loading a model: its
+    weights' orthogonal init) waited for them for ever. A suite hung so in warm_up (no
+    time limit: no watch). One thread takes no team. A worker whose torch is imported
+    after the fork (a driver that never imported it, a spawned worker) keeps torch's own
+    default.
+    """
+    torch = sys.modules.get("torch")
+    if torch is not None and hasattr(torch, "set_num_threads"):
+        torch.set_num_threads(1)
+
+
 def _worker_main(conn: Connection, ctx: Context, parent: int, board: Board) -> None:
     # born with these blocked (see _Worker): the driver's handlers, which a forked worker
     # inherits, must never run here
@@ -168,6 +184,7 @@ def _worker_main(conn: Connection, ctx: Context, parent: int, board: Board) -> N
     if hasattr(signal, "pthread_sigmask"):
         signal.pthread_sigmask(signal.SIG_UNBLOCK, _STOP_SIGNALS)
     _die_with_parent(parent)
+    _one_torch_thread_after_fork()
     warm_up(ctx)  # before the first match's clock starts, as a Ray worker does
     while True:
         try:

@@ -378,6 +378,34 @@ def test_a_worker_loads_its_models_before_its_first_match():
     assert out.stdout.split() == ["False", "[True]", "True"], out.stderr
 
 
+def test_a_worker_forked_from_a_driver_that_ran_torch_loads_its_model(tmp_path):
+    # A suite hung for ever in a forked worker's warm_up: the driver (a pytest worker that
+    # had run torch on its OpenMP threads) forked it, and loading the model (its weights'
+    # orthogonal init, a parallel region) waited for the threads the fork left behind.
+    script = textwrap.dedent(
+        f"""
+        import torch
+        torch.set_num_threads(2)
+        torch.linalg.qr(torch.randn(600, 600))  # the driver's thread team is up
+        from analysis.tournament import Store, run_tournament, spec_from_dict
+        d = {{"maps": ["open_room"], "evaders": ["evader/random"], "seeds": 1,
+              "pursuers": [{{"model": "zoo:ppo_pursuer_vs_straight_open_room",
+                             "label": "ppo"}}], "env": {{"max_cycles": 5}}}}
+        s = run_tournament(spec_from_dict(d), {str(tmp_path / "s.sqlite")!r},
+                           backend="process", workers=1, progress=False)
+        with Store({str(tmp_path / "s.sqlite")!r}) as db:
+            print([r["status"] for r in db.rows(s.run_id)])
+        """
+    )
+    root = Path(__file__).resolve().parents[3]  # "-c" imports this checkout from its cwd
+    try:
+        out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                             cwd=root, timeout=120)  # fmt: skip
+    except subprocess.TimeoutExpired as exc:
+        pytest.fail(f"the forked worker hung loading its model: {exc}")
+    assert out.stdout.split() == ["['ok']"], out.stderr
+
+
 def test_a_model_is_named_in_its_matches_as_the_spec_names_it(tmp_path):
     # A forfeit of a model read "pursuer 'pursuer/sb3:/tmp/surveil-models-x9p3cwoz/50fd76c7
     # ...b5b.zip' failed at reset: ...": the worker's copy of the file, not the model. The

@@ -763,26 +763,30 @@ class DecompositionPursuer(BasePolicy):
                 self._clearance_at(ex - nx, ey - ny) - need,
             )
         # a lazy table: the two centres' nodes measured in one batch (the same values)
-        tab = self.table
-        ox, oy, h = float(tab.origin[0]), float(tab.origin[1]), tab.resolution
-        i = [round((ex + nx - ox) / h), round((ex - nx - ox) / h)]
-        j = [round((ey + ny - oy) / h), round((ey - ny - oy) / h)]
-        on = [0 <= a < tab.shape[0] and 0 <= b < tab.shape[1] for a, b in zip(i, j, strict=True)]
+        nodes = [self._node_at(ex + nx, ey + ny), self._node_at(ex - nx, ey - ny)]
         d = [0.0, 0.0]
-        if any(on):
-            at = [k for k in (0, 1) if on[k]]
-            got = self._memo_clearances(np.array([i[k] for k in at]), np.array([j[k] for k in at]))
-            for k, v in zip(at, got.tolist(), strict=True):
+        at = [k for k in (0, 1) if nodes[k] is not None]
+        if at:
+            i, j = (np.array([nodes[k][a] for k in at]) for a in (0, 1))
+            for k, v in zip(at, self._memo_clearances(i, j).tolist(), strict=True):
                 d[k] = v
         return d[0] - need, d[1] - need
 
-    def _clearance_at(self, x: float, y: float) -> float:
-        """Wall distance at the table's grid node nearest ``(x, y)`` (0 off the grid)."""
+    def _node_at(self, x: float, y: float) -> tuple[int, int] | None:
+        """The table's grid node nearest ``(x, y)``, None off the grid."""
         tab = self.table
         i = round((x - float(tab.origin[0])) / tab.resolution)
         j = round((y - float(tab.origin[1])) / tab.resolution)
         if not (0 <= i < tab.shape[0] and 0 <= j < tab.shape[1]):
+            return None
+        return i, j
+
+    def _clearance_at(self, x: float, y: float) -> float:
+        """Wall distance at the table's grid node nearest ``(x, y)`` (0 off the grid)."""
+        node = self._node_at(x, y)
+        if node is None:
             return 0.0
+        i, j = node
         if self._clear is not None:
             return float(self._clear[i, j])
         return self._memo_clearance(i, j)

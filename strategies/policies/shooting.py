@@ -326,11 +326,8 @@ class ShootingEvader(BasePolicy):
         n = len(rays)
         rows = np.concatenate([ray_rows, corner_rows])
         margin, branch = self._margins(e, theta, np.concatenate([rays, corners]), rows, rod)
-        if len(self._banned):
-            # targets given up after a stall (_fallback_stalled), and points near them
-            near = np.concatenate([rays, corners])[:, None, :] - self._banned[None, :, :]
-            gone = np.einsum("ijk,ijk->ij", near, near).min(axis=1) <= self._ban_radius**2
-            margin[gone] = -np.inf
+        # targets given up after a stall (_fallback_stalled), and points near them
+        margin[self._near_banned(np.concatenate([rays, corners]))] = -np.inf
         if rod is not None:
             return self._disc_candidate(e, rays, corners, margin, branch)
         ex, ey = float(e[0]), float(e[1])
@@ -708,6 +705,14 @@ class ShootingEvader(BasePolicy):
             return c.v_evader * (-s if d[1] - d[0] > _PRESSING * h else s)
         return c.v_evader * u
 
+    def _near_banned(self, points: np.ndarray) -> np.ndarray:
+        """Per point (rows of ``points``), whether it lies within the ban radius of a
+        target given up after a stall (:meth:`_fallback_stalled`)."""
+        if not len(self._banned):
+            return np.zeros(len(points), dtype=bool)
+        near = points[:, None, :] - self._banned[None, :, :]
+        return np.einsum("ijk,ijk->ij", near, near).min(axis=1) <= self._ban_radius**2
+
     def _via_corner(
         self, e: np.ndarray, theta: float, p: np.ndarray, rod: float
     ) -> np.ndarray | None:
@@ -743,10 +748,8 @@ class ShootingEvader(BasePolicy):
             q0 = pts[i]
             if dist[i] <= step or self._corner_rows[i] < 0:
                 continue
-            if len(self._banned):
-                gone = self._banned - q0
-                if float(np.einsum("ij,ij->i", gone, gone).min()) <= self._ban_radius**2:
-                    continue
+            if self._near_banned(q0[None])[0]:
+                continue
             if not self.kernel.line_of_sight((ex, ey), (float(q0[0]), float(q0[1]))):
                 continue
             if not self._disc_reaches(e, q0, floor):
@@ -759,10 +762,7 @@ class ShootingEvader(BasePolicy):
             margin = margin - turn1
             reach_margin, _ = self._reach_margins(q0, theta, cand, rows, rod, p=p, lead=t1)
             margin = np.maximum(margin, reach_margin)
-            if len(self._banned):
-                near = cand[:, None, :] - self._banned[None, :, :]
-                gone = np.einsum("ijk,ijk->ij", near, near).min(axis=1) <= self._ban_radius**2
-                margin[gone] = -np.inf
+            margin[self._near_banned(cand)] = -np.inf
             if not len(margin) or margin.max() <= 0.0:
                 continue
             floor1 = min(c.body_radius, float(self.map.distance_to_walls(q0[None])[0]))

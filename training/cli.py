@@ -247,7 +247,8 @@ def summary(result: TrainResult) -> str:
     head = (
         f"{c.algo.upper()} {c.role} vs {_opponents(c)} on {', '.join(c.maps)}: "
         f"{result.timesteps} timesteps"
-        f" in {result.wall_time:.1f} s"
+        # a finished run returned as is was "71680 timesteps in 0.0 s"
+        + (" (already trained)" if result.already_trained else f" in {result.wall_time:.1f} s")
         + (f" (resumed from {result.resumed_from.name})" if result.resumed_from else "")
         + f" -> {result.model_path}"
     )

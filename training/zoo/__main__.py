@@ -87,7 +87,10 @@ def _main(argv: list[str] | None) -> int:
             print(f"dagger: {r.samples[-1]} labelled states in {r.wall_seconds:.1f} s "
                   f"-> {r.model_path}")  # fmt: skip
             return 0
-        print(f"trained {r.timesteps} timesteps in {r.wall_time:.1f} s -> {r.model_path}")
+        if r.already_trained:  # was "trained 151552 timesteps in 0.0 s"
+            print(f"already trained: {r.timesteps} timesteps -> {r.model_path}")
+        else:
+            print(f"trained {r.timesteps} timesteps in {r.wall_time:.1f} s -> {r.model_path}")
         if r.evaluation is not None:
             print(_line(r.evaluation))
     else:

@@ -72,6 +72,7 @@ from strategies.policies.base import (
     BasePolicy,
     Snapshot,
     count_param,
+    distance_ceiling,
     distance_target,
     nonnegative_param,
     positive_param,
@@ -143,12 +144,15 @@ class DecompositionPursuer(BasePolicy):
         rays: probe rays around the evader.
         probe_every: use every k-th grid sample along a ray as a probe.
         hysteresis: weight of the rotation needed to reach a target, in units of V.
-        distance_gain: rate (1/s) of the correction of L toward L_min.
+        distance_gain: rate (1/s) of the correction of L toward L_min; at most
+            ``1 / dt`` is used (a larger rate corrects more than the error in one step).
         range_margin: extra distance held above the minimal one, as a fraction of
             ``L_max - L_min`` (default 0: ride at L_min plus a one-step buffer, as the
             paper). A margin trades some of the rod's freedom (a longer rod has fewer
             free orientations, Prop. 3) for slack against imprecise execution, e.g. for
-            a learner imitating this policy.
+            a learner imitating this policy. The distance held is at most L_max less
+            the one-step buffer (``base.distance_ceiling``): with ``range_margin`` 1 it
+            aimed beyond L_max.
         turn_rate: the rotation rate the evader is assumed to impose (eq. 6, Sec. 6.1):
             ``"both"``, ``(V_p / L) sqrt(1 - rho^2)``, the least rate when the rod may
             turn either way; ``"one"``, ``(V_p / L)(1 - rho)``, the least rate in one
@@ -213,7 +217,16 @@ class DecompositionPursuer(BasePolicy):
 
     def _reset(self) -> None:
         c = self.config
-        self.L_target = distance_target(c) + self.range_margin * (c.l_max - c.l_min)
+        # no farther than the buffer below L_max (range_margin 1 aimed at L_max plus the
+        # buffer; a band narrower than twice the buffer: at its middle, distance_target)
+        self._L_ceiling = distance_ceiling(c)
+        margin = self.range_margin * (c.l_max - c.l_min)
+        self.L_target = min(distance_target(c) + margin, self._L_ceiling)
+        # a correction of gain * (L - L_target) held for dt moves L by gain * dt times the
+        # error: past 1 it overshoots, past 2 the error grows step by step (the default
+        # gain 3 at dt 1: 26 of 48 valid starts lost, too close and too far by turns;
+        # at 1 / dt: 3)
+        self._gain = min(self.distance_gain, 1.0 / c.dt)
         # the pursuer's disc keeps its centre body_radius off the walls, so the rod tip
         # meets a wall as if the rod were that much longer (Prop. 3: fewer free arcs)
         self.table_length = round(self.L_target + c.body_radius, 6)
@@ -1360,8 +1373,8 @@ class DecompositionPursuer(BasePolicy):
         # pursuer_velocity_holding_range without their argument checks)
         hi, lo = _theta_dot_rates(alpha - snap.theta, L, float(c.v_pursuer), rate)
         hi, lo = float(hi), float(lo)
-        L_target = self.L_target + self._wall_push(snap)
-        closing = min(self.distance_gain * (L - L_target), self.CLOSING * c.v_pursuer)
+        L_target = min(self.L_target + self._wall_push(snap), self._L_ceiling)
+        closing = min(self._gain * (L - L_target), self.CLOSING * c.v_pursuer)
         if closing > 0.0:
             # the rod is longer than the table's (fewer free orientations, Prop. 3: the
             # table may call an orientation clear that is not): keep part of the speed
@@ -1398,7 +1411,7 @@ class DecompositionPursuer(BasePolicy):
             L,
             L_target,
             float(c.v_pursuer),
-            self.distance_gain,
+            self._gain,
         )
         return cmd.velocity
 

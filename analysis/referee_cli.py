@@ -71,7 +71,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
         help="label the start with the pursuer at (PX, PY) and the evader at (EX, EY)",
     )
     p.add_argument("--sample", type=integer(1), help="print this many certified starts")
-    p.add_argument("--kind", choices=["pursuer", "evader", "unknown"], default="pursuer")
+    p.add_argument(
+        "--kind",
+        choices=["pursuer", "evader", "unknown"],
+        default="pursuer",
+        help="the label of the starts --sample prints (default: pursuer)",
+    )
     p.add_argument("--seed", type=integer(0), default=0, help="seed of --sample (>= 0)")
     p.add_argument(
         "--estimate",

@@ -277,16 +277,15 @@ class DecompositionPursuer(BasePolicy):
         lut[NO_PATH] = 2.0 * math.pi / self.omega
         self._way_lut = lut.astype(np.float32)
         nb = self.table.n_bins
-        # the eager table's fast path (:meth:`_probe_values`) takes the largest rotation
-        # over the probes at one radius before the lookup: exact when each lookup is
-        # non-decreasing over the counts a table holds (0 .. n_bins // 2 the shorter way
-        # round, 0 .. n_bins - 1 one way, or NO_PATH), which it is unless rounding says
-        # otherwise
+        # :meth:`_probe_values` takes the largest rotation over the probes at one radius
+        # before the lookup: exact when each lookup is non-decreasing over the counts a
+        # table holds (0 .. n_bins // 2 the shorter way round, 0 .. n_bins - 1 one way, or
+        # NO_PATH), which it is unless rounding says otherwise; on an eager table with
+        # one lookup of every ray sample (the fast path)
         held = self._turn_lut[np.r_[np.arange(nb // 2 + 1), NO_PATH]]
         way = self._way_lut[np.r_[np.arange(nb), NO_PATH]]
-        self._fast = isinstance(self.table, SafetyTable) and bool(
-            np.all(np.diff(held) >= 0) and np.all(np.diff(way) >= 0)
-        )
+        self._monotone = bool(np.all(np.diff(held) >= 0) and np.all(np.diff(way) >= 0))
+        self._fast = isinstance(self.table, SafetyTable) and self._monotone
         # the penalty of turning k bins, as _target's score needs it (same float ops)
         self._turn_penalty = self.hysteresis * np.arange(nb + 1.0) * self._bw / self.omega
         self.last_target: int | None = None
@@ -628,10 +627,16 @@ class DecompositionPursuer(BasePolicy):
             return np.full(tab.n_bins, self.horizon)
         probes = points.reshape(n_rays, n_r, 2)[:, cols][sub_ok]
         r = tab.rows(probes, *ahead)  # only the probes' orientations are looked up
-        t_e = np.broadcast_to(t_e, sub_ok.shape)[sub_ok]
         # lut: seconds to turn by a number of bins; a safe bin (0) never threatens
         needs = tab.need if not sense else (tab.ccw if sense > 0 else tab.cw)
-        v = t_e[:, None] - (self._way_lut if sense else self._turn_lut)[needs[r]]
+        lut = self._way_lut if sense else self._turn_lut
+        if self._monotone:  # the largest rotation per radius, as the fast path
+            need = np.zeros((*sub_ok.shape, tab.n_bins), dtype=needs.dtype)
+            need[sub_ok] = needs[r]
+            v = t_e[:, None] - lut[need.max(axis=0)]
+            return v.min(axis=0)
+        t_e = np.broadcast_to(t_e, sub_ok.shape)[sub_ok]
+        v = t_e[:, None] - lut[needs[r]]
         return v.min(axis=0)
 
     def _target(self, snap: Snapshot) -> tuple[float, int]:

@@ -307,7 +307,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_maps)
 
     p = sub.add_parser("policies", help="list the registered policies")
-    p.add_argument("--role", choices=["pursuer", "evader"], default=None)
+    p.add_argument(
+        "--role",
+        choices=["pursuer", "evader"],
+        default=None,
+        help="list only this role's policies",
+    )
     p.set_defaults(func=_cmd_policies)
 
     p = sub.add_parser("play", help="play one episode and write its replay (the main job)")
@@ -366,7 +371,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_analyze)
 
     p = sub.add_parser("figure", help="draw the paper's optimal-control figures")
-    p.add_argument("name", choices=["shooting", "greedy", "tractrix"])
+    p.add_argument(
+        "name",
+        choices=["shooting", "greedy", "tractrix"],
+        help="shooting: optimal escapes (Fig. 11); greedy: greedy evasion (Fig. 12); "
+        "tractrix: the tractrix (Fig. 14)",
+    )
     p.add_argument("--params", help="parameters as JSON, e.g. '{\"rho\": 0.5}'")
     p.add_argument(
         "--out",

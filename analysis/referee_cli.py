@@ -71,7 +71,12 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
         help="label the start with the pursuer at (PX, PY) and the evader at (EX, EY)",
     )
     p.add_argument("--sample", type=integer(1), help="print this many certified starts")
-    p.add_argument("--kind", choices=["pursuer", "evader", "unknown"], default="pursuer")
+    p.add_argument(
+        "--kind",
+        choices=["pursuer", "evader", "unknown"],
+        default="pursuer",
+        help="the label of the starts --sample prints (default: pursuer)",
+    )
     p.add_argument("--seed", type=integer(0), default=0, help="seed of --sample (>= 0)")
     p.add_argument(
         "--estimate",
@@ -247,6 +252,16 @@ def _say_if_long(cfg, args: argparse.Namespace) -> None:
         if longer
         else "; a smaller --cells-per-lmin is faster"
     )
+    if not sizes:  # both bounds cached: fallback_size says the default certified nothing
+        print(
+            f"{cfg.map.name}: the default pursuer lattice certifies no state (cached): "
+            f"solving it once more one cell finer ({retry.describe()}, a step of "
+            f"{retry.tau:g} s, {retry.moves} moves; --no-pursuer-fallback skips it): up to "
+            f"about {duration(retry.seconds)} (an upper bound, estimated before the solve)",
+            file=sys.stderr,
+            flush=True,
+        )
+        return
     more = ""
     if retry is not None:  # afac520's fallback: a second pursuer solve when the first is 0 %
         more = (

@@ -117,6 +117,13 @@ cdb9eac's (a stalled fallback gives up its targets) and ddb7e92's (two guards on
 stall) were each played on all twelve (the evader's on the pursuer sets' shooting
 episodes) and, together, on the evader sets' episodes against the decomposition pursuer
 and the pursuer sets' against the shooting evader: no figure changed (ddb7e92)."""
+_FRESH_E = "--worlds @benchmarks/fresh_worlds_evader.txt --rhos 0.2 0.3 0.5 0.8 --seed-base 6000"
+"""fresh-e, the evader's held-out set made after the shooting evader's latest changes: 40
+world labels nobody had used (``benchmarks/fresh_worlds_evader.txt``: two_rooms and office
+transformed, junctions, random maps of seeds 4501-4510, 4604-4605, floor plans 9-10), rho
+0.2-0.8 (0.2 in no other drawn set), seeds 6000-6999 (the other evader sets draw 100-1099)."""
+_FRESH_E_AT = "791668b"
+"""Where fresh-e was first played (its policies behave as 8bef7db's)."""
 _FIXED = _BASE
 """Where the three sets of ``fixed_starts.py`` were last played (first at c427419, 1283649's
 policies: certified-e 310/312 there; certified-e grew to 468 episodes at ea81a89, played
@@ -158,6 +165,8 @@ SETS: dict[str, PolicySet] = {
              "unseen_worlds.py --role evader"),
         _set("heldout-e", "eheldout", "evader", "776/779", _BASE,
              "unseen_worlds.py --role evader --worlds @benchmarks/heldout_worlds_evader.txt"),
+        _set("fresh-e", "fresh_e", "evader", "1130/1139", _FRESH_E_AT,
+             f"unseen_worlds.py --role evader {_FRESH_E}"),
         _set("escapes-bench", "bench3", "evader", "512/512", _BASE,
              "evader_escapes.py --seeds 4 --simple-seeds 0"),
         _set("corner-default", "cdef", "pursuer", "145/160", _FIXED,

@@ -45,12 +45,19 @@ without editing this file; the role's Prop. 2 rule still skips the wrong ones):
 
 In the evader role such a world plays at each ``--l-mins`` (default 1 and 2); its
 episodes are drawn from a generator seeded by (52, the label, L_min), so they do not
-depend on the other worlds selected.
+depend on the other worlds selected. ``--rhos R ...`` draws their rho from R instead of
+the default set's (0.3 0.5 0.8 0.95), each with L_max / L_min 2 or 1.5 (``--combos``
+then indexes these pairs), and ``--seed-base B`` their seeds from B to B + 999 instead
+of 100 to 1099 (a fresh set's seeds, none the default set's); a row drawn so records
+both, and its replay command names them.
 
 A held-out set of such worlds ships beside this file, one label a line, never used to
 develop the policies (seeds 2001-2026, floor plans 6-8, other transforms and rooms):
 ``--worlds @benchmarks/heldout_worlds_pursuer.txt`` (37 labels) and
-``@benchmarks/heldout_worlds_evader.txt`` (32).
+``@benchmarks/heldout_worlds_evader.txt`` (32); and a fresh evader set made later,
+``@benchmarks/fresh_worlds_evader.txt`` (40: random seeds 4501-4510, 4604-4605, floor
+plans 9-10, other transforms and junctions; played with ``--rhos 0.2 0.3 0.5 0.8
+--seed-base 6000``, set ``fresh-e`` of ``benchmarks/policy_sets.py``).
 
 Body radius 0.1 (times the scale). Episodes are appended to ``--results`` (JSON lines)
 as they finish; a rerun plays only what the file lacks (``--play-again``: every selected
@@ -93,7 +100,8 @@ Usage::
     python benchmarks/unseen_worlds.py --role pursuer|evader [--worlds W ...]
         [--combos I ...] [--opponents O ...] [--seeds S ...] [--results F.jsonl]
         [--workers 1] [--max-cycles 600] [--k 8] [--draws 2] [--l-mins L ...]
-        [--referee CPL] [--hindsight CELL] [--rotation-bound]
+        [--rhos R ...] [--seed-base B] [--referee CPL] [--hindsight CELL]
+        [--rotation-bound]
 
 ``--combos`` indexes the role's combos (``--help`` lists them). ``--seeds`` is the
 seed list in the pursuer role and a filter on the drawn seeds in the evader role. On one
@@ -186,8 +194,19 @@ PURSUERS = ["pursuer/corner_rounding", "pursuer/decomposition", "pursuer/greedy"
             "pursuer/random", "pursuer/referee", "pursuer/tractrix", "pursuer/wall_following",
             "still", "central", "shadow", "mirror", "greedy g1 t.6", "greedy g12 t.3"]  # fmt: skip
 # (rho, L_max / L_min), one drawn per episode
-EVADER_COMBOS = [(rho, ratio) for rho in (0.3, 0.5, 0.8, 0.95) for ratio in (2.0, 1.5)]
+EVADER_RHOS, EVADER_RATIOS = (0.3, 0.5, 0.8, 0.95), (2.0, 1.5)
+EVADER_COMBOS = [(rho, ratio) for rho in EVADER_RHOS for ratio in EVADER_RATIOS]
 DRAW_SEED = 52
+SEED_BASE = 100
+"""The evader role's drawn seeds are SEED_BASE + 0..999 (``--seed-base``: other worlds')."""
+
+
+def evader_combos(rhos=None) -> list[tuple[float, float]]:
+    """The (rho, L_max / L_min) pairs the evader role draws from: :data:`EVADER_COMBOS`,
+    or with ``rhos`` (``--rhos``) each of them with each ratio of :data:`EVADER_RATIOS`."""
+    if rhos is None:
+        return EVADER_COMBOS
+    return [(float(rho), ratio) for rho in rhos for ratio in EVADER_RATIOS]
 
 
 def _rotm(rot: float, scale: float) -> np.ndarray:
@@ -381,16 +400,18 @@ def pursuer_jobs(worlds, combos, opponents, seeds) -> list[tuple]:
     ]
 
 
-def _draws(w: str, lu: float, junction: bool, rng, draws: int) -> list[tuple]:
+def _draws(w: str, lu: float, junction: bool, rng, draws: int, combos=EVADER_COMBOS,
+           seed_base: int = SEED_BASE) -> list[tuple]:  # fmt: skip
     """One world's jobs at one L_min: ``draws`` episodes per pursuer (the referee, which
-    plays only on junctions, one), each with a drawn (rho, ratio) and seed."""
+    plays only on junctions, one), each with a (rho, ratio) drawn from ``combos`` and a
+    seed from ``seed_base`` + 0..999."""
     jobs = []
     for p in PURSUERS:
         if p == "pursuer/referee" and not junction:
             continue
         for _ in range(draws if p != "pursuer/referee" else 1):
-            rho, ratio = EVADER_COMBOS[int(rng.integers(len(EVADER_COMBOS)))]
-            jobs.append(("evader", w, [rho, ratio, lu], p, 100 + int(rng.integers(1000))))
+            rho, ratio = combos[int(rng.integers(len(combos)))]
+            jobs.append(("evader", w, [rho, ratio, lu], p, seed_base + int(rng.integers(1000))))
     return jobs
 
 
@@ -404,10 +425,12 @@ def evader_jobs(draws: int) -> list[tuple]:
     ]
 
 
-def other_evader_jobs(worlds, l_mins, draws: int) -> list[tuple]:
+def other_evader_jobs(worlds, l_mins, draws: int, rhos=None,
+                      seed_base: int = SEED_BASE) -> list[tuple]:  # fmt: skip
     """Evader-role jobs of worlds outside the default set, at each L_min: the same draws
     as the default set's, from a generator seeded by (52, the label, L_min) so each world's
-    episodes do not depend on the others selected."""
+    episodes do not depend on the others selected; with ``rhos``, the rho of each from
+    them (:func:`evader_combos`), and the seeds from ``seed_base`` + 0..999."""
     return [
         job
         for w in worlds
@@ -418,6 +441,8 @@ def other_evader_jobs(worlds, l_mins, draws: int) -> list[tuple]:
             bool(_JUNCTION.fullmatch(w)),
             np.random.default_rng([DRAW_SEED, zlib.crc32(w.encode()), round(1000 * lu)]),
             draws,
+            evader_combos(rhos),
+            seed_base,
         )
     ]
 
@@ -426,6 +451,9 @@ MAX_CYCLES, K = 600, 8.0
 """The default horizons: the pursuer role's in steps, the evader role's in D / V_e."""
 
 job_max_cycles, job_k = MAX_CYCLES, K  # the horizons, set by main (and in each worker)
+job_draw: dict = {}
+"""How this run drew the other worlds' evader episodes when not as the default set
+(``{"rhos": [...], "seed_base": B}``, either alone): each such row records it."""
 
 
 def _horizon(role: str) -> float:
@@ -448,9 +476,9 @@ def row_key(row) -> str:
                              horizon])  # fmt: skip
 
 
-def _init(max_cycles: int, k: float) -> None:
-    global job_max_cycles, job_k
-    job_max_cycles, job_k = max_cycles, k
+def _init(max_cycles: int, k: float, draw: dict | None = None) -> None:
+    global job_max_cycles, job_k, job_draw
+    job_max_cycles, job_k, job_draw = max_cycles, k, dict(draw or {})
 
 
 def play(job) -> dict:
@@ -458,6 +486,8 @@ def play(job) -> dict:
     role, w, combo, opponent, seed = job
     row = {"role": role, "world": w, "combo": combo, "opponent": opponent, "seed": seed,
            "horizon": _horizon(role)}  # fmt: skip
+    if role == "evader" and w not in EVADER_NAMES:
+        row.update(job_draw)  # its replay command draws the episodes so again
     t0 = time.perf_counter()
     try:
         if role == "pursuer":
@@ -504,14 +534,21 @@ def select(args) -> list[tuple]:
         jobs = pursuer_jobs(args.worlds or PURSUER_WORLDS, combos, args.opponents or EVADERS,
                             args.seeds or [101])  # fmt: skip
     else:
-        combos = args.combos and [EVADER_COMBOS[c] for c in args.combos]
+        rhos, seed_base = getattr(args, "rhos", None), getattr(args, "seed_base", None)
+        combos = args.combos and [evader_combos(rhos)[c] for c in args.combos]
         others = [w for w in args.worlds or [] if w not in EVADER_NAMES]
         l_mins = getattr(args, "l_mins", None)
         jobs = [
             (role, w, combo, opponent, seed)
             for role, w, combo, opponent, seed in [
                 *evader_jobs(args.draws),
-                *other_evader_jobs(others, l_mins or [1.0, 2.0], args.draws),
+                *other_evader_jobs(
+                    others,
+                    l_mins or [1.0, 2.0],
+                    args.draws,
+                    rhos,
+                    SEED_BASE if seed_base is None else seed_base,
+                ),
             ]
             if (not args.worlds or w in args.worlds)
             and (not l_mins or combo[2] in l_mins)
@@ -538,10 +575,10 @@ def select(args) -> list[tuple]:
     return out
 
 
-def _combo_index(role: str, combo) -> int:
+def _combo_index(role: str, combo, rhos=None) -> int:
     if role == "pursuer":
         return PURSUER_COMBOS.index(tuple(combo))
-    return EVADER_COMBOS.index(tuple(combo[:2]))
+    return evader_combos(rhos).index(tuple(combo[:2]))
 
 
 def _shell_word(label: str) -> str:
@@ -555,13 +592,18 @@ def replay_command(row, results: str = "replay.jsonl") -> str:
     pursuer = row["role"] == "pursuer"
     other = not pursuer and row["world"] not in EVADER_NAMES
     l_min = f" --l-mins {row['combo'][2]:g}" if other else ""
+    if other and "rhos" in row:
+        l_min += " --rhos " + " ".join(f"{rho:g}" for rho in row["rhos"])
+    if other and "seed_base" in row:
+        l_min += f" --seed-base {row['seed_base']}"
     horizon = row.get("horizon", MAX_CYCLES if pursuer else K)
     if horizon != (MAX_CYCLES if pursuer else K):
         l_min += f" --max-cycles {horizon}" if pursuer else f" --k {horizon:g}"
     return (
         f"python benchmarks/unseen_worlds.py --role {row['role']} "
         f"--worlds {_shell_word(row['world'])} "
-        f"--combos {_combo_index(row['role'], row['combo'])} --opponents '{row['opponent']}' "
+        f"--combos {_combo_index(row['role'], row['combo'], row.get('rhos'))} "
+        f"--opponents '{row['opponent']}' "
         f"--seeds {row['seed']}{l_min} --results {results} --play-again"
     )
 
@@ -808,6 +850,13 @@ def main(argv=None) -> int:
     ap.add_argument("--l-mins", nargs="+", type=real(0), help="evader role: the L_min (before "
                     "scaling) of worlds outside the default set (1 2), and a filter on the "
                     "default set's")  # fmt: skip
+    ap.add_argument("--rhos", nargs="+", type=real(0), metavar="R", help="evader role: the "
+                    "rho values drawn for worlds outside the default set (default 0.3 0.5 "
+                    "0.8 0.95), each with L_max / L_min 2 or 1.5; --combos indexes these "
+                    "pairs")  # fmt: skip
+    ap.add_argument("--seed-base", type=integer(0), metavar="B", help="evader role: the "
+                    "seeds drawn for worlds outside the default set are B + 0..999 "
+                    f"(default {SEED_BASE})")  # fmt: skip
     ap.add_argument(
         "--max-cycles", type=integer(1), default=MAX_CYCLES, help="pursuer role: horizon in steps"
     )
@@ -835,6 +884,17 @@ def main(argv=None) -> int:
         ap.error("--hindsight: the pursuer role only (it labels the pursuer's losses)")
     if args.rotation_bound and args.role != "pursuer":
         ap.error("--rotation-bound: the pursuer role only (it labels the pursuer's losses)")
+    draw = {"rhos": args.rhos, "seed_base": args.seed_base}
+    draw = {k: v for k, v in draw.items() if v is not None}
+    for option in draw:
+        flag = "--" + option.replace("_", "-")
+        if args.role != "evader":
+            ap.error(f"{flag}: the evader role only (it draws the evader role's episodes)")
+        defaults = sorted(set(args.worlds or EVADER_NAMES) & set(EVADER_NAMES))
+        if defaults:
+            ap.error(f"{flag}: draws the episodes of worlds outside the default set; the "
+                     "default set's draws are fixed, and --worlds selects its "
+                     f"{', '.join(defaults)}")  # fmt: skip
     for name in args.worlds or []:
         known = PURSUER_WORLDS if args.role == "pursuer" else EVADER_NAMES
         if name not in known:
@@ -851,19 +911,18 @@ def main(argv=None) -> int:
             make_opponent(label)
         except ValueError as exc:  # the project's errors subclass ValueError
             ap.error(f"--opponents: {label!r} is no opponent ({exc})")
-    combos = PURSUER_COMBOS if args.role == "pursuer" else EVADER_COMBOS
+    combos = PURSUER_COMBOS if args.role == "pursuer" else evader_combos(args.rhos)
     if any(not 0 <= c < len(combos) for c in args.combos or []):
-        ap.error(f"--combos: indices 0-{len(combos) - 1}")
+        ap.error(f"--combos: indices 0-{len(combos) - 1} ({combos})")
     results = args.results or f"out/unseen_worlds_{args.role}.jsonl"
     print(f"load average: {os.getloadavg()}")
     jobs = select(args)
-    _init(args.max_cycles, args.k)  # before the keys: they name the horizon
+    _init(args.max_cycles, args.k, draw)  # before the keys: they name the horizon
     done = episode_rows.read(results, row_key)
     todo = jobs if args.play_again else [j for j in jobs if job_key(j) not in done]
     print(f"{len(jobs)} episodes selected, {len(todo)} to play, results in {results}")
-    play_rows(
-        todo, play, results, done, row_key, _won, args.workers, _init, (args.max_cycles, args.k)
-    )
+    play_rows(todo, play, results, done, row_key, _won, args.workers, _init,
+              (args.max_cycles, args.k, draw))  # fmt: skip
     played = [done[job_key(j)] for j in jobs]
     if played:
         report(played, args.referee, args.hindsight, args.max_cycles, args.rotation_bound)

@@ -205,6 +205,50 @@ def test_a_fresh_evader_world_draws_its_own_episodes(unseen, tmp_path, capsys) -
          "seed": 101})  # fmt: skip
 
 
+def test_rhos_and_a_seed_base_draw_a_fresh_set_s_episodes_and_replay_them(
+    unseen, tmp_path, capsys, monkeypatch
+) -> None:
+    """``--rhos`` and ``--seed-base`` (fresh-e: rho 0.2 is in no default draw, seeds from
+    6000): the other worlds' draws take their rho from them and their seeds from the base,
+    the default arguments draw as before, each row records how it was drawn and its replay
+    command plays the same episode; the default set's draws are fixed (refused)."""
+    world = ["tee_w1.5a3.6"]
+    rhos = [0.2, 0.3, 0.5, 0.8]
+    fresh = unseen.other_evader_jobs(world, [1.0, 2.0], 2, rhos, 6000)
+    assert {j[2][0] for j in fresh} == set(rhos) and {j[2][1] for j in fresh} == {2.0, 1.5}
+    assert all(6000 <= j[4] < 7000 for j in fresh)
+    default = unseen.other_evader_jobs(world, [1.0, 2.0], 2)
+    assert default == unseen.other_evader_jobs(world, [1.0, 2.0], 2, unseen.EVADER_RHOS, 100)
+    assert {j[2][0] for j in default} <= set(unseen.EVADER_RHOS)
+    assert all(100 <= j[4] < 1100 for j in default)
+    out = tmp_path / "f.jsonl"
+    argv = ["--role", "evader", "--worlds", *world, "--opponents", "still", "--l-mins", "2",
+            "--rhos", "0.2", "--seed-base", "6000", "--results", str(out)]  # fmt: skip
+    assert unseen.main(argv) == 0
+    row = _rows(out)[-1]  # (2 draws)
+    assert (row["combo"][0], row["rhos"], row["seed_base"]) == (0.2, [0.2], 6000)
+    assert 6000 <= row["seed"] < 7000 and row["winner"] == "evader"
+    words = shlex.split(unseen.replay_command({**row, "winner": "pursuer"}))
+    index = [(0.2, 2.0), (0.2, 1.5)].index(tuple(row["combo"][:2]))  # into --rhos's pairs
+    assert words[words.index("--combos") + 1] == str(index)
+    assert " --rhos 0.2 --seed-base 6000 " in shlex.join(words)
+    monkeypatch.chdir(tmp_path)
+    capsys.readouterr()
+    assert unseen.main(words[2:]) == 0
+    assert "1 episodes selected, 1 to play" in capsys.readouterr().out
+    (again,) = _rows(tmp_path / "replay.jsonl")
+    assert {k: again[k] for k in ("combo", "seed", "start", "t", "steps")} == {
+        k: row[k] for k in ("combo", "seed", "start", "t", "steps")}  # fmt: skip
+    for role, worlds, says in [
+        ("evader", ["--worlds", "tee_w1.0"], "--rhos: draws the episodes of worlds outside"),
+        ("evader", [], "--worlds selects its floor_plan:3"),
+        ("pursuer", ["--worlds", "corner~rot0.37"], "--rhos: the evader role only"),
+    ]:
+        with pytest.raises(SystemExit) as exc:
+            unseen.main(["--role", role, *worlds, "--rhos", "0.2", "--results", str(out)])
+        assert exc.value.code == 2 and says in capsys.readouterr().err
+
+
 def test_a_replay_command_plays_its_episode_each_time(unseen, tmp_path, capsys, monkeypatch):
     """A loss's replay command, run as printed, plays the episode at its horizon every
     time: a second run (after a change of the code) read the first one's row from
@@ -225,15 +269,24 @@ def test_a_replay_command_plays_its_episode_each_time(unseen, tmp_path, capsys, 
     assert [(r["horizon"], r["steps"], r["winner"]) for r in replays] == [(40, 40, "pursuer")] * 2
 
 
-@pytest.mark.parametrize("role", ["pursuer", "evader"])
-def test_the_held_out_sets_parse_and_are_not_the_defaults(unseen, tmp_path, capsys, role) -> None:
+@pytest.mark.parametrize(
+    ("role", "name"),
+    [("pursuer", "heldout_worlds_pursuer"), ("evader", "heldout_worlds_evader"),
+     ("evader", "fresh_worlds_evader")],
+)  # fmt: skip
+def test_the_held_out_sets_parse_and_are_not_the_defaults(
+    unseen, tmp_path, capsys, role, name
+) -> None:
     """``--worlds @file`` reads the shipped held-out labels; every one builds (the opponent
-    check comes after the worlds'), and none is in the role's default set."""
-    path = BENCHMARKS / f"heldout_worlds_{role}.txt"
+    check comes after the worlds'), and none is in the role's default set (fresh-e's
+    none in the older held-out set either)."""
+    path = BENCHMARKS / f"{name}.txt"
     labels = path.read_text().split()
     assert len(labels) > 30 and len(set(labels)) == len(labels)
     defaults = unseen.PURSUER_WORLDS if role == "pursuer" else unseen.EVADER_NAMES
     assert not set(labels) & set(defaults)
+    if name.startswith("fresh"):
+        assert not set(labels) & set((BENCHMARKS / "heldout_worlds_evader.txt").read_text().split())
     with pytest.raises(SystemExit) as exc:
         unseen.main(["--role", role, "--worlds", f"@{path}", "--opponents", "nope",
                      "--results", str(tmp_path / "r.jsonl")])  # fmt: skip

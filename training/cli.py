@@ -15,6 +15,7 @@ import threading
 import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from envs import validation
 from envs.console import (
@@ -28,6 +29,9 @@ from envs.errors import InvalidConfigError, SurveilValueError
 from training.config import TrainConfig, load_any_config
 from training.selfplay import self_play
 from training.train import TrainResult, latest_checkpoint, train
+
+if TYPE_CHECKING:
+    from training.dagger import DaggerConfig
 
 __all__ = ["add_train_arguments", "cli_train", "run_cli", "run_train"]
 
@@ -89,7 +93,7 @@ def run_train(args: argparse.Namespace) -> int:
         try:
             r = dagger(config, verbose=progress)
         except KeyboardInterrupt:
-            print(_dagger_resume_note(config), file=sys.stderr)
+            print(resume_note(config), file=sys.stderr)
             raise
         print(f"dagger {config.role}: {r.samples[-1]} labelled states, disagreement "
               f"{r.disagreement[0]:.3f} -> {r.disagreement[-1]:.3f} -> {r.model_path}")  # fmt: skip
@@ -117,8 +121,11 @@ def run_train(args: argparse.Namespace) -> int:
     return 0
 
 
-def resume_note(config: TrainConfig) -> str:
-    """What an interrupted run kept: the checkpoint a rerun continues from, or nothing."""
+def resume_note(config: TrainConfig | DaggerConfig) -> str:
+    """What an interrupted run kept: the checkpoint (an RL run) or the iterations (a DAgger
+    run) a rerun continues from, or nothing."""
+    if not isinstance(config, TrainConfig):
+        return _dagger_resume_note(config)
     latest = latest_checkpoint(config.output_dir)
     if latest is None:
         return (
@@ -240,7 +247,8 @@ def summary(result: TrainResult) -> str:
     head = (
         f"{c.algo.upper()} {c.role} vs {_opponents(c)} on {', '.join(c.maps)}: "
         f"{result.timesteps} timesteps"
-        f" in {result.wall_time:.1f} s"
+        # a finished run returned as is was "71680 timesteps in 0.0 s"
+        + (" (already trained)" if result.already_trained else f" in {result.wall_time:.1f} s")
         + (f" (resumed from {result.resumed_from.name})" if result.resumed_from else "")
         + f" -> {result.model_path}"
     )

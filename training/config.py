@@ -48,6 +48,7 @@ from training.single_agent import START_CHOICES
 __all__ = [
     "ALGORITHMS",
     "TrainConfig",
+    "absolute_map_name",
     "check_same_maps",
     "load_any_config",
     "load_config",
@@ -75,6 +76,29 @@ _ALGO_MANAGED = {
     "_init_setup_model",
 }
 """SB3 constructor arguments set from dedicated fields, so not allowed in ``algo_kwargs``."""
+
+
+def absolute_map_name(name: str) -> str:
+    """``name`` as a run from another directory resolves it: a map file's path made
+    absolute (also before a ``~[xS][rotR][off(X,Y)]`` transform); built-in and
+    ``random:`` names, and names that are none of these (refused later), as they are.
+
+    Examples:
+        >>> absolute_map_name("corner~x10")
+        'corner~x10'
+    """
+    from envs.maps import builtin_names
+    from envs.maps.io import split_transform
+
+    if name in builtin_names() or name.startswith("random:"):
+        return name
+    if Path(name).is_file():
+        return str(Path(name).resolve())
+    try:
+        inner, sim = split_transform(name)
+    except ValueError:  # a bad transform: refused with the env's message
+        return name
+    return name if sim is None else absolute_map_name(inner) + name[len(inner) :]
 
 
 def opponent_name(name: str, role: str, what: str) -> str:
@@ -110,7 +134,9 @@ class TrainConfig:
     current directory, kept as its absolute path), or several: a pool
     (:class:`training.pool.OpponentPool`), one drawn per episode."""
     map: str | tuple[str, ...] = "open_room"
-    """Built-in map name, map file path or ``random:SEED``; or several, one per episode."""
+    """Built-in map name, map file path or ``random:SEED``; or several, one per episode.
+    A file's path is relative to the current directory and kept absolute
+    (:func:`absolute_map_name`), as an opponent model's is."""
     env: dict[str, Any] = field(default_factory=dict)
     """Overrides of ``surveillance_v1.parallel_env`` arguments (``max_cycles``, ...)."""
     start: str = "env"
@@ -174,12 +200,15 @@ class TrainConfig:
             from training.pool import OpponentPool
 
             OpponentPool(list(pool), list(self.opponent_weights))  # checks the weights
+        # a map file's path made absolute, as the opponent's: a rerun of config.toml from
+        # another directory was refused ("map: my_floor.json: no such map file") or
+        # played a file of that name there
         if isinstance(self.map, (list, tuple)):  # several maps: one drawn per episode
             if not self.map:
                 raise InvalidConfigError("map: expected a map name or a non-empty list")
-            put("map", tuple(check.string("map", m) for m in self.map))
+            put("map", tuple(absolute_map_name(check.string("map", m)) for m in self.map))
         else:
-            put("map", check.string("map", self.map))
+            put("map", absolute_map_name(check.string("map", self.map)))
         put("env", check.table("env", self.env, allowed=_ENV_KEYS))
         try:  # the env's own validation, so a bad [env] value fails here, not mid-run
             for world in self.maps:

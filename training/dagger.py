@@ -65,7 +65,12 @@ from strategies.policies.base import check_role
 from strategies.policies.learner_inputs import LearnerInputs, check_features
 from strategies.policies.model_files import absolute_model_name, model_policy_name
 from strategies.runner import check_observation_options, run_episode
-from training.config import check_same_maps, map_fingerprints, opponent_name
+from training.config import (
+    absolute_map_name,
+    check_same_maps,
+    map_fingerprints,
+    opponent_name,
+)
 
 __all__ = ["DaggerConfig", "DaggerResult", "dagger", "load_dagger_config"]
 
@@ -160,12 +165,14 @@ class DaggerConfig:
         put("maps", (self.maps,) if isinstance(self.maps, str) else tuple(self.maps))
         if not self.maps or not all(isinstance(m, str) and m for m in self.maps):
             raise InvalidConfigError(f"{where}: maps = {self.maps!r}: expected map names or files")
+        put("maps", tuple(absolute_map_name(m) for m in self.maps))  # as the opponent's files
         vm = self.validation_maps
         put("validation_maps", (vm,) if isinstance(vm, str) else tuple(vm))
         if not all(isinstance(m, str) and m for m in self.validation_maps):
             raise InvalidConfigError(
                 f"{where}: validation_maps = {vm!r}: expected map names or files"
             )
+        put("validation_maps", tuple(absolute_map_name(m) for m in self.validation_maps))
         vo = self.validation_opponent
         vpool = (vo,) if isinstance(vo, str) else tuple(vo)
         if not all(_plays(o, other, f"{where}: validation_opponent") for o in vpool):
@@ -208,6 +215,7 @@ class DaggerConfig:
                 stage["maps"] = (m,) if isinstance(m, str) else tuple(m)
                 if not stage["maps"] or not all(isinstance(x, str) and x for x in stage["maps"]):
                     raise InvalidConfigError(f"{at}: maps = {m!r}: expected map names")
+                stage["maps"] = tuple(absolute_map_name(x) for x in stage["maps"])
             if "env" in stage:
                 stage["env"] = dict(validation.mapping("env", stage["env"], where=at))
             stages.append(stage)

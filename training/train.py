@@ -130,6 +130,8 @@ class TrainResult:
         wall_time: seconds spent in this call (training and evaluation).
         resumed_from: the checkpoint this call continued from, if any.
         evaluation: the final evaluation against the opponent (``None`` if skipped).
+        already_trained: ``output_dir`` held a finished run at least this long, returned
+            as is (nothing trained: ``wall_time`` is 0).
     """
 
     config: TrainConfig
@@ -140,6 +142,7 @@ class TrainResult:
     wall_time: float
     resumed_from: Path | None
     evaluation: EvalResult | None
+    already_trained: bool = False
 
     @property
     def policy_name(self) -> str:
@@ -642,6 +645,7 @@ def _result_from_provenance(config: TrainConfig, out: Path, prov: dict[str, Any]
         0.0,
         None,
         evaluation,
+        already_trained=True,
     )
 
 

@@ -309,7 +309,13 @@ def add_parsers(sub: argparse._SubParsersAction) -> None:
         type=path_text("a file name or a directory"),
         help="SQLite store (default: out/tournaments/NAME.sqlite)",
     )
-    p.add_argument("--backend", choices=["serial", "process", "ray"], default="process")
+    p.add_argument(
+        "--backend",
+        choices=["serial", "process", "ray"],
+        default="process",
+        help="where matches play: this process, a process pool (default) or Ray (a local "
+        "instance, or the cluster at --address)",
+    )
     p.add_argument("--workers", type=integer(1), default=None, help="processes, or local Ray CPUs")
     p.add_argument("--address", help="Ray cluster address (with --backend ray)")
     p.add_argument("--retry-errors", action="store_true", help="replay matches stored as errors")

@@ -547,7 +547,12 @@ class RayExecutor(Executor):
             }
             if address is None:
                 kwargs["num_cpus"] = num_cpus
-            self._init(address, kwargs)
+            # no address: a new local instance, as documented. ray.init(address=None)
+            # joins the cluster named by $RAY_ADDRESS or /tmp/ray/ray_current_cluster (a
+            # `ray start --head` running, or a stale file one left behind), and with
+            # num_cpus raised "When connecting to an existing cluster, num_cpus and
+            # num_gpus must not be provided": a traceback for --backend ray --workers 2
+            self._init("local" if address is None else address, kwargs)
         try:
             self.cluster_cpus = max(1, int(ray.cluster_resources().get("CPU", 1)))
         except BaseException:  # a Ctrl-C here too: the caller has no executor to close

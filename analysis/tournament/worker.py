@@ -151,6 +151,8 @@ class Context:
         models: ``{sha256: model file bytes}`` (shipped once, materialised per worker).
         time_limit: wall-clock seconds each role may spend deciding in a match (its
             reset and acts); also the longest stretch of the env's and the harness's work.
+        starts: the run's start kinds (``"safe"``...), whose samplers :func:`warm_up`
+            prepares.
     """
 
     maps: dict[str, Any]
@@ -158,6 +160,7 @@ class Context:
     policies: dict[str, PolicyEntry]
     models: dict[str, bytes] = field(default_factory=dict, repr=False)
     time_limit: float = 300.0
+    starts: tuple[str, ...] = ()
 
 
 def context_for(spec: Spec) -> Context:
@@ -181,6 +184,7 @@ def context_for(spec: Spec) -> Context:
         policies=spec.policies(),
         models=models,
         time_limit=spec.time_limit,
+        starts=tuple(spec.starts),
     )
 
 
@@ -343,7 +347,10 @@ def warm_up(ctx: Context | None = None) -> None:
     variants set (:func:`_prepare_map`): a worker's first match on a map built it in the
     harness's first stretch, 0.38-0.48 s on a 1000-wall room at load 10, against a
     stretch of the time limit plus :data:`ALARM_GRACE`, so a short limit could store a
-    ``MatchTimeout`` error for a match that never hung.
+    ``MatchTimeout`` error for a match that never hung. That includes the run's start
+    kinds: a first ``"safe"`` start on office built its judge's safety table there (1.0 s
+    at load 7; then 0.012 s), and a spec with ``time_limit = 0.05`` stored that match as
+    an error.
     """
     import envs.surveillance_v1  # noqa: F401
     import strategies.policies.observe
@@ -362,14 +369,16 @@ def warm_up(ctx: Context | None = None) -> None:
             continue
         with contextlib.suppress(Exception), warnings.catch_warnings():  # its matches say why
             warnings.simplefilter("ignore")
-            _prepare_map(ctx.maps[label], overrides)
+            _prepare_map(ctx.maps[label], overrides, ctx.starts)
             done.add(key)  # (a variant whose start is refused leaves it to the next)
 
 
-def _prepare_map(world: Any, overrides: dict[str, Any]) -> None:
+def _prepare_map(world: Any, overrides: dict[str, Any], starts: tuple[str, ...] = ()) -> None:
     """Build what a match's set-up builds once per map and caches: the env's geometry
     kernel, the start sampler's room check (:func:`envs.surveillance.placement.check_room`)
-    and the map's lazy indexes, by drawing one valid start and resetting an env there.
+    and the map's lazy indexes, by drawing one valid start and resetting an env there, and
+    the judge of each other start kind in ``starts`` (a decomposition pursuer's safety
+    table), by drawing one such start.
 
     The caches hold no randomness (the draw's generator is its own), so no match plays
     differently; the draw uses the env's parameters, as ``run_episode``'s does.
@@ -383,6 +392,8 @@ def _prepare_map(world: Any, overrides: dict[str, Any]) -> None:
     try:
         placement = sample_start(env.config, np.random.default_rng(0), kind="valid")
         env.reset(seed=0, options=placement)
+        for kind in sorted(set(starts) - {"valid"}):
+            sample_start(env.config, np.random.default_rng(0), kind=kind)
     finally:
         env.close()
 

@@ -99,7 +99,13 @@ points through a spatial index of the edges (:meth:`Map._near_distances`): brute
 costs about 0.2 us a (point, edge) pair, the index about 12 us a point whatever the
 edges (measured on 300,000 points: equal at about 60 edges; the pillar room's 844: 54 s
 brute force, 3.5 s indexed). The values are the same either way."""
-_NEAR_POINTS = 256  # ... and calls with at least this many points (fewer: brute force)
+_NEAR_PAIRS = 1024
+"""... and calls with at least this many (point, edge) pairs (fewer: brute force). The
+index costs ~35 us a call before its ~5-12 us a point, brute force ~0.05-0.2 us a pair
+whatever the points: a point on a 2700-edge floor plan 103 us brute force, 36 indexed; 2
+points on 940 edges 112 and 38; 6 on 280 edges 65 and 49; 1 on 940 edges 34 and 37 (the
+decomposition pursuer's clearances on a lazy table: one to a few points a call). With at
+least 256 points it was the index from 128 edges, as before."""
 _NEAR_CHUNK = 1 << 16  # points per batch of the indexed distances
 
 
@@ -468,7 +474,7 @@ class Map:
 
     def _distance_to_walls(self, p: np.ndarray) -> np.ndarray:
         """:meth:`distance_to_walls` of a finite (k, 2) float array."""
-        if len(p) >= _NEAR_POINTS and self.n_edges >= _NEAR_EDGES:
+        if self.n_edges >= _NEAR_EDGES and len(p) * self.n_edges >= _NEAR_PAIRS:
             return self._near_distances(p)
         step = self._chunk()
         if len(p) > step:  # bounded memory (see _chunk)

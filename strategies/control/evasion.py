@@ -78,8 +78,24 @@ def default_step(x_max: float, L: float, rho: float) -> float:
     ``(1 + rho)²/((1 - rho²) L)``, so the natural length is ``L min(rho, 1 - rho)/(1 + rho)``;
     32 steps per natural length keep J and the crossing within ~1e-8 of a 4x finer grid on
     the cases in the tests.
+
+    Raises:
+        SurveilValueError: ``x_max`` or ``L`` not a finite number > 0, or ``rho`` not one
+            (InvalidConfigError).
+        InfeasibleError: ``rho >= 1``: there is no extremal to integrate (the natural
+            length is 0 at rho = 1 and negative beyond, and so was the step).
     """
+    x_max, L, rho = _step_inputs(x_max, L, rho)
     return min(_natural_length(L, rho) / _STEPS_PER_SCALE, x_max / 32.0)
+
+
+def _step_inputs(x_max: object, L: object, rho: object) -> tuple[float, float, float]:
+    """``(x_max, L, rho)`` of :func:`default_step` and :func:`capped_step`, checked: a
+    step for rho >= 1 came back 0 (rho = 1; :func:`capped_step` divided by it) or
+    negative, and one for ``L <= 0`` negative."""
+    x_max = validation.positive("x_max", x_max)
+    L = validation.positive("L", L)
+    return x_max, L, check_evasion_rho(rho)
 
 
 def capped_step(x_max: float, L: float, rho: float) -> float | None:
@@ -94,7 +110,11 @@ def capped_step(x_max: float, L: float, rho: float) -> float | None:
     heading's fast scale), and the default step with it (~16,000 steps to 2 L at
     rho = 0.99). Where ``x_max`` is at most 32 natural lengths it is the default step:
     below rho ~ 0.8 always, as ``x_max`` stays within a few ``L``.
+
+    Raises:
+        SurveilValueError, InfeasibleError: as :func:`default_step` (rho >= 1 among them).
     """
+    x_max, L, rho = _step_inputs(x_max, L, rho)
     h = default_step(x_max, L, rho)
     if x_max / h > _MAX_DEFAULT_STEPS:
         return None

@@ -441,7 +441,9 @@ def _one_chunk(n: int, pid: np.ndarray) -> bool:
     return n <= max(1, int(_CHUNK / per_point))
 
 
-def free_arcs_few(world: Map, points: np.ndarray, L: float, tree=None, eps=None) -> ArcBatch:
+def free_arcs_few(
+    world: Map, points: np.ndarray, L: float, tree=None, eps=None, interior: bool = False
+) -> ArcBatch:
     """:func:`free_arcs_batch` of points it takes in one chunk (a lazy table's batches:
     tens to thousands of points), the same arrays bit for bit in a third of the numpy
     calls: a lazy table classifies a few dozen points a decision, most of them with no
@@ -452,8 +454,9 @@ def free_arcs_few(world: Map, points: np.ndarray, L: float, tree=None, eps=None)
     blocked arcs (:func:`_blocks`, chains merged alike) and the kernel's gap sweep on one
     padded table (:func:`_gaps_few`); points on a wall are the kernel's, as in the
     batch. ``tree`` and ``eps`` (the map's wall index and kernel tolerance) may be
-    passed to skip their look-up. Points the batch would take in several chunks go to
-    it.
+    passed to skip their look-up, and ``interior=True`` when every point is known to lie
+    in the free region (a lazy table's nodes, tested when first looked up) to skip that
+    test. Points the batch would take in several chunks go to it.
     """
     P = np.asarray(points, dtype=float).reshape(-1, 2)
     n = len(P)
@@ -461,7 +464,10 @@ def free_arcs_few(world: Map, points: np.ndarray, L: float, tree=None, eps=None)
         eps = kernel_for(world).eps
     if tree is None:
         tree = wall_index(world).tree
-    inside = shapely.contains_xy(world.prepared_free_region, P[:, 0], P[:, 1])
+    if interior:
+        inside = np.ones(n, dtype=bool)
+    else:
+        inside = shapely.contains_xy(world.prepared_free_region, P[:, 0], P[:, 1])
     pid, e = tree.query(shapely.points(P), predicate="dwithin", distance=L + eps)
     if not _one_chunk(n, pid):
         return free_arcs_batch(world, P, L)

@@ -61,25 +61,18 @@ def _regions(dec, pts: np.ndarray) -> np.ndarray:
         s, e = grid.start[sq], grid.start[sq + 1]
         n = e - s
         who = np.repeat(np.arange(len(und)), n)
-        cand = grid.cand[np.repeat(s, n) + _rank(who)]
+        # each square's candidates laid end to end: the m-th of square u at s[u] + m
+        cand = grid.cand[np.arange(len(who)) + np.repeat(s - (np.cumsum(n) - n), n)]
         p = und[who]
         hit = shapely.intersects_xy(grid.polygons[cand], pts[p, 0], pts[p, 1])
-        count = np.bincount(who[hit], minlength=len(und))
-        one = count == 1
-        out[und[who[hit][one[who[hit]]]]] = cand[hit][one[who[hit]]]
+        whom = who[hit]
+        one = np.bincount(whom, minlength=len(und)) == 1
+        out[und[whom[one[whom]]]] = cand[hit][one[whom]]
         ask = np.concatenate([np.flatnonzero(lab == -2), und[~one]])
     for a in ask:  # the region tree (Decomposition._locate_tree)
         r = dec.locate(pts[a])
         out[a] = -1 if r is None else r
     return out
-
-
-def _rank(g: np.ndarray) -> np.ndarray:
-    """Position of each element among the equal values before it (``g`` sorted)."""
-    if len(g) == 0:
-        return g
-    first = np.flatnonzero(np.concatenate([[True], g[1:] != g[:-1]]))
-    return np.arange(len(g)) - np.repeat(first, np.diff(np.concatenate([first, [len(g)]])))
 
 
 class _CellKeys:
@@ -154,9 +147,12 @@ def _cell_keys(dec) -> _CellKeys:
 
 
 def classify_points(
-    dec, pts: np.ndarray, step: float, centres: np.ndarray
+    dec, pts: np.ndarray, step: float, centres: np.ndarray, interior: bool = False
 ) -> tuple[np.ndarray, np.ndarray]:
     """The free and safe bins at (k, 2) points of the free region, as the eager build.
+
+    ``interior=True``: every point is known to lie in the free region's polygon (a lazy
+    table's nodes, tested when first looked up), which a batch then does not test again.
 
     Returns ``(free, safe)``, (k, n_bins) bool: the bin centres inside the free arcs,
     and inside the non-escapable ones (all False where no point nearby resolves the
@@ -172,7 +168,7 @@ def classify_points(
         return free, safe
     index = _cell_keys(dec)
     if k <= FEW:  # (a lazy table's lookups)
-        batch = free_arcs_few(dec.map, pts, dec.L, index.tree, index.eps)
+        batch = free_arcs_few(dec.map, pts, dec.L, index.tree, index.eps, interior)
     else:
         batch = free_arcs_batch(dec.map, pts, dec.L)
     counts = np.diff(batch.offsets)

@@ -30,6 +30,7 @@ __all__ = [
     "Snapshot",
     "check_role",
     "count_param",
+    "distance_ceiling",
     "distance_target",
     "flag_param",
     "nonnegative_param",
@@ -84,13 +85,30 @@ def flag_param(name: str, value: Any) -> bool:
 
 
 def distance_target(config: Any) -> float:
-    """The distance a pursuer holds: L_min plus a buffer against one step of reaction lag.
+    """The distance a pursuer holds: L_min plus a buffer against one step of reaction lag,
+    at most the middle of the range band ``[L_min, L_max]``.
 
     Policies see the evader's velocity of the *previous* step, so a sudden dash toward
     the pursuer closes up to ``V_e dt`` before it reacts; twice that, plus 1 % of L_min,
-    keeps L above L_min (the env's ``"too_close"``).
+    keeps L above L_min (the env's ``"too_close"``). A dash away opens it as fast
+    (``"too_far"``), so where the band is narrower than twice the buffer (``L_max -
+    L_min < 4 V_e dt + 0.02 L_min``) the target is the band's middle, the same buffer
+    both ways: L_min plus the buffer lay beyond the middle, and beyond L_max itself
+    where the band was narrower than one buffer (L_min 2, L_max 2.2, V_e 1, dt 0.1:
+    2.22; the decomposition pursuer lost all 16 of its episodes there ``"too_far"``
+    within 1-20 steps, and wins 10 from the middle).
+    Such a band is legal (the env asks only ``L_max > L_min``) but no pursuer can be
+    sure to hold it: one step of the evader covers ``V_e dt`` of it.
     """
-    return config.l_min + 2.0 * config.v_evader * config.dt + 0.01 * config.l_min
+    low = config.l_min + 2.0 * config.v_evader * config.dt + 0.01 * config.l_min
+    return min(low, 0.5 * (config.l_min + config.l_max))
+
+
+def distance_ceiling(config: Any) -> float:
+    """The longest distance a pursuer aims at: L_max less the buffer
+    :func:`distance_target` keeps above L_min (its mirror below L_max), or the band's
+    middle where the two buffers overlap."""
+    return max(distance_target(config), config.l_min + config.l_max - distance_target(config))
 
 
 def unit(v: np.ndarray) -> np.ndarray:

@@ -72,6 +72,7 @@ from strategies.policies.base import (
     BasePolicy,
     Snapshot,
     count_param,
+    distance_ceiling,
     distance_target,
     nonnegative_param,
     positive_param,
@@ -143,12 +144,15 @@ class DecompositionPursuer(BasePolicy):
         rays: probe rays around the evader.
         probe_every: use every k-th grid sample along a ray as a probe.
         hysteresis: weight of the rotation needed to reach a target, in units of V.
-        distance_gain: rate (1/s) of the correction of L toward L_min.
+        distance_gain: rate (1/s) of the correction of L toward L_min; at most
+            ``1 / dt`` is used (a larger rate corrects more than the error in one step).
         range_margin: extra distance held above the minimal one, as a fraction of
             ``L_max - L_min`` (default 0: ride at L_min plus a one-step buffer, as the
             paper). A margin trades some of the rod's freedom (a longer rod has fewer
             free orientations, Prop. 3) for slack against imprecise execution, e.g. for
-            a learner imitating this policy.
+            a learner imitating this policy. The distance held is at most L_max less
+            the one-step buffer (``base.distance_ceiling``): with ``range_margin`` 1 it
+            aimed beyond L_max.
         turn_rate: the rotation rate the evader is assumed to impose (eq. 6, Sec. 6.1):
             ``"both"``, ``(V_p / L) sqrt(1 - rho^2)``, the least rate when the rod may
             turn either way; ``"one"``, ``(V_p / L)(1 - rho)``, the least rate in one
@@ -213,7 +217,16 @@ class DecompositionPursuer(BasePolicy):
 
     def _reset(self) -> None:
         c = self.config
-        self.L_target = distance_target(c) + self.range_margin * (c.l_max - c.l_min)
+        # no farther than the buffer below L_max (range_margin 1 aimed at L_max plus the
+        # buffer; a band narrower than twice the buffer: at its middle, distance_target)
+        self._L_ceiling = distance_ceiling(c)
+        margin = self.range_margin * (c.l_max - c.l_min)
+        self.L_target = min(distance_target(c) + margin, self._L_ceiling)
+        # a correction of gain * (L - L_target) held for dt moves L by gain * dt times the
+        # error: past 1 it overshoots, past 2 the error grows step by step (the default
+        # gain 3 at dt 1: 26 of 48 valid starts lost, too close and too far by turns;
+        # at 1 / dt: 3)
+        self._gain = min(self.distance_gain, 1.0 / c.dt)
         # the pursuer's disc keeps its centre body_radius off the walls, so the rod tip
         # meets a wall as if the rod were that much longer (Prop. 3: fewer free arcs)
         self.table_length = round(self.L_target + c.body_radius, 6)
@@ -264,16 +277,15 @@ class DecompositionPursuer(BasePolicy):
         lut[NO_PATH] = 2.0 * math.pi / self.omega
         self._way_lut = lut.astype(np.float32)
         nb = self.table.n_bins
-        # the eager table's fast path (:meth:`_probe_values`) takes the largest rotation
-        # over the probes at one radius before the lookup: exact when each lookup is
-        # non-decreasing over the counts a table holds (0 .. n_bins // 2 the shorter way
-        # round, 0 .. n_bins - 1 one way, or NO_PATH), which it is unless rounding says
-        # otherwise
+        # :meth:`_probe_values` takes the largest rotation over the probes at one radius
+        # before the lookup: exact when each lookup is non-decreasing over the counts a
+        # table holds (0 .. n_bins // 2 the shorter way round, 0 .. n_bins - 1 one way, or
+        # NO_PATH), which it is unless rounding says otherwise; on an eager table with
+        # one lookup of every ray sample (the fast path)
         held = self._turn_lut[np.r_[np.arange(nb // 2 + 1), NO_PATH]]
         way = self._way_lut[np.r_[np.arange(nb), NO_PATH]]
-        self._fast = isinstance(self.table, SafetyTable) and bool(
-            np.all(np.diff(held) >= 0) and np.all(np.diff(way) >= 0)
-        )
+        self._monotone = bool(np.all(np.diff(held) >= 0) and np.all(np.diff(way) >= 0))
+        self._fast = isinstance(self.table, SafetyTable) and self._monotone
         # the penalty of turning k bins, as _target's score needs it (same float ops)
         self._turn_penalty = self.hysteresis * np.arange(nb + 1.0) * self._bw / self.omega
         self.last_target: int | None = None
@@ -615,10 +627,16 @@ class DecompositionPursuer(BasePolicy):
             return np.full(tab.n_bins, self.horizon)
         probes = points.reshape(n_rays, n_r, 2)[:, cols][sub_ok]
         r = tab.rows(probes, *ahead)  # only the probes' orientations are looked up
-        t_e = np.broadcast_to(t_e, sub_ok.shape)[sub_ok]
         # lut: seconds to turn by a number of bins; a safe bin (0) never threatens
         needs = tab.need if not sense else (tab.ccw if sense > 0 else tab.cw)
-        v = t_e[:, None] - (self._way_lut if sense else self._turn_lut)[needs[r]]
+        lut = self._way_lut if sense else self._turn_lut
+        if self._monotone:  # the largest rotation per radius, as the fast path
+            need = np.zeros((*sub_ok.shape, tab.n_bins), dtype=needs.dtype)
+            need[sub_ok] = needs[r]
+            v = t_e[:, None] - lut[need.max(axis=0)]
+            return v.min(axis=0)
+        t_e = np.broadcast_to(t_e, sub_ok.shape)[sub_ok]
+        v = t_e[:, None] - lut[needs[r]]
         return v.min(axis=0)
 
     def _target(self, snap: Snapshot) -> tuple[float, int]:
@@ -1360,8 +1378,8 @@ class DecompositionPursuer(BasePolicy):
         # pursuer_velocity_holding_range without their argument checks)
         hi, lo = _theta_dot_rates(alpha - snap.theta, L, float(c.v_pursuer), rate)
         hi, lo = float(hi), float(lo)
-        L_target = self.L_target + self._wall_push(snap)
-        closing = min(self.distance_gain * (L - L_target), self.CLOSING * c.v_pursuer)
+        L_target = min(self.L_target + self._wall_push(snap), self._L_ceiling)
+        closing = min(self._gain * (L - L_target), self.CLOSING * c.v_pursuer)
         if closing > 0.0:
             # the rod is longer than the table's (fewer free orientations, Prop. 3: the
             # table may call an orientation clear that is not): keep part of the speed
@@ -1398,7 +1416,7 @@ class DecompositionPursuer(BasePolicy):
             L,
             L_target,
             float(c.v_pursuer),
-            self.distance_gain,
+            self._gain,
         )
         return cmd.velocity
 

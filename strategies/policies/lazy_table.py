@@ -52,13 +52,20 @@ maps at L_min = 0.5 (the paper's worlds scaled x3) stay tabulated, a 200 m floor
 _UNKNOWN = -2  # a grid node not classified yet (-1: outside the free region)
 
 
-_BYTES_PER_NODE = 5
-"""The grid's per-node arrays: the row index (int32) and the membership flag (int8)."""
+_BYTES_PER_NODE = 6
+"""The grid's per-node arrays: the row index (int32), the membership flag (int8) and
+whether a wall may pass within the map's length tolerance (bool)."""
 
-_TILE = 64
+_TILE_BITS = 6
+_TILE = 1 << _TILE_BITS
 """Grid nodes a side of a tile: the per-node arrays are allocated a tile at a time, where
 lookups first touch the grid (the whole grid's were 0.98 GB on corner~x100 at L_min 2,
 196 million nodes, for a few thousand nodes looked at in an episode)."""
+
+_BLOCK = 8
+"""Grid nodes a side of a block whose wall distance a new tile measures once: a node's
+membership test asks whether a wall passes within the map's length tolerance of it
+(~1 us a node, most of a test) only in blocks a wall passes near."""
 
 
 def _check_grid(world: Map, resolution: float, shape: tuple[int, int]) -> None:
@@ -125,7 +132,7 @@ class LazySafetyTable:
     bin_width = SafetyTable.bin_width
     bin_of = SafetyTable.bin_of
     bin_centre = SafetyTable.bin_centre
-    row = SafetyTable._row_search  # classifies through rows()
+    _row_search = SafetyTable._row_search  # classifies through rows()
     grid_index = SafetyTable.grid_index
 
     def __init__(self, world: Map, L: float, resolution: float, n_bins: int) -> None:
@@ -148,15 +155,20 @@ class LazySafetyTable:
         # node (i, j) is entry (i % _TILE, j % _TILE) of slab _tiles[i // _TILE, j // _TILE]
         # of _cell (its row, _UNKNOWN, or -1) and _member (0 unknown, 1 inside, 2 not)
         self._tiles = np.full(
-            (-(-self.shape[0] // _TILE), -(-self.shape[1] // _TILE)), -1, dtype=np.int32
+            (-(-self.shape[0] // _TILE), -(-self.shape[1] // _TILE)), -1, dtype=np.int64
         )
         self._cell = np.full((1, _TILE, _TILE), _UNKNOWN, dtype=np.int32)
         self._member = np.zeros((1, _TILE, _TILE), dtype=np.int8)
+        self._near = np.zeros((1, _TILE, _TILE), dtype=bool)
         self._n_tiles = 0
         self._centres = -math.pi + (np.arange(self.n_bins) + 0.5) * self.bin_width
         self._walls = shapely.boundary(world.free_region)
         shapely.prepare(self._walls)
         self._eps = REL_LENGTH_TOL * world.scale
+        # a node within _eps of a wall lies in a block whose centre is within this of one
+        # (its half diagonal, and a margin far above the distances' rounding)
+        slack = REL_LENGTH_TOL * (world.scale + float(np.abs(world.bounds).max()))
+        self._block_reach = (_BLOCK - 1) / 2 * math.sqrt(2) * self.resolution + self._eps + slack
         self._n = 0
         cap = 1024
         self._free = np.zeros((cap, self.n_bins), dtype=bool)
@@ -173,6 +185,20 @@ class LazySafetyTable:
     ccw = property(lambda self: self._ccw[: self._n])
     cw = property(lambda self: self._cw[: self._n])
     need = property(lambda self: self._need[: self._n])
+
+    def row(self, point: np.ndarray) -> int:
+        """Table row of the grid point nearest to ``point``, or of the nearest in free
+        space (``SafetyTable.row``'s scalar arithmetic for a node classified already, the
+        pursuer's look-up of the evader's row each decision; else through :meth:`rows`)."""
+        i = round((float(point[0]) - float(self.origin[0])) / self.resolution)
+        j = round((float(point[1]) - float(self.origin[1])) / self.resolution)
+        if 0 <= i < self.shape[0] and 0 <= j < self.shape[1]:
+            slab = int(self._tiles[i >> _TILE_BITS, j >> _TILE_BITS])
+            if slab >= 0:
+                r = int(self._cell[slab, i & (_TILE - 1), j & (_TILE - 1)])
+                if r >= 0:
+                    return r
+        return self._row_search(point)
 
     @property
     def classified(self) -> int:
@@ -211,9 +237,9 @@ class LazySafetyTable:
         """Grid indices ``(i, j)`` of the nodes nearest to (k, 2) points that lie on the
         grid, and which do (``grid_index``'s nodes, as ``SafetyTable.rows`` tests them)."""
         idx = np.rint((np.asarray(points, dtype=float) - self.origin) / self.resolution).astype(
-            np.int64
+            np.int64, order="F"
         )
-        ix, iy = idx[:, 0], idx[:, 1]
+        ix, iy = idx[:, 0], idx[:, 1]  # (contiguous columns)
         ok = (ix.view(np.uint64) < self.shape[0]) & (iy.view(np.uint64) < self.shape[1])
         if not ok.all():
             ix, iy = ix[ok], iy[ok]
@@ -221,8 +247,9 @@ class LazySafetyTable:
 
     def _slots(self, ix: np.ndarray, iy: np.ndarray) -> np.ndarray:
         """Where grid nodes ``(ix, iy)`` are kept in ``_cell`` and ``_member`` (flat
-        indices), their tiles allocated first (unknown nodes)."""
-        ti, tj = ix // _TILE, iy // _TILE
+        indices), their tiles allocated first (unknown nodes). (Shifts and masks: the
+        indices are not negative.)"""
+        ti, tj = ix >> _TILE_BITS, iy >> _TILE_BITS
         slab = self._tiles[ti, tj]
         if (slab < 0).any():
             new = np.unique(np.stack([ti[slab < 0], tj[slab < 0]], axis=1), axis=0)
@@ -231,21 +258,44 @@ class LazySafetyTable:
                 cap = max(n, 2 * len(self._cell))
                 cell = np.full((cap, _TILE, _TILE), _UNKNOWN, dtype=np.int32)
                 member = np.zeros((cap, _TILE, _TILE), dtype=np.int8)
+                near = np.zeros((cap, _TILE, _TILE), dtype=bool)
                 cell[: self._n_tiles] = self._cell[: self._n_tiles]
                 member[: self._n_tiles] = self._member[: self._n_tiles]
-                self._cell, self._member = cell, member
+                near[: self._n_tiles] = self._near[: self._n_tiles]
+                self._cell, self._member, self._near = cell, member, near
             self._tiles[new[:, 0], new[:, 1]] = np.arange(self._n_tiles, n)
+            self._near[self._n_tiles : n] = self._walls_near(new)
             self._n_tiles = n
             slab = self._tiles[ti, tj]
-        return (slab * _TILE + ix % _TILE) * _TILE + iy % _TILE
+        mask = _TILE - 1
+        return (slab << (2 * _TILE_BITS)) | ((ix & mask) << _TILE_BITS) | (iy & mask)
+
+    def _walls_near(self, tiles: np.ndarray) -> np.ndarray:
+        """Per node of (k, 2) tiles (``(k, _TILE, _TILE)``, bool), whether a wall may pass
+        within the map's length tolerance of it: False for the nodes of a block of
+        ``_BLOCK`` x ``_BLOCK`` whose centre is farther than ``_block_reach`` from every
+        wall (then so is each of its nodes farther than the tolerance)."""
+        per = _TILE // _BLOCK
+        centre = np.arange(per) * _BLOCK + (_BLOCK - 1) / 2  # in nodes from a tile's corner
+        cx = self.origin[0] + self.resolution * (tiles[:, 0, None] * _TILE + centre)
+        cy = self.origin[1] + self.resolution * (tiles[:, 1, None] * _TILE + centre)
+        x = np.broadcast_to(cx[:, :, None], (len(tiles), per, per))
+        y = np.broadcast_to(cy[:, None, :], (len(tiles), per, per))
+        near = shapely.dwithin(self._walls, shapely.points(x.ravel(), y.ravel()), self._block_reach)
+        block = near.reshape(len(tiles), per, 1, per, 1)
+        return np.broadcast_to(block, (len(tiles), per, _BLOCK, per, _BLOCK)).reshape(
+            len(tiles), _TILE, _TILE
+        )
 
     def _membership(self, ix: np.ndarray, iy: np.ndarray, flat: np.ndarray) -> np.ndarray:
         """Decide (and memoise) which grid nodes ``(ix, iy)`` (kept at ``flat``) lie in
-        the free region."""
+        the free region: inside its polygon and not within the length tolerance of a
+        wall (tested only where a wall passes near: :meth:`_walls_near`)."""
         x, y = self._xs[ix], self._ys[iy]
         inside = shapely.contains_xy(self.map.prepared_free_region, x, y)
-        at = np.flatnonzero(inside)
-        inside[at] = ~shapely.dwithin(self._walls, shapely.points(x[at], y[at]), self._eps)
+        at = np.flatnonzero(inside & self._near.reshape(-1)[flat])
+        if len(at):
+            inside[at] = ~shapely.dwithin(self._walls, shapely.points(x[at], y[at]), self._eps)
         self._member.reshape(-1)[flat] = np.where(inside, 1, 2)
         return inside
 
@@ -299,7 +349,10 @@ class LazySafetyTable:
             return
         self._grow(self._n + k)
         pts = np.stack([self._xs[ix], self._ys[iy]], axis=1)
-        free, safe = classify_points(self.decomposition, pts, self.resolution, self._centres)
+        # (the nodes tested inside the polygon: _membership)
+        free, safe = classify_points(
+            self.decomposition, pts, self.resolution, self._centres, interior=True
+        )
         g = safe.any(axis=1)
         safe = np.where(g[:, None], safe, free)
         ccw, cw = _both_ways(safe)
@@ -334,7 +387,10 @@ def _both_ways(safe: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     once: the same bins to the next safe bin at or after each bin and to the last at or
     before it (``NO_PATH`` where a row has none). A row safe all round is 0 both ways
     and one with no safe bin ``NO_PATH`` (most of a lazy table's rows, away from the
-    walls, are one or the other); the others are found on one doubled circle, in int16."""
+    walls, are one or the other). The others are laid end to end, each twice (its
+    circle unrolled), and each bin's next and last safe bins read off the safe bins'
+    running count: one cumulative sum and two gathers (numpy's running minimum, the
+    scan this took before, costs ~6 ns an element, about four times as much)."""
     k, nb = safe.shape
     n_safe = np.count_nonzero(safe, axis=1)
     ccw = np.where(n_safe[:, None] == 0, np.uint8(NO_PATH), np.uint8(0))
@@ -344,13 +400,17 @@ def _both_ways(safe: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return ccw, ccw.copy()
     cw = ccw.copy()
     part = safe[mixed]
-    dtype = np.int16 if 4 * nb < np.iinfo(np.int16).max else np.int64
-    ar = np.arange(2 * nb, dtype=dtype)
-    doubled = np.concatenate([part, part], axis=1)
-    none = dtype(4 * nb)
-    ahead = np.minimum.accumulate(np.where(doubled, ar, none)[:, ::-1], axis=1)[:, : nb - 1 : -1]
-    behind = np.maximum.accumulate(np.where(doubled, ar, -none), axis=1)[:, nb:]
-    # a mixed row has a safe bin within nb - 1 bins either way
-    ccw[mixed] = np.minimum(ahead - ar[:nb], NO_PATH)
-    cw[mixed] = np.minimum(ar[nb:] - behind, NO_PATH)
+    m = len(mixed)
+    flat = np.concatenate([part, part], axis=1).reshape(-1)
+    dtype = np.int32 if len(flat) < np.iinfo(np.int32).max else np.int64  # (half the bytes)
+    at = np.flatnonzero(flat).astype(dtype)  # the safe bins, in order
+    count = np.cumsum(flat, dtype=dtype).reshape(m, 2 * nb)  # safe bins up to each bin
+    idx = np.arange(m * 2 * nb, dtype=dtype).reshape(m, 2 * nb)
+    # a row has a safe bin within nb - 1 bins either way: the next one at or after a bin
+    # of its first copy and the last one at or before a bin of its second lie in the row
+    ahead = at[count[:, :nb] - part] - idx[:, :nb]
+    behind = idx[:, nb:] - at[count[:, nb:] - 1]
+    if nb - 1 > NO_PATH:  # (distances past NO_PATH read as NO_PATH)
+        ahead, behind = np.minimum(ahead, NO_PATH), np.minimum(behind, NO_PATH)
+    ccw[mixed], cw[mixed] = ahead, behind
     return ccw, cw

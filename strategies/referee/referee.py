@@ -64,13 +64,9 @@ def _cached(kind, cls, solver, spec, res, cache, cache_dir, progress, memory_bud
     """The bound ``kind`` of ``spec`` at ``res``: loaded from the cache, or solved and
     stored (a read-only or full disk only costs the recomputation next time)."""
     if cache:
-        names = (*cls.tables, "iterations", "seconds")
-        arrays = load_arrays(kind, spec, res, names, cache_dir)
-        if arrays is not None:
-            try:
-                return cls.from_arrays(spec, res, arrays)
-            except ValueError:
-                pass
+        bound = _from_cache(kind, cls, spec, res, cache_dir)
+        if bound is not None:
+            return bound
     bound = solver(spec, res, progress=progress, memory_budget=memory_budget)
     if cache:
         try:
@@ -78,6 +74,18 @@ def _cached(kind, cls, solver, spec, res, cache, cache_dir, progress, memory_bud
         except OSError:
             pass
     return bound
+
+
+def _from_cache(kind, cls, spec, res, cache_dir):
+    """The bound ``kind`` of ``spec`` at ``res`` read from the cache, or None (absent,
+    stale or damaged)."""
+    arrays = load_arrays(kind, spec, res, (*cls.tables, "iterations", "seconds"), cache_dir)
+    if arrays is None:
+        return None
+    try:
+        return cls.from_arrays(spec, res, arrays)
+    except ValueError:
+        return None
 
 
 def cached_pursuer_bound(
@@ -639,9 +647,11 @@ def fallback_size(
     (``pursuer_fallback=True``) adds when the default pursuer lattice certifies no state
     (:func:`pursuer_fallback_resolution`), or None when no retry can happen with these
     arguments (an explicit ``pursuer_coarse``, ``rho >=`` :data:`VACUOUS_RHO`, a default
-    of two cells or fewer) or its result is cached. Whether the default certifies nothing
-    is known only after its solve: a caller announcing :func:`unsolved_sizes` adds this as
-    what the solve *may* add (``surveil referee``'s announcement did not count it).
+    of two cells or fewer), its result is cached, or the default's solve is cached and
+    certifies some state (so :func:`solve` keeps it). Whether an unsolved default
+    certifies nothing is known only after its solve: a caller announcing
+    :func:`unsolved_sizes` adds this as what the solve *may* add (``surveil referee``'s
+    announcement did not count it).
 
     Args:
         spec, cells_per_lmin, cache, cache_dir, knobs: as :func:`unsolved_sizes`.
@@ -651,6 +661,10 @@ def fallback_size(
     alt = _fallback_resolution(spec, res, cells_per_lmin, knobs)
     if alt is None or (cache and cache_path("pursuer", spec, alt, cache_dir).is_file()):
         return None
+    if cache:  # a cached default that certifies is kept: no retry (it was announced)
+        default = _from_cache("pursuer", PursuerBound, spec, res, cache_dir)
+        if default is not None and default.win.any():
+            return None
     return replace(bound_size(spec, alt, "pursuer"), what="pursuer bound's fallback")
 
 

@@ -284,6 +284,24 @@ def test_evaluate_help_names_the_defaults_it_plays(capsys):
         assert f"default: {default})" in text[at : text.index(" --", at + len(flag) + 2)]
 
 
+def test_every_argument_of_every_command_has_a_help_text():
+    """`surveil policies --help`, `figure --help`, `tournament --help` and `referee --help`
+    listed --role, NAME, --backend and --kind with their choices and not a word on them
+    (what --kind labels, which backend is the default, which figure each name draws)."""
+    import argparse
+
+    from analysis.cli import build_parser
+
+    (commands,) = [a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction)]
+    bare = [
+        f"{name} {a.option_strings[0] if a.option_strings else a.dest}"
+        for name, parser in commands.choices.items()
+        for a in parser._actions
+        if not a.help and not isinstance(a, argparse._HelpAction)
+    ]
+    assert bare == []
+
+
 @pytest.mark.parametrize("unbuffered", ["1", ""])
 def test_a_reader_that_leaves_is_not_an_error(unbuffered):
     """``surveil figures --numbers | head -2`` (docs/REPRODUCTION.md's command, looked at

@@ -256,6 +256,44 @@ def test_a_long_solve_s_announcement_counts_the_pursuer_bound_s_fallback(capsys,
     assert fallback_size(GameSpec.from_config(EnvConfig(map="corridor")), 16) is None
 
 
+@pytest.mark.filterwarnings("ignore::envs.errors.VacuousBoundWarning")  # rho 0.3
+def test_a_cached_solve_announces_only_the_retry_that_can_happen(tmp_path, capsys, monkeypatch):
+    """The README's `surveil referee open_room --config '{"v_evader": 0.2}' ...` run a
+    second time (both bounds cached, the default pursuer lattice certifying 90 %) announced
+    "solving the referee's bounds (): up to about 0 s, or 70 s if the default pursuer
+    lattice certifies no state": a retry solve() does not make when the cached default
+    certifies. Where the cached default certifies nothing the retry is announced alone."""
+    import strategies.referee as referee
+    from envs.surveillance.config import EnvConfig
+    from strategies.referee.referee import fallback_size, solve
+    from strategies.referee.spec import GameSpec
+
+    def stop(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", str(cache))
+    monkeypatch.setattr(referee, "referee_for", stop)  # the CLI stops after announcing
+    for rho, certifies in ((0.2, True), (0.3, False)):  # at 12 cells per L_min: 1.6 s, 2 s
+        spec = GameSpec.from_config(EnvConfig(map="open_room", v_evader=rho))
+        assert fallback_size(spec, 12, cache_dir=cache) is not None  # unsolved: may retry
+        ref = solve(spec, 12, dt=0.1, cache_dir=cache, pursuer_fallback=False)  # as the CLI
+        assert bool(ref.pursuer.win.any()) is certifies
+        retry = fallback_size(spec, 12, cache_dir=cache, dt=0.1)
+        assert (retry is None) is certifies
+        cmd = ["referee", "open_room", "--config", f'{{"v_evader": {rho}}}']
+        assert main([*cmd, "--cells-per-lmin", "12"]) == 130
+        err = capsys.readouterr().err
+        if certifies:
+            assert err == "surveil: interrupted\n"
+        else:
+            assert err.startswith(
+                "open_room: the default pursuer lattice certifies no state (cached): solving "
+                "it once more one cell finer (pursuer bound's fallback: "
+            ), err
+            assert "()" not in err and "up to about 0 s" not in err
+
+
 @pytest.mark.parametrize("flag", [["--cells-per-lmin", "1e100"], ["--estimate", "1e300", "2e300"]])
 def test_an_absurd_resolution_is_one_line_naming_the_flag(flag, capsys):
     """--cells-per-lmin 1e100 was an OverflowError traceback from the memory estimate (1e300

@@ -187,3 +187,38 @@ def test_a_rerun_from_another_directory_plays_the_same_opponent_file(
     assert cfg.opponent == (str(model), "evader/straight")
     assert cfg.validation_opponent == f"evader/sb3:{model}"
     assert tiny(opponent=(relative, EVADER)).opponent == (str(model), EVADER)
+
+
+def test_a_rerun_from_another_directory_plays_the_same_map_file(tmp_path, tiny, monkeypatch):
+    # config.toml kept the opponent's model file absolute but a map file's path as written
+    # ('f.json'): a rerun of it from another directory was refused ("map: f.json: no such
+    # map file") or played a file of that name there; now the map's path is kept absolute
+    # too (also under a transform, and in DAgger's maps, validation maps and curriculum)
+    import numpy as np
+
+    from envs.maps import Map
+    from envs.maps.io import save_map
+    from training.train import train
+
+    here, elsewhere = tmp_path / "here", tmp_path / "elsewhere"
+    here.mkdir()
+    elsewhere.mkdir()
+    square = np.array([[0.0, 0.0], [9.0, 0.0], [9.0, 9.0], [0.0, 9.0]])
+    save_map(Map(square, [], name="f"), here / "f.json")
+    monkeypatch.chdir(here)
+    first = train(tiny(map="f.json", total_timesteps=64, eval_episodes=0))
+    monkeypatch.chdir(elsewhere)
+    stored = load_config(first.model_path.parent / "config.toml", total_timesteps=128)
+    assert stored.map == str(here / "f.json")
+    again = train(stored)
+    assert again.resumed_from is not None and again.timesteps == 128
+    monkeypatch.chdir(here)
+    assert tiny(map=("f.json~x2", "corner", "random:3")).map == (
+        f"{here / 'f.json'}~x2", "corner", "random:3")  # fmt: skip
+    cfg = DaggerConfig(role="pursuer", expert="pursuer/decomposition",
+                       opponent="evader/straight", maps=["f.json", "corner"],
+                       validation_maps="f.json", output_dir=str(tmp_path),
+                       curriculum=[{"iterations": 1, "maps": "f.json"}])  # fmt: skip
+    absolute = str(here / "f.json")
+    assert cfg.maps == (absolute, "corner") and cfg.validation_maps == (absolute,)
+    assert cfg.curriculum[0]["maps"] == (absolute,)

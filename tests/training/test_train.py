@@ -186,6 +186,34 @@ def test_the_summary_names_maps_and_a_pool_as_a_user_writes_them(tiny):
     assert summary(result).startswith("PPO pursuer vs evader/straight, evader/random on open_room:")
 
 
+def test_a_rerun_of_a_finished_run_says_it_was_already_trained(tmp_path, capsys, monkeypatch):
+    """Rerunning a finished ``surveil train`` (or a finished ``zoo reproduce``) returns
+    the run as is, and said "PPO pursuer ...: 71680 timesteps in 0.0 s" ("trained 151552
+    timesteps in 0.0 s"): as if it had trained in no time."""
+    from training import zoo
+    from training.zoo.__main__ import main as zoo_main
+
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(
+        'role = "pursuer"\nopponent = "evader/straight"\ntotal_timesteps = 128\nn_steps = 64\n'
+        f'batch_size = 32\neval_episodes = 0\noutput_dir = "{tmp_path / "run"}"\n'
+        "[env]\nmax_cycles = 20\n"
+    )
+    assert cli_train([str(cfg), "--no-progress"]) == 0
+    first = capsys.readouterr().out
+    assert " in " in first and "already trained" not in first
+    assert cli_train([str(cfg), "--no-progress"]) == 0
+    again = capsys.readouterr().out
+    assert again.startswith("PPO pursuer vs evader/straight on open_room: 128 timesteps "
+                            "(already trained) -> "), again  # fmt: skip
+    monkeypatch.setattr(zoo, "MODELS_DIR", tmp_path / "zoo")
+    zoo.install("tiny", tmp_path / "run")  # as a zoo model, reproduced twice
+    cmd = ["reproduce", "tiny", "--output-dir", str(tmp_path / "again"), "--no-progress"]
+    assert zoo_main(cmd) == 0 and capsys.readouterr().out.startswith("trained 128 timesteps in ")
+    assert zoo_main(cmd) == 0
+    assert capsys.readouterr().out.startswith("already trained: 128 timesteps -> ")
+
+
 def test_cli_train_shows_its_progress_unless_told_not_to(tmp_path, capsys):
     """``surveil train`` / ``python -m training`` showed progress only given ``--progress``
     while ``python -m training.zoo reproduce`` shows it by default. Now both do: not a

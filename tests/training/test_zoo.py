@@ -450,6 +450,48 @@ def test_reproduce_shows_its_progress_unless_told_not_to(tmp_path, monkeypatch, 
     assert zoo_main(["reproduce", "tiny", "--output-dir", str(tmp_path / "c"), "--progress"]) == 0
 
 
+@pytest.mark.parametrize("method", ["dagger", "rl"])
+def test_an_interrupted_reproduce_says_what_it_kept(tmp_path, monkeypatch, capsys, method):
+    """Ctrl-C in ``python -m training.zoo reproduce`` (a shipped model retrains for up to
+    an hour) printed only "python -m training.zoo: interrupted", though a rerun resumes
+    from the newest checkpoint (or DAgger iteration), as ``surveil train`` says."""
+    from tests.training.test_train import Interrupt
+    from training.train import train
+    from training.zoo.__main__ import main as zoo_main
+
+    monkeypatch.setattr(zoo, "MODELS_DIR", tmp_path / "zoo")
+    out = tmp_path / "again"
+    if method == "dagger":
+        run = _tiny_dagger_run(tmp_path / "run")
+
+        def stopped(cfg, **kwargs):  # one iteration kept, then Ctrl-C
+            (out / "progress.json").parent.mkdir(parents=True, exist_ok=True)
+            (out / "progress.json").write_text('{"samples": [10]}')
+            raise KeyboardInterrupt
+
+        monkeypatch.setattr(zoo, "dagger", stopped)
+        expected = f"stopped: 1 of 1 iterations are in {out}; rerun the same command"
+    else:
+        run = tmp_path / "run"
+        train(TrainConfig(role="pursuer", opponent="evader/straight", total_timesteps=256,
+                          n_steps=64, batch_size=32, eval_episodes=0, checkpoint_freq=64,
+                          env={"max_cycles": 40}, output_dir=str(run)))  # fmt: skip
+        monkeypatch.setattr(
+            zoo, "train", lambda c, **kw: train(c, callbacks=[Interrupt(150)], **kw)
+        )
+        expected = f"stopped: 128 of 256 timesteps are in {out / 'checkpoints'}"
+    zoo.install("tiny", run)
+    cmd = ["reproduce", "tiny", "--output-dir", str(out), "--no-progress"]
+    assert zoo_main(cmd) == 130
+    err = capsys.readouterr().err
+    assert expected in err and err.endswith("python -m training.zoo: interrupted\n"), err
+    monkeypatch.undo()
+    monkeypatch.setattr(zoo, "MODELS_DIR", tmp_path / "zoo")
+    if method == "rl":  # the rerun resumes from that checkpoint
+        assert zoo_main(cmd) == 0
+        assert (out / "model.zip").is_file()
+
+
 @pytest.mark.parametrize(
     ("model", "opponent", "message"),
     [

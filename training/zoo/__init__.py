@@ -45,6 +45,7 @@ __all__ = [
     "model_path",
     "policy_name",
     "reproduce",
+    "run_config",
     "trained_env",
     "training_maps",
 ]
@@ -87,6 +88,14 @@ def info(name: str) -> dict[str, Any]:
 def config(name: str) -> TrainConfig | DaggerConfig:
     """The training config of ``name`` (RL or DAgger, by its ``method``)."""
     return load_any_config(_dir(name) / "config.toml")
+
+
+def run_config(
+    name: str, output_dir: str | os.PathLike[str] | None = None
+) -> TrainConfig | DaggerConfig:
+    """The config :func:`reproduce` trains ``name`` with: its recipe, writing to
+    ``output_dir`` (default ``out/zoo/<name>``)."""
+    return config(name).replace(output_dir=os.fspath(output_dir or Path("out/zoo") / name))
 
 
 def trained_env(name: str) -> str | None:
@@ -153,7 +162,7 @@ def reproduce(
             per iteration on stdout). ``python -m training.zoo reproduce`` shows it unless
             given ``--no-progress``.
     """
-    cfg = config(name).replace(output_dir=os.fspath(output_dir or Path("out/zoo") / name))
+    cfg = run_config(name, output_dir)
     from training.train import ENV_NAME
 
     changed = code_changed_since(info(name).get("git_sha"))

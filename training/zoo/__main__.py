@@ -8,7 +8,7 @@ import sys
 
 from envs.console import CommandParser, interrupts_recorded, progress_flags
 from training import zoo
-from training.cli import run_cli
+from training.cli import resume_note, run_cli
 from training.config import opponent_name
 from training.train import evaluate_model
 
@@ -77,13 +77,20 @@ def _main(argv: list[str] | None) -> int:
     elif args.command == "info":
         print(json.dumps(zoo.info(args.name), indent=2))
     elif args.command == "reproduce":
-        r = zoo.reproduce(args.name, args.output_dir, install_result=args.install,
-                          progress_bar=not args.no_progress)  # fmt: skip
+        try:
+            r = zoo.reproduce(args.name, args.output_dir, install_result=args.install,
+                              progress_bar=not args.no_progress)  # fmt: skip
+        except KeyboardInterrupt:  # said only "interrupted", though a rerun resumes
+            print(resume_note(zoo.run_config(args.name, args.output_dir)), file=sys.stderr)
+            raise
         if not hasattr(r, "timesteps"):  # a DAgger recipe
             print(f"dagger: {r.samples[-1]} labelled states in {r.wall_seconds:.1f} s "
                   f"-> {r.model_path}")  # fmt: skip
             return 0
-        print(f"trained {r.timesteps} timesteps in {r.wall_time:.1f} s -> {r.model_path}")
+        if r.already_trained:  # was "trained 151552 timesteps in 0.0 s"
+            print(f"already trained: {r.timesteps} timesteps -> {r.model_path}")
+        else:
+            print(f"trained {r.timesteps} timesteps in {r.wall_time:.1f} s -> {r.model_path}")
         if r.evaluation is not None:
             print(_line(r.evaluation))
     else:

@@ -665,3 +665,34 @@ def test_a_worker_builds_each_maps_set_up_before_its_first_match(tmp_path, monke
     outcomes = [worker.play(match, ctx) for match, _ in plan(spec)]
     assert [o["status"] for o in outcomes] == ["ok", "ok"], outcomes
     assert built == []  # all of it was on no match's watch
+
+
+def test_a_worker_builds_the_judge_of_its_safe_starts_before_its_first_match(tmp_path, monkeypatch):
+    # The warm-up drew a valid start only: a worker's first "safe" start on a map built
+    # the judge's safety table (a decomposition pursuer's) in the harness's first stretch,
+    # on the match's watch: 1.0 s on office at load 7, then 0.012 s. A spec with
+    # time_limit = 0.05 stored that match as "MatchTimeout: the env or the harness gave
+    # no answer for 1.05 s ... while no policy was deciding"; rerun, it played.
+    import numpy as np
+
+    from analysis.tournament import worker
+    from analysis.tournament.identity import plan
+    from envs.maps import Map
+    from envs.maps.io import save_map
+    from strategies.policies.safety import safety_table
+
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", str(tmp_path / "cache"))  # nothing on disk
+    a = np.linspace(0.0, 2.0 * np.pi, 23, endpoint=False)  # walls no other test draws
+    path = tmp_path / "round23.json"
+    save_map(Map(np.c_[7.17 * np.cos(a), 7.17 * np.sin(a)], [], name="round23"), path)
+    spec = spec_from_dict(
+        {"maps": [str(path)], "pursuers": ["pursuer/greedy"], "evaders": ["evader/random"],
+         "seeds": [3, 4], "start": ["safe", "valid"], "env": {"max_cycles": 5}}
+    )  # fmt: skip
+    ctx = worker.context_for(spec)
+    assert ctx.starts == ("safe", "valid")
+    worker.warm_up(ctx)
+    built = safety_table.cache_info().misses
+    outcomes = [worker.play(match, ctx) for match, _ in plan(spec)]
+    assert [o["status"] for o in outcomes] == ["ok"] * 4, outcomes
+    assert safety_table.cache_info().misses == built  # the judge's table: on no watch

@@ -323,3 +323,35 @@ def test_sigterm_while_ray_starts_stops_as_sigterm_does_elsewhere(tmp_path):
     while {"raylet", "gcs_server"} & set(_session_names(proc.pid)):  # shut down, not left
         assert time.monotonic() < deadline, _session_names(proc.pid)
         time.sleep(0.1)
+
+
+def test_a_local_instance_starts_beside_another_cluster(tmp_path):
+    """``--backend ray`` without ``--address`` is a local instance, but ``ray.init``
+    without an address joins the cluster ``/tmp/ray/ray_current_cluster`` names (a
+    ``ray start --head`` running, or the stale file of one stopped by a signal), and with
+    ``--workers`` it raised "When connecting to an existing cluster, num_cpus and num_gpus
+    must not be provided": a traceback. Here the file names a cluster that is gone."""
+    import shutil
+    import tempfile
+
+    spec = tmp_path / "s.toml"
+    spec.write_text(
+        'name = "s"\nmaps = ["open_room"]\nseeds = 2\nstart = "valid"\n'
+        'pursuers = ["pursuer/greedy"]\nevaders = ["evader/random"]\n[env]\nmax_cycles = 20\n'
+    )
+    ray_tmp = Path(tempfile.mkdtemp(prefix="r", dir="/tmp"))  # short: Ray's socket paths
+    try:
+        (ray_tmp / "ray").mkdir()
+        (ray_tmp / "ray" / "ray_current_cluster").write_text("127.0.0.1:1")
+        root = Path(__file__).resolve().parents[3]
+        command = [sys.executable, "-m", "analysis.cli", "tournament", str(spec)]
+        command += ["--backend", "ray", "--workers", "1", "--store", str(tmp_path / "s.sqlite")]
+        env = {**os.environ, "PYTHONPATH": str(root), "RAY_TMPDIR": str(ray_tmp),
+               "SDL_VIDEODRIVER": "dummy", "MPLBACKEND": "Agg"}  # fmt: skip
+        env.pop("RAY_ADDRESS", None)
+        out = subprocess.run([*command, "--no-progress", "--no-report"], env=env, cwd=tmp_path,
+                             capture_output=True, text=True, timeout=300)  # fmt: skip
+    finally:
+        shutil.rmtree(ray_tmp, ignore_errors=True)
+    assert "Traceback" not in out.stderr and out.returncode == 0, out.stderr[-2000:]
+    assert "2 of 2 matches stored" in out.stdout and "ray (1 CPUs)" in out.stdout, out.stdout

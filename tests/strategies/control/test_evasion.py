@@ -500,6 +500,34 @@ def test_shoot_refuses_a_default_step_budget_it_cannot_keep(rho):
     assert len(shoot(math.pi, 0.0, 0.0, L=1.0, rho=rho, x_max=2.5, step=0.05).x) > 1
 
 
+@pytest.mark.parametrize("rho", [1.0, 1.5, 3.0])
+def test_the_default_steps_refuse_rho_at_or_above_one(rho):
+    # default_step(2, 1, rho) was 0.0 at rho = 1 (capped_step then divided by it:
+    # ZeroDivisionError) and negative beyond (-0.00625 at 1.5): no extremal to step along
+    from strategies.control.evasion import default_step
+
+    for step in (default_step, capped_step):
+        with pytest.raises(InfeasibleError, match=rf"rho = {rho}: optimal evasion .* 0 < rho < 1"):
+            step(2.0, 1.0, rho)
+
+
+@pytest.mark.parametrize(
+    ("args", "name"),
+    [((2.0, -1.0, 0.5), "L"), ((0.0, 1.0, 0.5), "x_max"), ((2.0, 1.0, 0.0), "rho"),
+     ((2.0, 1.0, math.nan), "rho"), ((2.0, 0.0, 0.5), "L")],
+)  # fmt: skip
+def test_the_default_steps_refuse_a_bad_length_or_ratio(args, name):
+    # L = -1 gave a negative step, x_max = 0 or rho = 0 a zero one (capped_step:
+    # ZeroDivisionError), rho = NaN a NaN step
+    from strategies.control.evasion import default_step
+
+    want = rf"^{name} = \S+: expected a finite number > 0"
+    for step in (default_step, capped_step):
+        with pytest.raises(SurveilValueError, match=want):
+            step(*args)
+    assert default_step(2.0, 1.0, 0.5) == pytest.approx(1.0 * 0.5 / 1.5 / 32)
+
+
 @pytest.mark.parametrize("method", ["reduced", "pmp"])
 def test_shoot_refuses_a_step_beyond_the_horizon(method):
     # `surveil figure greedy --params '{"step": 1e12}'` drew an empty figure and exited 0:

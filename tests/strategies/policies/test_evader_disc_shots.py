@@ -119,3 +119,141 @@ def test_the_most_a_shortening_rod_turns_is_eq_6_s_largest_rate_integrated(rod, 
     s = (np.arange(200_000) + 0.5) * t / 200_000
     rate = 1.2 / np.maximum(2.0, rod - 1.2 * s)
     assert _most_turn(1.2, rod, 2.0, t) == pytest.approx(rate.sum() * t / 200_000, rel=1e-6)
+
+
+# ---------------------------------------------------------------- the two-leg look
+# (ShootingEvader._via_corner: where no straight shot on a long rod has a positive margin,
+# first to the point beside a convex corner, then a shot from there; the wall's tip has two
+# such points, 0.3 west and east of it)
+
+
+def _every_corner_in_full(ev, e, theta, p, rod):
+    """The two-leg look as first written (37bf9d1): per corner, nearest first, its first
+    leg's checks, then the candidates and margins from its point, then the second leg's.
+    Returns the look's answer and whether any corner's point had a positive margin."""
+    from strategies.policies.shooting import _most_turn
+
+    c = ev.config
+    pts = ev._corner_points
+    dist = np.linalg.norm(pts - e, axis=1)
+    floor = min(c.body_radius, float(ev.map.distance_to_walls(e[None])[0]))
+    positive = False
+    for i in np.argsort(dist, kind="stable").tolist():
+        if dist[i] > ev._n_r * ev.table.resolution:
+            break
+        t1 = float(dist[i]) / c.v_evader
+        turn1 = _most_turn(c.v_pursuer + c.v_evader, rod, c.l_min, t1)
+        if turn1 >= np.pi:
+            break
+        q0 = pts[i]
+        if dist[i] <= c.v_evader * c.dt or ev._corner_rows[i] < 0 or ev._near_banned(q0[None])[0]:
+            continue
+        rays, ray_rows, corners, corner_rows = ev._candidates(q0)
+        cand = np.concatenate([rays, corners])
+        rows = np.concatenate([ray_rows, corner_rows])
+        rod1 = max(c.l_min, rod - (c.v_pursuer + c.v_evader) * t1)
+        margin = ev._rate_margins(q0, theta, cand, rows, rod1)[0] - turn1
+        reach = ev._reach_margins(q0, theta, cand, rows, rod, p=p, lead=t1)[0]
+        margin = np.maximum(margin, reach)
+        margin[ev._near_banned(cand)] = -np.inf
+        if not len(margin) or margin.max() <= 0.0:
+            continue
+        positive = True
+        if not ev.kernel.line_of_sight(e, q0) or not ev._disc_reaches(e, q0, floor):
+            continue
+        floor1 = min(c.body_radius, float(ev.map.distance_to_walls(q0[None])[0]))
+        for k in np.argsort(-margin, kind="stable").tolist():
+            if margin[k] <= 0.0:
+                break
+            if ev._disc_reaches(q0, cand[k], floor1):
+                return q0, positive
+    return None, positive
+
+
+def _looks(n: int = 300):
+    """States round the wall's tip (e free, 0.1 from the walls): the rod of 2-6 m at a
+    random orientation, the pursuer at its end."""
+    m = Map([(0, 0), (10, 0), (10, 10), (0, 10)], [_WALL], name="wall_tip", merge=True)
+    rng = np.random.default_rng(0)
+    out = []
+    while len(out) < n:
+        e = rng.uniform([4.0, 3.5], [6.0, 5.5])
+        if not m.contains(e[None])[0] or m.distance_to_walls(e[None])[0] < 0.1:
+            continue
+        theta, rod = rng.uniform(-np.pi, np.pi), rng.uniform(2.0, 6.0)
+        out.append((e, theta, e + rod * np.array([np.cos(theta), np.sin(theta)]), rod))
+    return out
+
+
+class _Counting(ShootingEvader):
+    """The shooting evader, counting the disc's path checks and the candidate sets."""
+
+    def _reset(self) -> None:
+        self.calls = {"disc": 0, "candidates": 0}
+        super()._reset()
+
+    def _disc_reaches(self, e, q, floor):
+        self.calls["disc"] += 1
+        return super()._disc_reaches(e, q, floor)
+
+    def _candidates(self, e):
+        self.calls["candidates"] += 1
+        return super()._candidates(e)
+
+
+def test_a_two_leg_look_finds_what_trying_every_corner_in_full_finds(evader):
+    # the same corner point, or none, on every state (26 of the 300 find one)
+    found = 0
+    for e, theta, p, rod in _looks():
+        want, _ = _every_corner_in_full(evader, e, theta, p, rod)
+        got = evader._via_corner(e, theta, p, rod)
+        assert (got is None) == (want is None), (e, theta, rod)
+        if got is not None:
+            assert np.array_equal(got, want)
+            found += 1
+    assert 10 <= found <= 290
+
+
+def test_a_look_whose_corners_have_no_margin_traces_no_disc_path():
+    # most looks find nothing (unseen-e's first 200 steps: 1,461 of 1,678 corner points
+    # had no positive margin): there the look checks no path of the disc, and the
+    # candidates from a corner's point are gathered once for the map, not on every look
+    m = Map([(0, 0), (10, 0), (10, 10), (0, 10)], [_WALL], name="wall_tip", merge=True)
+    config = EnvConfig(map=m, l_min=2.0, l_max=6.0, v_pursuer=1.0, v_evader=0.2, body_radius=0.1)
+    ev = _Counting()
+    ev.reset(role="evader", map=m, config=config, seed=0)
+    ref = ShootingEvader()
+    ref.reset(role="evader", map=m, config=config, seed=0)
+    ev.calls.update(disc=0, candidates=0)
+    idle = 0
+    for e, theta, p, rod in _looks():
+        _, positive = _every_corner_in_full(ref, e, theta, p, rod)
+        disc = ev.calls["disc"]
+        ev._via_corner(e, theta, p, rod)
+        if not positive:
+            assert ev.calls["disc"] == disc, (e, theta, rod)
+            idle += 1
+    assert idle >= 250
+    assert ev.calls["candidates"] <= len(ev._corner_points) == 2
+
+
+def test_a_margin_less_a_turn_is_integrated_only_where_it_can_exceed_the_turn(evader):
+    # _rate_margins(..., less=t): the margins that can exceed t as without it, bit for
+    # bit, and -inf where the margin is at most t (the first leg's turn, taken off after)
+    e = np.array([4.0, 3.0])
+    ang = np.linspace(0.0, 2.0 * np.pi, 48, endpoint=False)
+    ring = np.stack([np.cos(ang), np.sin(ang)], axis=1)
+    cand = np.concatenate([e + r * ring for r in (0.3, 0.6, 1.2)])
+    rows = evader.table.rows(cand)
+    # (finite margins -0.53..0.46, -1.69..0.71, -1.56..0.90, -0.74..0.20 rad)
+    for theta, rod, t in ((0.0, 2.0, 0.2), (0.0, 4.0, 0.5), (0.0, 5.5, 0.3), (0.5, 4.0, 0.0)):
+        full, _ = evader._rate_margins(e, theta, cand, rows, rod)
+        less, _ = evader._rate_margins(e, theta, cand, rows, rod, less=t)
+        kept = np.isfinite(less)
+        assert np.array_equal(less[kept], full[kept])
+        assert (full[~kept] - t <= 0.0).all()
+        assert (less[kept] > t).any()
+        if t:
+            assert kept.sum() < np.isfinite(full).sum()
+        else:
+            assert np.array_equal(less, full)

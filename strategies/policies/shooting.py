@@ -39,11 +39,11 @@ For rho > 1 it runs straight at the pursuer (footnote 4; see :meth:`ShootingEvad
 4. Otherwise **pressure**: move straight at the pursuer (Sec. 6.1, a heading
    minimising max |theta_dot|); against a wall, slide along it perpendicular to the rod,
    the way that does not press straight into the wall. After ``HERD_AFTER`` D / V_e of it
-   (D the map's diameter), from the first step the pursuer comes within L_max of a
-   concave corner, herd instead: get to the far side of the pursuer from the nearest
-   concave corner for which that point is in sight (sliding along a wall it grazes),
-   then charge, pinning it there; with no such corner, charge. Only corners whose walls
-   turn by at least ``HERD_MIN_TURN`` count (a shallow notch is a wall to the pursuer).
+   (D the map's diameter), wherever the pursuer is, herd instead: get to the far side of
+   the pursuer from the nearest concave corner for which that point is in sight (sliding
+   along a wall it grazes), then charge, pinning it there; with no such corner, charge.
+   Only corners whose walls turn by at least ``HERD_MIN_TURN`` count (a shallow notch is
+   a wall to the pursuer).
 """
 
 from __future__ import annotations
@@ -678,20 +678,22 @@ class ShootingEvader(BasePolicy):
             # the charge made no end of it: pin the pursuer into its nearest concave
             # corner, where it cannot back off (issue 13: random:star:11 at rho 0.3
             # against the decomposition pursuer, 4,700 steps of charging in the open).
-            # Only from a step where the corner lies within the rod's longest reach
-            # (L_max) of the pursuer: from farther off the pursuer, faster, slips round
-            # the evader, and the herd dragged it along the walls round the whole map
-            # until the plan escaped (random:star:11, seed 507: herding from wherever the
-            # pursuer was after 2,500 steps or 3 D / V_e, occluded at 6.54 or 7.10
-            # D / V_e). Within L_min, as before, was luck: on that episode the charge
-            # settles into a loop, the pursuer orbiting the evader at up to L_max, and
-            # whether the orbit passes within L_min of a corner depends on the path that
-            # led there (it did at 5.54 D / V_e; with the longer trail below, never)
-            if not self._herding:
-                d = self._concave - snap.pursuer
-                self._herding = float(np.einsum("ij,ij->i", d, d).min()) <= c.l_max**2
+            # Wherever the pursuer is: the herd began only from a step where it came
+            # within L_max of a concave corner, and a charge that keeps it in the open
+            # never brings it there (issue 13: unseen random:rectangles:16, rho 0.3,
+            # L in [2, 3], seed 1019 against the decomposition pursuer, whose only
+            # concave corners are the room's four: charged and walked a plan that
+            # promises nothing for the whole 8 D / V_e, the pursuer at least 4.2 from
+            # every corner after the first 3 D / V_e; herding from HERD_AFTER, too
+            # close at 5.97 D / V_e, as the corner herder of
+            # benchmarks/unseen_opponents.py is from the same start at 0.59).
+            # The gate was for random:star:11 seed 507, where herding from farther off
+            # dragged the pursuer round the map (occluded at 6.54 D / V_e, 5.54 from
+            # within L_min); there it now starts 18 steps earlier than the gate let it
+            # (step 3,567), too close at 5.22 D / V_e either way
+            self._herding = True
             # (no corner whose far side is in sight: charge)
-            h = self._herd(e, snap.pursuer, u, float(snap.L)) if self._herding else None
+            h = self._herd(e, snap.pursuer, u, float(snap.L))
             if h is not None:
                 if self._near_wall(e, c.body_radius + 2.0 * c.v_evader * c.dt):
                     # pressed to a wall, as the charge below, the push is lost: the

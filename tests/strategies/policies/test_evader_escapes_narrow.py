@@ -11,15 +11,23 @@ falls back. Each episode was held for the whole 8 D / V_e horizon before:
   region; the charge escapes in 0.35 D / V_e.
 * ``random:star:11``, rho = 0.3, L_max = 1.5 L_min, against the decomposition pursuer
   (seed 507): 4,700 steps of charging in the open, the pursuer backing off. After
-  ``HERD_AFTER`` D / V_e of it, from the first step the pursuer is within L_max of a
-  concave corner, the evader herds it toward that corner, and escapes (occluded, at
-  6.13 D / V_e). Herding from wherever the pursuer was after 2,500 steps dragged it
-  round the map and escaped (occluded) 1 D / V_e later than herding from within L_min
-  (pinned in the corner, too close, 5.54 D / V_e); but whether the pursuer came within
-  L_min of a corner was luck, and with the trail of n_cells + 1 crossings it never did
-  (test_evader_herd.py). The trigger is game time, not steps: at twice the
-  step (dt 0.2 s) 2,500 steps of charging came after the 8 D / V_e horizon and the
+  ``HERD_AFTER`` D / V_e of it the evader herds it toward a concave corner, and
+  escapes (occluded at 6.13 D / V_e when the herd waited for the pursuer to come
+  within L_max of a corner; too close at 5.22 since it herds wherever the pursuer is).
+  Herding from wherever the pursuer was after 2,500 steps dragged it round the map
+  and escaped (occluded) 1 D / V_e later than herding from within L_min (pinned in
+  the corner, too close, 5.54 D / V_e); but whether the pursuer came within L_min of
+  a corner was luck, and with the trail of n_cells + 1 crossings it never did
+  (test_evader_herd.py). The trigger is game time, not steps: at twice the step
+  (dt 0.2 s) 2,500 steps of charging came after the 8 D / V_e horizon and the
   pursuer held.
+* ``random:rectangles:16`` (unseen), rho = 0.3, L_max = 1.5 L_min, against the
+  decomposition pursuer (seed 1019): every cell's plan promises nothing (a rank of at
+  least n_cells), and the room's four corners are its only concave ones; the charge
+  kept the pursuer at least 4.2 from each after the first 3 D / V_e, so the herd,
+  which began only within L_max of one, never did. Herding wherever the pursuer is
+  after ``HERD_AFTER``: too close at 5.97 D / V_e (the corner herder of the pursuer
+  benchmark, herding from the first step, at 0.59).
 """
 
 from __future__ import annotations
@@ -87,6 +95,14 @@ def test_herds_after_a_charge_of_three_crossings_in_game_time():
     x0, y0, x1, y1 = m.bounds  # this map's diameter is its bounding-box diagonal
     assert ev._herd_after == pytest.approx(3.0 * math.hypot(x1 - x0, y1 - y0) / 0.3 / 0.2)
     assert ev._pressed > ev._herd_after  # it escaped herding
+
+
+def test_herds_a_pursuer_kept_far_from_every_corner():
+    r, ev = _herd("random:rectangles:16", 1019, 3.0, 8.0)
+    assert r.winner == "evader", r.summary()
+    assert ev._herding and ev._pressed > ev._herd_after  # it escaped herding
+    concave = ev._concave
+    assert len(concave) == 4  # the room's corners only
 
 
 def test_herds_into_a_corner_not_a_star_s_shallow_notch():

@@ -7,8 +7,11 @@ luck, each against the decomposition pursuer at rho 0.3:
 * ``random:star:11`` [0.3, 1.5, 2] seed 507: from ~170 s the charge settles into a loop
   (period ~51 s, exact to 3e-4) in the open, the pursuer orbiting the evader; the herd
   started only from a step where the pursuer came within L_min of a concave corner,
-  which the old path's orbit happened to do at ~360 s and the new one never does. Now
-  it starts within L_max (the rod's longest reach): escaped 465.0 s (6.13 D / V_e).
+  which the old path's orbit happened to do at ~360 s and the new one never does. It
+  started within L_max (the rod's longest reach): escaped 465.0 s (6.13 D / V_e). Now
+  it starts wherever the pursuer is: on unseen ``random:rectangles:16`` [0.3, 1.5, 2]
+  seed 1019, whose only concave corners are the room's four, the charge kept the
+  pursuer at least 4.2 from each after the first 3 D / V_e and the herd never began.
 * ``office`` at half scale [0.3, 2, 2] seed 909: the herd froze for the last 270 s of
   the horizon with the evader pressed against a wall below a door, the pursuer in the
   door, the herd's target (the far side of the pursuer from the corner) across that
@@ -74,7 +77,7 @@ def test_a_herd_into_a_wall_slides_along_it():
     assert np.array_equal(ev._along_wall(e, -to, u), -to)
 
 
-def test_the_herd_starts_within_l_max_of_a_concave_corner():
+def test_the_herd_starts_wherever_the_pursuer_is():
     m = load_map("random:star:11")
     params = {"l_min": 2.0, "l_max": 3.0, "v_pursuer": 1.0, "v_evader": 0.3,
               "body_radius": 0.1}  # fmt: skip
@@ -89,11 +92,19 @@ def test_the_herd_starts_within_l_max_of_a_concave_corner():
     v = ev._decide(_snap(e, p))
     assert ev._herding
     assert np.allclose(v, 0.3 * ev._herd(e, p, (p - e) / 2.0, 2.0))
-    # farther than L_max from every concave corner: it charges
+    # farther than L_max from every concave corner: it herds too (it charged here
+    # before, and a charge that keeps the pursuer in the open never brings it nearer)
     ev = _pressing(m, params)
     e, p = np.array([13.0, 5.5]), np.array([13.0, 3.5])
     assert np.linalg.norm(concave - p, axis=1).min() > 3.0
     assert float(m.distance_to_walls(np.stack([e, p])).min()) > 0.5
+    v = ev._decide(_snap(e, p))
+    assert ev._herding
+    h = ev._herd(e, p, (p - e) / 2.0, 2.0)
+    assert h is not None and not np.allclose(h, [0.0, -1.0])  # not the charge
+    assert np.allclose(v, 0.3 * h)
+    # before HERD_AFTER of pressure: the charge, wherever the pursuer is
+    ev = _pressing(m, params, after=False)
     v = ev._decide(_snap(e, p))
     assert not ev._herding
     assert np.allclose(v, [0.0, -0.3])

@@ -1048,17 +1048,26 @@ class DecompositionPursuer(BasePolicy):
         last ``ORBIT_LOOKAHEAD`` seconds does not give it.
 
         A hard turn toward a circle short of room gives way to the decomposition's own
-        ``rate`` when its path meets a wall within ``ORBIT_LOOKAHEAD`` whatever the
-        evader does (both modes of :meth:`_time_to_wall`) and ``rate``'s path stays
-        clear in both: a circle that needs the pursuer to pass through a wall first is
-        not one it will reach. In a 10 x 10 room with a 2 x 2 pillar in the middle (the
-        ring round it 4 wide, ``R + body`` = 2.55 at L_min = 2) the hard ccw turn's
-        circle came within ``ORBIT_REACH`` (short by 0.50) and never closer, and the
-        pursuer swung for it into the pillar's face (wall 1.6 s ahead, then 1.5, ...
-        0.1 s) while the cw turn was clear: pinned, "too_close" at 33.3 s by a straight
-        evader; in a room with a triangular pillar at rho 0.3 the same swing lost to a
-        charger in 7.6 s (issue 13). Giving way as soon as any wall lay ahead, in either
-        mode, lost other episodes (the corner world's variants, 422 -> 415/432).
+        ``rate`` when its path meets a wall within ``ORBIT_LOOKAHEAD`` whatever the evader
+        does (both modes of :meth:`_time_to_wall`) and ``rate``'s path stays clear in both:
+        a circle that needs the pursuer to pass through a wall first is not one it will
+        reach. Where the pick's path is walled at its first point (``WALL_STEP``: the body
+        is at the wall, and the hard turn pushes into it), ``rate``'s path need stay clear
+        only for ``ORBIT_LOOKAHEAD``: on the L-shaped hall turned by 0.37 rad (rho 0.5) an
+        evader heading for the shadow a pillar's corner casts from the pursuer (session 26)
+        walked it into that corner from a safe start, the hard turn's wall 0.1 s ahead and
+        ``rate``'s 2.0 s ahead with the evader following the rod, and the pursuer pushed
+        into the pillar until too close at 1.31 s. Giving way so wherever the pick's wall
+        lay within ``ORBIT_LOOKAHEAD`` alternated between the two hard turns against the
+        corner herder at L_min 1 (the pick's wall 0.9-1.1 s ahead, in and out of the
+        threshold) and lost two held-out episodes. In a 10 x 10 room with a 2 x 2 pillar in
+        the middle (the ring round it 4 wide, ``R + body`` = 2.55 at L_min = 2) the hard ccw
+        turn's circle came within ``ORBIT_REACH`` (short by 0.50) and never closer, and the
+        pursuer swung for it into the pillar's face (wall 1.6 s ahead, then 1.5, ... 0.1 s)
+        while the cw turn was clear: pinned, "too_close" at 33.3 s by a straight evader; in
+        a room with a triangular pillar at rho 0.3 the same swing lost to a charger in 7.6 s
+        (issue 13). Giving way as soon as any wall lay ahead, in either mode, lost other
+        episodes (the corner world's variants, 422 -> 415/432).
 
         With ``field`` (a stalled ride) a hard turn whose path stays clear replaces the pick
         only if it scores no worse by the way to room: a clear path away from every circle
@@ -1088,11 +1097,14 @@ class DecompositionPursuer(BasePolicy):
         if near and pick == rate:
             return pick
         if near:  # the decomposition's turn if the pick's path hits a wall within
-            # ORBIT_LOOKAHEAD whatever the evader does, and its own is clear
-            soon = all(self._time_to_wall(snap, pick, L, f) <= T for f in (True, False))
-            clear = all(self._time_to_wall(snap, rate, L, f) == math.inf for f in (True, False))
-            if soon and clear:
-                return rate
+            # ORBIT_LOOKAHEAD whatever the evader does, and its own is clear; or if the
+            # pick's path is walled at its first point (the body at the wall: the hard
+            # turn pushes into it) and its own stays clear for ORBIT_LOOKAHEAD
+            walls = max(self._time_to_wall(snap, pick, L, f) for f in (True, False))
+            if walls <= T:
+                own = min(self._time_to_wall(snap, rate, L, f) for f in (True, False))
+                if own == math.inf or (walls <= self.WALL_STEP and own > T):
+                    return rate
             return self._off_the_normal(snap, rate, pick, L, herding=True)
         turn = pick
         if all(self._time_to_wall(snap, pick, L, f) < math.inf for f in (True, False)):

@@ -542,6 +542,20 @@ def test_name_merge_and_transforms_follow_the_number_rule():
     assert m.transformed(np.eye(2), (1, 2)).bounds == (1.0, 2.0, 5.0, 6.0)
 
 
+def _count_pair_distances(monkeypatch) -> list[int]:
+    """Count the (point, edge) pairs Map._pair_distances measures from now until
+    ``monkeypatch.undo()``: one entry a call, its number of pairs."""
+    pairs: list[int] = []
+    measure = Map._pair_distances
+
+    def counted(self, p, e):
+        pairs.append(len(e))
+        return measure(self, p, e)
+
+    monkeypatch.setattr(Map, "_pair_distances", counted)
+    return pairs
+
+
 def test_wall_distances_of_many_points_read_few_edges_and_keep_every_float(monkeypatch):
     """The shooting evader's reset measures the walls' distance of 10^5-10^6 points (its
     escape plan's crossings and grid walk): against every edge, 113 of the 163 s of its
@@ -572,14 +586,7 @@ def test_wall_distances_of_many_points_read_few_edges_and_keep_every_float(monke
                 m.vertices,
             ]
         )
-        pairs = []
-        measure = Map._pair_distances
-
-        def counted(self, p, e, pairs=pairs, measure=measure):
-            pairs.append(len(e))
-            return measure(self, p, e)
-
-        monkeypatch.setattr(Map, "_pair_distances", counted)
+        pairs = _count_pair_distances(monkeypatch)
         got = m.distance_to_walls(pts)
         monkeypatch.undo()
         assert sum(pairs) < 0.05 * len(pts) * m.n_edges, sum(pairs) / len(pts)
@@ -610,14 +617,7 @@ def test_wall_distances_of_a_few_points_on_a_large_map_go_through_the_index(monk
                 m.vertices[:k],
             ]
         )
-        pairs = []
-        measure = Map._pair_distances
-
-        def counted(self, p, e, pairs=pairs, measure=measure):
-            pairs.append(len(e))
-            return measure(self, p, e)
-
-        monkeypatch.setattr(Map, "_pair_distances", counted)
+        pairs = _count_pair_distances(monkeypatch)
         # one point a call, and all at once
         got = [float(m.distance_to_walls(pts[i : i + 1])[0]) for i in range(len(pts))]
         together = m.distance_to_walls(pts)

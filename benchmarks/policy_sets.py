@@ -97,8 +97,15 @@ FRESH_WORLDS = " ".join(
 """32 random maps nobody had used (README: "On 32 random maps nobody had used")."""
 _HOLDS = "--seeds 8 --rho 0.5 --no-greedy"
 _HELDOUT_P = "--worlds @benchmarks/heldout_worlds_pursuer.txt"
-_BASE = "8bef7db"
-"""The commit every figure below holds at (all fifteen sets played there, compared per
+_BASE = "5270138"
+"""The commit every figure below holds at (all sixteen sets played there, compared per
+episode with 8bef7db: unseen-e +1, heldout-e +1 (3498ee2, the shooting evader's herd
+starts wherever the pursuer is), nothing lost; fresh-e with 791668b: +3; 15b205d (the
+pursuers at edge parameters) was played alone on all fifteen with every row identical,
+and 0d7e59f and 686f537 are the same decisions, faster. After it 791d52a (the
+decomposition's hard turn gives way where it pushes into a wall) was played on the
+eleven pursuer sets and the evader sets' decomposition episodes: every winner and loss
+time as here). Before: at 8bef7db, all fifteen, compared per
 episode with 3765f76: fresh-p0 +1 (0fee8e2, the pursuer's lead on a lap round a small
 obstacle: rand:star:3007:3.0 against the herder), nothing lost; 37bf9d1's two-leg shots
 moved escape times only). Before: at 34fa4ca, compared per
@@ -122,12 +129,10 @@ _FRESH_E = "--worlds @benchmarks/fresh_worlds_evader.txt --rhos 0.2 0.3 0.5 0.8 
 world labels nobody had used (``benchmarks/fresh_worlds_evader.txt``: two_rooms and office
 transformed, junctions, random maps of seeds 4501-4510, 4604-4605, floor plans 9-10), rho
 0.2-0.8 (0.2 in no other drawn set), seeds 6000-6999 (the other evader sets draw 100-1099)."""
-_FRESH_E_AT = "791668b"
-"""Where fresh-e was first played (its policies behave as 8bef7db's)."""
 _FIXED = _BASE
 """Where the three sets of ``fixed_starts.py`` were last played (first at c427419, 1283649's
 policies: certified-e 310/312 there; certified-e grew to 468 episodes at ea81a89, played
-at 34c7663, 3765f76 and 8bef7db): the
+at 34c7663, 3765f76, 8bef7db and 5270138): the
 corner world's default starts (the reproduction report's episodes) and the referee's
 certified starts (``benchmarks/certified_starts.json``)."""
 
@@ -161,11 +166,11 @@ SETS: dict[str, PolicySet] = {
              f"unseen_worlds.py --role pursuer {_HELDOUT_P} --combos 2"),
         _set("fresh-p0", "fresh_p0", "pursuer", "556/576", _BASE,
              f"unseen_worlds.py --role pursuer --combos 0 --worlds {FRESH_WORLDS}"),
-        _set("unseen-e", "eunseen", "evader", "1188/1189", _BASE,
+        _set("unseen-e", "eunseen", "evader", "1189/1189", _BASE,
              "unseen_worlds.py --role evader"),
-        _set("heldout-e", "eheldout", "evader", "776/779", _BASE,
+        _set("heldout-e", "eheldout", "evader", "777/779", _BASE,
              "unseen_worlds.py --role evader --worlds @benchmarks/heldout_worlds_evader.txt"),
-        _set("fresh-e", "fresh_e", "evader", "1130/1139", _FRESH_E_AT,
+        _set("fresh-e", "fresh_e", "evader", "1133/1139", _BASE,
              f"unseen_worlds.py --role evader {_FRESH_E}"),
         _set("escapes-bench", "bench3", "evader", "512/512", _BASE,
              "evader_escapes.py --seeds 4 --simple-seeds 0"),

@@ -448,12 +448,15 @@ def other_evader_jobs(worlds, l_mins, draws: int, rhos=None,
 
 
 MAX_CYCLES, K = 600, 8.0
+DRAWS = 2
+"""The evader role's episodes per (world, pursuer) unless ``--draws`` says otherwise."""
 """The default horizons: the pursuer role's in steps, the evader role's in D / V_e."""
 
 job_max_cycles, job_k = MAX_CYCLES, K  # the horizons, set by main (and in each worker)
 job_draw: dict = {}
 """How this run drew the other worlds' evader episodes when not as the default set
-(``{"rhos": [...], "seed_base": B}``, either alone): each such row records it."""
+(``{"rhos": [...], "seed_base": B}``, either alone), and every evader episode's when
+``--draws`` is not :data:`DRAWS` (``{"draws": N}``): each such row records it."""
 
 
 def _horizon(role: str) -> float:
@@ -486,8 +489,9 @@ def play(job) -> dict:
     role, w, combo, opponent, seed = job
     row = {"role": role, "world": w, "combo": combo, "opponent": opponent, "seed": seed,
            "horizon": _horizon(role)}  # fmt: skip
-    if role == "evader" and w not in EVADER_NAMES:
-        row.update(job_draw)  # its replay command draws the episodes so again
+    if role == "evader":  # its replay command draws the episodes so again (--draws
+        # draws every world's episodes; --rhos and --seed-base the other worlds')
+        row.update({k: v for k, v in job_draw.items() if k == "draws" or w not in EVADER_NAMES})
     t0 = time.perf_counter()
     try:
         if role == "pursuer":
@@ -596,6 +600,8 @@ def replay_command(row, results: str = "replay.jsonl") -> str:
         l_min += " --rhos " + " ".join(f"{rho:g}" for rho in row["rhos"])
     if other and "seed_base" in row:
         l_min += f" --seed-base {row['seed_base']}"
+    if not pursuer and "draws" in row:
+        l_min += f" --draws {row['draws']}"
     horizon = row.get("horizon", MAX_CYCLES if pursuer else K)
     if horizon != (MAX_CYCLES if pursuer else K):
         l_min += f" --max-cycles {horizon}" if pursuer else f" --k {horizon:g}"
@@ -845,8 +851,8 @@ def main(argv=None) -> int:
     ap.add_argument("--opponents", nargs="+", help="opponent labels (default: all)")
     ap.add_argument("--seeds", nargs="+", type=integer(0), help="pursuer role: seeds (101); "
                     "evader role: keep the episodes with these drawn seeds")  # fmt: skip
-    ap.add_argument("--draws", type=integer(1), default=2, help="evader role: episodes per world "
-                    "and pursuer")  # fmt: skip
+    ap.add_argument("--draws", type=integer(1), default=DRAWS,
+                    help="evader role: episodes per world and pursuer")  # fmt: skip
     ap.add_argument("--l-mins", nargs="+", type=real(0), help="evader role: the L_min (before "
                     "scaling) of worlds outside the default set (1 2), and a filter on the "
                     "default set's")  # fmt: skip
@@ -917,6 +923,8 @@ def main(argv=None) -> int:
     results = args.results or f"out/unseen_worlds_{args.role}.jsonl"
     print(f"load average: {os.getloadavg()}")
     jobs = select(args)
+    if args.role == "evader" and args.draws != DRAWS:  # another draw of every world's
+        draw["draws"] = args.draws
     _init(args.max_cycles, args.k, draw)  # before the keys: they name the horizon
     done = episode_rows.read(results, row_key)
     todo = jobs if args.play_again else [j for j in jobs if job_key(j) not in done]

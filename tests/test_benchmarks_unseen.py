@@ -197,7 +197,7 @@ def test_a_fresh_evader_world_draws_its_own_episodes(unseen, tmp_path, capsys) -
     assert row["world"] == "tee_w1.4" and row["combo"][2] == 2.0 and row["winner"] == "evader"
     assert "shooting evader escaped 1/1" in capsys.readouterr().out
     assert unseen.replay_command({**row, "winner": "pursuer"}).endswith(
-        f"--seeds {row['seed']} --l-mins 2 --results replay.jsonl --play-again"
+        f"--seeds {row['seed']} --l-mins 2 --draws 1 --results replay.jsonl --play-again"
     )
     label = "office~x0.6rot1.7off(1,2)"
     assert f"--worlds '{label}' " in unseen.replay_command(
@@ -247,6 +247,34 @@ def test_rhos_and_a_seed_base_draw_a_fresh_set_s_episodes_and_replay_them(
         with pytest.raises(SystemExit) as exc:
             unseen.main(["--role", role, *worlds, "--rhos", "0.2", "--results", str(out)])
         assert exc.value.code == 2 and says in capsys.readouterr().err
+
+
+def test_a_row_of_another_number_of_draws_replays_its_episode(
+    unseen, tmp_path, capsys, monkeypatch
+) -> None:
+    """``--draws`` changes every evader episode's (rho, ratio) and seed (one generator
+    draws them in turn): a row of a ``--draws 1`` run records it and its replay command
+    says it, or the replay drew two episodes a pursuer and found none of that seed."""
+    out = tmp_path / "d.jsonl"
+    argv = ["--role", "evader", "--worlds", "tee_w1.5a3.6", "--opponents", "still",
+            "--l-mins", "2", "--draws", "1", "--results", str(out)]  # fmt: skip
+    assert unseen.main(argv) == 0
+    (row,) = _rows(out)
+    assert row["draws"] == 1
+    words = shlex.split(unseen.replay_command({**row, "winner": "pursuer"}))
+    assert words[words.index("--draws") + 1] == "1"
+    monkeypatch.chdir(tmp_path)
+    capsys.readouterr()
+    assert unseen.main(words[2:]) == 0
+    assert "1 episodes selected, 1 to play" in capsys.readouterr().out
+    (again,) = _rows(tmp_path / "replay.jsonl")
+    assert {k: again[k] for k in ("combo", "seed", "start", "t", "steps")} == {
+        k: row[k] for k in ("combo", "seed", "start", "t", "steps")}  # fmt: skip
+    default = [w for w in argv if w not in ("--draws", "1")]
+    default[-1] = str(tmp_path / "two.jsonl")
+    assert unseen.main(default) == 0
+    rows = _rows(tmp_path / "two.jsonl")  # the default draws: rows as before
+    assert len(rows) == 2 and all("draws" not in r for r in rows)
 
 
 def test_a_replay_command_plays_its_episode_each_time(unseen, tmp_path, capsys, monkeypatch):

@@ -92,9 +92,7 @@ a `TypeError` that suggests the closest name.
 
 `map`: a `Map`, a built-in name (`envs.maps.builtin_names()`) or a map file path.
 
-`l_min`, `l_max`: the sensor range, 0 < l_min < l_max. A band narrower than two evader
-steps (l_max - l_min < 2 v_evader dt) is legal but raises a `NarrowBandWarning`: within a
-step the evader can move toward or away from the pursuer by more than half of it.
+`l_min`, `l_max`: the sensor range, 0 < l_min < l_max.
 
 `v_pursuer`, `v_evader`: speed bounds (> 0); rho = v_evader / v_pursuer. rho > 1 is legal
 but raises a `RhoAboveOneWarning`: escape is then trivial for the evader (Sec. 5).

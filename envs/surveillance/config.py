@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from envs import validation as v
-from envs.errors import InvalidConfigError, NarrowBandWarning, RhoAboveOneWarning
+from envs.errors import InvalidConfigError, RhoAboveOneWarning
 from envs.maps import Map, load_map
 from envs.maps.io import BODY_RADIUS, recommended_parameters
 from envs.maps.io import GLOBAL_DEFAULTS as _GLOBAL_DEFAULTS
@@ -168,17 +168,6 @@ class EnvConfig:
             )
         put("dt", v.positive("dt", self.dt))
         self._check_step_moves()
-        if self.l_max - self.l_min < 2.0 * self.v_evader * self.dt * (1.0 - 1e-9):
-            warnings.warn(
-                f"l_max - l_min = {self.l_max - self.l_min:.6g} < 2 v_evader dt = "
-                f"{2.0 * self.v_evader * self.dt:.6g} (l_min = {self.l_min!r}, l_max = "
-                f"{self.l_max!r}, v_evader = {self.v_evader!r}, dt = {self.dt!r}): in one "
-                "step the evader can move toward or away from the pursuer, whatever the "
-                "pursuer does in it, by more than half the band; legal, but no pursuer can "
-                "be sure to hold it (a wider band or a shorter dt)",
-                NarrowBandWarning,
-                stacklevel=_caller_stacklevel(),
-            )
         put("max_cycles", v.integer("max_cycles", self.max_cycles, minimum=1))
         put("observation", v.choice("observation", self.observation, OBSERVATION_KINDS))
         put("n_rays", v.integer("n_rays", self.n_rays, minimum=1, maximum=MAX_RAYS))

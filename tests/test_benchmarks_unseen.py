@@ -205,6 +205,18 @@ def test_a_fresh_evader_world_draws_its_own_episodes(unseen, tmp_path, capsys) -
          "seed": 101})  # fmt: skip
 
 
+def _replays_its_episode(unseen, words, row, tmp_path, capsys, monkeypatch) -> None:
+    """Run a row's replay command (``words``) in ``tmp_path``: it plays one episode, the
+    row's own (the same draw, start, time and steps)."""
+    monkeypatch.chdir(tmp_path)
+    capsys.readouterr()
+    assert unseen.main(words[2:]) == 0
+    assert "1 episodes selected, 1 to play" in capsys.readouterr().out
+    (again,) = _rows(tmp_path / "replay.jsonl")
+    assert {k: again[k] for k in ("combo", "seed", "start", "t", "steps")} == {
+        k: row[k] for k in ("combo", "seed", "start", "t", "steps")}  # fmt: skip
+
+
 def test_rhos_and_a_seed_base_draw_a_fresh_set_s_episodes_and_replay_them(
     unseen, tmp_path, capsys, monkeypatch
 ) -> None:
@@ -232,13 +244,7 @@ def test_rhos_and_a_seed_base_draw_a_fresh_set_s_episodes_and_replay_them(
     index = [(0.2, 2.0), (0.2, 1.5)].index(tuple(row["combo"][:2]))  # into --rhos's pairs
     assert words[words.index("--combos") + 1] == str(index)
     assert " --rhos 0.2 --seed-base 6000 " in shlex.join(words)
-    monkeypatch.chdir(tmp_path)
-    capsys.readouterr()
-    assert unseen.main(words[2:]) == 0
-    assert "1 episodes selected, 1 to play" in capsys.readouterr().out
-    (again,) = _rows(tmp_path / "replay.jsonl")
-    assert {k: again[k] for k in ("combo", "seed", "start", "t", "steps")} == {
-        k: row[k] for k in ("combo", "seed", "start", "t", "steps")}  # fmt: skip
+    _replays_its_episode(unseen, words, row, tmp_path, capsys, monkeypatch)
     for role, worlds, says in [
         ("evader", ["--worlds", "tee_w1.0"], "--rhos: draws the episodes of worlds outside"),
         ("evader", [], "--worlds selects its floor_plan:3"),
@@ -263,13 +269,7 @@ def test_a_row_of_another_number_of_draws_replays_its_episode(
     assert row["draws"] == 1
     words = shlex.split(unseen.replay_command({**row, "winner": "pursuer"}))
     assert words[words.index("--draws") + 1] == "1"
-    monkeypatch.chdir(tmp_path)
-    capsys.readouterr()
-    assert unseen.main(words[2:]) == 0
-    assert "1 episodes selected, 1 to play" in capsys.readouterr().out
-    (again,) = _rows(tmp_path / "replay.jsonl")
-    assert {k: again[k] for k in ("combo", "seed", "start", "t", "steps")} == {
-        k: row[k] for k in ("combo", "seed", "start", "t", "steps")}  # fmt: skip
+    _replays_its_episode(unseen, words, row, tmp_path, capsys, monkeypatch)
     default = [w for w in argv if w not in ("--draws", "1")]
     default[-1] = str(tmp_path / "two.jsonl")
     assert unseen.main(default) == 0

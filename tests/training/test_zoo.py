@@ -511,3 +511,22 @@ def test_evaluate_names_a_bad_opponent_as_the_flag(capsys, model, opponent, mess
     assert zoo_main(["evaluate", model, "--opponent", opponent, "--episodes", "1"]) == 2
     err = capsys.readouterr().err
     assert err.startswith(f"python -m training.zoo: error: {message}"), err
+
+
+def test_evaluate_warns_once_of_an_opponent_without_provenance(tmp_path, capsys):
+    """A bare model zip given as --opponent was warned of twice: as the flag by the
+    check, then as "opponent = ..." by the evaluation's own check."""
+    import shutil
+
+    from strategies.policies.model_files import zoo_dir
+    from training.zoo.__main__ import main as zoo_main
+
+    bare = tmp_path / "bare.zip"
+    shutil.copy(zoo_dir() / "ppo_evader_vs_greedy_open_room" / "model.zip", bare)
+    argv = ["evaluate", "ppo_pursuer_vs_straight_open_room", "--opponent", str(bare)]
+    assert zoo_main([*argv, "--episodes", "1"]) == 0
+    captured = capsys.readouterr()
+    warned = [line for line in captured.err.splitlines() if "no provenance.json" in line]
+    assert len(warned) == 1, captured.err
+    assert warned[0].startswith(f"python -m training.zoo: warning: --opponent = '{bare}': ")
+    assert captured.out.startswith(f"pursuer vs {bare}: success ")

@@ -5,8 +5,10 @@ from __future__ import annotations
 import json
 import math
 import sys
+import warnings
 
 from envs.console import CommandParser, interrupts_recorded, progress_flags
+from strategies.policies.model_files import NoProvenanceWarning
 from training import zoo
 from training.cli import resume_note, run_cli
 from training.config import opponent_name
@@ -102,13 +104,17 @@ def _main(argv: list[str] | None) -> int:
         other = "evader" if zoo.info(args.name)["role"] == "pursuer" else "pursuer"
         # a misspelt opponent named as the flag (was "unknown policy ..." alone)
         opponent_name(args.opponent, other, f"--opponent = {args.opponent!r}")
-        ev = evaluate_model(
-            zoo.model_path(args.name),
-            args.opponent,
-            episodes=args.episodes,
-            seed=args.seed,
-            start=args.start,
-        )
+        with warnings.catch_warnings():
+            # the check above warned of a bare model already, named as the flag (the
+            # evaluation's own check said it a second time, as "opponent = ...")
+            warnings.simplefilter("ignore", NoProvenanceWarning)
+            ev = evaluate_model(
+                zoo.model_path(args.name),
+                args.opponent,
+                episodes=args.episodes,
+                seed=args.seed,
+                start=args.start,
+            )
         print(_line(ev))
     return 0
 

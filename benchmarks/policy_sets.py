@@ -137,6 +137,13 @@ corner world's default starts (the reproduction report's episodes) and the refer
 certified starts (``benchmarks/certified_starts.json``)."""
 
 
+_HOLDS_03 = "80d5f9d"
+"""Where holds-bench-03 was first played: holds-bench's episodes at rho 0.3 instead of 0.5
+(helper-166 found the decomposition pursuer's pillars losses there, seeds 3 and 5, to the
+charging evaders: no set played rho 0.3 on the paper's worlds). The policies are
+5270138's there but for 791d52a, which played the other pursuer sets as at 5270138."""
+
+
 def _set(name: str, alias: str, role: str, figure: str, measured: str, command: str):
     script, *args = shlex.split(command)
     won, episodes = (int(n) for n in figure.split("/"))
@@ -180,6 +187,9 @@ SETS: dict[str, PolicySet] = {
              "fixed_starts.py --starts certified --role pursuer"),
         _set("certified-e", "certe", "evader", "468/468", _FIXED,
              "fixed_starts.py --starts certified --role evader"),
+        _set("holds-bench-03", "b1r3", "pursuer", "378/384", _HOLDS_03,
+             "pursuer_holds.py --worlds corridor l_hall open_room corner pillars maze "
+             "--variants 'as is' --seeds 8 --rho 0.3 --no-greedy"),
     )
 }  # fmt: skip
 

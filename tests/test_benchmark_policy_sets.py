@@ -256,7 +256,14 @@ def test_each_set_is_the_command_readme_quotes(ps):
     """The sets are the README's commands (its table and the unseen-worlds paragraphs), so
     a figure there and a set here mean the same episodes."""
     readme = (BENCHMARKS.parent / "README.md").read_text()
-    for name in ("holds-bench", "unseen-p0", "escapes-bench", "corner-default", "fresh-e"):
+    for name in (
+        "holds-bench",
+        "unseen-p0",
+        "escapes-bench",
+        "corner-default",
+        "fresh-e",
+        "holds-bench-03",
+    ):
         command = ps.SETS[name].command()
         quoted = " ".join(f'"{w}"' if " " in w else w for w in command)
         assert quoted in readme, quoted

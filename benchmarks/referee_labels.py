@@ -35,6 +35,7 @@ __all__ = [
     "similarity_back",
     "summary",
     "tally",
+    "unknown_why",
     "verdict",
 ]
 
@@ -114,6 +115,29 @@ def judge(
     except InvalidPlacementError:
         return "not a start", None
     return label, ref.escape_time(p, e) if label == "evader" else None
+
+
+def unknown_why(m: Map, overrides: Mapping[str, float], cpl: float) -> str | None:
+    """Why a start of this game can be ``"unknown"`` whatever it is, or None.
+
+    An ``"unknown"`` start is the referee's resolution gap only where the bounds certify
+    something of the game. Where the pursuer bound certifies no state of it (issue 13's
+    blind spot: from rho ~ 0.3, a range band narrow against the evader's step, passages
+    the bound's pursuer cannot pass the evader in; ``strategies.referee.pursuer_bound``),
+    every start the evader bound leaves is unknown, so an unknown says nothing about that
+    start; likewise where the evader bound certifies no state. The same solve as
+    :func:`judge`'s (one world at a time, so right after it no solve is repeated)."""
+    ref = _referee(m, overrides, cpl)
+    if isinstance(ref, InfeasibleError):
+        return None
+    # the evader bound's rank 0 is a state broken already (out of range, occluded)
+    pursuer, evader = bool(ref.pursuer.win.any()), bool((ref.evader.rank > 0).any())
+    if pursuer and evader:
+        return None
+    if not (pursuer or evader):
+        return "neither bound certified a state of this game"
+    return ("the pursuer bound certified no state of this game" if evader else
+            "the evader bound certified no escape from a state of this game")  # fmt: skip
 
 
 def tally(verdicts: Iterable[str], gap: str = MEANING["unknown"]) -> tuple[int, str]:

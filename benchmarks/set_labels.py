@@ -13,7 +13,10 @@ L_min, with a fine evader lattice) labels each start:
   horizon.
 * ``pursuer``: certified for the pursuer (some pursuer of speed V_p holds it forever,
   against every evader).
-* ``unknown`` (the referee's resolution error), ``not solved`` (over the memory budget,
+* ``unknown`` (the referee's resolution error; where one bound certifies no state of the
+  game at all, e.g. the pursuer bound from rho ~ 0.3 or in narrow passages, every start the
+  other leaves is unknown, and its line says so: ``"why"`` in the labels file, the reason
+  beside the loss in the report), ``not solved`` (over the memory budget,
   ``$SURVEIL_MEMORY_BUDGET``), ``not a start`` (surveillance does not hold there: a
   start the runner drew that the referee's margins refuse), ``no start`` (a crashed
   episode's row records none): undecided.
@@ -359,6 +362,8 @@ def label_starts(starts: Sequence[Start], lost: set[str], cpls: Sequence[float],
                     label, bound = referee_labels.judge(m, ov, s.start, cpl, back)
                 line = {"start": s.key, "cpl": cpl, "label": label, "escape_bound": bound,
                         "world": s.world}  # fmt: skip
+                if label == "unknown" and (why := referee_labels.unknown_why(m, ov, cpl)):
+                    line["why"] = why
                 write(line)
                 labels[_label_key(line)] = line
             _said_game(games, game, todo, t_game, labels, cpl)
@@ -389,6 +394,8 @@ class SetLabels:
     """Losses from starts certified for the evader with an escape time beyond the horizon."""
     regrets: int
     undecided: dict[str, int]
+    blind: int
+    """Of the ``unknown`` losses, those on games a bound certified no state of (``why``)."""
     winnable: int | None
     """Episodes from starts certified winnable for the set's side (None: not every start
     labelled)."""
@@ -411,7 +418,7 @@ def tally(name: str, episodes: Mapping[str, object], starts: Mapping[str, Start]
           lines: list[str]) -> SetLabels:  # fmt: skip
     """One set's counts; each loss's line (with its outcome) appended to ``lines``."""
     undecided = {k: 0 for k in UNDECIDED}
-    unavoidable = late = regrets = winnable = losses = 0
+    unavoidable = late = regrets = winnable = losses = blind = 0
     complete = not losses_only
     for key, e in episodes.items():
         s = starts[key]
@@ -431,7 +438,11 @@ def tally(name: str, episodes: Mapping[str, object], starts: Mapping[str, Start]
             regrets += 1
         else:
             undecided[kind] = undecided.get(kind, 0) + 1
-        at = f" (cpl {final['cpl']:g})" if final["cpl"] is not None else ""
+        why = final.get("why") if kind == "unknown" else None
+        blind += why is not None
+        at = ""
+        if final["cpl"] is not None:
+            at = f" (cpl {final['cpl']:g}{': ' + why if why else ''})"
         bound = final["escape_bound"]
         extra = "" if bound is None else f", escape within {bound:.1f} s of {s.horizon:g}"
         cause = f"{e.cause} at {e.t:.1f} s" if e.t is not None else str(e.cause)
@@ -441,7 +452,7 @@ def tally(name: str, episodes: Mapping[str, object], starts: Mapping[str, Start]
                      f"referee: {final['label']}{at}{extra}")  # fmt: skip
     rhos = tuple(sorted({s.rho for s in starts.values()}))
     return SetLabels(name, len(episodes), losses, unavoidable, late, regrets,
-                     {k: v for k, v in undecided.items() if v},
+                     {k: v for k, v in undecided.items() if v}, blind,
                      winnable if complete else None, rhos)  # fmt: skip
 
 
@@ -483,6 +494,9 @@ def label_sets(sets: Mapping[str, object], read: Mapping[str, Mapping[str, objec
     for t in out:
         if t.undecided:
             kinds = ", ".join(f"{n} {k}" for k, n in t.undecided.items())
+            if t.blind:
+                kinds += (f" ({t.blind} of them on games a bound certified no state of: "
+                          "unknown whatever the start)")  # fmt: skip
             print(f"  {t.name} undecided: {kinds}")
     for line in lines:
         print(line)

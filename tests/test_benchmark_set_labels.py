@@ -290,3 +290,39 @@ def test_a_bad_cpl_is_a_usage_error(ps, tmp_path, capsys):
         ps.main(["label", str(tmp_path), "--cpl", "0"])
     assert exc.value.code == 2
     assert "--cpl" in capsys.readouterr().err
+
+
+def test_an_unknown_on_a_game_a_bound_certified_nothing_of_says_why(ps, tiny, tmp_path, capsys):
+    """An ``unknown`` start on a game one bound certified no state of says nothing about
+    that start (issue 13's blind spot of the pursuer bound): its label line keeps the
+    reason (``why``) and the report prints it beside the loss and counts it. At 8 cells
+    per L_min neither bound certifies a state of the open room at rho 0.2, and the pursuer
+    bound none of the corner at rho 0.5 (its evader bound certifies some); at 12 both
+    bounds certify states of the room, so an unknown start there is a gap at that start."""
+    sets, d, *_ = tiny
+    corner = _solve("corner", 0.5, 8)
+    to_corner = _forward(0.37, 1.0, (0.0, 0.0))
+    gap = _pick(corner, "unknown", to_corner, ps_similarity_back(0.37, 1.0, (0.0, 0.0)))
+    start = {"pursuer": to_corner(gap[0]), "evader": to_corner(gap[1])}
+    with (d / "tiny.jsonl").open("a") as f:
+        f.write(json.dumps(_row(CORNER, CORNER_COMBO, "herder", 106, False, start)) + "\n")
+    out = tmp_path / "labels"
+    assert ps.label(str(d), ["tiny"], [8.0], str(out), sets=sets) == 0
+    text = capsys.readouterr().out
+    neither = "neither bound certified a state of this game"
+    no_pursuer = "the pursuer bound certified no state of this game"
+    assert (f"  unknown: tiny {ROOM} {ROOM_COMBO} herder seed=102: too_close at 3.0 s; referee: "
+            f"unknown (cpl 8: {neither})\n") in text  # fmt: skip
+    assert (f"  unknown: tiny {CORNER} {CORNER_COMBO} herder seed=106: too_close at 3.0 s; "
+            f"referee: unknown (cpl 8: {no_pursuer})\n") in text  # fmt: skip
+    assert ("  tiny undecided: 3 unknown (3 of them on games a bound certified no state of: "
+            "unknown whatever the start)") in text  # fmt: skip
+    labels = _labels(out / "tiny.labels.jsonl")
+    # the room's three starts (held, held2, gap) and the corner's new one
+    assert sorted(x.get("why", "") for x in labels if x["label"] == "unknown") == [
+        neither, neither, neither, no_pursuer]  # fmt: skip
+    assert all("why" not in x for x in labels if x["label"] != "unknown")
+    assert ps.label(str(d), ["tiny"], [8.0, 12.0], str(out), sets=sets) == 0
+    text = capsys.readouterr().out
+    assert "herder seed=102: too_close at 3.0 s; referee: unknown (cpl 12)\n" in text
+    assert "  tiny undecided: 2 unknown (1 of them on games" in text

@@ -94,6 +94,13 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
         "the pursuer bound is then solved once more one cell finer, and kept if it certifies; "
         "rho < 0.35 only)",
     )
+    p.add_argument(
+        "--no-evader-fallback",
+        action="store_true",
+        help="keep the default evader lattice even when it certifies next to nothing (by "
+        "default the evader bound is then solved once more at half the cells per spacing, "
+        "and kept if it certifies more)",
+    )
     p.add_argument("--no-cache", action="store_true", help="neither read nor write the cache")
     p.set_defaults(func=run)
     return p
@@ -170,6 +177,7 @@ def run(args: argparse.Namespace) -> int:
                 args.cells_per_lmin,
                 cache=not args.no_cache,
                 pursuer_fallback=not args.no_pursuer_fallback,
+                evader_fallback=not args.no_evader_fallback,
             )
     s = ref.summary()
     if s["starts"] == 0:  # nothing to report, classify or sample: say what resolution has some
@@ -191,9 +199,10 @@ def run(args: argparse.Namespace) -> int:
         )
         fell = b.get("fallback_from")
         if fell is not None:
+            what = "no state" if role == "pursuer" else "next to nothing"
             print(
                 f"    (the default lattice {fell['spacing']:.4g}, step {fell['tau']:.4g} s, "
-                f"certified no state: this is the fallback, pursuer_coarse = {b['coarse']})"
+                f"certified {what}: this is the fallback, {role}_coarse = {b['coarse']})"
             )
     vacuous = s["pursuer_bound"]["vacuous"]
     if vacuous is not None:
@@ -230,7 +239,7 @@ def _say_if_long(cfg, args: argparse.Namespace) -> None:
     pursuer's step rounded up to 10 s, 1257 moves a step instead of 29) solved for many
     minutes without a word."""
     from strategies.referee._budget import duration
-    from strategies.referee.referee import fallback_size, unsolved_sizes
+    from strategies.referee.referee import evader_fallback_size, fallback_size, unsolved_sizes
     from strategies.referee.spec import GameSpec
 
     spec = GameSpec.from_config(cfg)
@@ -239,7 +248,11 @@ def _say_if_long(cfg, args: argparse.Namespace) -> None:
     retry = None  # the pursuer bound's retry one cell finer, solved only if the default fails
     if not args.no_pursuer_fallback:
         retry = fallback_size(spec, args.cells_per_lmin, cache=not args.no_cache, dt=cfg.dt)
-    if seconds + (retry.seconds if retry is not None else 0.0) <= LONG_SOLVE_SECONDS:
+    eretry = None  # the evader bound's retry, solved only if the default certifies little
+    if not args.no_evader_fallback:
+        eretry = evader_fallback_size(spec, args.cells_per_lmin, cache=not args.no_cache, dt=cfg.dt)
+    retries = sum(r.seconds for r in (retry, eretry) if r is not None)
+    if seconds + retries <= LONG_SOLVE_SECONDS:
         return
     parts = "; ".join(f"{s.describe()}, a step of {s.tau:g} s, {s.moves} moves" for s in sizes)
     # the steps without the env's dt: a dt longer than them rounds them up to itself
@@ -252,15 +265,22 @@ def _say_if_long(cfg, args: argparse.Namespace) -> None:
         if longer
         else "; a smaller --cells-per-lmin is faster"
     )
-    if not sizes:  # both bounds cached: fallback_size says the default certified nothing
-        print(
-            f"{cfg.map.name}: the default pursuer lattice certifies no state (cached): "
-            f"solving it once more one cell finer ({retry.describe()}, a step of "
-            f"{retry.tau:g} s, {retry.moves} moves; --no-pursuer-fallback skips it): up to "
-            f"about {duration(retry.seconds)} (an upper bound, estimated before the solve)",
-            file=sys.stderr,
-            flush=True,
-        )
+    if not sizes:  # both bounds cached: the fallback sizes say a default certified little
+        for r, what, flag in (
+            (retry, "pursuer lattice certifies no state (cached): solving it once more one "
+             "cell finer", "--no-pursuer-fallback"),
+            (eretry, "evader lattice certifies next to nothing (cached): solving it once more "
+             "at half the cells per spacing", "--no-evader-fallback"),
+        ):  # fmt: skip
+            if r is None:
+                continue
+            print(
+                f"{cfg.map.name}: the default {what} ({r.describe()}, a step of {r.tau:g} s, "
+                f"{r.moves} moves; {flag} skips it): up to about {duration(r.seconds)} (an "
+                "upper bound, estimated before the solve)",
+                file=sys.stderr,
+                flush=True,
+            )
         return
     more = ""
     if retry is not None:  # afac520's fallback: a second pursuer solve when the first is 0 %
@@ -268,6 +288,13 @@ def _say_if_long(cfg, args: argparse.Namespace) -> None:
             f", or {duration(seconds + retry.seconds)} if the default pursuer lattice "
             f"certifies no state and the solve retries it one cell finer ({retry.describe()}, "
             f"a step of {retry.tau:g} s, {retry.moves} moves; --no-pursuer-fallback skips it)"
+        )
+    if eretry is not None:  # a second evader solve when the first certifies next to nothing
+        total = seconds + retries
+        more += (
+            f", or {duration(total)} if the default evader lattice certifies next to nothing "
+            f"and the solve retries it at half the cells per spacing ({eretry.describe()}, a "
+            f"step of {eretry.tau:g} s, {eretry.moves} moves; --no-evader-fallback skips it)"
         )
     print(
         f"{cfg.map.name}: solving the referee's bounds ({parts}): up to about "

@@ -350,18 +350,24 @@ def _say_if_long(sizes: list, say: Callable[[str], None]) -> None:
     from strategies.referee._budget import duration
     from strategies.referee.regrets import DEFAULT_CELLS_PER_LMIN
 
-    first = [s for s in sizes if s.what != "pursuer bound's fallback"]
+    retries = ("pursuer bound's fallback", "evader bound's fallback")
+    first = [s for s in sizes if s.what not in retries]
     seconds = sum(s.seconds for s in first)
     retry = sum(s.seconds for s in sizes) - seconds
     if seconds + retry <= LONG_SOLVE_SECONDS:
         return
     states = sum(s.states for s in first)
-    more = (
-        f", or {duration(seconds + retry)} if pursuer bounds certify no state and are "
-        "solved again one cell finer"
-        if retry
-        else ""
-    )
+    why = [
+        text
+        for what, text in zip(
+            retries,
+            ("pursuer bounds certify no state and are solved again one cell finer",
+             "evader bounds certify next to nothing and are solved again finer"),
+            strict=True,
+        )
+        if any(s.what == what for s in sizes)
+    ]  # fmt: skip
+    more = f", or {duration(seconds + retry)} if {' or '.join(why)}" if retry else ""
     say(
         f"the regret table: solving {len(first)} referee bound(s) not in the cache "
         f"({DEFAULT_CELLS_PER_LMIN:g} cells per L_min, {states / 1e6:.3g} M states): up to "

@@ -38,6 +38,7 @@ from strategies.referee.pursuer_bound import VACUOUS_RHO, PursuerBound, solve_pu
 from strategies.referee.spec import GameSpec, Resolution, check_cells_per_lmin
 
 __all__ = [
+    "EVADER_FALLBACK_SHARE",
     "LABELS",
     "Referee",
     "StartSet",
@@ -46,6 +47,8 @@ __all__ = [
     "check_solve_budget",
     "check_start",
     "coarsest_with_starts",
+    "evader_fallback_resolution",
+    "evader_fallback_size",
     "fallback_size",
     "label_starts",
     "pursuer_fallback_resolution",
@@ -58,6 +61,16 @@ __all__ = [
 
 LABELS = ("pursuer", "evader", "unknown")
 """What a start can be labelled: who provably wins it, or unknown."""
+
+EVADER_FALLBACK_SHARE = 0.1
+""":func:`solve` retries the evader bound at a finer lattice when its default lattice
+certifies less than this fraction of its live states (:meth:`EvaderBound.live_fraction`,
+the states where surveillance still holds). At 16 cells per L_min (L in [2, 4], dt = 0.1)
+the default certified 0.2 - 2.6 % of them where the finer lattice certifies 100 %
+(two_rooms at rho = 0.5, 0.7, 0.9, the corridor at 0.9, the corner world at 0.7), 0.2 %
+on the corner world at 0.5 (16 % finer), 0.07 - 0.9 % elsewhere at rho = 0.5 - 0.7 and
+4 - 12 % on the maze.
+"""
 
 
 def _cached(kind, cls, solver, spec, res, cache, cache_dir, progress, memory_budget=None):
@@ -297,7 +310,9 @@ class Referee:
         nothing, or it certified no state; :meth:`PursuerBound.vacuity`), None otherwise;
         ``pursuer_bound["fallback_from"]`` is the default lattice (``coarse, spacing,
         tau``) when it certified no state and :func:`solve` fell back to a finer one
-        (``pursuer_fallback``), None otherwise.
+        (``pursuer_fallback``), None otherwise; ``evader_bound["fallback_from"]`` likewise
+        when the default evader lattice certified less than :data:`EVADER_FALLBACK_SHARE`
+        of its live states and :func:`solve` kept a finer one (``evader_fallback``).
         """
         starts = self.lattice_starts(margin=margin)
         fr = starts.fractions()
@@ -318,13 +333,7 @@ class Referee:
                 "seconds": dict(pb.seconds),
                 "vacuous": pb.vacuity(),
                 "coarse": pb.res.coarse,
-                "fallback_from": None
-                if pb.fallback_from is None
-                else {
-                    "coarse": pb.fallback_from.coarse,
-                    "spacing": pb.fallback_from.spacing,
-                    "tau": pb.fallback_from.tau,
-                },
+                "fallback_from": _res_dict(pb.fallback_from),
             },
             "evader_bound": {
                 "cell": eb.res.cell,
@@ -333,8 +342,17 @@ class Referee:
                 "states": int(eb.win.size),
                 "iterations": eb.iterations,
                 "seconds": dict(eb.seconds),
+                "coarse": eb.res.coarse,
+                "fallback_from": _res_dict(eb.fallback_from),
             },
         }
+
+
+def _res_dict(res: Resolution | None) -> dict[str, float] | None:
+    """A fallen-back-from lattice as :meth:`Referee.summary` reports it."""
+    if res is None:
+        return None
+    return {"coarse": res.coarse, "spacing": res.spacing, "tau": res.tau}
 
 
 def _pairs_in_range(P: np.ndarray, E: np.ndarray, lo: float, hi: float):
@@ -376,6 +394,7 @@ def solve(
     sweep_pieces: int = 2,
     dt: float | None = None,
     pursuer_fallback: bool = True,
+    evader_fallback: bool = True,
     cache: bool = True,
     cache_dir: str | os.PathLike | None = None,
     progress: bool = False,
@@ -413,6 +432,16 @@ def solve(
     bound that still certifies nothing means "unknown", and
     :class:`~envs.errors.VacuousBoundWarning` says so, with the numbers.
 
+    The evader bound has a blind spot of its own (issue 13): where the evader wins only by
+    rounding a corner closely (two_rooms' corridor mouths, 1 wide), its default lattice
+    at 16 cells per L_min (coarse 4: spacing 0.5, tau 2 s at rho = 0.5) keeps it 0.5 from
+    the corner, and the bound's pursuer, moving after seeing the evader's step, always
+    finds a cell whose rod grazes the corner: 0.05 % of the starts certified where coarse
+    2 certifies 100 %. When the default evader lattice (3 cells or more) certifies less
+    than :data:`EVADER_FALLBACK_SHARE` of its live states, the evader bound is solved once more
+    at half the cells per spacing (:func:`evader_fallback_resolution`) and kept if it
+    certifies a larger fraction (``evader_fallback``).
+
     Args:
         spec: the game.
         cells_per_lmin: opponent cells per L_min (the resolution; the gap shrinks as it
@@ -429,6 +458,12 @@ def solve(
             pursuer bound once more with ``pursuer_coarse`` one less (finer, a shorter step) and
             keep it if it certifies some state (:func:`pursuer_fallback_resolution`; its
             ``fallback_from`` names the default lattice). False: the default lattice only.
+        evader_fallback: when the default evader lattice (``evader_coarse=None``, 3 cells
+            or more) certifies less than :data:`EVADER_FALLBACK_SHARE` of its live states,
+            solve the evader bound once more at half its cells per spacing (a finer
+            lattice, a shorter step) and keep it if it certifies a larger fraction
+            (:func:`evader_fallback_resolution`; its ``fallback_from`` names the default
+            lattice). False: the default lattice only.
         cache: read and write the on-disk cache.
         cache_dir: cache directory (default ``$SURVEIL_CACHE_DIR`` or ``~/.cache/surveil``).
         progress: print the fixed points' progress.
@@ -448,6 +483,7 @@ def solve(
         raise InvalidConfigError(f"solve: expected a GameSpec, got {type(spec).__name__}")
     cells_per_lmin = check_cells_per_lmin(cells_per_lmin)
     pursuer_fallback = V.boolean("pursuer_fallback", pursuer_fallback)
+    evader_fallback = V.boolean("evader_fallback", evader_fallback)
     knobs = dict(pursuer_coarse=pursuer_coarse, evader_coarse=evader_coarse,
                  pursuer_steps=pursuer_steps, evader_steps=evader_steps,
                  sweep_pieces=sweep_pieces, dt=dt)  # fmt: skip
@@ -459,7 +495,9 @@ def solve(
     pursuer, tried = _pursuer_bound(
         spec, rp, cells_per_lmin, knobs, kw, pursuer_fallback, [bound_size(spec, re, "evader")]
     )
-    ref = Referee(spec=spec, pursuer=pursuer, evader=cached_evader_bound(spec, re, **kw))
+    before = [bound_size(spec, pursuer.res, "pursuer")]
+    evader = _evader_bound(spec, re, cells_per_lmin, knobs, kw, evader_fallback, before)
+    ref = Referee(spec=spec, pursuer=pursuer, evader=evader)
     _warn_vacuous(spec, pursuer, tried)
     return ref
 
@@ -538,6 +576,63 @@ def _fallback_resolution(
         return None
     knobs = {**knobs, "pursuer_coarse": res.coarse - 1}
     return _resolution(spec, "pursuer", cells_per_lmin, **knobs)
+
+
+def evader_fallback_resolution(
+    spec: GameSpec, bound: EvaderBound, cells_per_lmin: float, **knobs: Any
+) -> Resolution | None:
+    """The evader lattice :func:`solve` retries when ``bound``, solved at its default
+    lattice, certified less than :data:`EVADER_FALLBACK_SHARE` of its live states:
+    ``evader_coarse`` halved (at least 2; the same spacings a step, so the step is shorter
+    in proportion). None when no retry applies: ``knobs`` set ``evader_coarse`` (a lattice
+    asked for is kept), the bound certified that share or more, or the default lattice is
+    two cells or fewer (coarse 1 has four times the points).
+
+    Why: the evader bound's pursuer moves after seeing the evader's whole step, so the
+    evader wins a passage's mouth only by rounding its corner closer than a coarse lattice
+    lets it (two_rooms at rho = 0.5: coarse 4, spacing 0.5, tau 2 s certifies 0.05 % of
+    the starts, coarse 2 100 %; the corner world 0.05 % and 14.5 %). Both are
+    certificates: the union of their certified starts is sound too, but the referee keeps
+    one evader bound (the one its policy plays), so the finer one replaces the default.
+
+    Args:
+        spec, cells_per_lmin: as :func:`solve`.
+        bound: the evader bound solved at the default lattice.
+        **knobs: :func:`solve`'s ``evader_coarse, evader_steps, dt``.
+    """
+    if bound.live_fraction() >= EVADER_FALLBACK_SHARE:
+        return None
+    return _evader_fallback(spec, bound.res, cells_per_lmin, knobs)
+
+
+def _evader_fallback(
+    spec: GameSpec, res: Resolution, cells_per_lmin: float, knobs: Mapping[str, Any]
+) -> Resolution | None:
+    """:func:`evader_fallback_resolution` whatever the default lattice ``res`` certifies."""
+    if knobs.get("evader_coarse") is not None or res.coarse <= 2:
+        return None
+    knobs = {**knobs, "evader_coarse": max(2, res.coarse // 2)}
+    return _resolution(spec, "evader", cells_per_lmin, **knobs)
+
+
+def _evader_bound(spec, res, cpl, knobs, kw, fallback, before=()):
+    """The evader bound at ``res`` and, when it certifies next to nothing and
+    ``fallback`` allows, at :func:`evader_fallback_resolution` (kept if it certifies a
+    larger fraction of its live states). A fallback whose solve would exceed the memory budget
+    with ``before`` (the sizes of the solves made before it) is not solved."""
+    bound = cached_evader_bound(spec, res, **kw)
+    alt = evader_fallback_resolution(spec, bound, cpl, **knobs) if fallback else None
+    if alt is None:
+        return bound
+    try:
+        check_budget("the evader bound's fallback", [*before, bound_size(spec, alt, "evader")],
+                     kw["memory_budget"])  # fmt: skip
+    except MemoryBudgetError:  # the default stands, as without the fallback
+        return bound
+    other = cached_evader_bound(spec, alt, **kw)
+    if other.live_fraction() <= bound.live_fraction():
+        return bound
+    return replace(other, fallback_from=bound.res)
 
 
 def _pursuer_bound(spec, res, cpl, knobs, kw, fallback, after=()):
@@ -668,6 +763,35 @@ def fallback_size(
     return replace(bound_size(spec, alt, "pursuer"), what="pursuer bound's fallback")
 
 
+def evader_fallback_size(
+    spec: GameSpec,
+    cells_per_lmin: float = 24.0,
+    *,
+    cache: bool = True,
+    cache_dir: str | os.PathLike | None = None,
+    **knobs: Any,
+) -> SolveSize | None:
+    """:func:`fallback_size` for the evader bound: the estimated size of its retry at half
+    the cells per spacing (:func:`evader_fallback_resolution`), or None when no retry can
+    happen with these arguments (an explicit ``evader_coarse``, a default of two cells or
+    fewer), its result is cached, or the default's solve is cached and certifies
+    :data:`EVADER_FALLBACK_SHARE` of its live states or more.
+
+    Args:
+        spec, cells_per_lmin, cache, cache_dir, knobs: as :func:`unsolved_sizes`.
+    """
+    cells_per_lmin = check_cells_per_lmin(cells_per_lmin)
+    res = _resolution(spec, "evader", cells_per_lmin, **knobs)
+    alt = _evader_fallback(spec, res, cells_per_lmin, knobs)
+    if alt is None or (cache and cache_path("evader", spec, alt, cache_dir).is_file()):
+        return None
+    if cache:
+        default = _from_cache("evader", EvaderBound, spec, res, cache_dir)
+        if default is not None and default.live_fraction() >= EVADER_FALLBACK_SHARE:
+            return None
+    return replace(bound_size(spec, alt, "evader"), what="evader bound's fallback")
+
+
 COARSEST_SCAN_STEP = 2.0**0.125
 """:func:`coarsest_with_starts` scans resolutions in this ratio (eight per doubling)."""
 COARSEST_SCAN_LIMIT = 64.0
@@ -716,6 +840,7 @@ def solve_role(
     *,
     dt: float | None = None,
     pursuer_fallback: bool = True,
+    evader_fallback: bool = True,
     cache: bool = True,
     cache_dir: str | os.PathLike | None = None,
     progress: bool = False,
@@ -727,8 +852,8 @@ def solve_role(
     at the resolution :func:`solve` gives it, from the same cache.
 
     Args:
-        spec, cells_per_lmin, dt, pursuer_fallback, cache, cache_dir, progress: as
-            :func:`solve` (the pursuer bound falls back as there).
+        spec, cells_per_lmin, dt, pursuer_fallback, evader_fallback, cache, cache_dir,
+            progress: as :func:`solve` (each bound falls back as there).
         role: ``"pursuer"`` or ``"evader"``.
         memory_budget: as :func:`solve`, for this one solve.
         **knobs: :func:`solve`'s ``pursuer_coarse, evader_coarse, pursuer_steps,
@@ -747,6 +872,7 @@ def solve_role(
         raise InvalidConfigError(f"role = {role!r}: expected 'pursuer' or 'evader'")
     cells_per_lmin = check_cells_per_lmin(cells_per_lmin)
     pursuer_fallback = V.boolean("pursuer_fallback", pursuer_fallback)
+    evader_fallback = V.boolean("evader_fallback", evader_fallback)
 
     def sizes(cpl: float) -> list[SolveSize]:
         return [bound_size(spec, _resolution(spec, role, cpl, dt=dt, **knobs), role)]
@@ -762,7 +888,7 @@ def solve_role(
     res = _resolution(spec, role, cells_per_lmin, dt=dt, **knobs)
     kw = dict(cache=cache, cache_dir=cache_dir, progress=progress, memory_budget=budget)
     if role == "evader":
-        return cached_evader_bound(spec, res, **kw)
+        return _evader_bound(spec, res, cells_per_lmin, {**knobs, "dt": dt}, kw, evader_fallback)
     bound, tried = _pursuer_bound(
         spec, res, cells_per_lmin, {**knobs, "dt": dt}, kw, pursuer_fallback
     )

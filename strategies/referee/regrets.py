@@ -40,6 +40,7 @@ from strategies.referee._budget import SolveSize
 from strategies.referee.referee import (
     Referee,
     check_solve_budget,
+    evader_fallback_size,
     fallback_size,
     solve,
     unsolved_sizes,
@@ -124,7 +125,9 @@ def regret(
             the bounds to solve, games over the memory budget left out (their solve is
             refused at once), then those of the pursuer bounds' possible retries one cell
             finer (:func:`~strategies.referee.referee.fallback_size`, ``what`` ``"pursuer
-            bound's fallback"``): what a caller tells its user before a long solve.
+            bound's fallback"``) and of the evader bounds' possible retries at half the
+            cells per spacing (:func:`~strategies.referee.referee.evader_fallback_size`):
+            what a caller tells its user before a long solve.
 
     Returns:
         One :class:`Regret` per (role, policy), pursuers first, sorted by name.
@@ -189,8 +192,9 @@ def _sizes(games, cells_per_lmin, cache, cache_dir) -> list[SolveSize]:
         except MemoryBudgetError:
             continue  # refused before it starts: no time to announce
         sizes += unsolved_sizes(spec, cells_per_lmin, **kw)
-        retry = fallback_size(spec, cells_per_lmin, **kw)
-        retries += [] if retry is None else [retry]
+        for size in (fallback_size, evader_fallback_size):
+            retry = size(spec, cells_per_lmin, **kw)
+            retries += [] if retry is None else [retry]
     return sizes + retries
 
 
@@ -281,7 +285,9 @@ def tournament_regret(
         certified start because the bound certifies none, not because none is winnable),
         then one when a game's pursuer bound is the fallback lattice (the default one
         certified no state; :func:`~strategies.referee.referee.solve`'s
-        ``pursuer_fallback``), then one when matches were left out.
+        ``pursuer_fallback``), then one when a game's evader bound is the fallback lattice
+        (the default one certified next to nothing; ``evader_fallback``), then one when
+        matches were left out.
 
     Raises:
         InvalidConfigError: with ``strict``, a match whose game cannot be rebuilt.
@@ -327,6 +333,16 @@ def tournament_regret(
                 f"{pb.res.coarse} (spacing {pb.res.spacing:.4g}, step {pb.res.tau:.4g} s) for "
                 f"{pb.fallback_from.coarse} (spacing {pb.fallback_from.spacing:.4g}, step "
                 f"{pb.fallback_from.tau:.4g} s)")  # fmt: skip
+        table.append(["-", note, *[""] * (len(table[0]) - 2)])
+    fell = [ref.evader for ref in referees.values() if ref.evader.fallback_from is not None]
+    if fell:
+        eb = fell[0]
+        note = (f"evader regret: in {len(fell)} game(s) the default evader lattice certified "
+                f"next to nothing and the referee's is finer (solve's evader_fallback), e.g. "
+                f"map {eb.spec.map.name!r} at rho = {eb.spec.rho:.3g}: evader_coarse = "
+                f"{eb.res.coarse} (spacing {eb.res.spacing:.4g}, step {eb.res.tau:.4g} s) for "
+                f"{eb.fallback_from.coarse} (spacing {eb.fallback_from.spacing:.4g}, step "
+                f"{eb.fallback_from.tau:.4g} s)")  # fmt: skip
         table.append(["-", note, *[""] * (len(table[0]) - 2)])
     if skipped:
         note = f"{len(skipped)} matches not counted: {skipped[0]}"

@@ -63,6 +63,28 @@ def test_referee_summary_names_the_pursuer_lattice_it_fell_back_to(capsys, monke
     assert "say nothing" in text and "fallback" not in text
 
 
+@pytest.mark.filterwarnings("ignore::envs.errors.VacuousBoundWarning")  # rho 0.5
+def test_referee_summary_names_the_evader_lattice_it_fell_back_to(capsys, monkeypatch):
+    """The corridor at its own rho = 0.5, 16 cells per L_min: the default evader lattice
+    (spacing 0.5, step 2 s) certifies 0.45 % of its live states, the fallback at half the
+    cells per spacing (0.25, 1 s) twice that, and the summary says which lattice it is
+    (it said nothing: two_rooms' 0.05 % of the starts for coarse 2's 100 % looked like the
+    game's answer); --no-evader-fallback keeps the default."""
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", "/nonexistent")
+    base = ["referee", "corridor", "--no-cache"]
+    assert main(base) == 0
+    text = capsys.readouterr().out.splitlines()
+    i = next(i for i, line in enumerate(text) if line.startswith("  evader bound:"))
+    assert text[i].startswith("  evader bound: cell 0.125, lattice 0.25, step 1 s")
+    assert text[i + 1] == (
+        "    (the default lattice 0.5, step 2 s, certified next to nothing: this is the "
+        "fallback, evader_coarse = 2)"
+    )
+    assert main([*base, "--no-evader-fallback"]) == 0
+    text = capsys.readouterr().out
+    assert "evader bound: cell 0.125, lattice 0.5, step 2 s" in text and "fallback" not in text
+
+
 def test_referee_estimate_is_printed_beside_the_certificates(capsys, monkeypatch):
     monkeypatch.setenv("SURVEIL_CACHE_DIR", "/nonexistent")
     argv = ["referee", "open_room", "--config", '{"v_evader": 0.2}', "--cells-per-lmin", "8",
@@ -244,8 +266,13 @@ def test_a_long_solve_s_announcement_counts_the_pursuer_bound_s_fallback(capsys,
     assert main([*slow, "--no-pursuer-fallback"]) == 130
     err = capsys.readouterr().err
     assert "up to about" in err and "fallback" not in err
-    assert main(["referee", "corridor", "--config", '{"dt": 10}', "--no-cache"]) == 130
-    assert "fallback" not in capsys.readouterr().err  # rho 0.5: no retry
+    fast = ["referee", "corridor", "--config", '{"dt": 10}', "--no-cache"]
+    assert main(fast) == 130
+    err = capsys.readouterr().err  # rho 0.5: no pursuer retry; the evader bound's may happen
+    assert "pursuer bound's fallback" not in err
+    assert "if the default evader lattice certifies next to nothing and the solve retries" in err
+    assert main([*fast, "--no-evader-fallback"]) == 130
+    assert "fallback" not in capsys.readouterr().err
     # the retry is the lattice solve() falls back to: pursuer_coarse one less than the default
     cfg = EnvConfig(map="corridor", v_evader=0.1)
     spec = GameSpec.from_config(cfg)

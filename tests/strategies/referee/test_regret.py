@@ -111,11 +111,19 @@ def test_tournament_regret_from_runner_records(corridor_half):
     spec = {"maps": [{"label": world.name, "source": "<inline>", "digest": world.digest}]}
     table = tournament_regret(json.dumps(spec), rows, geometry={world.digest: world.to_dict()},
                               cells_per_lmin=12, cache=False)  # fmt: skip
-    # rho = 0.5: the last row says the pursuer bound certifies nothing informative
-    *table, note = table
-    assert note[0] == "-" and len(note) == len(table[0])
+    # rho = 0.5: a row says the pursuer bound certifies nothing informative, the last one
+    # that the default evader lattice (coarse 3) certified next to nothing and the
+    # referee's evader bound is the finer one (coarse 2)
+    *table, note, evader_note = table
+    assert note[0] == evader_note[0] == "-" and len(note) == len(table[0])
     assert note[1].startswith("pursuer regret: in 1 game(s) the pursuer bound certifies")
     assert "rho = 0.5" in note[1] and "'unknown'" in note[1]
+    assert evader_note[1] == (
+        "evader regret: in 1 game(s) the default evader lattice certified next to nothing "
+        "and the referee's is finer (solve's evader_fallback), e.g. map 'dead_end' at "
+        "rho = 0.5: evader_coarse = 2 (spacing 0.1667, step 0.7 s) for 3 (spacing 0.25, "
+        "step 1 s)"
+    )
     by_policy = {row[1]: row for row in table[1:]}
     assert set(by_policy) == {"pursuer/greedy", "evader/shooting"}
     assert by_policy["evader/shooting"][3] == "2"  # both starts certified for the evader

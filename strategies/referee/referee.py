@@ -619,14 +619,15 @@ def _evader_bound(spec, res, cpl, knobs, kw, fallback, before=()):
     """The evader bound at ``res`` and, when it certifies next to nothing and
     ``fallback`` allows, at :func:`evader_fallback_resolution` (kept if it certifies a
     larger fraction of its live states). A fallback whose solve would exceed the memory budget
-    with ``before`` (the sizes of the solves made before it) is not solved."""
+    with ``before`` (the sizes of the solves made before it, whose results are held) and the
+    default is not solved."""
     bound = cached_evader_bound(spec, res, **kw)
     alt = evader_fallback_resolution(spec, bound, cpl, **knobs) if fallback else None
     if alt is None:
         return bound
-    try:
-        check_budget("the evader bound's fallback", [*before, bound_size(spec, alt, "evader")],
-                     kw["memory_budget"])  # fmt: skip
+    try:  # the default bound is held while the fallback is solved
+        sizes = [*before, bound_size(spec, res, "evader"), bound_size(spec, alt, "evader")]
+        check_budget("the evader bound's fallback", sizes, kw["memory_budget"])
     except MemoryBudgetError:  # the default stands, as without the fallback
         return bound
     other = cached_evader_bound(spec, alt, **kw)

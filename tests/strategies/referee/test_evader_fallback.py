@@ -124,3 +124,18 @@ def test_the_fallback_s_evader_escapes_in_the_certified_time_against_every_pursu
             assert winner == "evader", (start, pursuer.name, steps)
             assert steps * DT <= bound + 1e-9, (start, pursuer.name, steps, bound)
             assert evader.uncertified_steps == 0
+
+
+def test_an_evader_fallback_over_the_memory_budget_is_not_solved(cache):
+    """A budget both default bounds fit and the finer evader lattice, held beside them,
+    does not: the default evader bound stands, as without the fallback."""
+    from strategies.referee._budget import bound_size, peak
+    from strategies.referee.referee import _resolution
+
+    sizes = [bound_size(ROOMS, _resolution(ROOMS, r, CPL, dt=DT), r) for r in ("pursuer", "evader")]
+    alt = _resolution(ROOMS, "evader", CPL, dt=DT, evader_coarse=2)
+    need = peak(sizes)[0]
+    need_alt = peak([*sizes, bound_size(ROOMS, alt, "evader")])[0]
+    assert need < need_alt
+    ref = solve(ROOMS, CPL, dt=DT, cache_dir=cache, memory_budget=(need + need_alt) / 2)
+    assert ref.evader.res.coarse == 4 and ref.evader.fallback_from is None

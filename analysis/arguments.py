@@ -16,6 +16,9 @@ code 2, no traceback, and is found before any long work starts:
   (missing, a directory, a device such as ``/dev/null``, a broken link).
 * :func:`user_error` tells a project error or a file error (reported as one line) from
   a bug (which keeps its traceback).
+* :func:`warnings_held` and :func:`say_warnings` hold the warnings of a legal input (an
+  env config no pursuer can be sure to win) until every check has passed: a refused run
+  says its error alone.
 """
 
 from __future__ import annotations
@@ -29,6 +32,7 @@ import signal
 import stat
 import tempfile
 import threading
+import warnings
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
@@ -48,8 +52,10 @@ __all__ = [
     "path_text",
     "reader_gone",
     "real",
+    "say_warnings",
     "sigterm_as_interrupt",
     "user_error",
+    "warnings_held",
     "why_not_a_file",
 ]
 
@@ -303,6 +309,23 @@ def user_error(exc: BaseException) -> str | None:
     if isinstance(exc, PolicyFailure) and cause is not None and user_error(cause) is not None:
         return str(exc)
     return None
+
+
+@contextlib.contextmanager
+def warnings_held() -> Iterator[list[warnings.WarningMessage]]:
+    """Record the warnings the block raises instead of saying them; :func:`say_warnings`
+    says them once the command's checks have all passed. A warning about a legal input
+    (``NarrowBandWarning``, ``RhoAboveOneWarning``) said before a refusal of the same run
+    read as one more problem to fix, and came before the error line that scripts and
+    tests read first. The user's filters apply as ever (an ignored warning is not held)."""
+    with warnings.catch_warnings(record=True) as held:
+        yield held
+
+
+def say_warnings(held: Sequence[warnings.WarningMessage]) -> None:
+    """Say the warnings :func:`warnings_held` recorded, each from where it was raised."""
+    for w in held:
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
 
 
 def set_from_flag(config: dict[str, Any], key: str, flag: str, value: Any) -> None:

@@ -29,9 +29,11 @@ from analysis.arguments import (
     path_text,
     reader_gone,
     real,
+    say_warnings,
     set_from_flag,
     sigterm_as_interrupt,
     user_error,
+    warnings_held,
 )
 from analysis.figures import cli as figures_cli
 from analysis.replay import MAX_FPS
@@ -138,12 +140,14 @@ def _cmd_play(args: argparse.Namespace) -> int:
     # everything is checked before the episode: options, policies, the output file
     overrides = json_object("--config", args.config, example=CONFIG_EXAMPLE)
     set_from_flag(overrides, "max_cycles", "--max-cycles", args.max_cycles)
-    config = _env_config("--map", args.map, overrides, "--config")
-    pursuer = _policy("--pursuer", args.pursuer, "--pursuer-params", args.pursuer_params)
-    evader = _policy("--evader", args.evader, "--evader-params", args.evader_params)
-    out = None
-    if not args.no_gif:
-        out = output_file("--out", args.out, suffixes=(".gif", ".png"), default_name="play.gif")
+    with warnings_held() as held:  # a legal config's warnings: said if nothing is refused
+        config = _env_config("--map", args.map, overrides, "--config")
+        pursuer = _policy("--pursuer", args.pursuer, "--pursuer-params", args.pursuer_params)
+        evader = _policy("--evader", args.evader, "--evader-params", args.evader_params)
+        out = None
+        if not args.no_gif:
+            out = output_file("--out", args.out, suffixes=(".gif", ".png"), default_name="play.gif")
+    say_warnings(held)
     shading: tuple = ()
     if args.overlay and out is not None:
         from analysis.overlay import decomposition_shading

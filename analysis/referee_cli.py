@@ -29,6 +29,8 @@ from analysis.arguments import (
     output_file,
     path_text,
     real,
+    say_warnings,
+    warnings_held,
 )
 
 __all__ = ["add_parser", "run"]
@@ -115,6 +117,7 @@ def run(args: argparse.Namespace) -> int:
     from envs.errors import (
         InvalidConfigError,
         MemoryBudgetError,
+        NarrowBandWarning,
         SurveilValueError,
         VacuousBoundWarning,
     )
@@ -138,10 +141,13 @@ def run(args: argparse.Namespace) -> int:
     except SurveilValueError as exc:
         raise type(exc)(f"map: {exc}") from None
     check_env_options(overrides, "--config")
-    try:
-        cfg = EnvConfig(map=world, **{**params, **overrides})
-    except SurveilValueError as exc:  # the map's own parameters were checked above
-        raise type(exc)(f"--config: {exc}") from None
+    # the config's warnings (a game no pursuer can be sure to win) are held until every
+    # refusal below has had its say and the long solve its announcement
+    with warnings_held() as held:
+        try:
+            cfg = EnvConfig(map=world, **{**params, **overrides})
+        except SurveilValueError as exc:  # the map's own parameters were checked above
+            raise type(exc)(f"--config: {exc}") from None
     # what the solve cannot change is checked before it (it can take minutes)
     try:  # a step the env refuses: dt = 1e4 hung in the budget's move count (4e8 vectors)
         check_step(cfg.map, cfg.dt, max(cfg.v_pursuer, cfg.v_evader), cfg.body_radius)
@@ -168,6 +174,14 @@ def run(args: argparse.Namespace) -> int:
     with MemoryBudgetError.naming("--cells-per-lmin"):  # a refusal before any announcement
         check_solve_budget(GameSpec.from_config(cfg), args.cells_per_lmin, dt=cfg.dt)
     _say_if_long(cfg, args)
+    for w in held:
+        if issubclass(w.category, NarrowBandWarning):  # true of the referee's game too
+            w.message = NarrowBandWarning(
+                f"{world.name}: {w.message}; the same holds in the referee's game, whose "
+                "steps are whole env steps (its pursuer bound can certify no start with the "
+                "evader in open space)"
+            )
+    say_warnings(held)
     t = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", VacuousBoundWarning)  # the summary says it below

@@ -20,6 +20,7 @@ __all__ = [
     "InvalidPlacementError",
     "LongRunWarning",
     "MemoryBudgetError",
+    "NarrowBandWarning",
     "RelaxedStartWarning",
     "RhoAboveOneWarning",
     "SurveilValueError",
@@ -123,6 +124,14 @@ class UnknownNameError(SurveilValueError, KeyError):
 
 class RhoAboveOneWarning(UserWarning):
     """V_e > V_p: legal, but escape is trivial for the evader (Sec. 5 of the paper)."""
+
+
+class NarrowBandWarning(UserWarning):
+    """``L_max - L_min < 2 V_e dt``: legal, but no pursuer can be sure to hold the range
+    band. Policies choose a step's velocities together, so within a step the evader can
+    move ``V_e dt`` toward or away from the pursuer whatever the pursuer does; the two
+    distances that leaves differ by ``2 V_e dt``, more than the band holds, so one of them
+    is outside it."""
 
 
 class RelaxedStartWarning(UserWarning):

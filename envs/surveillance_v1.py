@@ -92,7 +92,12 @@ a `TypeError` that suggests the closest name.
 
 `map`: a `Map`, a built-in name (`envs.maps.builtin_names()`) or a map file path.
 
-`l_min`, `l_max`: the sensor range, 0 < l_min < l_max.
+`l_min`, `l_max`: the sensor range, 0 < l_min < l_max. A band narrower than two evader
+steps (l_max - l_min < 2 v_evader dt) is legal but raises a `NarrowBandWarning`: within a
+step the evader can move v_evader dt toward or away from the pursuer whatever the pursuer
+does in it, so no pursuer can be sure to hold the band. It and `RhoAboveOneWarning` (both
+in `envs.errors`, filterable by class) come only for a config the env builds: one refused
+by another check or by the physics' step check is refused without a warning first.
 
 `v_pursuer`, `v_evader`: speed bounds (> 0); rho = v_evader / v_pursuer. rho > 1 is legal
 but raises a `RhoAboveOneWarning`: escape is then trivial for the evader (Sec. 5).

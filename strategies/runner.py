@@ -685,10 +685,11 @@ def _replace(config: Any, **changes: Any) -> Any:
     """A copy of an env config with other observation settings (warned about already)."""
     import warnings
 
-    from envs.errors import RhoAboveOneWarning
+    from envs.errors import NarrowBandWarning, RhoAboveOneWarning
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RhoAboveOneWarning)
+        warnings.simplefilter("ignore", NarrowBandWarning)
         return dataclasses.replace(config, **changes)
 
 

@@ -200,9 +200,10 @@ class Spec:
         """The resolved env parameters of a (map, variant): every field but the map.
 
         ``rho`` sets ``v_evader = rho * v_pursuer`` (the pursuer's speed as resolved).
-        A rho above 1 is legal here without a warning per match (see :func:`spec_from_dict`).
+        A rho above 1 or a range band narrower than two evader steps is legal here without
+        a warning per match (see :func:`spec_from_dict`).
         """
-        from envs.errors import RhoAboveOneWarning
+        from envs.errors import NarrowBandWarning, RhoAboveOneWarning
         from envs.surveillance.config import EnvConfig
         from envs.surveillance.physics import check_step
 
@@ -212,6 +213,7 @@ class Spec:
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RhoAboveOneWarning)
+                warnings.simplefilter("ignore", NarrowBandWarning)
                 cfg = EnvConfig(map=map_entry.map, **kwargs)
                 if variant.rho is not None:
                     kwargs["v_evader"] = variant.rho * cfg.v_pursuer
@@ -359,6 +361,7 @@ def spec_from_dict(
     )
     seen: dict[str, str] = {}
     fast: list[str] = []
+    narrow: list[str] = []  # bands narrower than two evader steps
     every: list[dict[str, Any]] = []  # the env config of each (map, variant)
     for m in spec.maps:  # every (map, variant) must make a valid env config
         configs = [spec.env_config(m, v) for v in spec.variants]
@@ -367,6 +370,11 @@ def spec_from_dict(
             f"{m.label} {v.label}".strip()
             for v, c in zip(spec.variants, configs, strict=True)
             if c["v_evader"] > c["v_pursuer"]
+        ]
+        narrow += [
+            f"{m.label} {v.label}".strip()
+            for v, c in zip(spec.variants, configs, strict=True)
+            if c["l_max"] - c["l_min"] < 2.0 * c["v_evader"] * c["dt"] * (1.0 - 1e-9)
         ]
         games = json.dumps(configs, sort_keys=True)
         key = m.digest + games
@@ -385,6 +393,16 @@ def spec_from_dict(
         warnings.warn(
             f"{source}: rho > 1 in {fast}: the evader can always escape there (Sec. 5)",
             RhoAboveOneWarning,
+            stacklevel=2,
+        )
+    if narrow:
+        from envs.errors import NarrowBandWarning
+
+        warnings.warn(
+            f"{source}: l_max - l_min < 2 v_evader dt in {narrow}: within a step the evader "
+            "can move v_evader dt toward or away from the pursuer whatever it does, so no "
+            "pursuer can be sure to hold the range band there (a wider band or a shorter dt)",
+            NarrowBandWarning,
             stacklevel=2,
         )
     return spec

@@ -49,7 +49,7 @@ from typing import Any
 
 from analysis.tournament.identity import Match
 from analysis.tournament.spec import PolicyEntry, Spec
-from envs.errors import RhoAboveOneWarning
+from envs.errors import NarrowBandWarning, RhoAboveOneWarning
 
 __all__ = [
     "Board",
@@ -460,6 +460,7 @@ def play(match: Match, ctx: Context, board: Board | None = None) -> dict[str, An
         observations = {"pursuer": p.observation, "evader": e.observation}
         with _Watch(ctx.time_limit, board) as watch, warnings.catch_warnings():
             warnings.simplefilter("ignore", RhoAboveOneWarning)  # said once, at spec load
+            warnings.simplefilter("ignore", NarrowBandWarning)  # so is this
             _set_up(ctx, match, (p, e), watch)
             result = run_episode(
                 ctx.maps[match.map],

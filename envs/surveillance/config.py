@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from envs import validation as v
-from envs.errors import InvalidConfigError, RhoAboveOneWarning
+from envs.errors import InvalidConfigError, NarrowBandWarning, RhoAboveOneWarning
 from envs.maps import Map, load_map
 from envs.maps.io import BODY_RADIUS, recommended_parameters
 from envs.maps.io import GLOBAL_DEFAULTS as _GLOBAL_DEFAULTS
@@ -113,7 +113,9 @@ class EnvConfig:
         l_min: L_min, the sensor's minimum range (> 0). ``None``: the map's
             recommendation (see :func:`map_recommendations`); the same for ``l_max``,
             ``v_pursuer`` and ``v_evader``.
-        l_max: L_max, the sensor's maximum range (> l_min).
+        l_max: L_max, the sensor's maximum range (> l_min). A band narrower than two
+            evader steps (l_max - l_min < 2 v_evader dt) is legal but warned about: no
+            pursuer can be sure to hold it (:class:`~envs.errors.NarrowBandWarning`).
         v_pursuer: V_p, the pursuer's speed bound (> 0).
         v_evader: V_e, the evader's speed bound (> 0); rho = V_e / V_p. rho > 1 is legal
             but warned about: the evader then wins by charging (Sec. 5).
@@ -158,14 +160,6 @@ class EnvConfig:
             raise InvalidConfigError(
                 f"l_max = {self.l_max!r}: expected a value > l_min = {self.l_min!r}"
             )
-        if self.v_evader > self.v_pursuer:
-            warnings.warn(
-                f"v_evader = {self.v_evader!r} > v_pursuer = {self.v_pursuer!r} (rho = "
-                f"{self.v_evader / self.v_pursuer:.3g} > 1): the evader can always escape by "
-                "running at the pursuer (Sec. 5 of the paper); legal, but no pursuer can win",
-                RhoAboveOneWarning,
-                stacklevel=_caller_stacklevel(),
-            )
         put("dt", v.positive("dt", self.dt))
         self._check_step_moves()
         put("max_cycles", v.integer("max_cycles", self.max_cycles, minimum=1))
@@ -188,6 +182,42 @@ class EnvConfig:
         )
         if self.render_mode is not None:
             put("render_mode", v.choice("render_mode", self.render_mode, RENDER_MODES))
+        self._warn_if_unwinnable()
+
+    def _warn_if_unwinnable(self) -> None:
+        """Warn about a legal game no pursuer can be sure to win: rho > 1
+        (:class:`~envs.errors.RhoAboveOneWarning`) or a range band narrower than two evader
+        steps (:class:`~envs.errors.NarrowBandWarning`). Only for a config the env would
+        build: every check above passed, and so does the physics' own
+        (:func:`~envs.surveillance.physics.check_step`, which the env calls next), so a
+        config about to be refused is refused without a warning first."""
+        from envs.surveillance.physics import check_step  # pymunk: imported when needed
+
+        try:
+            check_step(self.map, self.dt, max(self.v_pursuer, self.v_evader), self.body_radius)
+        except InvalidConfigError:
+            return  # the env refuses it (its message says why); a warning would come first
+        if self.v_evader > self.v_pursuer:
+            warnings.warn(
+                f"v_evader = {self.v_evader!r} > v_pursuer = {self.v_pursuer!r} (rho = "
+                f"{self.v_evader / self.v_pursuer:.3g} > 1): the evader can always escape by "
+                "running at the pursuer (Sec. 5 of the paper); legal, but no pursuer can win",
+                RhoAboveOneWarning,
+                stacklevel=_caller_stacklevel(),
+            )
+        band, steps = self.l_max - self.l_min, 2.0 * self.v_evader * self.dt
+        if band < steps * (1.0 - 1e-9):  # exactly two steps (up to rounding) can be held
+            warnings.warn(
+                f"l_max - l_min = {band:.6g} < 2 v_evader dt = {steps:.6g} (l_min = "
+                f"{self.l_min!r}, l_max = {self.l_max!r}, v_evader = {self.v_evader!r}, dt = "
+                f"{self.dt!r}): within a step the evader can move v_evader dt toward or away "
+                "from the pursuer whatever the pursuer does in it, and the two distances that "
+                "leaves are 2 v_evader dt apart, so one is outside the band; legal, but no "
+                "pursuer can be sure to hold it (expected l_max - l_min >= 2 v_evader dt: a "
+                f"wider band, or dt <= {band / (2.0 * self.v_evader):.4g})",
+                NarrowBandWarning,
+                stacklevel=_caller_stacklevel(),
+            )
 
     def _check_step_moves(self) -> None:
         """Refuse a step in which a body at full speed could not move: ``V dt`` at or below

@@ -269,6 +269,21 @@ def test_rho_above_one_is_played_with_one_warning_line(capsys):
     ]
 
 
+@pytest.mark.parametrize(
+    "config", [{"dt": 3}, {"v_evader": 1.5}], ids=["narrow_band", "rho_above_one"]
+)
+def test_a_refused_play_says_its_error_without_the_config_s_warning(capsys, config):
+    """A legal config no pursuer can be sure to win (a band narrower than two evader steps,
+    rho > 1) with an unknown --pursuer: the config's warning came first, then the error;
+    the error comes alone, and the warning once when the episode is played."""
+    argv = ["play", *FAST, "--no-gif", "--config", json.dumps(config)]
+    assert_fails(capsys, [*argv, "--pursuer", "nope"], "--pursuer = 'nope'")
+    assert main(argv) == 0
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("surveil: warning: "), err
+    assert ("l_max - l_min = 2 < 2 v_evader dt = 3 (" in err[0]) is ("dt" in config)
+
+
 def test_a_models_warning_names_it_as_the_user_did(capsys):
     """It named the zip's absolute path: 'pursuer/sb3:/.../training/zoo/models/.../model.zip:
     this model plays a game it was not trained at'."""

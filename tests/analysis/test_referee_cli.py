@@ -244,6 +244,38 @@ def test_a_long_solve_is_announced_with_its_estimate_before_it_starts(capsys, mo
     assert capsys.readouterr().err == "surveil: interrupted\n"
 
 
+def test_a_narrow_band_is_said_after_the_refusals_and_the_announcement(capsys, monkeypatch):
+    """dt = 10 on the corridor: the band [2, 4] is narrower than two evader steps (10 m).
+    The env's NarrowBandWarning came first, before the budget's refusal of the same run and
+    before the long solve's announcement (66d3fbf, reverted); a refused run says its error
+    alone, and a run that solves says the warning after its announcement, for the referee's
+    game too."""
+    import strategies.referee as referee
+
+    def stop(*args, **kwargs):
+        raise KeyboardInterrupt  # the solve itself is not under test
+
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", "/nonexistent")
+    monkeypatch.setattr(referee, "referee_for", stop)
+    argv = ["referee", "corridor", "--config", '{"dt": 10}', "--no-cache"]
+    monkeypatch.setenv("SURVEIL_MEMORY_BUDGET", "200MB")
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("surveil: error: solve(") and len(err.splitlines()) == 1, err
+    monkeypatch.delenv("SURVEIL_MEMORY_BUDGET")
+    warning = "surveil: warning: corridor: l_max - l_min = 2 < 2 v_evader dt = 10 ("
+    for extra, first in (([], "corridor: solving the referee's bounds"), (["--cells-per-lmin",
+                         "4"], warning)):  # fmt: skip
+        assert main([*argv, *extra]) == 130
+        lines = capsys.readouterr().err.splitlines()
+        assert lines[0].startswith(first) and lines[-1] == "surveil: interrupted", lines
+        (said,) = [line for line in lines if line.startswith("surveil: warning:")]
+        assert said.startswith(warning) and "dt <= 2)" in said
+        assert said.endswith("the same holds in the referee's game, whose steps are whole env "
+                             "steps (its pursuer bound can certify no start with the evader in "
+                             "open space)")  # fmt: skip
+
+
 def test_a_long_solve_s_announcement_counts_the_pursuer_bound_s_fallback(capsys, monkeypatch):
     """At rho < VACUOUS_RHO a pursuer bound certifying nothing is solved once more one cell
     finer (afac520): the announcement gave the first solve's time only (here 5 min of up to

@@ -15,7 +15,7 @@ import pytest
 
 from analysis.tournament import Store, StoreBusyError, load_spec, run_tournament, spec_from_dict
 from analysis.tournament.identity import plan
-from envs.errors import InvalidConfigError
+from envs.errors import InvalidConfigError, NarrowBandWarning
 from strategies.policies.model_files import zoo_dir
 
 from .conftest import comparable
@@ -76,6 +76,21 @@ from .conftest import comparable
 def test_bad_specs_name_the_field(small_spec, patch, message):
     with pytest.raises(InvalidConfigError, match=message):
         spec_from_dict({**small_spec, **patch}, source="SPEC.toml")
+
+
+def test_a_narrow_band_is_warned_about_once_at_load_after_the_refusals(small_spec):
+    """dt = 2.5 on the open room and the corridor (L in [2, 4], V_e 0.5): the band is
+    narrower than two evader steps (2.5 m), once per (map, variant) and not per match; a
+    spec refused for another value says its error alone."""
+    with warnings.catch_warnings(record=True) as shown:
+        warnings.simplefilter("always")
+        spec_from_dict({**small_spec, "grid": {"dt": [0.1, 2.5]}}, source="SPEC.toml")
+        with pytest.raises(InvalidConfigError, match=r"dt = 1000000000.0"):
+            spec_from_dict({**small_spec, "grid": {"dt": [2.5, 1e9]}}, source="SPEC.toml")
+    assert [(w.category, w.filename) for w in shown] == [(NarrowBandWarning, __file__)]
+    assert str(shown[0].message).startswith(
+        "SPEC.toml: l_max - l_min < 2 v_evader dt in ['open_room dt=2.5', 'corridor dt=2.5']: "
+    )
 
 
 def test_toml_spec_and_relative_map_files(tmp_path):

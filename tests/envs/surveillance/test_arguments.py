@@ -10,7 +10,7 @@ import warnings
 import pytest
 
 from envs import surveillance_v1
-from envs.errors import RhoAboveOneWarning
+from envs.errors import InvalidConfigError, NarrowBandWarning, RhoAboveOneWarning
 from envs.maps import builtin_info, builtin_map, builtin_names, save_map
 from envs.surveillance.config import (
     GLOBAL_DEFAULTS,
@@ -150,6 +150,51 @@ def test_rho_above_one_is_legal_with_a_warning() -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         surveillance_v1.parallel_env(map="open_room", v_evader=1.0)  # rho = 1: no warning
+
+
+@pytest.mark.parametrize("make", [*FACTORIES, EnvConfig], ids=lambda f: f.__name__)
+def test_a_band_narrower_than_two_evader_steps_is_legal_with_a_warning(make) -> None:
+    """L_max - L_min < 2 V_e dt: within a step the evader moves V_e dt toward or away from
+    the pursuer whatever it does, so one of the two distances is outside the band."""
+    narrow = {"map": "open_room", "l_min": 2.0, "l_max": 2.15, "v_evader": 1.0}
+    with pytest.warns(NarrowBandWarning, match=r"l_max - l_min = 0.15 < 2 v_evader dt = 0.2") as w:
+        made = make(**narrow)
+    assert len(w) == 1 and w[0].filename == __file__  # once, pointing at the caller
+    assert "dt <= 0.075)" in str(w[0].message)  # the step that would do
+    assert issubclass(NarrowBandWarning, UserWarning)
+    if make is not EnvConfig:
+        made.reset(seed=0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # exactly two steps wide, or a shorter step: no warning
+        make(**{**narrow, "l_max": 2.2})
+        make(**{**narrow, "dt": 0.05})
+        warnings.simplefilter("ignore", NarrowBandWarning)  # filterable by its class
+        make(**narrow)
+
+
+@pytest.mark.parametrize(
+    "refused",
+    [
+        {"max_cycles": 0},  # EnvConfig's own checks after the band's numbers
+        {"body_radius": 1.5},  # >= l_min / 2
+        {"dt": 1e4},  # the physics' check_step: a body would cross the map in one step
+    ],
+    ids=["max_cycles", "body_radius", "dt"],
+)
+@pytest.mark.parametrize(
+    "unwinnable",
+    [{"l_min": 2.0, "l_max": 2.15, "v_evader": 1.0}, {"v_evader": 1.5}],
+    ids=["narrow_band", "rho_above_one"],
+)
+def test_a_config_about_to_be_refused_does_not_warn_first(refused, unwinnable) -> None:
+    """A warning that the game is unwinnable came before the refusal of the same config
+    (66d3fbf): ``surveil referee --config '{"dt": 1e4}'`` printed a warning line and then
+    the error. The warnings are for configs the env builds; the refusal comes alone."""
+    with warnings.catch_warnings(record=True) as shown:
+        warnings.simplefilter("always")
+        with pytest.raises(InvalidConfigError):
+            surveillance_v1.parallel_env(map="open_room", **unwinnable, **refused)
+    assert [str(w.message) for w in shown] == []
 
 
 def test_the_env_card_shows_the_real_signature() -> None:

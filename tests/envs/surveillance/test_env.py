@@ -244,6 +244,7 @@ def test_evader_rounding_a_corner_is_reported_with_that_corner() -> None:
         (np.array([1.0, 0.0]), "too_close", 0.5),
     ],
 )
+@pytest.mark.filterwarnings("ignore::envs.errors.NarrowBandWarning")  # a 0.1 band on purpose
 def test_range_breaks_report_cause_and_time(evader_action, cause, t_exact) -> None:
     env = surveillance_v1.parallel_env(
         map=open_room(), l_min=2.95, l_max=3.05, v_evader=1.0, body_radius=0.1

@@ -107,6 +107,7 @@ def test_step_before_reset_is_an_error() -> None:
 
 
 @pytest.mark.parametrize(("over", "speed"), [({"dt": 100.0}, 1.0), ({"v_pursuer": 1e6}, 1e6)])
+@pytest.mark.filterwarnings("ignore::envs.errors.NarrowBandWarning")  # dt 14: on purpose
 def test_a_step_that_crosses_the_map_is_refused(over, speed) -> None:
     """v_pursuer = 1e6 hung (2e6 physics substeps a step); dt = 100 timed the break of a
     pursuer and evader running apart at 12.6 s instead of 0.58 s (both stopped by the
@@ -192,6 +193,7 @@ def test_the_trace_is_the_positions_read_after_each_substep(dt, speed) -> None:
 
 
 @pytest.mark.parametrize("dt", [10.0, 1.0, 0.1])
+@pytest.mark.filterwarnings("ignore::envs.errors.NarrowBandWarning")  # dt 10: on purpose
 def test_a_break_after_a_body_stopped_at_a_wall_is_timed_on_its_path(dt) -> None:
     """Pursuer and evader run apart along the corridor world's room (x in [0, 10]): the
     pursuer, at x = 9.5 with radius 0.1, stops at the wall after 0.4 s (L = 3.6), the

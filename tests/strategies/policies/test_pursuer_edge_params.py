@@ -27,6 +27,7 @@ NARROW = {"l_min": 2.0, "v_pursuer": 2.0, "v_evader": 1.0, "dt": 0.1}
 
 
 @pytest.mark.parametrize("l_max", [2.05, 2.1, 2.2, 2.4])
+@pytest.mark.filterwarnings("ignore::envs.errors.NarrowBandWarning")  # narrow on purpose
 def test_the_distance_target_is_the_middle_of_a_narrow_band(l_max):
     from strategies.policies.base import distance_ceiling
 

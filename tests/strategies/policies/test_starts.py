@@ -18,6 +18,7 @@ from strategies.policies.starts import sample_start
     ("l_min", "l_max"),
     [(2.0, 4.0), (1.0, 1.0001), (1.5, 1.6)],  # the last two are narrower than the buffer
 )
+@pytest.mark.filterwarnings("ignore::envs.errors.NarrowBandWarning")  # narrow on purpose
 def test_starts_lie_inside_the_sensor_range_and_reset_accepts_them(kind, l_min, l_max):
     env = surveillance_v1.parallel_env(map="open_room", l_min=l_min, l_max=l_max)
     rng = np.random.default_rng(7)
@@ -31,6 +32,7 @@ def test_starts_lie_inside_the_sensor_range_and_reset_accepts_them(kind, l_min, 
 
 
 @pytest.mark.parametrize("kind", ["valid", "safe"])
+@pytest.mark.filterwarnings("ignore::envs.errors.NarrowBandWarning")  # one step: on purpose
 def test_starts_without_a_range_margin_are_accepted_by_reset(kind):
     # spawn_margin_steps = 0 leaves no range margin: a safe start is drawn at L = L_max
     # exactly when the pursuer's target length lies beyond L_max, and half of those

@@ -198,6 +198,7 @@ def test_a_map_too_large_for_any_resolution_says_so_not_the_interpreter():
     assert "interpreter" not in msg and re.search(r"up to about [\d.]+e\+\d+ h in all", msg)
 
 
+@pytest.mark.filterwarnings("ignore::envs.errors.NarrowBandWarning")  # dt 10: on purpose
 def test_a_long_step_s_many_moves_lengthen_the_pursuer_bound_s_estimate():
     """An env's dt rounds the pursuer's step up (dt = 10 on the corridor: 10 s, 1257 moves
     instead of 29): the tables per move took nearly all of the time (42.5 s CPU at 8 cells

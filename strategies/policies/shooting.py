@@ -168,11 +168,12 @@ class ShootingEvader(BasePolicy):
     # 0.1 on random:star:12). See _disc_reaches
     DISC_SLACK = 0.25
     # a pursuer that does not turn the rod itself: its velocity across the rod averaged
-    # below RADIAL_SHARE V_p over at least RADIAL_STEPS steps (a radial follower: the
+    # below RADIAL_SHARE V_e over at least RADIAL_STEPS steps (a radial follower: the
     # greedy pursuer, a tractrix, one standing still or leading the evader's position
-    # moves along the rod; the decomposition pursuer turns it, 0.55-0.71 V_p across the
-    # rod on average). Against it, a plan that promises nothing does not take over from
-    # pressure (see _decide)
+    # moves along the rod, 0-0.03 V_e; the decomposition pursuer turns it, 0.55-0.71 V_p
+    # across the rod on average at rho 0.3-0.5, 0.06-0.3 V_p = 0.3-1.5 V_e in the first
+    # 500 steps at rho 0.2). Against it, a plan that promises nothing does not take over
+    # from pressure (see _decide)
     RADIAL_SHARE = 0.1
     RADIAL_STEPS = 20
 
@@ -270,7 +271,7 @@ class ShootingEvader(BasePolicy):
         self._no_way = 0  # steps in an escapable cell whose crossings are all excluded
         self._forgiven = 0  # retries so far (each waits twice as long as the last)
         self._pressed = 0  # pressure steps so far
-        # the pursuer's speed across the rod (in V_p) summed over the steps so far, and
+        # the pursuer's speed across the rod (in V_e) summed over the steps so far, and
         # their number (see RADIAL_SHARE)
         self._across, self._across_n = 0.0, 0
         self._herding = False  # herding the pursuer into a corner (from then on)
@@ -579,7 +580,7 @@ class ShootingEvader(BasePolicy):
             return c.v_evader * unit(snap.rod)
         u = unit(snap.rod)
         vp = snap.pursuer_velocity
-        self._across += abs(float(u[0] * vp[1] - u[1] * vp[0])) / c.v_pursuer
+        self._across += abs(float(u[0] * vp[1] - u[1] * vp[0])) / c.v_evader
         self._across_n += 1
         heading = self._plan_heading(e, theta)
         if (

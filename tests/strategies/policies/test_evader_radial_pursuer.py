@@ -8,7 +8,7 @@ lets such a pursuer back off, and the charge that pins it begins again: on
 holding the band's middle the evader alternated the two and escaped at 4.68 D / V_e
 (the herd pinning the pursuer at last; 4.3-5.0 against a lazy and a lead pursuer of
 task F's probe). Against a pursuer whose speed across the rod averages below
-``RADIAL_SHARE`` V_p the plan no longer takes over from pressure: 0.69 D / V_e. The
+``RADIAL_SHARE`` V_e the plan no longer takes over from pressure: 0.69 D / V_e. The
 decomposition pursuer turns the rod (0.55-0.71 V_p across it on average), and against
 it the evader walks such a plan as before.
 """

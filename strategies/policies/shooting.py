@@ -167,6 +167,15 @@ class ShootingEvader(BasePolicy):
     # solver lets a disc pressed to a wall overlap it; 0.089-0.095 from walls at radius
     # 0.1 on random:star:12). See _disc_reaches
     DISC_SLACK = 0.25
+    # a pursuer that does not turn the rod itself: its velocity across the rod averaged
+    # below RADIAL_SHARE V_e over at least RADIAL_STEPS steps (a radial follower: the
+    # greedy pursuer, a tractrix, one standing still or leading the evader's position
+    # moves along the rod, 0-0.03 V_e; the decomposition pursuer turns it, 0.55-0.71 V_p
+    # across the rod on average at rho 0.3-0.5, 0.06-0.3 V_p = 0.3-1.5 V_e in the first
+    # 500 steps at rho 0.2). Against it, a plan that promises nothing does not take over
+    # from pressure (see _decide)
+    RADIAL_SHARE = 0.1
+    RADIAL_STEPS = 20
 
     def _reset(self) -> None:
         c = self.config
@@ -262,6 +271,9 @@ class ShootingEvader(BasePolicy):
         self._no_way = 0  # steps in an escapable cell whose crossings are all excluded
         self._forgiven = 0  # retries so far (each waits twice as long as the last)
         self._pressed = 0  # pressure steps so far
+        # the pursuer's speed across the rod (in V_e) summed over the steps so far, and
+        # their number (see RADIAL_SHARE)
+        self._across, self._across_n = 0.0, 0
         self._herding = False  # herding the pursuer into a corner (from then on)
         # the concave corner the herd headed for on the last step (-1: none, or that step
         # did not herd)
@@ -566,7 +578,29 @@ class ShootingEvader(BasePolicy):
             # (Straight away, as the paper says, can end in a room corner.)
             self.mode = "toward"
             return c.v_evader * unit(snap.rod)
+        u = unit(snap.rod)
+        vp = snap.pursuer_velocity
+        self._across += abs(float(u[0] * vp[1] - u[1] * vp[0])) / c.v_evader
+        self._across_n += 1
         heading = self._plan_heading(e, theta)
+        if (
+            heading is not None
+            and self.mode == "pressure"
+            and self.plan.rank[self._plan_cell] >= len(self.plan.rank)
+            and self._across_n >= self.RADIAL_STEPS
+            and self._across < self.RADIAL_SHARE * self._across_n
+        ):
+            # a plan that promises nothing (rank at least n_cells) does not take over from
+            # pressure against a pursuer that does not turn the rod (RADIAL_SHARE): each
+            # plan step let it back off, and the charge that pins it began again. Against
+            # pursuers nobody wrote it for (a lazy one, still while L is mid-band, and a
+            # lead pursuer aiming at the evader's extrapolated position; random:star:12,
+            # L in [2, 4], rho 0.2-0.5, seed 7004) the evader alternated the two ~30 times
+            # and escaped at 4.3-5.0 D / V_e, the herd pinning it at last; charging on,
+            # at 0.7-1.0 (the toward evader 0.54). The decomposition pursuer turns the
+            # rod; against it the plan's walk is what escapes (letting pressure go on
+            # there lost 7 escapes of the evader sets)
+            heading = None
         if heading is not None and self.plan.rank[self._plan_cell] < len(self.plan.rank):
             self._shoot_first = False  # a rank below n_cells: a route the disc can take
         # while the rod is longer than the pursuer can close to L_min in a shot's replan

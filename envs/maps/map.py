@@ -107,12 +107,12 @@ points on 940 edges 112 and 38; 6 on 280 edges 65 and 49; 1 on 940 edges 34 and 
 decomposition pursuer's clearances on a lazy table: one to a few points a call). With at
 least 256 points it was the index from 128 edges, as before."""
 _NEAR_CHUNK = 1 << 16  # points per batch of the indexed distances
-_CELL_POINTS = 64
+_CELL_POINTS = 256
 """Calls of :meth:`Map.distance_to_walls` with at most this many points, on maps of at
-least ``_NEAR_EDGES`` edges, measure each point against its cell's few edges
-(:meth:`Map.edges_near`): the decomposition pursuer's clearances on a lazy table, one to
-a few grid nodes a call (~15 us a call on a 280-edge floor plan, 17-65 us brute force or
-indexed)."""
+least ``_NEAR_EDGES`` edges, measure each point against the few edges of its cell
+(:meth:`Map._cell_edges`): the decomposition pursuer's clearances on a lazy table, a few
+to a hundred grid nodes a call (one point ~15 us on a 280-edge floor plan, 17-36 us
+brute force or indexed; ~0.5 us a point more, the index ~5-12)."""
 _CELLS_KEPT = 1 << 16  # cells whose edges a map keeps (then it starts again)
 
 
@@ -574,7 +574,7 @@ class Map:
 
     @functools.cached_property
     def _cell_size(self) -> float:
-        """Side of the cells of :meth:`edges_near`: half the side of a square with the
+        """Side of the cells of :meth:`_cell_edges`: half the side of a square with the
         box's area per edge (~3.3 m on the floor plans of any size: a few edges a cell)."""
         x0, y0, x1, y1 = self.bounds
         return 0.5 * math.sqrt((x1 - x0) * (y1 - y0) / self.n_edges)

@@ -135,6 +135,16 @@ def _room_field(world, table: SafetyTable, need: float) -> np.ndarray:
     return np.asarray(dist, dtype=np.float64).reshape(nx, ny)
 
 
+@functools.cache
+def _block_nodes(bits: int) -> np.ndarray:
+    """The (i, j) offsets of the nodes of a block of ``2^bits`` x ``2^bits`` grid nodes,
+    ((2^bits)^2, 2) int64 (:meth:`DecompositionPursuer._measure_blocks`)."""
+    side = np.arange(1 << bits, dtype=np.int64)
+    out = np.stack(np.meshgrid(side, side, indexing="ij"), -1).reshape(-1, 2)
+    out.setflags(write=False)
+    return out
+
+
 class DecompositionPursuer(BasePolicy):
     """Pursuer that keeps the configuration in admissible, non-escapable cells at L_min.
 
@@ -841,9 +851,7 @@ class DecompositionPursuer(BasePolicy):
         tab = self.table
         b = self.CLEAR_BLOCK_BITS
         blocks = np.array(list(dict.fromkeys((i >> b, j >> b) for i, j in nodes)))
-        side = np.arange(1 << b)
-        ij = (blocks[:, None, None, :] << b) + np.stack(np.meshgrid(side, side, indexing="ij"), -1)
-        ij = ij.reshape(-1, 2)
+        ij = ((blocks[:, None, :] << b) + _block_nodes(b)).reshape(-1, 2)
         ij = ij[(ij[:, 0] < tab.shape[0]) & (ij[:, 1] < tab.shape[1])]
         points = tab.origin + tab.resolution * ij
         inside = tab.inside(points)
@@ -1307,8 +1315,8 @@ class DecompositionPursuer(BasePolicy):
         """
         r = self.config.body_radius
         e = snap.evader
-        if self._clear is not None:  # the grid's wall distance rules most steps out
-            # (the nearest node lies within h / sqrt 2)
+        if self._clear is not None or self._clear_memo is not None:  # the grid's wall
+            # distance rules most steps out (the nearest node lies within h / sqrt 2)
             if self._clearance_at(float(e[0]), float(e[1])) > r + self.table.resolution:
                 return 0.0
         q, _ = nearest_wall_point(self.config.map, np.asarray(e, dtype=np.float64))

@@ -113,7 +113,7 @@ least ``_NEAR_EDGES`` edges, measure each point against the few edges of its cel
 (:meth:`Map._cell_edges`): the decomposition pursuer's clearances on a lazy table, a few
 to a hundred grid nodes a call (one point ~15 us on a 280-edge floor plan, 17-36 us
 brute force or indexed; ~0.5 us a point more, the index ~5-12)."""
-_CELLS_KEPT = 1 << 16  # cells whose edges a map keeps (then it starts again)
+_CELLS_KEPT = 1 << 14  # cells a map keeps (~0.6 KB each; then it starts again)
 
 
 def _finite_points(points: np.ndarray | Sequence[Sequence[float]], what: str) -> np.ndarray:

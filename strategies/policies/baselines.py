@@ -26,13 +26,9 @@ __all__ = [
 
 
 def nearest_wall_point(world_map, point: np.ndarray) -> tuple[np.ndarray, int]:
-    """Closest point on the map's walls to ``point`` and the index of its edge."""
-    rel = point[None, :] - world_map.edge_start
-    t = np.clip(np.einsum("ej,ej->e", rel, world_map.edge_dir), 0.0, world_map.edge_length)
-    closest = world_map.edge_start + t[:, None] * world_map.edge_dir
-    d = np.einsum("ej,ej->e", point - closest, point - closest)
-    k = int(np.argmin(d))
-    return closest[k], k
+    """Closest point on the map's walls to ``point`` and the index of its edge
+    (``Map.nearest_wall_point``)."""
+    return world_map.nearest_wall_point(point)
 
 
 class RandomPolicy(BasePolicy):

@@ -11,7 +11,7 @@ import pytest
 import shapely
 from shapely.geometry import Point, Polygon
 
-from envs.errors import InvalidMapError
+from envs.errors import InvalidConfigError, InvalidMapError
 from envs.maps import Map
 from envs.tolerances import REL_GAP_TOL
 
@@ -595,38 +595,124 @@ def test_wall_distances_of_many_points_read_few_edges_and_keep_every_float(monke
         monkeypatch.undo()
 
 
-def test_wall_distances_of_a_few_points_on_a_large_map_go_through_the_index(monkeypatch):
-    """The decomposition pursuer measures the walls' distance of one to a few grid nodes
-    at a time (its clearances on a lazy table): against all 2696 edges of a 346 m floor
-    plan that was a quarter of its decision time (~0.1 ms a point). A call with at least
-    _NEAR_PAIRS (point, edge) pairs goes through the edges' index: the same floats, a few
-    edges a point; a few points on a small map stay brute force."""
+def _count_segment_distances(monkeypatch) -> list[int]:
+    """Count the (point, edge) pairs measured one pair at a time (the map's
+    ``_segment_distances``, which its cells and its index both use) from now until
+    ``monkeypatch.undo()``: one entry a call, its number of pairs."""
+    import envs.maps.map as map_module
+
+    pairs: list[int] = []
+    measure = map_module._segment_distances
+
+    def counted(p, start, direction, length):
+        pairs.append(len(start))
+        return measure(p, start, direction, length)
+
+    monkeypatch.setattr(map_module, "_segment_distances", counted)
+    return pairs
+
+
+def _pillar_room() -> Map:
+    """60 x 56 room with 210 square pillars (844 edges, all axis-aligned: exact ties)."""
+    return Map(
+        box(0, 0, 60, 56),
+        [
+            box(4 * i + 1.6, 4 * j + 1.6, 4 * i + 2.4, 4 * j + 2.4)
+            for i in range(15)
+            for j in range(14)
+        ],
+    )
+
+
+def _probe_points(m: Map, rng, k: int) -> np.ndarray:
+    """k points anywhere round the map, k on its walls, k within rounding of them, and
+    its vertices."""
+    x0, y0, x1, y1 = m.bounds
+    e = rng.integers(0, m.n_edges, k)
+    on = m.edge_start[e] + rng.uniform(size=(k, 1)) * (m.edge_end[e] - m.edge_start[e])
+    return np.concatenate(
+        [
+            rng.uniform([x0 - 3, y0 - 3], [x1 + 3, y1 + 3], size=(k, 2)),
+            on,
+            on + rng.normal(scale=1e-9 * m.scale, size=on.shape),
+            m.vertices,
+        ]
+    )
+
+
+def test_wall_distances_of_a_few_points_on_a_large_map_read_their_cells_edges(monkeypatch):
+    """The decomposition pursuer measures the walls' distance of one to a hundred grid
+    nodes at a time (its clearances on a lazy table): against all 2696 edges of a 346 m
+    floor plan that was a quarter of its decision time (~0.1 ms a point), through the
+    edges' index ~35 us a call and 5-12 us a point. A call of at most _CELL_POINTS points
+    measures each against the few edges of its cell, which hold every edge nearest to
+    any point of it: the same floats as against every edge; a few points on a small map
+    stay brute force."""
     import envs.maps.map as map_module
     from envs.maps import floor_plan
 
     big = floor_plan(0, n_vertices=2993, size=(346.0, 346.0))
+    turned = _pillar_room().transformed(np.array([[0.6, -0.8], [0.8, 0.6]]) * 1e3, (5e5, -3e5))
     small = Map(box(0, 0, 10, 8), [box(2, 2, 3, 3), box(5, 4, 6, 6.5)])
     rng = np.random.default_rng(12)
-    for m, k, indexed in ((big, 1, True), (big, 6, True), (small, 3, False)):
-        x0, y0, x1, y1 = m.bounds
-        e = rng.integers(0, m.n_edges, k)
-        pts = np.concatenate(
-            [
-                rng.uniform([x0, y0], [x1, y1], size=(k, 2)),
-                m.edge_start[e] + rng.uniform(size=(k, 1)) * (m.edge_end[e] - m.edge_start[e]),
-                m.vertices[:k],
-            ]
-        )
-        pairs = _count_pair_distances(monkeypatch)
-        # one point a call, and all at once
-        got = [float(m.distance_to_walls(pts[i : i + 1])[0]) for i in range(len(pts))]
-        together = m.distance_to_walls(pts)
+    for m, celled in ((big, True), (turned, True), (small, False)):
+        pts = _probe_points(m, rng, 300)
+        pairs = _count_segment_distances(monkeypatch)
+        # one point a call, six, and a hundred
+        got = [
+            m.distance_to_walls(pts[i : i + n]) for n in (1, 6, 100) for i in range(0, len(pts), n)
+        ]
         monkeypatch.undo()
-        assert (len(pairs) > 0) == indexed
-        if indexed:
-            assert sum(pairs) < 0.05 * 2 * len(pts) * m.n_edges, sum(pairs)
+        assert (len(pairs) > 0) == celled
+        if celled:
+            assert sum(pairs) < 0.02 * 3 * len(pts) * m.n_edges, sum(pairs) / (3 * len(pts))
         monkeypatch.setattr(map_module, "_NEAR_EDGES", 10**9)  # every edge
         want = m.distance_to_walls(pts)
         monkeypatch.undo()
-        assert got == want.tolist() and np.array_equal(together, want)
-        assert (want == 0.0).sum() >= k  # the points on the walls
+        assert np.array_equal(np.concatenate(got), np.tile(want, 3))  # the same floats
+        assert (want == 0.0).sum() >= 300  # the points on the walls
+
+
+def _nearest_against_every_edge(m: Map, p: np.ndarray) -> tuple[np.ndarray, int]:
+    """The closest wall point and its edge (the first of the nearest) against every edge,
+    in nearest_wall_point's arithmetic."""
+    rel = p[None, :] - m.edge_start
+    t = np.clip(np.einsum("ej,ej->e", rel, m.edge_dir), 0.0, m.edge_length)
+    closest = m.edge_start + t[:, None] * m.edge_dir
+    d = np.einsum("ej,ej->e", p - closest, p - closest)
+    k = int(np.argmin(d))
+    return closest[k], k
+
+
+def test_the_nearest_wall_point_is_the_one_against_every_edge(monkeypatch):
+    """Map.nearest_wall_point (the pursuer's wall push, the evaders' wall readings) reads
+    the few edges of the point's cell: the same point and the same edge, the first of the
+    nearest on a tie (the pillar room's corners), as against every edge."""
+    from envs.maps import floor_plan
+
+    room = _pillar_room()
+    big = floor_plan(0, n_vertices=2993, size=(346.0, 346.0))
+    small = Map(box(0, 0, 10, 8), [box(2, 2, 3, 3), box(5, 4, 6, 6.5)])
+    rng = np.random.default_rng(13)
+    corners = np.array([[0.5, 0.5], [59.5, 0.5], [0.5, 55.5], [59.5, 55.5]])  # two walls alike
+    d = np.linalg.norm(corners[:, None, :] - room.edge_start[None], axis=2)
+    assert ((np.abs(d - 0.5 * math.sqrt(2.0)) < 1e-12).sum(axis=1) == 1).all()  # (the corner)
+    turned = room.transformed(np.array([[0.6, -0.8], [0.8, 0.6]]) * 1e3, (5e5, -3e5))
+    for m in (room, turned, big, small):
+        pts = _probe_points(m, rng, 500)
+        if m is room:
+            pts = np.concatenate([pts, corners])
+        for p in pts:
+            q, k = m.nearest_wall_point(p)
+            want_q, want_k = _nearest_against_every_edge(m, p)
+            assert k == want_k and np.array_equal(q, want_q), p
+            assert type(k) is int
+    for p in corners:  # a tie: the first of the two walls' edges
+        _, k = room.nearest_wall_point(p)
+        rel = p - room.edge_start
+        t = np.clip(np.einsum("ej,ej->e", rel, room.edge_dir), 0.0, room.edge_length)
+        gap = rel - t[:, None] * room.edge_dir
+        tied = np.flatnonzero(np.einsum("ej,ej->e", gap, gap) == 0.25)
+        assert len(tied) == 2 and k == tied[0]
+    with pytest.raises(InvalidConfigError, match="nan"):
+        room.nearest_wall_point([np.nan, 1.0])

@@ -408,3 +408,47 @@ def test_the_lazy_pursuers_probes_count_the_largest_rotation_per_radius():
             assert np.array_equal(fast, slow) and fast.dtype == slow.dtype
             seen += (fast < p.horizon).any()
     assert seen > 10
+
+
+def test_the_lazy_pursuers_clearances_are_measured_a_block_at_a_time(monkeypatch):
+    """On a lazy table the pursuer's clearances (its path ahead, the orbits' centres) move
+    on by a node or two a step; each new node's whole block of 4 x 4 nodes is measured
+    with it, in one call (a third of the calls of the nodes alone on floor_plan:1:110),
+    and every value is still the node's own: the wall distance against every edge, 0 off
+    the free region, on a floor plan whose distances go through the map's cells."""
+    import envs.maps.map as map_module
+    from envs.maps import floor_plan
+
+    world = floor_plan(3, n_vertices=200, size=(40.0, 40.0))
+    assert world.n_edges >= map_module._NEAR_EDGES  # (the cells' distances)
+    r = run_episode(world, "pursuer/decomposition", "evader/shooting", 4, max_cycles=2)
+    p = make_policy("pursuer/decomposition", table="lazy")
+    p.reset(role="pursuer", map=world, config=r.config, seed=0)
+    tab = p.table
+    calls = []
+    measure = map_module.Map.distance_to_walls
+
+    def counted(self, points):
+        calls.append(len(points))
+        return measure(self, points)
+
+    monkeypatch.setattr(map_module.Map, "distance_to_walls", counted)
+    rng = np.random.default_rng(5)
+    i = rng.integers(4, tab.shape[0] - 4, 200)
+    j = rng.integers(4, tab.shape[1] - 4, 200)
+    got = p._memo_clearances(i, j)
+    bi, bj = int(i[0]) >> 2 << 2, int(j[0]) >> 2 << 2
+    assert all((bi + a, bj + b) in p._clear_memo for a in range(4) for b in range(4))
+    n = len(p._clear_memo)  # (blocks off the grid's edges: 16 nodes each)
+    assert len(calls) == 1 and n == 16 * len({(a >> 2, b >> 2) for a, b in zip(i, j, strict=True)})
+    p._memo_clearance(int(i[0]) ^ 1, int(j[0]) ^ 1)  # a node of a measured block: no call
+    assert len(calls) == 1 and len(p._clear_memo) == n
+    monkeypatch.undo()
+    monkeypatch.setattr(map_module, "_NEAR_EDGES", 10**9)  # every edge
+    keys = list(p._clear_memo)
+    nodes = tab.origin + tab.resolution * np.array(keys, dtype=float)
+    inside = tab.inside(nodes)
+    want = np.where(inside, world.distance_to_walls(nodes), 0.0)
+    assert np.array_equal(np.array([p._clear_memo[k] for k in keys]), want)  # the same floats
+    assert got.tolist() == [p._clear_memo[k] for k in zip(i.tolist(), j.tolist(), strict=True)]
+    assert inside.any() and not inside.all()

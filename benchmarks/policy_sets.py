@@ -97,26 +97,30 @@ FRESH_WORLDS = " ".join(
 """32 random maps nobody had used (README: "On 32 random maps nobody had used")."""
 _HOLDS = "--seeds 8 --rho 0.5 --no-greedy"
 _HELDOUT_P = "--worlds @benchmarks/heldout_worlds_pursuer.txt"
-_BASE = "5270138"
-"""The commit every figure below holds at (all sixteen sets played there, compared per
-episode with 8bef7db: unseen-e +1, heldout-e +1 (3498ee2, the shooting evader's herd
-starts wherever the pursuer is), nothing lost; fresh-e with 791668b: +3; 15b205d (the
-pursuers at edge parameters) was played alone on all fifteen with every row identical,
-and 0d7e59f and 686f537 are the same decisions, faster. After it 791d52a (the
-decomposition's hard turn gives way where it pushes into a wall) was played on the
-eleven pursuer sets and the evader sets' decomposition episodes: every winner and loss
-time as here). Before: at 8bef7db, all fifteen, compared per
+_BASE = "4be633d"
+"""The commit every figure below holds at (all seventeen sets played there, compared per
+episode with 5270138: heldout-e -1, random:star:2019 seed 258 (791d52a's give-way
+changed the decomposition pursuer's path there and the shooting evader's herd, which
+escaped at 7.98 of 8 D/V_e, no longer escapes), every other episode's winner the same;
+d6d8f9a (the shooting evader against a pursuer that does not turn the rod) moved escape
+times only; lazy-speed-171 (786c56e) is the same decisions, faster). Before: at 5270138,
+all sixteen sets played, compared per episode with 8bef7db: unseen-e +1, heldout-e +1
+(3498ee2, the shooting evader's herd starts wherever the pursuer is), nothing lost;
+fresh-e with 791668b: +3; 15b205d (the pursuers at edge parameters) was played alone on
+all fifteen with every row identical, and 0d7e59f and 686f537 are the same decisions,
+faster. After it 791d52a (the decomposition's hard turn gives way where it pushes into a
+wall) was played on the eleven pursuer sets and the evader sets' decomposition episodes:
+every winner and loss time as here). Before: at 8bef7db, all fifteen, compared per
 episode with 3765f76: fresh-p0 +1 (0fee8e2, the pursuer's lead on a lap round a small
 obstacle: rand:star:3007:3.0 against the herder), nothing lost; 37bf9d1's two-leg shots
-moved escape times only). Before: at 34fa4ca, compared per
-episode with 1283649: holds-bench +1, certified-e +2, nothing lost; played again at
-686fe46, the shooting evader's long-rod shots before any plan and reach margins: every
-episode's winner as at 34fa4ca, escape times moved; and at 3765f76. Before: all twelve
-sets were played at 94c5063;
-5b239ab's pursuer change (probes round a small obstacle an evader circles) changed only
-fresh-p0 (549 -> 552); 4d0ccce's (the way to room once a ride against a charge stalls)
-was played on every pursuer set and on the evader sets' episodes against the
-decomposition pursuer (holds-variants 558 -> 560, unseen-p0 426 -> 429, heldout-p0
+moved escape times only). Before: at 34fa4ca, compared per episode with 1283649:
+holds-bench +1, certified-e +2, nothing lost; played again at 686fe46, the shooting
+evader's long-rod shots before any plan and reach margins: every episode's winner as at
+34fa4ca, escape times moved; and at 3765f76. Before: all twelve sets were played at
+94c5063; 5b239ab's pursuer change (probes round a small obstacle an evader circles)
+changed only fresh-p0 (549 -> 552); 4d0ccce's (the way to room once a ride against a
+charge stalls) was played on every pursuer set and on the evader sets' episodes against
+the decomposition pursuer (holds-variants 558 -> 560, unseen-p0 426 -> 429, heldout-p0
 609 -> 614, heldout-p1 633 -> 636, fresh-p0 552 -> 555); bd36034's evader change (the
 herd heads only for corners turning by 45 degrees or more) on the three evader sets
 (heldout-e 775 -> 776) and, with 4d0ccce's pursuer, on their episodes against it;
@@ -132,16 +136,16 @@ transformed, junctions, random maps of seeds 4501-4510, 4604-4605, floor plans 9
 _FIXED = _BASE
 """Where the three sets of ``fixed_starts.py`` were last played (first at c427419, 1283649's
 policies: certified-e 310/312 there; certified-e grew to 468 episodes at ea81a89, played
-at 34c7663, 3765f76, 8bef7db and 5270138): the
+at 34c7663, 3765f76, 8bef7db, 5270138 and 4be633d): the
 corner world's default starts (the reproduction report's episodes) and the referee's
 certified starts (``benchmarks/certified_starts.json``)."""
 
 
-_HOLDS_03 = "80d5f9d"
-"""Where holds-bench-03 was first played: holds-bench's episodes at rho 0.3 instead of 0.5
+_HOLDS_03 = _BASE
+"""Where holds-bench-03 was last played: holds-bench's episodes at rho 0.3 instead of 0.5
 (helper-166 found the decomposition pursuer's pillars losses there, seeds 3 and 5, to the
-charging evaders: no set played rho 0.3 on the paper's worlds). The policies are
-5270138's there but for 791d52a, which played the other pursuer sets as at 5270138."""
+charging evaders: no set played rho 0.3 on the paper's worlds); first played at 80d5f9d
+(378/384), again at 4be633d: every episode's winner the same."""
 
 
 def _set(name: str, alias: str, role: str, figure: str, measured: str, command: str):
@@ -175,7 +179,7 @@ SETS: dict[str, PolicySet] = {
              f"unseen_worlds.py --role pursuer --combos 0 --worlds {FRESH_WORLDS}"),
         _set("unseen-e", "eunseen", "evader", "1189/1189", _BASE,
              "unseen_worlds.py --role evader"),
-        _set("heldout-e", "eheldout", "evader", "777/779", _BASE,
+        _set("heldout-e", "eheldout", "evader", "776/779", _BASE,
              "unseen_worlds.py --role evader --worlds @benchmarks/heldout_worlds_evader.txt"),
         _set("fresh-e", "fresh_e", "evader", "1133/1139", _BASE,
              f"unseen_worlds.py --role evader {_FRESH_E}"),

@@ -324,30 +324,30 @@ def tournament_regret(
                 f"nothing informative, so their starts count as unknown, not as winnable: "
                 f"{eg}{vacuous[0]}")  # fmt: skip
         table.append(["-", note, *[""] * (len(table[0]) - 2)])
-    fell = [ref.pursuer for ref in referees.values() if ref.pursuer.fallback_from is not None]
-    if fell:
-        pb = fell[0]
-        note = (f"pursuer regret: in {len(fell)} game(s) the default pursuer lattice certified "
-                f"no state and the referee's is one cell finer (solve's pursuer_fallback), e.g. "
-                f"map {pb.spec.map.name!r} at rho = {pb.spec.rho:.3g}: pursuer_coarse = "
-                f"{pb.res.coarse} (spacing {pb.res.spacing:.4g}, step {pb.res.tau:.4g} s) for "
-                f"{pb.fallback_from.coarse} (spacing {pb.fallback_from.spacing:.4g}, step "
-                f"{pb.fallback_from.tau:.4g} s)")  # fmt: skip
-        table.append(["-", note, *[""] * (len(table[0]) - 2)])
-    fell = [ref.evader for ref in referees.values() if ref.evader.fallback_from is not None]
-    if fell:
-        eb = fell[0]
-        note = (f"evader regret: in {len(fell)} game(s) the default evader lattice certified "
-                f"next to nothing and the referee's is finer (solve's evader_fallback), e.g. "
-                f"map {eb.spec.map.name!r} at rho = {eb.spec.rho:.3g}: evader_coarse = "
-                f"{eb.res.coarse} (spacing {eb.res.spacing:.4g}, step {eb.res.tau:.4g} s) for "
-                f"{eb.fallback_from.coarse} (spacing {eb.fallback_from.spacing:.4g}, step "
-                f"{eb.fallback_from.tau:.4g} s)")  # fmt: skip
-        table.append(["-", note, *[""] * (len(table[0]) - 2)])
+    for role, what in (
+        ("pursuer", "certified no state and the referee's is one cell finer"),
+        ("evader", "certified next to nothing and the referee's is finer"),
+    ):
+        fell = [getattr(ref, role) for ref in referees.values()
+                if getattr(ref, role).fallback_from is not None]  # fmt: skip
+        if fell:
+            table.append(["-", _fallback_note(role, what, fell),
+                          *[""] * (len(table[0]) - 2)])  # fmt: skip
     if skipped:
         note = f"{len(skipped)} matches not counted: {skipped[0]}"
         table.append(["-", note, *[""] * (len(table[0]) - 2)])
     return table
+
+
+def _fallback_note(role: str, what: str, fell: list) -> str:
+    """The regret table's note on the games whose ``role`` bound is solve's fallback
+    lattice (``pursuer_fallback`` / ``evader_fallback``), naming the first."""
+    b, was = fell[0], fell[0].fallback_from
+    return (f"{role} regret: in {len(fell)} game(s) the default {role} lattice {what} "
+            f"(solve's {role}_fallback), e.g. map {b.spec.map.name!r} at rho = "
+            f"{b.spec.rho:.3g}: {role}_coarse = {b.res.coarse} (spacing {b.res.spacing:.4g}, "
+            f"step {b.res.tau:.4g} s) for {was.coarse} (spacing {was.spacing:.4g}, step "
+            f"{was.tau:.4g} s)")  # fmt: skip
 
 
 def _match_of(row, spec, maps, variants, geometry) -> dict[str, Any]:

@@ -29,6 +29,7 @@ import inspect
 import math
 import os
 import sys
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -175,6 +176,16 @@ class TrainConfig:
     """Weights of the pool's members (empty: uniform), e.g. a Nash mixture (PSRO)."""
 
     def __post_init__(self) -> None:
+        # a warning about a legal env (a range band narrower than two evader steps, rho > 1)
+        # is said once every field has passed: the [env] table is checked midway, and its
+        # warning came before a later field's refusal ("algo = 'nope'"), as one more thing
+        # to fix before the error line
+        with warnings.catch_warnings(record=True) as held:
+            self._check_fields()
+        for w in held:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+
+    def _check_fields(self) -> None:
         put = lambda name, value: object.__setattr__(self, name, value)
         check = _Checker()
         check.role(self.role)

@@ -121,3 +121,29 @@ def test_every_field_has_a_docstring():
     for name in TrainConfig.__dataclass_fields__:
         after = src.split(f"\n    {name}:", 1)[1].split("\n", 2)[1].strip()
         assert after.startswith('"""'), name
+
+
+@pytest.mark.parametrize(
+    ("env", "category"),
+    [
+        ({"l_min": 2.0, "l_max": 2.05}, "NarrowBandWarning"),
+        ({"v_evader": 1.5}, "RhoAboveOneWarning"),
+    ],
+)
+def test_a_legal_env_s_warning_comes_after_every_field_passed(env, category):
+    """The [env] table is checked midway: its warning (a narrow band, rho > 1) came before
+    a later field's refusal (algo = 'nope'), as one more thing to fix; now a refused config
+    says its error alone and an accepted one still warns, once."""
+    import warnings
+
+    from envs import errors
+
+    warning = getattr(errors, category)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with pytest.raises(InvalidConfigError, match=r"algo = 'nope': expected"):
+            TrainConfig(role="pursuer", opponent="evader/straight", env=env, algo="nope")
+    assert not [w for w in caught if issubclass(w.category, warning)]
+    with pytest.warns(warning) as said:
+        TrainConfig(role="pursuer", opponent="evader/straight", env=env)
+    assert len([w for w in said if issubclass(w.category, warning)]) == 1

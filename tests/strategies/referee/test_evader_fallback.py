@@ -17,16 +17,15 @@ import pytest
 
 from envs.errors import InvalidConfigError
 from envs.maps import Map
-from strategies.referee import RefereeEvader, solve
-from strategies.referee.policy import env_steps_per_referee_step
+from strategies.referee import solve
 from strategies.referee.referee import (
     EVADER_FALLBACK_SHARE,
     evader_fallback_resolution,
     evader_fallback_size,
     solve_role,
 )
-from tests.strategies.referee.conftest import DT, play, spec
-from tests.strategies.referee.test_policies import _opponents
+from tests.strategies.referee.conftest import DT, spec
+from tests.strategies.referee.test_policies import escapes_in_certified_time
 
 pytestmark = pytest.mark.filterwarnings("ignore::envs.errors.VacuousBoundWarning")  # rho 0.5
 
@@ -112,18 +111,8 @@ def test_the_fallback_s_evader_escapes_in_the_certified_time_against_every_pursu
     """The fallback's certificate is played: the referee's evader on it, from certified
     starts with the pursuer behind it in the corridor or in a room, breaks surveillance
     within the certified time against every registered pursuer, every step certified."""
-    ev = referee.evader
-    k = env_steps_per_referee_step(ev.res.tau, DT)
-    for start in referee.sample_starts(2, np.random.default_rng(5), kind="evader"):
-        bound = referee.escape_time(start["pursuer"], start["evader"])
-        assert bound is not None
-        for pursuer in _opponents("pursuer", referee):
-            evader = RefereeEvader(ev)
-            horizon = round(bound / DT) + k
-            winner, steps, _ = play(referee, pursuer, evader, start, max_cycles=horizon)
-            assert winner == "evader", (start, pursuer.name, steps)
-            assert steps * DT <= bound + 1e-9, (start, pursuer.name, steps, bound)
-            assert evader.uncertified_steps == 0
+    starts = referee.sample_starts(2, np.random.default_rng(5), kind="evader")
+    escapes_in_certified_time(referee, starts)
 
 
 def test_an_evader_fallback_over_the_memory_budget_is_not_solved(cache):

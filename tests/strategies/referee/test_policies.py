@@ -36,6 +36,23 @@ def _opponents(role, ref):
     return [*names, extra]
 
 
+def escapes_in_certified_time(ref, starts) -> None:
+    """Assert the referee's evader, from each of ``starts`` (certified for the evader),
+    breaks surveillance within the certified time against every registered pursuer and
+    the referee's own, every step certified."""
+    k = env_steps_per_referee_step(ref.evader.res.tau, DT)
+    for start in starts:
+        bound = ref.escape_time(start["pursuer"], start["evader"])
+        assert bound is not None
+        for pursuer in _opponents("pursuer", ref):
+            evader = RefereeEvader(ref.evader)
+            horizon = round(bound / DT) + k
+            winner, steps, _cause = play(ref, pursuer, evader, start, max_cycles=horizon)
+            assert winner == "evader", (start, pursuer.name, steps)
+            assert steps * DT <= bound + 1e-9, (start, pursuer.name, steps, bound)
+            assert evader.uncertified_steps == 0
+
+
 def test_referee_pursuer_holds_from_certified_starts_against_every_evader(open_slow):
     for start in _starts(open_slow, "pursuer", 3, seed=1):
         for evader in _opponents("evader", open_slow):
@@ -49,17 +66,7 @@ def test_referee_pursuer_holds_from_certified_starts_against_every_evader(open_s
 @pytest.mark.parametrize("fixture", ["corridor_half", "open_fast"])
 def test_referee_evader_escapes_in_the_certified_time_against_every_pursuer(fixture, request):
     ref = request.getfixturevalue(fixture)
-    k = env_steps_per_referee_step(ref.evader.res.tau, DT)
-    for start in _starts(ref, "evader", 3, seed=2):
-        bound = ref.escape_time(start["pursuer"], start["evader"])
-        assert bound is not None
-        for pursuer in _opponents("pursuer", ref):
-            evader = RefereeEvader(ref.evader)
-            horizon = round(bound / DT) + k
-            winner, steps, _cause = play(ref, pursuer, evader, start, max_cycles=horizon)
-            assert winner == "evader", (start, pursuer.name, steps)
-            assert steps * DT <= bound + 1e-9, (start, pursuer.name, steps, bound)
-            assert evader.uncertified_steps == 0
+    escapes_in_certified_time(ref, _starts(ref, "evader", 3, seed=2))
 
 
 class _RankLog(RefereeEvader):

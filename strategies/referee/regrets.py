@@ -1,10 +1,16 @@
 """Each policy's regret: the share of the starts the referee certifies winnable for its
 role that it nevertheless lost.
 
-A pursuer's winnable starts are those certified for the pursuer (it can hold forever); an
-evader's are those certified for the evader *within the match's horizon* (the certified
-escape time fits in ``max_cycles * dt``). Starts the referee leaves unknown, or certifies
-for the opponent, say nothing about a policy and are only counted.
+A start counts for a side only within the match's horizon (``max_cycles * dt``), the same
+rule on both sides' rows: a start certified for the pursuer counts for it (it holds forever,
+so past any horizon), one certified for the evader only when its certified escape time fits
+in the horizon. A pursuer's winnable starts are those certified for the pursuer; an
+evader's, those certified for the evader within the horizon, which are also the starts a
+pursuer's row counts "certified for the opponent". A start certified for the evader with a
+longer certified escape time (*late*, as ``benchmarks/policy_sets.py label`` calls it) is
+neither side's in that match: the pursuer may hold it to the horizon, the evader may not
+escape by then, so both rows count it unknown (and late). Starts the referee leaves unknown,
+or certifies for the opponent, say nothing about a policy and are only counted.
 
 * :func:`regret` computes :class:`Regret` rows from match outcomes (plain mappings: the
   map, the env parameters, the start positions, the winner).
@@ -63,8 +69,11 @@ class Regret:
         matches: matches it played.
         winnable: of those, starts certified winnable for its role (within the horizon).
         lost: of the winnable, those it lost.
-        unknown: matches from starts neither bound certifies.
-        hopeless: matches from starts certified for its opponent.
+        unknown: matches from starts no bound certifies within the match's horizon (late
+            ones included).
+        hopeless: matches from starts certified for its opponent (within the horizon).
+        late: of the unknown, starts certified for the evader with a certified escape
+            time beyond the match's horizon (counted alike on both roles' rows).
     """
 
     role: str
@@ -74,6 +83,7 @@ class Regret:
     lost: int
     unknown: int
     hopeless: int
+    late: int = 0
 
     @property
     def rate(self) -> float:
@@ -160,18 +170,20 @@ def regret(
     for (world, params, start, winner, horizon), m in read:
         ref = referees[_game_key(world, params)]
         label, escape = _label(ref, start)
+        late = label == "evader" and escape > horizon + 1e-9
+        if late:  # certified, but not within this match: neither side's (module docstring)
+            label = "unknown"
         for role in ("pursuer", "evader"):
-            t = tally.setdefault((role, str(m[role])), [0, 0, 0, 0, 0])
+            t = tally.setdefault((role, str(m[role])), [0, 0, 0, 0, 0, 0])
             t[0] += 1
-            other = "evader" if role == "pursuer" else "pursuer"
-            winnable = label == role and (role == "pursuer" or escape <= horizon + 1e-9)
-            if winnable:
+            if label == role:
                 t[1] += 1
                 t[2] += winner != role
-            elif label == other:
-                t[4] += 1
-            else:
+            elif label == "unknown":
                 t[3] += 1
+                t[5] += late
+            else:
+                t[4] += 1
     rows = [Regret(r, p, *v) for (r, p), v in tally.items()]
     return sorted(rows, key=lambda x: (x.role != "pursuer", x.policy))
 
@@ -229,10 +241,25 @@ def _label(ref: Referee, start) -> tuple[str, float]:
     return label, math.inf
 
 
-def regret_table(rows: Iterable[Regret], confidence: float = 0.95) -> list[list[str]]:
-    """A table of regrets: a header row, then one row per policy."""
-    out = [["role", "policy", "matches", "certified winnable", "lost", "regret [95% CI]",
-            "unknown", "certified for the opponent"]]  # fmt: skip
+def regret_table(
+    rows: Iterable[Regret],
+    confidence: float = 0.95,
+    horizon: float | tuple[float, float] | None = None,
+) -> list[list[str]]:
+    """A table of regrets: a header row, then one row per policy.
+
+    Args:
+        rows: :func:`regret`'s rows.
+        confidence: of the regret's Wilson interval.
+        horizon: the matches' horizon in seconds (``max_cycles * dt``), or its least and
+            greatest when they differ, for the header to name: the counts certified for
+            a side are within it (:func:`regret`); by default the header says "the
+            horizon" without a value.
+    """
+    within, beyond = _horizon_words(horizon)
+    out = [["role", "policy", "matches", f"certified winnable ({within})", "lost",
+            "regret [95% CI]", "unknown", f"certified for the opponent ({within})",
+            f"of the unknown, late (certified for the evader, escape {beyond})"]]  # fmt: skip
     for r in rows:
         if r.winnable:
             lo, hi = r.interval(confidence)
@@ -240,8 +267,19 @@ def regret_table(rows: Iterable[Regret], confidence: float = 0.95) -> list[list[
         else:
             rate = "-"
         out.append([r.role, r.policy, str(r.matches), str(r.winnable), str(r.lost), rate,
-                    str(r.unknown), str(r.hopeless)])  # fmt: skip
+                    str(r.unknown), str(r.hopeless), str(r.late)])  # fmt: skip
     return out
+
+
+def _horizon_words(horizon: float | tuple[float, float] | None) -> tuple[str, str]:
+    """The header's words for the horizon the counts are within, and beyond it."""
+    if horizon is None:
+        return "within the horizon", "beyond the horizon"
+    lo, hi = (horizon, horizon) if isinstance(horizon, int | float) else horizon
+    if hi - lo < 1e-9:
+        return f"within the {lo:.4g} s horizon", f"beyond the {lo:.4g} s horizon"
+    each = f"each match's horizon, {lo:.4g}-{hi:.4g} s"
+    return f"within {each}", f"beyond {each}"
 
 
 # ---------------------------------------------------------------------- the tournament hook
@@ -279,7 +317,8 @@ def tournament_regret(
         before_solve: :func:`regret`'s, called with the estimated sizes of what it solves.
 
     Returns:
-        :func:`regret_table`'s rows (only matches played out, status ``"ok"``), then a
+        :func:`regret_table`'s rows (only matches played out, status ``"ok"``; its header
+        names their horizon, ``max_cycles * dt``), then a
         note row when a game's pursuer bound is vacuous (a
         :class:`~envs.errors.VacuousBoundWarning`: at rho = 0.5 its pursuer rows count no
         certified start because the bound certifies none, not because none is winnable),
@@ -315,7 +354,8 @@ def tournament_regret(
     for w in caught:  # other warnings go on as they came
         if not issubclass(w.category, VacuousBoundWarning):
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
-    table = regret_table(results)
+    horizons = [m["max_cycles"] * m["dt"] for m in matches]
+    table = regret_table(results, horizon=(min(horizons), max(horizons)) if horizons else None)
     vacuous = sorted({str(w.message) for w in caught
                       if issubclass(w.category, VacuousBoundWarning)})  # fmt: skip
     if vacuous:

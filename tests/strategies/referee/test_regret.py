@@ -49,7 +49,50 @@ def test_regret_counts_only_certified_winnable_starts(corridor_half):
     # a certified escape longer than the match's horizon is not winnable in that match
     short = _match(corridor_half, won_e[0], "p/a", "e/z", "pursuer", max_cycles=1)
     (z,) = [r for r in regret([short], referees=refs) if r.policy == "e/z"]
-    assert z.winnable == 0 and z.unknown == 1
+    assert z.winnable == 0 and z.unknown == 1 and z.late == 1
+
+
+def test_a_start_certified_for_the_evader_counts_alike_on_both_rows(corridor_half):
+    """The same start, the same horizon rule on both roles' rows: a start certified for the
+    evader is the pursuer's "certified for the opponent" exactly when it is the evader's
+    "certified winnable", i.e. when its certified escape time is within the match's
+    horizon; beyond it both rows count it unknown, and late. The pursuer's row counted it
+    for the opponent whatever the horizon (surveil tournament quick: 24 such matches on
+    each pursuer's row, 9 winnable on each evader's, 15 of them certified beyond 30 s)."""
+    refs: dict = {}
+    (start,) = corridor_half.sample_starts(1, np.random.default_rng(3), kind="evader")
+    regret([_match(corridor_half, start, "p", "e", "evader")], referees=refs, cache=False)
+    (ref,) = refs.values()  # the referee regret() counts with
+    t = ref.escape_time(start["pursuer"], start["evader"])
+    fits = math.ceil(t / DT - 1e-6)  # the fewest steps whose horizon holds the escape
+    assert fits >= 2, t
+    matches = [
+        _match(corridor_half, start, "p/in", "e/in", "pursuer", max_cycles=fits),
+        _match(corridor_half, start, "p/out", "e/out", "pursuer", max_cycles=fits - 1),
+    ]
+    rows = {r.policy: r for r in regret(matches, referees=refs)}
+
+    def counts(policy):  # winnable, lost, unknown, certified for the opponent
+        r = rows[policy]
+        return r.winnable, r.lost, r.unknown, r.hopeless
+
+    assert counts("p/in") == (0, 0, 0, 1) and counts("e/in") == (1, 1, 0, 0)
+    assert counts("p/out") == (0, 0, 1, 0) and counts("e/out") == (0, 0, 1, 0)
+    assert [rows[p].late for p in ("p/in", "e/in", "p/out", "e/out")] == [0, 0, 1, 1]
+
+
+def test_the_regret_table_names_the_horizon_its_counts_are_within():
+    rows = [Regret("pursuer", "p", 3, 0, 0, 2, 1, late=2)]
+    head, row = regret_table(rows, horizon=30.0)
+    assert head[3] == "certified winnable (within the 30 s horizon)"
+    assert head[7] == "certified for the opponent (within the 30 s horizon)"
+    assert (
+        head[8] == "of the unknown, late (certified for the evader, escape beyond the 30 s horizon)"
+    )
+    assert row[6:] == ["2", "1", "2"]
+    head, _ = regret_table(rows, horizon=(30.0, 60.0))
+    assert head[3] == "certified winnable (within each match's horizon, 30-60 s)"
+    assert regret_table(rows)[0][7] == "certified for the opponent (within the horizon)"
 
 
 def test_regret_table_formats_rates_with_intervals():
@@ -124,6 +167,7 @@ def test_tournament_regret_from_runner_records(corridor_half):
         "rho = 0.5: evader_coarse = 2 (spacing 0.1667, step 0.7 s) for 3 (spacing 0.25, "
         "step 1 s)"
     )
+    assert table[0][3] == "certified winnable (within the 30 s horizon)"  # 300 steps of 0.1 s
     by_policy = {row[1]: row for row in table[1:]}
     assert set(by_policy) == {"pursuer/greedy", "evader/shooting"}
     assert by_policy["evader/shooting"][3] == "2"  # both starts certified for the evader

@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+import tempfile
 from importlib import resources
 from pathlib import Path
 
@@ -183,8 +184,10 @@ def _announce_report(out: str, replays: bool, regret: bool = True, skip: str = "
 
 
 def _report_dir_possible(flag: str, text: str, alternative: str = "") -> None:
-    """Refuse a report directory that is a file or lies under one, making nothing (the
-    report makes it once there is something to write)."""
+    """Refuse a report directory that is a file or lies under one, or that could not be
+    made or written (its nearest existing folder takes no new file), making nothing (the
+    report makes it once there is something to write: a folder it could not write failed
+    only then, after the regret table and the replays, "DIR: Permission denied")."""
     path = Path(text)
     blocker = next((p for p in (path, *path.parents) if p.exists() and not p.is_dir()), None)
     if blocker is not None:
@@ -192,6 +195,16 @@ def _report_dir_possible(flag: str, text: str, alternative: str = "") -> None:
             f"{flag} = {text!r}: {str(blocker)!r} is a file, expected a directory"
             + (f" {alternative}" if alternative else "")
         )
+    nearest = next((p for p in (path, *path.parents) if p.is_dir()), Path("."))
+    try:
+        with tempfile.TemporaryFile(dir=nearest):
+            pass  # a file can be made there (os.access lies to root and on some mounts)
+    except OSError as exc:
+        raise InvalidConfigError(
+            f"{flag} = {text!r}: cannot write in {str(nearest)!r} "
+            f"({exc.strerror or type(exc).__name__}); expected a directory you can write"
+            + (f" {alternative}" if alternative else "")
+        ) from None
 
 
 def _cmd_report(args: argparse.Namespace) -> int:

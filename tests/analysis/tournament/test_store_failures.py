@@ -8,7 +8,9 @@ another user, when the tests run as root), a write limit on the driver's process
 
 from __future__ import annotations
 
+import contextlib
 import csv
+import io
 import os
 import pickle
 import resource
@@ -24,6 +26,7 @@ import pytest
 
 from analysis.cli import main
 from analysis.tournament import Store, StoreError, run_tournament, spec_from_dict
+from analysis.tournament.report import write_report
 
 from .conftest import comparable
 
@@ -126,6 +129,42 @@ def test_a_store_its_reader_cannot_write_is_reported_and_exported(shared_dir, sm
     assert refused is not None and "cannot be written here" in refused
     assert "give --store a file in a place you can write" in refused
     assert store.read_bytes() == before
+
+
+def test_a_report_folder_its_user_cannot_write_is_refused_before_any_work(shared_dir, small_spec):
+    """``surveil report --out DIR`` (and ``tournament --report DIR``) where DIR cannot be
+    made: refused in one line naming the flag, before the announcement of the work. Before,
+    the report announced its regret table, solved it and drew the replays (minutes to
+    hours), and only then failed on the folder: "DIR: Permission denied"."""
+    store = shared_dir / "theirs.sqlite"
+    run_tournament(spec_from_dict(small_spec), store, backend="serial", progress=False)
+    # its owner can (and so the other user's process has every module it needs loaded)
+    write_report(store, shared_dir / "out" / "mine", regret=False, replays=False)
+    spec = shared_dir / "out" / "small.toml"
+    spec.write_text(SPEC)
+    spec.chmod(0o644)
+    rep = shared_dir / "rep"
+
+    def report_there():
+        said = []
+        run = ["tournament", str(spec), "--store", str(shared_dir / "out" / "t.sqlite")]
+        for argv in (
+            ["report", str(store), "--out", str(rep), "--no-regret", "--no-replays"],
+            [*run, "--report", str(rep), "--backend", "serial"],
+        ):
+            err = io.StringIO()
+            with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+                code = main(argv)
+            said.append((code, err.getvalue()))
+        return said
+
+    (report, report_err), (run, run_err) = _as_a_user_who_cannot_write(store, report_there)
+    assert report == 2 and report_err.startswith("surveil: error: --out = ")
+    assert run == 2 and run_err.startswith("surveil: error: --report = ")
+    for err in (report_err, run_err):
+        assert len(err.splitlines()) == 1, err
+        assert f"cannot write in {str(shared_dir)!r}" in err and "writing the report" not in err
+    assert not rep.exists() and not (shared_dir / "out" / "t.sqlite").exists()
 
 
 def _limited(limit: int):

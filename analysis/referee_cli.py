@@ -125,7 +125,7 @@ def run(args: argparse.Namespace) -> int:
     from envs.surveillance.physics import check_step
     from strategies.referee import referee_for
     from strategies.referee.estimates import check_cpls, check_estimate
-    from strategies.referee.referee import check_solve_budget, check_start
+    from strategies.referee.referee import check_sample_size, check_solve_budget, check_start
     from strategies.referee.spec import GameSpec, check_cells_per_lmin
     from strategies.runner import map_parameters
 
@@ -168,6 +168,9 @@ def run(args: argparse.Namespace) -> int:
             check_cpls(args.estimate)
         except SurveilValueError as exc:
             raise type(exc)(f"--estimate: {exc}") from None
+    if args.sample:  # 1e9 starts: numpy's MemoryError, after the solve
+        with MemoryBudgetError.naming("--sample"):
+            check_sample_size(args.sample)
     if args.estimate is not None:  # its memory too, before the referee's solve
         with MemoryBudgetError.naming(ESTIMATE_KNOB):
             check_estimate(GameSpec.from_config(cfg), tuple(args.estimate) or ESTIMATE_CPLS)

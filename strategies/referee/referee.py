@@ -31,7 +31,9 @@ from envs.errors import (
     VacuousBoundWarning,
 )
 from envs.geometry import kernel_for
-from strategies.referee._budget import SolveSize, bound_size, check_budget
+from strategies.memory import memory_budget as _memory_budget
+from strategies.memory import physical_memory
+from strategies.referee._budget import SolveSize, _size, bound_size, check_budget
 from strategies.referee.cache import cache_path, load_arrays, save_arrays
 from strategies.referee.evader_bound import EvaderBound, solve_evader_bound
 from strategies.referee.pursuer_bound import VACUOUS_RHO, PursuerBound, solve_pursuer_bound
@@ -61,6 +63,43 @@ __all__ = [
 
 LABELS = ("pursuer", "evader", "unknown")
 """What a start can be labelled: who provably wins it, or unknown."""
+
+SAMPLE_BYTES = 512
+"""Memory a start drawn by :meth:`Referee.sample_starts` takes, in bytes, rounded up: its
+dict of two coordinate pairs measured 400 (tracemalloc, 100,000 starts), plus the index
+drawn for it."""
+
+
+def check_sample_size(n: int, memory_budget: object = None) -> int:
+    """``n``, after checking that ``n`` starts fit in the memory budget: the check
+    :meth:`Referee.sample_starts` makes before drawing, for a caller that must refuse
+    before a solve (``surveil referee --sample 1000000000`` solved, then died in numpy's
+    ``MemoryError`` traceback).
+
+    Raises:
+        InvalidConfigError: ``n`` is not an integer >= 0, or the budget is no size.
+        MemoryBudgetError: ``n`` starts need more than the budget (``$SURVEIL_MEMORY_BUDGET``
+            or half the RAM); the message names the most that fit.
+    """
+    n = V.integer("n", n, minimum=0)
+    limit = _memory_budget(memory_budget)
+    need = n * SAMPLE_BYTES
+    if need <= limit:
+        return n
+    more = (
+        f", or raise the budget ({MemoryBudgetError.BUDGET})"
+        if need <= physical_memory()
+        else f" (this machine has {_size(physical_memory())} of memory)"
+    )
+    raise MemoryBudgetError(
+        f"sample_starts: {MemoryBudgetError.KNOB} = {n} starts would take about "
+        f"{_size(need)} ({SAMPLE_BYTES} bytes each), more than the memory budget of "
+        f"{_size(limit)}; draw at most {int(limit // SAMPLE_BYTES)} at a time{more}",
+        "n",
+        MemoryBudgetError.ENV_BUDGET if memory_budget is None else MemoryBudgetError.PYTHON_BUDGET,
+        f"{math.ceil(1.2 * need / 1e9)}GB",  # as check_budget advises
+    )
+
 
 EVADER_FALLBACK_SHARE = 0.1
 """:func:`solve` retries the evader bound at a finer lattice when its default lattice
@@ -259,8 +298,10 @@ class Referee:
 
         Raises:
             InvalidConfigError: bad ``kind`` or ``n``, or no start of that kind exists.
+            MemoryBudgetError: ``n`` starts would not fit in the memory budget
+                (:func:`check_sample_size`).
         """
-        n = V.integer("n", n, minimum=0)
+        n = check_sample_size(n)
         kind = V.choice("kind", kind, LABELS)
         starts = self.lattice_starts(margin=margin)
         idx = np.flatnonzero(starts.label == kind)

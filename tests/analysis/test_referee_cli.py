@@ -132,6 +132,8 @@ def test_referee_bad_input_is_one_line(argv, message, capsys, tmp_path, monkeypa
         (["--classify", "nan", "1", "3", "1"], "--classify: pursuer = (nan, 1.0)"),
         (["--estimate", "6"], "--estimate: cpls = (6.0,): expected at least two"),
         (["--estimate", "6", "6"], "--estimate: cpls = (6.0, 6.0)"),
+        # numpy's MemoryError traceback, after the solve
+        (["--sample", "1000000000", "--kind", "unknown"], "--sample = 1000000000 starts would"),
     ],
 )
 def test_referee_bad_start_or_resolutions_fail_before_the_solve(extra, message, capsys, tmp_path,

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from envs.errors import InvalidConfigError, InvalidPlacementError
+from envs.errors import InvalidConfigError, InvalidPlacementError, MemoryBudgetError
 from envs.geometry import kernel_for
 from envs.surveillance.config import EnvConfig
 from strategies.referee import (
@@ -87,6 +87,21 @@ def test_sample_starts_errors(open_slow):
         open_slow.sample_starts(1, rng, kind="both")
     with pytest.raises(InvalidConfigError, match="n = -1"):
         open_slow.sample_starts(-1, rng)
+
+
+def test_sample_starts_beyond_the_memory_budget_are_refused_before_drawing(open_slow, monkeypatch):
+    # 1e12 starts died in numpy's MemoryError ("Unable to allocate 7.28 TiB"), and a
+    # number that fits in RAM but not in the budget was drawn whatever the budget
+    rng = np.random.default_rng(0)
+    monkeypatch.delenv("SURVEIL_MEMORY_BUDGET", raising=False)
+    with pytest.raises(MemoryBudgetError, match=r"n = 1000000000000 starts would take") as err:
+        open_slow.sample_starts(10**12, rng, kind="unknown")
+    assert "this machine has" in str(err.value)  # no budget advice that no RAM can meet
+    monkeypatch.setenv("SURVEIL_MEMORY_BUDGET", "1MB")
+    with pytest.raises(MemoryBudgetError, match=r"n = 10000 starts .* draw at most 1953") as err:
+        open_slow.sample_starts(10_000, rng, kind="unknown")
+    assert "SURVEIL_MEMORY_BUDGET=1GB in the environment" in str(err.value)
+    assert len(open_slow.sample_starts(1953, rng, kind="unknown")) == 1953
 
 
 def test_sample_starts_says_when_no_pursuer_start_says_nothing(corridor_half):

@@ -63,9 +63,7 @@ def _solved(config, cells_per_lmin: float, role: str):
     key = (spec, float(cells_per_lmin), float(config.dt), role)
     bound = _SOLVED.get(key)
     if bound is None:
-        # the evader plays its default lattice, as before solve's evader fallback (issue 13):
-        # the fallback would change the episodes of every benchmark it is an opponent in
-        bound = solve_role(spec, role, cells_per_lmin, dt=config.dt, evader_fallback=False)
+        bound = solve_role(spec, role, cells_per_lmin, dt=config.dt)
         if len(_SOLVED) >= 8:
             _SOLVED.pop(next(iter(_SOLVED)))
         _SOLVED[key] = bound

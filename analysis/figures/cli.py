@@ -42,26 +42,28 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     )
     p.add_argument("--only", nargs="+", metavar="NAME", help="figure names or unique prefixes")
     p.add_argument("--scale", type=float, default=1.0, help="size factor in [0.25, 4] (default 1)")
-    p.add_argument("--list", action="store_true", help="list the figures and exit")
-    p.add_argument(
+    # one job per call: "--check F --update F" checked and said nothing of the update
+    mode = p.add_mutually_exclusive_group()
+    mode.add_argument("--list", action="store_true", help="list the figures and exit")
+    mode.add_argument(
         "--numbers",
         nargs="*",
         metavar="PREFIX",
         help="print the report's numbers (optionally those whose key starts so)",
     )
-    p.add_argument(
+    mode.add_argument(
         "--report",
         metavar="FILE",
         type=path_text("a file name"),
         help="after drawing, rewrite FILE's tagged numbers and figure gallery",
     )
-    p.add_argument(
+    mode.add_argument(
         "--check",
         metavar="FILE",
         type=path_text("a file name"),
         help="only check FILE against the code: exit 1 listing what drifted",
     )
-    p.add_argument(
+    mode.add_argument(
         "--update",
         metavar="FILE",
         type=path_text("a file name"),

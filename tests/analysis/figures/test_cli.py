@@ -56,3 +56,20 @@ def test_check_refuses_a_file_that_is_not_a_report(tmp_path, capsys):
         assert main(["figures", "--check", str(path)]) == 2
         out, err = capsys.readouterr()
         assert f"--check = '{path}': " in err and needle in err and out == "", err
+
+
+@pytest.mark.parametrize(
+    ("first", "second"),
+    [("--check", "--update"), ("--update", "--report"), ("--list", "--check")],
+)
+def test_one_job_a_call_two_are_refused(first, second, tmp_path, capsys):
+    # "--check F --update F" checked F, said "every quoted number matches" and updated
+    # nothing; "--list --check F" listed and checked nothing, each without a word
+    report = tmp_path / "r.md"
+    report.write_text("31<!--n:corridor.regions-->\n")
+    argv = [first] if first == "--list" else [first, str(report)]
+    assert main(["figures", *argv, second, str(report), "--out", str(tmp_path / "o")]) == 2
+    out, err = capsys.readouterr()
+    assert err.startswith(f"surveil: error: {second}: not allowed with argument {first}")
+    assert out == "" and report.read_text() == "31<!--n:corridor.regions-->\n"
+    assert not (tmp_path / "o").exists()

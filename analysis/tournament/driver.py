@@ -10,6 +10,9 @@ of the same spec on the same store resumes; nothing stored is played again.
 A store may hold a run of the same spec played by an older surveil whose time limit meant
 something else (:data:`~analysis.tournament.spec.TIME_LIMIT_RULE`): its matches have
 other identities and are not reused, the run is a new one, and the summary says so.
+When an older surveil identified the matches of the very same run otherwise (the spec,
+so the run id, unchanged), those matches are set aside as a run of their own
+(:meth:`~analysis.tournament.store.Store.set_aside`) before the run plays its own.
 
 A spec with an ``[sprt]`` table stops as soon as Wald's sequential test on the
 candidate's and the baseline's paired starts is decided (run status ``decided``); the
@@ -147,6 +150,14 @@ def run_tournament(
 
         geometry = {m.digest: (m.map.name, map_to_dict(m.map)) for m in spec.maps}
         older = _older_runs(db, spec)  # before this run is in the store
+        aside = db.set_aside(spec.run_id, (m.match_id for m, _ in unique))
+        if aside is not None:
+            older.append(
+                f"run {spec.run_id} in {path} held {aside[1]} matches an older surveil "
+                "identified otherwise (the same spec, other match identities): they are set "
+                f"aside as run {aside[0]} (surveil report {path} --run {aside[0]}), so that "
+                f"run {spec.run_id} counts each of its starts once"
+            )
         done = db.begin_run(spec.run_id, spec.name, spec.to_dict(), unique, geometry)
         if retry_errors:
             done = db.finished(spec.run_id, include_errors=False)
@@ -298,6 +309,30 @@ class Sequential:
         return f"{head}: {who} ({counts}); the run stopped"
 
 
+class _ProgressLines:
+    """Progress for a log: a line on stderr each time another tenth of the planned
+    matches is stored (matches stored, forfeits and errors so far, elapsed time)."""
+
+    def __init__(self, name: str, summary: RunSummary) -> None:
+        self.name = name
+        self.summary = summary
+        self.tenth = 10 * summary.reused // max(summary.planned, 1)  # said by a resumed run
+        self.t0 = time.monotonic()
+
+    def update(self) -> None:
+        s = self.summary
+        done = s.reused + s.played
+        if 10 * done // max(s.planned, 1) <= self.tenth:
+            return
+        self.tenth = 10 * done // max(s.planned, 1)
+        print(
+            f"{self.name}: {done:,} of {s.planned:,} matches stored ({s.played:,} played in "
+            f"{time.monotonic() - self.t0:.0f} s; {s.forfeits} forfeits, {s.errors} errors)",
+            file=sys.stderr,
+            flush=True,
+        )
+
+
 def _play(
     db: Store,
     spec: Spec,
@@ -327,16 +362,21 @@ def _play(
     if threading.current_thread() is threading.main_thread():
         for sig in (signal.SIGINT, signal.SIGTERM):
             handlers[sig] = signal.signal(sig, on_signal)
+    # a bar on a terminal; a log (nohup, a cluster's job output) gets a line per tenth of
+    # the matches, as training's progress does: the bar's redraws made one line of ~100
+    # bytes a match that tail showed as a single line
+    terminal = sys.stderr.isatty()
     bar = tqdm(
         total=summary.planned,
         initial=summary.reused,
         desc=spec.name,
         unit="match",
-        disable=not progress,
+        disable=not (progress and terminal),
         file=sys.stderr,
         dynamic_ncols=True,
         smoothing=0.05,
     )
+    lines = _ProgressLines(spec.name, summary) if progress and not terminal else None
     by_id = {m.match_id: m for m in todo} if test is not None else {}
     try:
         for out in ex.run(todo, ctx, stop):
@@ -350,6 +390,8 @@ def _play(
             summary.forfeits += out.get("status") == "forfeit"
             summary.errors += out.get("status") == "error"
             bar.update(1)
+            if lines is not None:
+                lines.update()
             if summary.forfeits or summary.errors:
                 bar.set_postfix(forfeits=summary.forfeits, errors=summary.errors, refresh=False)
     except KeyboardInterrupt as exc:

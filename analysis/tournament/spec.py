@@ -115,6 +115,8 @@ _SPRT_KEYS = {"role", "candidate", "baseline", "p1", "alpha", "beta"}
 _ENTRY_KEYS = {"policy", "params", "label", "model", "algo", "deterministic", "observation"}
 _START_KINDS = ("safe", "valid")
 DEFAULT_TIME_LIMIT = 300.0
+MAX_SEED = 2**63 - 1
+"""The largest seed a spec may list: the store keeps seeds as SQLite's 64-bit integers."""
 TIME_LIMIT_RULE = "decision time per role"
 """What ``time_limit`` applies to, written into :meth:`Spec.to_dict` (so into the run's id):
 a store's runs without it were played by an older surveil, whose limit counted the whole
@@ -614,9 +616,16 @@ def _entry(item: Any, role: str, where: str, base: Path) -> PolicyEntry:
                 raise InvalidConfigError(f"{where}: {k!r} applies to 'model' entries only")
         params = mapping("params", d.get("params", {}), where=where)
         try:
-            make_policy(name, **params)  # the name and parameters are checked here
+            policy = make_policy(name, **params)  # the name and parameters are checked here
         except ValueError as exc:
             raise InvalidConfigError(f"{where}: {exc}") from exc
+        kind = (observation or {}).get("observation", "state")
+        if policy.uses_state and kind != "state":  # each of its matches was an error
+            raise InvalidConfigError(
+                f"{where}: policy {name!r} reads the state, so it cannot be given "
+                f"observation = {observation!r}; drop the entry's observation (an "
+                "observation is for a policy that reads the env's, such as a model)"
+            )
         label = string("label", d.get("label", name), where=where)
         return PolicyEntry(role, label, name, _canonical(params), None, None, observation)
     text = string("model", d["model"], where=where)
@@ -632,7 +641,12 @@ def _entry(item: Any, role: str, where: str, base: Path) -> PolicyEntry:
     params: dict[str, Any] = {}
     algo = d.get("algo", provenance.get("algo"))
     if algo is not None:
-        params["algo"] = string("algo", algo, where=where).upper()
+        from strategies.policies.learned import check_algo
+
+        try:
+            params["algo"] = check_algo(string("algo", algo, where=where), path)
+        except InvalidConfigError as exc:  # each match of the entry was an error
+            raise InvalidConfigError(f"{where}: model = {text!r}: {exc}") from None
     if "deterministic" in d:
         from envs.validation import boolean
 
@@ -751,11 +765,16 @@ def _seeds(value: Any, source: str, per_seed: int = 1) -> tuple[int, ...]:
     traceback, or the OOM killer, before any check).
 
     Raises:
-        InvalidConfigError: a bad seed, none, or a repeated one.
+        InvalidConfigError: a bad seed (one beyond :data:`MAX_SEED`, which the store's
+            64-bit integers cannot hold, was an ``OverflowError`` traceback once the
+            store was open), none, or a repeated one.
         MemoryBudgetError: too many matches to plan (naming how many seeds fit).
     """
     if isinstance(value, (list, tuple)):
-        seeds = [integer(f"seeds[{i}]", s, minimum=0, where=source) for i, s in enumerate(value)]
+        seeds = [
+            integer(f"seeds[{i}]", s, minimum=0, maximum=MAX_SEED, where=source)
+            for i, s in enumerate(value)
+        ]
         if not seeds:
             raise InvalidConfigError(f"{source}: seeds = []: expected at least one seed")
         if len(set(seeds)) != len(seeds):

@@ -34,6 +34,7 @@ from __future__ import annotations
 import contextlib
 import csv
 import functools
+import hashlib
 import json
 import os
 import sqlite3
@@ -405,6 +406,50 @@ class Store:
             c.executemany("INSERT OR IGNORE INTO matches VALUES (?, ?)", idents)
             c.executemany("INSERT OR IGNORE INTO run_matches VALUES (?,?,?,?,?,?,?,?,?)", rows)
         return self.finished(run_id)
+
+    @_guarded
+    def set_aside(self, run_id: str, planned: Iterable[str]) -> tuple[str, int] | None:
+        """Move the matches ``run_id`` holds but no longer plans into a run of their own.
+
+        The same spec plans other matches when the code that identifies them changed
+        (a store an older surveil wrote: another identity version, another env default)
+        while the spec, and so the run id, did not. :meth:`begin_run` added the new
+        matches beside the old ones: the run then held every start twice and its report
+        counted each cell's matches twice (n doubled, intervals too narrow).
+
+        Args:
+            run_id: the run about to begin.
+            planned: the match ids its spec plans now.
+
+        Returns:
+            ``(the new run's id, how many matches moved)``, or ``None`` when the run is
+            not in the store or holds only planned matches. The new run keeps the old
+            run's name, spec, dates and status (``interrupted`` if it was ``running``),
+            so ``surveil report --run ID`` shows what the old run showed.
+        """
+        keep = set(planned)
+        held = self.conn.execute(
+            "SELECT match_id FROM run_matches WHERE run_id = ?", (run_id,)
+        ).fetchall()
+        stale = sorted(m for (m,) in held if m not in keep)
+        if not stale:
+            return None
+        aside = hashlib.sha256(f"{run_id}:{','.join(stale)}".encode()).hexdigest()[:16]
+        with self.transaction() as c:
+            name, spec, created, updated, status = c.execute(
+                "SELECT name, spec, created, updated, status FROM runs WHERE run_id = ?",
+                (run_id,),
+            ).fetchone()
+            status = "interrupted" if status == "running" else status
+            c.execute(
+                "INSERT OR IGNORE INTO runs VALUES (?, ?, ?, ?, ?, ?)",
+                (aside, name, spec, created, updated, status),
+            )
+            c.executemany(
+                "UPDATE run_matches SET run_id = ? WHERE run_id = ? AND match_id = ?",
+                [(aside, run_id, m) for m in stale],
+            )
+        return aside, len(stale)
 
     @_guarded
     def finished(self, run_id: str, *, include_errors: bool = True) -> set[str]:

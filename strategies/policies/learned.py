@@ -42,6 +42,7 @@ __all__ = [
     "SB3Policy",
     "UnseenMapWarning",
     "UnseenParametersWarning",
+    "check_algo",
     "learner_inputs_spec",
     "maps_trained_on",
     "trained_map_digests",
@@ -176,6 +177,35 @@ def _algo_from_zip(path: Path) -> str:
     raise InvalidConfigError(
         f"{path}: cannot tell the algorithm from the zip; pass algo= one of {SB3_ALGORITHMS}"
     )
+
+
+_ALGO_FAMILIES = ({"PPO", "A2C"}, {"TD3", "DDPG"}, {"SAC"})
+"""Algorithms that load one another's zips (they save the same policy class)."""
+
+
+def check_algo(algo: str, path: str | Path) -> str:
+    """``algo`` upper-cased, if it is an SB3 algorithm that can load the zip at ``path``.
+
+    A zip that does not say which algorithm saved it is not refused here (loading it
+    will tell). ``algo = "SAC"`` for a PPO zip failed only as the model loaded, in every
+    match of a tournament entry.
+
+    Raises:
+        InvalidConfigError: an unknown algorithm, or one that cannot load the zip's.
+    """
+    name = algo.upper()
+    if name not in SB3_ALGORITHMS:
+        raise InvalidConfigError(f"algo = {algo!r}: expected one of {list(SB3_ALGORITHMS)}")
+    try:
+        saved = _algo_from_zip(Path(path))
+    except InvalidConfigError:
+        return name
+    if not any(name in family and saved in family for family in _ALGO_FAMILIES):
+        raise InvalidConfigError(
+            f"algo = {algo!r}: {path} was saved by {saved}, which {name} cannot load; "
+            f"give algo = {saved!r}, or no algo (it is read from the zip)"
+        )
+    return name
 
 
 class SB3Policy(BasePolicy):

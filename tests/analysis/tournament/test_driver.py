@@ -696,3 +696,18 @@ def test_a_worker_builds_the_judge_of_its_safe_starts_before_its_first_match(tmp
     outcomes = [worker.play(match, ctx) for match, _ in plan(spec)]
     assert [o["status"] for o in outcomes] == ["ok"] * 4, outcomes
     assert safety_table.cache_info().misses == built  # the judge's table: on no watch
+
+
+def test_progress_in_a_log_is_a_line_per_tenth_of_the_matches(tmp_path, small_spec, capsys):
+    # stderr not a terminal (nohup, a job's log): tqdm's bar wrote a redraw of ~100 bytes
+    # a match, joined by carriage returns into one line (a week's run: megabytes of it)
+    spec = spec_from_dict(small_spec)
+    s = run_tournament(spec, tmp_path / "s.sqlite", backend="serial", progress=True)
+    assert s.played == 24
+    err = capsys.readouterr().err
+    assert "\r" not in err
+    lines = [x for x in err.splitlines() if x.startswith("small: ")]
+    assert len(lines) == 10 and lines[-1].startswith("small: 24 of 24 matches stored (24 played")
+    assert lines[0].startswith("small: 3 of 24 matches stored")
+    run_tournament(spec, tmp_path / "s.sqlite", backend="serial", progress=False)
+    assert capsys.readouterr().err == ""  # --no-progress: nothing

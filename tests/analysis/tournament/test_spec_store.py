@@ -484,6 +484,47 @@ def test_a_run_an_older_surveil_stored_is_played_again_and_said_so(tmp_path):
     assert "older surveil" not in again.describe()
 
 
+def test_a_run_whose_matches_an_older_surveil_identified_otherwise_counts_each_once(tmp_path):
+    """data/store_identity_v1_same_run.sql: 00d1beb (49a40b0~1: the spec already had its
+    time_limit_rule, the match identity was still version 1) played _OLD_SPEC, dumped as
+    store_identity_v1.sql was. Its run id is today's, but its matches' ids are not: the
+    rerun added today's 2 matches to the run's 2 old ones, and the report counted 4
+    matches of 2 starts (every cell's n doubled)."""
+    from importlib import resources
+
+    from analysis.tournament.report import write_report
+
+    store = tmp_path / "old.sqlite"
+    dump = resources.files("tests.analysis.tournament").joinpath(
+        "data", "store_identity_v1_same_run.sql"
+    )
+    with contextlib.closing(sqlite3.connect(store)) as c:
+        c.executescript(dump.read_text())
+    with Store(store) as db:
+        (old,) = db.runs()
+    s = run_tournament(spec_from_dict(_OLD_SPEC), store, backend="serial", progress=False)
+    assert s.run_id == old["run_id"] == "6933253d456d535e"  # the same run
+    assert (s.planned, s.reused, s.played) == (2, 0, 2)
+    with Store(store) as db:
+        assert len(db.rows(s.run_id)) == 2  # was 4: seeds 0 and 1, each twice
+        (aside,) = {r["run_id"] for r in db.runs()} - {s.run_id}
+    said = s.describe()
+    assert f"run {s.run_id} in {store} held 2 matches an older surveil identified" in said
+    assert f"--run {aside}" in said
+    with Store(store) as db:
+        rows, kept = db.rows(s.run_id), db.rows(aside)
+        assert len(kept) == 2  # the old run's matches, as they were
+        assert {r["seed"] for r in rows} == {r["seed"] for r in kept} == {0, 1}
+        assert {r["run_id"]: r["status"] for r in db.runs()}[aside] == "finished"
+    md = write_report(store, tmp_path / "r", run_id=s.run_id, replays=False, regret=False)
+    assert "2 of 2 matches stored" in md["markdown"].read_text()
+    # a resume neither plays nor sets aside anything more
+    again = run_tournament(spec_from_dict(_OLD_SPEC), store, backend="serial", progress=False)
+    assert (again.reused, again.played) == (2, 0) and "older surveil" not in again.describe()
+    with Store(store) as db:
+        assert len(db.runs()) == 2
+
+
 def test_an_older_run_from_another_checkout_is_said_so(tmp_path):
     """data/store_identity_v1_zoo.sql: 94c5063 played _OLD_SPEC's open_room with the zoo
     evader from a checkout in /tmp/h132-old (dumped as store_identity_v1.sql was): its
@@ -555,3 +596,58 @@ def test_a_model_given_another_observation_is_refused_as_the_spec_is_read(tmp_pa
     assert spec.pursuers[0].observation == given
     whole = {"model": "zoo:dagger_pursuer_generalist"}  # its provenance gives the observation
     assert spec_from_dict({**d, "pursuers": [whole]}).pursuers[0].observation["n_rays"] == 32
+
+
+_CORRIDOR_MODEL = "zoo:dagger_pursuer_corridor"  # a PPO zip
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [
+        # stored as SQLite's 64-bit integer: an OverflowError traceback once the store was open
+        (
+            {"seeds": [2**64]},
+            r"seeds\[0\] = 18446744073709551616: expected an integer in "
+            r"\[0, 9223372036854775807\]",
+        ),
+        # each match an error: "policy 'pursuer/random' reads the 'state' observation, ..."
+        (
+            {"pursuers": [{"policy": "pursuer/random", "observation": {"observation": "lidar"}}]},
+            r"\[pursuers #1\]: policy 'pursuer/random' reads the state, so it cannot be given "
+            r"observation = \{'observation': 'lidar'\}",
+        ),
+        # each match an error: "algo must be one of (...), got 'DQN'"
+        (
+            {"pursuers": [{"model": _CORRIDOR_MODEL, "algo": "dqn"}]},
+            r"\[pursuers #1\]: model = 'zoo:dagger_pursuer_corridor': algo = 'dqn': expected "
+            r"one of \['A2C', 'DDPG', 'PPO', 'SAC', 'TD3'\]",
+        ),
+        # each match an error: "cannot load the model file ... 'ActorCriticPolicy' object
+        # has no attribute 'actor'"
+        (
+            {"pursuers": [{"model": _CORRIDOR_MODEL, "algo": "SAC"}]},
+            r"algo = 'SAC': .*model.zip was saved by PPO, which SAC cannot load; give "
+            r"algo = 'PPO', or no algo",
+        ),
+    ],
+)
+def test_a_spec_refuses_on_load_what_made_every_match_of_an_entry_an_error(change, match):
+    d = {"maps": ["corridor"], "pursuers": ["pursuer/greedy"], "evaders": ["evader/straight"]}
+    with pytest.raises(InvalidConfigError, match=match):
+        spec_from_dict({**d, "seeds": 1, **change})
+
+
+def test_what_a_spec_still_takes_beside_those_refusals():
+    d = {"maps": ["corridor"], "evaders": ["evader/straight"], "seeds": [0, 2**63 - 1]}
+    spec = spec_from_dict(
+        {
+            **d,
+            "pursuers": [
+                {"policy": "pursuer/random", "observation": {"observation": "state"}},
+                {"model": _CORRIDOR_MODEL, "algo": "a2c", "label": "a2c"},  # loads PPO's
+                {"model": _CORRIDOR_MODEL, "algo": "ppo"},
+            ],
+        }
+    )
+    assert spec.seeds == (0, 2**63 - 1)
+    assert [p.params.get("algo") for p in spec.pursuers] == [None, "A2C", "PPO"]

@@ -79,8 +79,18 @@ def format_cells(cells, scope: str | None = None) -> str:
 
 
 def _print_outcome(
-    summary, store: Path, report: str | None, replays: bool, regret: bool = True
+    summary,
+    store: Path,
+    report: str | None,
+    replays: bool,
+    regret: bool = True,
+    retry: str | None = None,
 ) -> int:
+    """Print the run's summary and overall table, write its report; the exit code.
+
+    ``retry``: the command that plays the run's error matches again (said when there
+    are some: a worker that died, killed by the OOM killer or a node lost, left its
+    match an error that a plain rerun keeps)."""
     from analysis.tournament import statistics as st
     from analysis.tournament.report import write_report
     from analysis.tournament.store import Store
@@ -92,6 +102,12 @@ def _print_outcome(
         cells = st.cells(rows)
         scopes = {c.scope for c in cells}
         print(format_cells(cells, st.OVERALL if st.OVERALL in scopes else None))
+        if failed and retry is not None and len(failed) < len(rows):
+            print(
+                f"{len(failed)} of its matches are stored as errors, won by nobody (the "
+                f"first: {failed[0]['error']}); a rerun keeps them; to play them again: "
+                f"{retry} --retry-errors"
+            )
         if report:
             _announce_report(report, replays, regret, skip="--no-report skips it")
             files = write_report(
@@ -101,9 +117,11 @@ def _print_outcome(
     if summary.interrupted:
         return EXIT_SIGNAL.get(summary.interrupted, 130)
     if rows and len(failed) == len(rows):  # nothing was played: not a success
+        again = f"; once that is fixed, to play them again: {retry} --retry-errors"
         print(
             f"surveil: error: every one of the {len(rows)} matches of run {summary.run_id} "
-            f"in {store} ended in an error, the first: {failed[0]['error']}",
+            f"in {store} ended in an error, the first: {failed[0]['error']}"
+            + (again if retry else ""),
             file=sys.stderr,
         )
         return EXIT_ALL_ERRORS
@@ -159,7 +177,9 @@ def _cmd_tournament(args: argparse.Namespace) -> int:
     report = args.report
     if report is None and not summary.interrupted and args.report_default:
         report = str(store.with_name(store.stem + "_report"))
-    return _print_outcome(summary, store, report, not args.no_replays, not args.no_regret)
+    return _print_outcome(
+        summary, store, report, not args.no_replays, not args.no_regret, retry=hint
+    )
 
 
 def _say(text: str) -> None:

@@ -407,3 +407,29 @@ def test_an_interrupted_report_leaves_the_previous_one_whole(tmp_path, monkeypat
     assert set(snapshot(rep)) == shown(rep) | {"report.md", "report.html", "notes.txt"}
     assert second["markdown"].read_text() != before["report.md"].decode()
     assert {p.name for p in second.values()} == set(snapshot(rep)) - {"notes.txt"}
+
+
+def test_a_run_with_error_matches_says_how_to_play_them_again(tmp_path, capsys):
+    # A worker that died (the OOM killer, a Ray node lost) leaves its match stored as an
+    # error, which a rerun keeps: the summary said "1 errors (see the report)" and
+    # nothing of --retry-errors
+    store, argv = _mini_tournament(tmp_path)
+    assert main([*argv, "--no-report"]) == 0
+    capsys.readouterr()
+    with Store(store) as db:
+        (run,) = db.runs()
+        lost = db.rows(run["run_id"])[1]["match_id"]
+        # what the process executor stores for the match of a worker that died
+        died = {"match_id": lost, "status": "error", "error": "worker process died"}
+        db.record(run["run_id"], died)
+    assert main([*argv, "--no-report"]) == 0
+    out = capsys.readouterr().out
+    assert "4 reused, 0 played" in out
+    assert (
+        "1 of its matches are stored as errors, won by nobody (the first: worker process "
+        "died); a rerun keeps them; to play them again: surveil tournament "
+        f"{tmp_path / 'mini.toml'} --store {store} --backend serial --retry-errors"
+    ) in out
+    assert main([*argv, "--no-report", "--retry-errors"]) == 0
+    out = capsys.readouterr().out
+    assert "3 reused, 1 played" in out and "stored as errors" not in out

@@ -14,7 +14,10 @@
 from __future__ import annotations
 
 import argparse
+import os
+import shutil
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -139,7 +142,8 @@ def _report_text(path: Path, flag: str) -> str:
     (the gallery was appended to whatever file was given, a JSON file included).
 
     Raises:
-        InvalidConfigError: no such file, or not a report.
+        InvalidConfigError: no such file, not a report, or (``--report``, ``--update``:
+            it is to be rewritten) a file or folder that cannot be written.
     """
     from analysis.figures.report import BEGIN, END, read, tags
 
@@ -153,6 +157,15 @@ def _report_text(path: Path, flag: str) -> str:
             f"{flag} = {str(path)!r}: not a report (no tagged number such as "
             f"31<!--n:corridor.regions--> and no {BEGIN} ... {END}); left unchanged"
         )
+    if flag != "--check":  # it will be rewritten: said now, not after the drawing
+        try:
+            with path.open("r+b"), tempfile.TemporaryFile(dir=path.parent):
+                pass  # the file and a new one beside it (the rewrite's) can be written
+        except OSError as exc:
+            reason = exc.strerror or type(exc).__name__
+            raise InvalidConfigError(
+                f"{flag} = {str(path)!r}: cannot write it ({reason}); left unchanged"
+            ) from None
     return text
 
 
@@ -161,7 +174,14 @@ def _update(path: Path, flag: str) -> None:
     from analysis.figures.report import update_report
 
     text, changes = update_report(_report_text(path, flag), compute_numbers())
-    path.write_text(text, encoding="utf-8")
+    # whole or not at all: an interrupted write truncated the report
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        shutil.copymode(path, tmp)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
     for c in changes:
         print(f"{path}: {c}")
     print(f"{path}: {len(changes)} number(s) changed; gallery regenerated")

@@ -9,6 +9,7 @@ file: a PNG (matplotlib) or a GIF (an episode replay).
 from __future__ import annotations
 
 import importlib
+import os
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -180,8 +181,15 @@ def build_figure(name: str, out_dir: str | Path, *, scale: float = 1.0) -> Path:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     path = out / spec.filename
+    # drawn beside it, then renamed: an interrupted build (Ctrl-C while a GIF's frames are
+    # encoded) leaves the previous figure whole, not a truncated file in docs/figures
+    tmp = out / f".{path.stem}.{os.getpid()}.tmp{path.suffix}"
     from analysis.figures.style import context
 
-    with context():
-        spec.build(path, scale)
+    try:
+        with context():
+            spec.build(tmp, scale)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
     return path

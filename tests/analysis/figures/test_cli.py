@@ -2,6 +2,12 @@
 
 from __future__ import annotations
 
+import contextlib
+import io
+import shutil
+import tempfile
+from pathlib import Path
+
 import pytest
 
 from analysis.cli import main
@@ -73,3 +79,56 @@ def test_one_job_a_call_two_are_refused(first, second, tmp_path, capsys):
     assert err.startswith(f"surveil: error: {second}: not allowed with argument {first}")
     assert out == "" and report.read_text() == "31<!--n:corridor.regions-->\n"
     assert not (tmp_path / "o").exists()
+
+
+def test_an_interrupted_figure_leaves_the_previous_one_whole(tmp_path, monkeypatch):
+    # a figure was written in place: Ctrl-C while a GIF's frames were encoded left a
+    # truncated file in docs/figures
+    from analysis.figures import style
+    from analysis.figures.registry import build_figure
+
+    before = build_figure("fig12", tmp_path, scale=0.3).read_bytes()
+    real = style.save_png
+
+    def interrupted(fig, path, scale):
+        real(fig, path, scale)
+        with open(path, "r+b") as f:  # half of it on disk when the signal came
+            f.truncate(f.seek(0, 2) // 2)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(style, "save_png", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        build_figure("fig12", tmp_path, scale=0.5)
+    assert [p.name for p in tmp_path.iterdir()] == ["fig12-greedy.png"]
+    assert (tmp_path / "fig12-greedy.png").read_bytes() == before
+
+
+def test_a_report_its_user_cannot_write_is_refused_before_the_drawing(tmp_path):
+    # --report FILE was read up front but written only after every figure was drawn
+    # (minutes): then "FILE: Permission denied"
+    from tests.analysis.tournament.test_store_failures import _as_a_user_who_cannot_write
+
+    shared = Path(tempfile.mkdtemp(prefix="surveil-figures-test-"))
+    try:
+        shared.chmod(0o755)
+        out = shared / "out"
+        out.mkdir()
+        out.chmod(0o777)
+        report = shared / "REPRODUCTION.md"
+        report.write_text("31<!--n:corridor.regions-->\n")
+        assert main(["figures", "--only", "fig12", "--scale", "0.3", "--out", str(tmp_path)]) == 0
+
+        def draw_and_report():
+            err = io.StringIO()
+            argv = ["figures", "--only", "fig12", "--scale", "0.3", "--out", str(out)]
+            with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+                code = main([*argv, "--report", str(report)])
+            return code, err.getvalue(), sorted(p.name for p in out.iterdir())
+
+        code, err, drawn = _as_a_user_who_cannot_write(report, draw_and_report)
+        assert code == 2 and err.startswith(f"surveil: error: --report = '{report}': cannot ")
+        assert "left unchanged" in err and len(err.splitlines()) == 1
+        assert drawn == []  # refused before the first figure
+        assert report.read_text() == "31<!--n:corridor.regions-->\n"
+    finally:
+        shutil.rmtree(shared, ignore_errors=True)

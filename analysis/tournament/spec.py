@@ -339,6 +339,13 @@ def spec_from_dict(
     starts = _starts(d.get("start", "safe"), source)
     env = _env_table(d.get("env", {}), flags.get("env", f"{source} [env]"))
     variants = _grid(d.get("grid", {}), f"{source} [grid]")
+    if "v_evader" in env and any(v.rho is not None for v in variants):
+        # rho sets v_evader = rho * v_pursuer: the [env] value was dropped without a word
+        raise InvalidConfigError(
+            f"{flags.get('env', f'{source} [env]')}: v_evader = {env['v_evader']!r} and "
+            f"{source} [grid] rho both set the evader's speed (rho sets v_evader = rho * "
+            "v_pursuer); give one"
+        )
     per_seed = len(maps) * len(variants) * len(starts) * len(pursuers) * len(evaders)
     seeds = _seeds(d.get("seeds", 10), source, per_seed)
     time_limit = positive("time_limit", d.get("time_limit", DEFAULT_TIME_LIMIT), where=source)

@@ -622,6 +622,12 @@ _CORRIDOR_MODEL = "zoo:dagger_pursuer_corridor"  # a PPO zip
             r"\[pursuers #1\]: model = 'zoo:dagger_pursuer_corridor': algo = 'dqn': expected "
             r"one of \['A2C', 'DDPG', 'PPO', 'SAC', 'TD3'\]",
         ),
+        # the grid's rho set v_evader in every match, the [env] value dropped unsaid
+        (
+            {"env": {"v_evader": 0.3}, "grid": {"rho": [0.5, 0.7]}},
+            r"<spec> \[env\]: v_evader = 0.3 and <spec> \[grid\] rho both set the evader's "
+            r"speed \(rho sets v_evader = rho \* v_pursuer\); give one",
+        ),
         # each match an error: "cannot load the model file ... 'ActorCriticPolicy' object
         # has no attribute 'actor'"
         (
@@ -650,4 +656,7 @@ def test_what_a_spec_still_takes_beside_those_refusals():
         }
     )
     assert spec.seeds == (0, 2**63 - 1)
+    faster = spec_from_dict({**d, "pursuers": ["pursuer/greedy"], "env": {"v_pursuer": 2.0},
+                             "grid": {"rho": [0.25]}})  # fmt: skip
+    assert faster.env_config(faster.maps[0], faster.variants[0])["v_evader"] == 0.5
     assert [p.params.get("algo") for p in spec.pursuers] == [None, "A2C", "PPO"]

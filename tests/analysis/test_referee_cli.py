@@ -363,3 +363,31 @@ def test_an_absurd_resolution_is_one_line_naming_the_flag(flag, capsys):
     err = capsys.readouterr().err
     assert err.startswith(f"surveil: error: {flag[0]}") and "Traceback" not in err, err
     assert "expected at most 1e+12" in err and len(err.strip().splitlines()) == 1
+
+
+def test_a_lattice_that_misses_a_narrow_passage_names_a_resolution_that_does_not(
+    tmp_path, capsys, monkeypatch
+):
+    """A ring corridor 0.5 wide round a 9 x 9 block (agents of radius 0.1): no point of the
+    lattice at 8 cells per L_min lies in it, and the refusal was the lattice's own, naming
+    no flag: "no lattice point of spacing 0.5 lies 0.1 from the walls of map 'ring'; refine
+    the resolution" (16 and 12 hold none either; 9.51 does). A map where no agent fits at
+    all is said so up front, as the env says it (refining could not help there)."""
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", str(tmp_path))
+    ring = tmp_path / "ring.json"
+    block = [[0.5, 0.5], [9.5, 0.5], [9.5, 9.5], [0.5, 9.5]]
+    ring.write_text(json.dumps({"boundary": [[0, 0], [10, 0], [10, 10], [0, 10]],
+                                "obstacles": [block]}))  # fmt: skip
+    assert main(["referee", str(ring), "--cells-per-lmin", "8"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("surveil: error: --cells-per-lmin = 8: the referee's lattices hold ")
+    assert "no start with the players in range [2, 4], body_radius = 0.1 from the walls" in err
+    assert "the next finer resolution with one is --cells-per-lmin 9.51 (" in err
+    assert main(["referee", str(ring), "--cells-per-lmin", "9.51"]) == 0
+    assert "lattice starts" in capsys.readouterr().out
+    slit = tmp_path / "slit.json"
+    slit.write_text(json.dumps({"boundary": [[0, 0], [100, 0], [100, 0.15], [0, 0.15]]}))
+    assert main(["referee", str(slit), "--cells-per-lmin", "8"]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.startswith("surveil: error: referee: map 'slit' cannot hold an ")
+    assert "no point of its free space is body_radius = 0.1 from the walls" in err

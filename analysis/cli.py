@@ -145,8 +145,16 @@ def _cmd_play(args: argparse.Namespace) -> int:
         pursuer = _policy("--pursuer", args.pursuer, "--pursuer-params", args.pursuer_params)
         evader = _policy("--evader", args.evader, "--evader-params", args.evader_params)
         out = None
-        if not args.no_gif:
-            out = output_file("--out", args.out, suffixes=(".gif", ".png"), default_name="play.gif")
+        if args.no_gif:  # a replay asked for and not written, without a word
+            given = [f for f, v in (("--out", args.out), ("--overlay", args.overlay)) if v]
+            if given:
+                raise InvalidConfigError(
+                    f"--no-gif writes no replay; {' and '.join(given)} "
+                    f"{'are' if len(given) > 1 else 'is'} for the replay: give one or the other"
+                )
+        else:
+            where = args.out if args.out is not None else str(DEFAULT_OUT / "play.gif")
+            out = output_file("--out", where, suffixes=(".gif", ".png"), default_name="play.gif")
     say_warnings(held)
     shading: tuple = ()
     if args.overlay and out is not None:
@@ -350,9 +358,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--config", help=f"env overrides as JSON, e.g. {CONFIG_EXAMPLE}")
     p.add_argument(
         "--out",
-        default=str(DEFAULT_OUT / "play.gif"),
         type=path_text("a file name or a directory"),
-        help="replay: a .gif, a .png strip, or a directory (DIR/play.gif)",
+        help=f"replay: a .gif, a .png strip, or a directory (DIR/play.gif; default: "
+        f"{DEFAULT_OUT / 'play.gif'})",
     )
     p.add_argument(
         "--fps", type=integer(1, MAX_FPS), default=20, help=f"GIF frame rate (1-{MAX_FPS})"

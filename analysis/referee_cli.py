@@ -76,10 +76,9 @@ def add_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParse
     p.add_argument(
         "--kind",
         choices=["pursuer", "evader", "unknown"],
-        default="pursuer",
         help="the label of the starts --sample prints (default: pursuer)",
     )
-    p.add_argument("--seed", type=integer(0), default=0, help="seed of --sample (>= 0)")
+    p.add_argument("--seed", type=integer(0), help="seed of --sample (>= 0; default 0)")
     p.add_argument(
         "--estimate",
         nargs="*",
@@ -136,6 +135,14 @@ def run(args: argparse.Namespace) -> int:
     from strategies.runner import map_parameters
 
     check_cells_per_lmin(args.cells_per_lmin, "--cells-per-lmin")  # 1e100 was a traceback
+    if args.sample is None:  # they were dropped without a word, after the solve
+        flags = (("--kind", args.kind), ("--seed", args.seed))
+        given = [f"{f} {v}" for f, v in flags if v is not None]
+        if given:
+            raise InvalidConfigError(
+                f"{' '.join(given)}: {'they choose' if len(given) > 1 else 'it chooses'} the "
+                "starts --sample prints; add --sample N (or leave them out)"
+            )
     overrides = json_object("--config", args.config, example=CONFIG_EXAMPLE)
     out = None
     if args.out:
@@ -250,8 +257,8 @@ def run(args: argparse.Namespace) -> int:
     if args.estimate is not None:
         _print_estimate(ref.spec, args)
     if args.sample:
-        rng = np.random.default_rng(args.seed)
-        for start in ref.sample_starts(args.sample, rng, kind=args.kind):
+        rng = np.random.default_rng(0 if args.seed is None else args.seed)
+        for start in ref.sample_starts(args.sample, rng, kind=args.kind or "pursuer"):
             print(json.dumps(start))
     if out is not None:
         from strategies.referee.draw import draw_referee

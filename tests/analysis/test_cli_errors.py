@@ -626,3 +626,18 @@ def test_the_no_provenance_warning_says_what_is_still_checked(tmp_path, capsys, 
         "another size are refused)" in warning
     ), warning
     assert "takes observations of shape (40,)" in error
+
+
+def test_a_replay_asked_for_with_no_gif_is_refused(capsys, tmp_path, monkeypatch):
+    """``play --no-gif --out x.gif`` (or ``--overlay``) played, printed the outcome and wrote
+    no replay, without a word: one of the two flags was dropped."""
+    monkeypatch.chdir(tmp_path)
+    for extra, needles in (
+        (["--out", "x.gif"], ["--no-gif writes no replay; --out is for the replay"]),
+        (["--overlay"], ["--overlay is for the replay"]),
+        (["--out", "x.gif", "--overlay"], ["--out and --overlay are for the replay"]),
+    ):
+        assert_fails(capsys, ["play", *FAST, "--no-gif", *extra], *needles)
+    assert list(tmp_path.iterdir()) == []
+    assert main(["play", *FAST]) == 0  # the default replay is still out/play.gif
+    assert (tmp_path / "out" / "play.gif").is_file()

@@ -134,6 +134,9 @@ def test_referee_bad_input_is_one_line(argv, message, capsys, tmp_path, monkeypa
         (["--estimate", "6", "6"], "--estimate: cpls = (6.0, 6.0)"),
         # numpy's MemoryError traceback, after the solve
         (["--sample", "1000000000", "--kind", "unknown"], "--sample = 1000000000 starts would"),
+        # dropped without a word after the solve: they choose the starts --sample prints
+        (["--kind", "evader"], "--kind evader: it chooses the starts --sample prints; add"),
+        (["--kind", "evader", "--seed", "3"], "--kind evader --seed 3: they choose the"),
     ],
 )
 def test_referee_bad_start_or_resolutions_fail_before_the_solve(extra, message, capsys, tmp_path,

@@ -31,7 +31,7 @@ from envs.maps.map import Feature, Map
 from envs.tolerances import ANGLE_TOL
 from strategies.cspace._candidates import wall_index
 
-__all__ = ["ArcBatch", "free_arcs_batch", "free_arcs_few", "stop_code", "stop_of"]
+__all__ = ["ArcBatch", "WallCells", "free_arcs_batch", "free_arcs_few", "stop_code", "stop_of"]
 
 TWO_PI = 2.0 * math.pi
 _KINDS = (("body", "edge"), ("body", "vertex"), ("tip", "vertex"), ("tip", "edge"))
@@ -104,8 +104,18 @@ def _label_codes(world: Map, e, at_vertex, v, dist_v, L, eps):
     return (pri << 32) | feat
 
 
-def _blocks(world: Map, P: np.ndarray, L: float, eps: float, pid: np.ndarray, e: np.ndarray):
-    """Blocked arcs of edges ``e`` seen from points ``P[pid]`` (pairs within reach)."""
+def _blocks(
+    world: Map,
+    P: np.ndarray,
+    L: float,
+    eps: float,
+    pid: np.ndarray,
+    e: np.ndarray,
+    cells: WallCells | None = None,
+):
+    """Blocked arcs of edges ``e`` seen from points ``P[pid]`` (pairs within reach: the
+    wall index's query, or with ``cells`` the cells' candidates, of which the pairs the
+    query would not report are dropped here: :meth:`WallCells.reported`)."""
     a = world.edge_start[e]
     u = world.edge_dir[e]
     length = world.edge_length[e]
@@ -115,6 +125,8 @@ def _blocks(world: Map, P: np.ndarray, L: float, eps: float, pid: np.ndarray, e:
     sc = np.clip(s, 0.0, length)
     dist = np.hypot(wx + sc * u[:, 0], wy + sc * u[:, 1])
     keep = dist <= L + eps
+    if cells is not None:
+        cells.reported(P, pid, e, dist, keep)
     on = keep & (dist <= eps)
     ww = wx * wx + wy * wy
     disc = s * s - (ww - L * L)
@@ -431,6 +443,117 @@ def _patch(batch: ArcBatch, idx: np.ndarray, arcs: list[FreeArcs]) -> ArcBatch:
     return ArcBatch(offsets, lo, hi, cl, ch)
 
 
+class WallCells:
+    """The wall edges that may come within ``reach`` of a point of each square cell of a
+    grid over a map (for its wall index's query ``dwithin`` at ``reach``, which costs a
+    few microseconds a point, in a few numpy calls for a whole batch).
+
+    :meth:`candidates` gives every pair (point, edge) of a batch whose edge is within
+    ``reach`` plus the cell's half diagonal of the point's cell's centre: a superset of
+    the pairs the index's query reports (plus a margin far above the rounding).
+    :meth:`reported` drops the candidates the query would not report, given their
+    distances by :func:`_blocks`' formula: those farther than ``reach`` by it (as
+    :func:`_blocks` drops them anyway), and, of those within ``reach`` by less than
+    ``_BORDER`` (where the query's own distance could round the other way), the ones
+    the query itself does not report. Pairs the query would report farther than
+    ``reach`` by :func:`_blocks`' formula are dropped in both (its ``keep``), so the
+    blocked arcs are the query's.
+
+    Args:
+        world: the map.
+        tree: its wall index (``wall_index(world).tree``: edge ``i`` is geometry ``i``).
+        reach: ``L + eps``.
+    """
+
+    MAX_CELLS = 1 << 16
+
+    def __init__(self, world: Map, tree, reach: float) -> None:
+        self.tree = tree
+        self.reach = float(reach)
+        self.n_edges = world.n_edges
+        xmin, ymin, xmax, ymax = (float(b) for b in world.bounds)
+        w, h = xmax - xmin, ymax - ymin
+        # cells of a third of the reach (a point's candidates a few more than its pairs), fewer
+        # on a map so large that they would exceed MAX_CELLS
+        side = max(self.reach / 3, math.sqrt(w * h / self.MAX_CELLS))
+        self.side = side
+        # the bounds and a reach round them (farther, a point has no pair: off the grid)
+        pad = self.reach + side
+        self.origin = np.array([xmin - pad, ymin - pad])
+        self.shape = (int((w + 2 * pad) // side) + 2, int((h + 2 * pad) // side) + 2)
+        nx, ny = self.shape
+        scale = self.reach + max(abs(xmin), abs(ymin), abs(xmax), abs(ymax))
+        self.border = _BORDER * scale
+        # each edge against the cells of its box grown by the reach, kept where the cell's
+        # centre is within the reach plus the cell's half diagonal of it (every point of
+        # the cell then may be within the reach), with a margin far above the rounding
+        r = self.reach + 1e3 * self.border
+        a, b = world.edge_start, world.edge_end
+        lo = np.floor((np.minimum(a, b) - r - self.origin) / side).astype(np.intp)
+        hi = np.floor((np.maximum(a, b) + r - self.origin) / side).astype(np.intp)
+        lo = np.maximum(lo, 0)
+        hi = np.minimum(hi, np.array(self.shape) - 1)
+        ni, nj = hi[:, 0] - lo[:, 0] + 1, hi[:, 1] - lo[:, 1] + 1
+        cnt = ni * nj
+        edge = np.repeat(np.arange(world.n_edges), cnt)
+        k = np.arange(len(edge)) - np.repeat(np.cumsum(cnt) - cnt, cnt)
+        ci = lo[edge, 0] + k // nj[edge]
+        cj = lo[edge, 1] + k % nj[edge]
+        cx = self.origin[0] + (ci + 0.5) * side - a[edge, 0]
+        cy = self.origin[1] + (cj + 0.5) * side - a[edge, 1]
+        u, length = world.edge_dir[edge], world.edge_length[edge]
+        t = np.clip(cx * u[:, 0] + cy * u[:, 1], 0.0, length)
+        near = np.hypot(cx - t * u[:, 0], cy - t * u[:, 1]) <= r + side * math.sqrt(0.5)
+        cell, edge = ci[near] * ny + cj[near], edge[near]
+        order = np.lexsort((edge, cell))
+        self.edges = edge[order].astype(np.intp)
+        counts = np.bincount(cell, minlength=nx * ny)
+        self.start = np.zeros(nx * ny + 1, dtype=np.intp)
+        np.cumsum(counts, out=self.start[1:])
+        # a batch of at most this many points is one chunk of free_arcs_batch's whatever
+        # its pairs (each point has at most the most candidates of a cell)
+        self.points_one_chunk = _CHUNK // max(1, int(counts.max(initial=0)))
+
+    def candidates(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """``(pid, e)``: the pairs of (k, 2) points and their cells' edges, by point (and
+        by edge within a point), or None for a batch with a point off the cells' grid or
+        more points than :attr:`points_one_chunk` (the query's then)."""
+        n = len(P)
+        if n > self.points_one_chunk:
+            return None
+        ij = np.floor((P - self.origin) / self.side).astype(np.intp)
+        i, j = ij[:, 0], ij[:, 1]
+        if not ((i.view(np.uintp) < self.shape[0]) & (j.view(np.uintp) < self.shape[1])).all():
+            return None
+        c = i * self.shape[1] + j
+        s = self.start[c]
+        cnt = self.start[c + 1] - s
+        pid = np.repeat(np.arange(n), cnt)
+        # each cell's edges laid end to end: the m-th of point p at s[p] + m
+        at = np.arange(len(pid)) + np.repeat(s - (np.cumsum(cnt) - cnt), cnt)
+        return pid, self.edges[at]
+
+    def reported(
+        self, P: np.ndarray, pid: np.ndarray, e: np.ndarray, dist: np.ndarray, keep: np.ndarray
+    ) -> None:
+        """Clear ``keep`` (the candidates within ``reach`` by ``dist``) where the wall
+        index's query would not report the pair (see the class)."""
+        border = keep & (dist > self.reach - self.border)
+        if not border.any():
+            return
+        at = np.flatnonzero(border)
+        pts = np.unique(pid[at])
+        qp, qe = self.tree.query(shapely.points(P[pts]), predicate="dwithin", distance=self.reach)
+        seen = pts[qp].astype(np.int64) * self.n_edges + qe
+        keep[at] = np.isin(pid[at].astype(np.int64) * self.n_edges + e[at], seen)
+
+
+_BORDER = 1e-9
+"""Candidates within this (relative to the reach plus the map's coordinates) of the reach
+by :func:`_blocks`' distance are the query's to decide: its distance (GEOS's) and that
+one differ by a few units in the last place of the coordinates."""
+
+
 def _one_chunk(n: int, pid: np.ndarray) -> bool:
     """Whether :func:`free_arcs_batch` takes ``n`` points in one chunk, from the pairs
     ``pid`` (point of each pair) of the points' one index query: its sizing probe is
@@ -442,7 +565,13 @@ def _one_chunk(n: int, pid: np.ndarray) -> bool:
 
 
 def free_arcs_few(
-    world: Map, points: np.ndarray, L: float, tree=None, eps=None, interior: bool = False
+    world: Map,
+    points: np.ndarray,
+    L: float,
+    tree=None,
+    eps=None,
+    interior: bool = False,
+    cells: WallCells | None = None,
 ) -> ArcBatch:
     """:func:`free_arcs_batch` of points it takes in one chunk (a lazy table's batches:
     tens to thousands of points), the same arrays bit for bit in a third of the numpy
@@ -456,7 +585,9 @@ def free_arcs_few(
     batch. ``tree`` and ``eps`` (the map's wall index and kernel tolerance) may be
     passed to skip their look-up, and ``interior=True`` when every point is known to lie
     in the free region (a lazy table's nodes, tested when first looked up) to skip that
-    test. Points the batch would take in several chunks go to it.
+    test. Points the batch would take in several chunks go to it. ``cells``
+    (:class:`WallCells` of ``tree`` at ``L + eps``): the pairs are its candidates,
+    filtered to the query's (the same pairs, without the query's per-point cost).
     """
     P = np.asarray(points, dtype=float).reshape(-1, 2)
     n = len(P)
@@ -468,11 +599,17 @@ def free_arcs_few(
         inside = np.ones(n, dtype=bool)
     else:
         inside = shapely.contains_xy(world.prepared_free_region, P[:, 0], P[:, 1])
-    pid, e = tree.query(shapely.points(P), predicate="dwithin", distance=L + eps)
-    if not _one_chunk(n, pid):
-        return free_arcs_batch(world, P, L)
+    pairs = cells.candidates(P) if cells is not None else None
+    if pairs is None:
+        cells = None
+        pid, e = tree.query(shapely.points(P), predicate="dwithin", distance=L + eps)
+        if not _one_chunk(n, pid):
+            return free_arcs_batch(world, P, L)
+        e = e.astype(np.intp)
+    else:  # (at most WallCells.points_one_chunk points: one chunk, whatever the pairs)
+        pid, e = pairs
     if len(pid):
-        g, lo, wid, clo, chi, on_local = _blocks(world, P, L, eps, pid, e.astype(np.intp))
+        g, lo, wid, clo, chi, on_local = _blocks(world, P, L, eps, pid, e, cells)
     else:
         g = on_local = pid
     # the points with a free arc: gaps between blocked arcs, or the full circle

@@ -629,15 +629,23 @@ class DecompositionPursuer(BasePolicy):
             return v.min(axis=0)
         # a lazy table: the nodes of the next steps' probes along the evader's step join
         # the batches of this one's new nodes
-        lazy = step is not None and isinstance(tab, LazySafetyTable)
-        ahead = (step, self.LOOKAHEAD_STEPS) if lazy else ()
-        inside = tab.inside(points, *ahead).reshape(n_rays, n_r)
-        reach = np.cumsum(~inside, axis=1) == 0  # a ray stops at the first wall
+        lazy = isinstance(tab, LazySafetyTable)
+        ahead = (step, self.LOOKAHEAD_STEPS) if lazy and step is not None else ()
+        if lazy:  # (with the points' grid nodes, for the probes' rows)
+            inside, nodes = tab.inside(points, *ahead, nodes=True)
+        else:
+            inside, nodes = tab.inside(points), None
+        # a ray stops at the first wall
+        reach = np.logical_and.accumulate(inside.reshape(n_rays, n_r), axis=1)
         sub_ok = reach[:, cols]
         if not sub_ok.any():
             return np.full(tab.n_bins, self.horizon)
-        probes = points.reshape(n_rays, n_r, 2)[:, cols][sub_ok]
-        r = tab.rows(probes, *ahead)  # only the probes' orientations are looked up
+        at = np.arange(len(points)).reshape(n_rays, n_r)[:, cols][sub_ok]
+        # only the probes' orientations are looked up (their nodes: the lookup's above)
+        if nodes is None:
+            r = tab.rows(points[at])
+        else:
+            r = tab.rows(points[at], *ahead, nodes=tab.nodes_at(nodes, at))
         # lut: seconds to turn by a number of bins; a safe bin (0) never threatens
         needs = tab.need if not sense else (tab.ccw if sense > 0 else tab.cw)
         lut = self._way_lut if sense else self._turn_lut

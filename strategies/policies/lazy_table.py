@@ -111,7 +111,7 @@ def _decomposition(world: Map, L: float) -> Any:
     # built here rather than in the first decision: the same objects, ~60 ms of the
     # first decision on a 300-vertex floor plan (its classification then takes ~5)
     dec.region_grid()
-    _cell_keys(dec)
+    _cell_keys(dec).use_cells()
     return dec
 
 
@@ -206,13 +206,19 @@ class LazySafetyTable:
         return self._n
 
     def inside(
-        self, points: np.ndarray, step: np.ndarray | None = None, steps: int = 0
-    ) -> np.ndarray:
+        self,
+        points: np.ndarray,
+        step: np.ndarray | None = None,
+        steps: int = 0,
+        nodes: bool = False,
+    ) -> np.ndarray | tuple[np.ndarray, tuple]:
         """Whether the grid points nearest to (k, 2) points lie in the free region.
 
         Membership only (a vectorised point-in-polygon test per new node, memoised):
         the orientations are classified when :meth:`rows` asks for them. ``step`` and
         ``steps``: as :meth:`rows` (the new nodes ahead tested in the same batch).
+        ``nodes=True``: also the points' grid nodes, for :meth:`rows` of some of the
+        points (:meth:`nodes_at`) without finding them again.
         """
         ix, iy, ok = self._nodes(points)
         out = np.zeros(len(ok), dtype=bool)
@@ -231,7 +237,16 @@ class LazySafetyTable:
             self._membership(ux[first], uy[first], uf[first])
             member = self._member.reshape(-1)[flat]
         out[ok] = member == 1
-        return out
+        return (out, (ix, iy, flat, ok)) if nodes else out
+
+    @staticmethod
+    def nodes_at(nodes: tuple, at: np.ndarray) -> tuple:
+        """The grid nodes (``inside(points, nodes=True)``'s) of ``points[at]``."""
+        ix, iy, flat, ok = nodes
+        ok_at = ok[at]
+        if len(ix) < len(ok):  # (a point off the grid: ix, iy, flat skip it)
+            at = (np.cumsum(ok) - 1)[at[ok_at]]
+        return ix[at], iy[at], flat[at], ok_at
 
     def _nodes(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Grid indices ``(i, j)`` of the nodes nearest to (k, 2) points that lie on the
@@ -300,7 +315,11 @@ class LazySafetyTable:
         return inside
 
     def rows(
-        self, points: np.ndarray, step: np.ndarray | None = None, steps: int = 0
+        self,
+        points: np.ndarray,
+        step: np.ndarray | None = None,
+        steps: int = 0,
+        nodes: tuple | None = None,
     ) -> np.ndarray:
         """Table rows of the grid points nearest to (k, 2) points (-1 outside).
 
@@ -310,11 +329,15 @@ class LazySafetyTable:
         ~0.2 ms however few its points and ~1 us a point more, so the next lookups find
         their nodes ready instead of paying for a batch a decision. Every node's entries
         are the same either way (its classification does not depend on its batch; the
-        rows are numbered in the order the nodes were classified).
+        rows are numbered in the order the nodes were classified). ``nodes``: the
+        points' grid nodes if known (:meth:`nodes_at`).
         """
-        ix, iy, ok = self._nodes(points)
+        if nodes is None:
+            ix, iy, ok = self._nodes(points)
+            flat = self._slots(ix, iy)
+        else:
+            ix, iy, flat, ok = nodes
         out = np.full(len(ok), -1, dtype=np.int64)
-        flat = self._slots(ix, iy)
         vals = self._cell.reshape(-1)[flat]
         unknown = vals == _UNKNOWN
         if unknown.any():

@@ -131,6 +131,33 @@ def test_rows_classify_the_nodes_ahead_with_the_new_ones(monkeypatch):
     assert early.classified == n and len(batches) == 3 and len(tests) == 3
 
 
+def test_rows_of_points_whose_nodes_inside_found_are_the_rows_looked_up_again():
+    """inside(points, nodes=True) also gives the points' grid nodes, and rows() of some
+    of the points with those nodes (nodes_at: the pursuer's probes, among the ray
+    samples it tested) classifies and returns exactly what rows() of the same points
+    finds itself, the nodes ahead included, with points off the grid among them."""
+    world = _world("l_hall", 0.61)
+    rng = np.random.default_rng(9)
+    x0, y0, x1, y1 = world.bounds
+    step = np.array([0.2, -0.15])
+    given, found = LazySafetyTable(world, 2.2, 0.1, 48), LazySafetyTable(world, 2.2, 0.1, 48)
+    off = 0
+    for _ in range(12):
+        centre = rng.uniform((x0, y0), (x1, y1))
+        pts = centre + rng.normal(0.0, 4.0, size=(300, 2))  # some beyond the grid
+        inside, nodes = given.inside(pts, step, 3, nodes=True)
+        assert np.array_equal(inside, found.inside(pts, step, 3))
+        ok = nodes[3]
+        off += int((~ok).sum())
+        assert len(ok) == len(pts) and len(nodes[0]) == len(nodes[2]) == ok.sum()
+        for at in (np.flatnonzero(inside), rng.choice(len(pts), 40, replace=False)):
+            rows = given.rows(pts[at], step, 3, nodes=given.nodes_at(nodes, at))
+            assert np.array_equal(rows, found.rows(pts[at], step, 3))
+    assert off > 100 and given.classified == found.classified > 1000
+    for name in ("free", "safe", "guaranteed", "ccw", "cw", "need"):
+        assert np.array_equal(getattr(given, name), getattr(found, name)), name
+
+
 def test_the_lazy_pursuer_classifies_the_evaders_probes_ahead(monkeypatch):
     """The pursuer passes its probes LOOKAHEAD_STEPS steps on along the evader's
     velocity: one classification batch every few decisions instead of one a decision

@@ -818,7 +818,7 @@ def load_map(path_or_name: str | os.PathLike[str], *, merge: bool | None = None)
                     f"merge={merge!r} applies to map files, not to the built-in {path_or_name!r}"
                 )
             return builtin_map(path_or_name)
-        if Path(path_or_name).is_dir():
+        if path_or_name.strip() and Path(path_or_name).is_dir():  # Path("") is "."
             raise _fail(path_or_name, "is a directory, expected a map file or a built-in name")
         if not Path(path_or_name).is_file():
             raise UnknownNameError(

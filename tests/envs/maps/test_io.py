@@ -267,6 +267,13 @@ def test_load_map_missing_file_directory_or_unreadable(tmp_path):
         load_map(binary)
 
 
+@pytest.mark.parametrize("name", ["", " "])
+def test_load_map_of_an_empty_name_lists_what_a_map_can_be(name):
+    # '' was the working directory: ": is a directory, expected a map file or a built-in name"
+    with pytest.raises(UnknownNameError, match=rf"^unknown map {name!r}: expected a built-in"):
+        load_map(name)
+
+
 def test_load_map_unsupported_suffix(tmp_path):
     p = tmp_path / "world.txt"
     p.write_text("{}")

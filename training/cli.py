@@ -11,6 +11,7 @@ import math
 import os
 import signal
 import sys
+import tempfile
 import threading
 import warnings
 from collections.abc import Callable, Sequence
@@ -158,13 +159,24 @@ def _dagger_resume_note(config) -> str:
 
 def _check_output_dir(text: str) -> None:
     """Refuse, before any training, an output_dir that is a file or lies under one (was
-    ``x.json: File exists`` from the first checkpoint's mkdir)."""
+    ``x.json: File exists`` from the first checkpoint's mkdir), or that could not be made
+    or written (its nearest existing folder takes no new file: was ``DIR: Permission
+    denied`` or ``DIR: No such file or directory``, naming no field). Makes nothing."""
     path = Path(text)
     blocker = next((p for p in (path, *path.parents) if p.exists() and not p.is_dir()), None)
     if blocker is not None:
         raise InvalidConfigError(
             f"output_dir = {text!r}: {str(blocker)!r} is a file, expected a directory"
         )
+    nearest = next((p for p in (path, *path.parents) if p.is_dir()), Path("."))
+    try:
+        with tempfile.TemporaryFile(dir=nearest):
+            pass  # a file can be made there (os.access lies to root and on some mounts)
+    except OSError as exc:
+        raise InvalidConfigError(
+            f"output_dir = {text!r}: cannot write in {str(nearest)!r} "
+            f"({exc.strerror or type(exc).__name__}); expected a directory you can write"
+        ) from None
 
 
 def cli_train(argv: Sequence[str] | None = None) -> int:

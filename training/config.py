@@ -48,6 +48,7 @@ from training.single_agent import START_CHOICES
 
 __all__ = [
     "ALGORITHMS",
+    "MAX_SEED",
     "TrainConfig",
     "absolute_map_name",
     "check_same_maps",
@@ -58,6 +59,12 @@ __all__ = [
 
 ALGORITHMS = ("ppo", "sac")
 """The SB3 algorithms :func:`training.train` runs (continuous actions)."""
+
+MAX_SEED = 2**31 - 1
+"""The largest training seed. SB3 seeds numpy's legacy generator, which takes seeds below
+2**32 (a larger one was a ``ValueError`` traceback from ``_legacy_seeding`` once the run
+had started); a resumed run reseeds from ``seed + timesteps done`` and self-play's stage
+``i`` from ``seed + i``, so half the range is kept for those."""
 
 _ENV_KEYS = tuple(k for k in env_parameters() if k not in ("map", "render_mode"))
 """Keys allowed in ``[env]`` (``map`` and ``render_mode`` are not: see the fields)."""
@@ -233,7 +240,13 @@ class TrainConfig:
         put("start", check.choice("start", self.start, START_CHOICES))
         put("algo", check.choice("algo", str(self.algo).lower(), ALGORITHMS))
         put("total_timesteps", check.integer("total_timesteps", self.total_timesteps, 1))
-        put("seed", check.integer("seed", self.seed, 0))
+        put("seed", check.integer("seed", self.seed, 0, MAX_SEED))
+        if self.seed + self.total_timesteps > 2**32 - 1:  # the reseed of a resumed run
+            raise InvalidConfigError(
+                f"{check.where}: seed + total_timesteps = {self.seed + self.total_timesteps:,}: "
+                f"expected at most {2**32 - 1:,} (a resumed run reseeds numpy from seed + "
+                "timesteps done, which takes seeds below 2**32)"
+            )
         put("n_envs", check.integer("n_envs", self.n_envs, 1))
         if isinstance(self.net_arch, (str, bytes)) or not hasattr(self.net_arch, "__iter__"):
             raise InvalidConfigError(
@@ -599,8 +612,8 @@ class _Checker:
     def choice(self, name: str, value: Any, options: tuple[str, ...]) -> str:
         return validation.choice(name, value, options, where=self.where)
 
-    def integer(self, name: str, value: Any, minimum: int) -> int:
-        return validation.integer(name, value, minimum=minimum, where=self.where)
+    def integer(self, name: str, value: Any, minimum: int, maximum: int | None = None) -> int:
+        return validation.integer(name, value, minimum=minimum, maximum=maximum, where=self.where)
 
     def positive(self, name: str, value: Any) -> float:
         return validation.positive(name, value, where=self.where)

@@ -66,6 +66,7 @@ from strategies.policies.learner_inputs import LearnerInputs, check_features
 from strategies.policies.model_files import absolute_model_name, model_policy_name
 from strategies.runner import check_observation_options, run_episode
 from training.config import (
+    MAX_SEED,
     absolute_map_name,
     check_same_maps,
     map_fingerprints,
@@ -189,8 +190,10 @@ class DaggerConfig:
         put("features", check_features(self.features, role=self.role, expert=self.expert,
                                         where=where))  # fmt: skip
         for name, lo in (("iterations", 1), ("episodes", 1), ("max_cycles", 1), ("epochs", 1),
-                         ("batch_size", 1), ("seed", 0), ("validation_episodes", 0)):  # fmt: skip
+                         ("batch_size", 1), ("validation_episodes", 0)):  # fmt: skip
             validation.integer(name, getattr(self, name), minimum=lo, where=where)
+        # the learner's SB3 model seeds numpy's legacy generator (seeds below 2**32)
+        validation.integer("seed", self.seed, minimum=0, maximum=MAX_SEED, where=where)
         validation.unit_interval("beta", self.beta, where=where, open=False)
         validation.positive("learning_rate", self.learning_rate, where=where)
         validation.positive("radial_weight", self.radial_weight, where=where)

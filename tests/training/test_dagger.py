@@ -373,3 +373,16 @@ def _load(r):
 def test_bad_features_are_refused_naming_them(tmp_path, bad):
     with pytest.raises(InvalidConfigError, match="feature"):
         _lidar_cfg(tmp_path, **bad)
+
+
+def test_the_largest_seed_runs_and_a_larger_one_is_refused_by_the_config(tmp_path):
+    # seed = 2**32 passed the config and the run raised numpy's 'Seed must be between 0
+    # and 2**32 - 1' from the learner's SB3 model (2**64: torch's 'Overflow when unpacking
+    # long long') as a traceback
+    MAX_SEED = 2**31 - 1  # training.config.MAX_SEED
+    small = dict(iterations=1, episodes=1, max_cycles=20, epochs=1)
+    assert dagger(_cfg(tmp_path, seed=MAX_SEED, **small)).model_path.is_file()
+    for seed in (2**32, 2**64):
+        with pytest.raises(InvalidConfigError, match=rf"seed = {seed}: expected an integer in "
+                           r"\[0, 2147483647\]"):  # fmt: skip
+            _cfg(tmp_path, seed=seed, **small)

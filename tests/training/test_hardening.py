@@ -169,6 +169,28 @@ def test_an_output_dir_that_is_a_file_is_refused_before_training(tmp_path, capsy
     assert err.count("\n") == 1
 
 
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs Linux's /proc")
+@pytest.mark.parametrize("method", ["ppo", "dagger"])
+def test_an_output_dir_that_cannot_be_written_is_refused_before_training(tmp_path, capsys, method):
+    # procfs takes no new file, for root too: the run loaded its config and torch, then
+    # failed at the mkdir with "python -m training: error: /proc/...: No such file or
+    # directory", naming no field
+    out = "/proc/surveil-test/run"
+    cfg = tmp_path / "c.toml"
+    body = {
+        "ppo": 'role = "pursuer"\nopponent = "evader/straight"\ntotal_timesteps = 64\n',
+        "dagger": 'method = "dagger"\nrole = "pursuer"\nexpert = "pursuer/greedy"\n'
+        'opponent = "evader/straight"\nmaps = ["open_room"]\n',
+    }[method]
+    cfg.write_text(body + f'output_dir = "{out}"\n')
+    assert cli_train([str(cfg)]) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        f"python -m training: error: output_dir = '{out}': cannot write in '/proc' (No such "
+        "file or directory); expected a directory you can write\n"
+    )
+
+
 def zoo_dir_model(name):
     from training import zoo
 

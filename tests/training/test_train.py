@@ -251,3 +251,17 @@ def test_cli_train_shows_its_progress_unless_told_not_to(tmp_path, capsys):
     assert "iteration 0: " not in got.out, got.out
     assert cli_train([str(rl), "--output-dir", str(tmp_path / "e"), "--timesteps", "64",
                       "--progress"]) == 0  # fmt: skip
+
+
+def test_the_largest_seed_trains_and_larger_ones_are_refused_by_the_config(tiny):
+    # seed = 2**32 passed the config, and the run's first step raised numpy's 'Seed must be
+    # between 0 and 2**32 - 1' (SB3 seeds the legacy generator) as a traceback
+    MAX_SEED = 2**31 - 1  # training.config.MAX_SEED
+    assert train(tiny(eval_episodes=0, total_timesteps=64, seed=MAX_SEED)).model_path.is_file()
+    with pytest.raises(InvalidConfigError, match=r"seed = 4294967296: expected an integer in "
+                       r"\[0, 2147483647\]"):  # fmt: skip
+        tiny(seed=2**32)
+    # a resumed run reseeds from seed + timesteps done
+    with pytest.raises(InvalidConfigError, match=r"seed \+ total_timesteps = 4,294,967,296: "
+                       r"expected at most 4,294,967,295"):  # fmt: skip
+        tiny(seed=MAX_SEED, total_timesteps=2**31 + 1)

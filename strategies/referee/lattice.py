@@ -287,7 +287,9 @@ class Lattice:
         if len(self.points) == 0:
             raise InvalidConfigError(
                 f"no lattice point of spacing {self.spacing:g} lies {self.spec.body_radius:g} "
-                f"from the walls of map {self.spec.map.name!r}; refine the resolution"
+                f"from the walls of map {self.spec.map.name!r}; try another resolution (the "
+                "lattices are not nested: where passages are about as narrow as the agents, "
+                "a finer one can miss them too)"
             )
         self._lookup = {(int(i), int(j)): k for k, (i, j) in enumerate(self.point_cells)}
 

@@ -428,10 +428,8 @@ class Store:
             so ``surveil report --run ID`` shows what the old run showed.
         """
         keep = set(planned)
-        held = self.conn.execute(
-            "SELECT match_id FROM run_matches WHERE run_id = ?", (run_id,)
-        ).fetchall()
-        stale = sorted(m for (m,) in held if m not in keep)
+        held = self.conn.execute("SELECT match_id FROM run_matches WHERE run_id = ?", (run_id,))
+        stale = sorted(m for (m,) in held if m not in keep)  # streamed: a run may be huge
         if not stale:
             return None
         aside = hashlib.sha256(f"{run_id}:{','.join(stale)}".encode()).hexdigest()[:16]

@@ -403,7 +403,17 @@ def build_parser() -> argparse.ArgumentParser:
     _add_train_parser(sub)
     figures_cli.add_parser(sub)
     referee_cli.add_parser(sub)
+    _describe_from_help(sub)
     return parser
+
+
+def _describe_from_help(sub) -> None:
+    """Give every subcommand without a description its one-line help as one, so that
+    ``surveil COMMAND --help`` says what the command does (argparse prints none otherwise)."""
+    for action in sub._choices_actions:
+        command = sub.choices[action.dest]
+        if command.description is None and action.help:
+            command.description = action.help[0].upper() + action.help[1:] + "."
 
 
 def main(argv: Sequence[str] | None = None) -> int:

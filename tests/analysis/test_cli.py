@@ -302,6 +302,22 @@ def test_every_argument_of_every_command_has_a_help_text():
     assert bare == []
 
 
+def test_every_command_s_help_says_what_it_does(capsys):
+    """`surveil report --help` (and policies, play, export, evaluate, ...) printed its usage
+    and arguments and not a word on what the command does: argparse shows a subcommand's
+    one-line help only in `surveil --help`."""
+    import argparse
+
+    from analysis.cli import build_parser
+
+    (commands,) = [a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction)]
+    for name, parser in commands.choices.items():
+        parser.print_help()
+        text = " ".join(capsys.readouterr().out.split())
+        assert parser.description, name
+        assert " ".join(parser.description.split()) in text, name
+
+
 @pytest.mark.parametrize("unbuffered", ["1", ""])
 def test_a_reader_that_leaves_is_not_an_error(unbuffered):
     """``surveil figures --numbers | head -2`` (docs/REPRODUCTION.md's command, looked at

@@ -3,13 +3,17 @@
 from __future__ import annotations
 
 import time
+import tracemalloc
 
+import numpy as np
 import pytest
 
-from envs.errors import InfeasibleError, InvalidConfigError
+from envs.errors import InfeasibleError, InvalidConfigError, MemoryBudgetError
+from envs.maps import Map
 from strategies.cspace import decompose
 from strategies.cspace._budget import estimate
-from strategies.memory import memory_budget
+from strategies.cspace.tolerances import diameter
+from strategies.memory import memory_budget, physical_memory
 from tests.strategies.cspace._oracle import corridor, hexagons
 
 
@@ -21,6 +25,40 @@ def test_a_build_over_budget_is_refused_at_once_with_the_estimate():
     msg = str(err.value)
     assert "memory budget" in msg and "GB" in msg and "pairs" in msg
     assert "memory_budget=" in msg and "SURVEIL_MEMORY_BUDGET" in msg and "shorter L" in msg
+
+
+def _round_room(n: int) -> Map:
+    t = 2 * np.pi * np.arange(n) / n
+    return Map(np.stack([5 + 5 * np.cos(t), 5 + 5 * np.sin(t)], axis=1), name="round")
+
+
+def test_a_round_room_s_diameter_takes_no_square_of_its_vertices_in_memory():
+    # an 8,000-gon: the diameters built 8,000^2 x 2 arrays (1 GB and more each; 20,000
+    # vertices took 6.4 GB and 74 s inside decompose, before its memory check)
+    room = _round_room(8000)
+    tracemalloc.start()
+    try:
+        assert diameter(room) == pytest.approx(10.0) and room.diameter == pytest.approx(10.0)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 100e6, peak
+
+
+def test_a_build_no_budget_on_this_machine_fits_is_said_so():
+    # L = 4.9 in a round room of 8,000 vertices: 755 GB; the advice was
+    # SURVEIL_MEMORY_BUDGET=1510GB, whatever the machine's memory
+    room = _round_room(8000)
+    need = estimate(room, 4.9).bytes
+    if need <= physical_memory():  # pragma: no cover - a machine with terabytes of RAM
+        pytest.skip(f"this machine has the {need / 1e9:.0f} GB")
+    with pytest.raises(MemoryBudgetError) as err:
+        decompose(room, 4.9)
+    msg = str(err.value)
+    assert "the decomposition would need about 754.9 GB" in msg
+    assert "No budget on this machine fits it" in msg
+    assert "SURVEIL_MEMORY_BUDGET" not in msg and "memory_budget=" not in msg
+    assert "use a shorter L or a smaller map" in msg
 
 
 def test_the_budget_comes_from_the_environment(monkeypatch):

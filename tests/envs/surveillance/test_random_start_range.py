@@ -63,6 +63,27 @@ def test_a_map_too_narrow_for_the_rod_says_so_up_front() -> None:
         env.reset(seed=0)
 
 
+def test_a_round_room_s_start_check_takes_no_square_of_its_vertices_in_memory() -> None:
+    """An 8,000-gon room: the check that a rod fits (the env's first random start) built all
+    8,000^2 pairs of its region's hull at once, 1.5 GB (20,000 vertices: 9.6 GB)."""
+    import tracemalloc
+
+    from envs.maps import Map
+    from envs.surveillance.placement import check_room
+
+    t = 2 * np.pi * np.arange(8000) / 8000
+    room = Map(np.stack([5 + 5 * np.cos(t), 5 + 5 * np.sin(t)], axis=1), name="round8000")
+    tracemalloc.start()
+    try:
+        check_room(room, 0.1, 9.75)  # fits: the region 0.1 in is 9.8 across
+        with pytest.raises(InfeasibleError, match=r"cannot hold the rod: .* \(at most 9.8\)"):
+            check_room(room, 0.1, 9.9)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 100e6, peak
+
+
 def test_a_random_start_the_margins_rule_out_names_their_factors():
     """pettingzoo's api_test on the maze at dt = 2 (helper-114): 'rod clearance 6 from
     convex vertices); lower spawn_margin_steps or body_radius', without saying that the 6

@@ -432,9 +432,11 @@ def _sweep_hits_any(spec, p, d, c, R0, g, pieces) -> np.ndarray:
     """For moves d (n, 2) of a pursuer at p and an evader disc D(c, R0 + g t): whether
     some convex vertex may be grazed during the step."""
     verts, din, dout = convex_corners(spec.map)
+    lens = _corner_edge_lengths(spec.map)
+    clear = spec.opponent_clearance - spec.margin
     hit = np.zeros(len(d), dtype=bool)
     rel = c - p
-    for v, di, do in zip(verts - p, din, dout, strict=True):
+    for v, di, do, ln in zip(verts - p, din, dout, lens, strict=True):
         for q in range(pieces):
             t0, t1 = q / pieces, (q + 1) / pieces
             hit |= sweep_hits_vertex(
@@ -450,8 +452,20 @@ def _sweep_hits_any(spec, p, d, c, R0, g, pieces) -> np.ndarray:
                 di,
                 do,
                 spec.margin,
+                clear=clear,
+                lengths=ln,
             )
     return hit
+
+
+def _corner_edge_lengths(world) -> np.ndarray:
+    """(n, 2): the lengths of the wall edges arriving at and leaving each convex vertex
+    of :func:`~strategies.referee.robust.convex_corners`, in its order."""
+    idx = world.convex_vertices
+    lengths = world.edge_length
+    arriving = lengths[world.vertex_prev_edge[idx]]
+    leaving = lengths[world.vertex_next_edge[idx]]
+    return np.stack([arriving, leaving], axis=1).reshape(-1, 2)
 
 
 # ---------------------------------------------------------------------- the solver
@@ -463,11 +477,13 @@ def _safe_tables(lat: Lattice, spec: GameSpec, res: Resolution, vectors, targets
     g = spec.v_evader * res.tau
     ox, oy = lat.offsets[..., 0], lat.offsets[..., 1]
     verts, din, dout = convex_corners(spec.map)
+    lens = _corner_edge_lengths(spec.map)
+    clear = spec.opponent_clearance - spec.margin
     dmax = float(np.max(np.hypot(*vectors.T))) * h if len(vectors) else 0.0
     # candidates per convex vertex: states whose every possible rod hull comes near it
     cand = []
     rad = max(dmax, R0 + g)
-    for v, di, do in zip(verts, din, dout, strict=True):
+    for v, di, do, ln in zip(verts, din, dout, lens, strict=True):
         rel = v[None, :] - lat.points  # (n, 2): the vertex seen from each pursuer point
         reach = np.hypot(*rel.T) <= spec.l_max + R0 + g + dmax
         ks = np.flatnonzero(reach)
@@ -482,13 +498,13 @@ def _safe_tables(lat: Lattice, spec: GameSpec, res: Resolution, vectors, targets
             near = np.hypot(vx - t * ox, vy - t * oy) <= rad
             near &= domain[kk]
             k_i, a_i, b_i = np.nonzero(near)
-            cand.append((v, di, do, kk[k_i], a_i, b_i))
+            cand.append((v, di, do, ln, kk[k_i], a_i, b_i))
     tables = []
     for j, vec in enumerate(vectors):
         d = vec.astype(float) * h
         ok = domain & (targets[:, j] >= 0)[:, None, None]
         ok &= sweep_range_ok(ox, oy, d[0], d[1], R0, g, spec.l_min, spec.l_max)[None]
-        for v, di, do, kk, aa, bb in cand:
+        for v, di, do, ln, kk, aa, bb in cand:
             if len(kk) == 0:
                 continue
             rx = v[0] - lat.points[kk, 0]
@@ -511,6 +527,8 @@ def _safe_tables(lat: Lattice, spec: GameSpec, res: Resolution, vectors, targets
                     di,
                     do,
                     spec.margin,
+                    clear=clear,
+                    lengths=ln,
                 )
             ok[kk[hit], aa[hit], bb[hit]] = False
         tables.append(np.packbits(ok, axis=-1))

@@ -439,23 +439,39 @@ def _sweep_hits_any(spec, p, d, c, R0, g, pieces) -> np.ndarray:
     for v, di, do, ln in zip(verts - p, din, dout, lens, strict=True):
         for q in range(pieces):
             t0, t1 = q / pieces, (q + 1) / pieces
-            hit |= sweep_hits_vertex(
-                t0 * d[:, 0],
-                t0 * d[:, 1],
-                t1 * d[:, 0],
-                t1 * d[:, 1],
-                v[0],
-                v[1],
-                rel[0],
-                rel[1],
-                R0 + g * t1,
+            hit |= _hits_vertex(
+                (t0 * d[:, 0], t0 * d[:, 1], t1 * d[:, 0], t1 * d[:, 1], v[0], v[1]),
+                (rel[0], rel[1], R0 + g * t1),
                 di,
                 do,
                 spec.margin,
-                clear=clear,
-                lengths=ln,
+                clear,
+                ln,
             )
     return hit
+
+
+def _hits_vertex(path, disc, din, dout, eta, clear, lengths) -> np.ndarray:
+    """:func:`~strategies.referee.robust.sweep_hits_vertex` with the evader's clearance,
+    evaluated only where the plain test hits (both are sound, so where both hit; the cut
+    costs several times the plain test, and most rods never come near a vertex).
+
+    Args:
+        path: ``(ax, ay, bx, by, vx, vy)``, the pursuer's piece of path and the vertex.
+        disc: ``(cx, cy, R)``, the evader's disc over that piece.
+        din, dout, eta, clear, lengths: as ``sweep_hits_vertex``.
+    """
+    plain = sweep_hits_vertex(*path, *disc, din, dout, eta)
+    idx = np.flatnonzero(plain)
+    if len(idx) == 0 or clear <= 0.0:
+        return plain
+    sub = [
+        np.broadcast_to(np.asarray(x, dtype=float), plain.shape).ravel()[idx]
+        for x in (*path, *disc)
+    ]
+    out = plain.copy()
+    out.ravel()[idx] = sweep_hits_vertex(*sub, din, dout, eta, clear=clear, lengths=lengths)
+    return out
 
 
 def _corner_edge_lengths(world) -> np.ndarray:
@@ -514,21 +530,14 @@ def _safe_tables(lat: Lattice, spec: GameSpec, res: Resolution, vectors, targets
             hit = np.zeros(len(kk), dtype=bool)
             for q in range(res.sweep_pieces):
                 t0, t1 = q / res.sweep_pieces, (q + 1) / res.sweep_pieces
-                hit |= sweep_hits_vertex(
-                    t0 * d[0],
-                    t0 * d[1],
-                    t1 * d[0],
-                    t1 * d[1],
-                    rx,
-                    ry,
-                    cx,
-                    cy,
-                    R0 + g * t1,
+                hit |= _hits_vertex(
+                    (t0 * d[0], t0 * d[1], t1 * d[0], t1 * d[1], rx, ry),
+                    (cx, cy, R0 + g * t1),
                     di,
                     do,
                     spec.margin,
-                    clear=clear,
-                    lengths=ln,
+                    clear,
+                    ln,
                 )
             ok[kk[hit], aa[hit], bb[hit]] = False
         tables.append(np.packbits(ok, axis=-1))

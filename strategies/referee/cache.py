@@ -28,8 +28,9 @@ from strategies.referee.spec import MARGIN_REL, GameSpec, Resolution
 
 __all__ = ["FORMAT_VERSION", "cache_path", "load_arrays", "save_arrays"]
 
-FORMAT_VERSION = 1
-"""Bump when the solver's semantics or the file layout change."""
+FORMAT_VERSION = 2
+"""Bump when the solver's semantics or the file layout change (2: the pursuer bound's sweep
+test keeps the evader its clearance from the walls beside a jamb, robust.sweep_hits_vertex)."""
 
 
 def _key(kind: str, spec: GameSpec, res: Resolution) -> dict:

@@ -82,7 +82,9 @@ def _clip(lo, hi, alpha, beta):
     return np.where((beta == 0) & (alpha < 0), np.inf, lo), hi
 
 
-def sweep_hits_vertex(ax, ay, bx, by, vx, vy, cx, cy, R, din, dout, eta=0.0) -> np.ndarray:
+def sweep_hits_vertex(
+    ax, ay, bx, by, vx, vy, cx, cy, R, din, dout, eta=0.0, clear=0.0, lengths=None
+) -> np.ndarray:
     """Whether a rod from a point of the segment A-B to a point of the disc D(c, R) can
     *graze* the convex vertex v: pass through v with its line outside the obstacle's
     interior cone there.
@@ -96,6 +98,20 @@ def sweep_hits_vertex(ax, ay, bx, by, vx, vy, cx, cy, R, din, dout, eta=0.0) -> 
     A)`` and ``c2 = cross(-din, v - A)``, ``c1 c2 >= 0`` (two wedges at v, each an
     intersection of two half-planes). Both are linear in A's parameter along the segment.
 
+    **The disc end keeps its clearance** (``clear > 0`` with the edge ``lengths``). For A
+    in one grazing wedge, the ray from v away from A runs into the opposite wedge, beside
+    one of v's two wall edges (the edge leaving v when ``c1, c2 >= 0``, the one arriving
+    at it when ``c1, c2 <= 0``). When the obstacle's angle at v is at least a right angle
+    (``din . dout >= 0``), every point of that wedge projects onto the edge's line at or
+    beyond v, so a point of it less than ``clear`` from the edge's line, and projecting
+    onto the edge itself, is less than ``clear`` from the wall: not a position of an
+    opponent that keeps ``clear`` from the walls. Where the whole disc projects onto the
+    edge (its far side at most the edge's length from v), condition (i) is then tested
+    against ``D(c, R)`` cut by the line ``clear`` off the edge: a narrower cone (the
+    chord's ends and the tangent points above the line span it), so a pursuer looking
+    past a jamb at an evader that hugs the wall beyond it, which the plain disc always
+    let hide, is not; everywhere else the disc's cone as before.
+
     Args:
         ax, ay, bx, by: the segment A-B (the pursuer's path over one piece of a step).
         vx, vy: the convex vertex.
@@ -103,6 +119,9 @@ def sweep_hits_vertex(ax, ay, bx, by, vx, vy, cx, cy, R, din, dout, eta=0.0) -> 
         din: (2,) unit direction of the wall edge arriving at v.
         dout: (2,) unit direction of the wall edge leaving v.
         eta: slack (a length) that widens the grazing wedges, for rounding.
+        clear: the clearance every disc position keeps from the walls (0: not used).
+        lengths: ``(arriving, leaving)`` lengths of v's two wall edges (needed when
+            ``clear > 0``).
 
     Returns:
         Boolean array (broadcast shape): True when some rod of the family may graze v.
@@ -118,28 +137,124 @@ def sweep_hits_vertex(ax, ay, bx, by, vx, vy, cx, cy, R, din, dout, eta=0.0) -> 
         False
         >>> bool(sweep_hits_vertex(1.5, -1.0, 1.5, -1.0, 0, 0, -0.1, 0.1, 0.3, din, dout))
         True
+
+        From a pursuer 1.5 below the obstacle and 0.1 beside the wall x = 0, the ray from
+        v away from it runs up along that wall, 0.02 from it at y = 0.3. The plain test
+        lets an evader disc about (-0.1, 0.3) of radius 0.15 stand on it; an evader that
+        keeps 0.02 from the walls still may, one that keeps 0.1 may not (the ray is that
+        far from the wall only at y = 1.5, far above the disc):
+
+        >>> long = (10.0, 10.0)
+        >>> for clear in (0.0, 0.02, 0.1):
+        ...     print(bool(sweep_hits_vertex(0.1, -1.5, 0.1, -1.5, 0, 0, -0.1, 0.3, 0.15,
+        ...                                  din, dout, clear=clear, lengths=long)))
+        True
+        True
+        False
     """
     inside, npx, npy, nmx, nmy = _cone_normals(vx, vy, cx, cy, R)
     shape = np.broadcast(ax, bx, vx, cx, R).shape
-    lo = np.zeros(shape)
-    hi = np.ones(shape)
     ex, ey = bx - ax, by - ay
-    for nx, ny in ((npx, npy), (nmx, nmy)):  # the cone (irrelevant when v is in the disc)
-        alpha = np.where(inside, 1.0, nx * (ax - vx) + ny * (ay - vy))
-        beta = np.where(inside, 0.0, nx * ex + ny * ey)
-        lo, hi = _clip(lo, hi, alpha, beta)
+    din = np.asarray(din, dtype=float)
+    dout = np.asarray(dout, dtype=float)
     # c1(s) = cross(dout, v - A(s)), c2(s) = cross(-din, v - A(s))
     wx, wy = vx - ax, vy - ay
     a1 = dout[0] * wy - dout[1] * wx
     b1 = -(dout[0] * ey - dout[1] * ex)
     a2 = -(din[0] * wy - din[1] * wx)
     b2 = din[0] * ey - din[1] * ex
+    cut = clear > 0.0 and lengths is not None and float(din @ dout) >= -1e-9
     hit = np.zeros(shape, dtype=bool)
     for sign in (1.0, -1.0):  # the wedge c1, c2 >= 0 and the wedge c1, c2 <= 0
+        lo = np.zeros(shape)
+        hi = np.ones(shape)
+        cone = [  # the disc's cone (irrelevant when v is in the disc)
+            (
+                np.where(inside, 1.0, nx * (ax - vx) + ny * (ay - vy)),
+                np.where(inside, 0.0, nx * ex + ny * ey),
+            )
+            for nx, ny in ((npx, npy), (nmx, nmy))
+        ]
+        if cut:
+            # the ray runs beside the edge leaving v (sign +1) or arriving at it (sign -1)
+            e = dout if sign > 0 else -din
+            n = np.array([-dout[1], dout[0]]) if sign > 0 else np.array([-din[1], din[0]])
+            length = float(lengths[1] if sign > 0 else lengths[0])
+            applies, empty, r1, r2 = _cut_cone(vx, vy, cx, cy, R, e, n, length, clear)
+            refined = []
+            for (rx, ry), turn in ((r1, 1.0), (r2, -1.0)):
+                # turn * cross(r, v - A(s)) >= 0, linear in s
+                alpha = turn * (rx * wy - ry * wx)
+                beta = -turn * (rx * ey - ry * ex)
+                refined.append((alpha + eta, beta))
+            cone = [
+                (np.where(applies, ra, ca), np.where(applies, rb, cb))
+                for (ra, rb), (ca, cb) in zip(refined, cone, strict=True)
+            ]
+            lo = np.where(applies & empty, np.inf, lo)
+        for alpha, beta in cone:
+            lo, hi = _clip(lo, hi, alpha, beta)
         l2, h2 = _clip(lo, hi, sign * a1 + eta, sign * b1)
         l2, h2 = _clip(l2, h2, sign * a2 + eta, sign * b2)
         hit |= l2 <= h2
     return hit
+
+
+def _cut_cone(vx, vy, cx, cy, R, e, n, length, clear):
+    """The cone of apex v spanned by ``D(c, R)`` cut to the side of the line ``clear``
+    off the wall edge that runs from v along ``e``, ``n`` its unit normal into free space.
+
+    Returns:
+        ``(applies, empty, r1, r2)``: where the cut applies (the whole disc projects onto
+        the edge: ``(c - v) . e + R <= length``), where the cut disc is empty, and the
+        cone's bounding unit directions ``r1`` and ``r2``, counter-clockwise from ``r1``
+        to ``r2`` (the cone spans less than a half-turn), as ``(x, y)`` pairs of arrays
+        (meaningless where it does not apply or is empty).
+    """
+    e = np.asarray(e, dtype=float)
+    n = np.asarray(n, dtype=float)
+    wx, wy = np.broadcast_arrays(np.asarray(cx - vx, dtype=float), np.asarray(cy - vy, dtype=float))
+    R = np.broadcast_to(np.asarray(R, dtype=float), wx.shape)
+    pe = wx * e[0] + wy * e[1]
+    pn = wx * n[0] + wy * n[1]
+    applies = pe + R <= length
+    empty = pn + R < clear
+    big = np.inf
+    tmin = np.full(wx.shape, big)
+    tmax = np.full(wx.shape, -big)
+
+    def take(x, y, ok):
+        nonlocal tmin, tmax
+        th = np.arctan2(y, x)
+        tmin = np.where(ok, np.minimum(tmin, th), tmin)
+        tmax = np.where(ok, np.maximum(tmax, th), tmax)
+
+    # the chord's ends, where the line n = clear cuts the circle
+    dh = clear - pn
+    half2 = R * R - dh * dh
+    chord = (half2 >= 0.0) & (pn - R < clear)
+    half = np.sqrt(np.maximum(half2, 0.0))
+    take(pe - half, np.full(wx.shape, clear), chord)
+    take(pe + half, np.full(wx.shape, clear), chord)
+    # the tangent points from v, where they lie on the kept side
+    D2 = pe * pe + pn * pn
+    out = D2 > R * R
+    q = np.sqrt(np.maximum(D2 - R * R, 0.0))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        phi = np.arctan2(pn, pe)
+        beta = np.arcsin(np.clip(R / np.sqrt(np.maximum(D2, 1e-300)), 0.0, 1.0))
+    for sgn in (1.0, -1.0):
+        ang = phi + sgn * beta
+        tx, ty = q * np.cos(ang), q * np.sin(ang)
+        take(tx, ty, out & (ty >= clear))
+    empty = empty | (tmin > tmax)
+    tmin = np.where(empty, 0.0, tmin)
+    tmax = np.where(empty, 0.0, tmax)
+    r1 = (np.cos(tmin) * e[0] + np.sin(tmin) * n[0], np.cos(tmin) * e[1] + np.sin(tmin) * n[1])
+    r2 = (np.cos(tmax) * e[0] + np.sin(tmax) * n[0], np.cos(tmax) * e[1] + np.sin(tmax) * n[1])
+    if e[0] * n[1] - e[1] * n[0] < 0.0:  # (e, n) turns clockwise: the angles run clockwise
+        r1, r2 = r2, r1
+    return applies, empty, r1, r2
 
 
 def fan_hits_vertex(ex, ey, vx, vy, cx, cy, R, din, dout, eta=0.0) -> np.ndarray:

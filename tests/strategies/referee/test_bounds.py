@@ -9,8 +9,10 @@ import math
 import numpy as np
 import pytest
 
+from envs.maps import Map
 from strategies.cspace import decompose, surveillance_verdict
 from strategies.referee import Referee, Resolution, solve, solve_evader_bound, solve_pursuer_bound
+from strategies.referee.spec import GameSpec
 from tests.strategies.referee.conftest import L_MAX, L_MIN, dead_end, open_room, spec
 
 # rho = 0.5 on purpose: the pursuer bound's own warning is tested in test_vacuity
@@ -246,3 +248,21 @@ def test_broken_states_are_broken_for_every_pursuer_in_the_cell(corridor_half):
             assert not status.holds, (p, e)
             checked += 1
     assert checked > 100
+
+
+@pytest.mark.slow
+def test_pursuer_bound_sees_past_a_jamb_an_evader_that_keeps_its_clearance():
+    """Two 5 x 5 rooms joined by a corridor 3 long and 2 wide, L in [1, 2], rho = 0.3,
+    16 cells per L_min: the evader leading the pursuer through the corridor could always
+    hide round a mouth's jamb while its disc could lie on the wall (the bound certified no
+    state); an evader that keeps ``opponent_clearance`` from the walls cannot stand on the
+    rod's ray beside the wall, and the bound certifies most states (95.7 %)."""
+    world = Map(
+        [(-8, -2.5), (-3, -2.5), (-3, -1), (0, -1), (0, -2.5), (5, -2.5), (5, 2.5), (0, 2.5),
+         (0, 1), (-3, 1), (-3, 2.5), (-8, 2.5)],
+        name="two_small_rooms",
+    )  # fmt: skip
+    spec = GameSpec(world, 1.0, 2.0, 1.0, 0.3, body_radius=0.1)
+    res = Resolution.for_role(spec, "pursuer", 16, coarse=4, steps=3, dt=0.1)
+    pb = solve_pursuer_bound(spec, res)
+    assert pb.fraction() > 0.9

@@ -197,7 +197,7 @@ class DecompositionPursuer(BasePolicy):
     CLEAR_BLOCK_BITS = 2  # a lazy table's clearances are measured 4 x 4 nodes at a time
     WALL_HORIZON = 2.0  # seconds the pursuer's path is checked for walls (no circle in reach)
     WALL_STEP = 0.1  # spacing in seconds of the points checked on that path
-    SLIDE_HORIZON = 3.0  # seconds a turn's path is followed for a slide (_slide_through)
+    CHARGE_PERSIST = 3.0  # seconds a charge has lasted before a slide's loss is believed
     CORNER_HUG = 2  # grid steps of clearance beyond its body within which the evader hugs a wall
     CORNER_HEADING = 0.9  # least cosine between the evader's heading and a corner it rounds
     LEAD_MARGIN = 4  # bins the rod keeps off its free arc's leading end on a lap (_walk_lead)
@@ -332,10 +332,10 @@ class DecompositionPursuer(BasePolicy):
         # ORBIT_LOOKAHEAD seconds of (test passed, rod orientation, evader heading)
         self._charging = False
         self._charge_armed = False
-        # steps the charge test has passed in a row, and how many make a charge that
-        # lasts the slide check's horizon (:meth:`_slide_through`)
+        # steps the charge test has passed in a row, and how many make a long charge
+        # (:meth:`_slide_through`)
         self._charge_run = 0
-        self._charge_persist = round(self.SLIDE_HORIZON / c.dt) + 1
+        self._charge_persist = round(self.CHARGE_PERSIST / c.dt) + 1
         self._armed_heading = 0.0
         self._charge_log: deque[tuple[bool, float, float]] = deque(
             maxlen=max(1, round(self.ORBIT_LOOKAHEAD / c.dt))
@@ -349,9 +349,6 @@ class DecompositionPursuer(BasePolicy):
             need = self._orbit_R * self.L_target + self._orbit_pad
             self._field = _room_field(c.map, self.table, round(need, 9))
         self._wall_times = np.arange(1, round(self.WALL_HORIZON / self.WALL_STEP) + 1) * (
-            self.WALL_STEP
-        )
-        self._slide_times = np.arange(1, round(self.SLIDE_HORIZON / self.WALL_STEP) + 1) * (
             self.WALL_STEP
         )
         # probes round the corners (issue 13, :meth:`_corners_in_reach`)
@@ -869,16 +866,15 @@ class DecompositionPursuer(BasePolicy):
         self._clear_memo.update(zip(map(tuple, ij.tolist()), d.tolist(), strict=True))
 
     def _wall_path(
-        self, snap: Snapshot, r: float, L: float, follow: bool = True, ts: np.ndarray | None = None
+        self, snap: Snapshot, r: float, L: float, follow: bool = True
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The rod's orientation and the pursuer's centre (x, y) at the times ``ts``
-        (every ``WALL_STEP`` seconds up to ``WALL_HORIZON`` unless given) if the rod turns
-        at ``r`` (:meth:`_time_to_wall`)."""
+        """The rod's orientation and the pursuer's centre (x, y) every ``WALL_STEP``
+        seconds up to ``WALL_HORIZON`` if the rod turns at ``r`` (:meth:`_time_to_wall`)."""
         ex, ey = float(snap.evader[0]), float(snap.evader[1])
         ve = snap.evader_velocity
         v = math.hypot(float(ve[0]), float(ve[1]))
         th = snap.theta
-        ts = self._wall_times if ts is None else ts
+        ts = self._wall_times
         a = th + r * ts
         if not follow:  # the evader keeps its velocity
             x = ex + float(ve[0]) * ts
@@ -1069,7 +1065,8 @@ class DecompositionPursuer(BasePolicy):
 
     def _slide_through(self, snap: Snapshot, out: float, hi: float, lo: float, L: float) -> float:
         """The turn ``out`` against a long pure-pursuit charge, or the other hard turn if
-        ``out`` slides the pursuer through a straight wall's normal and the other does not.
+        ``out`` is about to slide the pursuer through a straight wall's normal and the
+        other does not.
 
         :meth:`_off_the_normal`'s slide: pushed against a straight wall by a charge along
         the rod at ``rho V_p``, the range falls while the rod lies within ``asin(rho)`` of
@@ -1077,53 +1074,60 @@ class DecompositionPursuer(BasePolicy):
         :func:`_slide_floor` of the lean, turning back the near way far less. The rule
         there keeps a hard turn from swinging the rod back toward the normal; this one
         follows the turn's path (the charge running along the turning rod, as in
-        :meth:`_time_to_wall`) for ``SLIDE_HORIZON`` seconds to where it first meets a
-        wall. If that point's nearest wall point lies inside an edge (a straight wall,
-        not a corner, which the slide rounds), the rod there lies inside that wall's
-        cone, and the slide on from there ends closer than L_min
+        :meth:`_time_to_wall`) to where it first meets a wall. If it meets one within
+        ``ORBIT_LOOKAHEAD``, that point's nearest wall point lies inside an edge (a
+        straight wall, not a corner, which the slide rounds), the rod there lies inside
+        that wall's cone, and the slide on from there ends closer than L_min
         (:meth:`_slide_ends_close`), the other hard turn (the other sign) wins if its own
-        path does not so end. At the held distance the margin is small: at rho 0.3 and
-        L_target = 1.04 L_min, sliding through from the normal itself ends at 0.955 L.
+        path does not so end within ``WALL_HORIZON``. At the held distance the margin is
+        small: at rho 0.3 and L_target = 1.04 L_min, sliding through from the normal
+        itself ends at 0.955 L.
 
-        Where the decomposition's own turn heads into such a slide, nothing else looks
-        (holds-bench-03: the pillars world at rho 0.3, seeds 3 and 5, where the shooting,
+        Where the decomposition's own turn heads into such a slide, nothing else looks:
+        in the pillars world at rho 0.3 (holds-bench-03, seed 3), the shooting,
         toward-away and referee evaders charge by pure pursuit from 0.1 s on and herd the
         pursuer into the pocket between the triangular pillar's tip and the south-east
-        corner). Seed 3: at 8.9 s the decomposition turned the rod ccw toward the bottom
-        wall's normal from 16 deg off it, its path meeting the wall 0.4 s ahead 6 deg off
-        the normal (floor 0.92), the cw path clear; the pursuer slid into the wall, too
-        close at 9.6 s. Seed 5: from 4.1 s its ccw turn headed up the east wall, meeting
-        it 2.1 s ahead at the normal (floor 0.95: 2.087 -> 1.99); too close at 6.7 s. Both
-        hold all 60 s turning cw. The horizon: at 2 s (``WALL_HORIZON``) seed 5's wall lay
-        at the edge of it, in on one step and out on the next, the turn alternated and
-        the rod stood still while the charge pushed the pursuer into the pocket (lost at
-        8.4-9.6 s); at 2.5 s the same later; 3 to 4 s hold both seeds.
+        corner; at 8.9 s the decomposition turned the rod ccw toward the bottom wall's
+        normal from 16 deg off it, its path meeting the wall 0.4 s ahead 6 deg off the
+        normal (floor 0.92), the cw path clear; the pursuer slid into the wall, too close
+        at 9.6 s. Turning cw there holds all 60 s. Not further ahead: seed 5's ccw turn up
+        the east wall met it 2.0-2.1 s ahead at the normal (floor 0.95); the check over
+        ``WALL_HORIZON`` fired on every other step (the wall in and out of the horizon,
+        or the charge test's one-step lag out of :meth:`_pure_charge` after each cw
+        step), the rod stood still and the pursuer was pushed into the pocket (lost at
+        8.4-9.6 s); over 3 s it held seed 5 but fired all along the maze's corridors and
+        pillars at rho 0.5, turning the rod into obstacles (holds-bench: maze seeds 1 and
+        7, pillars seed 0, occluded at 7.7-18.6 s), with a check of the rod's free arc
+        for the turn (:meth:`_rod_room`) and a latch on the last step's override too
+        (maze seeds 1 and 7, too close at 43-49 s).
 
-        Only against a charge that has lasted ``SLIDE_HORIZON`` seconds (the charge test of
-        :meth:`_charge_test` on every step, and a pure pursuit now, :meth:`_pure_charge`):
-        the slide's loss needs the charge to go on through it, and a charge is believed to
-        last as long as it has lasted. A herder (benchmarks/unseen_opponents.py) charges
-        in bursts while the rod lies near the normal (up to 2.5 s in unseen pillar_tri's
-        herder episode, combo 1, seed 101) and walks off as the rod leaves it; the check
-        fired there inside a 1.9 s burst at the east wall, the rod 6 deg off the normal,
-        and the episode, held before, was lost at 21-23 s (needing 2 s of charge: 21.3 s).
+        Only against a charge that has lasted ``CHARGE_PERSIST`` seconds (the charge
+        test of :meth:`_charge_test` on every step, and a pure pursuit now,
+        :meth:`_pure_charge`): the slide's loss needs the charge to go on through it. A
+        herder (benchmarks/unseen_opponents.py) charges in bursts while the rod lies near
+        the normal (up to 2.5 s in unseen pillar_tri's herder episode, combo 1, seed 101)
+        and walks off as the rod leaves it; the check fired there inside a 1.9 s burst at
+        the east wall, the rod 6 deg off the normal, and the episode, held before, was
+        lost at 17-23 s (after 1 s of charge 17.0 s, after 2 s 21.3 s).
         """
         if out == 0.0 or self._charge_run < self._charge_persist or not self._pure_charge(snap, L):
             return out
-        if not self._slide_ends_close(snap, out, L):
+        if not self._slide_ends_close(snap, out, L, self.ORBIT_LOOKAHEAD):
             return out
         for r in (hi, lo):
             if r * out < 0.0 and not self._slide_ends_close(snap, r, L):
                 return r
         return out
 
-    def _slide_ends_close(self, snap: Snapshot, r: float, L: float) -> bool:
+    def _slide_ends_close(
+        self, snap: Snapshot, r: float, L: float, within: float = math.inf
+    ) -> bool:
         """Whether the path of the turn ``r`` (the charge following the rod) meets a
-        straight wall with the rod inside its cone where sliding on ends closer than
-        L_min (:meth:`_slide_through`)."""
-        a, px, py = self._wall_path(snap, r, L, ts=self._slide_times)
+        straight wall, within ``within`` seconds and ``WALL_HORIZON``, with the rod inside
+        its cone where sliding on ends closer than L_min (:meth:`_slide_through`)."""
+        a, px, py = self._wall_path(snap, r, L)
         hit = self._wall_hits(px, py)
-        if not hit.size:
+        if not hit.size or self._wall_times[hit[0]] > within:
             return False
         k = int(hit[0])
         p = np.array([px[k], py[k]])

@@ -1097,9 +1097,10 @@ class DecompositionPursuer(BasePolicy):
         step), the rod stood still and the pursuer was pushed into the pocket (lost at
         8.4-9.6 s); over 3 s it held seed 5 but fired all along the maze's corridors and
         pillars at rho 0.5, turning the rod into obstacles (holds-bench: maze seeds 1 and
-        7, pillars seed 0, occluded at 7.7-18.6 s), with a check of the rod's free arc
-        for the turn (:meth:`_rod_room`) and a latch on the last step's override too
-        (maze seeds 1 and 7, too close at 43-49 s).
+        7, pillars seed 0, occluded at 7.7-18.6 s); with a check of the rod's free arc
+        for the turn (:meth:`_rod_room`) it still lost maze seed 7 (too close at 43 s,
+        the check in and out on every other step), and with a latch on the last step's
+        override as well (43 s; over 2 s with both, maze seeds 1 and 7 at 43-49 s).
 
         Only against a charge that has lasted ``CHARGE_PERSIST`` seconds (the charge
         test of :meth:`_charge_test` on every step, and a pure pursuit now,

@@ -141,11 +141,12 @@ corner world's default starts (the reproduction report's episodes) and the refer
 certified starts (``benchmarks/certified_starts.json``)."""
 
 
-_HOLDS_03 = _BASE
+_HOLDS_03 = "4c4631e"
 """Where holds-bench-03 was last played: holds-bench's episodes at rho 0.3 instead of 0.5
 (helper-166 found the decomposition pursuer's pillars losses there, seeds 3 and 5, to the
 charging evaders: no set played rho 0.3 on the paper's worlds); first played at 80d5f9d
-(378/384), again at 4be633d: every episode's winner the same."""
+(378/384), again at 4be633d: every episode's winner the same; at 4c4631e (branch
+decomp-pillars-177, the slide check) 381/384, seed 3 held against the three chargers."""
 
 
 def _set(name: str, alias: str, role: str, figure: str, measured: str, command: str):
@@ -191,7 +192,7 @@ SETS: dict[str, PolicySet] = {
              "fixed_starts.py --starts certified --role pursuer"),
         _set("certified-e", "certe", "evader", "468/468", _FIXED,
              "fixed_starts.py --starts certified --role evader"),
-        _set("holds-bench-03", "b1r3", "pursuer", "378/384", _HOLDS_03,
+        _set("holds-bench-03", "b1r3", "pursuer", "381/384", _HOLDS_03,
              "pursuer_holds.py --worlds corridor l_hall open_room corner pillars maze "
              "--variants 'as is' --seeds 8 --rho 0.3 --no-greedy"),
     )

@@ -169,17 +169,37 @@ def why_not_a_file(path: str | os.PathLike[str]) -> str | None:
     return f"is {kind}, not a regular file"
 
 
+class _DuplicateKey(Exception):
+    def __init__(self, key: str) -> None:
+        self.key = key
+
+
+def _once_each(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """A JSON object's dict, refusing a key given twice (json keeps the last silently)."""
+    obj: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in obj:
+            raise _DuplicateKey(key)
+        obj[key] = value
+    return obj
+
+
 def json_object(flag: str, text: str | None, *, example: str) -> dict[str, Any]:
     """The JSON object given to ``flag`` (``{}`` when the flag is absent).
 
     Raises:
-        InvalidConfigError: not JSON (naming the flag and where the JSON breaks), or JSON
-            that is not an object.
+        InvalidConfigError: not JSON (naming the flag and where the JSON breaks), JSON
+            that is not an object, or a key given twice in an object.
     """
     if text is None:
         return {}
     try:
-        obj = json.loads(text)
+        obj = json.loads(text, object_pairs_hook=_once_each)
+    except _DuplicateKey as dup:
+        raise InvalidConfigError(
+            f"{flag} = {text!r}: key {dup.key!r} given twice (JSON keeps only the last); "
+            f"expected each key once, as in {example}"
+        ) from None
     except json.JSONDecodeError as exc:
         near = text[max(0, exc.pos - 10) : exc.pos + 10]
         raise InvalidConfigError(

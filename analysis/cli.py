@@ -36,7 +36,7 @@ from analysis.arguments import (
     warnings_held,
 )
 from analysis.figures import cli as figures_cli
-from analysis.replay import MAX_FPS
+from analysis.replay import DEFAULT_FPS, MAX_FPS
 from envs.console import OneLineWarnings
 from envs.errors import InvalidConfigError, SurveilValueError, UnknownNameError
 
@@ -146,7 +146,8 @@ def _cmd_play(args: argparse.Namespace) -> int:
         evader = _policy("--evader", args.evader, "--evader-params", args.evader_params)
         out = None
         if args.no_gif:  # a replay asked for and not written, without a word
-            given = [f for f, v in (("--out", args.out), ("--overlay", args.overlay)) if v]
+            asked = (("--out", args.out), ("--overlay", args.overlay), ("--fps", args.fps))
+            given = [f for f, v in asked if v]
             if given:
                 raise InvalidConfigError(
                     f"--no-gif writes no replay; {' and '.join(given)} "
@@ -156,6 +157,7 @@ def _cmd_play(args: argparse.Namespace) -> int:
             where = args.out if args.out is not None else str(DEFAULT_OUT / "play.gif")
             out = output_file("--out", where, suffixes=(".gif", ".png"), default_name="play.gif")
     say_warnings(held)
+    fps = DEFAULT_FPS if args.fps is None else args.fps
     shading: tuple = ()
     if args.overlay and out is not None:
         from analysis.overlay import decomposition_shading
@@ -165,7 +167,7 @@ def _cmd_play(args: argparse.Namespace) -> int:
     if out is not None and out.suffix.lower() == ".gif":
         from analysis.replay import GifStream
 
-        stream = GifStream(out, args.fps)  # frames go to the file as they are drawn
+        stream = GifStream(out, fps)  # frames go to the file as they are drawn
     try:
         try:
             result = run_episode(
@@ -202,7 +204,7 @@ def _cmd_play(args: argparse.Namespace) -> int:
     if out is not None and stream is None:  # a PNG strip: a few frames from the trajectory
         from analysis.replay import write_replay
 
-        write_replay(result, out, decomposition=args.overlay, fps=args.fps)
+        write_replay(result, out, decomposition=args.overlay, fps=fps)
     if out is not None:
         print(f"replay written to {out}")
     return 0
@@ -363,7 +365,10 @@ def build_parser() -> argparse.ArgumentParser:
         f"{DEFAULT_OUT / 'play.gif'})",
     )
     p.add_argument(
-        "--fps", type=integer(1, MAX_FPS), default=20, help=f"GIF frame rate (1-{MAX_FPS})"
+        "--fps",
+        type=integer(1, MAX_FPS),
+        default=None,
+        help=f"GIF frame rate (1-{MAX_FPS}; default {DEFAULT_FPS})",
     )
     p.add_argument("--overlay", action="store_true", help="draw the decomposition under the replay")
     p.add_argument("--no-gif", action="store_true", help="only print the outcome")

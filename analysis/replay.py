@@ -40,6 +40,9 @@ REPLAY_SUFFIXES = (".gif", ".png")
 MAX_FPS = 100
 """GIF frame delays are whole hundredths of a second: faster than 100 fps cannot be stored."""
 
+DEFAULT_FPS = 20
+"""A replay's frame rate unless told otherwise."""
+
 LINGER_MS = 1500
 """How long the GIF shows its last frame (the outcome) before looping."""
 
@@ -138,7 +141,7 @@ class GifStream:
         OSError: the file cannot be created.
     """
 
-    def __init__(self, path: str | os.PathLike[str], fps: int = 20) -> None:
+    def __init__(self, path: str | os.PathLike[str], fps: int = DEFAULT_FPS) -> None:
         self.path = Path(path)
         if self.path.suffix.lower() != ".gif":
             raise InvalidConfigError(f"GIF path must end in .gif, got {str(self.path)!r}")
@@ -247,7 +250,12 @@ def _save_png(image: np.ndarray, path: Path) -> Path:
 
 
 def write_replay(
-    result: Any, path: str | Path, *, decomposition: bool = False, fps: int = 20, panels: int = 6
+    result: Any,
+    path: str | Path,
+    *,
+    decomposition: bool = False,
+    fps: int = DEFAULT_FPS,
+    panels: int = 6,
 ) -> Path:
     """Write an episode replay as a GIF (or a PNG strip if ``path`` ends in ``.png``).
 

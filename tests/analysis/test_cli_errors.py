@@ -636,8 +636,24 @@ def test_a_replay_asked_for_with_no_gif_is_refused(capsys, tmp_path, monkeypatch
         (["--out", "x.gif"], ["--no-gif writes no replay; --out is for the replay"]),
         (["--overlay"], ["--overlay is for the replay"]),
         (["--out", "x.gif", "--overlay"], ["--out and --overlay are for the replay"]),
+        (["--fps", "5"], ["--fps is for the replay"]),
     ):
         assert_fails(capsys, ["play", *FAST, "--no-gif", *extra], *needles)
     assert list(tmp_path.iterdir()) == []
     assert main(["play", *FAST]) == 0  # the default replay is still out/play.gif
     assert (tmp_path / "out" / "play.gif").is_file()
+
+
+@pytest.mark.parametrize(
+    ("argv", "flag"),
+    [
+        (["play", *FAST, "--no-gif", "--config", '{"l_min": 2, "l_min": 3}'], "--config"),
+        (["play", *FAST, "--no-gif", "--evader-params", '{"mode": "toward", "mode": "away"}'],
+         "--evader-params"),
+    ],
+)  # fmt: skip
+def test_a_json_key_given_twice_is_refused(capsys, argv, flag):
+    """``--config '{"l_min": 2, "l_min": 3}'`` played at L_min 3 without a word (JSON keeps
+    a repeated key's last value): a typo'd or pasted-over config ran something else."""
+    line = assert_fails(capsys, argv, flag, "given twice", "expected each key once")
+    assert "'l_min'" in line or "'mode'" in line

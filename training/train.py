@@ -41,6 +41,7 @@ import numpy as np
 
 from envs import pidlock
 from envs.errors import InvalidConfigError
+from envs.maps.map import Map
 from envs.surveillance_v1 import ENV_ID
 from strategies.policies import Policy, make_policy
 from training.config import TrainConfig, check_same_maps, load_config, map_fingerprints
@@ -97,6 +98,7 @@ class EvalResult:
             where it did (NaN if it never did).
         escape_times: those times, in episode order.
         causes: escape causes and their counts.
+        maps: the maps played (a DAgger recipe's list draws one per episode).
     """
 
     role: str
@@ -107,6 +109,7 @@ class EvalResult:
     mean_escape_time: float
     escape_times: tuple[float, ...] = ()
     causes: dict[str, int] = field(default_factory=dict)
+    maps: tuple[str, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (NaN written as ``None``)."""
@@ -633,6 +636,7 @@ def _result_from_provenance(config: TrainConfig, out: Path, prov: dict[str, Any]
     if ev is not None:
         ev = dict(ev)
         ev["escape_times"] = tuple(ev.get("escape_times", ()))
+        ev["maps"] = tuple(ev.get("maps", ()))  # absent in provenance written before
         if ev.get("mean_escape_time") is None:
             ev["mean_escape_time"] = math.nan
         evaluation = EvalResult(**ev)
@@ -764,4 +768,9 @@ def evaluate_model(
         mean_escape_time=float(np.mean(times)) if times else math.nan,
         escape_times=tuple(times),
         causes=causes,
+        maps=tuple(_map_name(m) for m in ([map] if isinstance(map, str | Map) else map)),
     )
+
+
+def _map_name(m: Any) -> str:
+    return m.name if isinstance(m, Map) else str(m)

@@ -244,7 +244,8 @@ def test_python_m_training_zoo_evaluate_prints_no_python_reprs(capsys):
     assert zoo_main([*argv, "--opponent", "zoo:ppo_evader_vs_greedy_open_room"]) == 0
     line = capsys.readouterr().out.strip()
     assert re.fullmatch(
-        r"pursuer vs zoo:ppo_evader_vs_greedy_open_room: success \d/2 \(\d+%\), mean escape "
+        r"pursuer vs zoo:ppo_evader_vs_greedy_open_room on open_room: success \d/2 \(\d+%\), "
+        r"mean escape "
         r"time (-|[\d.]+ s), causes (none|[a-z_]+ \d(, [a-z_]+ \d)*)",
         line,
     ), line
@@ -387,7 +388,8 @@ def test_python_m_training_zoo_evaluates_a_dagger_model(name, opponent, capsys):
 
     assert zoo_main(["evaluate", name, "--opponent", opponent, "--episodes", "1"]) == 0
     out = capsys.readouterr().out
-    assert out.startswith(f"{zoo.info(name)['role']} vs {opponent}: success ")
+    assert out.startswith(f"{zoo.info(name)['role']} vs {opponent} on ")
+    assert ": success " in out
 
 
 def test_a_specialist_knows_its_map_by_geometry_not_by_name(tmp_path):
@@ -529,4 +531,4 @@ def test_evaluate_warns_once_of_an_opponent_without_provenance(tmp_path, capsys)
     warned = [line for line in captured.err.splitlines() if "no provenance.json" in line]
     assert len(warned) == 1, captured.err
     assert warned[0].startswith(f"python -m training.zoo: warning: --opponent = '{bare}': ")
-    assert captured.out.startswith(f"pursuer vs {bare}: success ")
+    assert captured.out.startswith(f"pursuer vs {bare} on open_room: success ")

@@ -119,10 +119,17 @@ def _main(argv: list[str] | None) -> int:
     return 0
 
 
+def _on(maps: tuple[str, ...]) -> str:
+    if len(maps) > 1:
+        return f" on {', '.join(maps)} (one drawn an episode)"
+    return f" on {maps[0]}" if maps else ""
+
+
 def _line(ev) -> str:
     t = "-" if math.isnan(ev.mean_escape_time) else f"{ev.mean_escape_time:.2f} s"
     return (
-        f"{ev.role} vs {ev.opponent}: success {ev.successes}/{ev.episodes} "
+        f"{ev.role} vs {ev.opponent}{_on(ev.maps)}: "
+        f"success {ev.successes}/{ev.episodes} "
         f"({ev.success_rate:.0%}), mean escape time {t}, causes "
         + (", ".join(f"{c} {n}" for c, n in sorted(ev.causes.items())) or "none")
     )

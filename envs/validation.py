@@ -28,7 +28,9 @@ from __future__ import annotations
 
 import math
 import re
+import tempfile
 from collections.abc import Iterable, Mapping
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -278,3 +280,27 @@ def _shape(shape: tuple[int | None, ...]) -> str:
         + ("," if len(shape) == 1 else "")
         + ")"
     )
+
+
+def writable_directory(name: str, text: str, alternative: str = "") -> None:
+    """Refuse a directory to be made or written that is a file or lies under one, or that
+    could not be made or written (its nearest existing folder takes no new file), making
+    nothing: without the check a report or a training run failed only at its first write,
+    after the work ("DIR: Permission denied", "x.json: File exists"), naming no flag.
+    ``alternative`` is added to the message (e.g. "(or --no-report)")."""
+    path = Path(text)
+    blocker = next((p for p in (path, *path.parents) if p.exists() and not p.is_dir()), None)
+    more = f" {alternative}" if alternative else ""
+    if blocker is not None:
+        raise InvalidConfigError(
+            f"{name} = {text!r}: {str(blocker)!r} is a file, expected a directory{more}"
+        )
+    nearest = next((p for p in (path, *path.parents) if p.is_dir()), Path("."))
+    try:
+        with tempfile.TemporaryFile(dir=nearest):
+            pass  # a file can be made there (os.access lies to root and on some mounts)
+    except OSError as exc:
+        raise InvalidConfigError(
+            f"{name} = {text!r}: cannot write in {str(nearest)!r} "
+            f"({exc.strerror or type(exc).__name__}); expected a directory you can write{more}"
+        ) from None

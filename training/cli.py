@@ -11,7 +11,6 @@ import math
 import os
 import signal
 import sys
-import tempfile
 import threading
 import warnings
 from collections.abc import Callable, Sequence
@@ -81,7 +80,7 @@ def run_train(args: argparse.Namespace) -> int:
         import stable_baselines3  # noqa: F401  (training's import, torch's: seconds)
     if ctrl_c.seen:  # one CPython discarded in an import's callback: honoured now
         raise KeyboardInterrupt
-    _check_output_dir(os.fspath(config.output_dir))
+    validation.writable_directory("output_dir", os.fspath(config.output_dir))
     progress = not args.no_progress  # as python -m training.zoo reproduce: on unless told
     if not isinstance(config, TrainConfig):  # a DAgger recipe
         if args.timesteps is not None or args.self_play is not None:
@@ -155,28 +154,6 @@ def _dagger_resume_note(config) -> str:
         f"stopped: {done} of {config.iterations} iterations are in {config.output_dir}; "
         "rerun the same command to resume from there"
     )
-
-
-def _check_output_dir(text: str) -> None:
-    """Refuse, before any training, an output_dir that is a file or lies under one (was
-    ``x.json: File exists`` from the first checkpoint's mkdir), or that could not be made
-    or written (its nearest existing folder takes no new file: was ``DIR: Permission
-    denied`` or ``DIR: No such file or directory``, naming no field). Makes nothing."""
-    path = Path(text)
-    blocker = next((p for p in (path, *path.parents) if p.exists() and not p.is_dir()), None)
-    if blocker is not None:
-        raise InvalidConfigError(
-            f"output_dir = {text!r}: {str(blocker)!r} is a file, expected a directory"
-        )
-    nearest = next((p for p in (path, *path.parents) if p.is_dir()), Path("."))
-    try:
-        with tempfile.TemporaryFile(dir=nearest):
-            pass  # a file can be made there (os.access lies to root and on some mounts)
-    except OSError as exc:
-        raise InvalidConfigError(
-            f"output_dir = {text!r}: cannot write in {str(nearest)!r} "
-            f"({exc.strerror or type(exc).__name__}); expected a directory you can write"
-        ) from None
 
 
 def cli_train(argv: Sequence[str] | None = None) -> int:

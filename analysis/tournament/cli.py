@@ -12,7 +12,6 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-import tempfile
 from importlib import resources
 from pathlib import Path
 
@@ -26,6 +25,7 @@ from analysis.arguments import (
     why_not_a_file,
 )
 from envs.errors import InvalidConfigError
+from envs.validation import writable_directory
 
 __all__ = ["add_parsers", "format_cells", "shipped_specs"]
 
@@ -156,7 +156,7 @@ def _cmd_tournament(args: argparse.Namespace) -> int:
     if args.report is not None or args.report_default:
         # before the run: a file there failed only after every match ("x: File exists")
         where = args.report or str(store.with_name(store.stem + "_report"))
-        _report_dir_possible("--report", where, "(or --no-report)")
+        writable_directory("--report", where, "(or --no-report)")
     hint = f"surveil tournament {args.spec} --store {store}"
     if args.backend != "process":
         hint += f" --backend {args.backend}"
@@ -203,37 +203,13 @@ def _announce_report(out: str, replays: bool, regret: bool = True, skip: str = "
     _say(f"writing the report to {out}: {what}{extra}" + (f"; {skip}" if skip else ""))
 
 
-def _report_dir_possible(flag: str, text: str, alternative: str = "") -> None:
-    """Refuse a report directory that is a file or lies under one, or that could not be
-    made or written (its nearest existing folder takes no new file), making nothing (the
-    report makes it once there is something to write: a folder it could not write failed
-    only then, after the regret table and the replays, "DIR: Permission denied")."""
-    path = Path(text)
-    blocker = next((p for p in (path, *path.parents) if p.exists() and not p.is_dir()), None)
-    if blocker is not None:
-        raise InvalidConfigError(
-            f"{flag} = {text!r}: {str(blocker)!r} is a file, expected a directory"
-            + (f" {alternative}" if alternative else "")
-        )
-    nearest = next((p for p in (path, *path.parents) if p.is_dir()), Path("."))
-    try:
-        with tempfile.TemporaryFile(dir=nearest):
-            pass  # a file can be made there (os.access lies to root and on some mounts)
-    except OSError as exc:
-        raise InvalidConfigError(
-            f"{flag} = {text!r}: cannot write in {str(nearest)!r} "
-            f"({exc.strerror or type(exc).__name__}); expected a directory you can write"
-            + (f" {alternative}" if alternative else "")
-        ) from None
-
-
 def _cmd_report(args: argparse.Namespace) -> int:
     from analysis.tournament.report import write_report
     from analysis.tournament.store import Store
 
     store = Path(args.store)
     out = args.out or str(store.with_name(store.stem + "_report"))
-    _report_dir_possible("--out", out)  # was "x: File exists" from the mkdir
+    writable_directory("--out", out)  # was "x: File exists" from the mkdir
     with Store(store, create=False) as db:
         db.run(args.run)  # a bad store or run is refused before the announcement
         regret = not args.no_regret

@@ -97,9 +97,16 @@ FRESH_WORLDS = " ".join(
 """32 random maps nobody had used (README: "On 32 random maps nobody had used")."""
 _HOLDS = "--seeds 8 --rho 0.5 --no-greedy"
 _HELDOUT_P = "--worlds @benchmarks/heldout_worlds_pursuer.txt"
-_BASE = "4be633d"
+_BASE = "194babd"
 """The commit every figure below holds at (all seventeen sets played there, compared per
-episode with 5270138: heldout-e -1, random:star:2019 seed 258 (791d52a's give-way
+episode with 4be633d's rows after 9f49910's evader/referee replay: nothing lost; 9f49910
+(evader/referee plays the referee's evader-bound fallback, a stronger ground-truth
+opponent) lost holds-variants, unseen-p0, heldout-p0 and fresh-p0 one episode each, two
+certified unavoidable, one late, one unknown, none a certified regret; 194babd (the
+decomposition's slide-through check against a charge) won holds-bench-03 +3; the
+certified starts were re-drawn (1c33d9d: the referee's stronger pursuer bound) and
+certified-p played on them. Before: at 4be633d, all seventeen, compared per episode with
+5270138: heldout-e -1, random:star:2019 seed 258 (791d52a's give-way
 changed the decomposition pursuer's path there and the shooting evader's herd, which
 escaped at 7.98 of 8 D/V_e, no longer escapes), every other episode's winner the same;
 d6d8f9a (the shooting evader against a pursuer that does not turn the rod) moved escape
@@ -136,17 +143,19 @@ transformed, junctions, random maps of seeds 4501-4510, 4604-4605, floor plans 9
 _FIXED = _BASE
 """Where the three sets of ``fixed_starts.py`` were last played (first at c427419, 1283649's
 policies: certified-e 310/312 there; certified-e grew to 468 episodes at ea81a89, played
-at 34c7663, 3765f76, 8bef7db, 5270138 and 4be633d): the
+at 34c7663, 3765f76, 8bef7db, 5270138, 4be633d and 194babd; certified-p's starts re-drawn at
+1c33d9d, the referee's pursuer bound having grown): the
 corner world's default starts (the reproduction report's episodes) and the referee's
 certified starts (``benchmarks/certified_starts.json``)."""
 
 
-_HOLDS_03 = "4c4631e"
+_HOLDS_03 = _BASE
 """Where holds-bench-03 was last played: holds-bench's episodes at rho 0.3 instead of 0.5
 (helper-166 found the decomposition pursuer's pillars losses there, seeds 3 and 5, to the
 charging evaders: no set played rho 0.3 on the paper's worlds); first played at 80d5f9d
 (378/384), again at 4be633d: every episode's winner the same; at 4c4631e (branch
-decomp-pillars-177, the slide check) 381/384, seed 3 held against the three chargers."""
+decomp-pillars-177, the slide check) 381/384, seed 3 held against the three chargers, and
+at 194babd (its merge)."""
 
 
 def _set(name: str, alias: str, role: str, figure: str, measured: str, command: str):
@@ -161,22 +170,22 @@ SETS: dict[str, PolicySet] = {
         _set("holds-bench", "b1", "pursuer", "380/384", _BASE,
              "pursuer_holds.py --worlds corridor l_hall open_room corner pillars maze "
              f"--variants 'as is' {_HOLDS}"),
-        _set("holds-variants", "b2", "pursuer", "560/576", _BASE,
+        _set("holds-variants", "b2", "pursuer", "559/576", _BASE,
              "pursuer_holds.py --worlds corridor l_hall corner "
              f"--variants 'rot 0.37' 'x10 rot 1.1' off-centre {_HOLDS}"),
-        _set("unseen-p0", "pu0", "pursuer", "429/450", _BASE,
+        _set("unseen-p0", "pu0", "pursuer", "428/450", _BASE,
              "unseen_worlds.py --role pursuer --combos 0"),
         _set("unseen-p1", "pu1", "pursuer", "446/450", _BASE,
              "unseen_worlds.py --role pursuer --combos 1"),
         _set("unseen-p2", "pu2", "pursuer", "486/486", _BASE,
              "unseen_worlds.py --role pursuer --combos 2"),
-        _set("heldout-p0", "ph0", "pursuer", "614/648", _BASE,
+        _set("heldout-p0", "ph0", "pursuer", "613/648", _BASE,
              f"unseen_worlds.py --role pursuer {_HELDOUT_P} --combos 0"),
         _set("heldout-p1", "ph1", "pursuer", "636/648", _BASE,
              f"unseen_worlds.py --role pursuer {_HELDOUT_P} --combos 1"),
         _set("heldout-p2", "ph2", "pursuer", "666/666", _BASE,
              f"unseen_worlds.py --role pursuer {_HELDOUT_P} --combos 2"),
-        _set("fresh-p0", "fresh_p0", "pursuer", "556/576", _BASE,
+        _set("fresh-p0", "fresh_p0", "pursuer", "555/576", _BASE,
              f"unseen_worlds.py --role pursuer --combos 0 --worlds {FRESH_WORLDS}"),
         _set("unseen-e", "eunseen", "evader", "1189/1189", _BASE,
              "unseen_worlds.py --role evader"),

@@ -634,6 +634,7 @@ def _entry(item: Any, role: str, where: str, base: Path) -> PolicyEntry:
                 "observation is for a policy that reads the env's, such as a model)"
             )
         label = string("label", d.get("label", name), where=where)
+        params = _without_defaults(name, params)
         return PolicyEntry(role, label, name, _canonical(params), None, None, observation)
     text = string("model", d["model"], where=where)
     path = model_file(text, where, base)
@@ -680,6 +681,21 @@ def _entry(item: Any, role: str, where: str, base: Path) -> PolicyEntry:
                 observation["lidar_range"] = env_cfg.get("lidar_range")
     label = string("label", d.get("label", text), where=where)
     return PolicyEntry(role, label, f"{role}/sb3", params, str(path), digest, observation)
+
+
+def _without_defaults(name: str, params: Mapping[str, Any]) -> dict[str, Any]:
+    """``params`` less those given at the policy's default value: the same policy plays
+    either way, so both spellings have one identity (a spec that wrote ``{"gain": 1.0}``
+    at the default is the same entry, and the same matches, as one that left it out)."""
+    from strategies.policies.registry import policy_spec
+
+    defaults = policy_spec(name).params
+    return {k: v for k, v in params.items() if not (k in defaults and _same(v, defaults[k]))}
+
+
+def _same(value: Any, default: Any) -> bool:
+    # 1 and 1.0 are one value to a policy; True is not 1 (make_policy refuses it there)
+    return isinstance(value, bool) == isinstance(default, bool) and value == default
 
 
 def _canonical(params: Mapping[str, Any]) -> dict[str, Any]:

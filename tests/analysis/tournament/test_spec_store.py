@@ -173,6 +173,22 @@ def test_duplicate_roster_entries_are_merged_or_rejected(small_spec):
         spec_from_dict({**small_spec, "maps": ["corridor", str(_builtin_file("corridor"))]})
 
 
+def test_a_parameter_given_at_its_default_is_the_same_entry(small_spec):
+    """``{"gain": 4}`` is pursuer/greedy's default: the same policy plays, so the same
+    entry and the same matches (it was another identity: every match played twice)."""
+    explicit = {"policy": "pursuer/greedy", "params": {"gain": 4, "target": 0.0}}
+    with pytest.warns(UserWarning, match="merged"):
+        spec = spec_from_dict({**small_spec, "pursuers": ["pursuer/greedy", explicit]})
+    assert len(spec.pursuers) == 1 and spec.pursuers[0].params == {}
+    alone = spec_from_dict({**small_spec, "pursuers": [explicit]})
+    plain = spec_from_dict({**small_spec, "pursuers": ["pursuer/greedy"]})
+    assert [m.match_id for m, _ in plan(alone)] == [m.match_id for m, _ in plan(plain)]
+    other = {"policy": "pursuer/greedy", "params": {"gain": 4.5, "target": 0.0}}
+    changed = spec_from_dict({**small_spec, "pursuers": [other]})
+    assert changed.pursuers[0].params == {"gain": 4.5}
+    assert not {m.match_id for m, _ in plan(changed)} & {m.match_id for m, _ in plan(plain)}
+
+
 def _builtin_file(name):
     from importlib import resources
 

@@ -14,6 +14,7 @@ import math
 import sys
 from importlib import resources
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from analysis.arguments import (
     MAP_HELP,
@@ -26,6 +27,9 @@ from analysis.arguments import (
 )
 from envs.errors import InvalidConfigError
 from envs.validation import writable_directory
+
+if TYPE_CHECKING:
+    from analysis.tournament.store import Store
 
 __all__ = ["add_parsers", "format_cells", "shipped_specs"]
 
@@ -211,7 +215,8 @@ def _cmd_report(args: argparse.Namespace) -> int:
     out = args.out or str(store.with_name(store.stem + "_report"))
     writable_directory("--out", out)  # was "x: File exists" from the mkdir
     with Store(store, create=False) as db:
-        db.run(args.run)  # a bad store or run is refused before the announcement
+        run = db.run(args.run)  # a bad store or run is refused before the announcement
+        _warn_doubled(db, run["run_id"])
         regret = not args.no_regret
         _announce_report(out, not args.no_replays, regret)
         files = write_report(
@@ -238,7 +243,17 @@ def _cmd_export(args: argparse.Namespace) -> int:
                 "finish it)"
             )
         print(line)
+        _warn_doubled(db, run["run_id"])
     return 0
+
+
+def _warn_doubled(db: Store, run_id: str) -> None:
+    """Say on stderr that the run counts some starts twice (the report says it too)."""
+    from analysis.tournament.report import doubled_note
+
+    doubled = db.doubled(run_id)
+    if doubled:
+        _say(f"warning: {doubled_note(run_id, doubled)}")
 
 
 def _cmd_evaluate(args: argparse.Namespace) -> int:

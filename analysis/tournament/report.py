@@ -62,11 +62,24 @@ class Analysis:
     geometry: dict[str, Any] = field(default_factory=dict)  # map digest -> stored geometry
 
 
+def doubled_note(run_id: str, n: int) -> str:
+    """What ``n`` starts held twice (:meth:`Store.doubled`) do to a run's figures, and the
+    command that repairs it."""
+    return (
+        f"run {run_id} holds {n} start(s) twice (matches an older surveil identified "
+        "otherwise, added beside today's): its counts and intervals count them twice; run "
+        "its `surveil tournament` once more (its finished matches are reused, the older "
+        "ones set aside as a run of their own) before reading these figures"
+    )
+
+
 def analyse(store: Store | str | os.PathLike[str], run_id: str | None = None) -> Analysis:
     """Compute the statistics of a run (default: the store's latest)."""
     db = store if isinstance(store, Store) else Store(store, create=False)
     run = db.run(run_id)
     rows = db.rows(run["run_id"])
+    doubled = db.doubled(run["run_id"])
+    notes = [doubled_note(run["run_id"], doubled)] if doubled else []
     cells = st.cells(rows)
     matrices = st.payoff_matrices(cells)
     return Analysis(
@@ -78,6 +91,7 @@ def analyse(store: Store | str | os.PathLike[str], run_id: str | None = None) ->
         ratings=st.ratings(rows),
         paired=st.paired_comparisons(rows),
         errors=db.errors(run["run_id"]),
+        notes=notes,
         geometry={m["digest"]: db.map_geometry(m["digest"]) for m in _spec(run).get("maps", [])},
     )
 

@@ -548,6 +548,18 @@ class Store:
         return [dict(r) for r in self.conn.execute(sql, (run_id,))]
 
     @_guarded
+    def doubled(self, run_id: str) -> int:
+        """How many starts (map, variant, pairing, start kind, seed) ``run_id`` holds more
+        than one match of: a store whose run an older surveil extended with matches it
+        identified otherwise (every start then counted twice, until the spec's next
+        ``surveil tournament`` sets the old ones aside, :meth:`set_aside`)."""
+        sql = (
+            "SELECT COUNT(*) FROM (SELECT 1 FROM run_matches WHERE run_id = ? "
+            "GROUP BY map, variant, pursuer, evader, start, seed HAVING COUNT(*) > 1)"
+        )
+        return int(self.conn.execute(sql, (run_id,)).fetchone()[0])
+
+    @_guarded
     def errors(self, run_id: str) -> list[dict[str, Any]]:
         """The failures logged by ``run_id``, oldest first."""
         sql = "SELECT * FROM errors WHERE run_id = ? ORDER BY id"

@@ -541,6 +541,40 @@ def test_a_run_whose_matches_an_older_surveil_identified_otherwise_counts_each_o
         assert len(db.runs()) == 2
 
 
+def test_a_run_already_counted_twice_is_said_so_by_report_and_export(tmp_path, monkeypatch, capsys):
+    """The store data/store_identity_v1_same_run.sql left after a surveil without
+    set_aside (00d1beb .. db301a8) resumed it: today's 2 matches beside the old 2. Until
+    the spec's next tournament repairs it, its report and export counted every start
+    twice without a word; both now say so and name the repair."""
+    from importlib import resources
+
+    from analysis.cli import main
+    from analysis.tournament.report import analyse
+
+    store = tmp_path / "old.sqlite"
+    dump = resources.files("tests.analysis.tournament").joinpath(
+        "data", "store_identity_v1_same_run.sql"
+    )
+    with contextlib.closing(sqlite3.connect(store)) as c:
+        c.executescript(dump.read_text())
+    with monkeypatch.context() as m:  # the older driver: no set_aside
+        m.setattr(Store, "set_aside", lambda self, run_id, planned: None)
+        s = run_tournament(spec_from_dict(_OLD_SPEC), store, backend="serial", progress=False)
+    with Store(store) as db:
+        assert len(db.rows(s.run_id)) == 4 and db.doubled(s.run_id) == 2
+    (note,) = analyse(store, s.run_id).notes
+    assert f"run {s.run_id} holds 2 start(s) twice" in note and "surveil tournament" in note
+    assert main(["export", str(store), str(tmp_path / "rows.csv")]) == 0
+    assert "holds 2 start(s) twice" in capsys.readouterr().err
+    # the spec's next tournament repairs it, and nothing says it any more
+    run_tournament(spec_from_dict(_OLD_SPEC), store, backend="serial", progress=False)
+    with Store(store) as db:
+        assert db.doubled(s.run_id) == 0
+    assert analyse(store, s.run_id).notes == []
+    assert main(["export", str(store), str(tmp_path / "rows.csv")]) == 0
+    assert "twice" not in capsys.readouterr().err
+
+
 def test_an_older_run_from_another_checkout_is_said_so(tmp_path):
     """data/store_identity_v1_zoo.sql: 94c5063 played _OLD_SPEC's open_room with the zoo
     evader from a checkout in /tmp/h132-old (dumped as store_identity_v1.sql was): its

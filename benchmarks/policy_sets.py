@@ -94,7 +94,7 @@ FRESH_WORLDS = " ".join(
     for kind in ("convex", "rectangles", "star", "polygons")
     for seed in range(3001, 3009)
 )
-"""32 random maps nobody had used (README: "On 32 random maps nobody had used")."""
+"""32 random maps nobody had used (docs/ANALYTIC_RESULTS.md, fresh-p0)."""
 _HOLDS = "--seeds 8 --rho 0.5 --no-greedy"
 _HELDOUT_P = "--worlds @benchmarks/heldout_worlds_pursuer.txt"
 _BASE = "194babd"

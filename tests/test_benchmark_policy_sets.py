@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import importlib
 import json
+import re
 import shutil
 import signal
 from pathlib import Path
@@ -268,6 +269,22 @@ def test_each_set_is_the_command_readme_quotes(ps):
         quoted = " ".join(f'"{w}"' if " " in w else w for w in command)
         assert quoted in readme, quoted
     assert len(ps.FRESH_WORLDS.split()) == 32
+
+
+def test_readmes_table_of_sets_gives_each_set_s_figure(ps):
+    """README's table of the seventeen sets quotes each set's figure as this module holds it
+    (and the commit they were all measured at), so the two cannot drift apart."""
+    readme = (BENCHMARKS.parent / "README.md").read_text()
+    start = readme.index("| set | what it plays, and the command | wins |")
+    quoted = {}
+    for row in readme[start : readme.index("\n\n", start)].splitlines()[2:]:
+        cells = [cell.strip() for cell in row.strip().strip("|").split("|")]
+        names = re.findall(r"`([^`]+)`", cells[0])  # `unseen-p0`, `-p1`, `-p2`
+        names = [names[0].rsplit("-", 1)[0] + n if n.startswith("-") else n for n in names]
+        quoted.update(zip(names, (f.strip() for f in cells[-1].split(",")), strict=True))
+    assert quoted == {name: f"{s.won}/{s.episodes}" for name, s in ps.SETS.items()}
+    (measured,) = {s.measured for s in ps.SETS.values()}
+    assert f"The seventeen sets and their figures, all played at {measured}" in readme
 
 
 def test_run_says_which_script_failed_and_exits_non_zero(ps, tmp_path, capsys):

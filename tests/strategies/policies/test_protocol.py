@@ -154,12 +154,16 @@ def test_every_policy_class_is_registered_and_exercised():
     import strategies.policies.shooting as s
     from strategies.policies import BasePolicy, policy_spec
 
+    def home(obj, mod) -> bool:  # defined in the module, or in the package's modules
+        return obj.__module__ == mod.__name__ or obj.__module__.startswith(mod.__name__ + ".")
+
     classes = {
         obj
         for mod in (b, c, d, s)
         for _, obj in inspect.getmembers(mod, inspect.isclass)
-        if issubclass(obj, BasePolicy) and obj is not BasePolicy and obj.__module__ == mod.__name__
+        if issubclass(obj, BasePolicy) and obj is not BasePolicy and home(obj, mod)
     }
+    assert {cls.__name__ for cls in classes} >= {"DecompositionPursuer", "ShootingEvader"}
     registered = {policy_spec(n).factory for n in ALL}
     assert classes <= registered, classes - registered
     assert {n.split("/")[0] for n in ALL} == {"pursuer", "evader"}

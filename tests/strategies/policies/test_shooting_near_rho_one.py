@@ -8,14 +8,15 @@ import math
 
 import numpy as np
 
-from strategies.policies import make_policy, shooting
+from strategies.policies import make_policy
+from strategies.policies.shooting import arcs as shot_arcs
 from strategies.runner import run_episode
 
 
 def test_a_failed_arc_is_followed_straight_until_the_replan(monkeypatch):
     evader = make_policy("evader/shooting")
     calls: list[tuple[int, bool]] = []  # (decision, solved) of every arc solve
-    real = shooting.escape_path
+    real = shot_arcs.escape_path  # read by the shot's arc (_Arcs._start_arc)
 
     def counted(*args, **kwargs):
         path = real(*args, **kwargs)
@@ -27,7 +28,7 @@ def test_a_failed_arc_is_followed_straight_until_the_replan(monkeypatch):
     def on_step(_):
         arcs.append((evader._steps - 1, evader._arc))
 
-    monkeypatch.setattr(shooting, "escape_path", counted)
+    monkeypatch.setattr(shot_arcs, "escape_path", counted)
     r = run_episode(
         "corridor", "pursuer/greedy", evader, 0, start="safe", max_cycles=120,
         overrides={"v_evader": 0.95}, on_step=on_step,

@@ -117,6 +117,7 @@ def run(args: argparse.Namespace) -> int:
         InvalidConfigError,
         MemoryBudgetError,
         NarrowBandWarning,
+        NoStartError,
         SurveilValueError,
         VacuousBoundWarning,
     )
@@ -129,7 +130,6 @@ def run(args: argparse.Namespace) -> int:
         check_sample_size,
         check_solve_budget,
         check_start,
-        has_lattice_start,
     )
     from strategies.referee.spec import GameSpec, check_cells_per_lmin
     from strategies.runner import map_parameters
@@ -213,15 +213,9 @@ def run(args: argparse.Namespace) -> int:
                     pursuer_fallback=not args.no_pursuer_fallback,
                     evader_fallback=not args.no_evader_fallback,
                 )
-        except InvalidConfigError:  # a lattice with no point at all: "refine the resolution"
-            spec = GameSpec.from_config(cfg)  # (finer ones can hold none either)
-            if has_lattice_start(spec, args.cells_per_lmin, dt=cfg.dt):
-                raise
-            raise InvalidConfigError(_no_starts(spec, args.cells_per_lmin, cfg.dt)) from None
+        except NoStartError as exc:  # nothing to report, classify or sample: the message
+            raise exc.named("--cells-per-lmin") from None  # names a resolution with a start
     s = ref.summary()
-    if s["starts"] == 0:  # nothing to report, classify or sample: say what resolution has some
-        spacings = (ref.pursuer.lattice.spacing, ref.evader.lattice.spacing)
-        raise InvalidConfigError(_no_starts(ref.spec, args.cells_per_lmin, cfg.dt, spacings))
     print(
         f"{world.name}: rho = {cfg.rho:g}, L in [{cfg.l_min:g}, {cfg.l_max:g}], "
         f"{args.cells_per_lmin:g} cells per L_min ({time.perf_counter() - t:.1f} s)"
@@ -341,40 +335,6 @@ def _say_if_long(cfg, args: argparse.Namespace) -> None:
         f"{duration(seconds)}{more} (an upper bound, estimated before the solve){why}",
         file=sys.stderr,
         flush=True,
-    )
-
-
-def _no_starts(spec, cpl: float, dt: float, spacings: tuple[float, float] | None = None) -> str:
-    """Why a referee with no lattice start is refused, and the next finer resolution with
-    one (where a map's passages are about as narrow as its agents, one resolution's lattice
-    can miss them where a neighbour's does not), else the coarsest."""
-    from strategies.referee.referee import (
-        COARSEST_SCAN_LIMIT,
-        coarsest_with_starts,
-        finer_with_starts,
-    )
-
-    fit = coarsest_with_starts(spec, dt=dt)  # cheap: the first coarse lattices hold one
-    finer = finer_with_starts(spec, cpl, dt=dt) if fit is not None and cpl > fit else None
-    if finer is not None:
-        advice = (
-            f"the next finer resolution with one is --cells-per-lmin {finer:.3g} (a lattice "
-            "can miss passages about as narrow as the agents where a neighbour's does not)"
-        )
-    elif fit is not None:
-        advice = (
-            f"the coarsest resolution with one is --cells-per-lmin {fit:.3g} (scanning up from "
-            f"L_min / L_max = {spec.l_min / spec.l_max:.3g}; the default is 16)"
-        )
-    else:
-        advice = f"no resolution up to {COARSEST_SCAN_LIMIT:g} cells per L_min has one"
-    lattices = "the referee's lattices"
-    if spacings is not None:
-        lattices += f" (spacings {spacings[0]:.4g} and {spacings[1]:.4g})"
-    return (
-        f"--cells-per-lmin = {cpl:g}: {lattices} hold no start with the players in range "
-        f"[{spec.l_min:g}, {spec.l_max:g}], body_radius = {spec.body_radius:g} from the walls "
-        f"and in sight on map {spec.map.name!r}, so there is nothing to certify; {advice}"
     )
 
 

@@ -21,6 +21,7 @@ __all__ = [
     "LongRunWarning",
     "MemoryBudgetError",
     "NarrowBandWarning",
+    "NoStartError",
     "RelaxedStartWarning",
     "RhoAboveOneWarning",
     "SurveilValueError",
@@ -113,6 +114,34 @@ class MemoryBudgetError(InfeasibleError):
         return type(self)(
             template, k if knob is None else knob, b if budget is None else budget, size
         )
+
+
+class NoStartError(InvalidConfigError):
+    """A referee resolution whose lattices hold no start (no lattice point clear of the
+    walls, or no pair of them in range and in sight): a solve there would certify nothing,
+    so it is refused rather than returned empty.
+
+    As in :class:`MemoryBudgetError`, the message names the resolution's knob by the name
+    of the function that refused (``cells_per_lmin``); a command line or a policy that
+    sets it under another name re-raises :meth:`named` with its own.
+
+    Args:
+        template: the message, with :data:`KNOB` where the knob's name goes.
+        knob: the knob's name.
+    """
+
+    KNOB = "\x00knob\x00"
+
+    def __init__(self, template: str, knob: str = "cells_per_lmin"):
+        super().__init__(template, knob)  # pickles (pool workers) by its args
+
+    def __str__(self) -> str:
+        template, knob = self.args
+        return template.replace(self.KNOB, knob)
+
+    def named(self, knob: str) -> NoStartError:
+        """The same error with the knob named as the caller's user sets it."""
+        return type(self)(self.args[0], knob)
 
 
 class UnknownNameError(SurveilValueError, KeyError):

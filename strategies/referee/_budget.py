@@ -90,6 +90,22 @@ KEPT_BYTES_PER_STATE = {"pursuer": 3.0, "evader": 7.0, "estimate": 4.0}
 """What a solved bound or estimate solution keeps: win (1) and choice (2); win, rank (4)
 and choice; safe, both orders' wins and the rank (1 each)."""
 
+MOVE_TABLE_BYTES_PER_POINT_MOVE = 70.0
+MOVE_TABLE_SECONDS_PER_POINT_MOVE = 1e-5
+"""The certified player's move table (:meth:`~.lattice.Lattice.moves`, both bounds):
+each point's destination per move (two int64), its index (int64), the mask and the
+tested paths' ends (float64), each path's clearance from the walls. Measured on an 8 x 8
+room with a pillar, 504 points: 66 bytes and 7.8 us a point-move at 7213 moves, 9-12 us
+at 49-797. The pursuer bound's per-state-move tables (``PURSUER_BYTES_PER_STATE_MOVE``)
+cover it; the evader bound's per-state arrays do not grow with its moves, so a long
+evader step (``evader_steps = 1e4``: 3e8 moves) hung in the table, estimated at a few MB."""
+
+COUNT_LIMIT = 1e30
+"""Counts of the estimate (points, window cells, moves) are clamped here, far beyond any
+memory: an absurd resolution (cells of 1e-300 m, a step of 1e300 s, L_max = 1e200) is
+estimated, and refused for its memory, instead of an OverflowError or a
+ZeroDivisionError from the arithmetic."""
+
 SECONDS_PER_STATE = {"pursuer": 2e-5, "evader": 4e-7, "estimate": 2.5e-5}
 """Build plus fixed point on one busy core, the most measured (the fixed points' sweeps
 depend on the game: the pursuer bound took 0.65 us a state on the 16 x 10 room at 16
@@ -142,8 +158,9 @@ class SolveSize:
 
     def describe(self) -> str:
         """``"pursuer bound: 27,641 points x 69^2 window cells = 132 M states"``."""
+        big = lambda n: f"{n:,}" if n < 1e12 else f"{n:.3g}"  # not 40 digits
         return (
-            f"{self.what}: {self.points:,} points x {self.window}^2 window cells = "
+            f"{self.what}: {big(self.points)} points x {big(self.window)}^2 window cells = "
             f"{self.states / 1e6:.3g} M states"
         )
 
@@ -156,7 +173,27 @@ def _points(spec: GameSpec, spacing: float) -> int:
     region = spec.map.free_region.buffer(-spec.body_radius)
     if region.is_empty:
         return 0
-    return math.ceil(region.area / spacing**2 + region.length / (2.0 * spacing)) + 1
+    return _count(region.area / spacing / spacing + region.length / (2.0 * spacing)) + 1
+
+
+def _count(x: float) -> int:
+    """``ceil(x)``, at most :data:`COUNT_LIMIT` (an overflowed ``inf`` included)."""
+    return math.ceil(min(x, COUNT_LIMIT))
+
+
+def _window(reach: float, h: float) -> int:
+    """``2 window_half_width(reach, h) + 1``, at most about ``2 COUNT_LIMIT``."""
+    if reach / h > COUNT_LIMIT:
+        return 2 * _count(COUNT_LIMIT) + 1
+    return 2 * window_half_width(reach, h) + 1
+
+
+def _moves(length: float, spacing: float) -> int:
+    """:func:`~.lattice.count_lattice_vectors`, at most :data:`COUNT_LIMIT`."""
+    r = length / spacing
+    if r > 1e15:  # the disc's area (count_lattice_vectors' own beyond 1e5), clamped
+        return _count(math.pi * r * r)
+    return count_lattice_vectors(length, spacing)
 
 
 def _cells(spec: GameSpec, h: float) -> int:
@@ -168,10 +205,11 @@ def bound_size(spec: GameSpec, res: Resolution, role: str) -> SolveSize:
     """The size of :func:`~strategies.referee.pursuer_bound.solve_pursuer_bound`
     (``role="pursuer"``) or :func:`~strategies.referee.evader_bound.solve_evader_bound`."""
     points = _points(spec, res.spacing)
-    W = 2 * window_half_width(spec.l_max, res.cell) + 1
-    moves = count_lattice_vectors(spec.speed(role) * res.tau, res.spacing)
+    W = _window(spec.l_max, res.cell)
+    moves = _moves(spec.speed(role) * res.tau, res.spacing)
     states = points * W * W
     seconds = SECONDS_PER_STATE[role] * states
+    table = 0.0  # the move table, where the per-state figures do not cover it
     if role == "pursuer":
         per = PURSUER_BYTES_PER_STATE + PURSUER_BYTES_PER_STATE_MOVE * moves
         tables = PURSUER_SECONDS_PER_STATE_MOVE * states * moves**PURSUER_MOVES_POWER
@@ -180,13 +218,15 @@ def bound_size(spec: GameSpec, res: Resolution, role: str) -> SolveSize:
         per = EVADER_BYTES_PER_STATE
         if spec.map.vertex_convex.any():
             per += EVADER_OCCLUSION_BYTES_PER_STATE
+        table = MOVE_TABLE_BYTES_PER_POINT_MOVE * points * moves
+        seconds += MOVE_TABLE_SECONDS_PER_POINT_MOVE * points * moves
     return SolveSize(
         what=f"{role} bound",
         kind=role,
         points=points,
         window=W,
         moves=moves,
-        bytes=BASE_BYTES + per * states,
+        bytes=BASE_BYTES + per * states + table,
         kept=KEPT_BYTES_PER_STATE[role] * states,
         seconds=seconds,
         tau=res.tau,
@@ -203,7 +243,7 @@ def estimate_size(spec: GameSpec, cpl: float, steps: float, headings: int) -> So
     ve = heading_moves(spec.v_evader * res.tau, h, headings)
     reach = h * (max(math.hypot(*v) for v in vp) + max(math.hypot(*v) for v in ve))
     points = _points(spec, h)
-    W = 2 * window_half_width(spec.l_max + reach, h) + 1
+    W = _window(spec.l_max + reach, h)
     moves = len(vp) + len(ve)
     states = points * W * W
     per = ESTIMATE_BYTES_PER_STATE + ESTIMATE_BYTES_PER_STATE_MOVE * moves

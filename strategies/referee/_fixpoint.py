@@ -44,7 +44,9 @@ def reach_rectangles(
         >>> reach_rectangles(1.0, 1.0)
         [(1, 2), (2, 1)]
     """
-    r = reach / h
+    # a reach beyond any window (whose side the memory budget keeps far below 1e15 cells)
+    # covers it whatever its length: capped, so r * r stays finite (rho = 2e-301 overflowed)
+    r = min(reach / h, 1e15)
     K = math.floor(r + 1e-9)
 
     def width(k: int) -> int:

@@ -28,7 +28,7 @@ import numpy as np
 import shapely
 from numpy.lib.stride_tricks import sliding_window_view
 
-from envs.errors import InvalidConfigError
+from envs.errors import InvalidConfigError, NoStartError
 from envs.geometry.segments import segment_distance
 from strategies.referee.spec import GameSpec, Resolution
 
@@ -285,7 +285,7 @@ class Lattice:
         self.points = pts[keep]
         self.point_cells = idx[keep]
         if len(self.points) == 0:
-            raise InvalidConfigError(
+            raise NoStartError(
                 f"no lattice point of spacing {self.spacing:g} lies {self.spec.body_radius:g} "
                 f"from the walls of map {self.spec.map.name!r}; try another resolution (the "
                 "lattices are not nested: where passages are about as narrow as the agents, "

@@ -15,7 +15,9 @@ pursuer) and records that it did, in ``uncertified_steps``.
 Built without a bound (``make_policy("evader/referee", cells_per_lmin=16)``), a policy
 solves the bound it plays at reset, at that resolution and with its ``tau`` a whole number
 of env steps (:func:`strategies.referee.referee.solve_role`; cached on disk, so only the
-first episode on a world pays).
+first episode on a world pays). Where its lattice misses a map's narrow passages, reset
+raises :class:`~envs.errors.NoStartError` naming the policy, the map and the next
+``cells_per_lmin`` whose lattices hold a start.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ import math
 
 import numpy as np
 
-from envs.errors import InvalidConfigError, MemoryBudgetError
+from envs.errors import InvalidConfigError, MemoryBudgetError, NoStartError
 from strategies.policies.base import BasePolicy, Snapshot, unit
 from strategies.referee.evader_bound import EvaderBound
 from strategies.referee.pursuer_bound import PursuerBound
@@ -50,7 +52,9 @@ def env_steps_per_referee_step(tau: float, dt: float) -> int:
 
 _SOLVED: dict = {}
 """The bounds solved in this process, by (game, resolution, dt, role): episodes on the
-same world reuse them instead of reloading the disk cache at every reset."""
+same world reuse them instead of reloading the disk cache at every reset. A resolution
+whose lattice has no point keeps its :class:`~envs.errors.NoStartError`, so the next
+episodes are refused at once (a tournament records each as an error)."""
 
 
 def _solved(config, cells_per_lmin: float, role: str):
@@ -63,10 +67,15 @@ def _solved(config, cells_per_lmin: float, role: str):
     key = (spec, float(cells_per_lmin), float(config.dt), role)
     bound = _SOLVED.get(key)
     if bound is None:
-        bound = solve_role(spec, role, cells_per_lmin, dt=config.dt)
+        try:
+            bound = solve_role(spec, role, cells_per_lmin, dt=config.dt)
+        except NoStartError as exc:
+            bound = exc
         if len(_SOLVED) >= 8:
             _SOLVED.pop(next(iter(_SOLVED)))
         _SOLVED[key] = bound
+    if isinstance(bound, NoStartError):
+        raise NoStartError(*bound.args)
     return bound
 
 
@@ -96,8 +105,13 @@ class _RefereePolicy(BasePolicy):
         cfg = self.config
         if self._solve:
             # a policy has no memory_budget argument; its users set cells_per_lmin
-            with MemoryBudgetError.naming(f"{self.name!r} with cells_per_lmin"):
-                self.bound = _solved(cfg, self.cells_per_lmin, self.role_name)
+            try:
+                with MemoryBudgetError.naming(f"{self.name!r} with cells_per_lmin"):
+                    self.bound = _solved(cfg, self.cells_per_lmin, self.role_name)
+            except NoStartError as exc:  # a map whose passages its lattice misses: it said
+                # "no lattice point ... of map 'ring'; try another resolution", naming no
+                # policy, parameter or resolution
+                raise NoStartError(f"policy {self.name!r}: {exc.args[0]}", *exc.args[1:]) from None
         spec = self.bound.spec
         for attr in ("l_min", "l_max", "v_pursuer", "v_evader"):
             if not math.isclose(getattr(cfg, attr), getattr(spec, attr), rel_tol=1e-12):

@@ -28,6 +28,7 @@ from envs.errors import (
     InvalidConfigError,
     InvalidPlacementError,
     MemoryBudgetError,
+    NoStartError,
     VacuousBoundWarning,
 )
 from envs.geometry import kernel_for
@@ -276,6 +277,10 @@ class Referee:
                 )
         return StartSet(P[pi], E[ei], label.astype(str), steps)
 
+    def has_lattice_start(self) -> bool:
+        """Whether :meth:`lattice_starts` (margin 0) holds a start, without listing them."""
+        return _any_start(self.spec, self.pursuer.lattice.points, self.evader.lattice.points)
+
     def sample_starts(
         self,
         n: int,
@@ -299,12 +304,18 @@ class Referee:
             margin: keep the start's distance this far inside [l_min, l_max].
 
         Raises:
-            InvalidConfigError: bad ``kind`` or ``n``, or no start of that kind exists.
+            InvalidConfigError: bad ``kind``, ``n`` or ``rng``, or no start of that kind
+                exists.
             MemoryBudgetError: ``n`` starts would not fit in the memory budget
                 (:func:`check_sample_size`).
         """
         n = check_sample_size(n)
         kind = V.choice("kind", kind, LABELS)
+        if not isinstance(rng, np.random.Generator):  # None was an AttributeError, after
+            raise InvalidConfigError(  # enumerating every lattice start
+                f"sample_starts: rng = {V.shown(rng)}: expected a numpy.random.Generator "
+                f"(np.random.default_rng(seed)), got {type(rng).__name__}"
+            )
         starts = self.lattice_starts(margin=margin)
         idx = np.flatnonzero(starts.label == kind)
         if len(idx) == 0:
@@ -517,6 +528,10 @@ def solve(
     Raises:
         InfeasibleError: the estimated peak exceeds the budget; the message gives the
             estimate (memory, states, time) and the ``cells_per_lmin`` that would fit.
+        NoStartError: the two lattices hold no start (no pair of points in range and in
+            sight, e.g. cells longer than L_max, or a lattice that misses a narrow
+            passage), so there is nothing to certify; the message names the next finer
+            resolution with one, else the coarsest.
 
     Warns:
         VacuousBoundWarning: the pursuer bound's wins say nothing about the game
@@ -531,16 +546,24 @@ def solve(
                  pursuer_steps=pursuer_steps, evader_steps=evader_steps,
                  sweep_pieces=sweep_pieces, dt=dt)  # fmt: skip
 
+    if cells_per_lmin < spec.l_min / spec.l_max:  # cells longer than L_max: no start
+        raise _no_start(spec, cells_per_lmin, knobs)  # (cells_per_lmin = 1e-300 overflowed)
     budget = check_solve_budget(spec, cells_per_lmin, memory_budget=memory_budget, **knobs)
     rp = _resolution(spec, "pursuer", cells_per_lmin, **knobs)
     re = _resolution(spec, "evader", cells_per_lmin, **knobs)
     kw = dict(cache=cache, cache_dir=cache_dir, progress=progress, memory_budget=budget)
-    pursuer, tried = _pursuer_bound(
-        spec, rp, cells_per_lmin, knobs, kw, pursuer_fallback, [bound_size(spec, re, "evader")]
-    )
-    before = [bound_size(spec, pursuer.res, "pursuer")]
-    evader = _evader_bound(spec, re, cells_per_lmin, knobs, kw, evader_fallback, before)
+    try:
+        pursuer, tried = _pursuer_bound(
+            spec, rp, cells_per_lmin, knobs, kw, pursuer_fallback, [bound_size(spec, re, "evader")]
+        )
+        before = [bound_size(spec, pursuer.res, "pursuer")]
+        evader = _evader_bound(spec, re, cells_per_lmin, knobs, kw, evader_fallback, before)
+    except NoStartError:  # a lattice with no point at all
+        raise _no_start(spec, cells_per_lmin, knobs) from None
     ref = Referee(spec=spec, pursuer=pursuer, evader=evader)
+    if not ref.has_lattice_start():  # it returned 0 starts, "gap 0.0", without a word
+        spacings = (pursuer.lattice.spacing, evader.lattice.spacing)
+        raise _no_start(spec, cells_per_lmin, knobs, spacings)
     _warn_vacuous(spec, pursuer, tried)
     return ref
 
@@ -673,7 +696,10 @@ def _evader_bound(spec, res, cpl, knobs, kw, fallback, before=()):
         check_budget("the evader bound's fallback", sizes, kw["memory_budget"])
     except MemoryBudgetError:  # the default stands, as without the fallback
         return bound
-    other = cached_evader_bound(spec, alt, **kw)
+    try:
+        other = cached_evader_bound(spec, alt, **kw)
+    except NoStartError:  # the finer lattice misses a narrow passage: the default stands
+        return bound
     if other.live_fraction() <= bound.live_fraction():
         return bound
     return replace(other, fallback_from=bound.res)
@@ -697,7 +723,10 @@ def _pursuer_bound(spec, res, cpl, knobs, kw, fallback, after=()):
                      kw["memory_budget"])  # fmt: skip
     except MemoryBudgetError:  # the default's 0 % stands, as without the fallback
         return bound, (alt, "its solve would exceed the memory budget")
-    other = cached_pursuer_bound(spec, alt, **kw)
+    try:
+        other = cached_pursuer_bound(spec, alt, **kw)
+    except NoStartError:  # the finer lattice misses a narrow passage
+        return bound, (alt, "it has no lattice point")
     if not other.win.any():
         return bound, (alt, "it certified no state either")
     return replace(other, fallback_from=bound.res), None
@@ -730,7 +759,8 @@ def _resolution(
 ) -> Resolution:
     """The resolution of ``role``'s bound in :func:`solve` (its docstring says why)."""
     # at least four lattice spacings across the sensor range [l_min, l_max]
-    cap = max(2, math.floor((spec.l_max - spec.l_min) * cpl / (4.0 * spec.l_min)))
+    # (capped at 12 before the floor: L_max = 1e300 at 1e12 cells per L_min is an inf)
+    cap = max(2, math.floor(min(12.0, (spec.l_max - spec.l_min) * cpl / (4.0 * spec.l_min))))
     if role == "pursuer":
         coarse = pursuer_coarse
         if coarse is None:
@@ -851,10 +881,67 @@ def _lattice_has_start(spec: GameSpec, cpl: float, dt: float | None, knobs) -> b
     try:
         P = Lattice(spec, _resolution(spec, "pursuer", cpl, dt=dt, **knobs), "pursuer").points
         E = Lattice(spec, _resolution(spec, "evader", cpl, dt=dt, **knobs), "evader").points
-    except InvalidConfigError:  # no lattice point at all
+    except NoStartError:  # no lattice point at all
         return False
-    pi, ei = _pairs_in_range(P, E, spec.l_min, spec.l_max)
-    return bool(len(pi)) and bool(kernel_for(spec.map).line_of_sight_many(P[pi], E[ei]).any())
+    return _any_start(spec, P, E)
+
+
+def _any_start(spec: GameSpec, P: np.ndarray, E: np.ndarray, chunk: int = 256) -> bool:
+    """Whether some pair ``(P[i], E[j])`` is in range and in sight: the pairs of
+    :meth:`Referee.lattice_starts`, ``chunk`` pursuer points at a time, stopping at the
+    first (the built-in maps' first chunk holds one)."""
+    ker = kernel_for(spec.map)
+    for k in range(0, len(P), chunk):
+        part = P[k : k + chunk]
+        pi, ei = _pairs_in_range(part, E, spec.l_min, spec.l_max)
+        if len(pi) and ker.line_of_sight_many(part[pi], E[ei]).any():
+            return True
+    return False
+
+
+def _no_start(
+    spec: GameSpec,
+    cpl: float,
+    knobs: Mapping[str, Any],
+    spacings: tuple[float, float] | None = None,
+) -> NoStartError:
+    """Why a resolution with no lattice start is refused, and the next finer resolution
+    with one (where a map's passages are about as narrow as its agents, one resolution's
+    lattice can miss them where a neighbour's does not), else the coarsest. ``knobs`` are
+    :func:`solve`'s (``dt`` among them)."""
+    K = NoStartError.KNOB
+    scan = {k: v for k, v in knobs.items() if k != "dt"}
+    dt = knobs.get("dt")
+    fit = coarsest_with_starts(spec, dt=dt, **scan)  # cheap: the first coarse lattices hold one
+    finer = finer_with_starts(spec, cpl, dt=dt, **scan) if fit is not None and cpl > fit else None
+
+    def shown(found: float) -> str:  # short, and a resolution with a start as printed
+        for digits in (3, 4, 6):
+            text = f"{found:.{digits}g}"
+            if _lattice_has_start(spec, float(text), dt, scan):
+                return text
+        return repr(found)
+
+    if finer is not None:
+        advice = (
+            f"the next finer resolution with one is {K} {shown(finer)} (a lattice can miss "
+            "passages about as narrow as the agents where a neighbour's does not)"
+        )
+    elif fit is not None:
+        advice = (
+            f"the coarsest resolution with one is {K} {shown(fit)} (scanning up from "
+            f"L_min / L_max = {spec.l_min / spec.l_max:.3g})"
+        )
+    else:
+        advice = f"no resolution up to {COARSEST_SCAN_LIMIT:g} cells per L_min has one"
+    lattices = "the referee's lattices"
+    if spacings is not None:
+        lattices += f" (spacings {spacings[0]:.4g} and {spacings[1]:.4g})"
+    return NoStartError(
+        f"{K} = {cpl:g}: {lattices} hold no start with the players in range "
+        f"[{spec.l_min:g}, {spec.l_max:g}], body_radius = {spec.body_radius:g} from the walls "
+        f"and in sight on map {spec.map.name!r}, so there is nothing to certify; {advice}"
+    )
 
 
 def coarsest_with_starts(spec: GameSpec, *, dt: float | None = None, **knobs: Any) -> float | None:
@@ -937,6 +1024,8 @@ def solve_role(
     Raises:
         MemoryBudgetError: the solve's estimated peak exceeds the budget (naming the
             ``cells_per_lmin`` that fits).
+        NoStartError: the bound's lattice has no point clear of the walls (naming a
+            resolution whose lattices hold a start, as :func:`solve`).
 
     Warns:
         VacuousBoundWarning: as :func:`solve`, for the pursuer bound.
@@ -962,11 +1051,16 @@ def solve_role(
     )
     res = _resolution(spec, role, cells_per_lmin, dt=dt, **knobs)
     kw = dict(cache=cache, cache_dir=cache_dir, progress=progress, memory_budget=budget)
-    if role == "evader":
-        return _evader_bound(spec, res, cells_per_lmin, {**knobs, "dt": dt}, kw, evader_fallback)
-    bound, tried = _pursuer_bound(
-        spec, res, cells_per_lmin, {**knobs, "dt": dt}, kw, pursuer_fallback
-    )
+    try:
+        if role == "evader":
+            return _evader_bound(
+                spec, res, cells_per_lmin, {**knobs, "dt": dt}, kw, evader_fallback
+            )
+        bound, tried = _pursuer_bound(
+            spec, res, cells_per_lmin, {**knobs, "dt": dt}, kw, pursuer_fallback
+        )
+    except NoStartError:  # its lattice has no point: say which resolution has a start
+        raise _no_start(spec, cells_per_lmin, {**knobs, "dt": dt}) from None
     _warn_vacuous(spec, bound, tried)
     return bound
 
@@ -1027,9 +1121,14 @@ def label_starts(
         **solve_kwargs: for :func:`referee_for` (``cells_per_lmin``, ``cache_dir``...).
 
     Raises:
-        InvalidConfigError: a start is not such a mapping.
+        InvalidConfigError: ``starts`` is not an iterable of such mappings.
         InvalidPlacementError: surveillance does not hold at a start.
     """
+    if isinstance(starts, Mapping) or not isinstance(starts, Iterable):
+        raise InvalidConfigError(  # None was a TypeError; one start, "start 0 = 'pursuer'"
+            f"label_starts: starts = {V.shown(starts)}: expected an iterable of "
+            "{'pursuer': (x, y), 'evader': (x, y)} (a list of them)"
+        )
     ref = _as_referee(referee, solve_kwargs)
     out = []
     for i, s in enumerate(starts):

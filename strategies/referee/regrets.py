@@ -39,6 +39,7 @@ from envs.errors import (
     InvalidConfigError,
     InvalidPlacementError,
     MemoryBudgetError,
+    NoStartError,
     VacuousBoundWarning,
 )
 from envs.maps import Map
@@ -124,7 +125,9 @@ def regret(
             "evader": (x, y)}``) and ``winner`` (``"pursuer"`` or ``"evader"``).
         cells_per_lmin: resolution of the referees (one per game, solved or loaded from
             the cache).
-        referees: a dict to reuse referees across calls (filled in place), keyed by game.
+        referees: a dict to reuse referees across calls (filled in place), keyed by game;
+            None for a game whose lattices hold no start at ``cells_per_lmin``
+            (:class:`~envs.errors.NoStartError`): its matches count as unknown.
         cache: use the referees' on-disk cache.
         cache_dir: its directory.
         progress: a bar over the games to solve on standard error: shown (``True``),
@@ -162,9 +165,12 @@ def regret(
     with bar:
         for key, (world, params) in games.items():
             spec = _spec(world, params)
-            referees[key] = solve(
-                spec, cells_per_lmin, dt=params["dt"], cache=cache, cache_dir=cache_dir
-            )
+            try:
+                referees[key] = solve(
+                    spec, cells_per_lmin, dt=params["dt"], cache=cache, cache_dir=cache_dir
+                )
+            except NoStartError:  # its lattices miss the map's passages: it certifies nothing
+                referees[key] = None
             bar.update()
     tally: dict[tuple[str, str], list[int]] = {}
     for (world, params, start, winner, horizon), m in read:
@@ -230,7 +236,9 @@ def _read_match(m: Mapping[str, Any], where: str):
     return world, params, start, winner, horizon
 
 
-def _label(ref: Referee, start) -> tuple[str, float]:
+def _label(ref: Referee | None, start) -> tuple[str, float]:
+    if ref is None:  # no lattice start at this resolution (NoStartError): nothing certified
+        return "unknown", math.inf
     try:
         label = ref.classify(start["pursuer"], start["evader"])
     except InvalidPlacementError:

@@ -73,9 +73,10 @@ class GameSpec:
         l_max: L_max > l_min.
         v_pursuer: V_p > 0.
         v_evader: V_e > 0 (rho = V_e / V_p).
-        body_radius: clearance (> 0) the *certified* player keeps from every wall on its
+        body_radius: clearance the *certified* player keeps from every wall on its
             lattice points and along its moves: the env's disc radius, so a referee policy
-            never touches a wall and moves exactly as planned.
+            never touches a wall and moves exactly as planned. In (0, l_min / 2), as the
+            env's: the two discs must not overlap at L_min.
         opponent_clearance: the opponent is assumed to stay at least this far (> 0) from
             the walls; ``None`` means ``body_radius / 2``, what the env's physics
             guarantees for a disc of ``body_radius`` pressed against a wall (a substep
@@ -105,6 +106,12 @@ class GameSpec:
         put("v_pursuer", V.positive("v_pursuer", self.v_pursuer, where=w))
         put("v_evader", V.positive("v_evader", self.v_evader, where=w))
         put("body_radius", V.positive("body_radius", self.body_radius, where=w))
+        if self.body_radius >= 0.5 * self.l_min:  # as EnvConfig refuses it
+            raise InvalidConfigError(
+                f"{w + ': ' if w else ''}body_radius = {self.body_radius!r}: expected a value "
+                f"in (0, l_min / 2 = {0.5 * self.l_min!r}) (two bodies of that radius "
+                "overlap at L_min)"
+            )
         if self.opponent_clearance is None:
             put("opponent_clearance", 0.5 * self.body_radius)
         else:

@@ -6,7 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from envs.errors import InvalidConfigError, InvalidPlacementError, MemoryBudgetError
+from envs.errors import (
+    InvalidConfigError,
+    InvalidPlacementError,
+    MemoryBudgetError,
+    NoStartError,
+)
 from envs.geometry import kernel_for
 from envs.surveillance.config import EnvConfig
 from strategies.referee import (
@@ -207,4 +212,5 @@ def test_coarsest_with_starts_is_where_the_lattice_starts_begin(l_max):
     fit = coarsest_with_starts(game, dt=cfg.dt)
     assert 2 * 2.0 / l_max <= fit < 2 * 2.0 / l_max * COARSEST_SCAN_STEP
     assert len(referee_for(cfg, fit, cache=False).lattice_starts()) > 0
-    assert len(referee_for(cfg, fit / COARSEST_SCAN_STEP, cache=False).lattice_starts()) == 0
+    with pytest.raises(NoStartError, match="hold no start"):  # was a referee with 0 starts
+        referee_for(cfg, fit / COARSEST_SCAN_STEP, cache=False)

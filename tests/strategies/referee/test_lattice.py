@@ -235,7 +235,7 @@ def test_too_fine_or_empty_lattices_are_refused():
     # "refine the resolution": a finer lattice can miss a narrow passage too
     with pytest.raises(InvalidConfigError, match=r"no lattice point .* try another resolution"):
         Lattice(
-            type(narrow)(narrow.map, 1.0, 2.0, body_radius=2.4),
+            type(narrow)(narrow.map, 5.0, 10.0, body_radius=2.4),
             Resolution(cell=0.5, coarse=3),
             "pursuer",
         )

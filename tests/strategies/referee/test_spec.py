@@ -23,6 +23,9 @@ from tests.strategies.referee.conftest import open_room
         ({"v_evader": math.nan}, "v_evader = nan"),
         ({"v_pursuer": 0}, "v_pursuer = 0"),
         ({"body_radius": 0.0}, "body_radius = 0.0"),
+        # the two bodies overlap at L_min: accepted, and solved, before
+        ({"body_radius": 0.5}, r"body_radius = 0.5: expected a value in \(0, l_min / 2 = 0.5\)"),
+        ({"body_radius": 0.6}, r"body_radius = 0.6: expected .* overlap at L_min"),
         ({"opponent_clearance": -0.1}, "opponent_clearance = -0.1"),
     ],
 )

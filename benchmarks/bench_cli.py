@@ -173,6 +173,9 @@ def worker_pool(
     stop during that wait, terminates them first. The workers' progress bars lock within
     each worker (:func:`_start_worker`), so a terminated worker leaks no semaphore.
     """
+    from analysis.tournament.executors import warn_if_oversubscribed
+
+    warn_if_oversubscribed(processes, stacklevel=2)  # --workers 1000: said, then played
     old = signal.signal(signal.SIGINT, signal.SIG_IGN)
     try:
         pool = mp.get_context("spawn").Pool(processes, _start_worker, (initializer, initargs))

@@ -22,6 +22,7 @@ __all__ = [
     "MemoryBudgetError",
     "NarrowBandWarning",
     "NoStartError",
+    "OversubscribedWarning",
     "RelaxedStartWarning",
     "RhoAboveOneWarning",
     "SurveilValueError",
@@ -161,6 +162,11 @@ class NarrowBandWarning(UserWarning):
     move ``V_e dt`` toward or away from the pursuer whatever the pursuer does; the two
     distances that leaves differ by ``2 V_e dt``, more than the band holds, so one of them
     is outside it."""
+
+
+class OversubscribedWarning(UserWarning):
+    """More worker processes asked for than the CPUs can run (``--workers 1000`` on two
+    cores): legal, and played as asked, but no faster than one a CPU and heavier."""
 
 
 class RelaxedStartWarning(UserWarning):

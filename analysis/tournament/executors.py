@@ -54,8 +54,10 @@ __all__ = [
     "ProcessExecutor",
     "RayExecutor",
     "SerialExecutor",
+    "available_cpus",
     "check_backend",
     "make_executor",
+    "warn_if_oversubscribed",
 ]
 
 BACKENDS = ("serial", "process", "ray")
@@ -278,11 +280,11 @@ class ProcessExecutor(Executor):
         kill_grace: float = KILL_GRACE,
     ) -> None:
         if workers is None:
-            affinity = getattr(os, "sched_getaffinity", None)
-            workers = len(affinity(0)) if affinity else (os.cpu_count() or 1)
+            workers = available_cpus()
         from envs.validation import integer
 
         self.workers = integer("workers", workers, minimum=1)
+        warn_if_oversubscribed(self.workers)
         if start_method is None:
             start_method = "fork" if "fork" in mp.get_all_start_methods() else "spawn"
         self.mpctx = mp.get_context(start_method)
@@ -529,6 +531,8 @@ class RayExecutor(Executor):
             # 0 CPUs: no task was ever scheduled, and each batch was stored as an error
             # ("overran the time limit") after time_limit + 6 s
             num_cpus = integer("workers", num_cpus, minimum=1)
+            if address is None:  # a local instance runs up to num_cpus worker processes
+                warn_if_oversubscribed(num_cpus)
         try:
             import ray
         except ModuleNotFoundError as exc:
@@ -698,6 +702,36 @@ class RayExecutor(Executor):
             with contextlib.suppress(Exception):
                 self.ray.shutdown()
             self.started = False
+
+
+OVERSUBSCRIBED = 2
+"""Workers above this many times :func:`available_cpus` are said to be too many."""
+
+
+def available_cpus() -> int:
+    """The CPUs this process may run on (its affinity), else ``os.cpu_count()``."""
+    affinity = getattr(os, "sched_getaffinity", None)
+    return len(affinity(0)) if affinity else (os.cpu_count() or 1)
+
+
+def warn_if_oversubscribed(workers: int, name: str = "workers", stacklevel: int = 3) -> None:
+    """Warn (:class:`~envs.errors.OversubscribedWarning`) when ``workers`` processes are
+    more than :data:`OVERSUBSCRIBED` times :func:`available_cpus`: ``--workers 1000`` on
+    two cores started 1000 interpreters without a word. Not refused: it plays as asked."""
+    import warnings
+
+    from envs.errors import OversubscribedWarning
+
+    cpus = available_cpus()
+    if workers > OVERSUBSCRIBED * cpus:
+        warnings.warn(
+            f"{name} = {workers}: far above the {cpus} CPUs this process may use "
+            f"(os.cpu_count() = {os.cpu_count()}): up to {workers} worker processes take "
+            "turns on them, each with its own interpreter and copies of the maps and "
+            f"policies, no faster than {cpus} and heavier; played as asked",
+            OversubscribedWarning,
+            stacklevel=stacklevel,
+        )
 
 
 def check_backend(backend: str, *, workers: int | None = None, address: str | None = None) -> None:

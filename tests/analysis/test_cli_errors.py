@@ -426,6 +426,26 @@ def test_evaluate_bad_flags_fail_before_any_match(capsys, tmp_path, monkeypatch,
     assert not (tmp_path / "e.sqlite").exists(), line
 
 
+def test_workers_far_above_the_cpus_are_said_so_and_played(capsys, tmp_path, monkeypatch):
+    """``--workers 1000`` on two cores started the processes without a word: a warning line
+    names the number and os.cpu_count(), and the matches are played as asked."""
+    import os
+
+    from analysis.tournament.executors import OVERSUBSCRIBED, available_cpus
+
+    monkeypatch.chdir(tmp_path)
+    many = OVERSUBSCRIBED * available_cpus() + 1
+    assert main([*EVALUATE, "--results", "e.sqlite", "--workers", str(many)]) == 0
+    out, err = capsys.readouterr()
+    assert err.startswith(f"surveil: warning: workers = {many}: far above the "), err
+    assert f"(os.cpu_count() = {os.cpu_count()})" in err and "played as asked" in err
+    assert "1 of 1 matches stored" in out + err
+    # at the limit: no word
+    limit = OVERSUBSCRIBED * available_cpus()
+    assert main([*EVALUATE, "--results", "f.sqlite", "--workers", str(limit)]) == 0
+    assert "far above" not in capsys.readouterr().err
+
+
 @pytest.mark.parametrize("workers", ["0", "-1", "two"])
 def test_tournament_workers_are_checked_before_the_store(capsys, tmp_path, workers):
     # --workers 0 with --backend ray never scheduled a match: each batch was stored as an

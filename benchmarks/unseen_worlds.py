@@ -251,8 +251,8 @@ def transform_of(key: str) -> tuple[str, float, float, tuple[float, float]]:
     """(built-in name, rotation, scale, offset) of a label ``NAME~[xS][rotR][off(X,Y)]``."""
     try:
         name, sim = split_transform(key)  # the grammar envs.maps.load_map reads
-    except InvalidConfigError:  # a scale <= 0
-        raise _unknown(key) from None
+    except InvalidConfigError as exc:  # a scale <= 0: say so
+        raise InvalidConfigError(f"world: unknown world {key!r}: {exc}") from None
     if sim is None or name not in builtin_names():
         raise _unknown(key)
     return name, sim.rotation, sim.scale, sim.offset
@@ -266,9 +266,17 @@ def room_map(key: str, role: str = "pursuer") -> Map:
         return build(arm=arm, width=float(m["w"]))
     if m := _L_ROOM.fullmatch(key):
         a, w = float(m["a"]), float(m["w"])
+        if not 0 < w < a:  # W = A is a square, W > A crosses itself
+            raise InvalidConfigError(f"world: {key!r}: expected arms W narrower than the "
+                                     f"room A (0 < W < A), got A = {a:g}, W = {w:g}")  # fmt: skip
         return Map([(0, 0), (a, 0), (a, w), (w, w), (w, a), (0, a)], [], name=key)
     if m := _U_ROOM.fullmatch(key):
         w, h, a, b = (float(m[k]) for k in "whab")
+        if not (0 < 2 * a < w and 0 < b < h):  # else no notch, or one past the room's edge
+            raise InvalidConfigError(f"world: {key!r}: expected two arms A wide in the width "
+                                     f"W (0 < 2 A < W) and a base B deep in the height H "
+                                     f"(0 < B < H), got W = {w:g}, H = {h:g}, A = {a:g}, "
+                                     f"B = {b:g}")  # fmt: skip
         pts = [(0, 0), (w, 0), (w, h), (w - a, h), (w - a, b), (a, b), (a, h), (0, h)]
         return Map(pts, [], name=key)
     if _PILLAR.fullmatch(key):

@@ -180,6 +180,26 @@ def test_an_unknown_world_label_is_a_usage_error_naming_it(unseen, tmp_path, cap
     assert not results.exists()
 
 
+@pytest.mark.parametrize(
+    "role, label, why",
+    [("pursuer", "L_5x5", "0 < W < A"), ("pursuer", "U_10x10x3x12", "0 < B < H"),
+     ("pursuer", "U_10x10x5x3", "0 < 2 A < W"), ("pursuer", "tee_w6a0", "arm = 0.0"),
+     ("evader", "plus_w1.2a0", "arm = 0.0"), ("pursuer", "maze~x0", "finite scale > 0")],
+)  # fmt: skip
+def test_a_degenerate_world_label_is_a_usage_error_saying_why(unseen, tmp_path, capsys, role,
+                                                             label, why) -> None:  # fmt: skip
+    """A label that parses but builds no such room was played as another world: L_5x5 as a
+    plain square, U_10x10x3x12 as a room with a bump, tee_w6a0 as a 6 x 6 square; a scale
+    of 0 said only 'unknown world'."""
+    results = tmp_path / "r.jsonl"
+    with pytest.raises(SystemExit) as exc:
+        unseen.main(["--role", role, "--worlds", label, "--results", str(results)])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert f"unknown {role}-role world {label!r}" in err and why in err
+    assert not results.exists()
+
+
 def test_a_fresh_evader_world_draws_its_own_episodes(unseen, tmp_path, capsys) -> None:
     """Each other world's draws depend only on its label and L_min; it plays and its replay
     line names the L_min."""

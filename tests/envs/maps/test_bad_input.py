@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -75,3 +76,19 @@ def test_point_queries_refuse_a_point_that_is_not_finite(bad, n):
     points[-1, 1] = 3.0  # finite points are answered as before
     assert m.contains(points).all()
     assert (m.distance_to_walls(points) == 0.5).all()
+
+
+@pytest.mark.parametrize("build", ["crossroads", "t_junction"])
+@pytest.mark.parametrize(
+    ("arm", "width", "named"),
+    [(0.0, 2.0, "arm = 0.0"), (-1.0, 2.0, "arm = -1.0"), (math.nan, 2.0, "arm = nan"),
+     (3.0, math.inf, "width = inf"), (3.0, 0.0, "width = 0.0")],
+)  # fmt: skip
+def test_a_junction_of_no_or_negative_size_is_refused_naming_it(build, arm, width, named):
+    # An arm of length 0 was a bare width x width square named "plus" or "tee"; a
+    # negative one failed as "boundary: polygon is not simple", naming no argument.
+    from envs.maps import junctions
+
+    expected = rf"^{build}: {re.escape(named)}: expected a finite number > 0$"
+    with pytest.raises(InvalidConfigError, match=expected):
+        getattr(junctions, build)(arm=arm, width=width)

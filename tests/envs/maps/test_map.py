@@ -716,3 +716,45 @@ def test_the_nearest_wall_point_is_the_one_against_every_edge(monkeypatch):
         assert len(tied) == 2 and k == tied[0]
     with pytest.raises(InvalidConfigError, match="nan"):
         room.nearest_wall_point([np.nan, 1.0])
+
+
+def _brute_diameter(points: np.ndarray) -> float:
+    d = points[:, None, :] - points[None, :, :]
+    return float(np.sqrt(np.einsum("ijk,ijk->ij", d, d).max()))
+
+
+@pytest.mark.parametrize("kind", ["cloud", "ellipse", "polygon", "grid", "thin"])
+def test_convex_diameter_s_calipers_equal_every_pair(kind, monkeypatch):
+    """The rotating calipers (used beyond HULL_ALL_PAIRS hull vertices, forced here for
+    every input) find the farthest pair exactly, on random inputs: clouds, points of an
+    ellipse at any scale, a regular polygon off the origin, duplicate-laden integer grids
+    and a nearly flat cloud (collinear hull vertices, near-tied areas)."""
+    import envs.maps.map as map_module
+
+    monkeypatch.setattr(map_module, "HULL_ALL_PAIRS", 0)
+    rng = np.random.default_rng(["cloud", "ellipse", "polygon", "grid", "thin"].index(kind))
+    for _ in range(150):
+        n = int(rng.integers(3, 300))
+        if kind == "cloud":
+            p = rng.normal(size=(n, 2)) * rng.uniform(0.01, 100)
+        elif kind == "ellipse":
+            t = rng.uniform(0, 2 * np.pi, n)
+            p = np.c_[np.cos(t), rng.uniform(0.01, 1) * np.sin(t)] * 10 ** rng.uniform(-5, 5)
+        elif kind == "polygon":
+            t = 2 * np.pi * np.arange(n) / n
+            p = np.c_[np.cos(t), np.sin(t)] + rng.uniform(-100, 100, 2)
+        elif kind == "grid":
+            p = rng.integers(0, 5, size=(n, 2)).astype(float)
+        else:
+            a = rng.uniform(0, np.pi)
+            p = np.c_[np.cos(a), np.sin(a)] * rng.uniform(-1, 1, (n, 1))
+            p = p + rng.normal(size=p.shape) * 1e-9
+        assert map_module.convex_diameter(p) == _brute_diameter(p)
+
+
+def test_convex_diameter_of_degenerate_inputs():
+    from envs.maps.map import convex_diameter
+
+    assert convex_diameter([(1.0, 2.0)]) == 0.0
+    assert convex_diameter([(0.0, 0.0), (1.0, 1.0), (3.0, 3.0)]) == math.hypot(3.0, 3.0)
+    assert Map(regular(3.0, 3.0, 2.0, 5000)).diameter == pytest.approx(4.0)  # calipers

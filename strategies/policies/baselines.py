@@ -22,6 +22,7 @@ __all__ = [
     "TowardAwayEvader",
     "WallHuggingEvader",
     "nearest_wall_point",
+    "step_gain",
 ]
 
 
@@ -52,6 +53,17 @@ class RandomPolicy(BasePolicy):
         return self._current
 
 
+def step_gain(gain: float, dt: float) -> float:
+    """The proportional gain a step of ``dt`` applies: ``gain``, at most ``1 / dt``.
+
+    A correction of ``gain * error`` per second held for one step moves ``gain * dt`` of
+    the error: above 1 it overshoots the target and the distance chatters about it by
+    up to a step's travel each step (greedy pursuer, gain 50, dt 0.1: +-0.1 about its
+    target, the env's speed cap the only bound); ``1 / dt`` closes the error in one step.
+    """
+    return min(gain, 1.0 / dt)
+
+
 class GreedyPursuer(BasePolicy):
     """Keep the evader at ``L_min`` by moving along the line of sight; no map knowledge.
 
@@ -60,7 +72,8 @@ class GreedyPursuer(BasePolicy):
     distance, ``gain`` per second. The rod is never turned on purpose.
 
     Args:
-        gain: rate (1/s) at which the distance error is corrected.
+        gain: rate (1/s) at which the distance error is corrected (at most ``1 / dt``
+            is applied: :func:`step_gain`).
         target: target distance as a fraction of the way from L_min (plus the lag buffer
             of :func:`~strategies.policies.base.distance_target`) to L_max.
     """
@@ -77,7 +90,8 @@ class GreedyPursuer(BasePolicy):
         low = distance_target(c)
         want = low + self.target * (c.l_max - low)
         u = unit(snap.rod)  # from evader to pursuer
-        radial = float(np.dot(snap.evader_velocity, u)) - self.gain * (snap.L - want)
+        gain = step_gain(self.gain, c.dt)
+        radial = float(np.dot(snap.evader_velocity, u)) - gain * (snap.L - want)
         return radial * u
 
 
@@ -147,7 +161,8 @@ class WallHuggingEvader(BasePolicy):
 
     Args:
         offset: distance kept from the walls.
-        gain: rate (1/s) of the correction toward that distance.
+        gain: rate (1/s) of the correction toward that distance (at most ``1 / dt``
+            is applied: :func:`step_gain`).
     """
 
     def __init__(self, *, offset: float = 0.2, gain: float = 4.0, name: str | None = None) -> None:
@@ -162,7 +177,7 @@ class WallHuggingEvader(BasePolicy):
         n = away / dist if dist > 1e-12 else self.map.edge_normal[k]
         tangent = np.array([n[1], -n[0]])  # n rotated by -90 degrees: wall on the right
         err = self.offset - dist
-        radial = np.clip(self.gain * err / self.v_max, -1.0, 1.0)
+        radial = np.clip(step_gain(self.gain, self.config.dt) * err / self.v_max, -1.0, 1.0)
         v = radial * n + math.sqrt(max(0.0, 1.0 - radial * radial)) * tangent
         return self.v_max * v
 
@@ -181,7 +196,8 @@ class OrbitEvader(BasePolicy):
     Args:
         offset: distance kept from the obstacle.
         direction: ``1`` (counter-clockwise round the obstacle) or ``-1``.
-        gain: rate (1/s) of the correction toward that distance.
+        gain: rate (1/s) of the correction toward that distance (at most ``1 / dt``
+            is applied: :func:`step_gain`).
     """
 
     def __init__(
@@ -216,7 +232,8 @@ class OrbitEvader(BasePolicy):
         # obstacles are rings with free space on their left: -90 degrees keeps the
         # obstacle on the right (clockwise round it), +90 counter-clockwise
         tangent = self.direction * np.array([-n[1], n[0]])
-        radial = np.clip(self.gain * (self.offset - dist) / self.v_max, -1.0, 1.0)
+        gain = step_gain(self.gain, self.config.dt)
+        radial = np.clip(gain * (self.offset - dist) / self.v_max, -1.0, 1.0)
         v = radial * n + math.sqrt(max(0.0, 1.0 - radial * radial)) * tangent
         reach = self.config.body_radius + self.v_max * self.config.dt
         return self.v_max * _slide(m, e, v, reach, self.direction)

@@ -123,20 +123,56 @@ def cross2d(u: np.ndarray, w: np.ndarray) -> np.ndarray:
     return u[..., 0] * w[..., 1] - u[..., 1] * w[..., 0]
 
 
+POINT_IN_WALLS_PAIRS = 1 << 22
+"""(point, edge) pairs :func:`point_in_walls` tests at a time (about 200 MB of temporaries)."""
+
+
 def point_in_walls(x: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Even-odd test of points ``x`` (k, 2) against all wall edges ``a-b`` (m, 2).
 
     Points exactly on a wall get an arbitrary answer; callers only ask about points
     away from the walls.
+
+    Only the pairs whose edge spans the point's height are tested (the ray's crossings:
+    ``min(ay, by) <= py < max(ay, by)``, found by sorting the points by height), with the
+    same arithmetic as every pair: all k x m pairs made the kernel of a map of 1000
+    square pillars (4004 edges, 8000 grid cells) take 3.1 s to build, 65 % of making its
+    env.
+
+    Examples:
+        >>> square = np.array([(0.0, 0.0), (2.0, 0.0), (2.0, 2.0), (0.0, 2.0)])
+        >>> point_in_walls(np.array([(1.0, 1.0), (3.0, 1.0)]), square, np.roll(square, -1, 0))
+        array([ True, False])
     """
-    px = x[:, None, 0]
-    py = x[:, None, 1]
-    ay, by = a[None, :, 1], b[None, :, 1]
-    ax, bx = a[None, :, 0], b[None, :, 0]
-    cond = (ay > py) != (by > py)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        xint = ax + (py - ay) * (bx - ax) / (by - ay)
-    return np.count_nonzero(cond & (px < xint), axis=1) % 2 == 1
+    x = np.asarray(x, dtype=float).reshape(-1, 2)
+    a = np.asarray(a, dtype=float).reshape(-1, 2)
+    b = np.asarray(b, dtype=float).reshape(-1, 2)
+    order = np.argsort(x[:, 1], kind="stable")
+    ys = x[order, 1]
+    ylo = np.minimum(a[:, 1], b[:, 1])
+    yhi = np.maximum(a[:, 1], b[:, 1])
+    first = np.searchsorted(ys, ylo, side="left")  # the points with ylo <= py < yhi
+    count = np.searchsorted(ys, yhi, side="left") - first
+    crossings = np.zeros(len(x), dtype=np.int64)
+    edges = np.flatnonzero(count > 0)
+    ends = np.cumsum(count[edges])
+    k = 0
+    while k < len(edges):  # a block of edges at a time, about POINT_IN_WALLS_PAIRS pairs
+        done = ends[k - 1] if k else 0
+        stop = max(k + 1, int(np.searchsorted(ends, done + POINT_IN_WALLS_PAIRS, side="right")))
+        e = edges[k:stop]
+        n = count[e]
+        ei = np.repeat(e, n)
+        within = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)  # 0..n-1 per edge
+        pi = order[np.repeat(first[e], n) + within]
+        px, py = x[pi, 0], x[pi, 1]
+        ax, ay, bx, by = a[ei, 0], a[ei, 1], b[ei, 0], b[ei, 1]
+        cond = (ay > py) != (by > py)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            xint = ax + (py - ay) * (bx - ax) / (by - ay)
+        crossings += np.bincount(pi[cond & (px < xint)], minlength=len(x))
+        k = stop
+    return crossings % 2 == 1
 
 
 def scan_segment(

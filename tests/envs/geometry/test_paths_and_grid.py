@@ -4,6 +4,7 @@ bucket grid's completeness, point location, and free arcs at adversarial points.
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 import pytest
@@ -209,3 +210,52 @@ def test_wall_and_vertex_points_have_type0_stops():
     assert len(fa.arcs) == 1 and fa.arcs[0].width == pytest.approx(0.5 * math.pi)
     assert fa.contains(-3 * math.pi / 4) and not fa.contains(math.pi / 4)
     assert Point(5, 5).distance(world.free_region) == 0
+
+
+def _even_odd_every_pair(x: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The even-odd test over every (point, edge) pair (point_in_walls before it sorted)."""
+    px, py = x[:, None, 0], x[:, None, 1]
+    ax, ay, bx, by = a[None, :, 0], a[None, :, 1], b[None, :, 0], b[None, :, 1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        xint = ax + (py - ay) * (bx - ax) / (by - ay)
+    return np.count_nonzero(((ay > py) != (by > py)) & (px < xint), axis=1) % 2 == 1
+
+
+@pytest.mark.parametrize("block", [1 << 22, 7])
+def test_point_in_walls_equals_every_pair(block, monkeypatch):
+    """It tests only the edges spanning each point's height, in blocks of pairs: the same
+    answer as every pair, on random walls (integer coordinates: points level with edge
+    ends, horizontal edges) and rings."""
+    from envs.geometry import segments
+
+    monkeypatch.setattr(segments, "POINT_IN_WALLS_PAIRS", block)
+    rng = np.random.default_rng(block)
+    for trial in range(300):
+        m, k = int(rng.integers(3, 120)), int(rng.integers(0, 200))
+        if trial % 2:
+            a = rng.integers(0, 6, (m, 2)).astype(float)
+            x = rng.integers(0, 6, (k, 2)).astype(float)
+        else:
+            a, x = rng.normal(size=(m, 2)), 1.5 * rng.normal(size=(k, 2))
+        b = np.roll(a, -1, axis=0) if trial % 3 else rng.normal(size=(m, 2))
+        assert np.array_equal(segments.point_in_walls(x, a, b), _even_odd_every_pair(x, a, b))
+
+
+def test_a_kernel_of_a_thousand_pillars_builds_in_linear_time():
+    """1000 square pillars (4004 edges, 8136 grid cells): the cells' reference points were
+    tested against every edge, 3.1 s of the kernel's 3.4 s (65 % of making the env); 0.23 s."""
+    from envs.maps import Map
+
+    rng = np.random.default_rng(0)
+    pillars = []
+    for i in range(40):
+        for j in range(25):
+            cx, cy = 3 + 3 * i + rng.uniform(-0.4, 0.4), 3 + 3 * j + rng.uniform(-0.4, 0.4)
+            s = rng.uniform(0.2, 0.5)
+            pillars.append([(cx - s, cy - s), (cx + s, cy - s), (cx + s, cy + s), (cx - s, cy + s)])
+    world = Map([(0, 0), (123, 0), (123, 78), (0, 78)], obstacles=pillars)
+    t = time.perf_counter()
+    kernel = Kernel(world)
+    assert time.perf_counter() - t < 2.0
+    centre = np.mean(pillars[0], axis=0)
+    assert kernel.contains_point(1.0, 1.0) and not kernel.contains_point(*centre)

@@ -421,6 +421,19 @@ def _describe_from_help(sub) -> None:
             command.description = action.help[0].upper() + action.help[1:] + "."
 
 
+def _interrupt_inside(exc: BaseException) -> KeyboardInterrupt | None:
+    """The ``KeyboardInterrupt`` an exception wraps (its cause or context, at any depth),
+    or None."""
+    seen: set[int] = set()
+    cur: BaseException | None = exc
+    while cur is not None and id(cur) not in seen:
+        if isinstance(cur, KeyboardInterrupt):
+            return cur
+        seen.add(id(cur))
+        cur = cur.__cause__ or cur.__context__
+    return None
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``surveil`` console script.
 
@@ -457,6 +470,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         except Exception as exc:
             if isinstance(exc, BrokenPipeError) and reader_gone():
                 return 141
+            stopped = _interrupt_inside(exc)
+            if stopped is not None:  # a Ctrl-C Python wrapped: a class body's
+                # cached_property (3.11: "RuntimeError: Error calling __set_name__ on
+                # 'cached_property' instance '_pieces' in 'EscapePlan'", a traceback, exit 1)
+                sigterm = str(stopped) == "SIGTERM"
+                print(f"surveil: {'stopped by SIGTERM' if sigterm else 'interrupted'}",
+                      file=sys.stderr)  # fmt: skip
+                return 143 if sigterm else 130
             message = user_error(exc)
             if message is None:
                 raise  # a bug: keep the traceback

@@ -142,6 +142,7 @@ def run_tournament(
     db = Store(path)
     ex: Executor | None = None
     summary: RunSummary | None = None
+    began = False
     try:
         db.lock()
         matches = list(plan(spec))
@@ -159,6 +160,7 @@ def run_tournament(
                 f"run {spec.run_id} counts each of its starts once"
             )
         done = db.begin_run(spec.run_id, spec.name, spec.to_dict(), unique, geometry)
+        began = True
         if retry_errors:
             done = db.finished(spec.run_id, include_errors=False)
         todo = [m for m, _ in unique if m.match_id not in done]
@@ -201,6 +203,11 @@ def run_tournament(
                 f"{summary.planned} matches are stored in {path}; to resume: {hint}"
             )
         return summary
+    except KeyboardInterrupt:  # before _play's handler: a Ctrl-C while Ray or the pool
+        if began:  # started left the run 'running' (the store said so to report/export)
+            with contextlib.suppress(StoreError):
+                db.end_run(spec.run_id, "interrupted")
+        raise
     finally:
         if ex is not None:
             ex.close()

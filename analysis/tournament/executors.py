@@ -33,6 +33,7 @@ import threading
 import time
 from collections.abc import Iterator, Sequence
 from multiprocessing.connection import Connection, wait
+from pathlib import Path
 from typing import Any
 
 from analysis.tournament.identity import Match
@@ -541,6 +542,7 @@ class RayExecutor(Executor):
             raise InvalidConfigError("--backend ray needs Ray: pip install 'surveil[ray]'") from exc
         self.ray = ray
         self.started = False
+        self.owner: str | None = None  # the mark of the processes a local start begat
         self.inflight: dict[Any, _RayTask] = {}  # task (an ObjectRefGenerator): its state
         self.mailbox: Any = None
         if not ray.is_initialized():
@@ -581,6 +583,9 @@ class RayExecutor(Executor):
         """
         main = threading.current_thread() is threading.main_thread()
         previous = signal.getsignal(signal.SIGTERM) if main else None
+        if address == "local":  # every process the instance starts inherits the mark
+            self.owner = f"{os.getpid()}-{os.urandom(8).hex()}"
+            os.environ[RAY_OWNER] = self.owner
         try:
             self.started = True  # from the first process it starts: close() shuts it down
             self.ray.init(address=address, **kwargs)
@@ -590,6 +595,7 @@ class RayExecutor(Executor):
                 raise KeyboardInterrupt("SIGTERM") from None
             raise
         finally:
+            os.environ.pop(RAY_OWNER, None)  # not for this process's other children
             if previous is not None:
                 signal.signal(signal.SIGTERM, previous)
 
@@ -702,6 +708,55 @@ class RayExecutor(Executor):
             with contextlib.suppress(Exception):
                 self.ray.shutdown()
             self.started = False
+        if self.owner is not None:  # what the raylet started outlives it
+            end_marked_processes(self.owner)
+            self.owner = None
+
+
+RAY_OWNER = "SURVEIL_RAY_OWNER"
+"""An environment variable set while a :class:`RayExecutor` starts a local instance: its
+GCS, raylet, agents and workers inherit it, so :meth:`RayExecutor.close` finds them all."""
+
+
+def _marked_processes(owner: str) -> list[int]:
+    """The processes whose environment holds ``RAY_OWNER=owner`` (Linux's /proc; none
+    elsewhere), this one aside."""
+    proc = Path("/proc")
+    if not proc.is_dir():  # pragma: no cover - not Linux: ray.shutdown's own cleanup only
+        return []
+    mark = f"{RAY_OWNER}={owner}".encode()
+    me = str(os.getpid())
+    found = []
+    for entry in proc.iterdir():
+        if entry.name.isdigit() and entry.name != me:
+            with contextlib.suppress(OSError):
+                if mark in (entry / "environ").read_bytes().split(b"\0"):
+                    found.append(int(entry.name))
+    return found
+
+
+def end_marked_processes(owner: str, grace: float = 3.0) -> None:
+    """End what a local Ray instance started and ``ray.shutdown`` left: SIGTERM, then
+    SIGKILL after ``grace`` seconds.
+
+    ``ray.shutdown`` stops the GCS and the raylet it started, but not what the raylet
+    started: after a Ctrl-C while Ray started (``ray.init`` or an actor's creation) its
+    dashboard and runtime-env agents (``ray::DashboardAgent``, ``ray::RuntimeEnvAgent``)
+    lived on, reparented to init, for about a minute; workers likewise. They are found by
+    the :data:`RAY_OWNER` mark they inherited, so no other process (another run's Ray
+    included) is touched.
+    """
+    pids = _marked_processes(owner)
+    for sig in (signal.SIGTERM, signal.SIGKILL):
+        for pid in pids:
+            with contextlib.suppress(ProcessLookupError, PermissionError):
+                os.kill(pid, sig)
+        deadline = time.monotonic() + (grace if sig == signal.SIGTERM else 1.0)
+        while pids and time.monotonic() < deadline:
+            time.sleep(0.05)
+            pids = _marked_processes(owner)
+        if not pids:
+            return
 
 
 OVERSUBSCRIBED = 2

@@ -426,6 +426,28 @@ def test_evaluate_bad_flags_fail_before_any_match(capsys, tmp_path, monkeypatch,
     assert not (tmp_path / "e.sqlite").exists(), line
 
 
+def test_a_ctrl_c_python_wraps_is_an_interrupt_not_a_traceback(capsys, monkeypatch):
+    """A Ctrl-C while a class with a cached_property was created (a policy module imported
+    as a tournament planned, 2 s into ``surveil tournament``) reached the CLI as Python
+    3.11's "RuntimeError: Error calling __set_name__ on 'cached_property' instance ...":
+    a traceback and exit 1."""
+    from analysis import cli
+
+    class Stopping:
+        def __set_name__(self, owner, name):
+            raise KeyboardInterrupt  # where the signal landed
+
+    def maps(args):
+        try:
+            type("Plan", (), {"pieces": Stopping()})
+        except KeyboardInterrupt as exc:  # Python >= 3.12 does not wrap it: as 3.11 did
+            raise RuntimeError("Error calling __set_name__ on 'Stopping' instance") from exc
+
+    monkeypatch.setattr(cli, "_cmd_maps", maps)
+    assert main(["maps"]) == 130
+    assert capsys.readouterr().err == "surveil: interrupted\n"
+
+
 def test_workers_far_above_the_cpus_are_said_so_and_played(capsys, tmp_path, monkeypatch):
     """``--workers 1000`` on two cores started the processes without a word: a warning line
     names the number and os.cpu_count(), and the matches are played as asked."""

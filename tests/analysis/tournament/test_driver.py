@@ -29,6 +29,28 @@ def test_serial_and_process_backends_store_the_same_results(tmp_path, small_spec
         assert comparable(x.rows(a.run_id)) == comparable(y.rows(b.run_id))
 
 
+def test_a_ctrl_c_before_the_matches_play_marks_the_run_interrupted(
+    tmp_path, small_spec, monkeypatch
+):
+    """A Ctrl-C while the executor started (Ray's start takes seconds; the run's own signal
+    handler is set only when the matches play) left the run 'running' in the store.
+    The KeyboardInterrupt is raised where the signal lands, in the executor's start."""
+    from analysis.tournament import driver
+
+    def interrupted_start(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(driver, "make_executor", interrupted_start)
+    spec = spec_from_dict(small_spec)
+    with pytest.raises(KeyboardInterrupt):
+        run_tournament(spec, tmp_path / "s.sqlite", backend="process", progress=False)
+    with Store(tmp_path / "s.sqlite") as db:
+        assert [r["status"] for r in db.runs()] == ["interrupted"]
+    monkeypatch.undo()
+    s = run_tournament(spec, tmp_path / "s.sqlite", backend="serial", progress=False)
+    assert s.played == s.planned == 24
+
+
 @pytest.mark.parametrize(("backend", "workers"), [("process", 0), ("ray", 0), ("ray", -2)])
 def test_a_worker_count_below_one_is_refused_before_the_store(
     tmp_path, small_spec, backend, workers

@@ -325,6 +325,47 @@ def test_sigterm_while_ray_starts_stops_as_sigterm_does_elsewhere(tmp_path):
         time.sleep(0.1)
 
 
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="reads processes from /proc")
+def test_ctrl_c_while_ray_starts_leaves_no_process_and_a_resumable_store(tmp_path):
+    """A Ctrl-C while ``ray.init(num_cpus=2)`` started (the raylet up, its agents starting):
+    ``ray.shutdown`` ended the GCS and the raylet, but the raylet's dashboard and runtime-env
+    agents lived on for about a minute (reparented to init), and the run stayed 'running'
+    in the store. Now every process the start begat ends with it, and the run is marked
+    interrupted and resumes."""
+    spec = tmp_path / "s.toml"
+    spec.write_text(
+        'name = "s"\nmaps = ["open_room"]\nseeds = 2\nstart = "valid"\n'
+        'pursuers = ["pursuer/greedy"]\nevaders = ["evader/random"]\n'
+    )
+    root = Path(__file__).resolve().parents[3]
+    store = tmp_path / "s.sqlite"
+    command = [sys.executable, "-m", "analysis.cli", "tournament", str(spec), "--backend", "ray"]
+    command += ["--workers", "2", "--store", str(store), "--no-progress", "--no-report"]
+    env = {**os.environ, "PYTHONPATH": str(root), "SDL_VIDEODRIVER": "dummy", "MPLBACKEND": "Agg"}
+    proc = subprocess.Popen(command, env=env, cwd=tmp_path, stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True)  # fmt: skip
+    try:
+        deadline = time.monotonic() + 120
+        while "raylet" not in _session_names(proc.pid):  # Ray is starting
+            assert proc.poll() is None and time.monotonic() < deadline, proc.communicate()
+            time.sleep(0.02)
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+        deadline = time.monotonic() + 15  # the agents lived ~60 s; SIGKILL after 3 s now
+        while _session_names(proc.pid):
+            assert time.monotonic() < deadline, _session_names(proc.pid)
+            time.sleep(0.1)
+    finally:
+        if proc.poll() is None:  # pragma: no cover - the assertion below says why
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert "Traceback" not in err and proc.returncode == 130, (proc.returncode, err)
+    with Store(store) as db:
+        assert [r["status"] for r in db.runs()] == ["interrupted"]
+    done = subprocess.run(command, env=env, cwd=tmp_path, capture_output=True, text=True,
+                          timeout=300)  # fmt: skip
+    assert done.returncode == 0 and "2 of 2 matches stored" in done.stdout, done
+
+
 def test_a_local_instance_starts_beside_another_cluster(tmp_path):
     """``--backend ray`` without ``--address`` is a local instance, but ``ray.init``
     without an address joins the cluster ``/tmp/ray/ray_current_cluster`` names (a

@@ -62,6 +62,13 @@ _TILE = 1 << _TILE_BITS
 lookups first touch the grid (the whole grid's were 0.98 GB on corner~x100 at L_min 2,
 196 million nodes, for a few thousand nodes looked at in an episode)."""
 
+_AROUND = 2
+"""Grid nodes either way of a node :meth:`LazySafetyTable.row` finds unclassified that
+join its batch: the pursuer looks up the evader's own node each decision, and an evader
+on new ground met a node of its own a step (a batch of one: ~0.3 ms, most of a batch's
+cost; 5 x 5 nodes: 525 batches instead of 561 over 1829 decisions on three floor plans,
+and 23 decisions with two batches instead of 35)."""
+
 _BLOCK = 8
 """Grid nodes a side of a block whose wall distance a new tile measures once: a node's
 membership test asks whether a wall passes within the map's length tolerance of it
@@ -189,16 +196,35 @@ class LazySafetyTable:
     def row(self, point: np.ndarray) -> int:
         """Table row of the grid point nearest to ``point``, or of the nearest in free
         space (``SafetyTable.row``'s scalar arithmetic for a node classified already, the
-        pursuer's look-up of the evader's row each decision; else through :meth:`rows`)."""
+        pursuer's look-up of the evader's row each decision; else through :meth:`rows`).
+
+        A node not classified yet is classified with the unknown nodes within
+        ``_AROUND`` nodes of it, in one batch: the evader's next nodes, which it would
+        otherwise meet one batch at a time (the same entries; the rows are numbered in
+        the order the nodes were classified)."""
         i = round((float(point[0]) - float(self.origin[0])) / self.resolution)
         j = round((float(point[1]) - float(self.origin[1])) / self.resolution)
         if 0 <= i < self.shape[0] and 0 <= j < self.shape[1]:
             slab = int(self._tiles[i >> _TILE_BITS, j >> _TILE_BITS])
-            if slab >= 0:
+            r = _UNKNOWN if slab < 0 else int(self._cell[slab, i & (_TILE - 1), j & (_TILE - 1)])
+            if r == _UNKNOWN:
+                self._classify_around(i, j)
+                slab = int(self._tiles[i >> _TILE_BITS, j >> _TILE_BITS])  # (allocated now)
                 r = int(self._cell[slab, i & (_TILE - 1), j & (_TILE - 1)])
-                if r >= 0:
-                    return r
+            if r >= 0:
+                return r
         return self._row_search(point)
+
+    def _classify_around(self, i: int, j: int) -> None:
+        """Classify the unknown grid nodes within ``_AROUND`` nodes of node ``(i, j)`` (in
+        each coordinate), in (i, j) order (as :meth:`rows`' batches)."""
+        ii = np.repeat(np.arange(i - _AROUND, i + _AROUND + 1), 2 * _AROUND + 1)
+        jj = np.tile(np.arange(j - _AROUND, j + _AROUND + 1), 2 * _AROUND + 1)
+        ok = (ii >= 0) & (ii < self.shape[0]) & (jj >= 0) & (jj < self.shape[1])
+        ii, jj = ii[ok], jj[ok]
+        flat = self._slots(ii, jj)  # (first: it may allocate tiles)
+        new = self._cell.reshape(-1)[flat] == _UNKNOWN
+        self._classify(ii[new], jj[new])
 
     @property
     def classified(self) -> int:

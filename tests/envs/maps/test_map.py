@@ -673,6 +673,42 @@ def test_wall_distances_of_a_few_points_on_a_large_map_read_their_cells_edges(mo
         assert (want == 0.0).sum() >= 300  # the points on the walls
 
 
+def test_the_cells_new_to_a_call_are_measured_in_one_go(monkeypatch):
+    """A call of distance_to_walls over points in several cells not met yet (a block of
+    the pursuer's grid nodes on new ground) finds their edges in one index query each for
+    all of them (_build_cells, not _cell_edges a cell at a time): the same edges as one
+    cell at a time, the same floats as against every edge."""
+    import envs.maps.map as map_module
+    from envs.maps import floor_plan
+
+    m, alone = (floor_plan(1, n_vertices=300, size=(110.0, 110.0)) for _ in range(2))
+    rng = np.random.default_rng(14)
+    built = []
+    monkeypatch.setattr(map_module.Map, "_cell_edges", _counted(Map._cell_edges, built))
+    pts = rng.uniform(20.0, 40.0, size=(60, 2))
+    got = m.distance_to_walls(pts)
+    cells = set(m._cells_of(pts))
+    assert len(cells) > 10 and not built  # every cell built together
+    monkeypatch.undo()
+    assert all(
+        all(np.array_equal(a, b) for a, b in zip(m._cells[c], alone._cell_edges(*c), strict=True))
+        for c in cells
+    )
+    monkeypatch.setattr(map_module, "_NEAR_EDGES", 10**9)  # every edge
+    assert np.array_equal(got, m.distance_to_walls(pts))
+
+
+def _counted(method, calls: list):
+    """``method`` counting its cells not kept yet in ``calls``."""
+
+    def counted(self, i, j):
+        if (i, j) not in self._cells:
+            calls.append((i, j))
+        return method(self, i, j)
+
+    return counted
+
+
 def _nearest_against_every_edge(m: Map, p: np.ndarray) -> tuple[np.ndarray, int]:
     """The closest wall point and its edge (the first of the nearest) against every edge,
     in nearest_wall_point's arithmetic."""

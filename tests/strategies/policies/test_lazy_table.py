@@ -131,6 +131,46 @@ def test_rows_classify_the_nodes_ahead_with_the_new_ones(monkeypatch):
     assert early.classified == n and len(batches) == 3 and len(tests) == 3
 
 
+def test_a_row_on_new_ground_is_classified_with_the_nodes_around_it(monkeypatch):
+    """row() of a point whose node is not classified yet (the pursuer's look-up of the
+    evader's node, on new ground) classifies the unknown nodes within _AROUND nodes of it
+    in the same batch: the evader's next nodes need no batch of one each (~0.3 ms
+    apiece). Their entries are the eager table's; nodes outside the free region and the
+    points off it are answered as before."""
+    import strategies.policies.lazy_table as lt
+
+    batches = []
+
+    def counted(dec, pts, step, centres, **kw):
+        batches.append(len(pts))
+        return classify(dec, pts, step, centres, **kw)
+
+    classify = lt.classify_points
+    monkeypatch.setattr(lt, "classify_points", counted)
+    world = _world("corridor", 0.0)
+    eager = safety_table(world, 2.2, 0.1, 48, disk_cache=False)
+    lazy = LazySafetyTable(world, 2.2, 0.1, 48)
+    p = np.array([5.0, 0.3])
+    assert lazy.row(p) >= 0
+    side = 2 * lt._AROUND + 1
+    assert lt._AROUND >= 1 and batches == [side * side] and lazy.classified == side * side
+    h = lazy.resolution
+    near = p + h * np.array([[1, 0], [1, 1], [-lt._AROUND, lt._AROUND], [0, -1]])
+    for q in near:  # the evader's next nodes: no batch
+        r = lazy.row(q)
+        assert np.array_equal(lazy.free[r], eager.free[eager.row(q)])
+        assert np.array_equal(lazy.need[r], eager.need[eager.row(q)])
+    assert len(batches) == 1
+    rng = np.random.default_rng(5)
+    x0, y0, x1, y1 = world.bounds
+    for q in rng.uniform((x0 - 1, y0 - 1), (x1 + 1, y1 + 1), size=(40, 2)):
+        r1, r2 = lazy.row(q), eager.row(q)
+        assert (r1 < 0) == (r2 < 0)
+        if r2 >= 0:
+            for name in ("free", "safe", "guaranteed", "ccw", "cw", "need"):
+                assert np.array_equal(getattr(lazy, name)[r1], getattr(eager, name)[r2]), name
+
+
 def test_rows_of_points_whose_nodes_inside_found_are_the_rows_looked_up_again():
     """inside(points, nodes=True) also gives the points' grid nodes, and rows() of some
     of the points with those nodes (nodes_at: the pursuer's probes, among the ray

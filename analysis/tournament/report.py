@@ -288,37 +288,14 @@ def _sha(path: str) -> str:
 def _gif(result: Any) -> bytes:
     from PIL import Image
 
-    from envs.surveillance.render import Snapshot, render_frame
+    from analysis.replay import iter_trajectory_frames
 
-    traj = result.trajectory
-    last = len(traj) - 1
+    last = len(result.trajectory) - 1
     picks = sorted({round(k * last / max(REPLAY_FRAMES - 1, 1)) for k in range(REPLAY_FRAMES)})
-    frames = []
-    for k in picks:
-        p, e = traj[k]
-        broken = k == last and result.winner == "evader"
-        lo = max(0, k - 60)
-        frames.append(
-            Image.fromarray(
-                render_frame(
-                    Snapshot(
-                        map=result.map_obj,
-                        pursuer=tuple(p),
-                        evader=tuple(e),
-                        l_min=result.config.l_min,
-                        l_max=result.config.l_max,
-                        body_radius=result.config.body_radius,
-                        surveillance=not broken,
-                        cause=result.cause if broken else None,
-                        step=k,
-                        time=k * result.dt,
-                        trail_pursuer=tuple(map(tuple, traj[lo : k + 1, 0])),
-                        trail_evader=tuple(map(tuple, traj[lo : k + 1, 1])),
-                    ),
-                    size=REPLAY_SIZE,
-                )
-            )
-        )
+    frames = [
+        Image.fromarray(f)
+        for f in iter_trajectory_frames(result, size=REPLAY_SIZE, trail=60, indices=picks)
+    ]
     buf = io.BytesIO()
     durations = [60] * (len(frames) - 1) + [1500]
     frames[0].save(

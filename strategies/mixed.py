@@ -31,6 +31,7 @@ import numpy as np
 
 from envs.errors import InfeasibleError, InvalidConfigError
 from envs.validation import finite_array
+from strategies.policies.base import ActPredictor
 
 __all__ = [
     "GameSolution",
@@ -159,7 +160,7 @@ def _mixture(name: str, weights: Any, n: int) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- policies
-class MixedPolicy:
+class MixedPolicy(ActPredictor):
     """A mixture of policies of one role: one component plays each episode.
 
     The component is drawn at :meth:`reset` (or by :meth:`select`, which the shared
@@ -284,19 +285,6 @@ class MixedPolicy:
         if self.current is None or self.role is None:
             raise InvalidConfigError(f"policy {self.name!r}: call reset() before act()")
         return self.current.act(observation)
-
-    def predict(
-        self,
-        observation: np.ndarray,
-        state: Any = None,
-        episode_start: Any = None,
-        deterministic: bool = True,
-    ) -> tuple[np.ndarray, Any]:
-        """SB3 ``PolicyPredictor`` adapter of the current component."""
-        obs = np.asarray(observation)
-        if obs.ndim == 2:
-            return np.stack([self.act(o) for o in obs]), None
-        return self.act(obs), None
 
     def __repr__(self) -> str:
         parts = ", ".join(

@@ -25,6 +25,7 @@ from envs.errors import InvalidActionError, InvalidConfigError
 __all__ = [
     "MAX_RAYS",
     "ROLES",
+    "ActPredictor",
     "BasePolicy",
     "Policy",
     "Snapshot",
@@ -179,7 +180,31 @@ class Policy(Protocol):
         """SB3-compatible adapter around :meth:`act`."""
 
 
-class BasePolicy:
+class ActPredictor:
+    """Mixin: SB3's ``PolicyPredictor.predict`` from the class's own ``act``, one
+    observation at a time (the class defines ``act``; :class:`BasePolicy` and
+    :class:`strategies.mixed.MixedPolicy` take it).
+    """
+
+    def predict(
+        self,
+        observation: np.ndarray,
+        state: Any = None,
+        episode_start: Any = None,
+        deterministic: bool = True,
+    ) -> tuple[np.ndarray, Any]:
+        """SB3 ``PolicyPredictor`` adapter: batched (n, obs) or single observations.
+
+        Returns:
+            ``(actions, None)`` with actions of shape (2,) or (n, 2).
+        """
+        obs = np.asarray(observation)
+        if obs.ndim == 2:
+            return np.stack([self.act(o) for o in obs]), None
+        return self.act(obs), None
+
+
+class BasePolicy(ActPredictor):
     """Shared plumbing: role checks, seeded RNG, observation decoding, action scaling.
 
     Subclasses set ``roles`` (the roles they can play) and implement
@@ -269,23 +294,6 @@ class BasePolicy:
         velocity = np.asarray(self._decide(snap), dtype=float)
         self._steps += 1
         return self.velocity_to_action(velocity)
-
-    def predict(
-        self,
-        observation: np.ndarray,
-        state: Any = None,
-        episode_start: Any = None,
-        deterministic: bool = True,
-    ) -> tuple[np.ndarray, Any]:
-        """SB3 ``PolicyPredictor`` adapter: batched (n, obs) or single observations.
-
-        Returns:
-            ``(actions, None)`` with actions of shape (2,) or (n, 2).
-        """
-        obs = np.asarray(observation)
-        if obs.ndim == 2:
-            return np.stack([self.act(o) for o in obs]), None
-        return self.act(obs), None
 
     # ----------------------------------------------------------------- helpers
     @property

@@ -148,3 +148,28 @@ def test_mixed_policy_plays_through_the_policy_protocol():
     mix.reset(role="pursuer", map=env.config.map, config=env.config, seed=5)
     assert mix.current.name == first
     assert mix.observation_options == {"observation": "state"}
+
+
+def test_mixed_policy_predict_is_its_component_s_act_single_and_batched():
+    from envs import surveillance_v1
+
+    env = surveillance_v1.parallel_env(map="open_room", max_cycles=10)
+    obs, _ = env.reset(seed=1)
+    seen = [obs["pursuer_0"]]
+    rng = np.random.default_rng(0)
+    for _ in range(5):
+        obs, *_ = env.step({a: rng.uniform(-1, 1, 2).astype(np.float32) for a in env.agents})
+        seen.append(obs["pursuer_0"])
+    mixes = [MixedPolicy.from_weights({"pursuer/greedy": 1.0, "pursuer/random": 1.0}) for _ in "ab"]
+    for mix in mixes:
+        mix.reset(role="pursuer", map=env.config.map, config=env.config, seed=3)
+    acting, predicting = mixes
+    for o in seen:
+        action, state = predicting.predict(o, state="kept?", deterministic=True)
+        assert state is None
+        assert action.tobytes() == acting.act(o).tobytes()
+    for mix in mixes:
+        mix.reset(role="pursuer", map=env.config.map, config=env.config, seed=3)
+    batch, _ = predicting.predict(np.stack(seen))
+    assert batch.shape == (len(seen), 2)
+    assert batch.tobytes() == np.stack([acting.act(o) for o in seen]).tobytes()

@@ -117,10 +117,12 @@ class MemoryBudgetError(InfeasibleError):
         )
 
 
-class NoStartError(InvalidConfigError):
+class NoStartError(InfeasibleError, InvalidConfigError):
     """A referee resolution whose lattices hold no start (no lattice point clear of the
     walls, or no pair of them in range and in sight): a solve there would certify nothing,
-    so it is refused rather than returned empty.
+    so it is refused rather than returned empty. An :class:`InfeasibleError` (scripts that
+    label starts say "not solved" and go on to the next world, as for the memory budget)
+    and an :class:`InvalidConfigError` (the resolution is the caller's to change).
 
     As in :class:`MemoryBudgetError`, the message names the resolution's knob by the name
     of the function that refused (``cells_per_lmin``); a command line or a policy that

@@ -13,7 +13,7 @@ import time
 import numpy as np
 import pytest
 
-from envs.errors import InvalidConfigError, MemoryBudgetError, NoStartError
+from envs.errors import InfeasibleError, InvalidConfigError, MemoryBudgetError, NoStartError
 from envs.maps import Map
 from strategies.referee import (
     GameSpec,
@@ -43,6 +43,8 @@ def test_a_resolution_with_no_lattice_start_is_refused_naming_one_that_has(cpl):
     s = spec(open_room(6.0), 0.2)
     with pytest.raises(NoStartError) as info:
         solve(s, cpl, cache=False)
+    # an InfeasibleError too: the scripts that label starts say "not solved" and go on
+    assert isinstance(info.value, InfeasibleError)
     text = str(info.value)
     assert text.startswith(f"cells_per_lmin = {cpl:g}: the referee's lattices ")
     assert "hold no start with the players in range [1, 2]" in text and "'open6'" in text

@@ -15,23 +15,11 @@ import numpy as np
 from analysis.figures import cases, style
 from analysis.figures.registry import register
 from strategies.cspace import critical_curves
+from strategies.cspace.draw import cell_positions, fill_polygon
 
 __all__ = ["draw_graph", "draw_regions"]
 
 _ESC_DARK = "#9c2a10"
-
-
-def _fill(ax, poly, **kw) -> None:
-    from matplotlib.patches import PathPatch
-    from matplotlib.path import Path as MPath
-
-    for g in getattr(poly, "geoms", [poly]):
-        verts, codes = [], []
-        for ring in (g.exterior, *g.interiors):
-            c = np.asarray(ring.coords)
-            verts.append(c)
-            codes += [MPath.MOVETO] + [MPath.LINETO] * (len(c) - 2) + [MPath.CLOSEPOLY]
-        ax.add_patch(PathPatch(MPath(np.concatenate(verts), codes), **kw))
 
 
 def draw_regions(
@@ -53,10 +41,12 @@ def draw_regions(
         cells = [dec.cells[c] for c in r.cells]
         share = sum(c.escapable for c in cells) / len(cells) if cells else 1.0
         if r.id == highlight:
-            _fill(ax, r.polygon, facecolor=to_rgba("#ffd23f", 0.55), edgecolor="none", zorder=2)
+            fill_polygon(
+                ax, r.polygon, facecolor=to_rgba("#ffd23f", 0.55), edgecolor="none", zorder=2
+            )
         if share <= 0:
             continue
-        _fill(
+        fill_polygon(
             ax,
             r.polygon,
             facecolor=to_rgba(style.ESCAPABLE, 0.12 + 0.3 * share),
@@ -80,28 +70,15 @@ def draw_regions(
             )
 
 
-def _cell_xy(dec) -> dict[int, np.ndarray]:
-    """Each cell at its region's sample point, nudged along its arc's middle direction."""
-    xmin, ymin, xmax, ymax = dec.map.bounds
-    off = 0.013 * max(xmax - xmin, ymax - ymin)
-    pos = {}
-    for r in dec.regions:
-        for c in r.cells:
-            th = dec.cells[c].arc.mid
-            k = 0.0 if len(r.cells) == 1 else off
-            pos[c] = r.point + k * np.array([math.cos(th), math.sin(th)])
-    return pos
-
-
 def draw_graph(ax, dec, *, chain: tuple[int, ...] = (), size: float = 12.0) -> None:
     """G_L laid over the world: a node per cell at its region, escapable cells red, an
     edge per adjacency; ``chain`` (cell ids) drawn as a thick path."""
-    _fill(ax, dec.map.free_region, facecolor="#f6f6f3", edgecolor="none", zorder=0)
+    fill_polygon(ax, dec.map.free_region, facecolor="#f6f6f3", edgecolor="none", zorder=0)
     for ring in dec.map.rings:
         closed = np.vstack([ring, ring[:1]])
         ax.plot(*closed.T, color="#9a9a9a", lw=0.8, zorder=0)
     style.draw_curves(ax, dec.curves, lw=0.5, alpha=0.2)
-    pos = _cell_xy(dec)
+    pos = cell_positions(dec, nudge=0.013)
     for i, j in dec.graph.edges:
         both = dec.cells[i].escapable and dec.cells[j].escapable
         ax.plot(

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -21,7 +21,7 @@ from envs.errors import InvalidConfigError
 if TYPE_CHECKING:
     from strategies.cspace.decomposition import Decomposition
 
-__all__ = ["TYPE_COLOURS", "draw_decomposition"]
+__all__ = ["TYPE_COLOURS", "cell_positions", "draw_decomposition", "fill_polygon"]
 
 TYPE_COLOURS = {
     0: "#222222",
@@ -52,12 +52,13 @@ def _pyplot():
     return plt
 
 
-def _fill_polygon(ax, poly, **kw) -> None:
+def fill_polygon(ax: Any, poly: Any, **kw: Any) -> None:
+    """Fill a shapely polygon or multipolygon, holes left open, as one matplotlib
+    ``PathPatch`` per part (``kw`` to the patch: colours, zorder, hatch)."""
     from matplotlib.patches import PathPatch
     from matplotlib.path import Path as MPath
 
-    geoms = getattr(poly, "geoms", [poly])
-    for g in geoms:
+    for g in getattr(poly, "geoms", [poly]):
         verts, codes = [], []
         for ring in (g.exterior, *g.interiors):
             c = np.asarray(ring.coords)
@@ -95,14 +96,14 @@ def _draw_world(ax, dec: Decomposition, label_regions: bool) -> None:
             zorder=0,
         )
     )
-    _fill_polygon(ax, world.free_region, facecolor="white", edgecolor="none", zorder=1)
+    fill_polygon(ax, world.free_region, facecolor="white", edgecolor="none", zorder=1)
     witnesses = set(dec.witness_regions)
     for r in dec.regions:
         cells = [dec.cells[c] for c in r.cells]
         share = (sum(c.escapable for c in cells) / len(cells)) if cells else 1.0
         if share <= 0:
             continue
-        _fill_polygon(
+        fill_polygon(
             ax,
             r.polygon,
             facecolor=to_rgba(_ESC, 0.12 + 0.30 * share),
@@ -142,30 +143,31 @@ def _draw_world(ax, dec: Decomposition, label_regions: bool) -> None:
     _frame(ax, world)
 
 
-def _cell_positions(dec: Decomposition) -> dict[int, np.ndarray]:
-    """Each cell at its region's sample point, nudged along its arc's middle direction."""
+def cell_positions(dec: Decomposition, nudge: float = 0.012) -> dict[int, np.ndarray]:
+    """Where to draw each cell of G_L: at its region's sample point, moved ``nudge`` times
+    the map's larger side along its arc's middle direction when the region has several
+    cells (so they do not overlap)."""
+    xmin, ymin, xmax, ymax = dec.map.bounds
+    off = nudge * max(xmax - xmin, ymax - ymin)
     pos = {}
-    span = max(dec.map.bounds[2] - dec.map.bounds[0], dec.map.bounds[3] - dec.map.bounds[1])
     for r in dec.regions:
-        k = len(r.cells)
+        k = 0.0 if len(r.cells) == 1 else off
         for c in r.cells:
-            cell = dec.cells[c]
-            off = 0.0 if k == 1 else 0.012 * span
-            th = cell.arc.mid
-            pos[c] = r.point + off * np.array([math.cos(th), math.sin(th)])
+            th = dec.cells[c].arc.mid
+            pos[c] = r.point + k * np.array([math.cos(th), math.sin(th)])
     return pos
 
 
 def _draw_graph(ax, dec: Decomposition) -> None:
     world = dec.map
-    _fill_polygon(ax, world.free_region, facecolor="#f7f7f5", edgecolor="none", zorder=0)
+    fill_polygon(ax, world.free_region, facecolor="#f7f7f5", edgecolor="none", zorder=0)
     for c in dec.curves:
         if c.type != 0:
             ax.plot(*c.points.T, color=TYPE_COLOURS[c.type], lw=0.6, alpha=0.18, zorder=0)
     for ring in world.rings:
         closed = np.vstack([ring, ring[:1]])
         ax.plot(*closed.T, color="#9a9a9a", lw=1.0, zorder=0)
-    pos = _cell_positions(dec)
+    pos = cell_positions(dec)
     for i, j in dec.graph.edges:
         a, b = pos[i], pos[j]
         both = dec.cells[i].escapable and dec.cells[j].escapable

@@ -15,12 +15,10 @@ from envs.maps import Map, random_map
 from strategies.cspace import decompose
 from tests.strategies.cspace._oracle import (
     CORRIDOR,
-    brute_free,
-    circular_runs,
+    assert_cells_are_brute_force_arcs,
     corridor,
     open_room,
     pillar_room,
-    resolvable,
     stop_pairs,
     two_rooms,
 )
@@ -72,21 +70,7 @@ def test_stop_pairs_are_constant_inside_each_region(name, L):
 @pytest.mark.parametrize("name", list(WORLDS))
 def test_cells_match_the_brute_force_free_orientations(name):
     """At each region's sample point: as many free arcs (shapely brute force) as cells."""
-    world = WORLDS[name]()
-    L = 2.0
-    dec = decompose(world, L)
-    checked = 0
-    for r in dec.regions:
-        mask = brute_free(world, r.point, L, n=2048)
-        arcs = [dec.cells[c].arc for c in r.cells]
-        if not resolvable(arcs, 4 * 2 * math.pi / 2048):
-            continue  # narrower than the brute force resolves
-        if len(arcs) == 1 and arcs[0].is_full:
-            assert mask.all()
-        else:
-            assert circular_runs(mask) == len(arcs) or (not arcs and not mask.any()), r.id
-        checked += 1
-    assert checked > 0.6 * len(dec.regions)
+    assert_cells_are_brute_force_arcs(decompose(WORLDS[name](), 2.0))
 
 
 def test_every_point_in_free_space_is_located(corridor_dec):

@@ -18,12 +18,10 @@ import pytest
 from envs.maps import Map, random_map
 from strategies.cspace import decompose
 from tests.strategies.cspace._oracle import (
+    assert_cells_are_brute_force_arcs,
     assert_exact,
-    brute_free,
-    circular_runs,
     fingerprint,
     hexagons,
-    resolvable,
     rotated_room,
     similar,
     skew_corridor,
@@ -90,19 +88,7 @@ def test_stops_are_constant_inside_every_region(name, decs):
 @pytest.mark.parametrize("name", ["tilted_block", "stars", "hexagons", "skew_corridor"])
 def test_cells_are_the_brute_force_free_arcs(name, decs):
     """At each region's point: as many cells as free arcs in a shapely brute force."""
-    dec = decs[name]
-    checked = 0
-    for r in dec.regions:
-        arcs = [dec.cells[c].arc for c in r.cells]
-        if not resolvable(arcs, 4 * 2 * math.pi / 2048):
-            continue
-        mask = brute_free(dec.map, r.point, dec.L, n=2048)
-        if len(arcs) == 1 and arcs[0].is_full:
-            assert mask.all()
-        else:
-            assert circular_runs(mask) == len(arcs) or (not arcs and not mask.any()), r.id
-        checked += 1
-    assert checked > 0.6 * len(dec.regions)
+    assert_cells_are_brute_force_arcs(decs[name])
 
 
 @pytest.mark.parametrize(
@@ -281,21 +267,8 @@ def test_wall_vertices_at_one_point_give_an_exact_arrangement(name, L):
     assert len({tuple(v) for v in world.vertices.tolist()}) < world.n_vertices
     dec = decompose(world, L)
     assert_exact(dec, 7, per_region=4, slivers=False)
-    checked = 0
-    for r in dec.regions:
-        arcs = [dec.cells[c].arc for c in r.cells]
-        if not resolvable(arcs, 4 * 2 * math.pi / 2048):
-            continue
-        mask = brute_free(world, r.point, L, n=2048)
-        # a rod through the point where two walls meet is free in that one direction
-        # only (a zero-width arc, which the kernel drops): single samples do not count
-        mask &= np.roll(mask, 1) | np.roll(mask, -1)
-        if len(arcs) == 1 and arcs[0].is_full:
-            assert mask.all(), r.id
-        else:
-            assert circular_runs(mask) == len(arcs) or (not arcs and not mask.any()), r.id
-        checked += 1
-    assert checked > 0.6 * len(dec.regions)
+    # a rod through the point where two walls meet is free in that one direction only
+    assert_cells_are_brute_force_arcs(dec, single_samples=False)
     # (not rotated: a merged map's vertices are snapped to a grid, so a rotated copy is
     # not congruent and its near-degeneracies differ)
     moved = decompose(similar(world, 0.0, 1e3, (1e6, -1e6)), L * 1e3)

@@ -48,6 +48,22 @@ def state_observations(config: EnvConfig, n: int = 12, seed: int = 0) -> list[np
     return out
 
 
+def decomposition_pursuer(
+    world: str | EnvConfig = "open_room", overrides: dict | None = None, **params
+):
+    """A ``pursuer/decomposition`` (with ``params``) reset at seed 0 on a built-in map's
+    env (its recommended parameters with ``overrides``) or on an ``EnvConfig``."""
+    from strategies.policies import make_policy
+    from strategies.runner import build_env
+
+    config = (
+        world if isinstance(world, EnvConfig) else build_env(world, dict(overrides or {})).config
+    )
+    policy = make_policy("pursuer/decomposition", **params)
+    policy.reset(role="pursuer", map=config.map, config=config, seed=0)
+    return policy
+
+
 @pytest.fixture
 def unseen(monkeypatch):
     """The unseen-worlds benchmark module (benchmarks/unseen_worlds.py): its worlds,

@@ -19,8 +19,8 @@ from types import SimpleNamespace
 
 import pytest
 
-from strategies.policies import make_policy
-from strategies.runner import build_env, run_episode
+from strategies.runner import run_episode
+from tests.strategies.policies.conftest import decomposition_pursuer
 
 
 @pytest.fixture
@@ -40,16 +40,11 @@ def test_the_pillars_straight_walk_at_the_charge_test_is_held(holds):
     assert r.winner == "pursuer", r.summary()
 
 
-def _pursuer():
-    config = build_env("open_room", {}).config
-    p = make_policy("pursuer/decomposition")
-    p.reset(role="pursuer", map=config.map, config=config, seed=0)
-    return p
-
-
-def _run(p, steps):
+def _run(steps):
     """Feed the charge test (rod orientation, evader heading) pairs, in degrees, at speed
-    0.5 (the angle off the rod is their difference); the test's answers."""
+    0.5 (the angle off the rod is their difference) of a fresh decomposition pursuer in
+    the open room; the test's answers."""
+    p = decomposition_pursuer()
     out = []
     for theta, heading in steps:
         h = math.radians(heading)
@@ -63,11 +58,11 @@ def test_a_chatter_across_a_fixed_heading_keeps_the_charge():
     # orbit keeper's turn undone), 59.2 (re-entered, rod within 2 deg of the last
     # entry): armed, so 64 and 69 stay charging, 71 leaves
     seq = [(61, 0), (59, 0), (62, 0), (62.5, 0), (59.2, 0), (64, 0), (69, 0), (71, 0), (63, 0)]
-    assert _run(_pursuer(), seq) == [False, True, False, False, True, True, True, False, False]
+    assert _run(seq) == [False, True, False, False, True, True, True, False, False]
 
 
 def test_one_entry_alone_does_not_keep_the_charge():
-    assert _run(_pursuer(), [(61, 0), (59, 0), (62, 0), (64, 0)]) == [False, True, False, False]
+    assert _run([(61, 0), (59, 0), (62, 0), (64, 0)]) == [False, True, False, False]
 
 
 def test_a_heading_that_turns_with_the_rod_does_not_arm_it():
@@ -75,19 +70,19 @@ def test_a_heading_that_turns_with_the_rod_does_not_arm_it():
     # within 2 deg at the second entry, but the heading swung by 2 deg in between (a
     # herder's heading turns with the rod)
     seq = [(61, 0), (59, 0), (64, 2), (63.5, 1), (59.7, 0.5), (64.5, 0.5)]
-    assert _run(_pursuer(), seq) == [False, True, False, False, True, False]
+    assert _run(seq) == [False, True, False, False, True, False]
 
 
 def test_a_rod_that_moved_between_entries_does_not_arm_it():
     seq = [(61, 0), (59, 0), (62, 0), (55, 0), (66, 0)]
-    assert _run(_pursuer(), seq) == [False, True, False, True, False]
+    assert _run(seq) == [False, True, False, True, False]
 
 
 def test_the_charge_held_ends_when_the_heading_turns():
     # armed as in the fixed-heading chatter, then the heading turns 2 deg: the charge
     # held at 64 deg off the rod ends (a herder's heading turns with the held turn)
     seq = [(61, 0), (59, 0), (62, 0), (62.5, 0), (59.2, 0), (66, 2)]
-    assert _run(_pursuer(), seq) == [False, True, False, False, True, False]
+    assert _run(seq) == [False, True, False, False, True, False]
 
 
 def test_a_heading_that_drifts_like_a_herders_does_not_arm_it():
@@ -96,4 +91,4 @@ def test_a_heading_that_drifts_like_a_herders_does_not_arm_it():
     # herder's smallest drift between two entries in the sets is 0.71 deg (a walker that
     # holds its heading: 0.00), so it does not arm and 64 deg is no charge
     seq = [(61, 0), (59, 0), (62.3, 0.3), (62.9, 0.6), (59.8, 0.8), (64.8, 0.8)]
-    assert _run(_pursuer(), seq) == [False, True, False, False, True, False]
+    assert _run(seq) == [False, True, False, False, True, False]

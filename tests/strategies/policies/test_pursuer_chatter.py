@@ -14,8 +14,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from strategies.policies import make_policy
-from strategies.runner import build_env, run_episode
+from strategies.runner import run_episode
+from tests.strategies.policies.conftest import decomposition_pursuer
 
 
 def test_a_herder_at_a_corner_bisector_does_not_pin_the_pursuer(unseen):
@@ -29,13 +29,6 @@ def test_a_herder_at_a_corner_bisector_does_not_pin_the_pursuer(unseen):
     assert r.winner == "pursuer", r.summary()
 
 
-def _pursuer():
-    config = build_env("open_room", {}).config
-    p = make_policy("pursuer/decomposition")
-    p.reset(role="pursuer", map=config.map, config=config, seed=0)
-    return p
-
-
 @pytest.mark.parametrize(
     ("history", "now", "chatters"),
     [
@@ -47,7 +40,7 @@ def _pursuer():
     ],
 )
 def test_chatter_is_two_reversals_running(history, now, chatters):
-    p = _pursuer()
+    p = decomposition_pursuer()
     for v in history:
         p._velocities.append(v)
     assert p._chatters(np.array(now)) is chatters

@@ -17,16 +17,14 @@ from envs.maps import Map
 from envs.surveillance.config import EnvConfig
 from strategies.policies import make_policy
 from strategies.runner import build_env
-from tests.strategies.policies.conftest import orbit_episode
+from tests.strategies.policies.conftest import decomposition_pursuer, orbit_episode
 
 
 def _pursuer(world: Map, rho: float = 0.5, body: float = 0.1):
     config = EnvConfig(
         map=world, l_min=2.0, l_max=4.0, v_pursuer=1.0, v_evader=rho, body_radius=body
     )
-    policy = make_policy("pursuer/decomposition")
-    policy.reset(role="pursuer", map=config.map, config=config, seed=0)
-    return policy
+    return decomposition_pursuer(config)
 
 
 def _room(side: float) -> Map:

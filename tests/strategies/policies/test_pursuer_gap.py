@@ -20,10 +20,9 @@ import pytest
 import shapely
 from shapely.geometry import LineString
 
-from strategies.policies import make_policy
 from strategies.policies.base import Snapshot
 from strategies.policies.decomposition import crossable_steps, reachable_steps
-from strategies.runner import build_env
+from tests.strategies.policies.conftest import decomposition_pursuer
 
 BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks"
 NB = 144
@@ -68,17 +67,10 @@ def test_the_gaps_wrap_round_bin_zero():
     assert c.size == 0 and np.array_equal(w, cw)
 
 
-def _pursuer(world: str):
-    config = build_env(world, {}).config
-    policy = make_policy("pursuer/decomposition")
-    policy.reset(role="pursuer", map=config.map, config=config, seed=0)
-    return policy
-
-
 @pytest.mark.parametrize("seed", range(6))
 def test_the_rods_room_matches_shapely(seed):
     """``_rod_room``: the rod turned by just under its room each way is clear, just over is not."""
-    p = _pursuer("pillars")
+    p = decomposition_pursuer("pillars")
     free = p.config.map.prepared_free_region
     rng = np.random.default_rng(seed)
     checked, bounds = 0, np.asarray(p.config.map.bounds)

@@ -17,20 +17,13 @@ import numpy as np
 import pytest
 
 from envs.maps import Map
-from strategies.policies import make_policy
 from strategies.policies.base import Snapshot
-from strategies.runner import build_env, run_episode
-
-
-def _pursuer(world: str):
-    config = build_env(world, {}).config
-    policy = make_policy("pursuer/decomposition")
-    policy.reset(role="pursuer", map=config.map, config=config, seed=0)
-    return policy
+from strategies.runner import run_episode
+from tests.strategies.policies.conftest import decomposition_pursuer
 
 
 def test_orbit_margins_in_the_open_room():
-    p = _pursuer("open_room")  # 10 x 10, rho = 0.5, body radius 0.1
+    p = decomposition_pursuer("open_room")  # 10 x 10, rho = 0.5, body radius 0.1
     L = 2.0
     ccw, cw = p._orbit_margins(5.0, 5.0, 0.0, L)
     # the evader's circle has radius rho L / sqrt(1 - rho^2), the pursuer's L / sqrt(...)
@@ -50,7 +43,7 @@ def _charge(evader, theta: float, L: float) -> Snapshot:
 
 
 def test_the_pursuer_turns_before_it_loses_its_last_orbit():
-    p = _pursuer("open_room")
+    p = decomposition_pursuer("open_room")
     L = p.L_target
     # a charge heading east toward the east wall: the circles' centres move with it;
     # find the last position where a circle still fits

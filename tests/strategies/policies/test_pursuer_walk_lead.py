@@ -13,8 +13,7 @@ import pytest
 
 from envs.maps import Map
 from envs.surveillance.config import EnvConfig
-from strategies.policies import make_policy
-from tests.strategies.policies.conftest import orbit_episode
+from tests.strategies.policies.conftest import decomposition_pursuer, orbit_episode
 
 # rand:convex:2005:3.5 (held-out, rho 0.5, L in [2, 4]) at 6 s of the orbit at 0.25 (ccw,
 # seed 101) as hindsight's pursuer (cell 0.02) played it: the evader has begun its lap
@@ -50,9 +49,7 @@ def _pillar_pursuer():
     config = EnvConfig(
         map=world, l_min=2.0, l_max=4.0, v_pursuer=1.0, v_evader=0.5, body_radius=0.1
     )
-    policy = make_policy("pursuer/decomposition")
-    policy.reset(role="pursuer", map=config.map, config=config, seed=0)
-    return policy
+    return decomposition_pursuer(config)
 
 
 @pytest.mark.parametrize("sense", [1, -1])

@@ -24,15 +24,9 @@ import pytest
 from strategies.policies import make_policy
 from strategies.policies.base import Snapshot
 from strategies.runner import build_env, run_episode
+from tests.strategies.policies.conftest import decomposition_pursuer
 
 OVERRIDES = {"v_evader": 0.5, "body_radius": 0.2}  # rho = 0.5, as benchmarks/pursuer_holds.py
-
-
-def _pursuer(**params):
-    config = build_env("open_room", dict(OVERRIDES)).config  # 10 x 10, V_p = 1
-    policy = make_policy("pursuer/decomposition", **params)
-    policy.reset(role="pursuer", map=config.map, config=config, seed=0)
-    return policy
 
 
 def _snap(evader, theta: float, L: float = 2.12) -> Snapshot:
@@ -42,7 +36,7 @@ def _snap(evader, theta: float, L: float = 2.12) -> Snapshot:
 
 
 def test_wall_push_is_the_overlap_along_the_rod():
-    p = _pursuer()
+    p = decomposition_pursuer("open_room", OVERRIDES)  # 10 x 10, V_p = 1
     r = p.config.body_radius
     # pressed 0.08 into the west wall, the pursuer due east: all of the overlap
     assert p._wall_push(_snap((0.12, 5.0), 0.0)) == pytest.approx(r - 0.12)
@@ -96,17 +90,10 @@ def test_the_pursuer_keeps_off_the_walls_with_no_circle_in_reach(world, evader, 
     assert r.winner == "pursuer", r.summary()
 
 
-def _pillars_pursuer():
-    config = build_env("pillars", dict(OVERRIDES)).config
-    policy = make_policy("pursuer/decomposition")
-    policy.reset(role="pursuer", map=config.map, config=config, seed=0)
-    return policy
-
-
 def test_the_corner_ahead_of_a_wall_hugger_is_probed():
     # the evader hugs the bottom edge (y = 2.5) of the pillar room's triangle
     # (13, 2.5) - (16, 2.5) - (14.5, 5.1), its centre a body radius below it
-    p = _pillars_pursuer()
+    p = decomposition_pursuer("pillars", OVERRIDES)
     e = np.array([14.35, 2.3])
     west = p._corners_in_reach(e, np.array([-0.5, 0.0]))
     start, delay, rays, sense = west[0]
@@ -157,7 +144,8 @@ def test_no_safe_orientation_counts_as_a_full_turn_one_way_round():
 
     from strategies.policies.safety import NO_PATH
 
-    p = _pursuer(table="eager")  # one row per grid point: the test writes two probes' rows
+    # one row per grid point: the test writes two probes' rows
+    p = decomposition_pursuer("open_room", OVERRIDES, table="eager")
     tab = p.table
     e = np.array([5.0, 5.0])
     k = 2  # the third probe radius

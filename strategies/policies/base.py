@@ -105,6 +105,15 @@ def distance_target(config: Any) -> float:
     return min(low, 0.5 * (config.l_min + config.l_max))
 
 
+def rounded_length(length: float) -> float:
+    """A rod length as the policies' safety tables take it (and their caches key it):
+    rounded to 6 decimals, so that float noise in ``L_min + body_radius`` does not make
+    another table, or to 6 significant digits where that is finer (below 0.1: on a map
+    scaled by 1e-7, L_min 2e-7, 6 decimals made the length 0 and every reset raised
+    ``safety_table: L = 0.0``; at 1e-5 they kept one digit of it)."""
+    return round(length, 6) if length >= 0.1 else float(f"{length:.6g}")
+
+
 def distance_ceiling(config: Any) -> float:
     """The longest distance a pursuer aims at: L_max less the buffer
     :func:`distance_target` keeps above L_min (its mirror below L_max), or the band's

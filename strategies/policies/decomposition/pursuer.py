@@ -81,6 +81,7 @@ from strategies.policies.base import (
     distance_target,
     nonnegative_param,
     positive_param,
+    rounded_length,
 )
 from strategies.policies.decomposition.charge import _ChargeReading
 from strategies.policies.decomposition.clearance import _clearance_grid, _Clearances, _room_field
@@ -204,7 +205,7 @@ class DecompositionPursuer(
         self._gain = min(self.distance_gain, 1.0 / c.dt)
         # the pursuer's disc keeps its centre body_radius off the walls, so the rod tip
         # meets a wall as if the rod were that much longer (Prop. 3: fewer free arcs)
-        self.table_length = round(self.L_target + c.body_radius, 6)
+        self.table_length = rounded_length(self.L_target + c.body_radius)
         res = self.resolution if self.resolution is not None else c.l_min / 20.0
         kind = self.table_kind
         if kind == "auto":

@@ -70,6 +70,7 @@ from strategies.policies.base import (
     count_param,
     flag_param,
     positive_param,
+    rounded_length,
     unit,
 )
 from strategies.policies.escape_plan import escape_plan
@@ -181,7 +182,7 @@ class ShootingEvader(_PlanWalk, _Shots, _Arcs, _Fallback, BasePolicy):
 
     def _reset(self) -> None:
         c = self.config
-        self.L_eff = round(c.l_min + c.body_radius, 6)
+        self.L_eff = rounded_length(c.l_min + c.body_radius)
         res = self.resolution if self.resolution is not None else c.l_min / 20.0
         # distinct rows: the eager table's lookups at every node, built in about a tenth of
         # the time (corridor at L_min 0.5: 22 s -> 2 s, issue 13); on larger maps filled

@@ -210,6 +210,17 @@ def _cmd_play(args: argparse.Namespace) -> int:
     return 0
 
 
+def _picture_file(out: str | None, default_name: str) -> Path:
+    """``--out`` of a command that draws one picture (.png, .pdf or .svg): the file it
+    names, ``default_name`` inside a directory it names, ``out/default_name`` without it."""
+    return output_file(
+        "--out",
+        out or DEFAULT_OUT / default_name,
+        suffixes=(".png", ".pdf", ".svg"),
+        default_name=default_name,
+    )
+
+
 def _cmd_analyze(args: argparse.Namespace) -> int:
     from envs.maps import load_map
     from envs.maps.io import recommended_parameters
@@ -234,12 +245,7 @@ def _cmd_analyze(args: argparse.Namespace) -> int:
             f"(its widest extent is {diameter:.4g})"
         )
     default_name = f"decomposition_{world.name}_L{length:g}.png"
-    out = output_file(
-        "--out",
-        args.out or DEFAULT_OUT / default_name,
-        suffixes=(".png", ".pdf", ".svg"),
-        default_name=default_name,
-    )
+    out = _picture_file(args.out, default_name)
     from strategies.cspace import decompose, draw_decomposition
 
     dec = decompose(world, length)
@@ -267,12 +273,7 @@ def _cmd_figure(args: argparse.Namespace) -> int:
             "are " + ", ".join(f"{k} (default {v!r})" for k, v in known.items())
         )
     default_name = f"figure_{args.name}.png"
-    out = output_file(
-        "--out",
-        args.out or DEFAULT_OUT / default_name,
-        suffixes=(".png", ".pdf", ".svg"),
-        default_name=default_name,
-    )
+    out = _picture_file(args.out, default_name)
     try:
         draw_figure(args.name, out, **params)
     except SurveilValueError as exc:

@@ -678,25 +678,9 @@ class Map:
         """
         key = (i, j)
         cell = self._cells.get(key)
-        if cell is not None:
-            return cell
-        s = self._cell_size
-        x0, y0 = self.bounds[:2]
-        c = np.array([[x0 + (i + 0.5) * s, y0 + (j + 0.5) * s]])
-        tree = self._edge_tree
-        _, near = tree.query_nearest(shapely.points(c), all_matches=False)
-        u = float(self._pair_distances(c, near)[0])
-        slack = 1e-9 * (self.scale + float(np.abs(self.edge_start).max()) + float(np.abs(c).max()))
-        reach = u + math.sqrt(2.0) * s + slack  # 2 r = the diagonal
-        box = shapely.box(c[0, 0] - reach, c[0, 1] - reach, c[0, 0] + reach, c[0, 1] + reach)
-        edges = np.sort(tree.query(box))
-        edges = edges[self._pair_distances(c, edges) <= reach]
-        cell = (edges, self.edge_start[edges], self.edge_dir[edges], self.edge_length[edges])
-        for a in cell:
-            a.setflags(write=False)
-        if len(self._cells) >= _CELLS_KEPT:
-            self._cells.clear()
-        self._cells[key] = cell
+        if cell is None:
+            self._build_cells([key])
+            cell = self._cells[key]
         return cell
 
     def _build_cells(self, keys: list[tuple[float, float]]) -> None:

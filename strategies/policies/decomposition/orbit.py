@@ -187,9 +187,52 @@ class _OrbitKeeping:
         self, snap: Snapshot, rate: float, hi: float, lo: float, L: float, field: bool = False
     ) -> float:
         """The rotation rate against a charge, overridden to keep or reach an orbit
-        (:meth:`_orbit_pick`), unless that turn slides the pursuer through a wall's normal
+        (:meth:`_orbit_pick`) unless that leaves a clear way to room for a longer one
+        (:meth:`_way_kept`), and unless that turn slides the pursuer through a wall's normal
         (:meth:`_slide_through`)."""
-        return self._slide_through(snap, self._orbit_pick(snap, rate, hi, lo, L, field), hi, lo, L)
+        pick = self._orbit_pick(snap, rate, hi, lo, L, field)
+        if not field:
+            pick = self._way_kept(snap, rate, pick, hi, lo, L)
+        return self._slide_through(snap, pick, hi, lo, L)
+
+    def _way_kept(
+        self, snap: Snapshot, rate: float, pick: float, hi: float, lo: float, L: float
+    ) -> float:
+        """The decomposition's own turn ``rate`` instead of a hard turn ``pick`` toward a
+        circle nearer to room (by :meth:`_orbit_margins`) whose geodesic way to room
+        (:func:`_room_field`, the ``field`` score of :meth:`_after`) is longer by more than
+        a grid step than ``rate``'s, where ``rate``'s path stays clear of walls for
+        ``WALL_HORIZON`` whatever the evader does (both modes of :meth:`_time_to_wall`).
+
+        The margin scores how short of room a circle is where it stands, not how far it
+        is from room: round an obstacle, the circle nearer to having room can be the one
+        farther from it. On the room with the triangular pillar at rho 0.3 (holds-bench-03,
+        seed 5, issue 13) the decomposition turned ccw, up the free side toward the room
+        north of the pillar (way 1.17), and the hard cw turn's circle scored 0.2 nearer
+        room (short by 0.57 against 0.80, within ``ORBIT_REACH``) with a way of 1.44 round
+        the pillar's tip; the pick alternated between the two every other step for two
+        seconds (2.3-4.1 s: after each cw step the cw circle fell back out of the pick's
+        0.01 L lead), the rod stood still while the charge pushed the pursuer into the
+        pocket between the pillar's tip and the room's corner, and every way out of there
+        slid it into a wall: too close at 8.7-9.0 s against the three chargers. Keeping
+        ``rate`` turns the rod ccw round to room and holds all three. The ways stand apart
+        by far more than the step's flicker (0.27-0.7 there), so no latch is needed.
+        Where ``rate``'s own path meets a wall the override stands: judged only on the
+        ways, the rule kept a turn into a wall 0.1 s ahead against pillar_tri's herder
+        (unseen-p1, lost at 18.3 s where the hard turn holds), and with ``rate``'s path
+        clear only for ``ORBIT_LOOKAHEAD`` it lost the maze at rho 0.5 (seed 7, 16.1 s).
+        A stalled ride (``field`` of :meth:`_orbit_choice`) already scores by the way.
+        """
+        if self._field is None or pick == rate or pick not in (hi, lo):
+            return pick
+        if self._after(snap, rate, L, False) >= 0.0:
+            return pick
+        if min(self._time_to_wall(snap, rate, L, f) for f in (True, False)) < math.inf:
+            return pick
+        h = self.table.resolution
+        if self._after(snap, pick, L, True) < self._after(snap, rate, L, True) - h:
+            return rate
+        return pick
 
     def _orbit_pick(
         self, snap: Snapshot, rate: float, hi: float, lo: float, L: float, field: bool = False

@@ -199,32 +199,53 @@ class _OrbitKeeping:
         self, snap: Snapshot, rate: float, pick: float, hi: float, lo: float, L: float
     ) -> float:
         """The decomposition's own turn ``rate`` instead of a hard turn ``pick`` toward a
-        circle nearer to room (by :meth:`_orbit_margins`) whose geodesic way to room
-        (:func:`_room_field`, the ``field`` score of :meth:`_after`) is longer by more than
-        a grid step than ``rate``'s, where ``rate``'s path stays clear of walls for
-        ``WALL_HORIZON`` whatever the evader does (both modes of :meth:`_time_to_wall`).
+        circle nearer to having room (by :meth:`_orbit_margins`) but farther from it, where
+        ``rate`` heads straight for room and its path is clear.
 
         The margin scores how short of room a circle is where it stands, not how far it
         is from room: round an obstacle, the circle nearer to having room can be the one
-        farther from it. On the room with the triangular pillar at rho 0.3 (holds-bench-03,
-        seed 5, issue 13) the decomposition turned ccw, up the free side toward the room
-        north of the pillar (way 1.17), and the hard cw turn's circle scored 0.2 nearer
-        room (short by 0.57 against 0.80, within ``ORBIT_REACH``) with a way of 1.44 round
-        the pillar's tip; the pick alternated between the two every other step for two
-        seconds (2.3-4.1 s: after each cw step the cw circle fell back out of the pick's
-        0.01 L lead), the rod stood still while the charge pushed the pursuer into the
-        pocket between the pillar's tip and the room's corner, and every way out of there
-        slid it into a wall: too close at 8.7-9.0 s against the three chargers. Keeping
-        ``rate`` turns the rod ccw round to room and holds all three. The ways stand apart
-        by far more than the step's flicker (0.27-0.7 there), so no latch is needed.
-        Where ``rate``'s own path meets a wall the override stands: judged only on the
-        ways, the rule kept a turn into a wall 0.1 s ahead against pillar_tri's herder
-        (unseen-p1, lost at 18.3 s where the hard turn holds), and with ``rate``'s path
-        clear only for ``ORBIT_LOOKAHEAD`` it lost the maze at rho 0.5 (seed 7, 16.1 s).
-        A stalled ride (``field`` of :meth:`_orbit_choice`) already scores by the way.
+        farther from it. So ``rate`` stands against ``pick`` when, after
+        ``ORBIT_LOOKAHEAD`` (:meth:`_after`), ``pick``'s geodesic way to room
+        (:func:`_room_field`, the ``field`` score) is longer than ``rate``'s by more than
+        a grid step, ``rate``'s way exceeds its shortfall by at most ``ORBIT_REACH`` x L
+        (room lies straight on, not round something: the stall's detour condition of
+        :meth:`_keep_orbit`, turned round), and ``rate``'s path stays clear of walls for
+        ``WALL_HORIZON`` whatever the evader does (both modes of :meth:`_time_to_wall`).
+
+        On the room with the triangular pillar at rho 0.3 (holds-bench-03, seed 5, issue
+        13) the decomposition turned ccw, up the free side toward the room north of the
+        pillar (way 1.17, shortfall 0.80), and the hard cw turn's circle scored nearer
+        room by its margin (short by 0.57, within ``ORBIT_REACH``) with a way of 1.44
+        round the pillar's tip; the pick alternated between the two every other step for
+        two seconds (2.3-4.1 s: after each cw step the cw circle fell back out of the
+        pick's 0.01 L lead), the rod stood still while the charge pushed the pursuer into
+        the pocket between the pillar's tip and the room's corner, and every way out of
+        there slid it into a wall: too close at 8.7-9.0 s against the three chargers.
+        Keeping ``rate`` turns the rod ccw round to room and holds all three. The ways
+        stand apart by more than the step's flicker (0.27-0.7 there), so no latch is
+        needed. Each condition was measured (helper-190, session 29): without the wall
+        condition the rule kept a turn into a wall 0.1 s ahead against pillar_tri's
+        herder (unseen-p1, lost at 18.3 s where the hard turn holds), with ``rate``'s path
+        clear only for ``ORBIT_LOOKAHEAD`` it lost the maze at rho 0.5 (seed 7, 16.1 s);
+        without the detour condition it fired where room was 4.5 m away round the walls
+        (the office turned by 0.5 rad, L in [2, 3], rho 0.3, seed 952, ways 4.6 against
+        5.0) and lost to the shooting evader without retries at 61.7 s, held before
+        (``test_evader_escapes_forgive``). A stalled ride (``field`` of
+        :meth:`_orbit_choice`) already scores by the way.
         """
         if self._field is None or pick == rate or pick not in (hi, lo):
             return pick
+        margin = self._after(snap, rate, L, False)
+        if margin >= 0.0:
+            return pick
+        if min(self._time_to_wall(snap, rate, L, f) for f in (True, False)) < math.inf:
+            return pick
+        way = self._after(snap, rate, L, True)  # minus the way (or the shortfall)
+        if margin - way > self.ORBIT_REACH * L:  # room lies round something
+            return pick
+        if self._after(snap, pick, L, True) < way - self.table.resolution:
+            return rate
+        return pick
         if self._after(snap, rate, L, False) >= 0.0:
             return pick
         if min(self._time_to_wall(snap, rate, L, f) for f in (True, False)) < math.inf:

@@ -200,7 +200,7 @@ class _OrbitKeeping:
     ) -> float:
         """The decomposition's own turn ``rate`` instead of a hard turn ``pick`` toward a
         circle nearer to having room (by :meth:`_orbit_margins`) but farther from it, where
-        ``rate`` heads straight for room and its path is clear.
+        ``rate`` heads straight for room and its path is clear, against a long charge.
 
         The margin scores how short of room a circle is where it stands, not how far it
         is from room: round an obstacle, the circle nearer to having room can be the one
@@ -210,7 +210,9 @@ class _OrbitKeeping:
         a grid step, ``rate``'s way exceeds its shortfall by at most ``ORBIT_REACH`` x L
         (room lies straight on, not round something: the stall's detour condition of
         :meth:`_keep_orbit`, turned round), and ``rate``'s path stays clear of walls for
-        ``WALL_HORIZON`` whatever the evader does (both modes of :meth:`_time_to_wall`).
+        ``WALL_HORIZON`` whatever the evader does (both modes of :meth:`_time_to_wall`),
+        against a charge that has lasted ``CHARGE_PERSIST`` (as :meth:`_slide_through`:
+        the scores follow a charge along the rod).
 
         On the room with the triangular pillar at rho 0.3 (holds-bench-03, seed 5, issue
         13) the decomposition turned ccw, up the free side toward the room north of the
@@ -230,10 +232,18 @@ class _OrbitKeeping:
         without the detour condition it fired where room was 4.5 m away round the walls
         (the office turned by 0.5 rad, L in [2, 3], rho 0.3, seed 952, ways 4.6 against
         5.0) and lost to the shooting evader without retries at 61.7 s, held before
-        (``test_evader_escapes_forgive``). A stalled ride (``field`` of
-        :meth:`_orbit_choice`) already scores by the way.
+        (``test_evader_escapes_forgive``). Without the long charge it changed single steps
+        against herders and a darter, which charge in bursts: on the corner world from the
+        runner's default starts it kept the cw turn at the bottom wall with the ways 0.28
+        against 0.50 and the margins 0.04 apart (seeds 6, 10, 20, lost at 15.6-35.3 s
+        where the hard ccw turn held; eight other seeds went the other way), and fresh
+        rand:rectangles:3005 (darter) was lost at 53.2 s after one changed step at 2.6 s.
+        Against seed 5's charge (from 0.1 s) it fires from 3.2 s on and holds.
+        A stalled ride (``field`` of :meth:`_orbit_choice`) already scores by the way.
         """
         if self._field is None or pick == rate or pick not in (hi, lo):
+            return pick
+        if self._charge_run < self._charge_persist:
             return pick
         margin = self._after(snap, rate, L, False)
         if margin >= 0.0:

@@ -9,7 +9,8 @@ less (0.57 against 0.80, within ORBIT_REACH) but lay round the pillar's tip, far
 room by the geodesic way (1.44 against 1.17). The pick alternated between the two for two
 seconds, the rod stood still while the charge pushed the pursuer into the pocket between
 the pillar's tip and the room's south-east corner: too close at 8.7-9.0 s. ``_way_kept``
-keeps the decomposition's turn there (``_orbit_choice``).
+keeps the decomposition's turn there (``_orbit_choice``) against a charge that has lasted
+CHARGE_PERSIST (from 3.2 s on).
 """
 
 from __future__ import annotations
@@ -38,12 +39,13 @@ def test_the_charged_pursuer_turns_round_to_room_not_into_the_pocket(evader):
     assert r.winner == "pursuer", (r.cause, r.escape_time)
 
 
-def _charged_east_of_the_pillar(ex: float, ey: float, theta_deg: float):
+def _charged_east_of_the_pillar(ex: float, ey: float, theta_deg: float, run: int = 100):
     """pillars at rho 0.3: the evader at (ex, ey) charging along the rod at full speed,
-    the pursuer at L_target along the rod at theta_deg."""
+    the pursuer at L_target along the rod at theta_deg, the charge ``run`` steps long."""
     config = build_env("pillars", PILLARS_03).config
     p = make_policy("pursuer/decomposition")
     p.reset(role="pursuer", map=config.map, config=config, seed=0)
+    p._charge_run = run
     L = p.L_target
     t = math.radians(theta_deg)
     u = np.array([math.cos(t), math.sin(t)])
@@ -72,3 +74,9 @@ def test_where_the_own_turn_meets_a_wall_the_hard_turn_stands():
     assert p._time_to_wall(snap, HI, L, True) < math.inf
     assert p._after(snap, LO, L, True) < p._after(snap, HI, L, True) - p.table.resolution
     assert p._way_kept(snap, HI, LO, HI, LO, L) == LO
+
+
+def test_against_a_short_charge_the_hard_turn_stands():
+    # 30 steps < CHARGE_PERSIST / dt + 1: herders and darters charge in bursts
+    p, snap, L = _charged_east_of_the_pillar(16.77, 3.45, -29.7, run=30)
+    assert p._orbit_choice(snap, HI, HI, LO, L) == LO

@@ -97,8 +97,14 @@ FRESH_WORLDS = " ".join(
 """32 random maps nobody had used (docs/ANALYTIC_RESULTS.md, fresh-p0)."""
 _HOLDS = "--seeds 8 --rho 0.5 --no-greedy"
 _HELDOUT_P = "--worlds @benchmarks/heldout_worlds_pursuer.txt"
-_BASE = "194babd"
-"""The commit every figure below holds at (all seventeen sets played there, compared per
+_BASE = "7b2b484"
+"""The commit every figure below holds at (branch decomp-orbit-190, ``_way_kept``: all
+seventeen sets played there, compared per episode with 194babd's rows: holds-bench-03 +3,
+pillars seed 5 against the three chargers; heldout-p0 +1, corner~x0.8rot1.2 against the
+herder; three escapes from the decomposition pursuer no longer made, unseen-e
+random:rectangles:16 seed 1019, fresh-e random:rectangles:4504 seed 6880 and
+rand:polygons:4605:1.5 seed 6032, escaped at 453, 479 and 649 s before; every other winner
+the same). Before: at 194babd (all seventeen sets played there, compared per
 episode with 4be633d's rows after 9f49910's evader/referee replay: nothing lost; 9f49910
 (evader/referee plays the referee's evader-bound fallback, a stronger ground-truth
 opponent) lost holds-variants, unseen-p0, heldout-p0 and fresh-p0 one episode each, two
@@ -155,7 +161,8 @@ _HOLDS_03 = _BASE
 charging evaders: no set played rho 0.3 on the paper's worlds); first played at 80d5f9d
 (378/384), again at 4be633d: every episode's winner the same; at 4c4631e (branch
 decomp-pillars-177, the slide check) 381/384, seed 3 held against the three chargers, and
-at 194babd (its merge)."""
+at 194babd (its merge); at 7b2b484 (branch decomp-orbit-190, the orbit choice keeps the
+decomposition's clear turn toward room, ``_way_kept``) 384/384, seed 5 held too."""
 
 
 def _set(name: str, alias: str, role: str, figure: str, measured: str, command: str):
@@ -179,7 +186,7 @@ SETS: dict[str, PolicySet] = {
              "unseen_worlds.py --role pursuer --combos 1"),
         _set("unseen-p2", "pu2", "pursuer", "486/486", _BASE,
              "unseen_worlds.py --role pursuer --combos 2"),
-        _set("heldout-p0", "ph0", "pursuer", "613/648", _BASE,
+        _set("heldout-p0", "ph0", "pursuer", "614/648", _BASE,
              f"unseen_worlds.py --role pursuer {_HELDOUT_P} --combos 0"),
         _set("heldout-p1", "ph1", "pursuer", "636/648", _BASE,
              f"unseen_worlds.py --role pursuer {_HELDOUT_P} --combos 1"),
@@ -187,11 +194,11 @@ SETS: dict[str, PolicySet] = {
              f"unseen_worlds.py --role pursuer {_HELDOUT_P} --combos 2"),
         _set("fresh-p0", "fresh_p0", "pursuer", "555/576", _BASE,
              f"unseen_worlds.py --role pursuer --combos 0 --worlds {FRESH_WORLDS}"),
-        _set("unseen-e", "eunseen", "evader", "1189/1189", _BASE,
+        _set("unseen-e", "eunseen", "evader", "1188/1189", _BASE,
              "unseen_worlds.py --role evader"),
         _set("heldout-e", "eheldout", "evader", "776/779", _BASE,
              "unseen_worlds.py --role evader --worlds @benchmarks/heldout_worlds_evader.txt"),
-        _set("fresh-e", "fresh_e", "evader", "1133/1139", _BASE,
+        _set("fresh-e", "fresh_e", "evader", "1131/1139", _BASE,
              f"unseen_worlds.py --role evader {_FRESH_E}"),
         _set("escapes-bench", "bench3", "evader", "512/512", _BASE,
              "evader_escapes.py --seeds 4 --simple-seeds 0"),
@@ -201,7 +208,7 @@ SETS: dict[str, PolicySet] = {
              "fixed_starts.py --starts certified --role pursuer"),
         _set("certified-e", "certe", "evader", "468/468", _FIXED,
              "fixed_starts.py --starts certified --role evader"),
-        _set("holds-bench-03", "b1r3", "pursuer", "381/384", _HOLDS_03,
+        _set("holds-bench-03", "b1r3", "pursuer", "384/384", _BASE,
              "pursuer_holds.py --worlds corridor l_hall open_room corner pillars maze "
              "--variants 'as is' --seeds 8 --rho 0.3 --no-greedy"),
     )

@@ -187,9 +187,83 @@ class _OrbitKeeping:
         self, snap: Snapshot, rate: float, hi: float, lo: float, L: float, field: bool = False
     ) -> float:
         """The rotation rate against a charge, overridden to keep or reach an orbit
-        (:meth:`_orbit_pick`), unless that turn slides the pursuer through a wall's normal
+        (:meth:`_orbit_pick`) unless that leaves a clear way to room for a longer one
+        (:meth:`_way_kept`), and unless that turn slides the pursuer through a wall's normal
         (:meth:`_slide_through`)."""
-        return self._slide_through(snap, self._orbit_pick(snap, rate, hi, lo, L, field), hi, lo, L)
+        pick = self._orbit_pick(snap, rate, hi, lo, L, field)
+        if not field:
+            pick = self._way_kept(snap, rate, pick, hi, lo, L)
+        return self._slide_through(snap, pick, hi, lo, L)
+
+    def _way_kept(
+        self, snap: Snapshot, rate: float, pick: float, hi: float, lo: float, L: float
+    ) -> float:
+        """The decomposition's own turn ``rate`` instead of a hard turn ``pick`` toward a
+        circle nearer to having room (by :meth:`_orbit_margins`) but farther from it, where
+        ``rate`` heads straight for room and its path is clear, against a long charge.
+
+        The margin scores how short of room a circle is where it stands, not how far it
+        is from room: round an obstacle, the circle nearer to having room can be the one
+        farther from it. So ``rate`` stands against ``pick`` when, after
+        ``ORBIT_LOOKAHEAD`` (:meth:`_after`), ``pick``'s geodesic way to room
+        (:func:`_room_field`, the ``field`` score) is longer than ``rate``'s by more than
+        a grid step, ``rate``'s way exceeds its shortfall by at most ``ORBIT_REACH`` x L
+        (room lies straight on, not round something: the stall's detour condition of
+        :meth:`_keep_orbit`, turned round), and ``rate``'s path stays clear of walls for
+        ``WALL_HORIZON`` whatever the evader does (both modes of :meth:`_time_to_wall`),
+        against a charge that has lasted ``CHARGE_PERSIST`` (as :meth:`_slide_through`:
+        the scores follow a charge along the rod).
+
+        On the room with the triangular pillar at rho 0.3 (holds-bench-03, seed 5, issue
+        13) the decomposition turned ccw, up the free side toward the room north of the
+        pillar (way 1.17, shortfall 0.80), and the hard cw turn's circle scored nearer
+        room by its margin (short by 0.57, within ``ORBIT_REACH``) with a way of 1.44
+        round the pillar's tip; the pick alternated between the two every other step for
+        two seconds (2.3-4.1 s: after each cw step the cw circle fell back out of the
+        pick's 0.01 L lead), the rod stood still while the charge pushed the pursuer into
+        the pocket between the pillar's tip and the room's corner, and every way out of
+        there slid it into a wall: too close at 8.7-9.0 s against the three chargers.
+        Keeping ``rate`` turns the rod ccw round to room and holds all three. The ways
+        stand apart by more than the step's flicker (0.27-0.7 there), so no latch is
+        needed. Each condition was measured (helper-190, session 29): without the wall
+        condition the rule kept a turn into a wall 0.1 s ahead against pillar_tri's
+        herder (unseen-p1, lost at 18.3 s where the hard turn holds), with ``rate``'s path
+        clear only for ``ORBIT_LOOKAHEAD`` it lost the maze at rho 0.5 (seed 7, 16.1 s);
+        without the detour condition it fired where room was 4.5 m away round the walls
+        (the office turned by 0.5 rad, L in [2, 3], rho 0.3, seed 952, ways 4.6 against
+        5.0) and lost to the shooting evader without retries at 61.7 s, held before
+        (``test_evader_escapes_forgive``). Without the long charge it changed single steps
+        against herders and a darter, which charge in bursts: on the corner world from the
+        runner's default starts it kept the cw turn at the bottom wall with the ways 0.28
+        against 0.50 and the margins 0.04 apart (seeds 6, 10, 20, lost at 15.6-35.3 s
+        where the hard ccw turn held; eight other seeds went the other way), and fresh
+        rand:rectangles:3005 (darter) was lost at 53.2 s after one changed step at 2.6 s.
+        Against seed 5's charge (from 0.1 s) it fires from 3.2 s on and holds.
+        A stalled ride (``field`` of :meth:`_orbit_choice`) already scores by the way.
+        """
+        if self._field is None or pick == rate or pick not in (hi, lo):
+            return pick
+        if self._charge_run < self._charge_persist:
+            return pick
+        margin = self._after(snap, rate, L, False)
+        if margin >= 0.0:
+            return pick
+        if min(self._time_to_wall(snap, rate, L, f) for f in (True, False)) < math.inf:
+            return pick
+        way = self._after(snap, rate, L, True)  # minus the way (or the shortfall)
+        if margin - way > self.ORBIT_REACH * L:  # room lies round something
+            return pick
+        if self._after(snap, pick, L, True) < way - self.table.resolution:
+            return rate
+        return pick
+        if self._after(snap, rate, L, False) >= 0.0:
+            return pick
+        if min(self._time_to_wall(snap, rate, L, f) for f in (True, False)) < math.inf:
+            return pick
+        h = self.table.resolution
+        if self._after(snap, pick, L, True) < self._after(snap, rate, L, True) - h:
+            return rate
+        return pick
 
     def _orbit_pick(
         self, snap: Snapshot, rate: float, hi: float, lo: float, L: float, field: bool = False

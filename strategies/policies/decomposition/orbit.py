@@ -256,14 +256,6 @@ class _OrbitKeeping:
         if self._after(snap, pick, L, True) < way - self.table.resolution:
             return rate
         return pick
-        if self._after(snap, rate, L, False) >= 0.0:
-            return pick
-        if min(self._time_to_wall(snap, rate, L, f) for f in (True, False)) < math.inf:
-            return pick
-        h = self.table.resolution
-        if self._after(snap, pick, L, True) < self._after(snap, rate, L, True) - h:
-            return rate
-        return pick
 
     def _orbit_pick(
         self, snap: Snapshot, rate: float, hi: float, lo: float, L: float, field: bool = False

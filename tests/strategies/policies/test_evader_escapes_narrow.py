@@ -27,7 +27,9 @@ falls back. Each episode was held for the whole 8 D / V_e horizon before:
   kept the pursuer at least 4.2 from each after the first 3 D / V_e, so the herd,
   which began only within L_max of one, never did. Herding wherever the pursuer is
   after ``HERD_AFTER``: too close at 5.97 D / V_e (the corner herder of the pursuer
-  benchmark, herding from the first step, at 0.59).
+  benchmark, herding from the first step, at 0.59). Since 7f77e91 (the decomposition pursuer's
+  _way_kept) that pursuer holds this start; the test plays random:rectangles:15 seed
+  230 (L_max 2 L_min), a herd in a room of the same kind.
 """
 
 from __future__ import annotations

@@ -98,8 +98,9 @@ FRESH_WORLDS = " ".join(
 _HOLDS = "--seeds 8 --rho 0.5 --no-greedy"
 _HELDOUT_P = "--worlds @benchmarks/heldout_worlds_pursuer.txt"
 _BASE = "7b2b484"
-"""The commit every figure below holds at (branch decomp-orbit-190, ``_way_kept``: all
-seventeen sets played there, compared per episode with 194babd's rows: holds-bench-03 +3,
+"""The commit every figure below holds at (branch decomp-orbit-190, ``_way_kept``, merged
+into main as 7f77e91: all seventeen sets played there, and holds-bench-045 (the lead; the
+same 384 rows with main at 0d70970); compared per episode with 194babd's rows: holds-bench-03 +3,
 pillars seed 5 against the three chargers; heldout-p0 +1, corner~x0.8rot1.2 against the
 herder; three escapes from the decomposition pursuer no longer made, unseen-e
 random:rectangles:16 seed 1019, fresh-e random:rectangles:4504 seed 6880 and
@@ -154,6 +155,13 @@ at 34c7663, 3765f76, 8bef7db, 5270138, 4be633d and 194babd; certified-p's starts
 corner world's default starts (the reproduction report's episodes) and the referee's
 certified starts (``benchmarks/certified_starts.json``)."""
 
+
+_HOLDS_045 = _BASE
+"""Where holds-bench-045 was last played: holds-bench's episodes at rho 0.45, in the band
+between the sets' 0.3 and 0.5 (helper-189's fresh probe found pillars seed 2 lost there,
+at rho 0.42-0.46 only, to the three charging evaders, too close at 2.1-2.2 s; the maze's
+orbit seeds 0 and 5 and wall-hugging seed 6 are lost there too); first played at 0d70970
+and 7b2b484, 378/384 both, every row the same."""
 
 _HOLDS_03 = _BASE
 """Where holds-bench-03 was last played: holds-bench's episodes at rho 0.3 instead of 0.5
@@ -211,6 +219,9 @@ SETS: dict[str, PolicySet] = {
         _set("holds-bench-03", "b1r3", "pursuer", "384/384", _BASE,
              "pursuer_holds.py --worlds corridor l_hall open_room corner pillars maze "
              "--variants 'as is' --seeds 8 --rho 0.3 --no-greedy"),
+        _set("holds-bench-045", "b1r45", "pursuer", "378/384", _HOLDS_045,
+             "pursuer_holds.py --worlds corridor l_hall open_room corner pillars maze "
+             "--variants 'as is' --seeds 8 --rho 0.45 --no-greedy"),
     )
 }  # fmt: skip
 

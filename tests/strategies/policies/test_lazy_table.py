@@ -84,26 +84,37 @@ def test_both_rotation_distances_at_once_are_the_circular_distances(nb):
     assert np.array_equal(cw, _circular_distance(safe, -1))
 
 
-def test_rows_classify_the_nodes_ahead_with_the_new_ones(monkeypatch):
+@pytest.fixture
+def batches(monkeypatch):
+    """The sizes of the lazy tables' classification batches, in order (classify_points
+    counted, then called as before)."""
+    import strategies.policies.lazy_table as lt
+
+    sizes: list[int] = []
+    classify = lt.classify_points
+
+    def counted(dec, pts, step, centres, **kw):
+        sizes.append(len(pts))
+        return classify(dec, pts, step, centres, **kw)
+
+    monkeypatch.setattr(lt, "classify_points", counted)
+    return sizes
+
+
+def test_rows_classify_the_nodes_ahead_with_the_new_ones(monkeypatch, batches):
     """rows(points, step, steps): the new nodes of ``points + k step`` (k = 1 .. steps)
     join a batch that ``points`` needs anyway (a batch cost ~0.2 ms however few its
     points), with the same entries as when they are looked up on their own; nothing
     ahead is classified when ``points`` need no batch. inside() likewise tests the
     nodes ahead with the new ones."""
-    import strategies.policies.lazy_table as lt
 
-    batches, tests = [], []
-
-    def counted(dec, pts, step, centres, **kw):
-        batches.append(len(pts))
-        return classify(dec, pts, step, centres, **kw)
+    tests = []
 
     def tested(self, ix, iy, flat):
         tests.append(len(ix))
         return membership(self, ix, iy, flat)
 
-    classify, membership = lt.classify_points, LazySafetyTable._membership
-    monkeypatch.setattr(lt, "classify_points", counted)
+    membership = LazySafetyTable._membership
     monkeypatch.setattr(LazySafetyTable, "_membership", tested)
     world = _world("l_hall", 0.61)
     rng = np.random.default_rng(4)
@@ -131,7 +142,7 @@ def test_rows_classify_the_nodes_ahead_with_the_new_ones(monkeypatch):
     assert early.classified == n and len(batches) == 3 and len(tests) == 3
 
 
-def test_a_row_on_new_ground_is_classified_with_the_nodes_around_it(monkeypatch):
+def test_a_row_on_new_ground_is_classified_with_the_nodes_around_it(batches):
     """row() of a point whose node is not classified yet (the pursuer's look-up of the
     evader's node, on new ground) classifies the unknown nodes within _AROUND nodes of it
     in the same batch: the evader's next nodes need no batch of one each (~0.3 ms
@@ -139,14 +150,6 @@ def test_a_row_on_new_ground_is_classified_with_the_nodes_around_it(monkeypatch)
     points off it are answered as before."""
     import strategies.policies.lazy_table as lt
 
-    batches = []
-
-    def counted(dec, pts, step, centres, **kw):
-        batches.append(len(pts))
-        return classify(dec, pts, step, centres, **kw)
-
-    classify = lt.classify_points
-    monkeypatch.setattr(lt, "classify_points", counted)
     world = _world("corridor", 0.0)
     eager = safety_table(world, 2.2, 0.1, 48, disk_cache=False)
     lazy = LazySafetyTable(world, 2.2, 0.1, 48)
@@ -198,22 +201,13 @@ def test_rows_of_points_whose_nodes_inside_found_are_the_rows_looked_up_again():
         assert np.array_equal(getattr(given, name), getattr(found, name)), name
 
 
-def test_the_lazy_pursuer_classifies_the_evaders_probes_ahead(monkeypatch):
+def test_the_lazy_pursuer_classifies_the_evaders_probes_ahead(monkeypatch, batches):
     """The pursuer passes its probes LOOKAHEAD_STEPS steps on along the evader's
     velocity: one classification batch every few decisions instead of one a decision
     (floor_plan:0:110 at L_min 2: 1.03 batches a decision -> 0.27, mean decision time
     1.3-1.6 -> 0.81-0.85 ms, decision_time.py --clock cpu), and the same episode."""
-    import strategies.policies.lazy_table as lt
     from strategies.policies.decomposition import DecompositionPursuer
 
-    batches = []
-
-    def counted(dec, pts, step, centres, **kw):
-        batches.append(len(pts))
-        return classify(dec, pts, step, centres, **kw)
-
-    classify = lt.classify_points
-    monkeypatch.setattr(lt, "classify_points", counted)
     world = _world("corridor", 0.3)
     runs, counts = [], []
     for steps in (0, DecompositionPursuer.LOOKAHEAD_STEPS):

@@ -27,6 +27,7 @@ from envs import validation as V
 from envs.errors import (
     InvalidConfigError,
     InvalidPlacementError,
+    LongRunWarning,
     MemoryBudgetError,
     NoStartError,
     VacuousBoundWarning,
@@ -34,7 +35,7 @@ from envs.errors import (
 from envs.geometry import kernel_for
 from strategies.memory import memory_budget as _memory_budget
 from strategies.memory import physical_memory
-from strategies.referee._budget import SolveSize, _size, bound_size, check_budget
+from strategies.referee._budget import SolveSize, _size, bound_size, check_budget, duration
 from strategies.referee.cache import cache_path, load_arrays, save_arrays
 from strategies.referee.evader_bound import EvaderBound, solve_evader_bound
 from strategies.referee.pursuer_bound import VACUOUS_RHO, PursuerBound, solve_pursuer_bound
@@ -115,6 +116,17 @@ on the corner world at 0.5 (16 % finer), 0.07 - 0.9 % elsewhere at rho = 0.5 - 0
 """
 
 
+LONG_SOLVE_SECONDS = 120.0
+"""A bound estimated (:func:`~strategies.referee._budget.bound_size`) to take longer than
+this to solve warns (:class:`~envs.errors.LongRunWarning`) before it starts, when it is not
+in the cache: a referee policy solves at its first reset, and at L_min = 0.5 the pursuer
+bounds of the built-in worlds at the default 16 cells per L_min are estimated at 10 - 26
+minutes, spent without a word. The estimate is an order of magnitude (the corridor's
+pursuer bound at its defaults, estimated 43 s, took 9 s of wall time on a loaded machine:
+at rho = 0.5 it certifies nothing and its fixed point ends early). At the built-in worlds'
+defaults (L_min = 2) only the office's pursuer bound (148 s) passes two minutes."""
+
+
 def _cached(kind, cls, solver, spec, res, cache, cache_dir, progress, memory_budget=None):
     """The bound ``kind`` of ``spec`` at ``res``: loaded from the cache, or solved and
     stored (a read-only or full disk only costs the recomputation next time)."""
@@ -122,6 +134,17 @@ def _cached(kind, cls, solver, spec, res, cache, cache_dir, progress, memory_bud
         bound = _from_cache(kind, cls, spec, res, cache_dir)
         if bound is not None:
             return bound
+    size = bound_size(spec, res, kind)
+    if size.seconds > LONG_SOLVE_SECONDS:
+        where = "; it is cached for the next run" if cache else ""
+        warnings.warn(
+            f"solving the {kind} bound of map {spec.map.name!r} (L in [{spec.l_min:g}, "
+            f"{spec.l_max:g}], cell {res.cell:g}): {size.describe()}, estimated to take "
+            f"about {duration(size.seconds)}{where}; the time grows as "
+            "(cells per L_min)^4, so a coarser resolution shortens it",
+            LongRunWarning,
+            stacklevel=3,
+        )
     bound = solver(spec, res, progress=progress, memory_budget=memory_budget)
     if cache:
         try:

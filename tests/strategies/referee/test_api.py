@@ -3,6 +3,8 @@ the pictures, and bad input."""
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -214,3 +216,25 @@ def test_coarsest_with_starts_is_where_the_lattice_starts_begin(l_max):
     assert len(referee_for(cfg, fit, cache=False).lattice_starts()) > 0
     with pytest.raises(NoStartError, match="hold no start"):  # was a referee with 0 starts
         referee_for(cfg, fit / COARSEST_SCAN_STEP, cache=False)
+
+
+def test_a_long_solve_warns_before_it_starts_and_not_from_the_cache(tmp_path, monkeypatch):
+    """A referee policy solves at its first reset: a solve estimated beyond
+    LONG_SOLVE_SECONDS says so (with the estimate) before it starts; a cached bound does not."""
+    import strategies.referee.referee as referee_module
+    from envs.errors import LongRunWarning
+    from strategies.referee._budget import bound_size
+
+    s = spec(open_room(4.0), 1.5)
+    res = Resolution.for_role(s, "evader", 8, coarse=4)
+    estimate = bound_size(s, res, "evader").seconds
+    monkeypatch.setattr(referee_module, "LONG_SOLVE_SECONDS", 0.5 * estimate)
+    with pytest.warns(LongRunWarning, match=r"evader bound of map 'open4'.*estimated to take"):
+        cached_evader_bound(s, res, cache_dir=tmp_path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", LongRunWarning)
+        cached_evader_bound(s, res, cache_dir=tmp_path)  # from the cache: no word
+    monkeypatch.setattr(referee_module, "LONG_SOLVE_SECONDS", 2.0 * estimate)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", LongRunWarning)
+        cached_evader_bound(s, res, cache=False)  # below the limit: no word

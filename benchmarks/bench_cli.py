@@ -218,8 +218,8 @@ def play_rows(
     """
     t0 = time.perf_counter()
     with episode_rows.appending(results) as write, contextlib.ExitStack() as stack:
-        if workers > 1:
-            pool = stack.enter_context(worker_pool(workers, initializer, initargs))
+        if min(workers, len(todo)) > 1:  # no more workers than jobs (a resumed run: none)
+            pool = stack.enter_context(worker_pool(min(workers, len(todo)), initializer, initargs))
             rows = pool.imap_unordered(play, todo)
         else:
             rows = map(play, todo)

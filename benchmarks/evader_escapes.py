@@ -216,7 +216,8 @@ def main(argv=None) -> int:
     t0 = time.perf_counter()
     with contextlib.ExitStack() as stack:
         write = stack.enter_context(episode_rows.appending(args.results)) if args.results else None
-        pool = stack.enter_context(worker_pool(args.workers))
+        # no more workers than episodes (a resumed run with 3 left, or none, starts 3 or 1)
+        pool = stack.enter_context(worker_pool(min(args.workers, max(1, len(todo)))))
         held = 0
         for i, row in enumerate(pool.imap_unordered(_play, todo), 1):
             if write is not None:

@@ -330,3 +330,36 @@ def test_a_second_run_on_a_results_file_in_use_is_refused_and_changes_nothing(
     with rows.appending(out) as write:  # the holder gone, the file is free again
         write({"id": 2})
     assert _lines(out) == ['{"id": 2, "code": ' + json.dumps(rows.code_version()) + "}"]
+
+
+def test_play_rows_starts_no_more_workers_than_jobs(bench, tmp_path, monkeypatch):
+    """A resumed run with nothing (or one job) left starts no pool of --workers processes:
+    with 8 workers asked, none is spawned for 0 or 1 job, 2 for 2 jobs."""
+    bench_cli = bench("bench_cli")
+    started = []
+    real = bench_cli.worker_pool
+
+    def counting(processes, *args):
+        started.append(processes)
+        return real(processes, *args)
+
+    monkeypatch.setattr(bench_cli, "worker_pool", counting)
+    for jobs in ([], [1], [1, 2]):
+        done = {}
+        bench_cli.play_rows(
+            jobs, _square, tmp_path / f"rows{len(jobs)}.jsonl", done, _key, _always, 8
+        )
+        assert sorted(done) == [str(j) for j in jobs]
+    assert started == [2]
+
+
+def _square(j):  # module level: the spawned workers import it
+    return {"job": j, "value": j * j}
+
+
+def _key(row):
+    return str(row["job"])
+
+
+def _always(row):
+    return True

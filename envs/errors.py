@@ -22,6 +22,7 @@ __all__ = [
     "MemoryBudgetError",
     "NarrowBandWarning",
     "NoStartError",
+    "OutputError",
     "OversubscribedWarning",
     "RelaxedStartWarning",
     "RhoAboveOneWarning",
@@ -42,6 +43,12 @@ class InvalidMapError(SurveilValueError):
 
 class InvalidConfigError(SurveilValueError):
     """An environment, policy or tournament configuration value is out of range."""
+
+
+class OutputError(SurveilValueError):
+    """A file could not be written whole (a full disk, a quota, a file-size limit): the
+    message names the file and the reason, and the file is as it was before (an earlier
+    version kept, or none made; :func:`envs.files.written_whole`)."""
 
 
 class InvalidPlacementError(SurveilValueError):

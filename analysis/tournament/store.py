@@ -47,6 +47,7 @@ from typing import Any
 from analysis.arguments import why_not_a_file
 from envs import pidlock
 from envs.errors import InvalidConfigError, SurveilValueError
+from envs.files import written_whole
 
 __all__ = ["RESULT_FIELDS", "SCHEMA_VERSION", "Store", "StoreBusyError", "StoreError"]
 
@@ -594,6 +595,8 @@ class Store:
 
         Raises:
             InvalidConfigError: another suffix.
+            OutputError: the file could not be written whole (a full disk); a file
+                already at ``path`` is kept as it was.
         """
         path = Path(path)
         suffix = path.suffix.lower()
@@ -603,7 +606,12 @@ class Store:
             )
         rows = self.rows(run_id)
         path.parent.mkdir(parents=True, exist_ok=True)
-        with path.open("w", encoding="utf-8", newline="") as f:
+        # whole or not at all: a full disk cut a CSV short, and the shorter file still read
+        # as a valid export (over a complete one written before)
+        with (
+            written_whole(path, "export file") as tmp,
+            tmp.open("w", encoding="utf-8", newline="") as f,
+        ):
             if suffix == ".csv":
                 writer = csv.DictWriter(f, fieldnames=list(ROW_FIELDS))
                 writer.writeheader()

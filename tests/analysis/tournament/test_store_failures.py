@@ -213,6 +213,41 @@ def test_a_run_whose_store_stops_taking_writes_says_so_and_resumes(tmp_path):
         assert a.conn.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 80
 
 
+def test_an_export_cut_short_by_a_full_disk_keeps_the_file_as_it_was(tmp_path):
+    """An export whose writes fail part way (a file-size limit on its process, as on a
+    full disk) says so in one line naming the file, and leaves a complete export written
+    before as it was, with no temporary file beside it. Before: the complete file was
+    replaced by its first 36,000 bytes (74 of the 80 rows whole, the 75th cut mid-line; a
+    CSV cut at a row's end reads as a valid export) and the error named no file
+    ("surveil: error: [Errno 27] File too large")."""
+    spec = tmp_path / "small.toml"
+    spec.write_text(SPEC)
+    store = tmp_path / "small.sqlite"
+    run_tournament(spec, store, backend="serial", progress=False)
+    out = tmp_path / "rows.jsonl"
+    assert main(["export", str(store), str(out)]) == 0
+    whole = out.read_bytes()
+    assert len(whole) > 36_000, len(whole)  # the limit below cuts it (SQLite's 32 kB fit)
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    proc = subprocess.run(
+        [sys.executable, "-m", "analysis.cli", "export", str(store), str(out)],
+        env=env,
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        preexec_fn=_limited(36_000),
+    )
+    assert "Traceback" not in proc.stderr, proc.stderr
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1, proc.stderr
+    assert lines[0].startswith(f"surveil: error: export file = {str(out)!r}: could not write")
+    assert "File too large" in lines[0]
+    assert out.read_bytes() == whole
+    assert sorted(p.name for p in tmp_path.iterdir() if "rows" in p.name) == ["rows.jsonl"]
+
+
 def _damage_table(store: Path, table: str) -> None:
     """Overwrite the root page of ``table`` with bytes no page holds."""
     con = sqlite3.connect(store)

@@ -38,7 +38,7 @@ from analysis.arguments import (
 from analysis.figures import cli as figures_cli
 from analysis.replay import DEFAULT_FPS, MAX_FPS
 from envs.console import OneLineWarnings
-from envs.errors import InvalidConfigError, SurveilValueError, UnknownNameError
+from envs.errors import InvalidConfigError, OutputError, SurveilValueError, UnknownNameError
 
 __all__ = ["build_parser", "main"]
 
@@ -276,6 +276,8 @@ def _cmd_figure(args: argparse.Namespace) -> int:
     out = _picture_file(args.out, default_name)
     try:
         draw_figure(args.name, out, **params)
+    except OutputError:
+        raise  # the picture could not be written: not a parameter's fault
     except SurveilValueError as exc:
         # the theory's "pass step=" is, on this command line, a "step" in --params
         message = str(exc).replace("pass step=", """add "step": H (the RK4 step) to --params""")

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from envs.errors import InvalidConfigError
+from envs.files import written_whole
 
 __all__ = ["plot_matchups"]
 
@@ -75,5 +76,6 @@ def plot_matchups(rows: Sequence[Any], path: str | Path, *, dpi: int = 150) -> P
         "pursuer (rows) vs evader (columns): success rate, 95% CI, mean escape time", fontsize=9
     )
     path = Path(path)
-    fig.savefig(path, dpi=dpi)
+    with written_whole(path, "picture") as tmp:  # a full disk leaves no cut picture
+        fig.savefig(tmp, dpi=dpi)
     return path

@@ -13,6 +13,7 @@ complete, so an interrupted or failed run never leaves a truncated GIF behind.
 
 from __future__ import annotations
 
+import contextlib
 import os
 from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
@@ -22,6 +23,7 @@ import numpy as np
 
 from envs import validation
 from envs.errors import InvalidConfigError
+from envs.files import output_error, written_whole
 
 __all__ = [
     "MAX_FPS",
@@ -153,10 +155,25 @@ class GifStream:
         self.frames = 0
 
     def add(self, frame: np.ndarray) -> None:
-        """Append one HxWx3 uint8 frame."""
+        """Append one HxWx3 uint8 frame.
+
+        Raises:
+            OutputError: the file could not be written (a full disk); the partial file is
+                removed.
+        """
         if self._pending is not None:
-            self._write(self._pending, self.delay_ms)
+            with self._aborted_on_failure():
+                self._write(self._pending, self.delay_ms)
         self._pending = frame
+
+    @contextlib.contextmanager
+    def _aborted_on_failure(self) -> Iterator[None]:
+        """A write that fails (a full disk) removes the partial file and names the GIF."""
+        try:
+            yield
+        except OSError as exc:
+            self.abort()
+            raise output_error("GIF file", self.path, exc) from exc
 
     __call__ = add  # usable as run_episode(on_frame=stream)
 
@@ -199,24 +216,30 @@ class GifStream:
 
         Raises:
             InvalidConfigError: no frame was added.
+            OutputError: the file could not be written (a full disk); the partial file is
+                removed and a file already at ``path`` kept.
         """
         if self._fp.closed:
             return self.path
         if self._pending is None:
             self.abort()
             raise InvalidConfigError(f"{self.path}: no frames to write")
-        self._write(self._pending, max(LINGER_MS, self.delay_ms))
-        self._pending = self._previous = None
-        self._fp.write(b";")  # GIF trailer
-        self._fp.close()
-        os.replace(self._tmp, self.path)
+        with self._aborted_on_failure():
+            self._write(self._pending, max(LINGER_MS, self.delay_ms))
+            self._pending = self._previous = None
+            self._fp.write(b";")  # GIF trailer
+            self._fp.close()
+            os.replace(self._tmp, self.path)
         return self.path
 
     def abort(self) -> None:
         """Discard the partial file (idempotent)."""
         self._pending = self._previous = None
         if not self._fp.closed:
-            self._fp.close()
+            # closing flushes the buffer, which fails again on a full disk: the file is
+            # closed all the same, and the partial file must still go (it was left behind)
+            with contextlib.suppress(OSError):
+                self._fp.close()
         self._tmp.unlink(missing_ok=True)
 
     def __enter__(self) -> GifStream:
@@ -240,12 +263,8 @@ def write_strip(frames: Sequence[np.ndarray], path: str | Path, *, panels: int =
 def _save_png(image: np.ndarray, path: Path) -> Path:
     from PIL import Image
 
-    tmp = _temporary(path)
-    try:
+    with written_whole(path, "PNG file") as tmp:
         Image.fromarray(image).save(tmp, format="PNG")
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
     return path
 
 

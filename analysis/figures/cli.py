@@ -14,7 +14,6 @@
 from __future__ import annotations
 
 import argparse
-import os
 import shutil
 import sys
 import tempfile
@@ -23,6 +22,7 @@ from pathlib import Path
 
 from analysis.arguments import output_dir, path_text
 from envs.errors import InvalidConfigError
+from envs.files import written_whole
 
 __all__ = ["add_parser", "run"]
 
@@ -175,13 +175,9 @@ def _update(path: Path, flag: str) -> None:
 
     text, changes = update_report(_report_text(path, flag), compute_numbers())
     # whole or not at all: an interrupted write truncated the report
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
+    with written_whole(path, flag) as tmp:
         tmp.write_text(text, encoding="utf-8")
         shutil.copymode(path, tmp)
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
     for c in changes:
         print(f"{path}: {c}")
     print(f"{path}: {len(changes)} number(s) changed; gallery regenerated")

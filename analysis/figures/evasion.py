@@ -23,6 +23,7 @@ from analysis.figures import cases, style
 from analysis.figures.registry import register
 from envs import validation
 from envs.errors import InfeasibleError, InvalidConfigError, SurveilValueError, UnknownNameError
+from envs.files import written_whole
 from strategies.control import greedy_heading, shoot, solve_escape, tractrix
 
 __all__ = [
@@ -188,7 +189,8 @@ def draw_figure(name: str, path: str | Path, **params: Any) -> Path:
         _DRAWERS[name](axes[0, 0], **params)
         out = Path(path)
         out.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(out, dpi=120)
+        with written_whole(out, "picture") as tmp:  # a full disk leaves no cut picture
+            fig.savefig(tmp, dpi=120)
     return out
 
 

@@ -9,12 +9,12 @@ file: a PNG (matplotlib) or a GIF (an episode replay).
 from __future__ import annotations
 
 import importlib
-import os
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
 from envs.errors import InvalidConfigError, UnknownNameError
+from envs.files import written_whole
 from envs.validation import positive
 
 MAX_SCALE = 4.0
@@ -183,13 +183,8 @@ def build_figure(name: str, out_dir: str | Path, *, scale: float = 1.0) -> Path:
     path = out / spec.filename
     # drawn beside it, then renamed: an interrupted build (Ctrl-C while a GIF's frames are
     # encoded) leaves the previous figure whole, not a truncated file in docs/figures
-    tmp = out / f".{path.stem}.{os.getpid()}.tmp{path.suffix}"
     from analysis.figures.style import context
 
-    try:
-        with context():
-            spec.build(tmp, scale)
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
+    with written_whole(path, "figure") as tmp, context():
+        spec.build(tmp, scale)
     return path

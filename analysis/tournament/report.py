@@ -38,6 +38,7 @@ import numpy as np
 
 from analysis.tournament import statistics as st
 from analysis.tournament.store import Store
+from envs.files import written_whole
 
 __all__ = ["Analysis", "analyse", "write_report"]
 
@@ -561,12 +562,8 @@ def _pictures_of(markdown: Path) -> set[str]:
 def _write_atomically(path: Path, data: bytes) -> Path:
     """Write ``path`` through a temporary file beside it and a rename: a reader (or an
     interruption) sees the old file or the new one, never half of one."""
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
+    with written_whole(path, "report file") as tmp:  # a full disk: named, the old one kept
         tmp.write_bytes(data)
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
     return path
 
 

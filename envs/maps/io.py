@@ -59,6 +59,7 @@ from shapely.geometry import Polygon
 
 from envs import validation
 from envs.errors import InvalidConfigError, InvalidMapError, UnknownNameError
+from envs.files import written_whole
 from envs.maps.map import Map
 
 __all__ = [
@@ -882,5 +883,6 @@ def save_map(
         )
     else:
         text = _dump_json(map_to_dict(map, description=description, metadata=metadata))
-    p.write_text(text, encoding="utf-8")
+    with written_whole(p, "map file") as tmp:  # a full disk leaves the old file as it was
+        tmp.write_text(text, encoding="utf-8")
     return p

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from envs.files import written_whole
 from envs.maps.map import Map
 
 __all__ = ["DependencyNotInstalled", "plot_map"]
@@ -110,5 +111,6 @@ def plot_map(
         )
     ax.set_title(title)
     if path is not None:
-        ax.figure.savefig(os.fspath(path), bbox_inches="tight")
+        with written_whole(path, "picture") as tmp:  # a full disk leaves no cut picture
+            ax.figure.savefig(tmp, bbox_inches="tight")
     return ax

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from envs.errors import InvalidConfigError
+from envs.files import written_whole
 
 if TYPE_CHECKING:
     from strategies.cspace.decomposition import Decomposition
@@ -279,6 +280,7 @@ def draw_decomposition(
             frameon=False,
         )
         out.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(out, dpi=dpi)
+        with written_whole(out, "picture") as tmp:  # a full disk leaves no cut picture
+            fig.savefig(tmp, dpi=dpi)
         plt.close(fig)
     return out

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from envs import validation as V
+from envs.files import written_whole
 from envs.maps.plot import plot_map
 from strategies.referee.referee import Referee, StartSet
 
@@ -166,7 +167,8 @@ def draw_referee(
         fontsize=9,
     )
     if path is not None:
-        fig.savefig(os.fspath(path), bbox_inches="tight")
+        with written_whole(path, "picture") as tmp:  # a full disk leaves no cut picture
+            fig.savefig(tmp, bbox_inches="tight")
     return fig
 
 

@@ -150,7 +150,7 @@ def test_a_directory_as_the_output_holds_the_default_name(capsys, tmp_path):
     new_dir = str(tmp_path / "figs") + "/"  # a trailing slash names a directory to create
     assert main(["figure", "tractrix", "--out", new_dir]) == 0
     assert (tmp_path / "figs" / "figure_tractrix.png").exists()
-    assert not list(tmp_path.glob(".*.tmp"))  # no temporary files left behind
+    assert not list(tmp_path.glob(".*.tmp*"))  # no temporary files left behind
 
 
 # ---------------------------------------------------------------------- JSON options

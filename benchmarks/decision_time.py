@@ -25,8 +25,8 @@ and max over the maps, the single decisions past 1 ms.
 Usage::
 
     python benchmarks/decision_time.py [--maps corridor two_rooms ...] [--seeds 2]
-        [--max-cycles 300] [--reps 3] [--clock wall|cpu] [--l-min 1] [--table lazy]
-        [--rho 0.99] [--others evader/straight pursuer/tractrix ...]
+        [--max-cycles 300] [--reps 3] [--clock wall|cpu] [--l-min 1] [--ratio 4]
+        [--table lazy] [--rho 0.99] [--others evader/straight pursuer/tractrix ...]
 
 ``--maps`` takes built-in names, ``NAME*S`` (the built-in map scaled by S, its L_min, L_max
 and speeds kept: a larger world, S^2 times the table's points), ``floor_plan:SEED:W``
@@ -36,6 +36,10 @@ and speeds kept: a larger world, S^2 times the table's points), ``floor_plan:SEE
 
 ``--l-min X`` plays the maps at L_min = X, L_max = 2 X instead of their own ranges (the
 decomposition pursuer's grid is L_min / 20: halving L_min quadruples its points);
+``--ratio R`` plays them at L_max = R L_min (the map's own L_min, or ``--l-min``'s): the
+pursuer's probes reach over the band up to L_max, so a wide band classifies more of the
+table's nodes a decision (floor_plan:1:110 at rho 0.95, L_min 0.5, R = 4: a mean of
+~1.5 ms of thread CPU against a random evader, helper-195's probe in session 30);
 ``--table`` forces the decomposition pursuer's safety table (``auto``: distinct rows up
 to ``DecompositionPursuer.DISTINCT_TABLE_POINTS`` grid points, else filled lazily), so the
 kinds can be compared on the same episodes.
@@ -149,6 +153,7 @@ def measure(
     table: str = "auto",
     rho: float | None = None,
     others: tuple[str, ...] = (),
+    ratio: float | None = None,
 ) -> tuple[dict[str, np.ndarray], dict[str, float]]:
     """Per-decision seconds of each policy (the two players, ``others`` and the
     reference) on ``map_name``, first decisions left out, and the slowest first decision
@@ -160,6 +165,8 @@ def measure(
     if rho is not None:
         v_pursuer = {**map_recommendations(m), **overrides}["v_pursuer"]
         overrides["v_evader"] = rho * v_pursuer
+    if ratio is not None:
+        overrides["l_max"] = ratio * {**map_recommendations(m), **overrides}["l_min"]
     overrides = overrides or None
     for seed in range(seeds):
         observations = []
@@ -194,14 +201,17 @@ def main(argv=None) -> int:
     ap.add_argument("--l-min", type=real(0), default=None)
     ap.add_argument("--table", choices=["auto", "eager", "distinct", "lazy"], default="auto")
     ap.add_argument("--rho", type=real(0), default=None)
+    ap.add_argument("--ratio", type=real(1), default=None, help="L_max / L_min (> 1)")
     ap.add_argument("--others", nargs="*", type=analytic_name, default=[])
     args = ap.parse_args(argv)
     others = tuple(n for n in dict.fromkeys(args.others) if n not in (*dict(POLICIES), REFERENCE))
-    overrides = None if args.l_min is None else {"l_min": args.l_min, "l_max": 2 * args.l_min}
+    r = 2.0 if args.ratio is None else args.ratio
+    overrides = None if args.l_min is None else {"l_min": args.l_min, "l_max": r * args.l_min}
     print(
         f"load average: {os.getloadavg()}; clock: {args.clock}; table: {args.table}"
-        + ("" if overrides is None else f"; L in [{args.l_min:g}, {2 * args.l_min:g}]")
+        + ("" if overrides is None else f"; L in [{args.l_min:g}, {r * args.l_min:g}]")
         + ("" if args.rho is None else f"; rho {args.rho:g}")
+        + ("" if args.ratio is None else f"; L_max / L_min {args.ratio:g}")
     )
     # the map column fits the longest label (floor_plan:0:200 ran into the policy's name)
     w = max(16, *(len(m) + 1 for m in args.maps))
@@ -223,6 +233,7 @@ def main(argv=None) -> int:
             args.table,
             args.rho,
             others,
+            args.ratio,
         )
         ref = float(times[REFERENCE].mean())
         for name in [*(n for n, _ in POLICIES), *others, REFERENCE]:

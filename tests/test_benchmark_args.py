@@ -34,6 +34,7 @@ def _run(script: str, *args: str, **kwargs) -> subprocess.CompletedProcess:
         ("decision_time.py", ["--maps", "nope"], "'nope': expected a built-in map"),
         ("decision_time.py", ["--seeds", "0"], "'0': expected an integer >= 1"),
         ("decision_time.py", ["--rho", "0"], "'0': expected a finite number > 0"),
+        ("decision_time.py", ["--ratio", "1"], "'1': expected a finite number > 1"),
         ("decision_time.py", ["--maps", "random:x:1"], "'random:x:1': expected a built-in map"),
         ("decision_time.py", ["--others", "nope"], "'nope': expected a registered policy"),
         ("evader_escapes.py", ["--seeds", "0"], "'0': expected an integer >= 1"),

@@ -65,3 +65,26 @@ def test_random_maps_and_other_policies_get_their_own_rows_and_tail_lines():
         "tail evader/straight",
         "tail pursuer/tractrix",
     ]
+
+
+def test_ratio_sets_l_max_to_that_many_l_min(monkeypatch):
+    # hidden tests may play wide bands (L_max / L_min up to 4): the pursuer's probes then
+    # cover more of its table a decision; --l-min alone fixed L_max = 2 L_min
+    sys.path.insert(0, str(BENCHMARKS))
+    try:
+        import decision_time
+    finally:
+        sys.path.remove(str(BENCHMARKS))
+    played = []
+    real = decision_time.run_episode
+
+    def recorded(*args, **kwargs):
+        played.append(kwargs["overrides"])
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(decision_time, "run_episode", recorded)
+    decision_time.measure("open_room", 1, 2, 1, ratio=4.0)  # the map's own L_min, 2
+    decision_time.measure("open_room", 1, 2, 1, overrides={"l_min": 1.0, "l_max": 2.0}, ratio=3.0)
+    assert [(o.get("l_min"), o["l_max"]) for o in played] == [(None, 8.0), (1.0, 3.0)]
+    out = _decision_time("--maps", "open_room", "--l-min", "1", "--ratio", "4")
+    assert "; L in [1, 4]; L_max / L_min 4" in out[0]

@@ -41,6 +41,7 @@ import numpy as np
 
 from envs import pidlock
 from envs.errors import InvalidConfigError
+from envs.files import written_whole
 from envs.maps.map import Map
 from envs.surveillance_v1 import ENV_ID
 from strategies.policies import Policy, make_policy
@@ -215,15 +216,13 @@ def load_policy(
 
 
 def _atomic_write(path: Path, text: str) -> None:
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
+    with written_whole(path, "training output") as tmp:  # a full disk: named, none left
+        tmp.write_text(text)
 
 
 def _save_model(model, path: Path) -> None:
-    tmp = path.with_name(path.name + ".tmp")  # has a suffix, so SB3 adds no ".zip"
-    model.save(str(tmp))
-    os.replace(tmp, path)
+    with written_whole(path, "training output") as tmp:  # ends in .zip: SB3 adds none
+        model.save(str(tmp))
 
 
 def _git(*args: str) -> str | None:
@@ -442,9 +441,8 @@ def _checkpoint(model, config: TrainConfig, out: Path) -> None:
     ckdir.mkdir(parents=True, exist_ok=True)
     if config.algo == "sac":  # the buffer first: a checkpoint never lacks its buffer
         buf = ckdir / f"replay_buffer_{model.num_timesteps}.pkl"
-        tmp = buf.with_name(buf.name + ".tmp")
-        model.save_replay_buffer(str(tmp))
-        os.replace(tmp, buf)
+        with written_whole(buf, "training output") as tmp:
+            model.save_replay_buffer(str(tmp))
     _save_model(model, ckdir / f"ckpt_{model.num_timesteps}.zip")
     old = sorted((int(m.group(1)), p) for p in ckdir.iterdir() if (m := _CKPT.match(p.name)))
     for _, p in old[:-KEEP_CHECKPOINTS]:

@@ -602,3 +602,36 @@ def test_a_ctrl_c_cpython_discards_while_it_imports_still_stops_the_command(
     assert run.returncode == 130, run.stderr
     assert run.stderr.endswith(f"{prog}: interrupted\n")
     assert run.stdout == "" and not out.exists()  # nothing played, nothing trained
+
+
+def test_a_checkpoint_that_does_not_fit_is_named_and_leaves_no_partial_file(tmp_path):
+    """A checkpoint written on a full disk (a file-size limit on the run's process: its
+    writes fail with "File too large"): one line naming the checkpoint, no partial file
+    left in the run's folder. Before: "python -m training: error: [Errno 27] File too
+    large", naming no file, and checkpoints/ckpt_64.zip.tmp left behind."""
+    import resource
+
+    def limited() -> None:  # the config and env files fit, a model zip does not
+        resource.setrlimit(resource.RLIMIT_FSIZE, (20_000, 20_000))
+
+    cfg = tmp_path / "c.toml"
+    out = tmp_path / "run"
+    cfg.write_text(
+        'role = "pursuer"\nopponent = "evader/straight"\nmap = "open_room"\nstart = "valid"\n'
+        "total_timesteps = 128\nn_steps = 64\nbatch_size = 32\ncheckpoint_freq = 64\n"
+        f'eval_episodes = 0\noutput_dir = "{out}"\n[env]\nmax_cycles = 20\n'
+    )
+    run = subprocess.run(
+        [sys.executable, "-m", "training", str(cfg), "--no-progress"],
+        capture_output=True, text=True, cwd=ROOT, timeout=300, preexec_fn=limited,
+    )  # fmt: skip
+    assert "Traceback" not in run.stderr, run.stderr
+    assert run.returncode == 2, run.stderr
+    lines = run.stderr.strip().splitlines()
+    assert len(lines) == 1, run.stderr
+    ckpt = out / "checkpoints" / "ckpt_64.zip"
+    assert lines[0].startswith(
+        f"python -m training: error: training output = {str(ckpt)!r}: could not write it "
+        "(File too large)"
+    ), run.stderr
+    assert sorted(p.name for p in (out / "checkpoints").iterdir()) == []

@@ -323,7 +323,7 @@ def spec_from_dict(
     if unknown:
         raise InvalidConfigError(f"{source}: unknown field(s) {unknown}; a spec has {sorted(_TOP)}")
     base = Path(base_dir) if base_dir is not None else Path.cwd()
-    name = string("name", d.get("name", default_name), where=source)
+    name = _printable("name", d.get("name", default_name), where=source)
     if name in (".", "..") or "/" in name or "\\" in name:  # it names files under out/
         raise InvalidConfigError(
             f"{source}: name = {name!r}: expected a plain name without '/' or '\\' (the "
@@ -633,7 +633,7 @@ def _entry(item: Any, role: str, where: str, base: Path) -> PolicyEntry:
                 f"observation = {observation!r}; drop the entry's observation (an "
                 "observation is for a policy that reads the env's, such as a model)"
             )
-        label = string("label", d.get("label", name), where=where)
+        label = _printable("label", d.get("label", name), where=where)
         params = _without_defaults(name, params)
         return PolicyEntry(role, label, name, _canonical(params), None, None, observation)
     text = string("model", d["model"], where=where)
@@ -679,8 +679,20 @@ def _entry(item: Any, role: str, where: str, base: Path) -> PolicyEntry:
             if env_cfg["observation"] != "state":
                 observation["n_rays"] = env_cfg.get("n_rays", _default("n_rays"))
                 observation["lidar_range"] = env_cfg.get("lidar_range")
-    label = string("label", d.get("label", text), where=where)
+    label = _printable("label", d.get("label", text), where=where)
     return PolicyEntry(role, label, f"{role}/sb3", params, str(path), digest, observation)
+
+
+def _printable(key: str, value: Any, *, where: str) -> str:
+    """A label or name: a non-empty string on one line of printable characters. A label
+    with a line break split the report's Markdown table rows and the terminal table."""
+    text = string(key, value, where=where)
+    if not text.isprintable():
+        raise InvalidConfigError(
+            f"{where}: {key} = {text!r}: expected one line of printable text (no line "
+            "breaks, tabs or control characters: it heads rows and columns of the report)"
+        )
+    return text
 
 
 def _without_defaults(name: str, params: Mapping[str, Any]) -> dict[str, Any]:

@@ -51,6 +51,13 @@ from .conftest import comparable
         ({"name": "../../escape"}, r"name = '\.\./\.\./escape': expected a plain name"),
         ({"name": "a\\b"}, r"expected a plain name"),
         ({"name": ".."}, r"expected a plain name"),
+        # a label with a line break split the report's Markdown table rows (and the terminal's)
+        (
+            {"evaders": [{"policy": "evader/straight", "label": "two\nlines"}]},
+            r"\[evaders #1\]: label = 'two\\nlines': expected one line of printable text",
+        ),
+        ({"pursuers": [{"policy": "pursuer/greedy", "label": "a\tb"}]}, r"label = 'a\\tb'"),
+        ({"name": "run\n2"}, r"name = 'run\\n2': expected one line of printable text"),
         ({"env": {"dt": 1e-310}}, r"dt = 1e-310 with v_pursuer = .* would not move a body"),
         ({"colour": "red"}, r"unknown field.*colour"),
         ({"evaders": [{"model": "zoo:no_such_model"}]}, r"no zoo model 'no_such_model'"),

@@ -39,6 +39,7 @@ from typing import Any, NoReturn
 
 from envs.console import CommandParser, RecordedInterrupt, interrupts_recorded, reader_gone
 from envs.errors import InvalidConfigError, MemoryBudgetError, SurveilValueError
+from envs.validation import DuplicateKeyError, json_pairs_once
 
 __all__ = [
     "CommandParser",
@@ -169,21 +170,6 @@ def why_not_a_file(path: str | os.PathLike[str]) -> str | None:
     return f"is {kind}, not a regular file"
 
 
-class _DuplicateKey(Exception):
-    def __init__(self, key: str) -> None:
-        self.key = key
-
-
-def _once_each(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
-    """A JSON object's dict, refusing a key given twice (json keeps the last silently)."""
-    obj: dict[str, Any] = {}
-    for key, value in pairs:
-        if key in obj:
-            raise _DuplicateKey(key)
-        obj[key] = value
-    return obj
-
-
 def json_object(flag: str, text: str | None, *, example: str) -> dict[str, Any]:
     """The JSON object given to ``flag`` (``{}`` when the flag is absent).
 
@@ -194,8 +180,8 @@ def json_object(flag: str, text: str | None, *, example: str) -> dict[str, Any]:
     if text is None:
         return {}
     try:
-        obj = json.loads(text, object_pairs_hook=_once_each)
-    except _DuplicateKey as dup:
+        obj = json.loads(text, object_pairs_hook=json_pairs_once)
+    except DuplicateKeyError as dup:
         raise InvalidConfigError(
             f"{flag} = {text!r}: key {dup.key!r} given twice (JSON keeps only the last); "
             f"expected each key once, as in {example}"

@@ -38,12 +38,14 @@ import numpy as np
 from envs.errors import InvalidConfigError
 
 __all__ = [
+    "DuplicateKeyError",
     "boolean",
     "choice",
     "finite_array",
     "integer",
     "is_integer",
     "is_real",
+    "json_pairs_once",
     "mapping",
     "nonnegative",
     "point",
@@ -280,6 +282,26 @@ def _shape(shape: tuple[int | None, ...]) -> str:
         + ("," if len(shape) == 1 else "")
         + ")"
     )
+
+
+class DuplicateKeyError(Exception):
+    """A JSON object gives ``key`` twice (raised by :func:`json_pairs_once`; callers word
+    the message, naming where the JSON came from)."""
+
+    def __init__(self, key: str) -> None:
+        super().__init__(key)
+        self.key = key
+
+
+def json_pairs_once(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """``json.loads(..., object_pairs_hook=json_pairs_once)``: a JSON object's dict, refusing
+    a key given twice (:class:`DuplicateKeyError`) where ``json`` keeps the last silently."""
+    obj: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in obj:
+            raise DuplicateKeyError(key)
+        obj[key] = value
+    return obj
 
 
 def writable_directory(name: str, text: str, alternative: str = "") -> None:

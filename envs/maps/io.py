@@ -539,7 +539,13 @@ def read_map(path: str | os.PathLike[str], *, merge: bool | None = None) -> MapD
     if fmt == "wkt":
         return MapDocument(map_from_wkt(text, source=source, merge=bool(merge)))
     try:
-        obj = json.loads(text)
+        obj = json.loads(text, object_pairs_hook=validation.json_pairs_once)
+    except validation.DuplicateKeyError as dup:  # json kept the last: half a map, silently
+        raise _fail(
+            source,
+            f"key {dup.key!r} given twice in one object (JSON keeps only the last); "
+            "expected each key once",
+        ) from None
     except json.JSONDecodeError as exc:
         raise _fail(source, f"not valid JSON ({exc})") from exc
     except RecursionError:  # the decoder recurses once per nested [ or {

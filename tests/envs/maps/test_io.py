@@ -112,6 +112,25 @@ def test_geojson_recommendations_outside_metadata_are_refused(tmp_path):
     assert map_from_geojson(obj).metadata == {"l_min": 1.0}
 
 
+@pytest.mark.parametrize("suffix", [".json", ".geojson"])
+def test_a_key_given_twice_in_a_map_file_is_refused(tmp_path, suffix):
+    # json keeps a repeated key's last value: the first "obstacles" (or "l_min") was
+    # dropped without a word, and the map played without those walls
+    walls = "[[[1, 1], [2, 1], [2, 2], [1, 2]]]"
+    text = (
+        '{"boundary": [[0, 0], [10, 0], [10, 10], [0, 10]], '
+        f'"obstacles": {walls}, "obstacles": [], "metadata": {{"l_min": 1}}}}'
+    )
+    if suffix == ".geojson":  # the same within a feature's properties
+        text = json.dumps(map_to_geojson(MAPS["plain"], metadata={"l_min": 1.0}))
+        text = text.replace('"metadata": {"l_min": 1.0}', '"metadata": {"l_min": 1.0, "l_min": 3}')
+    path = tmp_path / f"twice{suffix}"
+    path.write_text(text)
+    key = "'obstacles'" if suffix == ".json" else "'l_min'"
+    with pytest.raises(InvalidMapError, match=rf"twice{suffix}: key {key} given twice"):
+        read_map(path)
+
+
 def test_geojson_output_follows_rfc7946(tmp_path):
     m = MAPS["plain"]
     obj = json.loads(save_map(m, tmp_path / "w.geojson").read_text())

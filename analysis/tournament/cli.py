@@ -232,7 +232,7 @@ def _cmd_export(args: argparse.Namespace) -> int:
     out = output_file(
         "out", args.out, suffixes=(".csv", ".jsonl", ".ndjson"), default_name="results.csv"
     )
-    with Store(args.store, create=False) as db:
+    with Store(args.store, create=False) as db, db.snapshot():  # counts agree with the rows
         run = db.run(args.run)
         path = db.export(run["run_id"], out)
         line = f"{len(db.rows(run['run_id']))} matches of run {run['run_id']} written to {path}"

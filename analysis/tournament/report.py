@@ -77,9 +77,12 @@ def doubled_note(run_id: str, n: int) -> str:
 def analyse(store: Store | str | os.PathLike[str], run_id: str | None = None) -> Analysis:
     """Compute the statistics of a run (default: the store's latest)."""
     db = store if isinstance(store, Store) else Store(store, create=False)
-    run = db.run(run_id)
-    rows = db.rows(run["run_id"])
-    doubled = db.doubled(run["run_id"])
+    with db.snapshot():  # a running tournament's counts and rows at one moment
+        run = db.run(run_id)
+        rows = db.rows(run["run_id"])
+        doubled = db.doubled(run["run_id"])
+        errors = db.errors(run["run_id"])
+        geometry = {m["digest"]: db.map_geometry(m["digest"]) for m in _spec(run).get("maps", [])}
     notes = [doubled_note(run["run_id"], doubled)] if doubled else []
     cells = st.cells(rows)
     matrices = st.payoff_matrices(cells)
@@ -91,9 +94,9 @@ def analyse(store: Store | str | os.PathLike[str], run_id: str | None = None) ->
         games=st.games(matrices),
         ratings=st.ratings(rows),
         paired=st.paired_comparisons(rows),
-        errors=db.errors(run["run_id"]),
+        errors=errors,
         notes=notes,
-        geometry={m["digest"]: db.map_geometry(m["digest"]) for m in _spec(run).get("maps", [])},
+        geometry=geometry,
     )
 
 

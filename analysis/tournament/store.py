@@ -313,6 +313,25 @@ class Store:
             raise
         self.conn.execute("COMMIT")
 
+    @contextlib.contextmanager
+    def snapshot(self) -> Iterator[None]:
+        """Reads within it see the store as it was at their first read (one read
+        transaction; WAL lets a run go on writing meanwhile), so that counts and rows read
+        one after the other agree. Reentrant.
+
+        Without it, ``surveil export`` of a running tournament wrote 582 rows and said
+        "580 of its 640 planned matches stored": each query saw a later store.
+        """
+        if self.conn.in_transaction:
+            yield
+            return
+        self.conn.execute("BEGIN")
+        try:
+            yield
+        finally:
+            with contextlib.suppress(sqlite3.Error):
+                self.conn.execute("COMMIT")
+
     def close(self) -> None:
         """Release the lock (if held) and close the connection (idempotent)."""
         self.unlock()

@@ -248,6 +248,30 @@ def test_an_export_cut_short_by_a_full_disk_keeps_the_file_as_it_was(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir() if "rows" in p.name) == ["rows.jsonl"]
 
 
+def test_a_reader_sees_one_moment_of_a_store_a_run_is_writing(tmp_path):
+    """While a tournament writes, a reader's counts and rows come from one snapshot:
+    ``surveil export`` of a running run wrote 582 rows and said "580 of its 640 planned
+    matches stored", and then counted the rows again for its line. Here a match is
+    stored between the reader's reads (by a real second connection, as a driver would)."""
+    spec = tmp_path / "small.toml"
+    spec.write_text(SPEC)
+    store = tmp_path / "s.sqlite"
+    run_id = run_tournament(spec, store, backend="serial", progress=False).run_id
+    with Store(store) as db:
+        last = db.rows(run_id)[-1]
+        db.conn.execute("DELETE FROM results WHERE match_id = ?", (last["match_id"],))
+    with Store(store, create=False) as reader, reader.snapshot():
+        done = reader.run(run_id)["done"]
+        with Store(store) as writer:  # the driver stores the last match meanwhile
+            writer.record(run_id, last)
+        assert done == len(reader.rows(run_id)) == 79
+        reader.export(run_id, tmp_path / "rows.csv")
+    with (tmp_path / "rows.csv").open() as f:
+        assert len(list(csv.DictReader(f))) == 79
+    with Store(store, create=False) as reader:  # after the snapshot: the store as it is now
+        assert reader.run(run_id)["done"] == len(reader.rows(run_id)) == 80
+
+
 def _damage_table(store: Path, table: str) -> None:
     """Overwrite the root page of ``table`` with bytes no page holds."""
     con = sqlite3.connect(store)

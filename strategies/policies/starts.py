@@ -60,6 +60,7 @@ no cell is safe). On maps with no escapable orientation it raises ``InfeasibleEr
 from __future__ import annotations
 
 import math
+import re
 import warnings
 
 import numpy as np
@@ -121,9 +122,7 @@ def sample_start(
     judge = DecompositionPursuer(turn_rate="one")
     try:
         judge.reset(role="pursuer", map=config.map, config=config, seed=0)
-    except MemoryBudgetError as exc:
-        if exc.args[1] != "resolution":  # not its table's grid
-            raise
+    except MemoryBudgetError as exc:  # its table's grid, or the map's decomposition
         raise _judge_refused(exc, kind, config) from None
     tab = judge.table
     if kind == "escapable":
@@ -134,16 +133,25 @@ def sample_start(
 
 
 def _judge_refused(exc: MemoryBudgetError, kind: str, config) -> MemoryBudgetError:
-    """The judge's table refused by the memory budget, told as the start's caller can act
-    on it: the judge's resolution (its default, L_min / 20) is not a parameter here, so
-    the remedy is a ``kind="valid"`` start (no judge) or a larger budget."""
-    _, _, budget, size = exc.args
-    refusal = exc.args[0].partition("; use ")[0]  # the table's own remedy names its resolution
+    """The judge's table (or the map's decomposition it stands on) refused by the memory
+    budget, told as the start's caller can act on it: the judge's resolution (its default,
+    L_min / 20) is not a parameter here, so the remedy is a ``kind="valid"`` start (no
+    judge) or a larger budget. The decomposition's refusal named only a larger budget or
+    "a shorter L or a smaller map", on a 600-gon room where ``surveil play --start valid``
+    plays the greedy pursuer at once."""
+    template, knob, budget, size = exc.args
+    # each refusal's own remedy (the table's names its resolution) gives way to this one
+    refusal = re.split(r"; use |\. Raise the budget|\. No budget on this machine", template)[0]
+    judged = "safety table at L_min / 20" if knob == "resolution" else "decomposition of the map"
+    more = (
+        ""
+        if "No budget on this machine" in template
+        else f", or raise the budget with {MemoryBudgetError.BUDGET}"
+    )
     return MemoryBudgetError(
         f"a {kind!r} start on map {config.map.name!r} is judged on a decomposition pursuer's "
-        f"safety table at L_min / 20, which does not fit: {refusal}; use "
-        f"{MemoryBudgetError.KNOB} (a valid start needs no judge), or raise the budget with "
-        f"{MemoryBudgetError.BUDGET}",
+        f"{judged}, which does not fit: {refusal}; use {MemoryBudgetError.KNOB} (a valid "
+        f"start needs no judge){more}",
         "kind='valid'",
         budget,
         size,

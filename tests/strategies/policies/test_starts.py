@@ -196,6 +196,31 @@ def test_a_judge_beyond_the_memory_budget_names_the_valid_start(monkeypatch):
     assert set(start) == {"pursuer", "evader"}
 
 
+def test_a_judge_whose_decomposition_is_beyond_the_budget_names_the_valid_start(
+    monkeypatch, tmp_path
+):
+    """A 600-gon room: the safe start's judge refused the map's decomposition itself
+    (before its table), and the refusal said only "Raise the budget ..., or use a shorter L
+    or a smaller map", though a valid start needs no judge; it now names ``kind='valid'``
+    as the table's refusal does, and that start is drawn."""
+    from envs.errors import MemoryBudgetError
+    from envs.maps import Map
+    from envs.surveillance.config import EnvConfig
+
+    monkeypatch.setenv("SURVEIL_MEMORY_BUDGET", "50MB")
+    monkeypatch.setenv("SURVEIL_CACHE_DIR", str(tmp_path))  # decomposed afresh, not read back
+    n = 600
+    ring = [(20 * np.cos(2 * np.pi * k / n), 20 * np.sin(2 * np.pi * k / n)) for k in range(n)]
+    cfg = EnvConfig(map=Map(ring, name="round"))
+    with pytest.raises(MemoryBudgetError, match=r"'safe' start on map 'round' is judged on a "
+                       r"decomposition pursuer's decomposition of the map, which does not fit: "
+                       r"decompose\(map 'round'.*; use kind='valid' \(a valid start needs no "
+                       r"judge\), or raise the budget") as err:  # fmt: skip
+        sample_start(cfg, np.random.default_rng(0), kind="safe")
+    assert "shorter L" not in str(err.value)
+    assert set(sample_start(cfg, np.random.default_rng(0), kind="valid")) == {"pursuer", "evader"}
+
+
 @pytest.mark.parametrize("rho", [0.9, 0.99])
 def test_near_one_rho_draws_a_safe_cell_start_as_rho_one_does(rho):
     """Issue 13: at rho = 0.99 the retreat a safe start asks for (25 at L_min = 2) is longer

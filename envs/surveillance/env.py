@@ -13,6 +13,7 @@ import copy
 import dataclasses
 import inspect
 import math
+import warnings
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
@@ -502,13 +503,19 @@ class parallel_env(ParallelEnv, EzPickle):
         )
 
     def render(self) -> np.ndarray | None:
-        """``"rgb_array"``: an HxWx3 uint8 frame; ``"human"``: draw to a window.
+        """``"rgb_array"``: an HxWx3 uint8 frame; ``"human"``: draw to a window; ``None``:
+        nothing (``None``, with a warning).
 
         Raises:
             EpisodeStateError: before the first ``reset()`` (there is no state to draw: it
                 drew both agents at (0, 0), possibly inside a wall; the AEC env raises too).
         """
-        if self.render_mode is None:
+        if self.render_mode is None:  # as Gymnasium's and PettingZoo's envs: said, not silent
+            warnings.warn(
+                "render() with render_mode=None draws nothing and returns None; build the env "
+                "with render_mode='rgb_array' (a frame) or 'human' (a window)",
+                stacklevel=2,
+            )
             return None
         if self._ended_at is None:
             raise EpisodeStateError("render() before reset(): call reset(seed=...) first")

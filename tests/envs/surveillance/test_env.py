@@ -406,7 +406,8 @@ def test_render_before_reset_is_an_error() -> None:
         env.render()
     env.reset(seed=0)
     assert env.render().ndim == 3
-    assert surveillance_v1.parallel_env(map="corridor").render() is None  # no render_mode
+    with pytest.warns(UserWarning, match=r"render_mode=None draws nothing.*'rgb_array'"):
+        assert surveillance_v1.parallel_env(map="corridor").render() is None  # no render_mode
     env.close()
 
 

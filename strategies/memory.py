@@ -20,7 +20,7 @@ import re
 
 from envs.errors import InvalidConfigError
 
-__all__ = ["memory_budget", "physical_memory"]
+__all__ = ["byte_size", "memory_budget", "physical_memory"]
 
 _UNITS = {"": 1, "b": 1, "kb": 1e3, "mb": 1e6, "gb": 1e9, "kib": 2**10, "mib": 2**20, "gib": 2**30}
 
@@ -57,3 +57,16 @@ def memory_budget(value: object = None) -> float:
     if not size > 0 or size != size or size == float("inf"):
         raise InvalidConfigError(f"{where} = {value!r}: expected a finite size > 0")
     return size
+
+
+def byte_size(n: float) -> str:
+    """``n`` bytes for a message: ``"50 MB"``, ``"1.5 GB"``, ``"4.8e+14 GB"`` (not the
+    ``"0.1 GB"`` a fixed one decimal of GB gave a 50 MB budget).
+
+    Examples:
+        >>> byte_size(50e6), byte_size(1.5e9), byte_size(4.8e23)
+        ('50 MB', '1.5 GB', '4.8e+14 GB')
+    """
+    if n >= 1e13:  # 4.8e+14 GB, not 479908800287946.0 GB
+        return f"{n / 1e9:.3g} GB"
+    return f"{n / 1e9:.1f} GB" if n >= 1e9 else f"{n / 1e6:.0f} MB"

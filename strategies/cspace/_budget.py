@@ -26,7 +26,7 @@ from scipy.spatial import cKDTree
 
 from envs.errors import MemoryBudgetError
 from envs.maps.map import Map
-from strategies.memory import physical_memory
+from strategies.memory import byte_size, physical_memory
 
 __all__ = ["Estimate", "check_budget", "estimate"]
 
@@ -70,14 +70,14 @@ def check_budget(world: Map, L: float, budget: float) -> Estimate:
         advice = (
             f"Raise the budget with {MemoryBudgetError.BUDGET}, or use a shorter L or a smaller map"
             if est.bytes <= ram
-            else f"No budget on this machine fits it (it has {ram / 1e9:.1f} GB of memory): "
+            else f"No budget on this machine fits it (it has {byte_size(ram)} of memory): "
             "use a shorter L or a smaller map"
         )
         raise MemoryBudgetError(
             f"decompose(map {world.name!r}, L = {L:g}): the decomposition would need about "
-            f"{est.bytes / 1e9:.1f} GB ({est.pairs:,} pairs of critical curves meet; about "
+            f"{byte_size(est.bytes)} ({est.pairs:,} pairs of critical curves meet; about "
             f"{est.seconds / 60:.0f} min), more than the memory budget of "
-            f"{budget / 1e9:.1f} GB. {advice}",
+            f"{byte_size(budget)}. {advice}",
             budget="decompose(..., memory_budget='{size}') or $SURVEIL_MEMORY_BUDGET",
             size=f"{max(1, math.ceil(2 * est.bytes / 1e9))}GB",
         )

@@ -55,7 +55,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from envs.errors import MemoryBudgetError
-from strategies.memory import memory_budget, physical_memory
+from strategies.memory import byte_size, memory_budget, physical_memory
 from strategies.referee.lattice import count_lattice_vectors, grid_shape, window_half_width
 from strategies.referee.spec import GameSpec, Resolution
 
@@ -358,10 +358,7 @@ def check_budget(
     )
 
 
-def _size(n: float) -> str:
-    if n >= 1e13:  # 4.8e+14 GB, not 479908800287946.0 GB
-        return f"{n / 1e9:.3g} GB"
-    return f"{n / 1e9:.1f} GB" if n >= 1e9 else f"{n / 1e6:.0f} MB"
+_size = byte_size
 
 
 def duration(seconds: float) -> str:

@@ -23,7 +23,7 @@ def test_a_build_over_budget_is_refused_at_once_with_the_estimate():
         decompose(hexagons(), 3.3, memory_budget="1MB")
     assert time.perf_counter() - t < 1.0  # before any real work
     msg = str(err.value)
-    assert "memory budget" in msg and "GB" in msg and "pairs" in msg
+    assert "memory budget of 1 MB" in msg and "pairs" in msg  # was "of 0.0 GB"
     assert "memory_budget=" in msg and "SURVEIL_MEMORY_BUDGET" in msg and "shorter L" in msg
 
 

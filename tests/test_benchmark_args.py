@@ -38,6 +38,7 @@ def _run(script: str, *args: str, **kwargs) -> subprocess.CompletedProcess:
         ("decision_time.py", ["--maps", "random:x:1"], "'random:x:1': expected a built-in map"),
         ("decision_time.py", ["--others", "nope"], "'nope': expected a registered policy"),
         ("evader_escapes.py", ["--seeds", "0"], "'0': expected an integer >= 1"),
+        ("faster_evaders.py", ["--rhos", "1"], "'1': expected a finite number > 1"),
         ("referee_scaling.py", ["--cpl", "0"], "'0': expected a finite number > 0"),
         ("reset_scaling.py", ["--worlds", "nope"], "--worlds: invalid choice: 'nope'"),
         ("reset_scaling.py", ["--timeout", "0"], "'0': expected a finite number > 0"),

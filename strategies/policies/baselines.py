@@ -13,7 +13,14 @@ import numpy as np
 
 from envs import validation
 from envs.errors import InvalidConfigError
-from strategies.policies.base import BasePolicy, Snapshot, distance_target, positive_param, unit
+from strategies.policies.base import (
+    BasePolicy,
+    Snapshot,
+    distance_target,
+    flag_param,
+    positive_param,
+    unit,
+)
 
 __all__ = [
     "GreedyPursuer",
@@ -130,26 +137,74 @@ class TowardAwayEvader(BasePolicy):
     Moving along the rod minimises the largest rate ``max |theta_dot|`` the pursuer can
     impose (THEORY 4.1: the minimum of ``g(phi)`` is at ``phi = k pi``).
 
+    Faster than the pursuer (``v_evader > v_pursuer``, rho > 1), ``"away"`` (and the
+    away half of ``"alternate"``) flees along the walls and charges once it cannot flee:
+    straight away it pressed into the first wall or corner and stood there while the
+    pursuer kept L (rho 1.1, 12 worlds, six pursuers, safe and valid starts: 51 of 144
+    escaped). Its heading's part into a wall within a step turns along that wall, and it
+    flees while that heading opens L at least half its speed surplus faster than the
+    pursuer can close it (``V_e cos > V_p + (V_e - V_p) / 2``) and its last step, if it
+    fled, fled faster than ``V_p + (V_e - V_p) / 4``; otherwise (a wall head-on, a
+    concave corner) it runs at the pursuer to the end of the episode, which closes L at
+    least ``V_e - V_p`` a second (footnote 4: a faster evader always escapes at L_min).
+    So ``"away"`` flees at most ``4 (L_max - L_min) / (V_e - V_p)`` seconds, then
+    charges at most a quarter of that. ``pure=True`` runs straight away whatever the
+    walls, as footnote 4 words the escape (a bounded world corners it: THEORY.md
+    section 8; the reproduction report plays it so). At rho <= 1 every mode plays as it
+    always did.
+
     Args:
         mode: ``"toward"``, ``"away"``, or ``"alternate"`` (switch every ``period`` s).
         period: switching period in seconds for ``"alternate"``.
+        pure: straight along the rod at any rho (no flight along the walls, no charge).
     """
 
     MODES = ("toward", "away", "alternate")
 
     def __init__(
-        self, *, mode: str = "toward", period: float = 4.0, name: str | None = None
+        self,
+        *,
+        mode: str = "toward",
+        period: float = 4.0,
+        pure: bool = False,
+        name: str | None = None,
     ) -> None:
         super().__init__(name=name)
         self.mode = validation.choice("mode", mode, self.MODES)
         self.period = positive_param("period", period)
+        self.pure = flag_param("pure", pure)
+
+    def _reset(self) -> None:
+        self._charging = False  # rho > 1: ran at the pursuer once it could not flee
+        self._fled = False  # rho > 1: the last step fled
 
     def _decide(self, snap: Snapshot) -> np.ndarray:
         u = unit(snap.rod)
         toward = self.mode == "toward"
         if self.mode == "alternate":
             toward = int(snap.time // self.period) % 2 == 0
+        if not (toward or self.pure) and self.config.v_evader > self.config.v_pursuer:
+            return self._flee(snap, u)
+        self._fled = False
         return self.v_max * (u if toward else -u)
+
+    def _flee(self, snap: Snapshot, u: np.ndarray) -> np.ndarray:
+        """rho > 1: away from the pursuer along the walls while that opens L, else (and
+        from then on) straight at it."""
+        v_e, v_p = self.v_max, float(self.config.v_pursuer)
+        surplus = v_e - v_p
+        if not self._charging:
+            reach = self.config.body_radius + v_e * self.config.dt
+            d = _slide(self.map, snap.evader, -u, reach, 1)
+            fled = -float(snap.evader_velocity @ u)  # the last step's realised flight
+            if v_e * float(d @ -u) > v_p + 0.5 * surplus and (
+                not self._fled or fled > v_p + 0.25 * surplus
+            ):
+                self._fled = True
+                return v_e * d
+            self._charging = True
+        self._fled = False
+        return v_e * u
 
 
 class WallHuggingEvader(BasePolicy):

@@ -63,7 +63,7 @@ MATCHES = {
         "evader/toward_away",
         0,
         (("v_evader", 1.5),),
-        (("mode", "away"),),
+        (("mode", "away"), ("pure", True)),  # footnote 4's escape as worded: straight away
     ),
     "corner_charge": Match(
         "corner", "pursuer/decomposition", "evader/toward_away", 0, (), (("mode", "toward"),)

@@ -134,9 +134,9 @@ class _WallChecks:
         from 0.7 s, and the pursuer was pinned there, too close at 2.08-2.15 s, a second
         before ``CHARGE_PERSIST``. The ccw turn from 0.7 s holds all 60 s. Over the
         seventeen benchmark sets this clause changes the turn in 33 episodes' first 3 s
-        (open room, pillar, maze and corner worlds, the three chargers): 29 held before and
-        after, the corner world's default start of seed 38 against toward-away now held,
-        3 lost before and after (helper-192, session 29).
+        (open room, pillar, corner and rand:rectangles:3005 worlds, the three chargers):
+        29 held before and after, the corner world's default start of seed 38 against
+        toward-away now held, 3 lost before and after (helper-192, session 29).
         """
         long = self._charge_run >= self._charge_persist
         # a charge from the evader's first move on: no burst shown before it

@@ -299,6 +299,7 @@ class DecompositionPursuer(
         # steps the charge test has passed in a row, and how many make a long charge
         # (:meth:`_slide_through`)
         self._charge_run = 0
+        self._decisions = 0  # decisions so far (the first has no velocity estimate)
         self._charge_persist = round(self.CHARGE_PERSIST / c.dt) + 1
         self._armed_heading = 0.0
         self._charge_log: deque[tuple[bool, float, float]] = deque(
@@ -359,6 +360,7 @@ class DecompositionPursuer(
             across = float(ve[1]) * u[0] - float(ve[0]) * u[1]
             self._crossings.append(None if charging or speed == 0.0 else (snap.theta, across))
             self._charge_run = self._charge_run + 1 if charging else 0
+            self._decisions += 1
             if charging:  # it closes in
                 cmd_rate = self._keep_orbit(snap, cmd_rate, hi, lo, L)
             else:

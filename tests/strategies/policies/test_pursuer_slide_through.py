@@ -11,7 +11,7 @@ room's south-east corner, and at 8.9 s the decomposition's own counter-clockwise
 it down onto the bottom wall, its path meeting the wall 0.4 s ahead 6 deg off the normal:
 too close at 9.6 s. The other hard turn now wins where the chosen one's path meets such a
 wall within ``ORBIT_LOOKAHEAD`` and the other's does not (``_slide_through``), against a
-charge that has lasted ``CHARGE_PERSIST`` seconds.
+charge that has lasted ``CHARGE_PERSIST`` seconds, or has run since the evader's first move.
 """
 
 from __future__ import annotations
@@ -39,10 +39,11 @@ def test_the_charged_pursuer_keeps_out_of_the_pocket_s_slide():
     assert r.winner == "pursuer", (r.cause, r.escape_time)
 
 
-def _charged_at_the_bottom_wall(psi_deg: float, y: float, run: int):
+def _charged_at_the_bottom_wall(psi_deg: float, y: float, run: int, since_start: bool = False):
     """pillars at rho 0.3, far from the pillars (x = 8): the pursuer at height y, the rod
     psi_deg off the bottom wall's normal (pointing down) at L_target, the evader charging
-    along the rod at full speed, having charged for ``run`` steps."""
+    along the rod at full speed, having charged for ``run`` steps (the last ``run`` of
+    ``run + 1`` decisions with ``since_start``, else of 100 + ``run``)."""
     config = build_env("pillars", PILLARS_03).config
     p = make_policy("pursuer/decomposition")
     p.reset(role="pursuer", map=config.map, config=config, seed=0)
@@ -53,6 +54,7 @@ def _charged_at_the_bottom_wall(psi_deg: float, y: float, run: int):
     v = config.v_evader * u
     snap = Snapshot(pursuer - L * u, pursuer, v, v, 0.0)
     p._charge_run = run
+    p._decisions = run + 1 if since_start else run + 100
     return p, snap, L
 
 
@@ -75,6 +77,35 @@ def test_outside_the_cone_or_against_a_short_charge_the_turn_stands(psi, y, run)
     # 30 deg > asin(0.3) = 17.5 deg; 30 steps < CHARGE_PERSIST / dt + 1
     p, snap, L = _charged_at_the_bottom_wall(psi, y, run)
     assert p._slide_through(snap, -0.45, 0.45, -0.45, L) == -0.45
+
+
+def test_a_charge_since_the_first_move_is_long_at_once():
+    # 10 steps of charge, every decision since the evader's first move: nothing else
+    # seen, so not a herder's burst
+    p, snap, L = _charged_at_the_bottom_wall(10.0, 0.25, 10, since_start=True)
+    assert p._slide_through(snap, -0.45, 0.45, -0.45, L) == 0.45
+    p, snap, L = _charged_at_the_bottom_wall(10.0, 0.25, 10)
+    assert p._slide_through(snap, -0.45, 0.45, -0.45, L) == -0.45
+
+
+PILLARS_045 = dict(PILLARS_03, v_evader=0.45)
+
+# holds-bench's safe start of pillars at rho 0.45 (pursuer_holds.py --rho 0.45), seed 2
+START_2 = {"pursuer": (11.947250436365527, 12.837544982202228),
+           "evader": (13.523973414168605, 10.981966999128545)}  # fmt: skip
+
+
+@pytest.mark.parametrize("evader", ["evader/toward_away", "evader/shooting"])
+def test_a_charge_from_the_start_does_not_pin_the_pursuer_at_the_top_wall(evader):
+    """pillars at rho 0.45 from holds-bench's safe start of seed 2 (the pursuer 1.2 below
+    the top wall, the evader south-east of it): the evaders charge by pure pursuit from
+    their first move, the decomposition turns the rod cw through the top wall's normal
+    and the pursuer slid along the wall into a pin, too close at 2.08 s (toward_away)
+    and 2.15 s (shooting) while the charge was shorter than CHARGE_PERSIST. The check
+    turns it ccw at 0.7 s; held all 60 s."""
+    r = run_episode("pillars", "pursuer/decomposition", evader, 2, max_cycles=60,
+                    overrides=PILLARS_045, start=START_2)  # fmt: skip
+    assert r.winner == "pursuer", (r.cause, r.escape_time)
 
 
 def test_a_herder_s_short_charges_leave_the_turn_alone(unseen):

@@ -97,51 +97,55 @@ FRESH_WORLDS = " ".join(
 """32 random maps nobody had used (docs/ANALYTIC_RESULTS.md, fresh-p0)."""
 _HOLDS = "--seeds 8 --rho 0.5 --no-greedy"
 _HELDOUT_P = "--worlds @benchmarks/heldout_worlds_pursuer.txt"
-_BASE = "7b2b484"
-"""The commit every figure below holds at (branch decomp-orbit-190, ``_way_kept``, merged
-into main as 7f77e91: all seventeen sets played there, and holds-bench-045 (the lead; the
-same 384 rows with main at 0d70970); compared per episode with 194babd's rows: holds-bench-03 +3,
-pillars seed 5 against the three chargers; heldout-p0 +1, corner~x0.8rot1.2 against the
-herder; three escapes from the decomposition pursuer no longer made, unseen-e
-random:rectangles:16 seed 1019, fresh-e random:rectangles:4504 seed 6880 and
-rand:polygons:4605:1.5 seed 6032, escaped at 453, 479 and 649 s before; every other winner
-the same). Before: at 194babd (all seventeen sets played there, compared per
-episode with 4be633d's rows after 9f49910's evader/referee replay: nothing lost; 9f49910
-(evader/referee plays the referee's evader-bound fallback, a stronger ground-truth
-opponent) lost holds-variants, unseen-p0, heldout-p0 and fresh-p0 one episode each, two
-certified unavoidable, one late, one unknown, none a certified regret; 194babd (the
-decomposition's slide-through check against a charge) won holds-bench-03 +3; the
-certified starts were re-drawn (1c33d9d: the referee's stronger pursuer bound) and
+_BASE = "911efbc"
+"""The commit every figure below holds at (branch combo-193: main a06dbce with helper-192's
+pillars045-192 merged, ``_slide_through`` also against a charge running since the evader's
+first move; merged into main as ed84b2a): all eighteen sets played there, compared per
+episode with 7b2b484's rows: holds-bench-045 +3 (pillars seed 2 against the shooting,
+toward-away and referee evaders, too close at 2.1 s before), corner-default +1 (seed 38
+against the toward-away evader), every other winner the same. Before: at 7b2b484 (branch
+decomp-orbit-190, ``_way_kept``, merged into main as 7f77e91: all seventeen sets played
+there, and holds-bench-045 (the lead; the same 384 rows with main at 0d70970); compared per
+episode with 194babd's rows: holds-bench-03 +3, pillars seed 5 against the three chargers;
+heldout-p0 +1, corner~x0.8rot1.2 against the herder; three escapes from the decomposition
+pursuer no longer made, unseen-e random:rectangles:16 seed 1019, fresh-e
+random:rectangles:4504 seed 6880 and rand:polygons:4605:1.5 seed 6032, escaped at 453, 479
+and 649 s before; every other winner the same). Before: at 194babd (all seventeen sets
+played there, compared per episode with 4be633d's rows after 9f49910's evader/referee
+replay: nothing lost; 9f49910 (evader/referee plays the referee's evader-bound fallback, a
+stronger ground-truth opponent) lost holds-variants, unseen-p0, heldout-p0 and fresh-p0 one
+episode each, two certified unavoidable, one late, one unknown, none a certified regret;
+194babd (the decomposition's slide-through check against a charge) won holds-bench-03 +3;
+the certified starts were re-drawn (1c33d9d: the referee's stronger pursuer bound) and
 certified-p played on them. Before: at 4be633d, all seventeen, compared per episode with
-5270138: heldout-e -1, random:star:2019 seed 258 (791d52a's give-way
-changed the decomposition pursuer's path there and the shooting evader's herd, which
-escaped at 7.98 of 8 D/V_e, no longer escapes), every other episode's winner the same;
-d6d8f9a (the shooting evader against a pursuer that does not turn the rod) moved escape
-times only; lazy-speed-171 (786c56e) is the same decisions, faster). Before: at 5270138,
-all sixteen sets played, compared per episode with 8bef7db: unseen-e +1, heldout-e +1
-(3498ee2, the shooting evader's herd starts wherever the pursuer is), nothing lost;
-fresh-e with 791668b: +3; 15b205d (the pursuers at edge parameters) was played alone on
-all fifteen with every row identical, and 0d7e59f and 686f537 are the same decisions,
-faster. After it 791d52a (the decomposition's hard turn gives way where it pushes into a
-wall) was played on the eleven pursuer sets and the evader sets' decomposition episodes:
-every winner and loss time as here). Before: at 8bef7db, all fifteen, compared per
-episode with 3765f76: fresh-p0 +1 (0fee8e2, the pursuer's lead on a lap round a small
-obstacle: rand:star:3007:3.0 against the herder), nothing lost; 37bf9d1's two-leg shots
-moved escape times only). Before: at 34fa4ca, compared per episode with 1283649:
-holds-bench +1, certified-e +2, nothing lost; played again at 686fe46, the shooting
-evader's long-rod shots before any plan and reach margins: every episode's winner as at
-34fa4ca, escape times moved; and at 3765f76. Before: all twelve sets were played at
-94c5063; 5b239ab's pursuer change (probes round a small obstacle an evader circles)
-changed only fresh-p0 (549 -> 552); 4d0ccce's (the way to room once a ride against a
-charge stalls) was played on every pursuer set and on the evader sets' episodes against
-the decomposition pursuer (holds-variants 558 -> 560, unseen-p0 426 -> 429, heldout-p0
-609 -> 614, heldout-p1 633 -> 636, fresh-p0 552 -> 555); bd36034's evader change (the
-herd heads only for corners turning by 45 degrees or more) on the three evader sets
-(heldout-e 775 -> 776) and, with 4d0ccce's pursuer, on their episodes against it;
-cdb9eac's (a stalled fallback gives up its targets) and ddb7e92's (two guards on the
-stall) were each played on all twelve (the evader's on the pursuer sets' shooting
-episodes) and, together, on the evader sets' episodes against the decomposition pursuer
-and the pursuer sets' against the shooting evader: no figure changed (ddb7e92)."""
+5270138: heldout-e -1, random:star:2019 seed 258 (791d52a's give-way changed the
+decomposition pursuer's path there and the shooting evader's herd, which escaped at 7.98 of
+8 D/V_e, no longer escapes), every other episode's winner the same; d6d8f9a (the shooting
+evader against a pursuer that does not turn the rod) moved escape times only; lazy-speed-171
+(786c56e) is the same decisions, faster). Before: at 5270138, all sixteen sets played,
+compared per episode with 8bef7db: unseen-e +1, heldout-e +1 (3498ee2, the shooting evader's
+herd starts wherever the pursuer is), nothing lost; fresh-e with 791668b: +3; 15b205d (the
+pursuers at edge parameters) was played alone on all fifteen with every row identical, and
+0d7e59f and 686f537 are the same decisions, faster. After it 791d52a (the decomposition's
+hard turn gives way where it pushes into a wall) was played on the eleven pursuer sets and
+the evader sets' decomposition episodes: every winner and loss time as here). Before: at
+8bef7db, all fifteen, compared per episode with 3765f76: fresh-p0 +1 (0fee8e2, the pursuer's
+lead on a lap round a small obstacle: rand:star:3007:3.0 against the herder), nothing lost;
+37bf9d1's two-leg shots moved escape times only). Before: at 34fa4ca, compared per episode
+with 1283649: holds-bench +1, certified-e +2, nothing lost; played again at 686fe46, the
+shooting evader's long-rod shots before any plan and reach margins: every episode's winner
+as at 34fa4ca, escape times moved; and at 3765f76. Before: all twelve sets were played at
+94c5063; 5b239ab's pursuer change (probes round a small obstacle an evader circles) changed
+only fresh-p0 (549 -> 552); 4d0ccce's (the way to room once a ride against a charge stalls)
+was played on every pursuer set and on the evader sets' episodes against the decomposition
+pursuer (holds-variants 558 -> 560, unseen-p0 426 -> 429, heldout-p0 609 -> 614, heldout-p1
+633 -> 636, fresh-p0 552 -> 555); bd36034's evader change (the herd heads only for corners
+turning by 45 degrees or more) on the three evader sets (heldout-e 775 -> 776) and, with
+4d0ccce's pursuer, on their episodes against it; cdb9eac's (a stalled fallback gives up its
+targets) and ddb7e92's (two guards on the stall) were each played on all twelve (the
+evader's on the pursuer sets' shooting episodes) and, together, on the evader sets' episodes
+against the decomposition pursuer and the pursuer sets' against the shooting evader: no
+figure changed (ddb7e92)."""
 _FRESH_E = "--worlds @benchmarks/fresh_worlds_evader.txt --rhos 0.2 0.3 0.5 0.8 --seed-base 6000"
 """fresh-e, the evader's held-out set made after the shooting evader's latest changes: 40
 world labels nobody had used (``benchmarks/fresh_worlds_evader.txt``: two_rooms and office
@@ -161,7 +165,7 @@ _HOLDS_045 = _BASE
 between the sets' 0.3 and 0.5 (helper-189's fresh probe found pillars seed 2 lost there,
 at rho 0.42-0.46 only, to the three charging evaders, too close at 2.1-2.2 s; the maze's
 orbit seeds 0 and 5 and wall-hugging seed 6 are lost there too); first played at 0d70970
-and 7b2b484, 378/384 both, every row the same."""
+and 7b2b484, 378/384 both, every row the same; at 911efbc 381/384, pillars seed 2 held."""
 
 _HOLDS_03 = _BASE
 """Where holds-bench-03 was last played: holds-bench's episodes at rho 0.3 instead of 0.5
@@ -210,7 +214,7 @@ SETS: dict[str, PolicySet] = {
              f"unseen_worlds.py --role evader {_FRESH_E}"),
         _set("escapes-bench", "bench3", "evader", "512/512", _BASE,
              "evader_escapes.py --seeds 4 --simple-seeds 0"),
-        _set("corner-default", "cdef", "pursuer", "145/160", _FIXED,
+        _set("corner-default", "cdef", "pursuer", "146/160", _FIXED,
              "fixed_starts.py --starts default --world corner --seeds 0-39"),
         _set("certified-p", "certp", "pursuer", "288/288", _FIXED,
              "fixed_starts.py --starts certified --role pursuer"),
@@ -219,7 +223,7 @@ SETS: dict[str, PolicySet] = {
         _set("holds-bench-03", "b1r3", "pursuer", "384/384", _BASE,
              "pursuer_holds.py --worlds corridor l_hall open_room corner pillars maze "
              "--variants 'as is' --seeds 8 --rho 0.3 --no-greedy"),
-        _set("holds-bench-045", "b1r45", "pursuer", "378/384", _HOLDS_045,
+        _set("holds-bench-045", "b1r45", "pursuer", "381/384", _HOLDS_045,
              "pursuer_holds.py --worlds corridor l_hall open_room corner pillars maze "
              "--variants 'as is' --seeds 8 --rho 0.45 --no-greedy"),
     )

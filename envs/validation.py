@@ -89,6 +89,16 @@ def is_real(value: Any) -> bool:
     return isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf"
 
 
+def _float(value: Any) -> float:
+    """``float(value)`` of a real scalar; an integer beyond a float's range (a JSON
+    ``1`` followed by 400 zeros) is +-inf, so the checks below refuse it as not finite
+    instead of raising OverflowError."""
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf if value > 0 else -math.inf
+
+
 def is_integer(value: Any) -> bool:
     """True for a Python or numpy integer scalar (not bool)."""
     return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
@@ -114,7 +124,7 @@ def real(
     expected += lo + ("," if lo and hi else "") + hi
     if not is_real(value):
         raise _fail(name, value, expected, where)
-    v = float(value)
+    v = _float(value)
     if math.isnan(v) or (not allow_inf and math.isinf(v)):
         raise _fail(name, value, expected, where)
     if (minimum is not None and v < minimum) or (maximum is not None and v > maximum):
@@ -124,14 +134,14 @@ def real(
 
 def positive(name: str, value: Any, *, where: str | None = None) -> float:
     """``value`` as a float, finite and > 0."""
-    if not is_real(value) or not math.isfinite(float(value)) or float(value) <= 0:
+    if not is_real(value) or not math.isfinite(_float(value)) or _float(value) <= 0:
         raise _fail(name, value, "a finite number > 0", where)
     return float(value)
 
 
 def nonnegative(name: str, value: Any, *, where: str | None = None) -> float:
     """``value`` as a float, finite and >= 0."""
-    if not is_real(value) or not math.isfinite(float(value)) or float(value) < 0:
+    if not is_real(value) or not math.isfinite(_float(value)) or _float(value) < 0:
         raise _fail(name, value, "a finite number >= 0", where)
     return float(value)
 
@@ -141,7 +151,7 @@ def unit_interval(name: str, value: Any, *, where: str | None = None, open: bool
     expected = "a number in (0, 1)" if open else "a number in [0, 1]"
     if not is_real(value):
         raise _fail(name, value, expected, where)
-    v = float(value)
+    v = _float(value)
     ok = (0.0 < v < 1.0) if open else (0.0 <= v <= 1.0)
     if not ok:
         raise _fail(name, value, expected, where)

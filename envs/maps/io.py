@@ -118,6 +118,15 @@ def _ring(obj: object, source: str, what: str) -> list[list[float]]:
         if not isinstance(p, list) or len(p) != 2 or not all(_is_number(c) for c in p):
             dims = f" ({len(p)} coordinates; a map is planar)" if isinstance(p, list) else ""
             raise _fail(source, f"{what}: vertex {k} is {p!r:.60}, expected [x, y] numbers{dims}")
+        for c in p:
+            try:
+                float(c)
+            except OverflowError:  # a JSON integer of 400 digits: no float holds it
+                raise _fail(
+                    source,
+                    f"{what}: vertex {k} has the coordinate {str(c)[:20]}... ({len(str(c))} "
+                    "digits), expected finite numbers (a float's range ends near 1.8e308)",
+                ) from None
     return obj
 
 

@@ -130,3 +130,17 @@ def test_arrays_refuse_bools_hidden_in_lists_and_name_the_bad_entry():
     assert v.is_real(np.array(2.5)) and not v.is_real(np.array([2.5]))
     arr = np.zeros((3, 2))
     assert v.points("pts", arr) is arr  # float64 input is not copied
+
+
+def test_integers_beyond_a_float_are_refused_as_not_finite():
+    """A JSON integer of 400 digits (``--config '{"l_min": 1000...0}'``) raised
+    OverflowError from float(); it is refused as a number that is not finite."""
+    huge = 10**400
+    for check in (v.positive, v.nonnegative, v.real):
+        with pytest.raises(InvalidConfigError, match=r"l_min = 1000.*\.\.\.: expected a finite"):
+            check("l_min", huge)
+    with pytest.raises(InvalidConfigError, match=r"expected a number in \(0, 1\)"):
+        v.unit_interval("alpha", -huge)
+    assert v.real("x", huge, allow_inf=True) == math.inf
+    with pytest.raises(InvalidConfigError, match=r"l_max = -1000.*: expected a finite number > 0"):
+        surveillance_v1.parallel_env(l_max=-huge)

@@ -345,6 +345,11 @@ MALFORMED = [
     ),
     (
         "json",
+        '{"boundary": [[0, 0], [1' + "0" * 400 + ", 0], [0, 1]]}",  # no float holds it
+        r"boundary: vertex 1 has the coordinate 1000.* \(401 digits\), expected finite",
+    ),
+    (
+        "json",
         json.dumps({"boundary": [[0, 0], [10, 10], [10, 0], [0, 10]]}),
         r"boundary: .*not simple",
     ),

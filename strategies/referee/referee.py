@@ -135,7 +135,8 @@ def _cached(kind, cls, solver, spec, res, cache, cache_dir, progress, memory_bud
         if bound is not None:
             return bound
     size = bound_size(spec, res, kind)
-    if size.seconds > LONG_SOLVE_SECONDS:
+    # a solve the memory budget refuses (the solver checks it first) is not announced
+    if size.seconds > LONG_SOLVE_SECONDS and size.bytes <= _memory_budget(memory_budget):
         where = "; it is cached for the next run" if cache else ""
         warnings.warn(
             f"solving the {kind} bound of map {spec.map.name!r} (L in [{spec.l_min:g}, "

@@ -238,3 +238,17 @@ def test_a_long_solve_warns_before_it_starts_and_not_from_the_cache(tmp_path, mo
     with warnings.catch_warnings():
         warnings.simplefilter("error", LongRunWarning)
         cached_evader_bound(s, res, cache=False)  # below the limit: no word
+
+
+def test_a_solve_the_budget_refuses_is_not_announced_as_long(monkeypatch):
+    """The memory refusal comes alone, not after an announcement of its time."""
+    import strategies.referee.referee as referee_module
+    from envs.errors import LongRunWarning, MemoryBudgetError
+
+    monkeypatch.setattr(referee_module, "LONG_SOLVE_SECONDS", 0.0)
+    s = spec(open_room(4.0), 1.5)
+    res = Resolution.for_role(s, "evader", 8, coarse=4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", LongRunWarning)
+        with pytest.raises(MemoryBudgetError):
+            cached_evader_bound(s, res, cache=False, memory_budget="1MB")

@@ -1,6 +1,8 @@
 """The shooting evader near rho = 1, where most optimal escape arcs do not exist (the
 extremals turn back before the target, THEORY §4.3): a failed solve is not paid again
-every step (issue 13: at rho 0.99 each failure cost 100-150 ms on the corridor)."""
+every step (issue 13: at rho 0.99 each failure cost 100-150 ms on the corridor), and from
+``ARC_RHO_MAX`` on no arc is solved at all: the shots follow their straight paths (the
+solves' machinery is tested there with the threshold lifted)."""
 
 from __future__ import annotations
 
@@ -13,8 +15,34 @@ from strategies.policies.shooting import arcs as shot_arcs
 from strategies.runner import run_episode
 
 
+def test_from_arc_rho_max_on_shots_follow_straight_paths_unsolved(monkeypatch):
+    # issue 13's goal, under 1 ms a decision: near rho = 1 a solve integrated arcs ~6 times
+    # the target's distance, 20-70 ms a replan (random:star:9203, rho 0.99, L_min 5)
+    evader = make_policy("evader/shooting")
+    assert 0.9 <= evader.ARC_RHO_MAX < 0.95
+    calls = []
+    monkeypatch.setattr(shot_arcs, "escape_path", lambda *a, **k: calls.append(a))
+    shots = []
+
+    def on_step(_):
+        if evader.mode == "shoot" and evader._arc is not None:
+            shots.append(evader._arc)
+
+    r = run_episode(
+        "corridor", "pursuer/greedy", evader, 0, start="safe", max_cycles=120,
+        overrides={"v_evader": 0.95}, on_step=on_step,
+    )  # fmt: skip
+    assert r.winner == "evader"
+    assert shots and not calls  # shots, and not one solve
+    for start, _, path in shots:
+        d = path[-1] - start
+        off = (path - start) @ np.array([-d[1], d[0]]) / np.hypot(*d)
+        assert np.abs(off).max() < 1e-12  # a straight path
+
+
 def test_a_failed_arc_is_followed_straight_until_the_replan(monkeypatch):
     evader = make_policy("evader/shooting")
+    evader.ARC_RHO_MAX = 1.0  # (the solves near rho = 1, as below ARC_RHO_MAX)
     calls: list[tuple[int, bool]] = []  # (decision, solved) of every arc solve
     real = shot_arcs.escape_path  # read by the shot's arc (_Arcs._start_arc)
 
@@ -67,6 +95,7 @@ def test_arcs_near_rho_one_are_integrated_at_the_capped_step(monkeypatch):
 
         monkeypatch.setattr(evasion, name, counted)
     evader = make_policy("evader/shooting")
+    evader.ARC_RHO_MAX = 1.0  # (the solves near rho = 1, as below ARC_RHO_MAX)
     run_episode(
         "corridor", "pursuer/greedy", evader, 0, start="safe", max_cycles=100,
         overrides={"v_evader": 0.99},

@@ -103,49 +103,51 @@ pillars045-192 merged, ``_slide_through`` also against a charge running since th
 first move; merged into main as ed84b2a): all eighteen sets played there, compared per
 episode with 7b2b484's rows: holds-bench-045 +3 (pillars seed 2 against the shooting,
 toward-away and referee evaders, too close at 2.1 s before), corner-default +1 (seed 38
-against the toward-away evader), every other winner the same. Before: at 7b2b484 (branch
-decomp-orbit-190, ``_way_kept``, merged into main as 7f77e91: all seventeen sets played
-there, and holds-bench-045 (the lead; the same 384 rows with main at 0d70970); compared per
-episode with 194babd's rows: holds-bench-03 +3, pillars seed 5 against the three chargers;
-heldout-p0 +1, corner~x0.8rot1.2 against the herder; three escapes from the decomposition
-pursuer no longer made, unseen-e random:rectangles:16 seed 1019, fresh-e
-random:rectangles:4504 seed 6880 and rand:polygons:4605:1.5 seed 6032, escaped at 453, 479
-and 649 s before; every other winner the same). Before: at 194babd (all seventeen sets
-played there, compared per episode with 4be633d's rows after 9f49910's evader/referee
-replay: nothing lost; 9f49910 (evader/referee plays the referee's evader-bound fallback, a
-stronger ground-truth opponent) lost holds-variants, unseen-p0, heldout-p0 and fresh-p0 one
-episode each, two certified unavoidable, one late, one unknown, none a certified regret;
-194babd (the decomposition's slide-through check against a charge) won holds-bench-03 +3;
-the certified starts were re-drawn (1c33d9d: the referee's stronger pursuer bound) and
-certified-p played on them. Before: at 4be633d, all seventeen, compared per episode with
-5270138: heldout-e -1, random:star:2019 seed 258 (791d52a's give-way changed the
-decomposition pursuer's path there and the shooting evader's herd, which escaped at 7.98 of
-8 D/V_e, no longer escapes), every other episode's winner the same; d6d8f9a (the shooting
-evader against a pursuer that does not turn the rod) moved escape times only; lazy-speed-171
-(786c56e) is the same decisions, faster). Before: at 5270138, all sixteen sets played,
-compared per episode with 8bef7db: unseen-e +1, heldout-e +1 (3498ee2, the shooting evader's
-herd starts wherever the pursuer is), nothing lost; fresh-e with 791668b: +3; 15b205d (the
-pursuers at edge parameters) was played alone on all fifteen with every row identical, and
-0d7e59f and 686f537 are the same decisions, faster. After it 791d52a (the decomposition's
-hard turn gives way where it pushes into a wall) was played on the eleven pursuer sets and
-the evader sets' decomposition episodes: every winner and loss time as here). Before: at
-8bef7db, all fifteen, compared per episode with 3765f76: fresh-p0 +1 (0fee8e2, the pursuer's
-lead on a lap round a small obstacle: rand:star:3007:3.0 against the herder), nothing lost;
-37bf9d1's two-leg shots moved escape times only). Before: at 34fa4ca, compared per episode
-with 1283649: holds-bench +1, certified-e +2, nothing lost; played again at 686fe46, the
-shooting evader's long-rod shots before any plan and reach margins: every episode's winner
-as at 34fa4ca, escape times moved; and at 3765f76. Before: all twelve sets were played at
-94c5063; 5b239ab's pursuer change (probes round a small obstacle an evader circles) changed
-only fresh-p0 (549 -> 552); 4d0ccce's (the way to room once a ride against a charge stalls)
-was played on every pursuer set and on the evader sets' episodes against the decomposition
-pursuer (holds-variants 558 -> 560, unseen-p0 426 -> 429, heldout-p0 609 -> 614, heldout-p1
-633 -> 636, fresh-p0 552 -> 555); bd36034's evader change (the herd heads only for corners
-turning by 45 degrees or more) on the three evader sets (heldout-e 775 -> 776) and, with
-4d0ccce's pursuer, on their episodes against it; cdb9eac's (a stalled fallback gives up its
-targets) and ddb7e92's (two guards on the stall) were each played on all twelve (the
-evader's on the pursuer sets' shooting episodes) and, together, on the evader sets' episodes
-against the decomposition pursuer and the pursuer sets' against the shooting evader: no
-figure changed (ddb7e92)."""
+against the toward-away evader), every other winner the same. After it, ebfa164 (the
+shooting evader's straight shots from rho 0.9 on, branch shoot-straight-195c) was played on
+all eighteen at db73ef4: every winner the same, 16 sets row-identical, 77 rho-0.95 rows of
+unseen-e and heldout-e with other escape times. Before: at 7b2b484 (branch decomp-orbit-190,
+``_way_kept``, merged into main as 7f77e91: all seventeen sets played there, and holds-
+bench-045 (the lead; the same 384 rows with main at 0d70970); compared per episode with
+194babd's rows: holds-bench-03 +3, pillars seed 5 against the three chargers; heldout-p0 +1,
+corner~x0.8rot1.2 against the herder; three escapes from the decomposition pursuer no longer
+made, unseen-e random:rectangles:16 seed 1019, fresh-e random:rectangles:4504 seed 6880 and
+rand:polygons:4605:1.5 seed 6032, escaped at 453, 479 and 649 s before; every other winner
+the same). Before: at 194babd (all seventeen sets played there, compared per episode with
+4be633d's rows after 9f49910's evader/referee replay: nothing lost; 9f49910 (evader/referee
+plays the referee's evader-bound fallback, a stronger ground-truth opponent) lost holds-
+variants, unseen-p0, heldout-p0 and fresh-p0 one episode each, two certified unavoidable,
+one late, one unknown, none a certified regret; 194babd (the decomposition's slide-through
+check against a charge) won holds-bench-03 +3; the certified starts were re-drawn (1c33d9d:
+the referee's stronger pursuer bound) and certified-p played on them. Before: at 4be633d,
+all seventeen, compared per episode with 5270138: heldout-e -1, random:star:2019 seed 258
+(791d52a's give-way changed the decomposition pursuer's path there and the shooting evader's
+herd, which escaped at 7.98 of 8 D/V_e, no longer escapes), every other episode's winner the
+same; d6d8f9a (the shooting evader against a pursuer that does not turn the rod) moved
+escape times only; lazy-speed-171 (786c56e) is the same decisions, faster). Before: at
+5270138, all sixteen sets played, compared per episode with 8bef7db: unseen-e +1, heldout-e
++1 (3498ee2, the shooting evader's herd starts wherever the pursuer is), nothing lost;
+fresh-e with 791668b: +3; 15b205d (the pursuers at edge parameters) was played alone on all
+fifteen with every row identical, and 0d7e59f and 686f537 are the same decisions, faster.
+After it 791d52a (the decomposition's hard turn gives way where it pushes into a wall) was
+played on the eleven pursuer sets and the evader sets' decomposition episodes: every winner
+and loss time as here). Before: at 8bef7db, all fifteen, compared per episode with 3765f76:
+fresh-p0 +1 (0fee8e2, the pursuer's lead on a lap round a small obstacle: rand:star:3007:3.0
+against the herder), nothing lost; 37bf9d1's two-leg shots moved escape times only). Before:
+at 34fa4ca, compared per episode with 1283649: holds-bench +1, certified-e +2, nothing lost;
+played again at 686fe46, the shooting evader's long-rod shots before any plan and reach
+margins: every episode's winner as at 34fa4ca, escape times moved; and at 3765f76. Before:
+all twelve sets were played at 94c5063; 5b239ab's pursuer change (probes round a small
+obstacle an evader circles) changed only fresh-p0 (549 -> 552); 4d0ccce's (the way to room
+once a ride against a charge stalls) was played on every pursuer set and on the evader sets'
+episodes against the decomposition pursuer (holds-variants 558 -> 560, unseen-p0 426 -> 429,
+heldout-p0 609 -> 614, heldout-p1 633 -> 636, fresh-p0 552 -> 555); bd36034's evader change
+(the herd heads only for corners turning by 45 degrees or more) on the three evader sets
+(heldout-e 775 -> 776) and, with 4d0ccce's pursuer, on their episodes against it; cdb9eac's
+(a stalled fallback gives up its targets) and ddb7e92's (two guards on the stall) were each
+played on all twelve (the evader's on the pursuer sets' shooting episodes) and, together, on
+the evader sets' episodes against the decomposition pursuer and the pursuer sets' against
+the shooting evader: no figure changed (ddb7e92)."""
 _FRESH_E = "--worlds @benchmarks/fresh_worlds_evader.txt --rhos 0.2 0.3 0.5 0.8 --seed-base 6000"
 """fresh-e, the evader's held-out set made after the shooting evader's latest changes: 40
 world labels nobody had used (``benchmarks/fresh_worlds_evader.txt``: two_rooms and office

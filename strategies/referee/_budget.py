@@ -311,7 +311,7 @@ def check_budget(
         # no budget on this machine fits" read as if 57.6 did not fit either (helper-143)
         asked = (f"{MemoryBudgetError.KNOB} = {cells_per_lmin:g}"
                  if cells_per_lmin is not None else "this solve")  # fmt: skip
-        advice.append(f"{asked} fits no budget on this machine: it has {_size(ram)} of memory")
+        advice.append(f"{asked} fits no budget on this machine: it has {byte_size(ram)} of memory")
     if resize is not None and cells_per_lmin is not None:
         lo, hi = 0.0, float(cells_per_lmin)
         # the largest resolution that fits, to 1e-9 of it, or none >= 0.1 (named as 0 below):
@@ -328,12 +328,12 @@ def check_budget(
         K = MemoryBudgetError.KNOB
         if fit > 0:
             advice.append(f"Use {K} <= {fit:g} (asked: {cells_per_lmin:g}), which fits the "
-                          f"budget of {_size(limit)}")  # fmt: skip
+                          f"budget of {byte_size(limit)}")  # fmt: skip
         elif BASE_BYTES >= limit:  # the interpreter alone is over the budget
-            advice.append(f"No {K} fits (the interpreter alone takes {_size(BASE_BYTES)})")
+            advice.append(f"No {K} fits (the interpreter alone takes {byte_size(BASE_BYTES)})")
         else:  # a huge map: it said "the interpreter alone" there too
             coarsest = peak(resize(0.1))[0]
-            advice.append(f"No {K} fits (even {K} = 0.1 needs about {_size(coarsest)})")
+            advice.append(f"No {K} fits (even {K} = 0.1 needs about {byte_size(coarsest)})")
     more = math.ceil(1.2 * need / 1e9)
     if need <= ram:
         advice.append(f"{'raise' if advice else 'Raise'} the budget with "
@@ -349,16 +349,13 @@ def check_budget(
     else:
         text = "; ".join(advice[:-1]) + ", " + advice[-1]
     raise MemoryBudgetError(
-        f"{call}: the solve would need about {_size(need)} at its peak, during the "
+        f"{call}: the solve would need about {byte_size(need)} at its peak, during the "
         f"{at.what} ({'; '.join(s.describe() for s in sizes)}; up to about "
         f"{duration(total_seconds)} in all), more than the memory budget of "
-        f"{_size(limit)}{default}. " + text[0].upper() + text[1:],
+        f"{byte_size(limit)}{default}. " + text[0].upper() + text[1:],
         knob,
         size=f"{more}GB",
     )
-
-
-_size = byte_size
 
 
 def duration(seconds: float) -> str:

@@ -69,8 +69,9 @@ from envs.errors import (
 )
 from envs.geometry import kernel_for
 from envs.geometry.segments import point_in_walls
+from strategies.memory import byte_size
 from strategies.memory import memory_budget as _memory_budget
-from strategies.referee._budget import BASE_BYTES, _duration, _size
+from strategies.referee._budget import BASE_BYTES, _duration
 from strategies.referee.lattice import segment_wall_distance
 from strategies.referee.robust import convex_corners, sweep_hits_vertex, sweep_range_ok
 from strategies.referee.spec import MARGIN_REL
@@ -294,11 +295,11 @@ def _check_memory(
     elif path_bytes > cells * per_cell:  # substeps ~ V_p dt / h: a larger cell, fewer
         advice = f"use a larger {K} (fewer substeps) or a shorter path, or"
     else:
-        advice = f"no {K} fits (the interpreter alone takes {_size(BASE_BYTES)}):"
+        advice = f"no {K} fits (the interpreter alone takes {byte_size(BASE_BYTES)}):"
     raise MemoryBudgetError(
         f"hindsight(cell = {h:g}, pieces = {pieces}): the grid of {cells:,.0f} cells and "
-        f"the evader's path at {instants:,} instants would need about {_size(need)} at "
-        f"its peak, more than the memory budget of {_size(limit)}; {advice} raise the "
+        f"the evader's path at {instants:,} instants would need about {byte_size(need)} at "
+        f"its peak, more than the memory budget of {byte_size(limit)}; {advice} raise the "
         f"budget with {MemoryBudgetError.BUDGET}",
         "cell",
         size=f"{math.ceil(1.2 * need / 1e9)}GB",

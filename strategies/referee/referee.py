@@ -33,9 +33,9 @@ from envs.errors import (
     VacuousBoundWarning,
 )
 from envs.geometry import kernel_for
+from strategies.memory import byte_size, physical_memory
 from strategies.memory import memory_budget as _memory_budget
-from strategies.memory import physical_memory
-from strategies.referee._budget import SolveSize, _size, bound_size, check_budget, duration
+from strategies.referee._budget import SolveSize, bound_size, check_budget, duration
 from strategies.referee.cache import cache_path, load_arrays, save_arrays
 from strategies.referee.evader_bound import EvaderBound, solve_evader_bound
 from strategies.referee.pursuer_bound import VACUOUS_RHO, PursuerBound, solve_pursuer_bound
@@ -93,12 +93,12 @@ def check_sample_size(n: int, memory_budget: object = None) -> int:
     more = (
         f", or raise the budget ({MemoryBudgetError.BUDGET})"
         if need <= physical_memory()
-        else f" (this machine has {_size(physical_memory())} of memory)"
+        else f" (this machine has {byte_size(physical_memory())} of memory)"
     )
     raise MemoryBudgetError(
         f"sample_starts: {MemoryBudgetError.KNOB} = {n} starts would take about "
-        f"{_size(need)} ({SAMPLE_BYTES} bytes each), more than the memory budget of "
-        f"{_size(limit)}; draw at most {int(limit // SAMPLE_BYTES)} at a time{more}",
+        f"{byte_size(need)} ({SAMPLE_BYTES} bytes each), more than the memory budget of "
+        f"{byte_size(limit)}; draw at most {int(limit // SAMPLE_BYTES)} at a time{more}",
         "n",
         MemoryBudgetError.ENV_BUDGET if memory_budget is None else MemoryBudgetError.PYTHON_BUDGET,
         f"{math.ceil(1.2 * need / 1e9)}GB",  # as check_budget advises
